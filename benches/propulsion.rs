@@ -1,0 +1,2 @@
+//! Placeholder: replaced by the propulsion benches.
+fn main() {}

@@ -1,0 +1,156 @@
+//! Cubic drag, eq (6), and parasitic power, eq (11), of the power seed.
+//!
+//! `f_D = mu1 v + mu2 v^2 + mu3 v^3`, directed along the freestream, and `P_par = f_D v`.
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | `v` | airspeed, the norm of the freestream `v_inf` | m/s |
+//! | `mu1`, `mu2`, `mu3` | drag coefficients | N s/m, N s^2/m^2, N s^3/m^3 |
+//! | `f_D` | drag force | N |
+//! | `P_par` | parasitic power | W |
+//!
+//! The paper fits the cubic to drag estimated from level flights of its M100 up to about 10 m/s
+//! (Fig. 3); outside the fitted range the cubic is an extrapolation.
+
+use crate::error::{finite, PowerError, Result};
+
+/// Highest airspeed at which [`CubicDrag::new`] checks that the drag force is not negative, m/s.
+pub const DRAG_CHECK_MAX_MPS: f64 = 60.0;
+
+/// The cubic drag law of eq (6).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CubicDrag {
+    mu1: f64,
+    mu2: f64,
+    mu3: f64,
+}
+
+impl CubicDrag {
+    /// Build the drag law, rejecting coefficients that give a negative drag force anywhere in
+    /// 0-[`DRAG_CHECK_MAX_MPS`] m/s (drag that pushes the vehicle forward is not physical).
+    pub fn new(mu1_n_s_per_m: f64, mu2_n_s2_per_m2: f64, mu3_n_s3_per_m3: f64) -> Result<Self> {
+        finite("mu1_n_s_per_m", mu1_n_s_per_m)?;
+        finite("mu2_n_s2_per_m2", mu2_n_s2_per_m2)?;
+        finite("mu3_n_s3_per_m3", mu3_n_s3_per_m3)?;
+        let drag = Self {
+            mu1: mu1_n_s_per_m,
+            mu2: mu2_n_s2_per_m2,
+            mu3: mu3_n_s3_per_m3,
+        };
+        // f_D(v) = v q(v) with q(v) = mu1 + mu2 v + mu3 v^2; f_D < 0 for some v > 0 iff q < 0 there.
+        // q is a parabola: its minimum over [0, vmax] is at an end or at the vertex.
+        let mut candidates = vec![1e-9, DRAG_CHECK_MAX_MPS];
+        if mu3_n_s3_per_m3 > 0.0 {
+            let vertex = -mu2_n_s2_per_m2 / (2.0 * mu3_n_s3_per_m3);
+            if vertex > 0.0 && vertex < DRAG_CHECK_MAX_MPS {
+                candidates.push(vertex);
+            }
+        }
+        for v in candidates {
+            let f = drag.force_n(v);
+            if f < 0.0 {
+                return Err(PowerError::NegativeDrag {
+                    airspeed_mps: v,
+                    drag_n: f,
+                });
+            }
+        }
+        Ok(drag)
+    }
+
+    /// Drag force magnitude `f_D` at airspeed `v`, eq (6), N.
+    #[inline]
+    pub fn force_n(&self, airspeed_mps: f64) -> f64 {
+        let v = airspeed_mps;
+        v * (self.mu1 + v * (self.mu2 + v * self.mu3))
+    }
+
+    /// Parasitic power `P_par = f_D v`, eq (11), W.
+    #[inline]
+    pub fn parasitic_power_w(&self, airspeed_mps: f64) -> f64 {
+        self.force_n(airspeed_mps) * airspeed_mps
+    }
+
+    /// Derivative of the parasitic power with respect to airspeed, `d P_par / d v`, W s/m.
+    #[inline]
+    pub fn parasitic_power_derivative(&self, airspeed_mps: f64) -> f64 {
+        let v = airspeed_mps;
+        v * (2.0 * self.mu1 + v * (3.0 * self.mu2 + v * 4.0 * self.mu3))
+    }
+
+    /// The coefficients `(mu1, mu2, mu3)`.
+    pub fn coefficients(&self) -> (f64, f64, f64) {
+        (self.mu1, self.mu2, self.mu3)
+    }
+
+    /// Drag force vector opposing the air-relative velocity `vel_air` (any frame), N.
+    ///
+    /// Zero at zero airspeed.
+    pub fn force_vector_n(&self, vel_air_mps: [f64; 3]) -> [f64; 3] {
+        let speed =
+            (vel_air_mps[0].powi(2) + vel_air_mps[1].powi(2) + vel_air_mps[2].powi(2)).sqrt();
+        if speed == 0.0 {
+            return [0.0; 3];
+        }
+        let scale = -self.force_n(speed) / speed;
+        [
+            vel_air_mps[0] * scale,
+            vel_air_mps[1] * scale,
+            vel_air_mps[2] * scale,
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn m100() -> CubicDrag {
+        CubicDrag::new(0.1816, -0.02326, 0.004045).unwrap()
+    }
+
+    #[test]
+    fn paper_val_parasitic_power_is_zero_at_zero_airspeed() {
+        assert_eq!(m100().parasitic_power_w(0.0), 0.0);
+        assert_eq!(m100().force_n(0.0), 0.0);
+    }
+
+    #[test]
+    fn paper_val_fig3_drag_at_10_mps_by_hand() {
+        // 0.1816*10 - 0.02326*100 + 0.004045*1000 = 1.816 - 2.326 + 4.045 = 3.535 N.
+        let f = m100().force_n(10.0);
+        assert!((f - 3.535).abs() < 1e-12, "{f}");
+        assert!((m100().parasitic_power_w(10.0) - 35.35).abs() < 1e-10);
+    }
+
+    #[test]
+    fn derivative_matches_finite_difference() {
+        let d = m100();
+        for v in [0.5, 3.0, 12.0, 30.0] {
+            let h = 1e-5;
+            let fd = (d.parasitic_power_w(v + h) - d.parasitic_power_w(v - h)) / (2.0 * h);
+            let an = d.parasitic_power_derivative(v);
+            assert!(
+                (fd - an).abs() <= 1e-7 * an.abs().max(1.0),
+                "{v}: {fd} vs {an}"
+            );
+        }
+    }
+
+    #[test]
+    fn negative_drag_is_rejected() {
+        // q(v) = 0.1 - 0.1 v + 0.001 v^2 is negative at v = 50 (vertex).
+        let err = CubicDrag::new(0.1, -0.1, 0.001).unwrap_err();
+        assert!(matches!(err, PowerError::NegativeDrag { .. }), "{err}");
+        assert!(CubicDrag::new(-0.1, 0.0, 0.0).is_err());
+        assert!(CubicDrag::new(f64::NAN, 0.0, 0.0).is_err());
+    }
+
+    #[test]
+    fn force_vector_opposes_motion() {
+        let f = m100().force_vector_n([3.0, 4.0, 0.0]);
+        let mag = m100().force_n(5.0);
+        assert!((f[0] + mag * 0.6).abs() < 1e-12 && (f[1] + mag * 0.8).abs() < 1e-12);
+        assert_eq!(m100().force_vector_n([0.0; 3]), [0.0; 3]);
+    }
+}

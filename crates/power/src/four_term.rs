@@ -1,0 +1,482 @@
+//! The four-term power model, eqs (5), (7) and (14) of the power seed.
+//!
+//! `P_req = P_ind + P_par + P_pro + P_c` (7) and `P_hat = P_req / eta` (14), with thrust
+//! `T = m g / (cos(phi) cos(theta))` (5) for a point query in steady level flight. The planner
+//! supplies its own thrust from the force balance through [`FlightCondition`].
+//!
+//! # Ablation and the hybrid model
+//! [`Terms`] removes any subset of the four terms (the rows of the paper's Table I); a removed term
+//! reports 0 W and is left out of the totals. [`ModelOptions::profile_cutoff_mps`] drops the profile
+//! term above a chosen airspeed: the hybrid the paper's conclusion suggests, since `P_pro` degraded
+//! its estimate at 8 m/s.
+//!
+//! # Deviation
+//! Eq (14) can go negative in a steep descent where the climb term outweighs the others; a
+//! multirotor's ESCs do not regenerate, so `electrical_w` is floored at 0 (the aerodynamic total
+//! `aero_w` keeps its sign).
+
+use serde::Serialize;
+
+use crate::angle_of_attack::{body_relative_inflow, paper_inflow, Inflow};
+use crate::climb::climb_power_w;
+use crate::error::{finite, non_negative, PowerError, Result};
+use crate::induced::{induced_power_w, induced_velocity_mps};
+use crate::profile::profile_power_w;
+use crate::vehicle::Vehicle;
+
+/// One of the four terms of eq (7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Term {
+    /// Induced power, eq (8).
+    Induced,
+    /// Parasitic power, eq (11).
+    Parasitic,
+    /// Profile power, eq (12).
+    Profile,
+    /// Climb power, eq (13).
+    Climb,
+}
+
+impl Term {
+    /// All four terms in the paper's order.
+    pub const ALL: [Term; 4] = [Term::Induced, Term::Parasitic, Term::Profile, Term::Climb];
+
+    /// The lower-case name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Term::Induced => "induced",
+            Term::Parasitic => "parasitic",
+            Term::Profile => "profile",
+            Term::Climb => "climb",
+        }
+    }
+}
+
+impl std::str::FromStr for Term {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "induced" | "ind" => Ok(Term::Induced),
+            "parasitic" | "par" => Ok(Term::Parasitic),
+            "profile" | "pro" => Ok(Term::Profile),
+            "climb" | "c" => Ok(Term::Climb),
+            other => Err(format!(
+                "unknown power term '{other}' (expected induced, parasitic, profile or climb)"
+            )),
+        }
+    }
+}
+
+/// Which of the four terms are included.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Terms {
+    /// Include induced power.
+    pub induced: bool,
+    /// Include parasitic power.
+    pub parasitic: bool,
+    /// Include profile power.
+    pub profile: bool,
+    /// Include climb power.
+    pub climb: bool,
+}
+
+impl Default for Terms {
+    fn default() -> Self {
+        Self::ALL
+    }
+}
+
+impl Terms {
+    /// The full model.
+    pub const ALL: Terms = Terms {
+        induced: true,
+        parasitic: true,
+        profile: true,
+        climb: true,
+    };
+
+    /// These terms with `term` removed.
+    pub fn without(mut self, term: Term) -> Self {
+        match term {
+            Term::Induced => self.induced = false,
+            Term::Parasitic => self.parasitic = false,
+            Term::Profile => self.profile = false,
+            Term::Climb => self.climb = false,
+        }
+        self
+    }
+
+    /// The full model with every term in `removed` taken out.
+    pub fn all_but(removed: &[Term]) -> Self {
+        removed.iter().fold(Self::ALL, |t, &r| t.without(r))
+    }
+
+    /// Whether `term` is included.
+    pub fn includes(&self, term: Term) -> bool {
+        match term {
+            Term::Induced => self.induced,
+            Term::Parasitic => self.parasitic,
+            Term::Profile => self.profile,
+            Term::Climb => self.climb,
+        }
+    }
+}
+
+/// Options of the model beyond the vehicle: ablation and the hybrid profile cutoff.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ModelOptions {
+    /// Terms included.
+    pub terms: Terms,
+    /// Hybrid model: drop the profile term when the airspeed exceeds this value, m/s.
+    pub profile_cutoff_mps: Option<f64>,
+}
+
+/// How the angle of attack of a point query is found.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum AoaInput {
+    /// The paper's approximation (3)-(4) from roll and pitch.
+    #[default]
+    Paper,
+    /// Exact geometry for horizontal air-relative motion in the direction `air_direction_rad`
+    /// from the nose (0 = forward, +pi/2 = to the right).
+    Geometric {
+        /// Direction of the air-relative velocity from the nose, rad.
+        air_direction_rad: f64,
+    },
+}
+
+/// A point query in steady level flight: the paper's inputs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlightState {
+    /// Airspeed `v_inf >= 0` (horizontal, as the paper assumes), m/s.
+    pub airspeed_mps: f64,
+    /// Roll `phi`, rad (positive right side down).
+    pub roll_rad: f64,
+    /// Pitch `theta`, rad (positive nose up).
+    pub pitch_rad: f64,
+    /// Vertical speed, positive up, m/s (enters only the climb term, eq (13)).
+    pub climb_rate_mps: f64,
+    /// Angle-of-attack model.
+    pub aoa: AoaInput,
+}
+
+impl FlightState {
+    /// Level, unaccelerated flight state with the paper's angle of attack.
+    pub fn new(airspeed_mps: f64, roll_rad: f64, pitch_rad: f64, climb_rate_mps: f64) -> Self {
+        Self {
+            airspeed_mps,
+            roll_rad,
+            pitch_rad,
+            climb_rate_mps,
+            aoa: AoaInput::Paper,
+        }
+    }
+}
+
+/// A fully resolved flight condition: thrust and inflow already known (the planner's input).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlightCondition {
+    /// Total thrust `T`, N.
+    pub thrust_n: f64,
+    /// Airspeed `v_inf`, the norm of the air-relative velocity, m/s.
+    pub airspeed_mps: f64,
+    /// The freestream decomposed on the rotor disk.
+    pub inflow: Inflow,
+    /// Vertical speed, positive up, m/s.
+    pub climb_rate_mps: f64,
+}
+
+/// Every term of the model at one flight condition. Field names are the JSON contract.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PowerBreakdown {
+    /// Total thrust `T`, N.
+    pub thrust_n: f64,
+    /// Induced velocity `v_i`, eq (9), m/s.
+    pub induced_velocity_mps: f64,
+    /// Hover induced velocity `vh`, eq (10), m/s.
+    pub hover_induced_velocity_mps: f64,
+    /// Induced power, eq (8), W (0 when removed).
+    pub induced_w: f64,
+    /// Parasitic power, eq (11), W (0 when removed).
+    pub parasitic_w: f64,
+    /// Profile power, eq (12), W (0 when removed or above the hybrid cutoff).
+    pub profile_w: f64,
+    /// Climb power, eq (13), W (0 when removed; negative in descent).
+    pub climb_w: f64,
+    /// Aerodynamic total `P_req`, eq (7), W.
+    pub aero_w: f64,
+    /// Electrical estimate `P_hat = P_req / eta`, eq (14), floored at 0, W.
+    pub electrical_w: f64,
+}
+
+/// The four-term power model of one vehicle with its options.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PowerModel {
+    vehicle: Vehicle,
+    options: ModelOptions,
+}
+
+/// Largest tilt a point query accepts: `cos(phi) cos(theta)` must exceed this.
+const MIN_TILT_COSINE: f64 = 1e-9;
+
+impl PowerModel {
+    /// The full model for `vehicle`.
+    pub fn new(vehicle: Vehicle) -> Self {
+        Self {
+            vehicle,
+            options: ModelOptions::default(),
+        }
+    }
+
+    /// The model with these options; a hybrid cutoff must be finite and not negative.
+    pub fn with_options(vehicle: Vehicle, options: ModelOptions) -> Result<Self> {
+        if let Some(cut) = options.profile_cutoff_mps {
+            non_negative("profile_cutoff_mps", cut)?;
+        }
+        Ok(Self { vehicle, options })
+    }
+
+    /// The vehicle.
+    pub fn vehicle(&self) -> &Vehicle {
+        &self.vehicle
+    }
+
+    /// The options.
+    pub fn options(&self) -> &ModelOptions {
+        &self.options
+    }
+
+    /// Thrust in steady level flight, eq (5): `T = m g / (cos(phi) cos(theta))`, N.
+    ///
+    /// Errors on non-finite angles and on a tilt of 90 deg or more.
+    #[inline]
+    pub fn level_flight_thrust_n(&self, roll_rad: f64, pitch_rad: f64) -> Result<f64> {
+        let tilt_cos = check_attitude(roll_rad, pitch_rad)?;
+        Ok(self.vehicle.weight_n() / tilt_cos)
+    }
+
+    /// Evaluate a point query: thrust from eq (5), inflow from the selected angle-of-attack model.
+    #[inline]
+    pub fn evaluate(&self, state: &FlightState) -> Result<PowerBreakdown> {
+        let tilt_cos = check_state(state)?;
+        let thrust_n = self.vehicle.weight_n() / tilt_cos;
+        let inflow = match state.aoa {
+            AoaInput::Paper => paper_inflow(state.airspeed_mps, state.roll_rad, state.pitch_rad),
+            AoaInput::Geometric { air_direction_rad } => {
+                finite("air_direction_rad", air_direction_rad)?;
+                body_relative_inflow(
+                    state.airspeed_mps,
+                    state.roll_rad,
+                    state.pitch_rad,
+                    air_direction_rad,
+                )
+            }
+        };
+        self.evaluate_condition(&FlightCondition {
+            thrust_n,
+            airspeed_mps: state.airspeed_mps,
+            inflow,
+            climb_rate_mps: state.climb_rate_mps,
+        })
+    }
+
+    /// Evaluate a resolved flight condition (thrust and inflow given).
+    #[inline]
+    pub fn evaluate_condition(&self, c: &FlightCondition) -> Result<PowerBreakdown> {
+        if !(c.thrust_n.is_finite() && c.thrust_n >= 0.0) {
+            finite("thrust_n", c.thrust_n)?;
+            non_negative("thrust_n", c.thrust_n)?;
+        }
+        if !(c.airspeed_mps.is_finite() && c.airspeed_mps >= 0.0) {
+            finite("airspeed_mps", c.airspeed_mps)?;
+            non_negative("airspeed_mps", c.airspeed_mps)?;
+        }
+        finite("climb_rate_mps", c.climb_rate_mps)?;
+        let v = &self.vehicle;
+        let vh = v.hover_induced_velocity_mps();
+        let opts = &self.options;
+        let vi = induced_velocity_mps(c.inflow.normal_mps, c.inflow.parallel_mps, vh)?;
+        let induced_w = if opts.terms.induced {
+            induced_power_w(c.thrust_n, vi, c.inflow.normal_mps)
+        } else {
+            0.0
+        };
+        let parasitic_w = if opts.terms.parasitic {
+            v.drag().parasitic_power_w(c.airspeed_mps)
+        } else {
+            0.0
+        };
+        let profile_on = opts.terms.profile
+            && opts
+                .profile_cutoff_mps
+                .is_none_or(|cut| c.airspeed_mps <= cut);
+        let profile_w = if profile_on {
+            profile_power_w(v.kappa1(), v.kappa2(), c.thrust_n, c.inflow.parallel_mps)
+        } else {
+            0.0
+        };
+        let climb_w = if opts.terms.climb {
+            climb_power_w(v.weight_n(), c.climb_rate_mps)
+        } else {
+            0.0
+        };
+        let aero_w = induced_w + parasitic_w + profile_w + climb_w;
+        Ok(PowerBreakdown {
+            thrust_n: c.thrust_n,
+            induced_velocity_mps: vi,
+            hover_induced_velocity_mps: vh,
+            induced_w,
+            parasitic_w,
+            profile_w,
+            climb_w,
+            aero_w,
+            electrical_w: aero_w.max(0.0) / v.efficiency(),
+        })
+    }
+}
+
+/// Validate roll and pitch; return `cos(phi) cos(theta)`.
+#[inline]
+pub(crate) fn check_attitude(roll_rad: f64, pitch_rad: f64) -> Result<f64> {
+    finite("roll_rad", roll_rad)?;
+    finite("pitch_rad", pitch_rad)?;
+    let tilt_cos = roll_rad.cos() * pitch_rad.cos();
+    if tilt_cos <= MIN_TILT_COSINE {
+        return Err(PowerError::TiltTooLarge {
+            tilt_deg: tilt_cos.clamp(-1.0, 1.0).acos().to_degrees(),
+            roll_deg: roll_rad.to_degrees(),
+            pitch_deg: pitch_rad.to_degrees(),
+        });
+    }
+    Ok(tilt_cos)
+}
+
+/// Validate a point query; return `cos(phi) cos(theta)`.
+#[inline]
+pub(crate) fn check_state(state: &FlightState) -> Result<f64> {
+    if !(state.airspeed_mps.is_finite() && state.airspeed_mps >= 0.0) {
+        finite("airspeed_mps", state.airspeed_mps)?;
+        non_negative("airspeed_mps", state.airspeed_mps)?;
+    }
+    finite("climb_rate_mps", state.climb_rate_mps)?;
+    check_attitude(state.roll_rad, state.pitch_rad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vehicle::{DiskArea, VehicleParams};
+
+    fn m100() -> Vehicle {
+        Vehicle::new(VehicleParams {
+            mass_kg: 3.29,
+            gravity_mps2: 9.8066,
+            air_density_kg_m3: 1.225,
+            rotor_count: 4,
+            rotor_radius_m: 0.172,
+            disk_area: DiskArea::OneRotor,
+            mu1_n_s_per_m: 0.1816,
+            mu2_n_s2_per_m2: -0.02326,
+            mu3_n_s3_per_m3: 0.004045,
+            kappa1_w_per_n1_5: 0.275,
+            kappa2_w_s2_per_m2_n0_5: 0.0,
+            efficiency: 0.8,
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn paper_val_hover_by_hand() {
+        // Hover: T = m g, v_i = vh, P_ind = T vh (eq 8), P_par = 0 (eq 11), P_pro = kappa1 T^1.5,
+        // P_c = 0; eq (10) vh = sqrt(m g / (2 rho pi r^2)).
+        let model = PowerModel::new(m100());
+        let p = model
+            .evaluate(&FlightState::new(0.0, 0.0, 0.0, 0.0))
+            .unwrap();
+        let w = 3.29 * 9.8066;
+        let vh = (w / (2.0 * 1.225 * std::f64::consts::PI * 0.172 * 0.172)).sqrt();
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+        assert!(rel(p.thrust_n, w) < 1e-15);
+        assert!(rel(p.hover_induced_velocity_mps, vh) < 1e-14);
+        assert!(rel(p.induced_velocity_mps, vh) < 1e-14);
+        assert!(rel(p.induced_w, w * vh) < 1e-14);
+        assert_eq!(p.parasitic_w, 0.0);
+        assert!(rel(p.profile_w, 0.275 * w.powf(1.5)) < 1e-14);
+        assert_eq!(p.climb_w, 0.0);
+        assert!(rel(p.electrical_w, (w * vh + 0.275 * w.powf(1.5)) / 0.8) < 1e-14);
+    }
+
+    #[test]
+    fn paper_val_eq5_thrust_grows_with_tilt() {
+        let model = PowerModel::new(m100());
+        let (r, q) = (0.2f64, -0.3f64);
+        let t = model.level_flight_thrust_n(r, q).unwrap();
+        assert!((t - 3.29 * 9.8066 / (r.cos() * q.cos())).abs() < 1e-12);
+    }
+
+    #[test]
+    fn ablation_removes_exactly_one_term() {
+        let full = PowerModel::new(m100());
+        let s = FlightState::new(6.0, 0.05, -0.15, 0.5);
+        let p = full.evaluate(&s).unwrap();
+        for term in Term::ALL {
+            let m = PowerModel::with_options(
+                m100(),
+                ModelOptions {
+                    terms: Terms::ALL.without(term),
+                    profile_cutoff_mps: None,
+                },
+            )
+            .unwrap();
+            let q = m.evaluate(&s).unwrap();
+            let removed = match term {
+                Term::Induced => p.induced_w,
+                Term::Parasitic => p.parasitic_w,
+                Term::Profile => p.profile_w,
+                Term::Climb => p.climb_w,
+            };
+            assert!(removed.abs() > 1.0, "{term:?} contributes at this state");
+            assert!((p.aero_w - q.aero_w - removed).abs() < 1e-9, "{term:?}");
+        }
+    }
+
+    #[test]
+    fn hybrid_drops_profile_above_cutoff() {
+        let m = PowerModel::with_options(
+            m100(),
+            ModelOptions {
+                terms: Terms::ALL,
+                profile_cutoff_mps: Some(7.0),
+            },
+        )
+        .unwrap();
+        let slow = m.evaluate(&FlightState::new(6.0, 0.0, -0.1, 0.0)).unwrap();
+        let fast = m.evaluate(&FlightState::new(8.0, 0.0, -0.1, 0.0)).unwrap();
+        assert!(slow.profile_w > 0.0);
+        assert_eq!(fast.profile_w, 0.0);
+    }
+
+    #[test]
+    fn bad_states_are_typed_errors() {
+        let m = PowerModel::new(m100());
+        let cases = [
+            (FlightState::new(-1.0, 0.0, 0.0, 0.0), "airspeed_mps"),
+            (FlightState::new(f64::NAN, 0.0, 0.0, 0.0), "airspeed_mps"),
+            (FlightState::new(1.0, 1.6, 0.0, 0.0), "tilt"),
+            (FlightState::new(1.0, 0.0, f64::INFINITY, 0.0), "pitch_rad"),
+            (FlightState::new(1.0, 0.0, 0.0, f64::NAN), "climb_rate_mps"),
+        ];
+        for (s, name) in cases {
+            let e = m.evaluate(&s).unwrap_err().to_string();
+            assert!(e.contains(name), "{e} should name {name}");
+        }
+    }
+
+    #[test]
+    fn electrical_never_negative_in_fast_descent() {
+        let m = PowerModel::new(m100());
+        let p = m.evaluate(&FlightState::new(0.0, 0.0, 0.0, -40.0)).unwrap();
+        assert!(p.aero_w < 0.0);
+        assert_eq!(p.electrical_w, 0.0);
+    }
+}

@@ -1,0 +1,63 @@
+//! # aloft-power: the four-term multirotor power model
+//!
+//! A white-box model of the electrical power a multirotor draws in any flight state, after
+//! "A Model of Quadrotor UAV Power Consumption and Its Performance Across a Range of Flight
+//! Conditions" (the power seed, `shared/seeds/power-consumption-model.txt`). Equation numbers in
+//! this crate are that paper's.
+//!
+//! `P_hat = (P_ind + P_par + P_pro + P_c) / eta` (7, 14) with
+//! - induced power `P_ind = T (v_i + v_inf sin a)` (8), `v_i` from the quartic of eq (9)
+//!   ([`induced`]), `vh` from eq (10);
+//! - parasitic power `P_par = f_D v_inf` (11) with cubic drag (6) ([`drag`]);
+//! - profile power `P_pro = kappa1 T^1.5 + kappa2 (v_inf cos a)^2 T^0.5` (12) ([`profile`]);
+//! - climb power `P_c = v_z m g` (13) ([`climb`]);
+//! - thrust `T = m g / (cos phi cos theta)` (5) for a point query, or given by the caller.
+//!
+//! Angle of attack: the paper's approximation (3)-(4) or exact geometry ([`angle_of_attack`]).
+//!
+//! ## Frames and units
+//! SI everywhere, angles in radians, the unit in every name. Attitude is roll/pitch/yaw of a
+//! forward-right-down body relative to north-east-down (positive pitch nose up, as the paper's
+//! Fig. 2); vectors returned for missions are east-north-up. Vertical speed is positive up.
+//!
+//! The crate does no I/O: it takes plain data and returns results or a [`PowerError`].
+//!
+//! ```
+//! use aloft_power::{DiskArea, FlightState, PowerModel, Vehicle, VehicleParams};
+//! let vehicle = Vehicle::new(VehicleParams {
+//!     mass_kg: 3.29, gravity_mps2: 9.8066, air_density_kg_m3: 1.225, rotor_count: 4,
+//!     rotor_radius_m: 0.172, disk_area: DiskArea::OneRotor, mu1_n_s_per_m: 0.1816,
+//!     mu2_n_s2_per_m2: -0.02326, mu3_n_s3_per_m3: 0.004045, kappa1_w_per_n1_5: 0.275,
+//!     kappa2_w_s2_per_m2_n0_5: 0.0, efficiency: 0.8,
+//! })?;
+//! let model = PowerModel::new(vehicle);
+//! let p = model.evaluate(&FlightState::new(6.0, 0.0, -8f64.to_radians(), 0.0))?;
+//! assert!(p.electrical_w > p.aero_w);
+//! # Ok::<(), aloft_power::PowerError>(())
+//! ```
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod angle_of_attack;
+pub mod climb;
+pub mod drag;
+pub mod efficiency;
+pub mod error;
+pub mod four_term;
+pub mod gradient;
+pub mod induced;
+pub mod metrics;
+pub mod profile;
+pub mod vehicle;
+
+pub use angle_of_attack::{AoaModel, Inflow};
+pub use drag::CubicDrag;
+pub use efficiency::{efficiency_from_hover, mean_power_w};
+pub use error::{PowerError, Result};
+pub use four_term::{
+    AoaInput, FlightCondition, FlightState, ModelOptions, PowerBreakdown, PowerModel, Term, Terms,
+};
+pub use gradient::PowerGradient;
+pub use metrics::{nrmse, rmse, Normalisation};
+pub use vehicle::{DiskArea, Vehicle, VehicleParams};

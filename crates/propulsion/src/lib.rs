@@ -1,0 +1,1 @@
+//! Propulsion chain (placeholder until the propulsion crate lands).

@@ -1,0 +1,92 @@
+//! Argument parsing and dispatch. Each subcommand lives in its own module.
+
+mod output;
+mod power;
+mod vehicles;
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use aloft::vehicle::{VehicleFile, DEFAULT_VEHICLE};
+
+/// Energy and feasibility of multirotor flights.
+///
+/// Exit codes: 0 success, 1 infeasible mission or failed check, 2 bad input.
+#[derive(Debug, Parser)]
+#[command(name = "aloft", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Electrical power of a flight state from the four-term model (power seed eqs 3-14).
+    Power(power::PowerArgs),
+    /// List the built-in vehicles.
+    Vehicles(vehicles::VehiclesArgs),
+}
+
+/// Output format of a result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum Format {
+    /// Aligned text for a terminal.
+    #[default]
+    Table,
+    /// JSON with snake_case keys carrying their unit (the scripting contract).
+    Json,
+    /// Comma-separated values with a header.
+    Csv,
+}
+
+/// What a successful run concluded.
+pub enum Outcome {
+    /// Everything fine: exit 0.
+    Ok,
+    /// A mission is infeasible or a check failed: exit 1.
+    #[allow(dead_code)]
+    Failed,
+}
+
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Power(args) => power::run(args),
+        Command::Vehicles(args) => vehicles::run(args),
+    };
+    match result {
+        Ok(Outcome::Ok) => ExitCode::SUCCESS,
+        Ok(Outcome::Failed) => ExitCode::from(1),
+        Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("aloft: error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Load a vehicle by built-in name or from a TOML file.
+pub fn load_vehicle(name_or_path: &str) -> Result<VehicleFile> {
+    if aloft::vehicle::builtin_names().contains(&name_or_path) {
+        return Ok(VehicleFile::builtin(name_or_path)?);
+    }
+    let path = Path::new(name_or_path);
+    if path.exists() {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read vehicle file {}", path.display()))?;
+        return Ok(VehicleFile::from_toml_str(
+            &text,
+            &path.display().to_string(),
+        )?);
+    }
+    anyhow::bail!(
+        "unknown vehicle '{name_or_path}': not a built-in vehicle ({}) and no such file",
+        aloft::vehicle::builtin_names().join(", ")
+    )
+}
+
+/// The default vehicle name, for clap defaults.
+pub const DEFAULT_VEHICLE_ARG: &str = DEFAULT_VEHICLE;

@@ -1,0 +1,46 @@
+//! Small rendering helpers shared by the subcommands.
+
+use std::io::{self, Write};
+
+/// True when the error chain holds a broken pipe (the reader went away: exit quietly).
+pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<io::Error>()
+            .is_some_and(|io| io.kind() == io::ErrorKind::BrokenPipe)
+            || c.downcast_ref::<csv::Error>().is_some_and(|ce| {
+                matches!(ce.kind(), csv::ErrorKind::Io(io) if io.kind() == io::ErrorKind::BrokenPipe)
+            })
+    })
+}
+
+/// One row of a text table: label, value already formatted, unit.
+pub struct Row<'a> {
+    pub label: &'a str,
+    pub value: String,
+    pub unit: &'a str,
+}
+
+impl<'a> Row<'a> {
+    pub fn new(label: &'a str, value: String, unit: &'a str) -> Self {
+        Self { label, value, unit }
+    }
+}
+
+/// Write rows as an aligned two-column table with units.
+pub fn write_table(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> io::Result<()> {
+    writeln!(out, "{title}")?;
+    let lw = rows.iter().map(|r| r.label.len()).max().unwrap_or(0);
+    let vw = rows.iter().map(|r| r.value.len()).max().unwrap_or(0);
+    for r in rows {
+        let line = format!("  {:<lw$}  {:>vw$} {}", r.label, r.value, r.unit);
+        writeln!(out, "{}", line.trim_end())?;
+    }
+    Ok(())
+}
+
+/// Write a serializable value as pretty JSON with a trailing newline.
+pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    serde_json::to_writer_pretty(&mut *out, value)?;
+    writeln!(out)?;
+    Ok(())
+}

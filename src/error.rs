@@ -1,0 +1,38 @@
+//! The facade's typed error.
+
+use thiserror::Error;
+
+/// Errors of the `aloft` facade: a model error, or a vehicle description that cannot be used.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The power model rejected a parameter or a flight state.
+    #[error(transparent)]
+    Power(#[from] aloft_power::PowerError),
+    /// A vehicle name that is not built in.
+    #[error("unknown vehicle '{name}': built-in vehicles are {known}")]
+    UnknownVehicle {
+        /// The name asked for.
+        name: String,
+        /// The built-in names, comma-separated.
+        known: String,
+    },
+    /// A vehicle file that is not valid TOML or does not match the format.
+    #[error("invalid vehicle description {origin}: {message}")]
+    VehicleFormat {
+        /// Where the text came from (file path or built-in name).
+        origin: String,
+        /// The parser's message (line, column and key).
+        message: String,
+    },
+    /// The vehicle has no table for the model that was asked for.
+    #[error("vehicle '{vehicle}' has no [{table}] table, which {needed_for} needs")]
+    MissingTable {
+        /// Vehicle name.
+        vehicle: String,
+        /// The missing table.
+        table: &'static str,
+        /// What needs it.
+        needed_for: &'static str,
+    },
+}

@@ -1,0 +1,27 @@
+//! # aloft
+//!
+//! What a multirotor flight costs in energy and whether it can be flown. This crate is the facade
+//! over the model crates and the home of the vehicle file format; the `aloft` binary is a thin
+//! command line over it.
+//!
+//! - [`power`]: the four-term power model (`aloft-power`).
+//! - [`propulsion`]: the propulsion chain (`aloft-propulsion`).
+//! - [`vehicle`]: vehicle files (TOML) and the built-in vehicles.
+//!
+//! ```
+//! let file = aloft::vehicle::VehicleFile::builtin("dji-m100")?;
+//! let model = aloft::power::PowerModel::new(file.power_vehicle()?);
+//! let hover = model.evaluate(&aloft::power::FlightState::new(0.0, 0.0, 0.0, 0.0))?;
+//! assert!(hover.electrical_w > 400.0 && hover.electrical_w < 600.0);
+//! # Ok::<(), aloft::Error>(())
+//! ```
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod error;
+pub mod vehicle;
+
+pub use aloft_power as power;
+pub use aloft_propulsion as propulsion;
+pub use error::Error;
