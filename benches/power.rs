@@ -1,1 +1,91 @@
-fn main() {}
+//! Benches of the four-term power model.
+//!
+//! Targets (issue 2): `power/four_term/single` at most 25 ns per evaluation;
+//! `power/four_term/batch` at least 20 million states per second on one core.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+
+use aloft::power::{AoaInput, FlightState, PowerBreakdown, PowerModel};
+use aloft::vehicle::VehicleFile;
+
+fn model() -> PowerModel {
+    PowerModel::new(
+        VehicleFile::builtin("dji-m100")
+            .and_then(|f| f.power_vehicle())
+            .expect("built-in vehicle"),
+    )
+}
+
+/// A spread of states over the envelope the paper flew and beyond: 0-20 m/s, +-25 deg roll and
+/// pitch, climb +-3 m/s, so the quartic solver sees many different inflows (generated, not random,
+/// so the workload is the same on every run).
+fn states(n: usize, geometric: bool) -> Vec<FlightState> {
+    (0..n)
+        .map(|i| {
+            let f = i as f64 / n as f64;
+            let s = (i as f64 * 0.618_033_988_75).fract();
+            FlightState {
+                airspeed_mps: 20.0 * f,
+                roll_rad: (50.0 * s - 25.0).to_radians(),
+                pitch_rad: (25.0 - 50.0 * (1.0 - f) * s).to_radians(),
+                climb_rate_mps: 6.0 * s - 3.0,
+                aoa: if geometric {
+                    AoaInput::Geometric {
+                        air_direction_rad: 6.0 * s - 3.0,
+                    }
+                } else {
+                    AoaInput::Paper
+                },
+            }
+        })
+        .collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let m = model();
+    let mut group = c.benchmark_group("power/four_term");
+    let one = FlightState::new(6.0, 0.03, -0.14, 0.2);
+    group.bench_function("single", |b| {
+        b.iter(|| m.evaluate(black_box(&one)).map(|p| p.electrical_w))
+    });
+    let geo = FlightState {
+        aoa: AoaInput::Geometric {
+            air_direction_rad: 0.3,
+        },
+        ..one
+    };
+    group.bench_function("single_geometric", |b| {
+        b.iter(|| m.evaluate(black_box(&geo)).map(|p| p.electrical_w))
+    });
+    for (name, geometric) in [("batch", false), ("batch_geometric", true)] {
+        let input = states(100_000, geometric);
+        let mut out = vec![
+            PowerBreakdown {
+                thrust_n: 0.0,
+                induced_velocity_mps: 0.0,
+                hover_induced_velocity_mps: 0.0,
+                induced_w: 0.0,
+                parasitic_w: 0.0,
+                profile_w: 0.0,
+                climb_w: 0.0,
+                aero_w: 0.0,
+                electrical_w: 0.0,
+            };
+            input.len()
+        ];
+        group.throughput(Throughput::Elements(input.len() as u64));
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                m.evaluate_batch(black_box(&input), &mut out)
+                    .expect("states are valid");
+                black_box(&out);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -9,6 +9,9 @@ pub enum Error {
     /// The power model rejected a parameter or a flight state.
     #[error(transparent)]
     Power(#[from] aloft_power::PowerError),
+    /// The propulsion chain rejected a parameter or an operating point.
+    #[error(transparent)]
+    Propulsion(#[from] aloft_propulsion::PropulsionError),
     /// A vehicle name that is not built in.
     #[error("unknown vehicle '{name}': built-in vehicles are {known}")]
     UnknownVehicle {

@@ -9,6 +9,10 @@
 //! [power]        # four-term power model parameters: aloft_power::VehicleParams
 //! mass_kg = 3.29
 //! # ...
+//!
+//! [propulsion]   # propulsion chain: aloft_propulsion::PropulsionSpec
+//! empty_mass_kg = 7.484
+//! # ... with [propulsion.propeller], [propulsion.motor], [propulsion.esc], [propulsion.battery]
 //! ```
 //!
 //! Tables are optional, so a vehicle can describe only the models it has data for; asking for a
@@ -29,10 +33,16 @@ pub struct BuiltinVehicle {
 }
 
 /// The built-in vehicles, the default first.
-pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[BuiltinVehicle {
-    name: "dji-m100",
-    toml: include_str!("../fixtures/vehicles/dji-m100.toml"),
-}];
+pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
+    BuiltinVehicle {
+        name: "dji-m100",
+        toml: include_str!("../fixtures/vehicles/dji-m100.toml"),
+    },
+    BuiltinVehicle {
+        name: "aec-quadrotor",
+        toml: include_str!("../fixtures/vehicles/aec-quadrotor.toml"),
+    },
+];
 
 /// Name of the default vehicle.
 pub const DEFAULT_VEHICLE: &str = "dji-m100";
@@ -49,6 +59,9 @@ pub struct VehicleFile {
     /// Four-term power model parameters.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub power: Option<aloft_power::VehicleParams>,
+    /// Propulsion chain: propeller, motor, ESC, battery packs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub propulsion: Option<aloft_propulsion::PropulsionSpec>,
 }
 
 impl VehicleFile {
@@ -61,6 +74,9 @@ impl VehicleFile {
         // Validate every table that is present, so a file that loads is usable.
         if let Some(p) = &file.power {
             aloft_power::Vehicle::new(p.clone())?;
+        }
+        if let Some(p) = &file.propulsion {
+            p.clone().into_model()?;
         }
         Ok(file)
     }
@@ -75,6 +91,16 @@ impl VehicleFile {
                 known: builtin_names().join(", "),
             })?;
         Self::from_toml_str(b.toml, &format!("built-in '{}'", b.name))
+    }
+
+    /// The validated propulsion chain of the `[propulsion]` table.
+    pub fn propulsion_system(&self) -> Result<aloft_propulsion::PropulsionSystem, Error> {
+        let spec = self.propulsion.clone().ok_or_else(|| Error::MissingTable {
+            vehicle: self.name.clone(),
+            table: "propulsion",
+            needed_for: "the propulsion chain",
+        })?;
+        Ok(spec.into_model()?)
     }
 
     /// The validated power-model vehicle of the `[power]` table.
@@ -132,6 +158,7 @@ mod tests {
             name: "bad".into(),
             description: String::new(),
             power: Some(p),
+            propulsion: None,
         })
         .unwrap();
         let e = VehicleFile::from_toml_str(&bad, "test")

@@ -31,10 +31,17 @@ pub fn run(args: VehiclesArgs) -> Result<Outcome> {
         if f.power.is_some() {
             models.push("power");
         }
+        if f.propulsion.is_some() {
+            models.push("propulsion");
+        }
         entries.push(Entry {
             name: b.name,
             description: f.description.clone(),
-            mass_kg: f.power.as_ref().map(|p| p.mass_kg),
+            mass_kg: f
+                .power
+                .as_ref()
+                .map(|p| p.mass_kg)
+                .or(f.propulsion.as_ref().map(|p| p.empty_mass_kg)),
             models,
         });
     }

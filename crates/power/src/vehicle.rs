@@ -80,6 +80,8 @@ pub struct Vehicle {
     weight_n: f64,
     disk_area_m2: f64,
     hover_induced_mps: f64,
+    inv_hover_induced: f64,
+    inv_efficiency: f64,
 }
 
 impl Vehicle {
@@ -121,12 +123,15 @@ impl Vehicle {
         let hover_induced_mps =
             hover_induced_velocity_mps(weight_n, params.air_density_kg_m3, disk_area_m2);
         finite("hover_induced_velocity_mps", hover_induced_mps)?;
+        let inv_efficiency = 1.0 / params.efficiency;
         Ok(Self {
             params,
             drag,
             weight_n,
             disk_area_m2,
             hover_induced_mps,
+            inv_hover_induced: 1.0 / hover_induced_mps,
+            inv_efficiency,
         })
     }
 
@@ -165,6 +170,14 @@ impl Vehicle {
     /// Hover induced velocity `vh` of eq (10), m/s.
     pub fn hover_induced_velocity_mps(&self) -> f64 {
         self.hover_induced_mps
+    }
+    /// `1 / vh`, s/m (cached for the hot path).
+    pub fn inverse_hover_induced_velocity(&self) -> f64 {
+        self.inv_hover_induced
+    }
+    /// `1 / eta` (cached for the hot path).
+    pub fn inverse_efficiency(&self) -> f64 {
+        self.inv_efficiency
     }
     /// Ideal hover power `m g vh`, W (the numerator of the paper's efficiency).
     pub fn ideal_hover_power_w(&self) -> f64 {

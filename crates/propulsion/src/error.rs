@@ -1,0 +1,252 @@
+//! The one error type of the crate.
+
+use thiserror::Error;
+
+/// Everything that can go wrong when building or evaluating a propulsion model.
+///
+/// Every variant carries the offending value together with its unit, so that a caller can
+/// print it without knowing the model.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum PropulsionError {
+    /// A motor velocity constant that is zero, negative or not finite.
+    #[error("motor Kv must be a positive finite number, got {kv_rpm_per_v} rpm/V")]
+    InvalidKv {
+        /// The rejected value, rpm/V.
+        kv_rpm_per_v: f64,
+    },
+    /// A mass that is zero, negative or not finite.
+    #[error("{name} must be a positive finite mass, got {mass_kg} kg")]
+    InvalidMass {
+        /// Which mass (e.g. `empty_mass_kg`).
+        name: &'static str,
+        /// The rejected value, kg.
+        mass_kg: f64,
+    },
+    /// A voltage that is zero, negative or not finite.
+    #[error("{name} must be a positive finite voltage, got {voltage_v} V")]
+    InvalidVoltage {
+        /// Which voltage.
+        name: &'static str,
+        /// The rejected value, V.
+        voltage_v: f64,
+    },
+    /// A resistance that is negative or not finite.
+    #[error("{name} must be a non-negative finite resistance, got {resistance_ohm} ohm")]
+    InvalidResistance {
+        /// Which resistance.
+        name: &'static str,
+        /// The rejected value, ohm.
+        resistance_ohm: f64,
+    },
+    /// Any other parameter outside its valid range.
+    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// Parameter name, with its unit suffix.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// Unit of `value`.
+        unit: &'static str,
+        /// What a valid value looks like.
+        expected: &'static str,
+    },
+    /// A count (rotors, packs, cells) that is zero or inconsistent.
+    #[error("{name} = {count} is invalid: expected {expected}")]
+    InvalidCount {
+        /// Which count.
+        name: &'static str,
+        /// The rejected value.
+        count: u32,
+        /// What a valid count looks like.
+        expected: &'static str,
+    },
+    /// The pack cannot deliver the requested power, whatever the current (eqs 29-30).
+    #[error("a pack cannot deliver {power_w:.1} W: its maximum is {max_power_w:.1} W (full-charge voltage and internal resistance, eqs 29-30)")]
+    PowerExceedsPack {
+        /// Power asked of one pack, W.
+        power_w: f64,
+        /// Largest power the pack can deliver to its load, W.
+        max_power_w: f64,
+    },
+    /// The pack current needed exceeds the pack's rated continuous current.
+    #[error("pack current {current_a:.1} A exceeds the pack's rated {limit_a:.1} A")]
+    PackCurrentLimit {
+        /// Current required, A.
+        current_a: f64,
+        /// Rated limit, A.
+        limit_a: f64,
+    },
+    /// The thrust asked of a rotor needs more motor current than the motor's rating.
+    #[error("thrust {thrust_n:.2} N per rotor needs {current_a:.1} A of motor current, above the motor's {limit_a:.1} A limit")]
+    CurrentLimitExceeded {
+        /// Thrust asked of one rotor, N.
+        thrust_n: f64,
+        /// Motor current it needs, A.
+        current_a: f64,
+        /// Motor current limit, A.
+        limit_a: f64,
+    },
+    /// A thrust that is negative or not finite.
+    #[error("thrust must be a non-negative finite force, got {thrust_n} N")]
+    InvalidThrust {
+        /// The rejected value, N.
+        thrust_n: f64,
+    },
+    /// Two data slices that should have the same length do not.
+    #[error("data length mismatch for {what}: expected {expected} values, got {found}")]
+    LengthMismatch {
+        /// Which slice.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Actual length.
+        found: usize,
+    },
+    /// Too few (usable) data points for a fit.
+    #[error("fit of {model} needs at least {required} usable points, got {points}")]
+    InsufficientData {
+        /// Which model is being fitted.
+        model: &'static str,
+        /// Usable points.
+        points: usize,
+        /// Minimum needed.
+        required: usize,
+    },
+    /// A data value that is not finite.
+    #[error("data value {what}[{index}] = {value} is not finite")]
+    NonFiniteData {
+        /// Which slice.
+        what: &'static str,
+        /// Index of the value.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// The optimiser did not return a usable result.
+    #[error("fit of {model} did not converge to a finite optimum")]
+    FitDidNotConverge {
+        /// Which model.
+        model: &'static str,
+    },
+    /// An ESC protocol name that is not in the transient seed's Table 4.
+    #[error("unknown ESC protocol {protocol:?}: expected dshot150, dshot300, oneshot42, oneshot125, multishot, pwm50 or pwm500")]
+    UnknownProtocol {
+        /// The rejected name.
+        protocol: String,
+    },
+    /// Keys of a spec table that must not be given together, or of which one is required.
+    #[error("in [{table}]: {problem}")]
+    ConflictingKeys {
+        /// The table (e.g. `propulsion.motor`).
+        table: &'static str,
+        /// What is wrong.
+        problem: &'static str,
+    },
+    /// A simulated step response that never reached its band (simulation too short).
+    #[error("step response did not settle within the simulated {duration_s} s")]
+    NotSettled {
+        /// Simulated duration, s.
+        duration_s: f64,
+    },
+}
+
+/// Check that `value` is finite and strictly positive.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PropulsionError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(PropulsionError::InvalidParameter {
+            name,
+            value,
+            unit,
+            expected: "a positive finite number",
+        })
+    }
+}
+
+/// Check that `value` is finite and not negative.
+pub(crate) fn non_negative(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PropulsionError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(PropulsionError::InvalidParameter {
+            name,
+            value,
+            unit,
+            expected: "a non-negative finite number",
+        })
+    }
+}
+
+/// Check a fraction in `[0, 1)` (losses) or `(0, 1]` (coefficients).
+pub(crate) fn fraction(
+    name: &'static str,
+    value: f64,
+    allow_zero: bool,
+    allow_one: bool,
+) -> Result<f64, PropulsionError> {
+    let lower_ok = if allow_zero {
+        value >= 0.0
+    } else {
+        value > 0.0
+    };
+    let upper_ok = if allow_one { value <= 1.0 } else { value < 1.0 };
+    if value.is_finite() && lower_ok && upper_ok {
+        Ok(value)
+    } else {
+        Err(PropulsionError::InvalidParameter {
+            name,
+            value,
+            unit: "(fraction)",
+            expected: "a fraction between 0 and 1",
+        })
+    }
+}
+
+/// Check a mass.
+pub(crate) fn mass(name: &'static str, mass_kg: f64) -> Result<f64, PropulsionError> {
+    if mass_kg.is_finite() && mass_kg > 0.0 {
+        Ok(mass_kg)
+    } else {
+        Err(PropulsionError::InvalidMass { name, mass_kg })
+    }
+}
+
+/// Check a voltage.
+pub(crate) fn voltage(name: &'static str, voltage_v: f64) -> Result<f64, PropulsionError> {
+    if voltage_v.is_finite() && voltage_v > 0.0 {
+        Ok(voltage_v)
+    } else {
+        Err(PropulsionError::InvalidVoltage { name, voltage_v })
+    }
+}
+
+/// Check a resistance (zero allowed).
+pub(crate) fn resistance(name: &'static str, resistance_ohm: f64) -> Result<f64, PropulsionError> {
+    if resistance_ohm.is_finite() && resistance_ohm >= 0.0 {
+        Ok(resistance_ohm)
+    } else {
+        Err(PropulsionError::InvalidResistance {
+            name,
+            resistance_ohm,
+        })
+    }
+}
+
+/// Check a Kv.
+pub(crate) fn kv(kv_rpm_per_v: f64) -> Result<f64, PropulsionError> {
+    if kv_rpm_per_v.is_finite() && kv_rpm_per_v > 0.0 {
+        Ok(kv_rpm_per_v)
+    } else {
+        Err(PropulsionError::InvalidKv { kv_rpm_per_v })
+    }
+}
