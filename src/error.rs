@@ -28,6 +28,56 @@ pub enum Error {
         /// The parser's message (line, column and key).
         message: String,
     },
+    /// A CSV input lacks a required column.
+    #[error("{origin}: missing column '{column}' (found: {found})")]
+    ColumnMissing {
+        /// The column asked for.
+        column: &'static str,
+        /// File or stream name.
+        origin: String,
+        /// The header that was found, comma-separated.
+        found: String,
+    },
+    /// A field that must be a number is not.
+    #[error("{origin}: row {row}: {column} = '{value}' is not a number")]
+    BadValue {
+        /// File or stream name.
+        origin: String,
+        /// 1-based data row (the header is row 0).
+        row: usize,
+        /// Column name.
+        column: &'static str,
+        /// The text found.
+        value: String,
+    },
+    /// A row whose values the model rejects.
+    #[error("{origin}: row {row}: {source}")]
+    BadRow {
+        /// File or stream name.
+        origin: String,
+        /// 1-based data row.
+        row: usize,
+        /// The model's error.
+        source: aloft_power::PowerError,
+    },
+    /// Malformed CSV (unequal field counts, invalid UTF-8, ...).
+    #[error("{origin}: row {row}: {message}")]
+    Csv {
+        /// File or stream name.
+        origin: String,
+        /// 1-based data row (0: the header).
+        row: usize,
+        /// The CSV parser's message.
+        message: String,
+    },
+    /// Reading or writing failed.
+    #[error("{origin}: {source}")]
+    Io {
+        /// File or stream name.
+        origin: String,
+        /// The I/O error.
+        source: std::io::Error,
+    },
     /// The vehicle has no table for the model that was asked for.
     #[error("vehicle '{vehicle}' has no [{table}] table, which {needed_for} needs")]
     MissingTable {

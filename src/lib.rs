@@ -7,6 +7,7 @@
 //! - [`power`]: the four-term power model (`aloft-power`).
 //! - [`propulsion`]: the propulsion chain (`aloft-propulsion`).
 //! - [`vehicle`]: vehicle files (TOML) and the built-in vehicles.
+//! - [`batch`]: streaming CSV evaluation of the power model.
 //!
 //! ```
 //! let file = aloft::vehicle::VehicleFile::builtin("dji-m100")?;
@@ -19,6 +20,7 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod batch;
 pub mod error;
 pub mod vehicle;
 

@@ -2,6 +2,8 @@
 
 mod output;
 mod power;
+mod propulsion;
+mod rotor;
 mod vehicles;
 
 use std::path::Path;
@@ -26,6 +28,10 @@ struct Cli {
 enum Command {
     /// Electrical power of a flight state from the four-term model (power seed eqs 3-14).
     Power(power::PowerArgs),
+    /// Propulsion chain at hover: rotor speed, currents, pack heat and flight time (propulsion seed).
+    Propulsion(propulsion::PropulsionArgs),
+    /// Rotor inertia, time constants and simulated step response (transient seed).
+    Rotor(rotor::RotorArgs),
     /// List the built-in vehicles.
     Vehicles(vehicles::VehiclesArgs),
 }
@@ -55,6 +61,8 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Power(args) => power::run(args),
+        Command::Propulsion(args) => propulsion::run(args),
+        Command::Rotor(args) => rotor::run(args),
         Command::Vehicles(args) => vehicles::run(args),
     };
     match result {

@@ -1,6 +1,5 @@
 //! `aloft power`: the four-term model for one flight state, or a CSV of states streamed through it.
 
-use std::fmt::Write as _;
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -69,32 +68,7 @@ pub struct PowerArgs {
     output: Option<PathBuf>,
 }
 
-/// The JSON/CSV column names of a result, in order (the scripting contract).
-const KEYS: [&str; 9] = [
-    "thrust_n",
-    "induced_velocity_mps",
-    "hover_induced_velocity_mps",
-    "induced_w",
-    "parasitic_w",
-    "profile_w",
-    "climb_w",
-    "aero_w",
-    "electrical_w",
-];
-
-fn values(p: &PowerBreakdown) -> [f64; 9] {
-    [
-        p.thrust_n,
-        p.induced_velocity_mps,
-        p.hover_induced_velocity_mps,
-        p.induced_w,
-        p.parasitic_w,
-        p.profile_w,
-        p.climb_w,
-        p.aero_w,
-        p.electrical_w,
-    ]
-}
+use aloft::batch::{power_values as values, POWER_KEYS as KEYS};
 
 #[derive(Serialize)]
 struct GradientJson {
@@ -249,97 +223,23 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
 /// Stream `path` through the model, one row at a time: memory does not grow with the file.
 fn batch(model: &PowerModel, path: &Path, output: Option<&Path>) -> Result<Outcome> {
     let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_reader(BufReader::with_capacity(1 << 16, file));
-    let headers = reader
-        .headers()
-        .with_context(|| format!("{}: cannot read the CSV header", path.display()))?
-        .clone();
-    let column = |name: &str| headers.iter().position(|h| h == name);
-    let mut required = [0usize; 3];
-    for (slot, name) in required
-        .iter_mut()
-        .zip(["airspeed_mps", "roll_deg", "pitch_deg"])
-    {
-        *slot = column(name).with_context(|| {
-            format!(
-                "{}: missing column '{name}' (the columns are airspeed_mps, roll_deg, pitch_deg, and optionally climb_rate_mps, air_direction_deg; found: {})",
-                path.display(),
-                headers.iter().collect::<Vec<_>>().join(",")
-            )
-        })?;
-    }
-    let climb_col = column("climb_rate_mps");
-    let dir_col = column("air_direction_deg");
-
-    let sink: Box<dyn Write> = match output {
+    let input = BufReader::with_capacity(1 << 16, file);
+    let origin = path.display().to_string();
+    match output {
         Some(p) => {
-            Box::new(File::create(p).with_context(|| format!("cannot create {}", p.display()))?)
+            let sink = File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
+            aloft::batch::power_csv(
+                model,
+                input,
+                BufWriter::with_capacity(1 << 16, sink),
+                &origin,
+            )?;
         }
-        None => Box::new(std::io::stdout().lock()),
-    };
-    let mut writer = csv::Writer::from_writer(BufWriter::with_capacity(1 << 16, sink));
-    let mut header: Vec<&str> = headers.iter().collect();
-    header.extend(KEYS);
-    writer.write_record(&header)?;
-
-    let mut record = csv::StringRecord::new();
-    let mut text = String::with_capacity(32);
-    let mut row = 0usize;
-    while reader
-        .read_record(&mut record)
-        .with_context(|| format!("{}: cannot read row {}", path.display(), row + 1))?
-    {
-        row += 1;
-        let field = |idx: usize, name: &str| -> Result<f64> {
-            let raw = record.get(idx).unwrap_or("");
-            raw.parse::<f64>().with_context(|| {
-                format!(
-                    "{}: row {row}: {name} = '{raw}' is not a number",
-                    path.display()
-                )
-            })
-        };
-        let optional = |idx: Option<usize>, name: &str| -> Result<Option<f64>> {
-            match idx.and_then(|i| record.get(i)) {
-                None | Some("") => Ok(None),
-                Some(_) => field(idx.unwrap_or_default(), name).map(Some),
-            }
-        };
-        let airspeed = field(required[0], "airspeed_mps")?;
-        let roll = field(required[1], "roll_deg")?;
-        let pitch = field(required[2], "pitch_deg")?;
-        let climb = optional(climb_col, "climb_rate_mps")?.unwrap_or(0.0);
-        let aoa = match optional(dir_col, "air_direction_deg")? {
-            Some(d) => AoaInput::Geometric {
-                air_direction_rad: d.to_radians(),
-            },
-            None => AoaInput::Paper,
-        };
-        let state = FlightState {
-            airspeed_mps: airspeed,
-            roll_rad: roll.to_radians(),
-            pitch_rad: pitch.to_radians(),
-            climb_rate_mps: climb,
-            aoa,
-        };
-        let p = model.evaluate(&state).with_context(|| {
-            format!(
-                "{}: row {row} (airspeed_mps {airspeed}, roll_deg {roll}, pitch_deg {pitch}, climb_rate_mps {climb})",
-                path.display()
-            )
-        })?;
-        for f in record.iter() {
-            writer.write_field(f)?;
+        None => {
+            let stdout = std::io::stdout();
+            let sink = BufWriter::with_capacity(1 << 16, stdout.lock());
+            aloft::batch::power_csv(model, input, sink, &origin)?;
         }
-        for v in values(&p) {
-            text.clear();
-            write!(text, "{v}").expect("writing to a String cannot fail");
-            writer.write_field(&text)?;
-        }
-        writer.write_record(None::<&[u8]>)?;
     }
-    writer.flush()?;
     Ok(Outcome::Ok)
 }

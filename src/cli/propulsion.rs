@@ -1,0 +1,294 @@
+//! `aloft propulsion`: the propulsion chain at hover for a payload, or swept over take-off mass
+//! (the propulsion seed's Fig. 13).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use serde::Serialize;
+
+use aloft::propulsion::{mass_range_kg, HoverResult};
+
+use super::output::{self, Row};
+use super::{load_vehicle, Format, Outcome};
+
+#[derive(Debug, Args)]
+pub struct PropulsionArgs {
+    /// Vehicle with a [propulsion] table: a built-in name or a vehicle TOML file.
+    #[arg(long, default_value = "aec-quadrotor")]
+    vehicle: String,
+    /// Payload in kg, added to the vehicle's empty mass.
+    #[arg(
+        long,
+        default_value_t = 0.0,
+        allow_negative_numbers = true,
+        conflicts_with = "takeoff_mass_kg"
+    )]
+    payload_kg: f64,
+    /// Take-off mass in kg (instead of --payload-kg).
+    #[arg(long, allow_negative_numbers = true)]
+    takeoff_mass_kg: Option<f64>,
+    /// Sweep take-off mass FROM:TO:STEP in kg (e.g. 7:13:0.5), the seed's Fig. 13.
+    #[arg(long, value_name = "FROM:TO:STEP", conflicts_with_all = ["payload_kg", "takeoff_mass_kg"])]
+    sweep_takeoff_mass: Option<String>,
+    /// With --sweep-takeoff-mass: also write an SVG chart of flight time and power against mass.
+    #[arg(long, value_name = "SVG", requires = "sweep_takeoff_mass")]
+    plot: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// One point of a sweep: the result, or why that mass cannot hover.
+#[derive(Serialize)]
+struct SweepPoint {
+    takeoff_mass_kg: f64,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    result: Option<HoverResult>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    error: Option<String>,
+}
+
+pub fn run(args: PropulsionArgs) -> Result<Outcome> {
+    let file = load_vehicle(&args.vehicle)?;
+    let system = file.propulsion_system()?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    if let Some(spec) = &args.sweep_takeoff_mass {
+        let parts: Vec<&str> = spec.split(':').collect();
+        let [from, to, step] = parts.as_slice() else {
+            bail!("--sweep-takeoff-mass '{spec}': expected FROM:TO:STEP in kg, e.g. 7:13:0.5");
+        };
+        let num = |s: &str, what: &str| -> Result<f64> {
+            s.trim().parse::<f64>().with_context(|| {
+                format!("--sweep-takeoff-mass '{spec}': {what} '{s}' is not a number")
+            })
+        };
+        let masses = mass_range_kg(num(from, "FROM")?, num(to, "TO")?, num(step, "STEP")?)
+            .with_context(|| format!("--sweep-takeoff-mass '{spec}'"))?;
+        let points: Vec<SweepPoint> = system
+            .sweep_takeoff_mass(&masses)
+            .into_iter()
+            .zip(&masses)
+            .map(|(r, &m)| match r {
+                Ok(h) => SweepPoint {
+                    takeoff_mass_kg: m,
+                    result: Some(h),
+                    error: None,
+                },
+                Err(e) => SweepPoint {
+                    takeoff_mass_kg: m,
+                    result: None,
+                    error: Some(e.to_string()),
+                },
+            })
+            .collect();
+        if let Some(path) = &args.plot {
+            plot_sweep(path, &file.name, &points)
+                .with_context(|| format!("cannot write the plot {}", path.display()))?;
+        }
+        match args.format {
+            Format::Json => output::write_json(&mut out, &points)?,
+            Format::Csv => {
+                let mut w = csv::Writer::from_writer(out);
+                w.write_record([
+                    "takeoff_mass_kg",
+                    "thrust_per_rotor_n",
+                    "rotor_speed_rpm",
+                    "motor_current_a",
+                    "pack_current_a",
+                    "power_required_w",
+                    "power_drawn_w",
+                    "battery_heat_w",
+                    "flight_time_min",
+                    "error",
+                ])?;
+                for p in &points {
+                    let mut row = vec![p.takeoff_mass_kg.to_string()];
+                    match &p.result {
+                        Some(h) => row.extend(
+                            [
+                                h.thrust_per_rotor_n,
+                                h.rotor_speed_rpm,
+                                h.motor_current_a,
+                                h.pack_current_a,
+                                h.power_required_w,
+                                h.power_drawn_w,
+                                h.battery_heat_w,
+                                h.flight_time_min,
+                            ]
+                            .map(|v| v.to_string()),
+                        ),
+                        None => row.extend(std::iter::repeat_n(String::new(), 8)),
+                    }
+                    row.push(p.error.clone().unwrap_or_default());
+                    w.write_record(&row)?;
+                }
+                w.flush()?;
+            }
+            Format::Table => {
+                writeln!(
+                    out,
+                    "{}: hover across take-off mass (propulsion seed Fig. 13)",
+                    file.name
+                )?;
+                writeln!(
+                    out,
+                    "{:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  rotor rpm",
+                    "mass kg", "power W", "drawn W", "pack A", "heat W", "time min"
+                )?;
+                for p in &points {
+                    match &p.result {
+                        Some(h) => writeln!(
+                            out,
+                            "{:>9.2} {:>9.0} {:>9.0} {:>9.2} {:>9.0} {:>9.2}  {:.0}",
+                            p.takeoff_mass_kg,
+                            h.power_required_w,
+                            h.power_drawn_w,
+                            h.pack_current_a,
+                            h.battery_heat_w,
+                            h.flight_time_min,
+                            h.rotor_speed_rpm
+                        )?,
+                        None => writeln!(
+                            out,
+                            "{:>9.2}  cannot hover: {}",
+                            p.takeoff_mass_kg,
+                            p.error.as_deref().unwrap_or_default()
+                        )?,
+                    }
+                }
+            }
+        }
+        return Ok(Outcome::Ok);
+    }
+
+    let h = match args.takeoff_mass_kg {
+        Some(m) => system
+            .hover_at_takeoff_mass(m)
+            .with_context(|| format!("--takeoff-mass-kg {m}"))?,
+        None => system
+            .hover_with_payload(args.payload_kg)
+            .with_context(|| format!("--payload-kg {}", args.payload_kg))?,
+    };
+    match args.format {
+        Format::Json => output::write_json(&mut out, &h)?,
+        Format::Csv => {
+            let mut w = csv::Writer::from_writer(out);
+            w.serialize(h)?;
+            w.flush()?;
+        }
+        Format::Table => {
+            let title = format!(
+                "{}: hover at {:.3} kg take-off mass ({} rotors, {} packs)",
+                file.name, h.takeoff_mass_kg, h.rotor_count, h.pack_count
+            );
+            let rows = vec![
+                Row::new(
+                    "thrust per rotor",
+                    format!("{:.2}", h.thrust_per_rotor_n),
+                    "N",
+                ),
+                Row::new("rotor speed", format!("{:.0}", h.rotor_speed_rpm), "rpm"),
+                Row::new("rotor torque", format!("{:.3}", h.torque_nm), "N m"),
+                Row::new("motor current", format!("{:.2}", h.motor_current_a), "A"),
+                Row::new("motor voltage", format!("{:.2}", h.motor_voltage_v), "V"),
+                Row::new("pack current", format!("{:.2}", h.pack_current_a), "A"),
+                Row::new(
+                    "pack terminal voltage",
+                    format!("{:.2}", h.pack_terminal_voltage_v),
+                    "V",
+                ),
+                Row::new(
+                    "power required (all motors)",
+                    format!("{:.0}", h.power_required_w),
+                    "W",
+                ),
+                Row::new(
+                    "power drawn from packs",
+                    format!("{:.0}", h.power_drawn_w),
+                    "W",
+                ),
+                Row::new("heat in packs", format!("{:.0}", h.battery_heat_w), "W"),
+                Row::new("flight time", format!("{:.2}", h.flight_time_min), "min"),
+            ];
+            output::write_table(&mut out, &title, &rows)?;
+            if h.motor_voltage_v > h.pack_terminal_voltage_v {
+                writeln!(
+                    out,
+                    "  note: the motor needs {:.2} V but the pack delivers {:.2} V at this current ({:.1} % over full throttle)",
+                    h.motor_voltage_v,
+                    h.pack_terminal_voltage_v,
+                    100.0 * (h.motor_voltage_v / h.pack_terminal_voltage_v - 1.0)
+                )?;
+            }
+        }
+    }
+    Ok(Outcome::Ok)
+}
+
+fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Result<()> {
+    use plotters::prelude::*;
+    let ok: Vec<(f64, &HoverResult)> = points
+        .iter()
+        .filter_map(|p| p.result.as_ref().map(|h| (p.takeoff_mass_kg, h)))
+        .collect();
+    if ok.is_empty() {
+        bail!("no mass in the sweep can hover: nothing to plot");
+    }
+    let (x0, x1) = (ok[0].0, ok[ok.len() - 1].0.max(ok[0].0 + 1e-6));
+    let t_max = ok
+        .iter()
+        .map(|(_, h)| h.flight_time_min)
+        .fold(0.0, f64::max)
+        * 1.1;
+    let p_max = ok
+        .iter()
+        .map(|(_, h)| h.power_required_w)
+        .fold(0.0, f64::max)
+        * 1.1;
+    let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("{name}: flight time and power against take-off mass"),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .right_y_label_area_size(60)
+        .build_cartesian_2d(x0..x1, 0.0..t_max)?
+        .set_secondary_coord(x0..x1, 0.0..p_max);
+    chart
+        .configure_mesh()
+        .x_desc("take-off mass (kg)")
+        .y_desc("flight time (min)")
+        .draw()?;
+    chart
+        .configure_secondary_axes()
+        .y_desc("power required (W)")
+        .draw()?;
+    chart
+        .draw_series(LineSeries::new(
+            ok.iter().map(|(m, h)| (*m, h.flight_time_min)),
+            &BLUE,
+        ))?
+        .label("flight time (min)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    chart
+        .draw_secondary_series(LineSeries::new(
+            ok.iter().map(|(m, h)| (*m, h.power_required_w)),
+            &RED,
+        ))?
+        .label("power required (W)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}

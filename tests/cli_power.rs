@@ -1,0 +1,380 @@
+//! End-to-end tests of `aloft power`, `aloft vehicles`, `aloft propulsion` and `aloft rotor`:
+//! output keys, agreement with the library, exit codes and error messages.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn aloft(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .expect("run aloft")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).unwrap()
+}
+
+#[test]
+fn power_json_has_the_contract_keys_and_matches_the_library() {
+    let o = aloft(&[
+        "power",
+        "--airspeed",
+        "6",
+        "--pitch",
+        "-8",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    for key in [
+        "thrust_n",
+        "induced_velocity_mps",
+        "hover_induced_velocity_mps",
+        "induced_w",
+        "parasitic_w",
+        "profile_w",
+        "climb_w",
+        "aero_w",
+        "electrical_w",
+    ] {
+        assert!(v[key].is_f64(), "missing {key}: {v}");
+    }
+    let model = aloft::power::PowerModel::new(
+        aloft::vehicle::VehicleFile::builtin("dji-m100")
+            .unwrap()
+            .power_vehicle()
+            .unwrap(),
+    );
+    let p = model
+        .evaluate(&aloft::power::FlightState::new(
+            6.0,
+            0.0,
+            (-8.0f64).to_radians(),
+            0.0,
+        ))
+        .unwrap();
+    // serde_json prints shortest round-trip floats: the CLI value is the library value exactly.
+    assert_eq!(
+        v["electrical_w"].as_f64().unwrap().to_bits(),
+        p.electrical_w.to_bits()
+    );
+}
+
+#[test]
+fn power_without_terms_removes_them() {
+    let o = aloft(&[
+        "power",
+        "--airspeed",
+        "6",
+        "--pitch",
+        "-8",
+        "--without",
+        "profile,parasitic",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["profile_w"].as_f64(), Some(0.0));
+    assert_eq!(v["parasitic_w"].as_f64(), Some(0.0));
+    let sum = v["induced_w"].as_f64().unwrap() + v["climb_w"].as_f64().unwrap();
+    assert!((v["aero_w"].as_f64().unwrap() - sum).abs() < 1e-9);
+}
+
+#[test]
+fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
+    let o = aloft(&[
+        "power",
+        "--airspeed",
+        "6",
+        "--pitch",
+        "-8",
+        "--aoa",
+        "geometric",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--air-direction-deg"), "{}", stderr(&o));
+    let paper = aloft(&[
+        "power",
+        "--airspeed",
+        "6",
+        "--pitch",
+        "-8",
+        "--format",
+        "json",
+    ]);
+    let geo = aloft(&[
+        "power",
+        "--airspeed",
+        "6",
+        "--pitch",
+        "-8",
+        "--air-direction-deg",
+        "0",
+        "--format",
+        "json",
+    ]);
+    let p: serde_json::Value = serde_json::from_str(&stdout(&paper)).unwrap();
+    let g: serde_json::Value = serde_json::from_str(&stdout(&geo)).unwrap();
+    // Nose-down forward flight: the exact geometry puts air through the disk (Vn > 0), which the
+    // paper's approximation sets to zero for a pure pitch, so the induced velocity is lower.
+    assert!(
+        g["induced_velocity_mps"].as_f64().unwrap()
+            < p["induced_velocity_mps"].as_f64().unwrap() - 0.1
+    );
+}
+
+#[test]
+fn bad_input_exits_2_naming_the_value() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["power", "--airspeed", "-1"], "-1"),
+        (&["power", "--airspeed", "NaN"], "NaN"),
+        (&["power", "--roll", "90"], "90"),
+        (&["power", "--pitch", "-120"], "tilt"),
+        (
+            &["power", "--vehicle", "no-such-vehicle"],
+            "no-such-vehicle",
+        ),
+        (&["power", "--without", "drag"], "drag"),
+        (&["power", "--vehicle", "aec-quadrotor"], "[power]"),
+        (&["propulsion", "--payload-kg", "-3"], "-3"),
+        (&["propulsion", "--payload-kg", "40"], "current"),
+        (&["propulsion", "--vehicle", "dji-m100"], "[propulsion]"),
+        (&["propulsion", "--sweep-takeoff-mass", "7:x:1"], "'x'"),
+        (&["rotor", "--rotor", "mn1806-6x2", "--motor-kv", "0"], "Kv"),
+        (
+            &["rotor", "--rotor", "mn1806-6x2", "--voltage", "-11.1"],
+            "-11.1",
+        ),
+        (&["rotor", "--motor-kv", "2300"], "--motor-resistance"),
+    ];
+    for (args, needle) in cases {
+        let o = aloft(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"), "{args:?}");
+    }
+}
+
+#[test]
+fn vehicle_files_load_and_bad_files_are_named() {
+    let dir = std::env::temp_dir().join(format!("aloft-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("heavy.toml");
+    let text = include_str!("../fixtures/vehicles/dji-m100.toml")
+        .replace("mass_kg = 3.29", "mass_kg = 4.0");
+    std::fs::write(&good, text).unwrap();
+    let o = aloft(&[
+        "power",
+        "--vehicle",
+        good.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!((v["thrust_n"].as_f64().unwrap() - 4.0 * 9.8066).abs() < 1e-9);
+
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[power]\nmass_lb = 3\n").unwrap();
+    let o = aloft(&["power", "--vehicle", bad.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("mass_lb") && stderr(&o).contains("bad.toml"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn batch_mode_streams_csv_and_reports_bad_rows() {
+    let dir = std::env::temp_dir().join(format!("aloft-batch-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("states.csv");
+    std::fs::write(
+        &input,
+        "airspeed_mps,roll_deg,pitch_deg,climb_rate_mps\n0,0,0,0\n6,0,-8,\n8,2,-10,1.5\n",
+    )
+    .unwrap();
+    let o = aloft(&["power", "--input", input.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4);
+    assert!(lines[0].starts_with("airspeed_mps,roll_deg,pitch_deg,climb_rate_mps,thrust_n,"));
+    // Each row equals the point query.
+    let point = aloft(&[
+        "power",
+        "--airspeed",
+        "8",
+        "--roll",
+        "2",
+        "--pitch",
+        "-10",
+        "--climb-rate",
+        "1.5",
+        "--format",
+        "csv",
+    ]);
+    let point_row = stdout(&point).lines().nth(1).unwrap().to_string();
+    let batch_vals: Vec<f64> = lines[3]
+        .split(',')
+        .skip(4)
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let point_vals: Vec<f64> = point_row
+        .split(',')
+        .skip(4)
+        .map(|s| s.parse().unwrap())
+        .collect();
+    assert_eq!(batch_vals, point_vals);
+
+    let missing = dir.join("missing.csv");
+    std::fs::write(&missing, "airspeed_mps,pitch_deg\n1,2\n").unwrap();
+    let o = aloft(&["power", "--input", missing.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("roll_deg"), "{}", stderr(&o));
+    let o = aloft(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("nope.csv"), "{}", stderr(&o));
+}
+
+#[test]
+fn broken_pipe_exits_quietly() {
+    let dir = std::env::temp_dir().join(format!("aloft-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("many.csv");
+    let mut f = std::fs::File::create(&input).unwrap();
+    writeln!(f, "airspeed_mps,roll_deg,pitch_deg").unwrap();
+    for i in 0..200_000 {
+        writeln!(f, "{},0,-5", (i % 15) as f64).unwrap();
+    }
+    drop(f);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(["power", "--input", input.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Read one line, then close the pipe (like `| head -1`).
+    let mut out = child.stdout.take().unwrap();
+    let mut buf = [0u8; 256];
+    let _ = std::io::Read::read(&mut out, &mut buf).unwrap();
+    drop(out);
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+#[test]
+fn vehicles_lists_the_builtins() {
+    let o = aloft(&["vehicles", "--format", "json"]);
+    assert!(o.status.success());
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let names: Vec<&str> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["dji-m100", "aec-quadrotor"]);
+}
+
+#[test]
+fn paper_val_propulsion_worked_example_from_the_cli() {
+    // Propulsion seed, Mission Planning / Fig. 13: 26.5 lb take-off (10 lb payload) needs nearly
+    // 3 kW, draws 42.5 A per pack, dissipates 505 W in the packs, flies a little over 9 min.
+    // Tolerances are the issue's (10 %, 10 %, 15 %, 9-10.5 min); heat and time are not independent
+    // of the pack resistance and capacity derived from the same sentence (see aec-quadrotor.toml).
+    let o = aloft(&[
+        "propulsion",
+        "--vehicle",
+        "aec-quadrotor",
+        "--payload-kg",
+        "4.536",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("missing {k}"));
+    for k in [
+        "takeoff_mass_kg",
+        "thrust_per_rotor_n",
+        "rotor_speed_rpm",
+        "motor_current_a",
+        "pack_current_a",
+        "power_required_w",
+        "power_drawn_w",
+        "battery_heat_w",
+        "flight_time_min",
+    ] {
+        get(k);
+    }
+    assert!((get("power_required_w") / 3000.0 - 1.0).abs() <= 0.10);
+    assert!((get("pack_current_a") / 42.5 - 1.0).abs() <= 0.10);
+    assert!((get("battery_heat_w") / 505.0 - 1.0).abs() <= 0.15);
+    assert!((9.0..=10.5).contains(&get("flight_time_min")));
+}
+
+#[test]
+fn rotor_mn1806_settles_within_the_issue_band() {
+    let o = aloft(&["rotor", "--rotor", "mn1806-6x2", "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    for k in [
+        "motor_inertia_kgm2",
+        "prop_inertia_kgm2",
+        "time_constant_s",
+        "rise_time_s",
+        "settling_time_s",
+        "steady_current_a",
+    ] {
+        assert!(v[k].as_f64().is_some(), "missing {k}");
+    }
+    let settle = v["settling_time_s"].as_f64().unwrap();
+    assert!((0.065..=0.150).contains(&settle), "{settle}");
+}
+
+#[test]
+fn propulsion_sweep_writes_csv_and_svg() {
+    let dir = std::env::temp_dir().join(format!("aloft-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("fig13.svg");
+    let o = aloft(&[
+        "propulsion",
+        "--sweep-takeoff-mass",
+        "7:13:0.5",
+        "--format",
+        "csv",
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert_eq!(text.lines().count(), 1 + 13);
+    let times: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(8).unwrap().parse().unwrap())
+        .collect();
+    // Fig. 13: flight time falls monotonically with take-off weight.
+    assert!(times.windows(2).all(|w| w[1] < w[0]), "{times:?}");
+    let svg_text = std::fs::read_to_string(&svg).unwrap();
+    assert!(svg_text.starts_with("<svg") && svg_text.contains("flight time"));
+}
