@@ -10,43 +10,24 @@ use aloft_propulsion::{
     mass_range_kg, rotor_step_response, EscProtocol, PropulsionError, PropulsionSpec,
     PropulsionSystem, RotorSpec,
 };
+use aloft::vehicle::VehicleFile;
 use proptest::prelude::*;
-use serde::Deserialize;
 
 const LB_KG: f64 = 0.453_592_37;
 
-/// The vehicle file layout: name, description, optional [power] (not ours), [propulsion].
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct VehicleFile {
-    #[allow(dead_code)]
-    name: String,
-    #[allow(dead_code)]
-    description: String,
-    #[serde(default)]
-    #[allow(dead_code)]
-    power: Option<toml::Value>,
-    propulsion: PropulsionSpec,
-}
-
-/// `fixtures/vehicles/aec-quadrotor.toml`, found from the manifest directory upwards.
-fn fixture_path() -> std::path::PathBuf {
-    let mut dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    loop {
-        let p = dir.join("fixtures/vehicles/aec-quadrotor.toml");
-        if p.exists() {
-            return p;
-        }
-        assert!(dir.pop(), "fixtures/vehicles/aec-quadrotor.toml not found");
-    }
+/// `fixtures/vehicles/aec-quadrotor.toml`, as compiled into the binary.
+fn aec_text() -> &'static str {
+    aloft::vehicle::BUILTIN_VEHICLES
+        .iter()
+        .find(|b| b.name == "aec-quadrotor")
+        .expect("aec-quadrotor is built in")
+        .toml
 }
 
 fn aec_spec() -> PropulsionSpec {
-    let text = std::fs::read_to_string(fixture_path()).expect("fixture aec-quadrotor.toml");
-    let file: VehicleFile = toml::from_str(&text).expect("aec-quadrotor.toml parses");
-    assert_eq!(file.name, "aec-quadrotor");
+    let file = VehicleFile::builtin("aec-quadrotor").expect("aec-quadrotor.toml parses");
     assert!(file.power.is_none(), "aec-quadrotor has no [power] table");
-    file.propulsion
+    file.propulsion.expect("aec-quadrotor has a [propulsion] table")
 }
 
 fn aec() -> PropulsionSystem {
@@ -282,7 +263,7 @@ fn paper_val_mn1806_settling_time() {
 // ---------------------------------------------------------------- bad input
 
 fn spec_with(table: &str, key: &str, value: &str) -> Result<PropulsionSystem, String> {
-    let text = std::fs::read_to_string(fixture_path()).unwrap();
+    let text = aec_text();
     let mut out = String::new();
     let mut current = String::new();
     for line in text.lines() {
@@ -297,8 +278,12 @@ fn spec_with(table: &str, key: &str, value: &str) -> Result<PropulsionSystem, St
             out.push('\n');
         }
     }
+    // Parse without the facade's validation, so the propulsion model's own error is what we see.
     let file: VehicleFile = toml::from_str(&out).map_err(|e| e.to_string())?;
-    file.propulsion.into_model().map_err(|e| e.to_string())
+    file.propulsion
+        .ok_or("no [propulsion] table")?
+        .into_model()
+        .map_err(|e| e.to_string())
 }
 
 #[test]

@@ -20,7 +20,9 @@ use serde::Serialize;
 use crate::angle_of_attack::Inflow;
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
-use crate::induced::{induced_power_w, induced_velocity_mps, solve_normalised};
+use crate::induced::{
+    induced_power_w, induced_velocity_mps, solve_normalised, solve_normalised_fast,
+};
 use crate::profile::profile_power_w;
 use crate::vehicle::Vehicle;
 
@@ -258,6 +260,14 @@ impl PowerModel {
     /// Evaluate a point query: thrust from eq (5), inflow from the selected angle-of-attack model.
     #[inline]
     pub fn evaluate(&self, state: &FlightState) -> Result<PowerBreakdown> {
+        let c = self.point_condition(state)?;
+        let vi = self.induced_velocity(&c)?;
+        Ok(self.assemble(&c, vi))
+    }
+
+    /// Validate a point query and resolve it: thrust from eq (5), inflow from the AoA model.
+    #[inline(always)]
+    fn point_condition(&self, state: &FlightState) -> Result<FlightCondition> {
         // libm's sincos (musl's kernels) is about twice as fast as std's here, within 1 ulp.
         let (sr, cr) = libm::sincos(state.roll_rad);
         let (sp, cp) = libm::sincos(state.pitch_rad);
@@ -271,6 +281,7 @@ impl PowerModel {
             finite("airspeed_mps", state.airspeed_mps)?;
             non_negative("airspeed_mps", state.airspeed_mps)?;
         }
+        finite("climb_rate_mps", state.climb_rate_mps)?;
         let v = state.airspeed_mps;
         let inflow = match state.aoa {
             AoaInput::Paper => Inflow {
@@ -288,7 +299,7 @@ impl PowerModel {
                 }
             }
         };
-        self.evaluate_condition(&FlightCondition {
+        Ok(FlightCondition {
             thrust_n: self.vehicle.weight_n() / tilt_cos,
             airspeed_mps: v,
             inflow,
@@ -298,7 +309,9 @@ impl PowerModel {
 
     /// Evaluate many point queries into `out` (same length), stopping at the first invalid state.
     ///
-    /// Returns the first state's error; `Ok(())` means every element of `out` was written.
+    /// Returns the first invalid state's error; `Ok(())` means every element of `out` was written.
+    /// Results are identical to [`Self::evaluate`]; the work is arranged in passes over chunks so
+    /// the CPU overlaps independent states (the throughput path).
     pub fn evaluate_batch(&self, states: &[FlightState], out: &mut [PowerBreakdown]) -> Result<()> {
         if states.len() != out.len() {
             return Err(PowerError::SeriesLength {
@@ -306,8 +319,39 @@ impl PowerModel {
                 measured_len: states.len(),
             });
         }
-        for (s, o) in states.iter().zip(out.iter_mut()) {
-            *o = self.evaluate(s)?;
+        const CHUNK: usize = 64;
+        let inv_vh = self.vehicle.inverse_hover_induced_velocity();
+        let mut conditions = [FlightCondition {
+            thrust_n: 0.0,
+            airspeed_mps: 0.0,
+            inflow: Inflow {
+                normal_mps: 0.0,
+                parallel_mps: 0.0,
+            },
+            climb_rate_mps: 0.0,
+        }; CHUNK];
+        let mut roots = [0.0f64; CHUNK];
+        for (sc, oc) in states.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            // Pass 1: validation, trigonometry, thrust and inflow.
+            for (s, c) in sc.iter().zip(conditions.iter_mut()) {
+                *c = self.point_condition(s)?;
+            }
+            // Pass 2: the quartic, branch-free where the root is unique.
+            for (c, x) in conditions.iter().zip(roots.iter_mut()).take(sc.len()) {
+                *x = solve_normalised_fast(
+                    c.inflow.normal_mps * inv_vh,
+                    c.inflow.parallel_mps * inv_vh,
+                );
+            }
+            // Pass 3: the terms; the rare states the fast path left out take the safeguarded solver.
+            for ((c, &x), o) in conditions.iter().zip(roots.iter()).zip(oc.iter_mut()) {
+                let vi = if x.is_nan() {
+                    self.induced_velocity(c)?
+                } else {
+                    x * self.vehicle.hover_induced_velocity_mps()
+                };
+                *o = self.assemble(c, vi);
+            }
         }
         Ok(())
     }
@@ -324,21 +368,32 @@ impl PowerModel {
             non_negative("airspeed_mps", c.airspeed_mps)?;
         }
         finite("climb_rate_mps", c.climb_rate_mps)?;
+        let vi = self.induced_velocity(c)?;
+        Ok(self.assemble(c, vi))
+    }
+
+    /// Induced velocity of eq (9) for a resolved condition.
+    #[inline(always)]
+    fn induced_velocity(&self, c: &FlightCondition) -> Result<f64> {
         let v = &self.vehicle;
         let vh = v.hover_induced_velocity_mps();
-        let opts = &self.options;
-        let vi = if c.inflow.normal_mps.is_finite() && c.inflow.parallel_mps >= 0.0 {
+        if c.inflow.normal_mps.is_finite() && c.inflow.parallel_mps >= 0.0 {
             let a = c.inflow.normal_mps * v.inverse_hover_induced_velocity();
             let b = c.inflow.parallel_mps * v.inverse_hover_induced_velocity();
-            match solve_normalised(a, b) {
-                Some(x) => x * vh,
-                // Builds the typed error with the values.
-                None => induced_velocity_mps(c.inflow.normal_mps, c.inflow.parallel_mps, vh)?,
+            if let Some(x) = solve_normalised(a, b) {
+                return Ok(x * vh);
             }
-        } else {
-            // Non-finite or negative inflow: the checked solver names the value.
-            induced_velocity_mps(c.inflow.normal_mps, c.inflow.parallel_mps, vh)?
-        };
+        }
+        // Non-finite or negative inflow, or no root continuous with hover: the checked solver
+        // builds the typed error with the values.
+        induced_velocity_mps(c.inflow.normal_mps, c.inflow.parallel_mps, vh)
+    }
+
+    /// The four terms and totals, eqs (7), (8), (11)-(14), for a resolved condition and `v_i`.
+    #[inline(always)]
+    fn assemble(&self, c: &FlightCondition, vi: f64) -> PowerBreakdown {
+        let v = &self.vehicle;
+        let opts = &self.options;
         let induced_w = if opts.terms.induced {
             induced_power_w(c.thrust_n, vi, c.inflow.normal_mps)
         } else {
@@ -364,17 +419,17 @@ impl PowerModel {
             0.0
         };
         let aero_w = induced_w + parasitic_w + profile_w + climb_w;
-        Ok(PowerBreakdown {
+        PowerBreakdown {
             thrust_n: c.thrust_n,
             induced_velocity_mps: vi,
-            hover_induced_velocity_mps: vh,
+            hover_induced_velocity_mps: v.hover_induced_velocity_mps(),
             induced_w,
             parasitic_w,
             profile_w,
             climb_w,
             aero_w,
             electrical_w: aero_w.max(0.0) * v.inverse_efficiency(),
-        })
+        }
     }
 }
 
@@ -411,24 +466,10 @@ pub(crate) fn check_state(state: &FlightState) -> Result<f64> {
 #[allow(clippy::float_cmp)]
 mod tests {
     use super::*;
-    use crate::vehicle::{DiskArea, VehicleParams};
+    use crate::vehicle::tests::m100_params;
 
     fn m100() -> Vehicle {
-        Vehicle::new(VehicleParams {
-            mass_kg: 3.29,
-            gravity_mps2: 9.8066,
-            air_density_kg_m3: 1.225,
-            rotor_count: 4,
-            rotor_radius_m: 0.172,
-            disk_area: DiskArea::OneRotor,
-            mu1_n_s_per_m: 0.1816,
-            mu2_n_s2_per_m2: -0.02326,
-            mu3_n_s3_per_m3: 0.004045,
-            kappa1_w_per_n1_5: 0.275,
-            kappa2_w_s2_per_m2_n0_5: 0.0,
-            efficiency: 0.8,
-        })
-        .unwrap()
+        Vehicle::new(m100_params()).unwrap()
     }
 
     #[test]
@@ -516,6 +557,51 @@ mod tests {
             let e = m.evaluate(&s).unwrap_err().to_string();
             assert!(e.contains(name), "{e} should name {name}");
         }
+    }
+
+    #[test]
+    fn batch_equals_single_evaluations_bit_for_bit() {
+        let m = PowerModel::new(m100());
+        let states: Vec<FlightState> = (0..1000)
+            .map(|i| {
+                let f = f64::from(i) / 1000.0;
+                let mut s = FlightState::new(
+                    30.0 * f,
+                    (f * 97.0).sin() * 0.7,
+                    (f * 53.0).cos() * 0.7,
+                    4.0 * f - 2.0,
+                );
+                if i % 3 == 0 {
+                    s.aoa = AoaInput::Geometric {
+                        air_direction_rad: f * 6.0,
+                    };
+                }
+                s
+            })
+            .collect();
+        let mut out = vec![m.evaluate(&states[0]).unwrap(); states.len()];
+        m.evaluate_batch(&states, &mut out).unwrap();
+        for (s, o) in states.iter().zip(&out) {
+            let single = m.evaluate(s).unwrap();
+            // The fast path may stop at a different (equally converged) iterate than the
+            // safeguarded loop: both satisfy eq (9) to 5e-13, so compare to 1e-11 relative.
+            assert!(
+                (single.electrical_w - o.electrical_w).abs() <= 1e-11 * single.electrical_w,
+                "{s:?}"
+            );
+            assert!(
+                (single.induced_velocity_mps - o.induced_velocity_mps).abs()
+                    <= 1e-11 * single.induced_velocity_mps
+            );
+        }
+        // A bad state stops the batch with its error.
+        let mut bad = states.clone();
+        bad[700].roll_rad = f64::NAN;
+        assert!(m.evaluate_batch(&bad, &mut out).is_err());
+        assert!(
+            m.evaluate_batch(&states[..3], &mut out).is_err(),
+            "length mismatch"
+        );
     }
 
     #[test]

@@ -103,24 +103,15 @@ impl PowerModel {
 mod tests {
     use super::*;
     use crate::four_term::{ModelOptions, Terms};
-    use crate::vehicle::{DiskArea, Vehicle, VehicleParams};
+    use crate::vehicle::tests::m100_params;
+    use crate::vehicle::{Vehicle, VehicleParams};
     use proptest::prelude::*;
 
     fn model(kappa2: f64) -> PowerModel {
         PowerModel::with_options(
             Vehicle::new(VehicleParams {
-                mass_kg: 3.29,
-                gravity_mps2: 9.8066,
-                air_density_kg_m3: 1.225,
-                rotor_count: 4,
-                rotor_radius_m: 0.172,
-                disk_area: DiskArea::OneRotor,
-                mu1_n_s_per_m: 0.1816,
-                mu2_n_s2_per_m2: -0.02326,
-                mu3_n_s3_per_m3: 0.004045,
-                kappa1_w_per_n1_5: 0.275,
                 kappa2_w_s2_per_m2_n0_5: kappa2,
-                efficiency: 0.8,
+                ..m100_params()
             })
             .unwrap(),
             ModelOptions {

@@ -144,6 +144,25 @@ pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
     Some(x)
 }
 
+/// Branch-free fast path of [`solve_normalised`] for batches: the root where it is unique and two
+/// Halley steps from the `a = 0` root reach the residual bound, otherwise NaN (the caller then runs
+/// the safeguarded solver). Without data-dependent branches, consecutive calls overlap in the CPU.
+#[inline(always)]
+pub(crate) fn solve_normalised_fast(a: f64, b: f64) -> f64 {
+    let b2 = b * b;
+    let c = a * a + b2;
+    let guess = (2.0 / (c + (c * c + 4.0).sqrt())).sqrt();
+    let x = halley_step(halley_step(guess, a, b2), a, b2);
+    let s = x + a;
+    let unique = (a >= 0.0) | (8.0 * b2 >= a * a);
+    let converged = (x > 0.0) & ((x * x * (s * s + b2) - 1.0).abs() <= 1e-12);
+    if unique & converged {
+        x
+    } else {
+        f64::NAN
+    }
+}
+
 /// One Halley step for `g(x) = x^2 ((x+a)^2 + b^2) = 1`.
 #[inline(always)]
 fn halley_step(x: f64, a: f64, b2: f64) -> f64 {

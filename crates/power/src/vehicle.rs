@@ -205,9 +205,10 @@ impl Vehicle {
 // Exact comparisons here check values that are exact by construction (zeros of removed terms and
 // of zero airspeed, bit-identical results of the same arithmetic).
 #[allow(clippy::float_cmp)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
+    /// The power seed's M100 (eta 0.8 for round numbers): the parameters every test module uses.
     pub(crate) fn m100_params() -> VehicleParams {
         VehicleParams {
             mass_kg: 3.29,
