@@ -1,7 +1,8 @@
 //! Benches of the four-term power model.
 //!
 //! Targets (issue 2): `power/four_term/single` at most 25 ns per evaluation;
-//! `power/four_term/batch` at least 20 million states per second on one core.
+//! `power/four_term/batch` at least 20 million states per second on one core;
+//! `fit/power_model`: a fit over 100,000 samples in under 1 s (issue 5).
 
 use std::hint::black_box;
 
@@ -87,5 +88,42 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+/// 100,000 synthetic samples of the M100 (forward flight 0-14 m/s at the pitch that balances
+/// drag, rolls, some climbs), fitted from a wrong template with the known-geometry options.
+fn bench_fit(c: &mut Criterion) {
+    use aloft::power::{fit_power_model, FitOptions, FitSample, Vehicle, VehicleParams};
+    let truth = model();
+    let samples: Vec<FitSample> = (0..100_000)
+        .map(|i| {
+            let f = f64::from(i % 1000) / 1000.0;
+            let s = (f64::from(i) * 0.618_033_988_75).fract() - 0.5;
+            let v = 14.0 * f;
+            let w = truth.vehicle().weight_n();
+            let pitch = -(truth.vehicle().drag().force_n(v) / w).atan() + 0.05 * s;
+            let state = FlightState::new(v, 0.3 * s, pitch, if i % 7 == 0 { 2.0 * s } else { 0.0 });
+            let p = truth.evaluate(&state).expect("valid").electrical_w;
+            FitSample {
+                state,
+                measured_power_w: p * (1.0 + 0.01 * s),
+            }
+        })
+        .collect();
+    let start = Vehicle::new(VehicleParams {
+        efficiency: 0.7,
+        mu1_n_s_per_m: 0.3,
+        ..truth.vehicle().params().clone()
+    })
+    .expect("valid template");
+    let mut group = c.benchmark_group("fit");
+    group.sample_size(10);
+    group.bench_function("power_model", |b| {
+        b.iter(|| {
+            fit_power_model(&start, black_box(&samples), &FitOptions::known_geometry())
+                .expect("fit")
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench, bench_fit);
 criterion_main!(benches);

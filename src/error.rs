@@ -78,6 +78,49 @@ pub enum Error {
         /// The I/O error.
         source: std::io::Error,
     },
+    /// A flight log could not be read or decoded.
+    #[error("{origin}: {source}")]
+    Log {
+        /// File.
+        origin: String,
+        /// The log reader's error.
+        source: Box<aloft_logs::LogError>,
+    },
+    /// A log without electrical power (no voltage and current, no power column).
+    #[error(
+        "{origin}: no electrical power in this log (no voltage and current, no power channel)"
+    )]
+    NoPower {
+        /// File.
+        origin: String,
+    },
+    /// A log without velocity and attitude.
+    #[error("{origin}: no samples with both velocity and attitude")]
+    NoMotion {
+        /// File.
+        origin: String,
+    },
+    /// Time runs backwards in a log that must be aligned.
+    #[error("{origin}: time is not monotonic; alignment needs an ordered time base (see `aloft log info`)")]
+    NotMonotonic {
+        /// File.
+        origin: String,
+    },
+    /// The calibration window leaves too little of the flight (or is too short).
+    #[error(
+        "{origin}: a calibration window of {window_s} s does not fit a flight of {duration_s:.1} s"
+    )]
+    CalibrationWindow {
+        /// File.
+        origin: String,
+        /// Requested window, s.
+        window_s: f64,
+        /// Flight duration, s.
+        duration_s: f64,
+    },
+    /// The power-model fit failed or was refused.
+    #[error(transparent)]
+    Fit(#[from] aloft_power::FitError),
     /// The vehicle has no table for the model that was asked for.
     #[error("vehicle '{vehicle}' has no [{table}] table, which {needed_for} needs")]
     MissingTable {

@@ -8,6 +8,7 @@
 //! - [`propulsion`]: the propulsion chain (`aloft-propulsion`).
 //! - [`vehicle`]: vehicle files (TOML) and the built-in vehicles.
 //! - [`batch`]: streaming CSV evaluation of the power model.
+//! - [`identify`]: flight logs to the power model: lag alignment, fit samples, validation.
 //!
 //! ```
 //! let file = aloft::vehicle::VehicleFile::builtin("dji-m100")?;
@@ -22,6 +23,7 @@
 
 pub mod batch;
 pub mod error;
+pub mod identify;
 pub mod vehicle;
 
 pub use aloft_power as power;

@@ -13,6 +13,15 @@
 //! [propulsion]   # propulsion chain: aloft_propulsion::PropulsionSpec
 //! empty_mass_kg = 7.484
 //! # ... with [propulsion.propeller], [propulsion.motor], [propulsion.esc], [propulsion.battery]
+//!
+//! [airframe]     # mass without battery, limits: aloft_planner::AirframeSpec
+//! mass_kg = 1.755
+//! # ...
+//!
+//! [[battery]]    # packs for missions, one table each: aloft_planner::BatterySpec
+//! name = "TB47D"
+//! default = true
+//! # ...
 //! ```
 //!
 //! Tables are optional, so a vehicle can describe only the models it has data for; asking for a
@@ -62,6 +71,12 @@ pub struct VehicleFile {
     /// Propulsion chain: propeller, motor, ESC, battery packs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub propulsion: Option<aloft_propulsion::PropulsionSpec>,
+    /// Airframe mass without battery and the flight envelope (missions and endurance queries).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub airframe: Option<aloft_planner::AirframeSpec>,
+    /// Battery packs for missions (`[[battery]]` tables).
+    #[serde(default, rename = "battery", skip_serializing_if = "Vec::is_empty")]
+    pub batteries: Vec<aloft_planner::BatterySpec>,
 }
 
 impl VehicleFile {
@@ -78,7 +93,123 @@ impl VehicleFile {
         if let Some(p) = &file.propulsion {
             p.clone().into_model()?;
         }
+        let planner_error = |e: aloft_planner::PlannerError| Error::VehicleFormat {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        };
+        if let Some(a) = &file.airframe {
+            aloft_planner::Airframe::new(a.clone()).map_err(planner_error)?;
+        }
+        for (k, b) in file.batteries.iter().enumerate() {
+            b.to_battery().map_err(planner_error)?;
+            if file.batteries[..k].iter().any(|o| o.name == b.name) {
+                return Err(Error::VehicleFormat {
+                    origin: origin.to_string(),
+                    message: format!("battery name '{}' appears twice", b.name),
+                });
+            }
+        }
+        if file.batteries.iter().filter(|b| b.default).count() > 1 {
+            return Err(Error::VehicleFormat {
+                origin: origin.to_string(),
+                message: "more than one [[battery]] has default = true".to_string(),
+            });
+        }
         Ok(file)
+    }
+
+    /// The validated `[airframe]` table.
+    pub fn airframe(&self) -> Result<aloft_planner::Airframe, Error> {
+        let spec = self.airframe.clone().ok_or_else(|| Error::MissingTable {
+            vehicle: self.name.clone(),
+            table: "airframe",
+            needed_for: "the mission planner (airframe mass and limits)",
+        })?;
+        aloft_planner::Airframe::new(spec).map_err(|e| Error::VehicleFormat {
+            origin: self.name.clone(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Names of the packs, the default first.
+    pub fn battery_names(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = self.batteries.iter().map(|b| b.name.as_str()).collect();
+        if let Some(d) = self.batteries.iter().position(|b| b.default) {
+            names.swap(0, d);
+        }
+        names
+    }
+
+    /// A pack by name (case-insensitive), or the default pack (the one marked `default`, else the
+    /// first).
+    pub fn battery(&self, name: Option<&str>) -> Result<aloft_planner::Battery, Error> {
+        if self.batteries.is_empty() {
+            return Err(Error::MissingTable {
+                vehicle: self.name.clone(),
+                table: "[battery]",
+                needed_for: "the mission planner (the pack)",
+            });
+        }
+        let spec = match name {
+            Some(n) => self
+                .batteries
+                .iter()
+                .find(|b| b.name.eq_ignore_ascii_case(n))
+                .ok_or_else(|| Error::VehicleFormat {
+                    origin: self.name.clone(),
+                    message: format!(
+                        "no battery '{n}' on this vehicle: its packs are {}",
+                        self.battery_names().join(", ")
+                    ),
+                })?,
+            None => self
+                .batteries
+                .iter()
+                .find(|b| b.default)
+                .unwrap_or(&self.batteries[0]),
+        };
+        spec.to_battery().map_err(|e| Error::VehicleFormat {
+            origin: self.name.clone(),
+            message: e.to_string(),
+        })
+    }
+
+    /// The aircraft the planner flies: the four-term model of `[power]` when present (its drag
+    /// and rotor radius), else the propulsion chain of `[propulsion]` with no drag (the chain
+    /// carries no drag law; a note says so). Returns the aircraft and notes for the reader.
+    pub fn aircraft(
+        &self,
+        options: aloft_power::ModelOptions,
+    ) -> Result<(aloft_planner::Aircraft, Vec<String>), Error> {
+        let airframe = self.airframe()?;
+        if self.power.is_some() {
+            let vehicle = self.power_vehicle()?;
+            return Ok((
+                aloft_planner::Aircraft::four_term(airframe, vehicle, options),
+                vec![],
+            ));
+        }
+        if self.propulsion.is_some() {
+            let system = self.propulsion_system()?;
+            let radius = system.propeller.diameter_m() / 2.0;
+            let drag = aloft_power::CubicDrag::new(0.0, 0.0, 0.0)?;
+            let aircraft = aloft_planner::Aircraft::propulsion_chain(
+                airframe, system, drag, radius,
+            )
+            .map_err(|e| Error::VehicleFormat {
+                origin: self.name.clone(),
+                message: e.to_string(),
+            })?;
+            return Ok((
+                aircraft,
+                vec!["propulsion chain without a drag law: drag is taken as zero".to_string()],
+            ));
+        }
+        Err(Error::MissingTable {
+            vehicle: self.name.clone(),
+            table: "power",
+            needed_for: "the mission planner (or a [propulsion] table)",
+        })
     }
 
     /// A built-in vehicle by name.
@@ -143,6 +274,35 @@ mod tests {
     }
 
     #[test]
+    fn m100_has_its_packs_and_airframe() {
+        let f = VehicleFile::builtin("dji-m100").unwrap();
+        assert_eq!(f.battery_names(), ["TB47D", "TB48D"]);
+        let b = f.battery(None).unwrap();
+        assert_eq!(b.name(), "TB47D");
+        // DJI: 2355 g with the TB47D
+        let a = f.airframe().unwrap();
+        assert!((a.mass_kg() + b.mass_kg() - 2.355).abs() < 1e-12);
+        assert!(f.battery(Some("tb48d")).is_ok());
+        let e = f.battery(Some("TB55")).unwrap_err().to_string();
+        assert!(e.contains("TB55") && e.contains("TB47D"), "{e}");
+    }
+
+    #[test]
+    fn invalid_airframe_and_battery_values_are_rejected_on_load() {
+        let text = include_str!("../fixtures/vehicles/dji-m100.toml");
+        let bad = text.replace("max_tilt_deg = 35.0", "max_tilt_deg = 95.0");
+        let e = VehicleFile::from_toml_str(&bad, "test")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("max_tilt_deg") && e.contains("95"), "{e}");
+        let bad = text.replace("energy_wh = 99.9", "energy_wh = 150.0");
+        let e = VehicleFile::from_toml_str(&bad, "test")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("energy_wh") && e.contains("150"), "{e}");
+    }
+
+    #[test]
     fn a_missing_power_table_is_named() {
         let f = VehicleFile::from_toml_str("name = \"bare\"\n", "test").unwrap();
         let e = f.power_vehicle().unwrap_err().to_string();
@@ -159,6 +319,8 @@ mod tests {
             description: String::new(),
             power: Some(p),
             propulsion: None,
+            airframe: None,
+            batteries: vec![],
         })
         .unwrap();
         let e = VehicleFile::from_toml_str(&bad, "test")

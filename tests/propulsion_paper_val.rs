@@ -2,6 +2,7 @@
 //! (`../shared/seeds/propulsion-system-design.txt`, `rotor-transient-response.txt`), plus the
 //! typed errors for bad input.
 
+use aloft::vehicle::VehicleFile;
 use aloft_propulsion::battery::{Battery, InternalResistance};
 use aloft_propulsion::motor::{kt_oz_in_per_a, KV_KT_HOBBY};
 use aloft_propulsion::propeller::{self, Propeller};
@@ -10,7 +11,6 @@ use aloft_propulsion::{
     mass_range_kg, rotor_step_response, EscProtocol, PropulsionError, PropulsionSpec,
     PropulsionSystem, RotorSpec,
 };
-use aloft::vehicle::VehicleFile;
 use proptest::prelude::*;
 
 const LB_KG: f64 = 0.453_592_37;
@@ -27,7 +27,8 @@ fn aec_text() -> &'static str {
 fn aec_spec() -> PropulsionSpec {
     let file = VehicleFile::builtin("aec-quadrotor").expect("aec-quadrotor.toml parses");
     assert!(file.power.is_none(), "aec-quadrotor has no [power] table");
-    file.propulsion.expect("aec-quadrotor has a [propulsion] table")
+    file.propulsion
+        .expect("aec-quadrotor has a [propulsion] table")
 }
 
 fn aec() -> PropulsionSystem {

@@ -1,5 +1,9 @@
 //! Argument parsing and dispatch. Each subcommand lives in its own module.
 
+mod convert;
+mod endurance;
+mod log;
+mod mission;
 mod output;
 mod power;
 mod propulsion;
@@ -34,6 +38,14 @@ enum Command {
     Rotor(rotor::RotorArgs),
     /// List the built-in vehicles.
     Vehicles(vehicles::VehiclesArgs),
+    /// Summarise a flight log: duration, rates, channels, energy used, time-base gaps.
+    Log(log::LogArgs),
+    /// Convert a flight log (CSV or MCAP) to MCAP that Foxglove displays.
+    Convert(convert::ConvertArgs),
+    /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
+    Mission(mission::MissionArgs),
+    /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
+    Endurance(endurance::EnduranceArgs),
 }
 
 /// Output format of a result.
@@ -64,6 +76,10 @@ pub fn main() -> ExitCode {
         Command::Propulsion(args) => propulsion::run(args),
         Command::Rotor(args) => rotor::run(args),
         Command::Vehicles(args) => vehicles::run(args),
+        Command::Log(args) => log::run(args),
+        Command::Convert(args) => convert::run(args),
+        Command::Mission(args) => mission::run(args),
+        Command::Endurance(args) => endurance::run(args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,

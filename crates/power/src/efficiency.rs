@@ -1,10 +1,19 @@
-//! Overall efficiency from hover data, as the power seed defines it (section IV-E).
+//! Overall efficiency from measured power.
 //!
+//! [`efficiency_from_hover`] is the power seed's definition (section IV-E):
 //! `eta = P_ideal / P_measured` with `P_ideal = m g vh` the theoretical hover power from eq (10) and
 //! `P_measured` the mean electrical power measured in hover. With the paper's one-disk eq (10) this
 //! `eta` also absorbs the disk-area convention (see [`crate::DiskArea`]).
+//!
+//! # Deviation
+//! That definition leaves out the profile power that eq (14) then divides by the same `eta`, so a
+//! model calibrated with it overestimates the very hover it was calibrated on by `P_pro / P_ind`
+//! (13 % for the M100). [`calibrate_efficiency`] instead returns the `eta` with which the full
+//! model reproduces a measured power at a given flight state; aloft's built-in vehicles and its
+//! in-flight re-estimate use it.
 
 use crate::error::{positive, PowerError, Result};
+use crate::four_term::{FlightState, PowerModel};
 use crate::vehicle::Vehicle;
 
 /// The paper's efficiency: ideal hover power of `vehicle` over the measured hover power.
@@ -19,6 +28,30 @@ pub fn efficiency_from_hover(vehicle: &Vehicle, measured_hover_power_w: f64) -> 
             name: "measured_hover_power_w",
             value: measured_hover_power_w,
             min: vehicle.ideal_hover_power_w(),
+            max: f64::INFINITY,
+        });
+    }
+    Ok(eta)
+}
+
+/// The efficiency with which `model` (its terms and options, any `eta`) reproduces
+/// `measured_power_w` at `state`: `eta = P_req(state) / P_measured`, eqs (7) and (14).
+///
+/// Errors when the state is invalid, the measured power is not positive, the model's
+/// aerodynamic power there is not positive, or the result exceeds 1.
+pub fn calibrate_efficiency(
+    model: &PowerModel,
+    state: &FlightState,
+    measured_power_w: f64,
+) -> Result<f64> {
+    positive("measured_power_w", measured_power_w)?;
+    let aero = positive("aero_w", model.evaluate(state)?.aero_w)?;
+    let eta = aero / measured_power_w;
+    if eta > 1.0 {
+        return Err(PowerError::OutOfRange {
+            name: "measured_power_w",
+            value: measured_power_w,
+            min: aero,
             max: f64::INFINITY,
         });
     }
@@ -69,6 +102,28 @@ mod tests {
         assert!(efficiency_from_hover(&v, -1.0).is_err());
         assert!(efficiency_from_hover(&v, f64::NAN).is_err());
         assert!(mean_power_w(99.9, 0.0).is_err());
+    }
+
+    #[test]
+    fn calibrated_model_reproduces_the_measured_power() {
+        let v = Vehicle::new(VehicleParams {
+            kappa1_w_per_n1_5: 0.275,
+            ..vehicle(3.0).params().clone()
+        })
+        .unwrap();
+        let hover = FlightState::new(0.0, 0.0, 0.0, 0.0);
+        let eta = calibrate_efficiency(&PowerModel::new(v.clone()), &hover, 600.0).unwrap();
+        let model = PowerModel::new(v.with_efficiency(eta).unwrap());
+        let p = model.evaluate(&hover).unwrap().electrical_w;
+        assert!((p - 600.0).abs() < 1e-9, "{p}");
+        // The paper's definition is lower by the profile share.
+        let paper = efficiency_from_hover(&v, 600.0).unwrap();
+        let profile_share = 0.275 * v.weight_n().powf(1.5) / v.ideal_hover_power_w();
+        assert!((eta / paper - 1.0 - profile_share).abs() < 1e-12);
+        assert!(
+            calibrate_efficiency(&model, &hover, 100.0).is_err(),
+            "eta > 1"
+        );
     }
 
     #[test]

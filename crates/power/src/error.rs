@@ -105,6 +105,77 @@ pub enum PowerError {
     },
 }
 
+/// Errors of the parameter fit ([`crate::fit`]).
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum FitError {
+    /// Fewer usable samples than the fit needs.
+    #[error(
+        "{samples} usable samples: the fit of {parameters} parameters needs at least {required}"
+    )]
+    TooFewSamples {
+        /// Usable samples.
+        samples: usize,
+        /// Free parameters.
+        parameters: usize,
+        /// Samples required.
+        required: usize,
+    },
+    /// A sample whose state or measured power is invalid.
+    #[error("sample {index}: {message}")]
+    BadSample {
+        /// 0-based index of the sample.
+        index: usize,
+        /// What is wrong, with the value.
+        message: String,
+    },
+    /// The data has too little forward flight to identify a speed-dependent parameter.
+    #[error(
+        "{parameter} cannot be identified: only {above} of {total} samples fly faster than {airspeed_mps} m/s (need forward flight; fix it in the template and fit without it)"
+    )]
+    NoForwardFlight {
+        /// The parameter.
+        parameter: &'static str,
+        /// Samples above the airspeed.
+        above: usize,
+        /// All samples.
+        total: usize,
+        /// The airspeed threshold, m/s.
+        airspeed_mps: f64,
+    },
+    /// The data leaves a parameter undetermined: its standard error is too large or the
+    /// information matrix is singular along it.
+    #[error(
+        "{parameter} cannot be identified from this data: fitted {value:.6e} {unit} with standard error {std_error:.3e} (fix it in the template and fit without it)"
+    )]
+    NotIdentifiable {
+        /// The parameter.
+        parameter: &'static str,
+        /// Its fitted value.
+        value: f64,
+        /// Its standard error (infinite when the information matrix is singular).
+        std_error: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
+    /// The fitted lumped constants give an efficiency above 1 with the template's mass.
+    #[error(
+        "the fit gives an efficiency of {efficiency:.3} (> 1) with the template's mass of {mass_kg} kg: the mass is too low for the measured power"
+    )]
+    EfficiencyAboveOne {
+        /// The implied efficiency.
+        efficiency: f64,
+        /// The template's mass, kg.
+        mass_kg: f64,
+    },
+    /// The optimiser failed.
+    #[error("the least-squares solver failed: {message}")]
+    Solver {
+        /// The solver's message.
+        message: String,
+    },
+}
+
 /// Result type of this crate.
 pub type Result<T, E = PowerError> = std::result::Result<T, E>;
 

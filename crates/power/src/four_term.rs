@@ -10,14 +10,26 @@
 //! term above a chosen airspeed: the hybrid the paper's conclusion suggests, since `P_pro` degraded
 //! its estimate at 8 m/s.
 //!
-//! # Deviation
+//! # Deviation: the geometric angle of attack and eq (8)
+//! Eq (8), `P_ind = T (v_i + v_inf sin a)`, is momentum theory's total rotor power: its
+//! `T v_inf sin a` part is the work thrust does along the freestream, which in steady flight IS
+//! the work against drag (and, with axial flow, against gravity). The paper can add `P_par` (11)
+//! on top because its approximation `sin a = sin(phi) sin(theta)` makes that part nearly vanish
+//! (exactly zero for a single-axis tilt). With the exact geometry the part is
+//! `T Vn = f_D v_inf` in steady level flight, and adding eq (11) would count the drag work twice
+//! (35 W aerodynamic at 10 m/s for the M100). So with [`AoaModel::Geometric`] aloft takes
+//! `P_ind = T v_i` and lets eqs (11) and (13) carry the drag and climb work; with
+//! [`AoaModel::Paper`] eq (8) is used as printed. `Vn` still enters the induced velocity (eq 9)
+//! in both.
+//!
+//! # Deviation: no regeneration
 //! Eq (14) can go negative in a steep descent where the climb term outweighs the others; a
 //! multirotor's ESCs do not regenerate, so `electrical_w` is floored at 0 (the aerodynamic total
 //! `aero_w` keeps its sign).
 
 use serde::Serialize;
 
-use crate::angle_of_attack::Inflow;
+use crate::angle_of_attack::{AoaModel, Inflow};
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
 use crate::induced::{
@@ -186,6 +198,9 @@ pub struct FlightCondition {
     pub inflow: Inflow,
     /// Vertical speed, positive up, m/s.
     pub climb_rate_mps: f64,
+    /// How the inflow was found: with [`AoaModel::Geometric`] eq (8)'s `T Vn` work term is left
+    /// to eqs (11) and (13) (see the module docs).
+    pub aoa: AoaModel,
 }
 
 /// Every term of the model at one flight condition. Field names are the JSON contract.
@@ -283,20 +298,26 @@ impl PowerModel {
         }
         finite("climb_rate_mps", state.climb_rate_mps)?;
         let v = state.airspeed_mps;
-        let inflow = match state.aoa {
-            AoaInput::Paper => Inflow {
-                normal_mps: v * sr * sp,
-                parallel_mps: v * tilt_cos,
-            },
+        let (inflow, aoa) = match state.aoa {
+            AoaInput::Paper => (
+                Inflow {
+                    normal_mps: v * sr * sp,
+                    parallel_mps: v * tilt_cos,
+                },
+                AoaModel::Paper,
+            ),
             AoaInput::Geometric { air_direction_rad } => {
                 finite("air_direction_rad", air_direction_rad)?;
                 let (sb, cb) = libm::sincos(air_direction_rad);
                 // Closed form of angle_of_attack::body_relative_inflow (tested equal there).
                 let normal = -v * (cb * cr * sp - sb * sr);
-                Inflow {
-                    normal_mps: normal,
-                    parallel_mps: (v * v - normal * normal).max(0.0).sqrt(),
-                }
+                (
+                    Inflow {
+                        normal_mps: normal,
+                        parallel_mps: (v * v - normal * normal).max(0.0).sqrt(),
+                    },
+                    AoaModel::Geometric,
+                )
             }
         };
         Ok(FlightCondition {
@@ -304,6 +325,7 @@ impl PowerModel {
             airspeed_mps: v,
             inflow,
             climb_rate_mps: state.climb_rate_mps,
+            aoa,
         })
     }
 
@@ -329,6 +351,7 @@ impl PowerModel {
                 parallel_mps: 0.0,
             },
             climb_rate_mps: 0.0,
+            aoa: AoaModel::Paper,
         }; CHUNK];
         let mut roots = [0.0f64; CHUNK];
         for (sc, oc) in states.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
@@ -395,7 +418,10 @@ impl PowerModel {
         let v = &self.vehicle;
         let opts = &self.options;
         let induced_w = if opts.terms.induced {
-            induced_power_w(c.thrust_n, vi, c.inflow.normal_mps)
+            match c.aoa {
+                AoaModel::Paper => induced_power_w(c.thrust_n, vi, c.inflow.normal_mps),
+                AoaModel::Geometric => induced_power_w(c.thrust_n, vi, 0.0),
+            }
         } else {
             0.0
         };
@@ -602,6 +628,34 @@ mod tests {
             m.evaluate_batch(&states[..3], &mut out).is_err(),
             "length mismatch"
         );
+    }
+
+    #[test]
+    fn geometric_aoa_counts_drag_work_once() {
+        // Steady level flight along the nose: the pitch balances drag, tan(theta) = f_D / (m g).
+        let m = PowerModel::new(m100());
+        let v = 10.0;
+        let pitch = -(m.vehicle().drag().force_n(v) / m.vehicle().weight_n()).atan();
+        let geo = FlightState {
+            aoa: AoaInput::Geometric {
+                air_direction_rad: 0.0,
+            },
+            ..FlightState::new(v, 0.0, pitch, 0.0)
+        };
+        let g = m.evaluate(&geo).unwrap();
+        let p = m.evaluate(&FlightState::new(v, 0.0, pitch, 0.0)).unwrap();
+        // T Vn equals the drag work here; the geometric induced term leaves it to eq (11).
+        let t_vn = g.thrust_n * (-v * pitch.sin());
+        assert!(
+            (t_vn - g.parasitic_w).abs() < 1e-9 * g.parasitic_w,
+            "{t_vn} vs {}",
+            g.parasitic_w
+        );
+        assert!((g.induced_w - g.thrust_n * g.induced_velocity_mps).abs() < 1e-9 * g.induced_w);
+        // The paper's approximation has Vn = 0 for a pure pitch: eq (8) is then T v_i as well, so
+        // the two differ only through v_i (the exact Vn lowers it).
+        assert!((p.induced_w - p.thrust_n * p.induced_velocity_mps).abs() < 1e-9 * p.induced_w);
+        assert!(g.induced_velocity_mps < p.induced_velocity_mps);
     }
 
     #[test]

@@ -76,7 +76,11 @@ impl PowerModel {
             let dvi = dvi_dvn * d_vn.0[i] + dvi_dvp2 * d_vp2.0[i];
             let mut d = 0.0;
             if terms.induced {
-                d += d_t.0[i] * (vi + vn) + thrust * (dvi + d_vn.0[i]);
+                // Geometric AoA: P_ind = T v_i (the T Vn work is in eqs 11 and 13; four_term docs).
+                d += match state.aoa {
+                    AoaInput::Paper => d_t.0[i] * (vi + vn) + thrust * (dvi + d_vn.0[i]),
+                    AoaInput::Geometric { .. } => d_t.0[i] * vi + thrust * dvi,
+                };
             }
             if terms.parasitic && i == 0 {
                 d += veh.drag().parasitic_power_derivative(v);

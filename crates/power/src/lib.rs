@@ -44,6 +44,7 @@ pub mod climb;
 pub mod drag;
 pub mod efficiency;
 pub mod error;
+pub mod fit;
 pub mod four_term;
 pub mod gradient;
 pub mod induced;
@@ -53,8 +54,9 @@ pub mod vehicle;
 
 pub use angle_of_attack::{AoaModel, Inflow};
 pub use drag::CubicDrag;
-pub use efficiency::{efficiency_from_hover, mean_power_w};
-pub use error::{PowerError, Result};
+pub use efficiency::{calibrate_efficiency, efficiency_from_hover, mean_power_w};
+pub use error::{FitError, PowerError, Result};
+pub use fit::{fit_power_model, FitOptions, FitParameter, FitSample, PowerFit};
 pub use four_term::{
     AoaInput, FlightCondition, FlightState, ModelOptions, PowerBreakdown, PowerModel, Term, Terms,
 };

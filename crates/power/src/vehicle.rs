@@ -143,6 +143,14 @@ impl Vehicle {
         })
     }
 
+    /// The same vehicle with another efficiency (a re-calibration), validated.
+    pub fn with_efficiency(&self, efficiency: f64) -> Result<Self> {
+        Self::new(VehicleParams {
+            efficiency,
+            ..self.params.clone()
+        })
+    }
+
     /// The parameters this vehicle was built from.
     pub fn params(&self) -> &VehicleParams {
         &self.params

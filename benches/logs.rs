@@ -1,0 +1,159 @@
+//! Benches of log reading.
+//!
+//! Targets (issue 5): `logs/csv_read` and `logs/mcap_read` at least 100 MB/s per core on a
+//! generated log (criterion reports the throughput in bytes of input per second).
+
+use std::collections::BTreeMap;
+use std::hint::black_box;
+use std::io::Cursor;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+
+use aloft_logs::cdr::CdrWriter;
+use aloft_logs::{ColumnMap, CsvSamples, McapOptions, McapSamples};
+
+/// A KAIST-layout CSV of `rows` rows at 10 Hz with varying, realistic values (about 170 bytes a row).
+fn kaist_csv(rows: usize) -> Vec<u8> {
+    let mut s = String::from("timestamp,lat,log,alt,roll,pitch,yaw,vel_x,vel_y,vel_z,acc_x,acc_y,acc_z,act_vx,act_vy,act_yr,capacity,vol,cur,power\n");
+    for i in 0..rows {
+        let t = i as f64 * 0.1;
+        let (a, b) = ((0.37 * t).sin(), (0.11 * t).cos());
+        let v = 49.0 - 5.0 * i as f64 / rows as f64;
+        let c = 28.0 + 8.0 * a;
+        s.push_str(&format!(
+            "{},{:.6},{:.6},{:.4},{:.6},{:.6},{:.6},{:.5},{:.5},{:.6},{:.5},{:.5},{:.5},{:.1},{:.1},0,{},{:.3},{:.3},{:.1}\n",
+            202_600_741 + i as u64 * 100_000,
+            0.634769 + 1e-6 * a,
+            2.223 + 1e-6 * b,
+            89.0 + 0.01 * a,
+            0.3 * a,
+            -0.3 * b,
+            0.8 + 0.05 * b,
+            3.0 * a,
+            2.0 * b,
+            0.01 * a,
+            0.5 * b,
+            0.4 * a,
+            0.02 * b,
+            -2.0 * a,
+            1.4 * b,
+            12150 - i / 100,
+            v,
+            c,
+            10.0 * v * c
+        ));
+    }
+    s.into_bytes()
+}
+
+/// An MCAP (zstd chunks, the `mcap` crate's default) with ROS 2 CDR PoseStamped at 100 Hz and
+/// BatteryState at 10 Hz.
+fn ros2_mcap(poses: u32) -> Vec<u8> {
+    let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
+    let sp = w
+        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"")
+        .unwrap();
+    let sb = w
+        .add_schema("sensor_msgs/msg/BatteryState", "ros2msg", b"")
+        .unwrap();
+    let cp = w.add_channel(sp, "/pose", "cdr", &BTreeMap::new()).unwrap();
+    let cb = w
+        .add_channel(sb, "/battery", "cdr", &BTreeMap::new())
+        .unwrap();
+    for k in 0..poses {
+        let ns = 1_700_000_000_000_000_000 + u64::from(k) * 10_000_000;
+        let t = f64::from(k) * 0.01;
+        let mut m = CdrWriter::new();
+        m.header(
+            (ns / 1_000_000_000) as i32,
+            (ns % 1_000_000_000) as u32,
+            "map",
+        )
+        .f64(t.sin())
+        .f64(t.cos())
+        .f64(10.0 + 0.1 * t)
+        .f64(0.0)
+        .f64(0.0)
+        .f64((0.5 * t).sin())
+        .f64((0.5 * t).cos());
+        let h = |c: u16| mcap::records::MessageHeader {
+            channel_id: c,
+            sequence: k,
+            log_time: ns,
+            publish_time: ns,
+        };
+        w.write_to_known_channel(&h(cp), &m.finish()).unwrap();
+        if k % 10 == 0 {
+            let mut b = CdrWriter::new();
+            b.header((ns / 1_000_000_000) as i32, 0, "")
+                .f32(16.0 - 0.0001 * t as f32)
+                .f32(25.0)
+                .f32(-20.0)
+                .f32(3.0)
+                .f32(5.0)
+                .f32(5.0)
+                .f32(0.6)
+                .u8(2)
+                .u8(1)
+                .u8(3)
+                .u8(1)
+                .u32(4);
+            for _ in 0..4 {
+                b.f32(4.0);
+            }
+            b.u32(0).string("").string("");
+            w.write_to_known_channel(&h(cb), &b.finish()).unwrap();
+        }
+    }
+    w.finish().unwrap();
+    w.into_inner().into_inner()
+}
+
+fn csv_read(c: &mut Criterion) {
+    let data = kaist_csv(150_000);
+    let mut g = c.benchmark_group("logs/csv_read");
+    g.throughput(Throughput::Bytes(data.len() as u64));
+    g.sample_size(10);
+    g.bench_function("kaist_150k_rows", |b| {
+        b.iter(|| {
+            let r = CsvSamples::from_reader(
+                black_box(&data[..]),
+                Path::new("bench.csv"),
+                &ColumnMap::kaist(),
+            )
+            .unwrap();
+            let mut n = 0usize;
+            for s in r {
+                n += usize::from(s.unwrap().voltage_v.is_some());
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+}
+
+fn mcap_read(c: &mut Criterion) {
+    let data = ros2_mcap(200_000);
+    let mut g = c.benchmark_group("logs/mcap_read");
+    g.throughput(Throughput::Bytes(data.len() as u64));
+    g.sample_size(10);
+    g.bench_function("ros2_cdr_pose_battery", |b| {
+        b.iter(|| {
+            let r = McapSamples::from_reader(
+                Cursor::new(black_box(&data[..])),
+                Path::new("bench.mcap"),
+                McapOptions::default(),
+            );
+            let mut n = 0usize;
+            for s in r {
+                n += usize::from(s.unwrap().pos_enu_m.is_some());
+            }
+            black_box(n)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, csv_read, mcap_read);
+criterion_main!(benches);

@@ -1,0 +1,141 @@
+//! Benches of the mission planner.
+//!
+//! Targets (issue 4): `planner/mission/one_hour`, a one-hour mission sampled at 10 ms
+//! (360,000 samples) in at most 15 ms, i.e. about 40 ns per sample including the four-term power
+//! model (about 35 ns of it), the trim, the wind and the pack; `planner/endurance/queries`, all
+//! endurance queries of one vehicle in at most 1 ms.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+
+use aloft::power::ModelOptions;
+use aloft::vehicle::VehicleFile;
+use aloft_planner::{
+    endurance, plan, AoaModel, BatterySpec, EnduranceQuery, MissionSpec, PlanOptions, Wind,
+};
+
+/// One hour: take-off, a leg, a long orbit, a leg back, landing (3600 s in total within a second).
+const ONE_HOUR: &str = r#"
+[[segment]]
+kind = "take-off"
+altitude_m = 40.0
+climb_rate_mps = 3.0
+[[segment]]
+kind = "leg"
+east_m = 600.0
+north_m = 0.0
+ground_speed_mps = 8.0
+[[segment]]
+kind = "orbit"
+centre_east_m = 600.0
+centre_north_m = 300.0
+radius_m = 300.0
+ground_speed_mps = 8.0
+direction = "clockwise"
+duration_s = 3397.0
+[[segment]]
+kind = "return"
+ground_speed_mps = 8.0
+[[segment]]
+kind = "landing"
+rate_mps = 2.0
+"#;
+
+fn bench_mission(c: &mut Criterion) {
+    let f = VehicleFile::builtin("dji-m100").expect("built-in");
+    let (aircraft, _) = f.aircraft(ModelOptions::default()).expect("aircraft");
+    // A pack big enough for an hour (a bench workload, not a real pack): 6S 40 Ah at TB47D's mass.
+    let battery = BatterySpec {
+        name: "bench-40Ah".into(),
+        default: false,
+        cells_series: 6,
+        capacity_mah: 40_000.0,
+        nominal_v: 22.2,
+        energy_wh: 888.0,
+        mass_kg: 0.6,
+        internal_resistance_ohm: 0.01,
+        cutoff_cell_v: 3.0,
+        usable_fraction: 1.0,
+        ocv_soc: None,
+        ocv_cell_v: None,
+        max_current_a: None,
+    }
+    .to_battery()
+    .expect("pack");
+    let mission = MissionSpec::from_toml_str(ONE_HOUR)
+        .expect("mission")
+        .compile(aircraft.airframe(), battery.mass_kg(), None)
+        .expect("compiles");
+    let wind = Wind::constant(5.0, 250.0).expect("wind");
+    let opts = PlanOptions {
+        time_step_s: 0.01,
+        ..PlanOptions::default()
+    };
+    let r = plan(&aircraft, &battery, &mission, &wind, &opts).expect("plan");
+    assert!(
+        r.feasible && (r.duration_s - 3600.0).abs() < 60.0,
+        "{}",
+        r.duration_s
+    );
+    let samples = (r.duration_s / 0.01).round() as u64;
+    let mut g = c.benchmark_group("planner/mission");
+    g.throughput(Throughput::Elements(samples));
+    g.sample_size(20);
+    g.bench_function("one_hour", |b| {
+        b.iter(|| {
+            plan(
+                black_box(&aircraft),
+                black_box(&battery),
+                black_box(&mission),
+                black_box(&wind),
+                black_box(&opts),
+            )
+            .expect("plan")
+        })
+    });
+    let no_pnr = PlanOptions {
+        point_of_no_return: false,
+        ..opts
+    };
+    g.bench_function("one_hour_without_pnr", |b| {
+        b.iter(|| {
+            plan(
+                black_box(&aircraft),
+                black_box(&battery),
+                black_box(&mission),
+                black_box(&wind),
+                black_box(&no_pnr),
+            )
+            .expect("plan")
+        })
+    });
+    g.finish();
+}
+
+fn bench_queries(c: &mut Criterion) {
+    let f = VehicleFile::builtin("dji-m100").expect("built-in");
+    let (aircraft, _) = f.aircraft(ModelOptions::default()).expect("aircraft");
+    let battery = f.battery(None).expect("pack");
+    let q = EnduranceQuery {
+        wind_mps: [-3.0, -4.0],
+        course: [0.0, 1.0],
+        start_soc: 1.0,
+        reserve_fraction: 0.2,
+        orbit: Some((25.0, 5.0)),
+    };
+    let mut g = c.benchmark_group("planner/endurance");
+    g.bench_function("queries", |b| {
+        b.iter(|| {
+            let m = aircraft.airframe().mass_kg() + battery.mass_kg();
+            let p = aircraft
+                .at_mass(black_box(m), AoaModel::Geometric)
+                .expect("mass");
+            endurance(&p, black_box(&battery), black_box(&q)).expect("queries")
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_mission, bench_queries);
+criterion_main!(benches);

@@ -1,0 +1,163 @@
+//! A summary of a log, accumulated while streaming: duration, per-channel rates, energy.
+
+use serde::Serialize;
+
+use crate::sample::{Channel, Sample};
+
+/// Samples and rate of one model channel.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ChannelStats {
+    /// The channel.
+    pub channel: Channel,
+    /// Samples carrying it.
+    pub samples: u64,
+    /// First and last time, s.
+    pub first_s: f64,
+    /// Last time, s.
+    pub last_s: f64,
+}
+
+impl ChannelStats {
+    /// Mean rate, Hz (`None` below two samples or with no time span).
+    pub fn rate_hz(&self) -> Option<f64> {
+        let span = self.last_s - self.first_s;
+        (self.samples > 1 && span > 0.0).then(|| (self.samples - 1) as f64 / span)
+    }
+}
+
+/// Streaming accumulator of [`ChannelStats`] and the electrical energy.
+///
+/// Energy is the trapezoidal integral of the electrical power (V x I when both are logged, else
+/// the power channel) over consecutive power samples with increasing time; steps where time does
+/// not increase are skipped and counted. Intervals across gaps are integrated as they are (the
+/// gaps are in the time report).
+#[derive(Debug, Clone, Default)]
+pub struct InfoAccumulator {
+    stats: Vec<ChannelStats>,
+    samples: u64,
+    last_power: Option<(f64, f64)>,
+    energy_j: f64,
+    power_samples: u64,
+    power_sum_w: f64,
+    power_max_w: Option<f64>,
+    skipped_steps: u64,
+    t_min: Option<f64>,
+    t_max: Option<f64>,
+}
+
+/// What [`InfoAccumulator::finish`] returns.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogStats {
+    /// Samples.
+    pub samples: u64,
+    /// Last minus first time, s.
+    pub duration_s: f64,
+    /// Per channel, for the channels present.
+    pub channels: Vec<ChannelStats>,
+    /// Integrated electrical energy, W h (`None` without power data).
+    pub energy_wh: Option<f64>,
+    /// Mean electrical power over the power samples, W.
+    pub mean_power_w: Option<f64>,
+    /// Largest electrical power, W.
+    pub max_power_w: Option<f64>,
+    /// Power steps skipped because time did not increase.
+    pub energy_skipped_steps: u64,
+}
+
+impl InfoAccumulator {
+    /// Empty.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Add a sample.
+    pub fn push(&mut self, s: &Sample) {
+        self.samples += 1;
+        let t = s.time_s;
+        self.t_min = Some(self.t_min.map_or(t, |m| m.min(t)));
+        self.t_max = Some(self.t_max.map_or(t, |m| m.max(t)));
+        for c in Channel::ALL {
+            if !c.present_in(s) {
+                continue;
+            }
+            match self.stats.iter_mut().find(|x| x.channel == c) {
+                Some(x) => {
+                    x.samples += 1;
+                    x.first_s = x.first_s.min(t);
+                    x.last_s = x.last_s.max(t);
+                }
+                None => self.stats.push(ChannelStats {
+                    channel: c,
+                    samples: 1,
+                    first_s: t,
+                    last_s: t,
+                }),
+            }
+        }
+        if let Some(p) = s.electrical_power_w() {
+            self.power_samples += 1;
+            self.power_sum_w += p;
+            self.power_max_w = Some(self.power_max_w.map_or(p, |m| m.max(p)));
+            if let Some((t0, p0)) = self.last_power {
+                if t > t0 {
+                    self.energy_j += 0.5 * (p + p0) * (t - t0);
+                } else {
+                    self.skipped_steps += 1;
+                }
+            }
+            self.last_power = Some((t, p));
+        }
+    }
+
+    /// The summary.
+    pub fn finish(mut self) -> LogStats {
+        self.stats.sort_by_key(|s| s.channel);
+        LogStats {
+            samples: self.samples,
+            duration_s: match (self.t_min, self.t_max) {
+                (Some(a), Some(b)) => b - a,
+                _ => 0.0,
+            },
+            channels: self.stats,
+            energy_wh: (self.power_samples > 1).then(|| self.energy_j / 3600.0),
+            mean_power_w: (self.power_samples > 0)
+                .then(|| self.power_sum_w / self.power_samples as f64),
+            max_power_w: self.power_max_w,
+            energy_skipped_steps: self.skipped_steps,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn energy_of_constant_power() {
+        let mut a = InfoAccumulator::new();
+        for i in 0..=3600 {
+            a.push(&Sample {
+                time_s: i as f64,
+                voltage_v: Some(10.0),
+                current_a: Some(10.0),
+                ..Sample::default()
+            });
+        }
+        let s = a.finish();
+        // 100 W for 3600 s is 100 W h; trapezoids of a constant are exact to rounding.
+        assert!((s.energy_wh.unwrap() - 100.0).abs() < 1e-9);
+        assert_eq!(s.channels.len(), 2);
+        assert!((s.channels[0].rate_hz().unwrap() - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn no_power_no_energy() {
+        let mut a = InfoAccumulator::new();
+        a.push(&Sample {
+            time_s: 0.0,
+            pos_enu_m: Some([0.0; 3]),
+            ..Sample::default()
+        });
+        assert_eq!(a.finish().energy_wh, None);
+    }
+}

@@ -1,0 +1,62 @@
+//! # aloft-logs
+//!
+//! Flight logs in, results out. Every source is converted on read to one model, [`Sample`]:
+//! SI units, positions and velocities in east-north-up (ENU), attitude as aerospace Euler angles
+//! relative to north-east-down (the convention of `aloft-power`), time in seconds from the first
+//! sample. Gaps and non-monotonic time are reported in a [`TimeReport`], never smoothed over.
+//!
+//! Sources:
+//! - CSV through a [`ColumnMap`]: built-in [`ColumnMap::kaist`], PX4 per-topic tables joined onto
+//!   one time base ([`px4`]), or a user TOML map.
+//! - MCAP ([`mcap_read`]): JSON and ROS 2 CDR messages of `sensor_msgs/BatteryState`,
+//!   `geometry_msgs/PoseStamped`, `geometry_msgs/TwistStamped`, `nav_msgs/Odometry`,
+//!   `sensor_msgs/Imu`, streamed with bounded memory.
+//!
+//! Output: [`mcap_write`] writes JSON-encoded MCAP with JSON Schemas that Foxglove displays, for
+//! converted logs and for missions ([`write_mission_mcap`] takes plain slices).
+//!
+//! Analysis: [`InfoAccumulator`] (duration, rates, energy), [`estimate_lag_s`] (power vs motion).
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use aloft_logs::{read_log, McapOptions, Profile};
+//! let log = read_log(Path::new("flight.csv"), Some(&Profile::Kaist), &McapOptions::default())?;
+//! let (t, p) = log.power_series()?;
+//! # Ok::<(), aloft_logs::LogError>(())
+//! ```
+//!
+//! The library never prints or exits; every failure is a [`LogError`] naming the file and the
+//! row, column, topic or channel.
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod cdr;
+pub mod column_map;
+pub mod csv_read;
+pub mod error;
+pub mod frame;
+pub mod info;
+pub mod lag;
+pub mod mcap_read;
+pub mod mcap_write;
+pub mod open;
+pub mod px4;
+pub mod ros;
+pub mod sample;
+
+pub use column_map::ColumnMap;
+pub use csv_read::CsvSamples;
+pub use error::{LogError, Result};
+pub use info::{ChannelStats, InfoAccumulator, LogStats};
+pub use lag::{estimate_lag_s, resample_uniform, LagEstimate};
+pub use mcap_read::{McapOptions, McapSamples, McapTime, TopicInfo};
+pub use mcap_write::{
+    write_log_mcap, write_mission_mcap, BatteryPoint, McapWriter, MissionSample, PathPoint,
+    PowerTerms, WriteSummary,
+};
+pub use open::{open_log, read_log, LogFormat, LogReader, Profile, BUILTIN_PROFILES};
+pub use px4::{Px4Options, Px4Samples};
+pub use sample::{
+    Attitude, Channel, DroppedValue, GeoOrigin, Log, Sample, TimeChecker, TimeReport,
+};

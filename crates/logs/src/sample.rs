@@ -1,0 +1,397 @@
+//! The common log model: one sample type for every source, SI units, ENU, seconds from log start.
+
+use serde::Serialize;
+
+/// Attitude as aerospace Z-Y-X Euler angles of the body (x forward, y right, z down) relative to
+/// north-east-down, the convention of `aloft-power`'s `angle_of_attack` module: positive roll
+/// lowers the right side, positive pitch raises the nose, yaw is the heading clockwise from north.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct Attitude {
+    /// Roll `phi`, rad.
+    pub roll_rad: f64,
+    /// Pitch `theta`, rad.
+    pub pitch_rad: f64,
+    /// Yaw (heading from north, clockwise) `psi`, rad, in (-pi, pi].
+    pub yaw_rad: f64,
+}
+
+/// One instant of a flight log. Fields a source does not provide are `None`; a CSV source fills
+/// every mapped channel on every row, an MCAP source fills the channels of one message per sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct Sample {
+    /// Time since the first sample of the log, s.
+    pub time_s: f64,
+    /// Position east, north, up relative to the log's origin, m.
+    pub pos_enu_m: Option<[f64; 3]>,
+    /// Ground velocity east, north, up, m/s.
+    pub vel_enu_mps: Option<[f64; 3]>,
+    /// Acceleration east, north, up (kinematic, without gravity), m/s^2.
+    pub acc_enu_mps2: Option<[f64; 3]>,
+    /// Attitude (aerospace Euler angles relative to NED).
+    pub attitude: Option<Attitude>,
+    /// Battery terminal voltage, V.
+    pub voltage_v: Option<f64>,
+    /// Battery current, positive when discharging, A.
+    pub current_a: Option<f64>,
+    /// Electrical power drawn from the battery, W: a logged power channel when mapped, else V x I.
+    pub power_w: Option<f64>,
+    /// Remaining charge as logged, A h (KAIST `capacity`, PX4 derived from `discharged_mah`).
+    pub charge_ah: Option<f64>,
+    /// Wind velocity east, north, up (the velocity of the air), m/s.
+    pub wind_enu_mps: Option<[f64; 3]>,
+}
+
+impl Sample {
+    /// The power of this sample: V x I when both are present, else the logged power channel.
+    pub fn electrical_power_w(&self) -> Option<f64> {
+        match (self.voltage_v, self.current_a) {
+            (Some(v), Some(i)) => Some(v * i),
+            _ => self.power_w,
+        }
+    }
+}
+
+/// Channels of the log model, used to say what a source provides.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Channel {
+    /// [`Sample::pos_enu_m`].
+    Position,
+    /// [`Sample::vel_enu_mps`].
+    Velocity,
+    /// [`Sample::acc_enu_mps2`].
+    Acceleration,
+    /// [`Sample::attitude`].
+    Attitude,
+    /// [`Sample::voltage_v`].
+    Voltage,
+    /// [`Sample::current_a`].
+    Current,
+    /// [`Sample::power_w`].
+    Power,
+    /// [`Sample::charge_ah`].
+    Charge,
+    /// [`Sample::wind_enu_mps`].
+    Wind,
+}
+
+impl Channel {
+    /// Every channel, in display order.
+    pub const ALL: [Channel; 9] = [
+        Channel::Position,
+        Channel::Velocity,
+        Channel::Acceleration,
+        Channel::Attitude,
+        Channel::Voltage,
+        Channel::Current,
+        Channel::Power,
+        Channel::Charge,
+        Channel::Wind,
+    ];
+
+    /// The snake_case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Position => "position",
+            Channel::Velocity => "velocity",
+            Channel::Acceleration => "acceleration",
+            Channel::Attitude => "attitude",
+            Channel::Voltage => "voltage",
+            Channel::Current => "current",
+            Channel::Power => "power",
+            Channel::Charge => "charge",
+            Channel::Wind => "wind",
+        }
+    }
+
+    /// Whether `sample` carries this channel.
+    pub fn present_in(self, s: &Sample) -> bool {
+        match self {
+            Channel::Position => s.pos_enu_m.is_some(),
+            Channel::Velocity => s.vel_enu_mps.is_some(),
+            Channel::Acceleration => s.acc_enu_mps2.is_some(),
+            Channel::Attitude => s.attitude.is_some(),
+            Channel::Voltage => s.voltage_v.is_some(),
+            Channel::Current => s.current_a.is_some(),
+            Channel::Power => s.power_w.is_some(),
+            Channel::Charge => s.charge_ah.is_some(),
+            Channel::Wind => s.wind_enu_mps.is_some(),
+        }
+    }
+}
+
+/// Geodetic origin of the local ENU positions of a log (first valid fix), WGS84.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GeoOrigin {
+    /// Latitude, rad.
+    pub lat_rad: f64,
+    /// Longitude, rad.
+    pub lon_rad: f64,
+    /// Altitude, m.
+    pub alt_m: f64,
+}
+
+/// A gap in time: an interval much longer than the log's nominal sample period.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Gap {
+    /// 0-based index of the sample after the gap.
+    pub index: u64,
+    /// Time of the sample before the gap, s.
+    pub from_s: f64,
+    /// Time of the sample after the gap, s.
+    pub to_s: f64,
+}
+
+/// Time going backwards (or repeating) between consecutive samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct NonMonotonic {
+    /// 0-based index of the offending sample.
+    pub index: u64,
+    /// Time of the previous sample, s.
+    pub previous_s: f64,
+    /// Time of this sample, s.
+    pub time_s: f64,
+}
+
+/// How regular the time base of a log is. Gaps and non-monotonic steps are reported here and left
+/// in the data: nothing is reordered, interpolated or dropped.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct TimeReport {
+    /// Samples seen.
+    pub samples: u64,
+    /// Last minus first time, s (0 for fewer than two samples).
+    pub duration_s: f64,
+    /// Median positive interval between samples (over the first intervals, see [`TimeChecker`]), s.
+    pub nominal_period_s: Option<f64>,
+    /// Intervals longer than [`TimeChecker::GAP_FACTOR`] nominal periods.
+    pub gap_count: u64,
+    /// The first [`TimeChecker::MAX_EVENTS`] gaps.
+    pub gaps: Vec<Gap>,
+    /// Steps where time decreased or repeated.
+    pub non_monotonic_count: u64,
+    /// The first [`TimeChecker::MAX_EVENTS`] such steps.
+    pub non_monotonic: Vec<NonMonotonic>,
+}
+
+impl TimeReport {
+    /// True when the time base has no gaps and never goes backwards.
+    pub fn is_clean(&self) -> bool {
+        self.gap_count == 0 && self.non_monotonic_count == 0
+    }
+}
+
+/// Streaming checker of a time base, with bounded memory: the nominal period is the median of the
+/// first [`Self::WARMUP`] positive intervals, and at most [`Self::MAX_EVENTS`] events of each kind
+/// are kept (all are counted).
+#[derive(Debug, Clone, Default)]
+pub struct TimeChecker {
+    report: TimeReport,
+    first_s: Option<f64>,
+    last_s: Option<f64>,
+    max_s: f64,
+    warmup: Vec<(u64, f64, f64)>,
+}
+
+impl TimeChecker {
+    /// Intervals used to estimate the nominal period.
+    pub const WARMUP: usize = 32;
+    /// An interval longer than this many nominal periods is a gap.
+    pub const GAP_FACTOR: f64 = 3.0;
+    /// Events of each kind kept in the report.
+    pub const MAX_EVENTS: usize = 100;
+
+    /// A checker that has seen nothing.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Feed the next time stamp, s.
+    pub fn push(&mut self, time_s: f64) {
+        let index = self.report.samples;
+        self.report.samples += 1;
+        if self.first_s.is_none() {
+            self.first_s = Some(time_s);
+            self.max_s = time_s;
+        }
+        if let Some(prev) = self.last_s {
+            let dt = time_s - prev;
+            if dt <= 0.0 {
+                self.report.non_monotonic_count += 1;
+                if self.report.non_monotonic.len() < Self::MAX_EVENTS {
+                    self.report.non_monotonic.push(NonMonotonic {
+                        index,
+                        previous_s: prev,
+                        time_s,
+                    });
+                }
+            } else if let Some(nominal) = self.report.nominal_period_s {
+                self.check_gap(index, prev, time_s, nominal);
+            } else {
+                self.warmup.push((index, prev, time_s));
+                if self.warmup.len() == Self::WARMUP {
+                    self.settle();
+                }
+            }
+        }
+        self.last_s = Some(time_s);
+        self.max_s = self.max_s.max(time_s);
+    }
+
+    fn check_gap(&mut self, index: u64, from_s: f64, to_s: f64, nominal: f64) {
+        if to_s - from_s > Self::GAP_FACTOR * nominal {
+            self.report.gap_count += 1;
+            if self.report.gaps.len() < Self::MAX_EVENTS {
+                self.report.gaps.push(Gap {
+                    index,
+                    from_s,
+                    to_s,
+                });
+            }
+        }
+    }
+
+    fn settle(&mut self) {
+        let mut dts: Vec<f64> = self.warmup.iter().map(|(_, a, b)| b - a).collect();
+        if dts.is_empty() {
+            return;
+        }
+        dts.sort_by(f64::total_cmp);
+        let nominal = dts[dts.len() / 2];
+        self.report.nominal_period_s = Some(nominal);
+        for (index, a, b) in std::mem::take(&mut self.warmup) {
+            self.check_gap(index, a, b, nominal);
+        }
+    }
+
+    /// The report so far.
+    pub fn finish(mut self) -> TimeReport {
+        if self.report.nominal_period_s.is_none() {
+            self.settle();
+        }
+        if let Some(first) = self.first_s {
+            self.report.duration_s = self.max_s - first;
+        }
+        self.report
+    }
+}
+
+/// A value that was read but left out of its sample because it contradicts the other channels
+/// of the row (e.g. a logged power far from V x I on an isolated row: a sensor glitch). Such
+/// values are reported here, not repaired.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DroppedValue {
+    /// 1-based line in the file.
+    pub row: u64,
+    /// The channel.
+    pub channel: &'static str,
+    /// The value (SI).
+    pub value: f64,
+}
+
+/// A whole log in memory: samples plus what is known about the source.
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
+pub struct Log {
+    /// Where it came from (file path or a description).
+    pub source: String,
+    /// The samples, in file order (not re-sorted).
+    pub samples: Vec<Sample>,
+    /// The origin of [`Sample::pos_enu_m`] when positions were geodetic.
+    pub origin: Option<GeoOrigin>,
+    /// Absolute time of the first sample in the source's clock (Unix or boot time), s.
+    pub start_time_s: f64,
+    /// Regularity of the time base.
+    pub time: TimeReport,
+    /// Values dropped as isolated contradictions (count of all).
+    pub dropped_count: u64,
+    /// The first [`TimeChecker::MAX_EVENTS`] dropped values.
+    pub dropped: Vec<DroppedValue>,
+}
+
+impl Log {
+    /// Channels present in at least one sample.
+    pub fn channels(&self) -> Vec<Channel> {
+        Channel::ALL
+            .into_iter()
+            .filter(|c| self.samples.iter().any(|s| c.present_in(s)))
+            .collect()
+    }
+
+    fn found(&self) -> String {
+        let c = self.channels();
+        if c.is_empty() {
+            "none".into()
+        } else {
+            c.iter().map(|c| c.name()).collect::<Vec<_>>().join(", ")
+        }
+    }
+
+    /// Time and electrical power of every sample that has power, or [`crate::LogError::NoPowerData`].
+    pub fn power_series(&self) -> crate::Result<(Vec<f64>, Vec<f64>)> {
+        let (t, p): (Vec<f64>, Vec<f64>) = self
+            .samples
+            .iter()
+            .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
+            .unzip();
+        if t.is_empty() {
+            return Err(crate::LogError::NoPowerData {
+                source_name: self.source.clone(),
+                found: self.found(),
+            });
+        }
+        Ok((t, p))
+    }
+
+    /// Time and ENU velocity of every sample that has velocity, or [`crate::LogError::NoChannel`].
+    pub fn velocity_series(&self) -> crate::Result<(Vec<f64>, Vec<[f64; 3]>)> {
+        let (t, v): (Vec<f64>, Vec<[f64; 3]>) = self
+            .samples
+            .iter()
+            .filter_map(|s| s.vel_enu_mps.map(|v| (s.time_s, v)))
+            .unzip();
+        if t.is_empty() {
+            return Err(crate::LogError::NoChannel {
+                source_name: self.source.clone(),
+                channel: "velocity",
+                found: self.found(),
+            });
+        }
+        Ok((t, v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checker_reports_gap_and_backwards_step() {
+        let mut c = TimeChecker::new();
+        let mut times: Vec<f64> = (0..50).map(|i| i as f64 * 0.1).collect();
+        times.push(10.0); // gap of 5.1 s
+        times.push(9.5); // backwards
+        times.push(9.6);
+        for t in &times {
+            c.push(*t);
+        }
+        let r = c.finish();
+        assert_eq!(r.samples, 53);
+        assert_eq!(r.gap_count, 1);
+        assert_eq!(r.gaps[0].index, 50);
+        assert_eq!(r.non_monotonic_count, 1);
+        assert_eq!(r.non_monotonic[0].index, 51);
+        // Duration is max - first, 10 s; 1e-12 covers the rounding of 0.1 multiples.
+        assert!((r.duration_s - 10.0).abs() < 1e-12);
+        assert!((r.nominal_period_s.unwrap() - 0.1).abs() < 1e-12);
+    }
+
+    #[test]
+    fn gaps_in_warmup_are_found_once_settled() {
+        let mut c = TimeChecker::new();
+        for t in [0.0, 0.1, 0.2, 5.0, 5.1, 5.2, 5.3] {
+            c.push(t);
+        }
+        let r = c.finish();
+        assert_eq!(r.gap_count, 1);
+        assert!(!r.is_clean());
+    }
+}

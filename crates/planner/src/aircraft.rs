@@ -1,0 +1,147 @@
+//! The aircraft as the planner flies it: airframe limits, drag, and the source of electrical
+//! power (the four-term model, or the propulsion chain per rotor).
+
+use aloft_power::{AoaModel, CubicDrag, ModelOptions, PowerModel, Vehicle};
+use aloft_propulsion::PropulsionSystem;
+
+use crate::airframe::Airframe;
+use crate::error::{positive, PlannerError};
+
+/// Where the electrical power of a flight condition comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PowerSource {
+    /// The four-term model (power seed eqs 3-14) of a vehicle; its mass is replaced by the
+    /// mission's mass at each phase.
+    FourTerm {
+        /// The vehicle (drag, rotors, efficiency).
+        vehicle: Vehicle,
+        /// Ablation and hybrid options.
+        options: ModelOptions,
+    },
+    /// The propulsion chain (propulsion seed): thrust per rotor -> rotor speed -> motor current ->
+    /// supply power (eq 28) summed over the rotors. The chain has no inflow model: forward flight
+    /// costs only the thrust it needs.
+    Chain(Box<PropulsionSystem>),
+}
+
+/// A vehicle ready to fly missions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Aircraft {
+    airframe: Airframe,
+    source: PowerSource,
+    drag: CubicDrag,
+    rotor_radius_m: f64,
+    rotor_count: u32,
+    gravity_mps2: f64,
+}
+
+impl Aircraft {
+    /// An aircraft powered by the four-term model of `vehicle`, whose drag and rotor radius it
+    /// uses.
+    pub fn four_term(airframe: Airframe, vehicle: Vehicle, options: ModelOptions) -> Self {
+        Self {
+            drag: *vehicle.drag(),
+            rotor_radius_m: vehicle.params().rotor_radius_m,
+            rotor_count: vehicle.params().rotor_count,
+            gravity_mps2: vehicle.gravity_mps2(),
+            airframe,
+            source: PowerSource::FourTerm { vehicle, options },
+        }
+    }
+
+    /// An aircraft powered by the propulsion chain, with the given drag law (use
+    /// `CubicDrag::new(0, 0, 0)` when none is known, and say so).
+    ///
+    /// # Errors
+    /// A non-positive rotor radius.
+    pub fn propulsion_chain(
+        airframe: Airframe,
+        system: PropulsionSystem,
+        drag: CubicDrag,
+        rotor_radius_m: f64,
+    ) -> Result<Self, PlannerError> {
+        positive("rotor_radius_m", rotor_radius_m, "m")?;
+        Ok(Self {
+            drag,
+            rotor_radius_m,
+            rotor_count: system.rotor_count(),
+            gravity_mps2: system.gravity_mps2(),
+            airframe,
+            source: PowerSource::Chain(Box::new(system)),
+        })
+    }
+
+    /// The airframe.
+    pub fn airframe(&self) -> &Airframe {
+        &self.airframe
+    }
+    /// The power source.
+    pub fn source(&self) -> &PowerSource {
+        &self.source
+    }
+    /// The drag law.
+    pub fn drag(&self) -> &CubicDrag {
+        &self.drag
+    }
+    /// Rotor radius, m.
+    pub fn rotor_radius_m(&self) -> f64 {
+        self.rotor_radius_m
+    }
+    /// Number of rotors.
+    pub fn rotor_count(&self) -> u32 {
+        self.rotor_count
+    }
+    /// Gravity, m/s^2.
+    pub fn gravity_mps2(&self) -> f64 {
+        self.gravity_mps2
+    }
+
+    /// The power evaluator at a total mass.
+    ///
+    /// # Errors
+    /// A mass the power model rejects.
+    pub fn at_mass(&self, mass_kg: f64, aoa: AoaModel) -> Result<Powered<'_>, PlannerError> {
+        positive("mass_kg", mass_kg, "kg")?;
+        let engine = match &self.source {
+            PowerSource::FourTerm { vehicle, options } => Engine::FourTerm(
+                PowerModel::with_options(vehicle.with_mass(mass_kg)?, *options)?,
+            ),
+            PowerSource::Chain(system) => Engine::Chain(system),
+        };
+        Ok(Powered {
+            aircraft: self,
+            mass_kg,
+            weight_n: mass_kg * self.gravity_mps2,
+            engine,
+            aoa,
+        })
+    }
+}
+
+/// The evaluator behind [`Powered`].
+#[derive(Debug, Clone)]
+pub(crate) enum Engine<'a> {
+    FourTerm(PowerModel),
+    Chain(&'a PropulsionSystem),
+}
+
+/// An aircraft at one mass: evaluates electrical power for a flight condition.
+#[derive(Debug, Clone)]
+pub struct Powered<'a> {
+    pub(crate) aircraft: &'a Aircraft,
+    pub(crate) mass_kg: f64,
+    pub(crate) weight_n: f64,
+    pub(crate) engine: Engine<'a>,
+    pub(crate) aoa: AoaModel,
+}
+
+impl Powered<'_> {
+    /// Total mass, kg.
+    pub fn mass_kg(&self) -> f64 {
+        self.mass_kg
+    }
+    /// The aircraft.
+    pub fn aircraft(&self) -> &Aircraft {
+        self.aircraft
+    }
+}

@@ -1,0 +1,159 @@
+//! Airframe: masses and the flight envelope (the `[airframe]` table of a vehicle file).
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{positive, PlannerError};
+
+/// The `[airframe]` table: mass without battery and payload, and the limits a mission must stay
+/// inside. Units are in the key names; unknown keys are rejected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeSpec {
+    /// Mass without battery and payload, kg.
+    pub mass_kg: f64,
+    /// Largest take-off mass, kg.
+    pub max_takeoff_mass_kg: f64,
+    /// Largest total thrust, N (default: the thrust of level flight at the largest take-off mass
+    /// and the largest tilt, `m_max g / cos(tilt_max)`, a lower bound of the true value).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_thrust_n: Option<f64>,
+    /// Largest tilt of the thrust axis from the vertical, deg.
+    pub max_tilt_deg: f64,
+    /// Largest horizontal ground speed, m/s.
+    pub max_speed_mps: f64,
+    /// Largest climb rate, m/s.
+    pub max_climb_rate_mps: f64,
+    /// Largest descent rate, m/s.
+    pub max_descent_rate_mps: f64,
+    /// Acceleration and deceleration along a horizontal path, m/s^2.
+    pub acceleration_mps2: f64,
+    /// Acceleration and deceleration along a vertical path, m/s^2.
+    pub vertical_acceleration_mps2: f64,
+    /// Yaw rate of the turn at a waypoint, deg/s.
+    pub yaw_rate_deg_s: f64,
+    /// Height of the rotor plane above the ground when landed, m (ground effect).
+    pub rotor_height_m: f64,
+}
+
+/// A validated airframe, angles in radians.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Airframe {
+    spec: AirframeSpec,
+    max_tilt_rad: f64,
+    yaw_rate_radps: f64,
+}
+
+impl Airframe {
+    /// Validate the table.
+    ///
+    /// # Errors
+    /// Any value non-positive or non-finite, a tilt limit of 90 deg or more, a largest take-off
+    /// mass below the airframe mass, a thrust limit below the weight at the largest take-off mass.
+    pub fn new(spec: AirframeSpec) -> Result<Self, PlannerError> {
+        positive("airframe mass_kg", spec.mass_kg, "kg")?;
+        positive(
+            "airframe max_takeoff_mass_kg",
+            spec.max_takeoff_mass_kg,
+            "kg",
+        )?;
+        positive("airframe max_tilt_deg", spec.max_tilt_deg, "deg")?;
+        positive("airframe max_speed_mps", spec.max_speed_mps, "m/s")?;
+        positive(
+            "airframe max_climb_rate_mps",
+            spec.max_climb_rate_mps,
+            "m/s",
+        )?;
+        positive(
+            "airframe max_descent_rate_mps",
+            spec.max_descent_rate_mps,
+            "m/s",
+        )?;
+        positive(
+            "airframe acceleration_mps2",
+            spec.acceleration_mps2,
+            "m/s^2",
+        )?;
+        positive(
+            "airframe vertical_acceleration_mps2",
+            spec.vertical_acceleration_mps2,
+            "m/s^2",
+        )?;
+        positive("airframe yaw_rate_deg_s", spec.yaw_rate_deg_s, "deg/s")?;
+        positive("airframe rotor_height_m", spec.rotor_height_m, "m")?;
+        if spec.max_tilt_deg >= 90.0 {
+            return Err(PlannerError::InvalidParameter {
+                name: "airframe max_tilt_deg",
+                value: spec.max_tilt_deg,
+                unit: "deg",
+                expected: "below 90 deg",
+            });
+        }
+        if spec.max_takeoff_mass_kg < spec.mass_kg {
+            return Err(PlannerError::InvalidParameter {
+                name: "airframe max_takeoff_mass_kg",
+                value: spec.max_takeoff_mass_kg,
+                unit: "kg",
+                expected: "at least the airframe mass",
+            });
+        }
+        if let Some(t) = spec.max_thrust_n {
+            positive("airframe max_thrust_n", t, "N")?;
+        }
+        Ok(Self {
+            max_tilt_rad: spec.max_tilt_deg.to_radians(),
+            yaw_rate_radps: spec.yaw_rate_deg_s.to_radians(),
+            spec,
+        })
+    }
+
+    /// The table it was built from.
+    pub fn spec(&self) -> &AirframeSpec {
+        &self.spec
+    }
+    /// Mass without battery and payload, kg.
+    pub fn mass_kg(&self) -> f64 {
+        self.spec.mass_kg
+    }
+    /// Largest take-off mass, kg.
+    pub fn max_takeoff_mass_kg(&self) -> f64 {
+        self.spec.max_takeoff_mass_kg
+    }
+    /// Largest total thrust for gravity `g_mps2`, N.
+    pub fn max_thrust_n(&self, g_mps2: f64) -> f64 {
+        self.spec
+            .max_thrust_n
+            .unwrap_or(self.spec.max_takeoff_mass_kg * g_mps2 / self.max_tilt_rad.cos())
+    }
+    /// Largest tilt, rad.
+    pub fn max_tilt_rad(&self) -> f64 {
+        self.max_tilt_rad
+    }
+    /// Largest horizontal speed, m/s.
+    pub fn max_speed_mps(&self) -> f64 {
+        self.spec.max_speed_mps
+    }
+    /// Largest climb rate, m/s.
+    pub fn max_climb_rate_mps(&self) -> f64 {
+        self.spec.max_climb_rate_mps
+    }
+    /// Largest descent rate, m/s.
+    pub fn max_descent_rate_mps(&self) -> f64 {
+        self.spec.max_descent_rate_mps
+    }
+    /// Horizontal acceleration, m/s^2.
+    pub fn acceleration_mps2(&self) -> f64 {
+        self.spec.acceleration_mps2
+    }
+    /// Vertical acceleration, m/s^2.
+    pub fn vertical_acceleration_mps2(&self) -> f64 {
+        self.spec.vertical_acceleration_mps2
+    }
+    /// Yaw rate, rad/s.
+    pub fn yaw_rate_radps(&self) -> f64 {
+        self.yaw_rate_radps
+    }
+    /// Rotor height above the ground when landed, m.
+    pub fn rotor_height_m(&self) -> f64 {
+        self.spec.rotor_height_m
+    }
+}

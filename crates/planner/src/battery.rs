@@ -1,0 +1,384 @@
+//! Battery pack for mission integration: charge counting, open-circuit voltage, internal
+//! resistance, usable fraction, cut-off voltage.
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | `Q` | rated capacity | A h |
+//! | `s` | state of charge, remaining charge over `Q` | - |
+//! | `V_oc(s)` | open-circuit (rest) voltage of the pack, cells in series x cell curve | V |
+//! | `R` | pack internal resistance (constant) | ohm |
+//! | `P` | power the load (ESCs, avionics) draws at the pack terminals | W |
+//! | `I` | pack current | A |
+//! | `V_t` | terminal voltage `V_oc - I R` | V |
+//!
+//! The current that delivers `P` is the smaller root of `R I^2 - V_oc I + P = 0`,
+//! `I = 2 P / (V_oc + sqrt(V_oc^2 - 4 R P))` (the form of the propulsion seed's eqs 29-30 with the
+//! full-charge voltage replaced by the open-circuit voltage at the present state of charge; with
+//! `R = 0` it is `P / V_oc`). No real root means the pack cannot deliver `P`. The state of charge
+//! falls by `I dt / (3600 Q)` per step (charge counting).
+//!
+//! The pack is empty when the state of charge reaches `1 - usable_fraction` or the terminal
+//! voltage falls below the cut-off (`cutoff_cell_v` per cell), whichever comes first.
+//!
+//! # Open-circuit curve
+//! By default the generic LiPo rest-voltage curve of `aloft_propulsion::OcvCurve::typical_lipo`
+//! (4.20 V full, mean 3.858 V per cell), not scaled: a 6S 4.5 Ah pack then holds 104.2 Wh at rest
+//! voltage, of which the resistance loses a few per cent at hover currents, which brings the
+//! delivered energy close to the rated `nominal_v x capacity` (99.9 Wh for DJI's TB47D). A measured
+//! curve can be given in the battery table.
+//!
+//! # Deviation
+//! The propulsion seed's pack model uses the full-charge voltage throughout a flight (eq 30); the
+//! planner follows the state of charge on the open-circuit curve instead, which is what makes the
+//! terminal voltage fall along a mission.
+
+use aloft_propulsion::OcvCurve;
+use serde::{Deserialize, Serialize};
+
+use crate::error::PlannerError;
+
+fn default_usable() -> f64 {
+    1.0
+}
+
+/// A `[[battery]]` table of a vehicle file. Units are in the key names; unknown keys are rejected.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BatterySpec {
+    /// Name used on the command line (`--battery`).
+    pub name: String,
+    /// The vehicle's default pack (at most one per vehicle; else the first).
+    #[serde(default)]
+    pub default: bool,
+    /// Cells in series.
+    pub cells_series: u32,
+    /// Rated capacity, mA h.
+    pub capacity_mah: f64,
+    /// Rated (nominal) pack voltage, V.
+    pub nominal_v: f64,
+    /// Rated energy, W h (checked against `capacity x nominal voltage` within 1 %).
+    pub energy_wh: f64,
+    /// Pack mass, kg.
+    pub mass_kg: f64,
+    /// Pack internal resistance, ohm (0 allowed: an ideal source).
+    pub internal_resistance_ohm: f64,
+    /// Cut-off voltage per cell under load, V.
+    pub cutoff_cell_v: f64,
+    /// Fraction of the rated capacity that may be drawn, in `(0, 1]` (default 1).
+    #[serde(default = "default_usable")]
+    pub usable_fraction: f64,
+    /// Open-circuit curve: state-of-charge points in `[0, 1]`, increasing (default: typical LiPo).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ocv_soc: Option<Vec<f64>>,
+    /// Open-circuit curve: cell voltage at each `ocv_soc` point, V.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ocv_cell_v: Option<Vec<f64>>,
+    /// Rated continuous current, A (default: no limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_current_a: Option<f64>,
+}
+
+/// Points of the uniform open-circuit table (0.5 % of state of charge apart).
+const OCV_TABLE_POINTS: usize = 201;
+
+/// A validated pack.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Battery {
+    name: String,
+    cells_series: u32,
+    capacity_ah: f64,
+    nominal_v: f64,
+    energy_wh: f64,
+    mass_kg: f64,
+    resistance_ohm: f64,
+    cutoff_v: f64,
+    usable_fraction: f64,
+    max_current_a: f64,
+    /// Pack open-circuit voltage at `k / (OCV_TABLE_POINTS - 1)`, V.
+    ocv_table_v: Vec<f64>,
+}
+
+/// The pack's answer to a power demand.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PackDraw {
+    /// Pack current, A.
+    pub current_a: f64,
+    /// Terminal voltage, V.
+    pub terminal_v: f64,
+}
+
+impl BatterySpec {
+    /// Validate and build the pack model.
+    ///
+    /// # Errors
+    /// Zero cells, non-positive capacity, voltage, energy or mass, a rated energy that disagrees
+    /// with capacity x voltage by more than 1 %, a negative resistance, a cut-off outside the
+    /// open-circuit curve, a usable fraction outside `(0, 1]`, an invalid curve.
+    pub fn to_battery(&self) -> Result<Battery, PlannerError> {
+        let bad = |key: &'static str, value: f64, unit: &'static str, expected: &'static str| {
+            PlannerError::InvalidBattery {
+                name: self.name.clone(),
+                key,
+                value,
+                unit,
+                expected,
+            }
+        };
+        let pos = |key, v: f64, unit| {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(bad(key, v, unit, "a positive finite number"))
+            }
+        };
+        if self.cells_series == 0 {
+            return Err(bad("cells_series", 0.0, "", "at least one cell"));
+        }
+        let capacity_ah = pos("capacity_mah", self.capacity_mah, "mA h")? / 1000.0;
+        let nominal_v = pos("nominal_v", self.nominal_v, "V")?;
+        let energy_wh = pos("energy_wh", self.energy_wh, "W h")?;
+        let mass_kg = pos("mass_kg", self.mass_kg, "kg")?;
+        // Rated energy is printed rounded; 1 % covers rounding of three significant figures.
+        if (energy_wh / (capacity_ah * nominal_v) - 1.0).abs() > 0.01 {
+            return Err(bad(
+                "energy_wh",
+                energy_wh,
+                "W h",
+                "within 1 % of capacity x nominal voltage",
+            ));
+        }
+        let r = self.internal_resistance_ohm;
+        if !(r.is_finite() && r >= 0.0) {
+            return Err(bad(
+                "internal_resistance_ohm",
+                r,
+                "ohm",
+                "a finite resistance, not negative",
+            ));
+        }
+        let u = self.usable_fraction;
+        if !(u.is_finite() && u > 0.0 && u <= 1.0) {
+            return Err(bad("usable_fraction", u, "", "a fraction in (0, 1]"));
+        }
+        let curve = match (&self.ocv_soc, &self.ocv_cell_v) {
+            (None, None) => OcvCurve::typical_lipo(),
+            (Some(s), Some(v)) => OcvCurve::new(s.clone(), v.clone())?,
+            (Some(_), None) | (None, Some(_)) => {
+                return Err(bad(
+                    "ocv_soc/ocv_cell_v",
+                    f64::NAN,
+                    "",
+                    "both keys or neither",
+                ))
+            }
+        };
+        let cells = f64::from(self.cells_series);
+        let cut = self.cutoff_cell_v;
+        if !(cut.is_finite() && cut > 0.0 && cut < curve.cell_v(1.0)) {
+            return Err(bad(
+                "cutoff_cell_v",
+                cut,
+                "V",
+                "positive and below the full-charge cell voltage",
+            ));
+        }
+        let max_current_a = match self.max_current_a {
+            Some(i) => pos("max_current_a", i, "A")?,
+            None => f64::INFINITY,
+        };
+        let ocv_table_v = (0..OCV_TABLE_POINTS)
+            .map(|k| cells * curve.cell_v(k as f64 / (OCV_TABLE_POINTS - 1) as f64))
+            .collect();
+        Ok(Battery {
+            name: self.name.clone(),
+            cells_series: self.cells_series,
+            capacity_ah,
+            nominal_v,
+            energy_wh,
+            mass_kg,
+            resistance_ohm: r,
+            cutoff_v: cut * cells,
+            usable_fraction: u,
+            max_current_a,
+            ocv_table_v,
+        })
+    }
+}
+
+impl Battery {
+    /// Name of the pack.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Cells in series.
+    pub fn cells_series(&self) -> u32 {
+        self.cells_series
+    }
+    /// Rated capacity, A h.
+    pub fn capacity_ah(&self) -> f64 {
+        self.capacity_ah
+    }
+    /// Rated nominal voltage, V.
+    pub fn nominal_v(&self) -> f64 {
+        self.nominal_v
+    }
+    /// Rated energy, W h.
+    pub fn rated_energy_wh(&self) -> f64 {
+        self.energy_wh
+    }
+    /// Pack mass, kg.
+    pub fn mass_kg(&self) -> f64 {
+        self.mass_kg
+    }
+    /// Internal resistance, ohm.
+    pub fn resistance_ohm(&self) -> f64 {
+        self.resistance_ohm
+    }
+    /// Pack cut-off voltage under load, V.
+    pub fn cutoff_v(&self) -> f64 {
+        self.cutoff_v
+    }
+    /// Usable fraction of the capacity.
+    pub fn usable_fraction(&self) -> f64 {
+        self.usable_fraction
+    }
+    /// State of charge at which the usable charge is exhausted, `1 - usable_fraction`.
+    pub fn empty_soc(&self) -> f64 {
+        1.0 - self.usable_fraction
+    }
+    /// Rated continuous current, A (infinite when none is given).
+    pub fn max_current_a(&self) -> f64 {
+        self.max_current_a
+    }
+
+    /// The same pack with another internal resistance (what-if studies and tests).
+    ///
+    /// # Errors
+    /// A negative or non-finite resistance.
+    pub fn with_resistance(&self, resistance_ohm: f64) -> Result<Self, PlannerError> {
+        if !(resistance_ohm.is_finite() && resistance_ohm >= 0.0) {
+            return Err(PlannerError::InvalidBattery {
+                name: self.name.clone(),
+                key: "internal_resistance_ohm",
+                value: resistance_ohm,
+                unit: "ohm",
+                expected: "a finite resistance, not negative",
+            });
+        }
+        Ok(Self {
+            resistance_ohm,
+            ..self.clone()
+        })
+    }
+
+    /// Pack open-circuit voltage at state of charge `soc` (clamped to `[0, 1]`), V.
+    #[inline]
+    pub fn ocv_v(&self, soc: f64) -> f64 {
+        let n = (OCV_TABLE_POINTS - 1) as f64;
+        let x = soc.clamp(0.0, 1.0) * n;
+        // x in [0, n]; the last interval is closed at its upper end.
+        let k = (x as usize).min(OCV_TABLE_POINTS - 2);
+        let f = x - k as f64;
+        let t = &self.ocv_table_v;
+        t[k] + (t[k + 1] - t[k]) * f
+    }
+
+    /// Current and terminal voltage when the load draws `power_w` at state of charge `soc`;
+    /// `None` when the pack cannot deliver that power (`V_oc^2 < 4 R P`).
+    #[inline]
+    pub fn draw(&self, power_w: f64, soc: f64) -> Option<PackDraw> {
+        let v_oc = self.ocv_v(soc);
+        let disc = v_oc * v_oc - 4.0 * self.resistance_ohm * power_w;
+        if disc < 0.0 {
+            return None;
+        }
+        let current_a = 2.0 * power_w / (v_oc + disc.sqrt());
+        Some(PackDraw {
+            current_a,
+            terminal_v: v_oc - current_a * self.resistance_ohm,
+        })
+    }
+
+    /// Energy the pack can deliver from `from_soc` down to `to_soc` with no resistive loss
+    /// (integral of the open-circuit voltage over the charge), W h.
+    pub fn rest_energy_wh(&self, from_soc: f64, to_soc: f64) -> f64 {
+        // Trapezoidal rule on a fine grid of the piecewise-linear table: exact to rounding when the
+        // grid includes the table's nodes; 2000 steps keep the error below 1e-6 relative otherwise.
+        let n = 2000;
+        let (a, b) = (to_soc.clamp(0.0, 1.0), from_soc.clamp(0.0, 1.0));
+        if b <= a {
+            return 0.0;
+        }
+        let h = (b - a) / n as f64;
+        let mut sum = 0.5 * (self.ocv_v(a) + self.ocv_v(b));
+        for k in 1..n {
+            sum += self.ocv_v(a + k as f64 * h);
+        }
+        sum * h * self.capacity_ah
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn tb47d() -> BatterySpec {
+        BatterySpec {
+            name: "TB47D".into(),
+            default: true,
+            cells_series: 6,
+            capacity_mah: 4500.0,
+            nominal_v: 22.2,
+            energy_wh: 99.9,
+            mass_kg: 0.6,
+            internal_resistance_ohm: 0.048,
+            cutoff_cell_v: 3.0,
+            usable_fraction: 1.0,
+            ocv_soc: None,
+            ocv_cell_v: None,
+            max_current_a: None,
+        }
+    }
+
+    #[test]
+    fn draw_delivers_the_power() {
+        let b = tb47d().to_battery().unwrap();
+        for (p, s) in [(50.0, 0.9), (450.0, 0.5), (900.0, 0.1)] {
+            let d = b.draw(p, s).unwrap();
+            // terminal power equals demand up to rounding of the closed-form root
+            assert!((d.current_a * d.terminal_v / p - 1.0).abs() < 1e-12);
+            assert!(d.terminal_v < b.ocv_v(s));
+        }
+        // V_oc^2 / 4R at 100 %: 25.2^2 / 0.192 = 3307.5 W; beyond it there is no root.
+        assert!(b.draw(3400.0, 1.0).is_none());
+    }
+
+    #[test]
+    fn ocv_table_matches_the_curve() {
+        let b = tb47d().to_battery().unwrap();
+        let c = OcvCurve::typical_lipo();
+        for s in [0.0, 0.03, 0.5, 0.77, 1.0] {
+            // the table holds the curve's nodes (every 5 %) exactly, so linear interpolation agrees
+            assert!((b.ocv_v(s) - 6.0 * c.cell_v(s)).abs() < 1e-12, "{s}");
+        }
+        // mean rest voltage 3.858 V per cell: 6 x 3.858 x 4.5 = 104.2 W h
+        assert!((b.rest_energy_wh(1.0, 0.0) - 6.0 * 3.85825 * 4.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn bad_packs_are_named() {
+        let mut s = tb47d();
+        s.energy_wh = 120.0;
+        let e = s.to_battery().unwrap_err().to_string();
+        assert!(e.contains("energy_wh") && e.contains("120"), "{e}");
+        let mut s = tb47d();
+        s.usable_fraction = 1.5;
+        assert!(s.to_battery().unwrap_err().to_string().contains("usable"));
+        let mut s = tb47d();
+        s.internal_resistance_ohm = -0.1;
+        assert!(s.to_battery().is_err());
+        let mut s = tb47d();
+        s.cutoff_cell_v = 4.5;
+        assert!(s.to_battery().is_err());
+    }
+}

@@ -1,0 +1,185 @@
+//! The one error type of the planner.
+
+use thiserror::Error;
+
+/// Everything the planner rejects. Variants carry the offending value with its unit and, for
+/// errors found while flying a mission, the time, segment and position where they happened.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum PlannerError {
+    /// The power model rejected a vehicle or a flight condition.
+    #[error(transparent)]
+    Power(#[from] aloft_power::PowerError),
+    /// The propulsion chain rejected a parameter or an operating point.
+    #[error(transparent)]
+    Propulsion(#[from] aloft_propulsion::PropulsionError),
+    /// A parameter outside its valid range.
+    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// Parameter name (with its unit suffix).
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// Unit of `value`.
+        unit: &'static str,
+        /// What a valid value looks like.
+        expected: &'static str,
+    },
+    /// A mission text that does not parse or does not match the format.
+    #[error("invalid mission file: {message}")]
+    MissionFormat {
+        /// The parser's message (line, column and key).
+        message: String,
+    },
+    /// A mission without segments.
+    #[error("the mission has no segments: add at least a take-off and a landing")]
+    EmptyMission,
+    /// A mission segment that is invalid in itself.
+    #[error("segment {index} ({kind}): {name} = {value} {unit} is invalid: {expected}")]
+    InvalidSegment {
+        /// Segment number, from 1.
+        index: usize,
+        /// Segment kind (`leg`, `orbit`, ...).
+        kind: &'static str,
+        /// The offending key.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// Unit of `value`.
+        unit: &'static str,
+        /// Why it is invalid.
+        expected: &'static str,
+    },
+    /// A segment asks for something the vehicle cannot do (speed, climb rate, turn load).
+    #[error("segment {index} ({kind}): {name} = {value:.3} {unit} is beyond the vehicle's limit of {limit:.3} {unit}")]
+    Unreachable {
+        /// Segment number, from 1.
+        index: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// What is beyond the limit.
+        name: &'static str,
+        /// The value asked for.
+        value: f64,
+        /// The vehicle's limit.
+        limit: f64,
+        /// Unit of both.
+        unit: &'static str,
+    },
+    /// Segments in an order that cannot be flown (a leg before take-off, a take-off in the air).
+    #[error("segment {index} ({kind}) cannot be flown here: {reason}")]
+    SegmentOrder {
+        /// Segment number, from 1.
+        index: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Why.
+        reason: &'static str,
+    },
+    /// The force balance asks for more thrust or tilt than the vehicle has.
+    #[error("at t = {time_s:.1} s in segment {index} ({kind}) at E {east_m:.0} m, N {north_m:.0} m, alt {up_m:.0} m the mission needs {value:.2} {unit} of {name}, beyond the vehicle's limit of {limit:.2} {unit}")]
+    BeyondVehicleLimit {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        index: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// East position, m.
+        east_m: f64,
+        /// North position, m.
+        north_m: f64,
+        /// Height above home, m.
+        up_m: f64,
+        /// `thrust` or `tilt`.
+        name: &'static str,
+        /// The value needed.
+        value: f64,
+        /// The limit.
+        limit: f64,
+        /// `N` or `deg`.
+        unit: &'static str,
+    },
+    /// The gridded wind field does not cover a point of the route.
+    #[error("the wind grid does not cover the route at t = {time_s:.1} s: E {east_m:.1} m, N {north_m:.1} m, alt {up_m:.1} m (grid spans E {min_m:?}..{max_m:?} m as [E, N, Up])")]
+    OutsideWindGrid {
+        /// Mission time, s.
+        time_s: f64,
+        /// East, m.
+        east_m: f64,
+        /// North, m.
+        north_m: f64,
+        /// Up, m.
+        up_m: f64,
+        /// Lower corner of the grid, m.
+        min_m: [f64; 3],
+        /// Upper corner of the grid, m.
+        max_m: [f64; 3],
+    },
+    /// Wind-grid rows that do not form a complete regular grid.
+    #[error("wind grid: {reason} (found {found})")]
+    InvalidWindGrid {
+        /// What is wrong.
+        reason: &'static str,
+        /// The count or value found.
+        found: f64,
+    },
+    /// A battery description that is inconsistent.
+    #[error("battery '{name}': {key} = {value} {unit} is invalid: {expected}")]
+    InvalidBattery {
+        /// Pack name.
+        name: String,
+        /// The offending key.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+        /// Unit.
+        unit: &'static str,
+        /// What is expected.
+        expected: &'static str,
+    },
+    /// The speed search of a query found no airspeed that can be flown.
+    #[error("no airspeed between {min_mps:.1} and {max_mps:.1} m/s can make headway along the course in this wind")]
+    NoHeadway {
+        /// Lower end of the search, m/s.
+        min_mps: f64,
+        /// Upper end of the search, m/s.
+        max_mps: f64,
+    },
+}
+
+/// Reject NaN, infinities and values that are zero or negative.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PlannerError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(PlannerError::InvalidParameter {
+            name,
+            value,
+            unit,
+            expected: "a positive finite number",
+        })
+    }
+}
+
+/// Reject NaN, infinities and negative values.
+pub(crate) fn non_negative(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PlannerError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(PlannerError::InvalidParameter {
+            name,
+            value,
+            unit,
+            expected: "a finite number, not negative",
+        })
+    }
+}

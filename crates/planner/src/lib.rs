@@ -1,0 +1,105 @@
+//! # aloft-planner: missions, wind, trim, energy and battery
+//!
+//! Flies a multirotor mission in a wind field sample by sample and says what it costs: energy per
+//! segment, how the battery ends, whether the reserve holds, where the point of no return lies.
+//! Also answers the endurance and range queries of one vehicle (hover, best-endurance speed,
+//! best-range speed along a course in wind, orbit endurance, the power curve).
+//!
+//! ## Frame and units
+//! Missions are in east-north-up (ENU) metres about the home point, heights above home on flat
+//! ground; latitude/longitude are converted to that local frame ([`geodesy`]). SI units with the
+//! unit in every name; angles are radians inside and degrees in files. Wind directions are the
+//! direction the wind blows FROM, clockwise from north.
+//!
+//! ## Models, one per file
+//! - [`mission`]: the mission file and its compilation into trajectory pieces;
+//! - [`trajectory`]: closed-form kinematics (trapezoidal speed, lines, arcs, holds);
+//! - [`wind`]: constant, power-law and logarithmic profiles, gridded field, seeded gusts;
+//! - [`trim`]: thrust vector from the force balance, attitude, electrical power;
+//! - [`ground_effect`]: survey seed eq (35);
+//! - [`battery`]: charge counting, open-circuit voltage, resistance, cut-off;
+//! - [`plan`]: the sampled flight, feasibility, point of no return, summary;
+//! - [`queries`]: endurance and range.
+//!
+//! The power comes from `aloft-power` (the four-term model of the power seed) or from the
+//! propulsion chain of `aloft-propulsion`. The crate does no I/O: it takes text or data and
+//! returns results or a [`PlannerError`].
+//!
+//! ```
+//! use aloft_planner::*;
+//! # fn main() -> Result<(), PlannerError> {
+//! let airframe = Airframe::new(AirframeSpec {
+//!     mass_kg: 1.755, max_takeoff_mass_kg: 3.6, max_thrust_n: None, max_tilt_deg: 35.0,
+//!     max_speed_mps: 17.0, max_climb_rate_mps: 5.0, max_descent_rate_mps: 4.0,
+//!     acceleration_mps2: 2.0, vertical_acceleration_mps2: 1.5, yaw_rate_deg_s: 60.0,
+//!     rotor_height_m: 0.3,
+//! })?;
+//! let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
+//!     mass_kg: 3.29, gravity_mps2: 9.8066, air_density_kg_m3: 1.225, rotor_count: 4,
+//!     rotor_radius_m: 0.172, disk_area: aloft_power::DiskArea::OneRotor,
+//!     mu1_n_s_per_m: 0.1816, mu2_n_s2_per_m2: -0.02326, mu3_n_s3_per_m3: 0.004045,
+//!     kappa1_w_per_n1_5: 0.275, kappa2_w_s2_per_m2_n0_5: 0.0, efficiency: 0.9703,
+//! })?;
+//! let aircraft = Aircraft::four_term(airframe, vehicle, Default::default());
+//! let battery = BatterySpec {
+//!     name: "TB47D".into(), default: true, cells_series: 6, capacity_mah: 4500.0,
+//!     nominal_v: 22.2, energy_wh: 99.9, mass_kg: 0.6, internal_resistance_ohm: 0.048,
+//!     cutoff_cell_v: 3.0, usable_fraction: 1.0, ocv_soc: None, ocv_cell_v: None,
+//!     max_current_a: None,
+//! }.to_battery()?;
+//! let mission = MissionSpec::from_toml_str(r#"
+//!     [[segment]]
+//!     kind = "take-off"
+//!     altitude_m = 20.0
+//!     climb_rate_mps = 2.0
+//!     [[segment]]
+//!     kind = "leg"
+//!     east_m = 300.0
+//!     north_m = 0.0
+//!     ground_speed_mps = 8.0
+//!     [[segment]]
+//!     kind = "return"
+//!     ground_speed_mps = 8.0
+//!     [[segment]]
+//!     kind = "landing"
+//!     rate_mps = 1.0
+//! "#)?.compile(aircraft.airframe(), battery.mass_kg(), None)?;
+//! let report = plan(&aircraft, &battery, &mission, &Wind::constant(5.0, 270.0)?,
+//!                   &PlanOptions::default())?;
+//! assert!(report.feasible && report.energy_wh > 0.0);
+//! # Ok(()) }
+//! ```
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod aircraft;
+pub mod airframe;
+pub mod battery;
+pub mod error;
+pub mod geodesy;
+pub mod ground_effect;
+pub mod mission;
+pub mod plan;
+pub mod queries;
+pub mod trajectory;
+pub mod trim;
+pub mod wind;
+
+pub use aircraft::{Aircraft, PowerSource, Powered};
+pub use airframe::{Airframe, AirframeSpec};
+pub use aloft_power::AoaModel;
+pub use battery::{Battery, BatterySpec, PackDraw};
+pub use error::PlannerError;
+pub use mission::{
+    HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
+};
+pub use plan::{
+    plan, MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
+};
+pub use queries::{
+    best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,
+    EnduranceQuery, EnduranceReport, SweepRow,
+};
+pub use trim::{attitude_rad, bank_rad, Trim};
+pub use wind::{Gusts, MeanWind, Profile as WindProfile, Wind, WindGrid};

@@ -1,0 +1,737 @@
+//! Flying a mission: sample the trajectory, trim each sample in the wind, draw the power from the
+//! pack, and summarise.
+//!
+//! # Integration
+//! Each trajectory piece of duration `D` is cut into `n = ceil(D / dt)` equal steps of
+//! `h = D / n <= dt` and every quantity is evaluated at the step's midpoint (midpoint rule:
+//! energy `sum P h`, charge `sum I h`). Pieces end exactly on a step, so the mission's duration is
+//! exact and the error is second order in `h` except at the few instants where the acceleration
+//! jumps.
+//!
+//! Per sample: wind at the position and time, `v_air = v_ground - wind`, trim (thrust vector from
+//! the force balance, [`crate::trim`]), ground effect (survey eq 35, [`crate::ground_effect`]) at
+//! the rotor height `altitude + rotor_height_m`, electrical power, pack current and terminal
+//! voltage ([`crate::battery`]), state of charge.
+//!
+//! # Feasibility
+//! The mission is infeasible (a valid result, not an error) when the pack cannot deliver the power,
+//! the current exceeds the pack's rating, the terminal voltage falls below the cut-off, the usable
+//! charge runs out, or the vehicle lands with less than the reserve. The simulation stops where
+//! the battery fails and reports the time, segment and position. Asking for more thrust or tilt
+//! than the airframe has is an error ([`PlannerError::BeyondVehicleLimit`]): the mission cannot be
+//! flown at all as written.
+//!
+//! # Point of no return
+//! Every `pnr_interval_s` while airborne the planner prices a straight return: fly home at the
+//! best-range airspeed for the home bearing in the mean wind at the present position
+//! ([`crate::queries::best_range`], cached per 0.5 deg of bearing), then descend vertically at
+//! `return_descent_rate_mps`. The charge it needs is taken at the pack's present state (current
+//! at the midpoint state of charge of the return). The point of no return is the last check
+//! before the first one at which the return would end below the reserve; it is absent when every
+//! check passes.
+
+use aloft_power::AoaModel;
+use serde::Serialize;
+
+use crate::aircraft::{Aircraft, Powered};
+use crate::battery::Battery;
+use crate::error::PlannerError;
+use crate::ground_effect::thrust_factor;
+use crate::mission::Mission;
+use crate::queries::best_range;
+use crate::trim::attitude_rad;
+use crate::wind::Wind;
+
+/// Options of a planning run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanOptions {
+    /// Largest sampling step, s (default 0.1).
+    pub time_step_s: f64,
+    /// Angle-of-attack model (default geometric).
+    pub aoa: AoaModel,
+    /// Apply ground effect near the ground (default true).
+    pub ground_effect: bool,
+    /// Reserve required at landing, fraction of the usable capacity (default 0.2).
+    pub reserve_fraction: f64,
+    /// State of charge at take-off (default 1).
+    pub start_soc: f64,
+    /// Keep every sample for a time series (default false: the hot loop stores nothing).
+    pub record_samples: bool,
+    /// Compute the point of no return (default true).
+    pub point_of_no_return: bool,
+    /// Interval of the point-of-no-return checks, s (default 1).
+    pub pnr_interval_s: f64,
+    /// Descent rate of the priced return, m/s (default: 2 m/s or the airframe's limit if lower).
+    pub return_descent_rate_mps: Option<f64>,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            time_step_s: 0.1,
+            aoa: AoaModel::Geometric,
+            ground_effect: true,
+            reserve_fraction: 0.2,
+            start_soc: 1.0,
+            record_samples: false,
+            point_of_no_return: true,
+            pnr_interval_s: 1.0,
+            return_descent_rate_mps: None,
+        }
+    }
+}
+
+/// One sample of the time series (at the midpoint of an integration step).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    /// Mission time, s.
+    pub time_s: f64,
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// East, m.
+    pub east_m: f64,
+    /// North, m.
+    pub north_m: f64,
+    /// Height above home, m.
+    pub up_m: f64,
+    /// Ground velocity east, m/s.
+    pub vel_east_mps: f64,
+    /// Ground velocity north, m/s.
+    pub vel_north_mps: f64,
+    /// Ground velocity up, m/s.
+    pub vel_up_mps: f64,
+    /// Acceleration east, m/s^2.
+    pub acc_east_mps2: f64,
+    /// Acceleration north, m/s^2.
+    pub acc_north_mps2: f64,
+    /// Acceleration up, m/s^2.
+    pub acc_up_mps2: f64,
+    /// Wind east, m/s.
+    pub wind_east_mps: f64,
+    /// Wind north, m/s.
+    pub wind_north_mps: f64,
+    /// Horizontal airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Thrust, N.
+    pub thrust_n: f64,
+    /// Roll, deg.
+    pub roll_deg: f64,
+    /// Pitch, deg.
+    pub pitch_deg: f64,
+    /// Heading, deg clockwise from north.
+    pub yaw_deg: f64,
+    /// Electrical power, W.
+    pub power_w: f64,
+    /// Pack current, A.
+    pub current_a: f64,
+    /// Pack terminal voltage, V.
+    pub voltage_v: f64,
+    /// State of charge after the step.
+    pub soc: f64,
+}
+
+/// Statistics of one mission segment.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentReport {
+    /// Segment number, from 1.
+    pub index: usize,
+    /// Kind (`take-off`, `leg`, `orbit`, `hover`, `return`, `descent`, `landing`).
+    pub kind: &'static str,
+    /// Duration flown, s.
+    pub duration_s: f64,
+    /// Path length flown, m.
+    pub distance_m: f64,
+    /// Electrical energy, W h.
+    pub energy_wh: f64,
+    /// Mean electrical power, W.
+    pub mean_power_w: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// State of charge at the end of the segment.
+    pub end_soc: f64,
+}
+
+/// Why a valid mission cannot be flown with this pack.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "cause", rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum Shortfall {
+    /// The usable charge ran out in flight.
+    BatteryEmpty {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+    },
+    /// The terminal voltage fell below the cut-off.
+    CutOffVoltage {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+        /// Terminal voltage, V.
+        voltage_v: f64,
+        /// Cut-off, V.
+        cutoff_v: f64,
+    },
+    /// The pack cannot deliver the power (`V_oc^2 < 4 R P`) or its rated current.
+    PackLimit {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+        /// Power asked, W.
+        power_w: f64,
+    },
+    /// The mission lands with less than the reserve.
+    Reserve {
+        /// Usable charge left at landing, fraction of capacity.
+        reserve_soc: f64,
+        /// Reserve required, fraction of capacity.
+        required_soc: f64,
+    },
+}
+
+impl std::fmt::Display for Shortfall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let at = |f: &mut std::fmt::Formatter<'_>, t: f64, seg: usize, kind: &str, p: [f64; 3]| {
+            write!(
+                f,
+                "at t = {t:.1} s ({}:{:04.1}) in segment {seg} ({kind}), {:.0} m east, {:.0} m north, {:.0} m up",
+                (t / 60.0).floor(),
+                t % 60.0,
+                p[0],
+                p[1],
+                p[2]
+            )
+        };
+        match self {
+            Shortfall::BatteryEmpty {
+                time_s,
+                segment,
+                kind,
+                position_m,
+            } => {
+                write!(f, "the battery runs out ")?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::CutOffVoltage {
+                time_s,
+                segment,
+                kind,
+                position_m,
+                voltage_v,
+                cutoff_v,
+            } => {
+                write!(
+                    f,
+                    "the pack voltage falls to {voltage_v:.2} V, below the {cutoff_v:.2} V cut-off, "
+                )?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::PackLimit {
+                time_s,
+                segment,
+                kind,
+                position_m,
+                power_w,
+            } => {
+                write!(
+                    f,
+                    "the pack cannot deliver {power_w:.0} W (its power or current limit) "
+                )?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::Reserve {
+                reserve_soc,
+                required_soc,
+            } => write!(
+                f,
+                "it lands with {:.1} % of the capacity usable, below the required reserve of {:.1} %",
+                reserve_soc * 100.0,
+                required_soc * 100.0
+            ),
+        }
+    }
+}
+
+/// The point of no return.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PointOfNoReturn {
+    /// Mission time, s.
+    pub time_s: f64,
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// Position, ENU m.
+    pub position_m: [f64; 3],
+}
+
+/// The result of a planning run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissionReport {
+    /// Whether the mission can be flown with the reserve.
+    pub feasible: bool,
+    /// Why not.
+    pub shortfall: Option<Shortfall>,
+    /// Take-off mass, kg.
+    pub takeoff_mass_kg: f64,
+    /// Duration flown, s.
+    pub duration_s: f64,
+    /// Path length flown, m.
+    pub distance_m: f64,
+    /// Electrical energy delivered to the load, W h.
+    pub energy_wh: f64,
+    /// Heat in the pack's internal resistance, W h.
+    pub pack_heat_wh: f64,
+    /// State of charge at take-off.
+    pub start_soc: f64,
+    /// State of charge at the end.
+    pub end_soc: f64,
+    /// Lowest terminal voltage, V.
+    pub min_voltage_v: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// Peak pack current, A.
+    pub peak_current_a: f64,
+    /// State of charge at which the usable charge is exhausted (`1 - usable_fraction`).
+    pub empty_soc: f64,
+    /// Usable charge left at the end, fraction of capacity (`end_soc - empty_soc`).
+    pub reserve_soc: f64,
+    /// Reserve required, fraction of capacity.
+    pub required_reserve_soc: f64,
+    /// Point of no return, when some part of the mission is past it.
+    pub point_of_no_return: Option<PointOfNoReturn>,
+    /// Per segment, in order (segments not reached are absent).
+    pub segments: Vec<SegmentReport>,
+    /// Samples, when recorded.
+    pub samples: Vec<Sample>,
+}
+
+#[derive(Default, Clone, Copy)]
+struct Acc {
+    duration_s: f64,
+    distance_m: f64,
+    energy_j: f64,
+    peak_w: f64,
+    end_soc: f64,
+    reached: bool,
+}
+
+/// Cached return cost per bearing bin for one mass phase and wind.
+struct ReturnCache {
+    phase: usize,
+    wind: [f64; 2],
+    bins: Vec<Option<(f64, f64)>>,
+}
+
+const BEARING_BINS: usize = 720;
+
+/// Fly `mission` with `aircraft` and `battery` in `wind`.
+///
+/// # Errors
+/// Invalid options, a thrust or tilt beyond the airframe's limit, a wind grid that does not cover
+/// the route, a flight condition the power model rejects.
+pub fn plan(
+    aircraft: &Aircraft,
+    battery: &Battery,
+    mission: &Mission,
+    wind: &Wind,
+    options: &PlanOptions,
+) -> Result<MissionReport, PlannerError> {
+    let dt = crate::error::positive("time_step_s", options.time_step_s, "s")?;
+    if !(options.reserve_fraction >= 0.0 && options.reserve_fraction < 1.0) {
+        return Err(PlannerError::InvalidParameter {
+            name: "reserve_fraction",
+            value: options.reserve_fraction,
+            unit: "",
+            expected: "a fraction in [0, 1)",
+        });
+    }
+    if !(options.start_soc > battery.empty_soc() && options.start_soc <= 1.0) {
+        return Err(PlannerError::InvalidParameter {
+            name: "start_soc",
+            value: options.start_soc,
+            unit: "",
+            expected: "a fraction in (empty point, 1]",
+        });
+    }
+    crate::error::positive("pnr_interval_s", options.pnr_interval_s, "s")?;
+    let airframe = aircraft.airframe();
+    let g = aircraft.gravity_mps2();
+    let return_rate = match options.return_descent_rate_mps {
+        Some(r) => crate::error::positive("return_descent_rate_mps", r, "m/s")?,
+        None => airframe.max_descent_rate_mps().min(2.0),
+    };
+    let base_mass = airframe.mass_kg() + battery.mass_kg();
+    let powered: Vec<Powered<'_>> = mission
+        .payloads_kg()
+        .iter()
+        .map(|p| aircraft.at_mass(base_mass + p, options.aoa))
+        .collect::<Result<_, _>>()?;
+    let max_thrust = airframe.max_thrust_n(g);
+    let cos_tilt_max = airframe.max_tilt_rad().cos();
+    let charge_as = battery.capacity_ah() * 3600.0;
+    let empty = battery.empty_soc();
+    let required = options.reserve_fraction * battery.usable_fraction();
+    let r_rotor = aircraft.rotor_radius_m();
+    let rotor_h = airframe.rotor_height_m();
+    let uniform_wind = if wind.is_uniform() {
+        wind.mean_at([0.0; 3])
+    } else {
+        None
+    };
+    let kinds = mission.segment_kinds();
+    let home = mission.home_m();
+
+    let mut acc = vec![Acc::default(); kinds.len()];
+    let mut soc = options.start_soc;
+    let mut energy_j = 0.0;
+    let mut heat_j = 0.0;
+    let mut min_v = f64::INFINITY;
+    let mut peak_w: f64 = 0.0;
+    let mut peak_a: f64 = 0.0;
+    let mut t0 = 0.0;
+    let mut shortfall = None;
+    let mut samples = Vec::new();
+    if options.record_samples {
+        samples.reserve((mission.duration_s() / dt) as usize + mission.pieces().len());
+    }
+    let mut next_check = 0.0;
+    let mut last_ok: Option<PointOfNoReturn> = None;
+    let mut pnr: Option<PointOfNoReturn> = None;
+    let mut pnr_done = !options.point_of_no_return;
+    let mut cache = ReturnCache {
+        phase: usize::MAX,
+        wind: [f64::NAN; 2],
+        bins: vec![None; BEARING_BINS],
+    };
+
+    'pieces: for piece in mission.pieces() {
+        let pw = &powered[piece.mass_phase];
+        let seg = piece.segment;
+        let dur = piece.duration_s();
+        let n = ((dur / dt) - 1e-9).ceil().max(1.0) as usize;
+        let h = dur / n as f64;
+        let a = &mut acc[seg];
+        a.reached = true;
+        let mut seg_energy = 0.0;
+        let mut seg_peak = a.peak_w;
+        for k in 0..n {
+            let tm = (k as f64 + 0.5) * h;
+            let t = t0 + tm;
+            let kin = piece.at(tm);
+            let w = match uniform_wind {
+                Some(w) => w,
+                None => wind
+                    .at(kin.pos_m, t)
+                    .ok_or_else(|| outside(wind, t, kin.pos_m))?,
+            };
+            let v_air = [
+                kin.vel_mps[0] - w[0],
+                kin.vel_mps[1] - w[1],
+                kin.vel_mps[2] - w[2],
+            ];
+            let ge = if options.ground_effect {
+                thrust_factor(r_rotor, kin.pos_m[2] + rotor_h)
+            } else {
+                1.0
+            };
+            let trim = pw.trim(kin.acc_mps2, v_air, kin.forward, ge)?;
+            if trim.thrust_n > max_thrust || trim.axis[2] < cos_tilt_max {
+                let thrust = trim.thrust_n > max_thrust;
+                return Err(PlannerError::BeyondVehicleLimit {
+                    time_s: t,
+                    index: seg + 1,
+                    kind: kinds[seg],
+                    east_m: kin.pos_m[0],
+                    north_m: kin.pos_m[1],
+                    up_m: kin.pos_m[2],
+                    name: if thrust { "thrust" } else { "tilt" },
+                    value: if thrust {
+                        trim.thrust_n
+                    } else {
+                        trim.axis[2].clamp(-1.0, 1.0).acos().to_degrees()
+                    },
+                    limit: if thrust {
+                        max_thrust
+                    } else {
+                        airframe.max_tilt_rad().to_degrees()
+                    },
+                    unit: if thrust { "N" } else { "deg" },
+                });
+            }
+            let p = trim.electrical_w;
+            let draw = match battery.draw(p, soc) {
+                Some(d) if d.current_a <= battery.max_current_a() => d,
+                _ => {
+                    shortfall = Some(Shortfall::PackLimit {
+                        time_s: t,
+                        segment: seg + 1,
+                        kind: kinds[seg],
+                        position_m: kin.pos_m,
+                        power_w: p,
+                    });
+                    a.duration_s += tm;
+                    a.distance_m += piece.profile.at(tm).0;
+                    break 'pieces;
+                }
+            };
+            soc -= draw.current_a * h / charge_as;
+            let e = p * h;
+            seg_energy += e;
+            heat_j += draw.current_a * draw.current_a * battery.resistance_ohm() * h;
+            seg_peak = seg_peak.max(p);
+            peak_a = peak_a.max(draw.current_a);
+            min_v = min_v.min(draw.terminal_v);
+            if options.record_samples {
+                let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
+                samples.push(Sample {
+                    time_s: t,
+                    segment: seg + 1,
+                    east_m: kin.pos_m[0],
+                    north_m: kin.pos_m[1],
+                    up_m: kin.pos_m[2],
+                    vel_east_mps: kin.vel_mps[0],
+                    vel_north_mps: kin.vel_mps[1],
+                    vel_up_mps: kin.vel_mps[2],
+                    acc_east_mps2: kin.acc_mps2[0],
+                    acc_north_mps2: kin.acc_mps2[1],
+                    acc_up_mps2: kin.acc_mps2[2],
+                    wind_east_mps: w[0],
+                    wind_north_mps: w[1],
+                    airspeed_mps: trim.airspeed_mps,
+                    thrust_n: trim.thrust_n,
+                    roll_deg: roll.to_degrees(),
+                    pitch_deg: pitch.to_degrees(),
+                    yaw_deg: yaw.to_degrees().rem_euclid(360.0),
+                    power_w: p,
+                    current_a: draw.current_a,
+                    voltage_v: draw.terminal_v,
+                    soc,
+                });
+            }
+            let failed = if draw.terminal_v < battery.cutoff_v() {
+                Some(Shortfall::CutOffVoltage {
+                    time_s: t,
+                    segment: seg + 1,
+                    kind: kinds[seg],
+                    position_m: kin.pos_m,
+                    voltage_v: draw.terminal_v,
+                    cutoff_v: battery.cutoff_v(),
+                })
+            } else if soc <= empty {
+                Some(Shortfall::BatteryEmpty {
+                    time_s: t,
+                    segment: seg + 1,
+                    kind: kinds[seg],
+                    position_m: kin.pos_m,
+                })
+            } else {
+                None
+            };
+            if let Some(f) = failed {
+                shortfall = Some(f);
+                a.duration_s += tm + 0.5 * h;
+                a.distance_m += piece.profile.at(tm + 0.5 * h).0;
+                a.energy_j += seg_energy;
+                a.peak_w = seg_peak;
+                a.end_soc = soc;
+                energy_j += seg_energy;
+                peak_w = peak_w.max(seg_peak);
+                break 'pieces;
+            }
+            if !pnr_done && t >= next_check && kin.pos_m[2] > 0.0 {
+                next_check = t + options.pnr_interval_s;
+                let here = PointOfNoReturn {
+                    time_s: t,
+                    segment: seg + 1,
+                    position_m: kin.pos_m,
+                };
+                let ok = can_return(
+                    pw,
+                    battery,
+                    wind,
+                    &mut cache,
+                    piece.mass_phase,
+                    kin.pos_m,
+                    home,
+                    soc,
+                    empty + required,
+                    return_rate,
+                    charge_as,
+                );
+                if ok {
+                    last_ok = Some(here);
+                } else {
+                    pnr = Some(last_ok.unwrap_or(PointOfNoReturn {
+                        time_s: 0.0,
+                        segment: 1,
+                        position_m: home,
+                    }));
+                    pnr_done = true;
+                }
+            }
+        }
+        a.duration_s += dur;
+        a.distance_m += piece.profile.length_m;
+        a.energy_j += seg_energy;
+        a.peak_w = seg_peak;
+        a.end_soc = soc;
+        energy_j += seg_energy;
+        peak_w = peak_w.max(seg_peak);
+        t0 += dur;
+    }
+
+    let duration_s: f64 = acc.iter().map(|a| a.duration_s).sum();
+    let reserve_soc = (soc - empty).max(0.0);
+    if shortfall.is_none() && reserve_soc < required {
+        shortfall = Some(Shortfall::Reserve {
+            reserve_soc,
+            required_soc: required,
+        });
+    }
+    let segments = acc
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.reached)
+        .map(|(i, a)| SegmentReport {
+            index: i + 1,
+            kind: kinds[i],
+            duration_s: a.duration_s,
+            distance_m: a.distance_m,
+            energy_wh: a.energy_j / 3600.0,
+            mean_power_w: if a.duration_s > 0.0 {
+                a.energy_j / a.duration_s
+            } else {
+                0.0
+            },
+            peak_power_w: a.peak_w,
+            end_soc: a.end_soc,
+        })
+        .collect::<Vec<_>>();
+    Ok(MissionReport {
+        feasible: shortfall.is_none(),
+        shortfall,
+        takeoff_mass_kg: powered[0].mass_kg(),
+        duration_s,
+        distance_m: segments.iter().map(|s| s.distance_m).sum(),
+        energy_wh: energy_j / 3600.0,
+        pack_heat_wh: heat_j / 3600.0,
+        start_soc: options.start_soc,
+        end_soc: soc.max(0.0),
+        min_voltage_v: if min_v.is_finite() { min_v } else { 0.0 },
+        peak_power_w: peak_w,
+        peak_current_a: peak_a,
+        empty_soc: empty,
+        reserve_soc,
+        required_reserve_soc: required,
+        point_of_no_return: pnr,
+        segments,
+        samples,
+    })
+}
+
+fn outside(wind: &Wind, t: f64, p: [f64; 3]) -> PlannerError {
+    let (min_m, max_m) = match wind.mean() {
+        crate::wind::MeanWind::Grid(g) => g.bounds_m(),
+        _ => ([f64::NAN; 3], [f64::NAN; 3]),
+    };
+    PlannerError::OutsideWindGrid {
+        time_s: t,
+        east_m: p[0],
+        north_m: p[1],
+        up_m: p[2],
+        min_m,
+        max_m,
+    }
+}
+
+/// Whether a straight return from `pos` lands with the state of charge at or above `floor_soc`.
+#[allow(clippy::too_many_arguments)]
+fn can_return(
+    pw: &Powered<'_>,
+    battery: &Battery,
+    wind: &Wind,
+    cache: &mut ReturnCache,
+    phase: usize,
+    pos: [f64; 3],
+    home: [f64; 3],
+    soc: f64,
+    floor_soc: f64,
+    descent_rate: f64,
+    charge_as: f64,
+) -> bool {
+    let w = match wind.mean_at(pos) {
+        Some(w) => w,
+        None => return false,
+    };
+    let wh = [w[0], w[1]];
+    // A cache entry is valid for this mass phase and a mean wind within 1 cm/s.
+    if cache.phase != phase
+        || !((cache.wind[0] - wh[0]).abs() < 0.01 && (cache.wind[1] - wh[1]).abs() < 0.01)
+    {
+        cache.phase = phase;
+        cache.wind = wh;
+        cache.bins.iter_mut().for_each(|b| *b = None);
+    }
+    let d = [home[0] - pos[0], home[1] - pos[1]];
+    let dist = d[0].hypot(d[1]);
+    // (power W, ground speed m/s) of the horizontal leg.
+    let leg = if dist > 1.0 {
+        let bearing = d[0].atan2(d[1]).rem_euclid(std::f64::consts::TAU);
+        let bin = ((bearing / std::f64::consts::TAU * BEARING_BINS as f64) as usize)
+            .min(BEARING_BINS - 1);
+        match cache.bins[bin] {
+            Some(v) => Some(v),
+            None => {
+                let b = (bin as f64 + 0.5) / BEARING_BINS as f64 * std::f64::consts::TAU;
+                let course = [b.sin(), b.cos()];
+                let max_air = pw.aircraft().airframe().max_speed_mps();
+                match best_range(pw, course, wh, max_air) {
+                    Ok(r) => {
+                        cache.bins[bin] = Some((r.power_w, r.ground_speed_mps));
+                        cache.bins[bin]
+                    }
+                    Err(_) => return false,
+                }
+            }
+        }
+    } else {
+        None
+    };
+    // Descent over home: air velocity is minus the wind, vertical -rate.
+    let descent_w = match pw.trim(
+        [0.0; 3],
+        [-wh[0], -wh[1], -descent_rate - w[2]],
+        [0.0, 1.0],
+        1.0,
+    ) {
+        Ok(t) => t.electrical_w,
+        Err(_) => return false,
+    };
+    let descent_s = pos[2] / descent_rate;
+    let charge = |s: f64| -> Option<f64> {
+        let mut q = 0.0;
+        if let Some((p, vg)) = leg {
+            q += battery.draw(p, s)?.current_a * dist / vg;
+        }
+        q += battery.draw(descent_w, s)?.current_a * descent_s;
+        Some(q)
+    };
+    let Some(q0) = charge(soc) else { return false };
+    let mid = soc - 0.5 * q0 / charge_as;
+    let Some(q) = charge(mid) else { return false };
+    soc - q / charge_as >= floor_soc
+}

@@ -1,0 +1,183 @@
+//! Trim: the thrust vector from the force balance, the attitude it implies, and the electrical
+//! power of the flight condition.
+//!
+//! Force balance in ENU (Newton, the survey seed's eq 16 without the rotational part):
+//!
+//! `m a = T + m g + F_D(v_air)`, so `T = m a + m g e_up + f_D(|v_air|) v_air / |v_air|`
+//!
+//! | symbol | meaning | unit |
+//! |---|---|---|
+//! | `m` | total mass (airframe, battery, payload) | kg |
+//! | `a` | acceleration over the ground (the trajectory's, centripetal included) | m/s^2 |
+//! | `T` | thrust vector along the rotor axis | N |
+//! | `v_air` | velocity of the vehicle relative to the air, `v_ground - wind` | m/s |
+//! | `f_D` | cubic drag of power seed eq (6) | N |
+//!
+//! The attitude follows from the thrust axis `t = T / |T|` with the heading along the track:
+//! with `f`, `r` the forward and right horizontal unit vectors, `sin(roll) = t.r`,
+//! `tan(pitch) = -t.f / t.up` (Z-Y-X Euler angles of a forward-right-down body, as in
+//! `aloft_power::angle_of_attack`).
+//!
+//! # Inflow and the climb term: no double counting
+//! The four-term model gets the thrust `|T|` (scaled for ground effect), the HORIZONTAL air
+//! velocity `v_h` and the vertical air speed `v_z` separately:
+//! - geometric angle of attack (default): `Vn = v_h . t`, `Vp = |v_h - Vn t|`, airspeed `|v_h|`;
+//! - the paper's eqs (3)-(4): `Vn = |v_h| sin(roll) sin(pitch)`, `Vp = |v_h| cos(roll) cos(pitch)`;
+//! - climb power, eq (13): `P_c = m g v_z` with `v_z` the vertical speed relative to the air.
+//!
+//! Physically the axial flow of a climb enters the rotor inflow (`Vn` would include `v_z`); but
+//! then `T (v_i + Vn)` of eq (8) already contains `T v_z ~ m g v_z`, which eq (13) adds again.
+//! The paper keeps climb in its own term (its `Vn` is built from level-flight attitude only), so
+//! the planner passes only the horizontal air velocity to the inflow and lets eq (13) carry the
+//! climb, once. The vertical air speed still enters the drag in the force balance. Using the air-
+//! relative `v_z` (not the ground's) in eq (13) makes a rising air mass lift the vehicle for free,
+//! as it physically does; with no vertical wind the two are the same.
+//!
+//! With the geometric angle of attack in steady level flight `T Vn = T . v_h = f_D |v_h|`: eq (8)'s
+//! work term is the parasitic power once more. The power model therefore takes `P_ind = T v_i`
+//! with the geometric inflow (see `aloft_power::four_term`, "Deviation"), so drag work is counted
+//! once, by eq (11).
+
+use aloft_power::{AoaModel, FlightCondition, Inflow};
+
+use crate::aircraft::{Engine, Powered};
+use crate::error::PlannerError;
+
+/// Result of a trim.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Trim {
+    /// Thrust magnitude (in ground effect: the thrust made, not the out-of-ground-effect
+    /// equivalent), N.
+    pub thrust_n: f64,
+    /// Unit thrust axis, ENU.
+    pub axis: [f64; 3],
+    /// Horizontal airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Electrical power, W.
+    pub electrical_w: f64,
+}
+
+/// Roll, pitch and yaw of a thrust axis with the nose along `forward` (east, north), rad.
+///
+/// Yaw is clockwise from north.
+pub fn attitude_rad(axis: [f64; 3], forward: [f64; 2]) -> (f64, f64, f64) {
+    let t_f = axis[0] * forward[0] + axis[1] * forward[1];
+    let t_r = axis[0] * forward[1] - axis[1] * forward[0];
+    let roll = t_r.clamp(-1.0, 1.0).asin();
+    let pitch = (-t_f).atan2(axis[2]);
+    (roll, pitch, forward[0].atan2(forward[1]))
+}
+
+/// Bank angle: tilt of the thrust axis in the vertical plane across the track,
+/// `atan2(t.r, t.up)`, rad (positive to the right).
+pub fn bank_rad(axis: [f64; 3], forward: [f64; 2]) -> f64 {
+    let t_r = axis[0] * forward[1] - axis[1] * forward[0];
+    t_r.atan2(axis[2])
+}
+
+impl Powered<'_> {
+    /// Trim for acceleration `acc_mps2` and air-relative velocity `vel_air_mps` (ENU), heading
+    /// along `forward`, with the ground-effect factor `ground_factor` = `T_inf / T` (1 away from
+    /// the ground).
+    ///
+    /// # Errors
+    /// A flight condition the power model rejects (non-finite values), or a thrust the propulsion
+    /// chain cannot make.
+    #[inline]
+    pub fn trim(
+        &self,
+        acc_mps2: [f64; 3],
+        vel_air_mps: [f64; 3],
+        forward: [f64; 2],
+        ground_factor: f64,
+    ) -> Result<Trim, PlannerError> {
+        let m = self.mass_kg;
+        let [vx, vy, vz] = vel_air_mps;
+        let speed = (vx * vx + vy * vy + vz * vz).sqrt();
+        // f_D(v) / v = mu1 + mu2 v + mu3 v^2 (eq 6 divided by v): no division on the hot path,
+        // and 0 N of drag at zero airspeed since f_D(0) = 0 multiplies v_air = 0.
+        let (mu1, mu2, mu3) = self.aircraft.drag().coefficients();
+        let k = mu1 + speed * (mu2 + speed * mu3);
+        let tx = m * acc_mps2[0] + k * vx;
+        let ty = m * acc_mps2[1] + k * vy;
+        let tz = m * acc_mps2[2] + self.weight_n + k * vz;
+        let thrust = (tx * tx + ty * ty + tz * tz).sqrt();
+        let inv = 1.0 / thrust;
+        let axis = [tx * inv, ty * inv, tz * inv];
+        let vh2 = vx * vx + vy * vy;
+        let vh = vh2.sqrt();
+        let electrical_w = match &self.engine {
+            Engine::FourTerm(model) => {
+                let inflow = match self.aoa {
+                    AoaModel::Geometric => {
+                        let normal = vx * axis[0] + vy * axis[1];
+                        Inflow {
+                            normal_mps: normal,
+                            parallel_mps: (vh2 - normal * normal).max(0.0).sqrt(),
+                        }
+                    }
+                    AoaModel::Paper => {
+                        let t_f = axis[0] * forward[0] + axis[1] * forward[1];
+                        let t_r = axis[0] * forward[1] - axis[1] * forward[0];
+                        let cos_roll = (1.0 - t_r * t_r).max(0.0).sqrt();
+                        Inflow {
+                            normal_mps: if cos_roll > 0.0 {
+                                vh * t_r * (-t_f / cos_roll)
+                            } else {
+                                0.0
+                            },
+                            parallel_mps: vh * axis[2].max(0.0),
+                        }
+                    }
+                };
+                model
+                    .evaluate_condition(&FlightCondition {
+                        thrust_n: thrust * ground_factor,
+                        airspeed_mps: vh,
+                        inflow,
+                        climb_rate_mps: vz,
+                        aoa: self.aoa,
+                    })?
+                    .electrical_w
+            }
+            Engine::Chain(system) => {
+                let n = f64::from(system.rotor_count());
+                let rotor = system.rotor_at_thrust(thrust * ground_factor / n)?;
+                let supply = rotor.supply_power_w * n;
+                // Climb: the paper's eq (13) through the chain's shaft-to-supply efficiency.
+                let climb = if rotor.efficiency > 0.0 {
+                    self.weight_n * vz / rotor.efficiency
+                } else {
+                    0.0
+                };
+                (supply + climb).max(0.0)
+            }
+        };
+        Ok(Trim {
+            thrust_n: thrust,
+            axis,
+            airspeed_mps: vh,
+            electrical_w,
+        })
+    }
+
+    /// Electrical power in steady level flight with horizontal air velocity `vel_air_mps`
+    /// (east, north) and the heading `forward`, out of ground effect, W.
+    ///
+    /// # Errors
+    /// As [`Self::trim`].
+    pub fn level_power_w(
+        &self,
+        vel_air_mps: [f64; 2],
+        forward: [f64; 2],
+    ) -> Result<f64, PlannerError> {
+        Ok(self
+            .trim(
+                [0.0; 3],
+                [vel_air_mps[0], vel_air_mps[1], 0.0],
+                forward,
+                1.0,
+            )?
+            .electrical_w)
+    }
+}

@@ -1,0 +1,769 @@
+//! Identification of the power-model parameters from measured electrical power.
+//!
+//! # What the data can identify
+//! Write `W = m g`, `c = cos(phi) cos(theta)` and `x = v_i / vh` (the normalised root of eq 9).
+//! Eqs (5)-(14) divided by `eta` depend on the parameters only through six lumped constants:
+//!
+//! `P = K/c (vh x(Vn/vh, Vp/vh) + Vn) + k_p / c^1.5 + d1 v^2 + d2 v^3 + d3 v^4 + K v_z`
+//!
+//! (with the geometric angle of attack the `+ Vn` work term is absent, as in
+//! [`crate::four_term`]).
+//!
+//! | constant | meaning | unit |
+//! |---|---|---|
+//! | `K = W / eta` | weight over efficiency | N |
+//! | `vh` | hover induced velocity, eq (10) | m/s |
+//! | `k_p = kappa1 W^1.5 / eta` | profile power at hover, electrical | W |
+//! | `d_k = mu_k / eta` | electrical drag coefficients | N s^k/m^k |
+//!
+//! (`kappa2` is held at the template's value.) Mass, rotor radius and efficiency are not separately
+//! identifiable from power: with the template's mass `m`, the fitted constants map back to
+//! `eta = W/K`, the rotor radius from `vh` through eq (10), `mu_k = d_k eta` and
+//! `kappa1 = k_p eta / W^1.5`. For a vehicle of known geometry `vh` is held fixed (and eta is then
+//! the physical efficiency); for one of unknown mass or rotor size `vh` is freed.
+//!
+//! # Method
+//! Nonlinear least squares on the residuals `P_model - P_measured`, all samples weighted equally,
+//! by Gauss-Newton with a backtracking (Armijo) line search (argmin), with the analytic Jacobian
+//! (implicit differentiation of the quartic for `x`). `K` and `vh` are fitted as logarithms (they
+//! stay positive); the others are scaled to the mean measured power. Outliers: after a first fit,
+//! samples whose residual is more than `outlier_sigma` robust standard deviations
+//! (1.4826 x median absolute deviation) from the median residual are dropped and the fit is
+//! repeated; the count is reported. Standard errors: `sigma^2 (J^T J)^-1` with
+//! `sigma^2 = SSR/(n - p)` at the solution. A parameter is refused ([`FitError::NotIdentifiable`])
+//! when its standard error exceeds `max_relative_std_error` times its magnitude, or the information
+//! matrix is singular along it; drag coefficients and a free `vh` are refused up front when the
+//! data has too little forward flight ([`FitError::NoForwardFlight`]).
+
+use std::sync::Arc;
+
+use argmin::core::{Executor, Jacobian, Operator, State};
+use argmin::solver::gaussnewton::GaussNewtonLS;
+use argmin::solver::linesearch::condition::ArmijoCondition;
+use argmin::solver::linesearch::BacktrackingLineSearch;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+
+use crate::error::FitError;
+use crate::four_term::{check_state, AoaInput, FlightState};
+use crate::induced::solve_normalised;
+use crate::vehicle::{DiskArea, Vehicle, VehicleParams};
+
+/// One measured sample: the flight state and the measured electrical power.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitSample {
+    /// Flight state (airspeed, attitude, climb rate, angle-of-attack model).
+    pub state: FlightState,
+    /// Measured electrical power, W.
+    pub measured_power_w: f64,
+}
+
+/// A lumped constant of the fit (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FitParameter {
+    /// `K = m g / eta`, N.
+    WeightOverEfficiency,
+    /// `vh`, m/s.
+    HoverInducedVelocity,
+    /// `k_p = kappa1 W^1.5 / eta`, W.
+    Profile,
+    /// `d1 = mu1 / eta`.
+    Mu1,
+    /// `d2 = mu2 / eta`.
+    Mu2,
+    /// `d3 = mu3 / eta`.
+    Mu3,
+}
+
+impl FitParameter {
+    /// All constants, in vector order.
+    pub const ALL: [FitParameter; 6] = [
+        FitParameter::WeightOverEfficiency,
+        FitParameter::HoverInducedVelocity,
+        FitParameter::Profile,
+        FitParameter::Mu1,
+        FitParameter::Mu2,
+        FitParameter::Mu3,
+    ];
+
+    /// Name used in reports and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            FitParameter::WeightOverEfficiency => "weight_over_efficiency_n",
+            FitParameter::HoverInducedVelocity => "hover_induced_velocity_mps",
+            FitParameter::Profile => "profile_hover_w",
+            FitParameter::Mu1 => "mu1_over_eta_n_s_per_m",
+            FitParameter::Mu2 => "mu2_over_eta_n_s2_per_m2",
+            FitParameter::Mu3 => "mu3_over_eta_n_s3_per_m3",
+        }
+    }
+
+    /// Unit of the constant.
+    pub fn unit(self) -> &'static str {
+        match self {
+            FitParameter::WeightOverEfficiency => "N",
+            FitParameter::HoverInducedVelocity => "m/s",
+            FitParameter::Profile => "W",
+            FitParameter::Mu1 => "N s/m",
+            FitParameter::Mu2 => "N s^2/m^2",
+            FitParameter::Mu3 => "N s^3/m^3",
+        }
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// A progress callback: iteration number and current cost (norm of the residuals, W).
+pub type ProgressFn = Arc<dyn Fn(u64, f64) + Send + Sync>;
+
+/// Options of [`fit_power_model`].
+#[derive(Clone)]
+pub struct FitOptions {
+    /// The constants to fit; the others keep the template's values.
+    pub free: Vec<FitParameter>,
+    /// Outlier threshold in robust standard deviations; `None` keeps every sample.
+    pub outlier_sigma: Option<f64>,
+    /// Largest accepted standard error relative to the value.
+    pub max_relative_std_error: f64,
+    /// Gauss-Newton iteration limit per pass.
+    pub max_iterations: u64,
+    /// Airspeed above which a sample counts as forward flight, m/s.
+    pub forward_flight_mps: f64,
+    /// Called after each iteration.
+    pub progress: Option<ProgressFn>,
+}
+
+impl std::fmt::Debug for FitOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FitOptions")
+            .field("free", &self.free)
+            .field("outlier_sigma", &self.outlier_sigma)
+            .field("max_relative_std_error", &self.max_relative_std_error)
+            .field("max_iterations", &self.max_iterations)
+            .field("forward_flight_mps", &self.forward_flight_mps)
+            .finish()
+    }
+}
+
+impl FitOptions {
+    /// Known mass and rotor size: fit `K` (hence eta), the profile constant and the drag.
+    pub fn known_geometry() -> Self {
+        Self {
+            free: vec![
+                FitParameter::WeightOverEfficiency,
+                FitParameter::Profile,
+                FitParameter::Mu1,
+                FitParameter::Mu2,
+                FitParameter::Mu3,
+            ],
+            outlier_sigma: Some(5.0),
+            max_relative_std_error: 1.0,
+            max_iterations: 50,
+            forward_flight_mps: 3.0,
+            progress: None,
+        }
+    }
+
+    /// Unknown mass or rotor size: also free `vh`.
+    pub fn unknown_geometry() -> Self {
+        let mut o = Self::known_geometry();
+        o.free.insert(1, FitParameter::HoverInducedVelocity);
+        o
+    }
+
+    /// These options without `parameter` (held at the template's value).
+    pub fn without(mut self, parameter: FitParameter) -> Self {
+        self.free.retain(|&p| p != parameter);
+        self
+    }
+}
+
+/// One fitted constant with its standard error.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedParameter {
+    /// Name (see [`FitParameter::name`]).
+    pub name: &'static str,
+    /// Fitted value.
+    pub value: f64,
+    /// Standard error from the Jacobian at the solution.
+    pub std_error: f64,
+    /// Unit.
+    pub unit: &'static str,
+}
+
+/// The result of a fit.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PowerFit {
+    /// The template's power parameters with the fitted values mapped back.
+    pub vehicle: VehicleParams,
+    /// The free constants with standard errors.
+    pub parameters: Vec<FittedParameter>,
+    /// Root-mean-square residual over the samples used, W.
+    pub rmse_w: f64,
+    /// RMSE over the mean measured power of the samples used (a fraction).
+    pub nrmse: f64,
+    /// Samples used in the final pass.
+    pub samples_used: usize,
+    /// Samples dropped as outliers.
+    pub outliers_rejected: usize,
+    /// Gauss-Newton iterations, both passes.
+    pub iterations: u64,
+}
+
+/// Per-sample quantities that do not depend on the parameters.
+#[derive(Debug, Clone, Copy)]
+struct Pre {
+    inv_c: f64,
+    inv_c15: f64,
+    vn: f64,
+    vp: f64,
+    v2: f64,
+    v: f64,
+    vz: f64,
+    measured: f64,
+    /// 1 with the paper's AoA (eq 8 as printed), 0 with the geometric one (P_ind = T v_i).
+    vn_work: f64,
+}
+
+/// Full lumped parameter vector in [`FitParameter::ALL`] order.
+type Lumped = [f64; 6];
+
+fn model_and_gradient(p: &Lumped, s: &Pre, want_gradient: bool) -> Option<(f64, Lumped)> {
+    let [k, vh, kp, d1, d2, d3] = *p;
+    let a = s.vn / vh;
+    let b = s.vp / vh;
+    let x = solve_normalised(a, b)?;
+    let v = s.v;
+    let induced = vh * x + s.vn_work * s.vn;
+    let power = k * s.inv_c * induced + kp * s.inv_c15 + s.v2 * (d1 + v * (d2 + v * d3)) + k * s.vz;
+    if !want_gradient {
+        return Some((power, [0.0; 6]));
+    }
+    // x(a, b) from g = x^2((x+a)^2 + b^2) - 1 = 0.
+    let sx = x + a;
+    let q = sx * sx + b * b;
+    let g_x = 2.0 * x * (q + x * sx);
+    let dx_da = -(2.0 * x * x * sx) / g_x;
+    let dx_db = -(2.0 * x * x * b) / g_x;
+    let grad = [
+        s.inv_c * induced + s.vz,
+        k * s.inv_c * (x - a * dx_da - b * dx_db),
+        s.inv_c15,
+        s.v2,
+        s.v2 * v,
+        s.v2 * v * v,
+    ];
+    Some((power, grad))
+}
+
+/// The least-squares problem in scaled coordinates `u`.
+struct Problem<'a> {
+    samples: &'a [Pre],
+    base: Lumped,
+    free: &'a [FitParameter],
+    scale: Lumped,
+}
+
+impl Problem<'_> {
+    /// Lumped parameters from the scaled free vector (K and vh as logarithms).
+    fn lumped(&self, u: &DVector<f64>) -> Lumped {
+        let mut p = self.base;
+        for (j, &f) in self.free.iter().enumerate() {
+            let i = f.index();
+            p[i] = match f {
+                FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => {
+                    self.base[i] * u[j].exp()
+                }
+                _ => u[j] * self.scale[i],
+            };
+        }
+        p
+    }
+
+    /// Residuals and (optionally) the Jacobian in `u`.
+    fn evaluate(&self, u: &DVector<f64>, jacobian: bool) -> (DVector<f64>, Option<DMatrix<f64>>) {
+        let p = self.lumped(u);
+        let n = self.samples.len();
+        let mut r = DVector::zeros(n);
+        let mut j = jacobian.then(|| DMatrix::zeros(n, self.free.len()));
+        for (i, s) in self.samples.iter().enumerate() {
+            match model_and_gradient(&p, s, jacobian) {
+                Some((power, grad)) => {
+                    r[i] = power - s.measured;
+                    if let Some(j) = j.as_mut() {
+                        for (col, &f) in self.free.iter().enumerate() {
+                            let k = f.index();
+                            j[(i, col)] = match f {
+                                FitParameter::WeightOverEfficiency
+                                | FitParameter::HoverInducedVelocity => grad[k] * p[k],
+                                _ => grad[k] * self.scale[k],
+                            };
+                        }
+                    }
+                }
+                // No root continuous with hover at these parameters: a large residual steers the
+                // line search away.
+                None => r[i] = 1e6 + s.measured.abs(),
+            }
+        }
+        (r, j)
+    }
+}
+
+impl Operator for Problem<'_> {
+    type Param = DVector<f64>;
+    type Output = DVector<f64>;
+    fn apply(&self, u: &Self::Param) -> Result<Self::Output, argmin::core::Error> {
+        Ok(self.evaluate(u, false).0)
+    }
+}
+
+impl Jacobian for Problem<'_> {
+    type Param = DVector<f64>;
+    type Jacobian = DMatrix<f64>;
+    fn jacobian(&self, u: &Self::Param) -> Result<Self::Jacobian, argmin::core::Error> {
+        Ok(self.evaluate(u, true).1.expect("requested"))
+    }
+}
+
+/// Fit the free lumped constants of `options` to `samples`, starting from `template`.
+pub fn fit_power_model(
+    template: &Vehicle,
+    samples: &[FitSample],
+    options: &FitOptions,
+) -> Result<PowerFit, FitError> {
+    // Validate and precompute.
+    let mut pre = Vec::with_capacity(samples.len());
+    for (index, s) in samples.iter().enumerate() {
+        let tilt_cos = check_state(&s.state).map_err(|e| FitError::BadSample {
+            index,
+            message: e.to_string(),
+        })?;
+        if !(s.measured_power_w.is_finite() && s.measured_power_w > 0.0) {
+            return Err(FitError::BadSample {
+                index,
+                message: format!(
+                    "measured_power_w must be finite and positive, got {}",
+                    s.measured_power_w
+                ),
+            });
+        }
+        let st = s.state;
+        let (sr, cr) = st.roll_rad.sin_cos();
+        let (sp, cp) = st.pitch_rad.sin_cos();
+        let v = st.airspeed_mps;
+        let (vn, vp) = match st.aoa {
+            AoaInput::Paper => (v * sr * sp, v * cr * cp),
+            AoaInput::Geometric { air_direction_rad } => {
+                let (sb, cb) = air_direction_rad.sin_cos();
+                let vn = -v * (cb * cr * sp - sb * sr);
+                (vn, (v * v - vn * vn).max(0.0).sqrt())
+            }
+        };
+        pre.push(Pre {
+            inv_c: 1.0 / tilt_cos,
+            inv_c15: tilt_cos.powf(-1.5),
+            vn,
+            vp,
+            v2: v * v,
+            v,
+            vz: st.climb_rate_mps,
+            measured: s.measured_power_w,
+            vn_work: match st.aoa {
+                AoaInput::Paper => 1.0,
+                AoaInput::Geometric { .. } => 0.0,
+            },
+        });
+    }
+    let mut free = options.free.clone();
+    free.dedup();
+    let required = 10 * free.len().max(1);
+    if pre.len() < required {
+        return Err(FitError::TooFewSamples {
+            samples: pre.len(),
+            parameters: free.len(),
+            required,
+        });
+    }
+    // Forward flight is needed for drag and for the speed dependence that separates vh from K.
+    let above = pre
+        .iter()
+        .filter(|s| s.v > options.forward_flight_mps)
+        .count();
+    for &f in &free {
+        let speed_dependent = matches!(
+            f,
+            FitParameter::Mu1
+                | FitParameter::Mu2
+                | FitParameter::Mu3
+                | FitParameter::HoverInducedVelocity
+        );
+        if speed_dependent && (above < 20 || above * 20 < pre.len()) {
+            return Err(FitError::NoForwardFlight {
+                parameter: f.name(),
+                above,
+                total: pre.len(),
+                airspeed_mps: options.forward_flight_mps,
+            });
+        }
+    }
+
+    let v = template;
+    let eta = v.efficiency();
+    let w = v.weight_n();
+    let (mu1, mu2, mu3) = v.drag().coefficients();
+    let base: Lumped = [
+        w / eta,
+        v.hover_induced_velocity_mps(),
+        v.kappa1() * w.powf(1.5) / eta,
+        mu1 / eta,
+        mu2 / eta,
+        mu3 / eta,
+    ];
+    let mean_power = pre.iter().map(|s| s.measured).sum::<f64>() / pre.len() as f64;
+    let vmax = pre.iter().map(|s| s.v).fold(1.0, f64::max);
+    let scale: Lumped = [
+        1.0,
+        1.0,
+        mean_power,
+        mean_power / vmax.powi(2),
+        mean_power / vmax.powi(3),
+        mean_power / vmax.powi(4),
+    ];
+
+    let mut iterations = 0;
+    let mut u = DVector::from_iterator(
+        free.len(),
+        free.iter().map(|f| match f {
+            FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => 0.0,
+            _ => base[f.index()] / scale[f.index()],
+        }),
+    );
+    let mut used = pre.clone();
+    let mut outliers = 0;
+    for pass in 0..2 {
+        let problem = Problem {
+            samples: &used,
+            base,
+            free: &free,
+            scale,
+        };
+        let (r0, _) = problem.evaluate(&u, false);
+        // argmin's Gauss-Newton line search measures cost as |r| but passes the gradient of
+        // |r|^2 / 2 (J^T r), so Armijo's sufficient decrease is scaled by |r|: a full Gauss-Newton
+        // step passes only for c <= 1/(2|r|), and with c = 1e-4 a fit of large residuals stalls at
+        // its start. A tiny c keeps the test as "the cost must fall".
+        let linesearch = BacktrackingLineSearch::new(ArmijoCondition::new(1e-12).map_err(|e| {
+            FitError::Solver {
+                message: e.to_string(),
+            }
+        })?);
+        let solver = GaussNewtonLS::new(linesearch)
+            .with_tolerance(1e-10 * r0.norm().max(1e-300))
+            .map_err(|e| FitError::Solver {
+                message: e.to_string(),
+            })?;
+        let mut executor = Executor::new(problem, solver)
+            .configure(|s| s.param(u.clone()).max_iters(options.max_iterations));
+        if let Some(cb) = &options.progress {
+            executor = executor.add_observer(
+                ProgressObserver {
+                    callback: cb.clone(),
+                    offset: iterations,
+                },
+                argmin::core::observers::ObserverMode::Always,
+            );
+        }
+        let result = executor.run().map_err(|e| FitError::Solver {
+            message: e.to_string(),
+        })?;
+        let state = result.state();
+        iterations += state.get_iter();
+        u = state
+            .get_best_param()
+            .cloned()
+            .ok_or_else(|| FitError::Solver {
+                message: "no parameter returned".to_string(),
+            })?;
+        let Some(sigma) = options.outlier_sigma.filter(|_| pass == 0) else {
+            break;
+        };
+        // Drop outliers once, then refit.
+        let problem = Problem {
+            samples: &used,
+            base,
+            free: &free,
+            scale,
+        };
+        let (r, _) = problem.evaluate(&u, false);
+        let mut sorted: Vec<f64> = r.iter().copied().collect();
+        let median = median_of(&mut sorted);
+        let mut dev: Vec<f64> = r.iter().map(|x| (x - median).abs()).collect();
+        let robust_sd = 1.4826 * median_of(&mut dev);
+        if robust_sd <= 0.0 {
+            break;
+        }
+        let keep: Vec<Pre> = used
+            .iter()
+            .zip(r.iter())
+            .filter(|(_, &ri)| (ri - median).abs() <= sigma * robust_sd)
+            .map(|(s, _)| *s)
+            .collect();
+        outliers = used.len() - keep.len();
+        if outliers == 0 {
+            break;
+        }
+        used = keep;
+    }
+
+    let problem = Problem {
+        samples: &used,
+        base,
+        free: &free,
+        scale,
+    };
+    let (r, j) = problem.evaluate(&u, true);
+    let j = j.expect("requested");
+    let n = used.len();
+    let dof = (n - free.len()).max(1);
+    let ssr = r.norm_squared();
+    let sigma2 = ssr / dof as f64;
+    let info = j.transpose() * &j;
+    let lumped = problem.lumped(&u);
+    let covariance = info.clone().try_inverse();
+    let mut parameters = Vec::new();
+    for (col, &f) in free.iter().enumerate() {
+        let k = f.index();
+        let value = lumped[k];
+        let var_u = covariance.as_ref().map_or(f64::INFINITY, |c| c[(col, col)]);
+        let se_u = (sigma2 * var_u).max(0.0).sqrt();
+        let std_error = match f {
+            FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => value * se_u,
+            _ => se_u * scale[k],
+        };
+        if !std_error.is_finite() || std_error > options.max_relative_std_error * value.abs() {
+            return Err(FitError::NotIdentifiable {
+                parameter: f.name(),
+                value,
+                std_error,
+                unit: f.unit(),
+            });
+        }
+        parameters.push(FittedParameter {
+            name: f.name(),
+            value,
+            std_error,
+            unit: f.unit(),
+        });
+    }
+
+    // Map the lumped constants back to the template's parameters.
+    let [k, vh, kp, d1, d2, d3] = lumped;
+    let efficiency = w / k;
+    if efficiency > 1.0 {
+        return Err(FitError::EfficiencyAboveOne {
+            efficiency,
+            mass_kg: v.mass_kg(),
+        });
+    }
+    let mut params = v.params().clone();
+    params.efficiency = efficiency;
+    let area = w / (2.0 * params.air_density_kg_m3 * vh * vh);
+    let disks = match params.disk_area {
+        DiskArea::OneRotor => 1.0,
+        DiskArea::AllRotors => f64::from(params.rotor_count),
+    };
+    params.rotor_radius_m = (area / (disks * std::f64::consts::PI)).sqrt();
+    params.kappa1_w_per_n1_5 = kp * efficiency / w.powf(1.5);
+    params.mu1_n_s_per_m = d1 * efficiency;
+    params.mu2_n_s2_per_m2 = d2 * efficiency;
+    params.mu3_n_s3_per_m3 = d3 * efficiency;
+    let mean_used = used.iter().map(|s| s.measured).sum::<f64>() / n as f64;
+    let rmse_w = (ssr / n as f64).sqrt();
+    Ok(PowerFit {
+        vehicle: params,
+        parameters,
+        rmse_w,
+        nrmse: rmse_w / mean_used,
+        samples_used: n,
+        outliers_rejected: outliers,
+        iterations,
+    })
+}
+
+fn median_of(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+struct ProgressObserver {
+    callback: ProgressFn,
+    offset: u64,
+}
+
+impl<I: State<Float = f64>> argmin::core::observers::Observe<I> for ProgressObserver {
+    fn observe_iter(
+        &mut self,
+        state: &I,
+        _kv: &argmin::core::KV,
+    ) -> Result<(), argmin::core::Error> {
+        (self.callback)(self.offset + state.get_iter(), state.get_cost());
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::four_term::PowerModel;
+    use crate::vehicle::tests::m100_params;
+
+    /// Synthetic flights of a vehicle: hover, forward flight 0-14 m/s with the pitch that balances
+    /// drag, turns with roll, climbs and descents.
+    fn flights(truth: &Vehicle, noise_w: f64) -> Vec<FitSample> {
+        let model = PowerModel::new(truth.clone());
+        let mut out = Vec::new();
+        let mut seed = 12345u64;
+        let mut rand = || {
+            // xorshift: reproducible noise without a dependency.
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % 1_000_000) as f64 / 1_000_000.0 - 0.5
+        };
+        for i in 0..3000 {
+            let v = 14.0 * (f64::from(i % 300) / 300.0);
+            let pitch = -(truth.drag().force_n(v) / truth.weight_n()).atan() + 0.05 * rand();
+            let roll = 0.3 * rand();
+            let climb = if i % 7 == 0 { 2.0 * rand() } else { 0.0 };
+            let state = FlightState {
+                aoa: AoaInput::Geometric {
+                    air_direction_rad: 0.2 * rand(),
+                },
+                ..FlightState::new(v, roll, pitch, climb)
+            };
+            let p = model.evaluate(&state).unwrap().electrical_w;
+            out.push(FitSample {
+                state,
+                measured_power_w: p + noise_w * 2.0 * rand(),
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn recovers_the_parameters_of_a_known_vehicle() {
+        let truth = Vehicle::new(VehicleParams {
+            efficiency: 0.7,
+            ..m100_params()
+        })
+        .unwrap();
+        let data = flights(&truth, 0.0);
+        // Start from a wrong template: eta 0.9, drag doubled, profile halved.
+        let start = Vehicle::new(VehicleParams {
+            efficiency: 0.9,
+            mu1_n_s_per_m: 0.36,
+            mu3_n_s3_per_m3: 0.008,
+            kappa1_w_per_n1_5: 0.14,
+            ..m100_params()
+        })
+        .unwrap();
+        let fit = fit_power_model(&start, &data, &FitOptions::known_geometry()).unwrap();
+        let p = &fit.vehicle;
+        // Noise-free synthetic data: the fit must land on the truth to solver precision.
+        assert!((p.efficiency - 0.7).abs() < 1e-6, "{p:?}");
+        assert!((p.mu1_n_s_per_m - 0.1816).abs() < 1e-5, "{p:?}");
+        assert!((p.kappa1_w_per_n1_5 - 0.275).abs() < 1e-5, "{p:?}");
+        assert!(fit.rmse_w < 1e-6, "{}", fit.rmse_w);
+        assert_eq!(fit.outliers_rejected, 0);
+    }
+
+    #[test]
+    fn unknown_geometry_recovers_vh_and_outliers_are_dropped() {
+        let truth = Vehicle::new(m100_params()).unwrap();
+        let mut data = flights(&truth, 2.0);
+        for s in data.iter_mut().step_by(100) {
+            s.measured_power_w += 300.0; // 30 gross outliers
+        }
+        let start = Vehicle::new(VehicleParams {
+            rotor_radius_m: 0.25,
+            ..m100_params()
+        })
+        .unwrap();
+        let fit = fit_power_model(&start, &data, &FitOptions::unknown_geometry()).unwrap();
+        assert_eq!(fit.outliers_rejected, 30);
+        let vh = fit
+            .parameters
+            .iter()
+            .find(|p| p.name == "hover_induced_velocity_mps")
+            .unwrap();
+        let true_vh = truth.hover_induced_velocity_mps();
+        // Uniform noise of +-2 W on ~500 W: vh to within 3 standard errors, and the SE is small.
+        assert!(
+            (vh.value - true_vh).abs() < 3.0 * vh.std_error + 1e-9,
+            "{vh:?} vs {true_vh}"
+        );
+        assert!(vh.std_error < 0.02 * true_vh);
+        assert!(
+            (fit.vehicle.rotor_radius_m - 0.172).abs() < 0.01,
+            "{}",
+            fit.vehicle.rotor_radius_m
+        );
+        // The noise is uniform on +-2 W: its RMS is 2/sqrt(3) = 1.155 W.
+        assert!((fit.rmse_w - 1.155).abs() < 0.1, "{}", fit.rmse_w);
+    }
+
+    #[test]
+    fn hover_only_data_refuses_drag() {
+        let truth = Vehicle::new(m100_params()).unwrap();
+        let data: Vec<FitSample> = flights(&truth, 1.0)
+            .into_iter()
+            .filter(|s| s.state.airspeed_mps < 1.0)
+            .collect();
+        let e = fit_power_model(&truth, &data, &FitOptions::known_geometry()).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FitError::NoForwardFlight {
+                    parameter: "mu1_over_eta_n_s_per_m",
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        // Without drag, the profile constant is collinear with K at constant thrust: refused too.
+        let opts = FitOptions::known_geometry()
+            .without(FitParameter::Mu1)
+            .without(FitParameter::Mu2)
+            .without(FitParameter::Mu3);
+        let level: Vec<FitSample> = data
+            .iter()
+            .map(|s| FitSample {
+                state: FlightState::new(s.state.airspeed_mps, 0.0, 0.0, 0.0),
+                ..*s
+            })
+            .collect();
+        let e = fit_power_model(&truth, &level, &opts).unwrap_err();
+        assert!(matches!(e, FitError::NotIdentifiable { .. }), "{e}");
+    }
+
+    #[test]
+    fn bad_samples_are_named() {
+        let truth = Vehicle::new(m100_params()).unwrap();
+        let mut data = flights(&truth, 0.0);
+        data[17].measured_power_w = f64::NAN;
+        let e = fit_power_model(&truth, &data, &FitOptions::known_geometry()).unwrap_err();
+        assert!(e.to_string().contains("sample 17"), "{e}");
+        let e = fit_power_model(&truth, &data[20..40], &FitOptions::known_geometry()).unwrap_err();
+        assert!(matches!(e, FitError::TooFewSamples { .. }), "{e}");
+    }
+}

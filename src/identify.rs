@@ -1,0 +1,407 @@
+//! From flight logs to the power model: time alignment of power with motion, fit samples, and
+//! validation in the layout of the power seed's Table I.
+//!
+//! # Alignment
+//! Logged power often lags the motion channels (in the KAIST logs by about 3 s). The lag is
+//! estimated by cross-correlating measured power with the tilt of the thrust axis
+//! (`acos(cos(roll) cos(pitch))`, which tracks thrust demand) on a common 0.1 s grid, searching
+//! +-`max_lag_s` ([`aloft_logs::estimate_lag_s`]). Each motion sample at time `t` is then paired
+//! with the measured power at `t + lag` (linear interpolation); samples whose partner falls outside
+//! the log are left out.
+//!
+//! # Flight state from a log
+//! Air-relative velocity = ground velocity - wind when the log carries wind, otherwise the ground
+//! velocity (no wind: an assumption, reported in the README). Airspeed is its horizontal norm (the
+//! paper's level-flight inputs), climb rate its vertical component, the angle of attack the exact
+//! geometry with the air direction `course - yaw` from the nose.
+
+use aloft_logs::{Log, Sample};
+use aloft_power::{
+    fit::FitSample, metrics, AoaInput, FlightState, ModelOptions, PowerModel, Term, Terms,
+};
+use serde::Serialize;
+
+use crate::error::Error;
+
+/// Options of [`align_flight`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlignOptions {
+    /// Search window of the lag estimate, s.
+    pub max_lag_s: f64,
+    /// Use this lag instead of estimating it, s.
+    pub lag_s: Option<f64>,
+}
+
+impl Default for AlignOptions {
+    fn default() -> Self {
+        Self {
+            max_lag_s: 10.0,
+            lag_s: None,
+        }
+    }
+}
+
+/// A flight with power paired to motion.
+#[derive(Debug, Clone)]
+pub struct AlignedFlight {
+    /// The log's source (file).
+    pub source: String,
+    /// Lag of power behind motion applied, s.
+    pub lag_s: f64,
+    /// Correlation of power with tilt at that lag (`None` when the lag was given).
+    pub lag_correlation: Option<f64>,
+    /// Motion time of each sample, s from the start of the log.
+    pub times_s: Vec<f64>,
+    /// Flight state and measured power at `t + lag`.
+    pub samples: Vec<FitSample>,
+    /// Motion samples left out (no velocity/attitude, tilt of 90 deg or more, no power partner).
+    pub skipped: usize,
+}
+
+fn interpolate(times: &[f64], values: &[f64], t: f64) -> Option<f64> {
+    if times.is_empty() || t < times[0] || t > times[times.len() - 1] {
+        return None;
+    }
+    let i = times.partition_point(|&x| x <= t);
+    if i == 0 {
+        return Some(values[0]);
+    }
+    if i >= times.len() {
+        return Some(values[times.len() - 1]);
+    }
+    let (t0, t1) = (times[i - 1], times[i]);
+    let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+    Some(values[i - 1] + w * (values[i] - values[i - 1]))
+}
+
+fn motion(s: &Sample) -> Option<(FlightState, f64)> {
+    let vel = s.vel_enu_mps?;
+    let att = s.attitude?;
+    let wind = s.wind_enu_mps.unwrap_or([0.0; 3]);
+    let air = [vel[0] - wind[0], vel[1] - wind[1], vel[2] - wind[2]];
+    let speed = air[0].hypot(air[1]);
+    // Course over the air, clockwise from north (ENU: x east, y north).
+    let course = air[0].atan2(air[1]);
+    let state = FlightState {
+        airspeed_mps: speed,
+        roll_rad: att.roll_rad,
+        pitch_rad: att.pitch_rad,
+        climb_rate_mps: air[2],
+        aoa: AoaInput::Geometric {
+            air_direction_rad: course - att.yaw_rad,
+        },
+    };
+    let tilt_cos = att.roll_rad.cos() * att.pitch_rad.cos();
+    (tilt_cos > 1e-6 && state.airspeed_mps.is_finite())
+        .then_some((state, tilt_cos.clamp(-1.0, 1.0).acos()))
+}
+
+/// Pair power with motion in `log` (see the module docs).
+pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, Error> {
+    let source = log.source.clone();
+    let (pt, pw): (Vec<f64>, Vec<f64>) = log
+        .samples
+        .iter()
+        .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
+        .filter(|(t, p)| t.is_finite() && p.is_finite())
+        .unzip();
+    if pt.len() < 2 {
+        return Err(Error::NoPower { origin: source });
+    }
+    if pt.windows(2).any(|w| w[1] < w[0]) {
+        return Err(Error::NotMonotonic { origin: source });
+    }
+    let mut mt = Vec::new();
+    let mut states = Vec::new();
+    let mut tilt = Vec::new();
+    let mut skipped = 0;
+    for s in &log.samples {
+        match motion(s) {
+            Some((state, tl)) if s.time_s.is_finite() => {
+                mt.push(s.time_s);
+                states.push(state);
+                tilt.push(tl);
+            }
+            _ => skipped += 1,
+        }
+    }
+    if mt.len() < 2 {
+        return Err(Error::NoMotion { origin: source });
+    }
+    if mt.windows(2).any(|w| w[1] < w[0]) {
+        return Err(Error::NotMonotonic { origin: source });
+    }
+    let (lag_s, lag_correlation) = match options.lag_s {
+        Some(l) => (l, None),
+        None => {
+            // Common 0.1 s grid over the overlap of the two channels.
+            let dt = 0.1;
+            let start = pt[0].max(mt[0]);
+            let end = pt[pt.len() - 1].min(mt[mt.len() - 1]);
+            let n = ((end - start) / dt).floor() as usize;
+            let grid: Vec<f64> = (0..n).map(|i| start + i as f64 * dt).collect();
+            let p: Vec<f64> = grid
+                .iter()
+                .filter_map(|&t| interpolate(&pt, &pw, t))
+                .collect();
+            let m: Vec<f64> = grid
+                .iter()
+                .filter_map(|&t| interpolate(&mt, &tilt, t))
+                .collect();
+            let est = aloft_logs::estimate_lag_s(&p, &m, dt, options.max_lag_s).map_err(|e| {
+                Error::Log {
+                    origin: source.clone(),
+                    source: Box::new(e),
+                }
+            })?;
+            (est.lag_s, Some(est.correlation))
+        }
+    };
+    let mut times_s = Vec::with_capacity(mt.len());
+    let mut samples = Vec::with_capacity(mt.len());
+    for (&t, state) in mt.iter().zip(&states) {
+        match interpolate(&pt, &pw, t + lag_s) {
+            Some(p) if p > 0.0 => {
+                times_s.push(t);
+                samples.push(FitSample {
+                    state: *state,
+                    measured_power_w: p,
+                });
+            }
+            _ => skipped += 1,
+        }
+    }
+    Ok(AlignedFlight {
+        source,
+        lag_s,
+        lag_correlation,
+        times_s,
+        samples,
+        skipped,
+    })
+}
+
+/// NRMSE of one model variant in one airspeed band.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BandNrmse {
+    /// Airspeed band, m/s, as `"low-high"` (the last open: `"9-"`).
+    pub airspeed_band_mps: &'static str,
+    /// Samples in the band.
+    pub samples: usize,
+    /// NRMSE (normalised by the band's mean measured power), percent; omitted when empty.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nrmse_percent: Option<f64>,
+}
+
+/// One row of the Table I layout: the model with one term dropped (or none).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AblationRow {
+    /// The dropped term: `none`, `parasitic`, `profile`, `induced` or `climb`.
+    pub dropped_term: &'static str,
+    /// NRMSE over the whole flight, percent.
+    pub nrmse_percent: f64,
+    /// NRMSE per airspeed band.
+    pub bands: Vec<BandNrmse>,
+}
+
+/// The in-flight re-estimate of the efficiency from the start of the flight.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Calibration {
+    /// Length of the calibration window, s.
+    pub calibrate_s: f64,
+    /// The efficiency re-estimated from that window.
+    pub efficiency: f64,
+    /// Measured energy after the window, Wh.
+    pub measured_energy_wh: f64,
+    /// Predicted energy after the window, Wh.
+    pub predicted_energy_wh: f64,
+    /// Energy error after the window, percent.
+    pub energy_error_percent: f64,
+    /// Instantaneous-power RMSE after the window, W.
+    pub rmse_w: f64,
+    /// RMSE of the best constant (the mean measured power after the window, which no forecast
+    /// can know), W.
+    pub best_constant_rmse_w: f64,
+}
+
+/// Validation of the model on one flight.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FlightValidation {
+    /// The log file.
+    pub file: String,
+    /// Duration of the aligned samples, s.
+    pub duration_s: f64,
+    /// Lag of power behind motion used, s.
+    pub lag_s: f64,
+    /// Measured energy over the aligned samples (integral of V x I), Wh.
+    pub measured_energy_wh: f64,
+    /// Model energy over the same samples, Wh.
+    pub predicted_energy_wh: f64,
+    /// `(predicted - measured) / measured`, percent.
+    pub energy_error_percent: f64,
+    /// NRMSE of the full model (normalised by the mean measured power), percent.
+    pub nrmse_percent: f64,
+    /// NRMSE of the flight's own mean power as the estimate, percent.
+    pub baseline_nrmse_percent: f64,
+    /// Samples used.
+    pub samples: usize,
+    /// Table I rows: full model and each term dropped, per airspeed band.
+    pub table_i: Vec<AblationRow>,
+    /// With a calibration window: the re-estimated efficiency and the errors after it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub calibration: Option<Calibration>,
+}
+
+/// Airspeed bands of the Table I layout, centred on the paper's hover, 2, 4, 6, 8 m/s.
+pub const AIRSPEED_BANDS: [(&str, f64, f64); 6] = [
+    ("0-1", 0.0, 1.0),
+    ("1-3", 1.0, 3.0),
+    ("3-5", 3.0, 5.0),
+    ("5-7", 5.0, 7.0),
+    ("7-9", 7.0, 9.0),
+    ("9-", 9.0, f64::INFINITY),
+];
+
+fn trapezoid_wh(times: &[f64], power: &[f64]) -> f64 {
+    times
+        .windows(2)
+        .zip(power.windows(2))
+        .map(|(t, p)| (t[1] - t[0]) * 0.5 * (p[0] + p[1]))
+        .sum::<f64>()
+        / 3600.0
+}
+
+fn nrmse_percent(est: &[f64], meas: &[f64]) -> Option<f64> {
+    metrics::nrmse(est, meas, metrics::Normalisation::Mean)
+        .ok()
+        .map(|x| 100.0 * x)
+}
+
+/// Predicted electrical power of every sample; samples the model rejects are reported as errors.
+pub fn predict(model: &PowerModel, flight: &AlignedFlight) -> Result<Vec<f64>, Error> {
+    flight
+        .samples
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            model
+                .evaluate(&s.state)
+                .map(|p| p.electrical_w)
+                .map_err(|e| Error::BadRow {
+                    origin: flight.source.clone(),
+                    row: i + 1,
+                    source: e,
+                })
+        })
+        .collect()
+}
+
+/// Validate `model` on `flight`, optionally re-estimating the efficiency from its first
+/// `calibrate_first_s` seconds (as a ground station would in flight).
+pub fn validate_flight(
+    model: &PowerModel,
+    flight: &AlignedFlight,
+    calibrate_first_s: Option<f64>,
+) -> Result<FlightValidation, Error> {
+    let measured: Vec<f64> = flight.samples.iter().map(|s| s.measured_power_w).collect();
+    if measured.len() < 2 {
+        return Err(Error::NoMotion {
+            origin: flight.source.clone(),
+        });
+    }
+    let predicted = predict(model, flight)?;
+    let t = &flight.times_s;
+    let measured_energy_wh = trapezoid_wh(t, &measured);
+    let predicted_energy_wh = trapezoid_wh(t, &predicted);
+    let mean = measured.iter().sum::<f64>() / measured.len() as f64;
+    let constant = vec![mean; measured.len()];
+    let mut table_i = Vec::new();
+    for (name, term) in [
+        ("none", None),
+        ("parasitic", Some(Term::Parasitic)),
+        ("profile", Some(Term::Profile)),
+        ("induced", Some(Term::Induced)),
+        ("climb", Some(Term::Climb)),
+    ] {
+        let variant = match term {
+            None => model.clone(),
+            Some(term) => PowerModel::with_options(
+                model.vehicle().clone(),
+                ModelOptions {
+                    terms: Terms {
+                        ..model.options().terms.without(term)
+                    },
+                    ..*model.options()
+                },
+            )?,
+        };
+        let est = predict(&variant, flight)?;
+        let bands = AIRSPEED_BANDS
+            .iter()
+            .map(|&(label, lo, hi)| {
+                let (e, m): (Vec<f64>, Vec<f64>) = flight
+                    .samples
+                    .iter()
+                    .zip(est.iter().zip(&measured))
+                    .filter(|(s, _)| s.state.airspeed_mps >= lo && s.state.airspeed_mps < hi)
+                    .map(|(_, (e, m))| (*e, *m))
+                    .unzip();
+                BandNrmse {
+                    airspeed_band_mps: label,
+                    samples: e.len(),
+                    nrmse_percent: nrmse_percent(&e, &m),
+                }
+            })
+            .collect();
+        table_i.push(AblationRow {
+            dropped_term: name,
+            nrmse_percent: nrmse_percent(&est, &measured).unwrap_or(f64::NAN),
+            bands,
+        });
+    }
+    let calibration = match calibrate_first_s {
+        None => None,
+        Some(window) => {
+            let split = t.partition_point(|&x| x < t[0] + window);
+            if split < 2 || split + 2 > t.len() {
+                return Err(Error::CalibrationWindow {
+                    origin: flight.source.clone(),
+                    window_s: window,
+                    duration_s: t[t.len() - 1] - t[0],
+                });
+            }
+            // Electrical power is aero power / eta: rescaling by the ratio of energies over the
+            // window is the least-biased re-estimate of eta from that window.
+            let scale = trapezoid_wh(&t[..split], &measured[..split])
+                / trapezoid_wh(&t[..split], &predicted[..split]);
+            let efficiency = model.vehicle().efficiency() / scale;
+            let rest_pred: Vec<f64> = predicted[split..].iter().map(|p| p * scale).collect();
+            let rest_meas = &measured[split..];
+            let measured_energy_wh = trapezoid_wh(&t[split..], rest_meas);
+            let predicted_energy_wh = trapezoid_wh(&t[split..], &rest_pred);
+            let rest_mean = rest_meas.iter().sum::<f64>() / rest_meas.len() as f64;
+            Some(Calibration {
+                calibrate_s: window,
+                efficiency,
+                measured_energy_wh,
+                predicted_energy_wh,
+                energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
+                rmse_w: metrics::rmse(&rest_pred, rest_meas)?,
+                best_constant_rmse_w: metrics::rmse(&vec![rest_mean; rest_meas.len()], rest_meas)?,
+            })
+        }
+    };
+    Ok(FlightValidation {
+        file: flight.source.clone(),
+        duration_s: t[t.len() - 1] - t[0],
+        lag_s: flight.lag_s,
+        measured_energy_wh,
+        predicted_energy_wh,
+        energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
+        nrmse_percent: nrmse_percent(&predicted, &measured).unwrap_or(f64::NAN),
+        baseline_nrmse_percent: nrmse_percent(&constant, &measured).unwrap_or(f64::NAN),
+        samples: measured.len(),
+        table_i,
+        calibration,
+    })
+}

@@ -1,0 +1,197 @@
+//! End-to-end `aloft log info` and `aloft convert`: output keys, exit codes, and clean failures.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn aloft(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn fixture(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/logs")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("logs_cli-{}-{name}", std::process::id()))
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn log_info_json_reports_duration_rates_and_energy() {
+    let o = aloft(&[
+        "log",
+        "info",
+        &fixture("kaist_small.csv"),
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["format"], "csv");
+    assert_eq!(j["profile"], "kaist");
+    assert_eq!(j["samples"], 20);
+    // 19 intervals of 0.1 s.
+    assert!((j["duration_s"].as_f64().unwrap() - 1.9).abs() < 1e-9);
+    let ch = j["channels"].as_array().unwrap();
+    let v = ch.iter().find(|c| c["channel"] == "voltage").unwrap();
+    assert!((v["rate_hz"].as_f64().unwrap() - 10.0).abs() < 1e-6);
+    // Energy: trapezoids of V x I over the fixture's rows, computed here independently.
+    let text = std::fs::read_to_string(fixture("kaist_small.csv")).unwrap();
+    let rows: Vec<(f64, f64)> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (f[0] * 1e-6, f[17] * f[18])
+        })
+        .collect();
+    let wh: f64 = rows
+        .windows(2)
+        .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+        .sum::<f64>()
+        / 3600.0;
+    assert!(
+        (j["energy_wh"].as_f64().unwrap() - wh).abs() < 1e-9,
+        "{} vs {wh}",
+        j["energy_wh"]
+    );
+    assert_eq!(j["power_available"], true);
+    assert_eq!(j["time"]["gap_count"], 0);
+    assert_eq!(j["columns"].as_array().unwrap().len(), 20);
+}
+
+#[test]
+fn log_info_table_reports_gaps() {
+    let o = aloft(&[
+        "log",
+        "info",
+        &fixture("kaist_gap_backwards.csv"),
+        "--profile",
+        "kaist",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("gap: "), "{out}");
+    assert!(out.contains("time goes back"), "{out}");
+}
+
+#[test]
+fn bad_inputs_exit_2_with_the_file_named() {
+    for (args, needle) in [
+        (
+            vec![
+                "log",
+                "info",
+                &fixture("kaist_missing_cur.csv") as &str,
+                "--profile",
+                "kaist",
+            ],
+            "'cur'",
+        ),
+        (vec!["log", "info", &fixture("kaist_empty.csv")], "empty"),
+        (vec!["log", "info", &fixture("truncated.mcap")], "truncated"),
+        (vec!["log", "info", &fixture("custom.csv")], "profile"),
+        (
+            vec!["log", "info", &fixture("custom.csv"), "--profile", "nosuch"],
+            "unknown profile",
+        ),
+        (
+            vec![
+                "log",
+                "info",
+                &fixture("custom.csv"),
+                "--profile",
+                &fixture("custom_wrong_units.toml"),
+            ],
+            "implausible",
+        ),
+        (
+            vec!["log", "info", "/nonexistent/flight.mcap"],
+            "flight.mcap",
+        ),
+    ] {
+        let o = aloft(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert!(e.contains(needle), "{args:?}: {e}");
+        assert!(!e.contains("panicked"), "{e}");
+    }
+}
+
+#[test]
+fn convert_writes_mcap_that_reads_back() {
+    let out = tmp("conv.mcap");
+    let o = aloft(&[
+        "convert",
+        &fixture("custom.csv"),
+        "--profile",
+        &fixture("custom.toml"),
+        "-o",
+        out.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["samples"], 10);
+    let o = aloft(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["format"], "mcap");
+    let topics: Vec<&str> = j["topics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["topic"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        topics,
+        vec!["/aloft/state", "/aloft/pose", "/aloft/battery"]
+    );
+    // 16 V x 12 A at the start: mean power a little above 190 W.
+    let p = j["mean_power_w"].as_f64().unwrap();
+    assert!((190.0..200.0).contains(&p), "{p}");
+}
+
+#[test]
+fn failed_convert_leaves_no_output_file() {
+    let out = tmp("bad.mcap");
+    let o = aloft(&[
+        "convert",
+        &fixture("custom_bad_number.csv"),
+        "--profile",
+        &fixture("custom.toml"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("row 6"), "{}", stderr(&o));
+    assert!(!out.exists());
+}
+
+#[test]
+fn power_lag_needs_power_data() {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/logs/custom.csv");
+    let o = aloft(&[
+        "log",
+        "info",
+        p.to_str().unwrap(),
+        "--profile",
+        &fixture("custom.toml"),
+        "--lag",
+        "1",
+    ]);
+    // custom.csv has power but no velocity.
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("velocity"), "{}", stderr(&o));
+}

@@ -1,0 +1,200 @@
+//! End-to-end checks of `aloft mission` and `aloft endurance`: outputs, JSON keys, exit codes.
+
+use std::process::Command;
+
+fn aloft(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .expect("run aloft");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("aloft-planner-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn the_demo_runs_feasible_and_reads_as_a_report() {
+    let (code, out, err) = aloft(&["mission"]);
+    assert_eq!(code, 0, "{err}");
+    for needle in [
+        "FEASIBLE",
+        "Point of no return: none",
+        "Segments",
+        "orbit",
+        "TB47D",
+        "Wind: 6.0 m/s from 250",
+    ] {
+        assert!(out.contains(needle), "missing '{needle}' in:\n{out}");
+    }
+}
+
+#[test]
+fn mission_json_has_the_contract_keys_and_omits_a_missing_point_of_no_return() {
+    let (code, out, err) = aloft(&["mission", "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for k in [
+        "feasible",
+        "duration_s",
+        "distance_m",
+        "energy_wh",
+        "start_soc",
+        "end_soc",
+        "min_voltage_v",
+        "peak_power_w",
+        "reserve_soc",
+        "segments",
+    ] {
+        assert!(v.get(k).is_some(), "missing {k}");
+    }
+    assert!(v.get("point_of_no_return_s").is_none());
+    let segs = v["segments"].as_array().unwrap();
+    for k in [
+        "kind",
+        "duration_s",
+        "distance_m",
+        "energy_wh",
+        "mean_power_w",
+        "peak_power_w",
+    ] {
+        assert!(segs.iter().all(|s| s.get(k).is_some()), "segment key {k}");
+    }
+    let sum: f64 = segs.iter().map(|s| s["energy_wh"].as_f64().unwrap()).sum();
+    assert!((sum - v["energy_wh"].as_f64().unwrap()).abs() < 1e-9);
+}
+
+#[test]
+fn an_infeasible_mission_exits_1_and_says_where() {
+    let path = tmp("long-hover.toml");
+    std::fs::write(
+        &path,
+        "[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n[[segment]]\nkind = \"hover\"\nduration_s = 3600.0\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
+    )
+    .unwrap();
+    let (code, out, _) = aloft(&["mission", path.to_str().unwrap()]);
+    assert_eq!(code, 1, "{out}");
+    assert!(
+        out.contains("NOT FEASIBLE")
+            && out.contains("runs out")
+            && out.contains("segment 2 (hover)"),
+        "{out}"
+    );
+    let (code, out, _) = aloft(&["mission", path.to_str().unwrap(), "--format", "json"]);
+    assert_eq!(code, 1);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["feasible"], serde_json::Value::Bool(false));
+    assert!(v["reason"].as_str().unwrap().contains("runs out"));
+    assert!(v["point_of_no_return_s"].as_f64().is_some());
+}
+
+#[test]
+fn bad_input_exits_2_with_a_clear_message() {
+    let path = tmp("bad-radius.toml");
+    std::fs::write(
+        &path,
+        "[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n[[segment]]\nkind = \"orbit\"\ncentre_east_m = 0.0\ncentre_north_m = 0.0\nradius_m = -25.0\nground_speed_mps = 4.0\ndirection = \"clockwise\"\nlaps = 1.0\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
+    )
+    .unwrap();
+    let (code, _, err) = aloft(&["mission", path.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("radius_m") && err.contains("-25"), "{err}");
+    let empty = tmp("empty.toml");
+    std::fs::write(&empty, "name = \"nothing\"\n").unwrap();
+    let (code, _, err) = aloft(&["mission", empty.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no segments"), "{err}");
+    // A wind grid that does not reach the demo's survey area.
+    let grid = tmp("small-grid.csv");
+    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps\n");
+    for x in [-10.0, 10.0] {
+        for y in [-10.0, 10.0] {
+            for z in [0.0, 50.0] {
+                text.push_str(&format!("{x},{y},{z},3,0,0\n"));
+            }
+        }
+    }
+    std::fs::write(&grid, text).unwrap();
+    let (code, _, err) = aloft(&["mission", "--wind-field", grid.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("does not cover"), "{err}");
+    let (code, _, err) = aloft(&["mission", "--battery", "TB99"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("TB99") && err.contains("TB48D"), "{err}");
+}
+
+#[test]
+fn timeseries_and_plot_are_written() {
+    let csv = tmp("demo.csv");
+    let svg = tmp("demo.svg");
+    let (code, _, err) = aloft(&[
+        "mission",
+        "--timeseries",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header = text.lines().next().unwrap();
+    for k in [
+        "time_s",
+        "east_m",
+        "north_m",
+        "up_m",
+        "power_w",
+        "current_a",
+        "voltage_v",
+        "soc",
+        "roll_deg",
+    ] {
+        assert!(header.split(',').any(|h| h == k), "{k} in {header}");
+    }
+    // 6:56 at a 0.1 s step: about 4160 rows
+    assert!(text.lines().count() > 4000);
+    let svg_text = std::fs::read_to_string(&svg).unwrap();
+    assert!(svg_text.contains("<svg") && svg_text.contains("ground track"));
+}
+
+#[test]
+fn endurance_json_has_the_contract_keys() {
+    let (code, out, err) = aloft(&[
+        "endurance",
+        "--format",
+        "json",
+        "--wind-speed",
+        "5",
+        "--wind-from",
+        "0",
+        "--course",
+        "0",
+        "--orbit-radius",
+        "25",
+        "--orbit-speed",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for k in [
+        "hover_power_w",
+        "hover_endurance_s",
+        "max_endurance_speed_mps",
+        "max_endurance_s",
+        "max_range_speed_mps",
+        "max_range_m",
+        "orbit_endurance_s",
+    ] {
+        assert!(v[k].as_f64().is_some_and(|x| x > 0.0), "{k}: {out}");
+    }
+    let (code, out, _) = aloft(&["endurance", "--sweep-speed", "1", "--format", "csv"]);
+    assert_eq!(code, 0);
+    assert!(out.starts_with("airspeed_mps,ground_speed_mps,power_w,endurance_s,range_m"));
+    assert_eq!(out.lines().count(), 1 + 18); // 0..=17 m/s
+}
