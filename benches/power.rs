@@ -70,6 +70,7 @@ fn bench(c: &mut Criterion) {
                 induced_w: 0.0,
                 parasitic_w: 0.0,
                 profile_w: 0.0,
+                acceleration_w: 0.0,
                 climb_w: 0.0,
                 aero_w: 0.0,
                 electrical_w: 0.0,

@@ -9,6 +9,11 @@
 //! with the measured power at `t + lag` (linear interpolation); samples whose partner falls outside
 //! the log are left out.
 //!
+//! # Ground time
+//! Logs that include take-off and landing have stretches on the ground with the motors idle or off.
+//! Samples whose measured power is below `idle_power_fraction` (default 0.25) of the flight's median
+//! are left out and counted ([`AlignedFlight::idle`]); energies are compared over the rest.
+//!
 //! # Flight state from a log
 //! Air-relative velocity = ground velocity - wind when the log carries wind, otherwise the ground
 //! velocity (no wind: an assumption, reported in the README). Airspeed is its horizontal norm (the
@@ -30,6 +35,10 @@ pub struct AlignOptions {
     pub max_lag_s: f64,
     /// Use this lag instead of estimating it, s.
     pub lag_s: Option<f64>,
+    /// Samples whose measured power is below this fraction of the flight's median are taken as
+    /// on the ground with the motors idle or off (logs that include take-off and landing) and
+    /// left out: the model describes flight, not a vehicle standing on its legs.
+    pub idle_power_fraction: f64,
 }
 
 impl Default for AlignOptions {
@@ -37,6 +46,7 @@ impl Default for AlignOptions {
         Self {
             max_lag_s: 10.0,
             lag_s: None,
+            idle_power_fraction: 0.25,
         }
     }
 }
@@ -56,6 +66,8 @@ pub struct AlignedFlight {
     pub samples: Vec<FitSample>,
     /// Motion samples left out (no velocity/attitude, tilt of 90 deg or more, no power partner).
     pub skipped: usize,
+    /// Samples left out as on the ground (measured power below the idle fraction of the median).
+    pub idle: usize,
 }
 
 fn interpolate(times: &[f64], values: &[f64], t: f64) -> Option<f64> {
@@ -171,14 +183,46 @@ pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, 
             _ => skipped += 1,
         }
     }
+    let mut sorted: Vec<f64> = samples.iter().map(|s| s.measured_power_w).collect();
+    sorted.sort_by(f64::total_cmp);
+    let threshold =
+        options.idle_power_fraction * sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let before = samples.len();
+    let (times_s, samples): (Vec<f64>, Vec<FitSample>) = times_s
+        .into_iter()
+        .zip(samples)
+        .filter(|(_, s)| s.measured_power_w >= threshold)
+        .unzip();
     Ok(AlignedFlight {
         source,
         lag_s,
         lag_correlation,
+        idle: before - samples.len(),
         times_s,
         samples,
         skipped,
     })
+}
+
+/// Force-balance samples of a log for [`aloft_power::fit_drag`]: air velocity (ground velocity
+/// minus wind, when logged), acceleration and attitude, where all are present.
+pub fn force_samples(log: &Log) -> Vec<aloft_power::ForceSample> {
+    log.samples
+        .iter()
+        .filter_map(|s| {
+            let vel = s.vel_enu_mps?;
+            let acc = s.acc_enu_mps2?;
+            let att = s.attitude?;
+            let wind = s.wind_enu_mps.unwrap_or([0.0; 3]);
+            Some(aloft_power::ForceSample {
+                vel_air_enu_mps: [vel[0] - wind[0], vel[1] - wind[1], vel[2] - wind[2]],
+                acc_enu_mps2: acc,
+                roll_rad: att.roll_rad,
+                pitch_rad: att.pitch_rad,
+                yaw_rad: att.yaw_rad,
+            })
+        })
+        .collect()
 }
 
 /// NRMSE of one model variant in one airspeed band.

@@ -378,3 +378,77 @@ fn propulsion_sweep_writes_csv_and_svg() {
     let svg_text = std::fs::read_to_string(&svg).unwrap();
     assert!(svg_text.starts_with("<svg") && svg_text.contains("flight time"));
 }
+
+#[test]
+fn fit_and_validate_reject_bad_input() {
+    let dir = std::env::temp_dir().join(format!("aloft-fitbad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("out.toml");
+    let fixture = |name: &str| format!("{}/fixtures/logs/{name}", env!("CARGO_MANIFEST_DIR"));
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec![
+                "fit".into(),
+                "--log".into(),
+                fixture("kaist_missing_cur.csv"),
+                "--profile".into(),
+                "kaist".into(),
+                "--vehicle-template".into(),
+                "dji-m100".into(),
+                "-o".into(),
+                out.display().to_string(),
+            ],
+            "cur",
+        ),
+        (
+            vec![
+                "fit".into(),
+                "--log".into(),
+                fixture("kaist_small.csv"),
+                "--profile".into(),
+                "kaist".into(),
+                "--vehicle-template".into(),
+                "aec-quadrotor".into(),
+                "-o".into(),
+                out.display().to_string(),
+            ],
+            "[power]",
+        ),
+        (
+            vec![
+                "fit".into(),
+                "--log".into(),
+                fixture("kaist_small.csv"),
+                "--profile".into(),
+                "kaist".into(),
+                "--vehicle-template".into(),
+                "dji-m100".into(),
+                "-o".into(),
+                out.display().to_string(),
+                "--free".into(),
+                "k,drag".into(),
+            ],
+            "drag",
+        ),
+        (
+            vec![
+                "validate".into(),
+                "--log".into(),
+                dir.join("none.csv").display().to_string(),
+                "--vehicle".into(),
+                "dji-m100".into(),
+            ],
+            "none.csv",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"));
+    }
+}

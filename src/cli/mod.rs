@@ -2,12 +2,14 @@
 
 mod convert;
 mod endurance;
+mod fit;
 mod log;
 mod mission;
 mod output;
 mod power;
 mod propulsion;
 mod rotor;
+mod validate;
 mod vehicles;
 
 use std::path::Path;
@@ -42,6 +44,10 @@ enum Command {
     Log(log::LogArgs),
     /// Convert a flight log (CSV or MCAP) to MCAP that Foxglove displays.
     Convert(convert::ConvertArgs),
+    /// Fit the power model of a vehicle to flight logs (lag alignment, Gauss-Newton, drag from the force balance).
+    Fit(fit::FitArgs),
+    /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
+    Validate(validate::ValidateArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
     Mission(mission::MissionArgs),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
@@ -78,6 +84,8 @@ pub fn main() -> ExitCode {
         Command::Vehicles(args) => vehicles::run(args),
         Command::Log(args) => log::run(args),
         Command::Convert(args) => convert::run(args),
+        Command::Fit(args) => fit::run(args),
+        Command::Validate(args) => validate::run(args),
         Command::Mission(args) => mission::run(args),
         Command::Endurance(args) => endurance::run(args),
     };

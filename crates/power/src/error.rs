@@ -143,6 +143,19 @@ pub enum FitError {
         /// The airspeed threshold, m/s.
         airspeed_mps: f64,
     },
+    /// A drag constant asked of power data evaluated with the geometric angle of attack, where
+    /// the drag work is already in the measured attitude.
+    #[error(
+        "{parameter} cannot be fitted from power: {geometric} of {total} samples use the geometric angle of attack, where the drag work is in the attitude (eq 8's T Vn), not in eq (11); fit drag from the force balance (aloft_power::fit::drag) or use the paper's angle of attack"
+    )]
+    DragNotInPower {
+        /// The parameter.
+        parameter: &'static str,
+        /// Samples with the geometric angle of attack.
+        geometric: usize,
+        /// All samples.
+        total: usize,
+    },
     /// The data leaves a parameter undetermined: its standard error is too large or the
     /// information matrix is singular along it.
     #[error(

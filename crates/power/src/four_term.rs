@@ -11,16 +11,22 @@
 //! its estimate at 8 m/s.
 //!
 //! # Deviation: the geometric angle of attack and eq (8)
-//! Eq (8), `P_ind = T (v_i + v_inf sin a)`, is momentum theory's total rotor power: its
-//! `T v_inf sin a` part is the work thrust does along the freestream, which in steady flight IS
-//! the work against drag (and, with axial flow, against gravity). The paper can add `P_par` (11)
-//! on top because its approximation `sin a = sin(phi) sin(theta)` makes that part nearly vanish
-//! (exactly zero for a single-axis tilt). With the exact geometry the part is
-//! `T Vn = f_D v_inf` in steady level flight, and adding eq (11) would count the drag work twice
-//! (35 W aerodynamic at 10 m/s for the M100). So with [`AoaModel::Geometric`] aloft takes
-//! `P_ind = T v_i` and lets eqs (11) and (13) carry the drag and climb work; with
-//! [`AoaModel::Paper`] eq (8) is used as printed. `Vn` still enters the induced velocity (eq 9)
-//! in both.
+//! Eq (8), `P_ind = T (v_i + v_inf sin a)`, is momentum theory's rotor power: its `T Vn` part is
+//! the work thrust does along the freestream. By the force balance `T = m a + m g + D`, that work
+//! is the drag work `D v`, plus (in unsteady flight) the rate of kinetic energy `m a . v`, plus
+//! (with axial flow) the climb work. The paper can add `P_par` (11) on top because its
+//! approximation `sin a = sin(phi) sin(theta)` makes `T Vn` nearly vanish (exactly zero for a
+//! single-axis tilt). With the exact geometry `T Vn = D v` in steady level flight, and adding
+//! eq (11) would count the drag work twice (35 W aerodynamic at 10 m/s for the M100).
+//!
+//! So with [`AoaModel::Geometric`] aloft books eq (8) as three terms that add up to it:
+//! `induced_w = T v_i`, `parasitic_w = D v` (eq 11) and `acceleration_w = T Vn - D v`, the work
+//! that goes into accelerating the vehicle (zero in steady flight; it is what an attitude that does
+//! not balance the drag implies). Their sum is `T (v_i + Vn)`: drag work is counted once, and
+//! the power of manoeuvres is kept. With [`AoaModel::Paper`] eq (8) is used as printed and
+//! `acceleration_w` is 0. The inflow `Vn` excludes the vertical air speed (the caller passes the
+//! horizontal air velocity), so eq (13) carries the climb work once. Removing the induced term
+//! (ablation) removes `acceleration_w` with it, as eq (8) contains both.
 //!
 //! # Deviation: no regeneration
 //! Eq (14) can go negative in a steep descent where the climb term outweighs the others; a
@@ -218,6 +224,9 @@ pub struct PowerBreakdown {
     pub parasitic_w: f64,
     /// Profile power, eq (12), W (0 when removed or above the hybrid cutoff).
     pub profile_w: f64,
+    /// Work of accelerating the vehicle, `T Vn - D v`, with the geometric angle of attack (0 with
+    /// the paper's, and in steady flight), W. Part of eq (8); see the module docs.
+    pub acceleration_w: f64,
     /// Climb power, eq (13), W (0 when removed; negative in descent).
     pub climb_w: f64,
     /// Aerodynamic total `P_req`, eq (7), W.
@@ -417,16 +426,20 @@ impl PowerModel {
     fn assemble(&self, c: &FlightCondition, vi: f64) -> PowerBreakdown {
         let v = &self.vehicle;
         let opts = &self.options;
-        let induced_w = if opts.terms.induced {
+        let drag_work_w = v.drag().parasitic_power_w(c.airspeed_mps);
+        let (induced_w, acceleration_w) = if opts.terms.induced {
             match c.aoa {
-                AoaModel::Paper => induced_power_w(c.thrust_n, vi, c.inflow.normal_mps),
-                AoaModel::Geometric => induced_power_w(c.thrust_n, vi, 0.0),
+                AoaModel::Paper => (induced_power_w(c.thrust_n, vi, c.inflow.normal_mps), 0.0),
+                AoaModel::Geometric => (
+                    induced_power_w(c.thrust_n, vi, 0.0),
+                    c.thrust_n * c.inflow.normal_mps - drag_work_w,
+                ),
             }
         } else {
-            0.0
+            (0.0, 0.0)
         };
         let parasitic_w = if opts.terms.parasitic {
-            v.drag().parasitic_power_w(c.airspeed_mps)
+            drag_work_w
         } else {
             0.0
         };
@@ -444,7 +457,7 @@ impl PowerModel {
         } else {
             0.0
         };
-        let aero_w = induced_w + parasitic_w + profile_w + climb_w;
+        let aero_w = induced_w + acceleration_w + parasitic_w + profile_w + climb_w;
         PowerBreakdown {
             thrust_n: c.thrust_n,
             induced_velocity_mps: vi,
@@ -452,6 +465,7 @@ impl PowerModel {
             induced_w,
             parasitic_w,
             profile_w,
+            acceleration_w,
             climb_w,
             aero_w,
             electrical_w: aero_w.max(0.0) * v.inverse_efficiency(),

@@ -76,11 +76,13 @@ impl PowerModel {
             let dvi = dvi_dvn * d_vn.0[i] + dvi_dvp2 * d_vp2.0[i];
             let mut d = 0.0;
             if terms.induced {
-                // Geometric AoA: P_ind = T v_i (the T Vn work is in eqs 11 and 13; four_term docs).
-                d += match state.aoa {
-                    AoaInput::Paper => d_t.0[i] * (vi + vn) + thrust * (dvi + d_vn.0[i]),
-                    AoaInput::Geometric { .. } => d_t.0[i] * vi + thrust * dvi,
-                };
+                // Both AoA models: induced + acceleration work = T (v_i + Vn) (four_term docs);
+                // with the geometric one the acceleration term subtracts the drag work that
+                // eq (11) adds back below.
+                d += d_t.0[i] * (vi + vn) + thrust * (dvi + d_vn.0[i]);
+                if matches!(state.aoa, AoaInput::Geometric { .. }) && i == 0 {
+                    d -= veh.drag().parasitic_power_derivative(v);
+                }
             }
             if terms.parasitic && i == 0 {
                 d += veh.drag().parasitic_power_derivative(v);

@@ -56,7 +56,9 @@ pub use angle_of_attack::{AoaModel, Inflow};
 pub use drag::CubicDrag;
 pub use efficiency::{calibrate_efficiency, efficiency_from_hover, mean_power_w};
 pub use error::{FitError, PowerError, Result};
-pub use fit::{fit_power_model, FitOptions, FitParameter, FitSample, PowerFit};
+pub use fit::{
+    fit_drag, fit_power_model, DragFit, FitOptions, FitParameter, FitSample, ForceSample, PowerFit,
+};
 pub use four_term::{
     AoaInput, FlightCondition, FlightState, ModelOptions, PowerBreakdown, PowerModel, Term, Terms,
 };

@@ -122,3 +122,117 @@ mod tests {
         assert!((f.min_current_a - 3.0).abs() < 1e-12 && (f.max_current_a - 60.0).abs() < 1e-12);
     }
 }
+
+/// Result of [`fit_pack_resistance`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PackResistanceFit {
+    /// Open-circuit voltage at the start of the data, V.
+    pub ocv_start_v: f64,
+    /// Slope of the open-circuit voltage with discharged charge, V/Ah (negative).
+    pub ocv_slope_v_per_ah: f64,
+    /// Internal resistance, ohm.
+    pub resistance_ohm: f64,
+    /// Standard error of the resistance, ohm.
+    pub resistance_std_error_ohm: f64,
+    /// RMS residual of the terminal voltage, V.
+    pub rmse_v: f64,
+    /// Samples used.
+    pub samples: usize,
+}
+
+/// Pack internal resistance from a flight's terminal voltage and current.
+///
+/// Over one discharge the open-circuit voltage falls nearly linearly with the charge drawn, so the
+/// terminal voltage is modelled as `V = V0 + b Q - R I` (eq 16 with a linear open-circuit voltage),
+/// with `Q` the charge drawn since the first sample (the integral of the current, trapezoids over
+/// `time_s`). Linear least squares in `V0`, `b`, `R`; the standard error of `R` from the residual
+/// variance. `R` is identified by the current varying faster than the charge: a flight at constant
+/// current cannot separate it.
+///
+/// # Errors
+/// Mismatched or non-finite columns; fewer than 10 samples; a singular system (constant current).
+pub fn fit_pack_resistance(
+    time_s: &[f64],
+    current_a: &[f64],
+    voltage_v: &[f64],
+) -> Result<PackResistanceFit, PropulsionError> {
+    let n = check_columns(
+        "pack resistance",
+        &[
+            ("time_s", time_s),
+            ("current_a", current_a),
+            ("voltage_v", voltage_v),
+        ],
+        10,
+    )?;
+    use nalgebra::{Matrix3, Vector3};
+    // R is identified only by the current varying: require a spread of at least 0.1 % of the mean.
+    let mean = current_a.iter().sum::<f64>() / n as f64;
+    let sd = (current_a.iter().map(|i| (i - mean).powi(2)).sum::<f64>() / n as f64).sqrt();
+    if sd <= 1e-3 * mean.abs().max(1e-9) {
+        return Err(PropulsionError::FitDidNotConverge {
+            model: "pack resistance (current does not vary)",
+        });
+    }
+    let mut charge_ah = 0.0;
+    let mut xtx = Matrix3::zeros();
+    let mut xty = Vector3::zeros();
+    let mut rows = Vec::with_capacity(n);
+    for i in 0..n {
+        if i > 0 {
+            charge_ah +=
+                (time_s[i] - time_s[i - 1]) * 0.5 * (current_a[i] + current_a[i - 1]) / 3600.0;
+        }
+        let x = Vector3::new(1.0, charge_ah, -current_a[i]);
+        xtx += x * x.transpose();
+        xty += x * voltage_v[i];
+        rows.push(x);
+    }
+    let inv = xtx
+        .try_inverse()
+        .ok_or(PropulsionError::FitDidNotConverge {
+            model: "pack resistance (current does not vary)",
+        })?;
+    let c = inv * xty;
+    let ssr: f64 = rows
+        .iter()
+        .zip(voltage_v)
+        .map(|(x, v)| (v - x.dot(&c)).powi(2))
+        .sum();
+    let sigma2 = ssr / (n - 3) as f64;
+    Ok(PackResistanceFit {
+        ocv_start_v: c[0],
+        ocv_slope_v_per_ah: c[1],
+        resistance_ohm: c[2],
+        resistance_std_error_ohm: (sigma2 * inv[(2, 2)]).max(0.0).sqrt(),
+        rmse_v: (ssr / n as f64).sqrt(),
+        samples: n,
+    })
+}
+
+#[cfg(test)]
+mod pack_tests {
+    use super::*;
+
+    #[test]
+    fn recovers_resistance_and_ocv_slope_of_a_synthetic_discharge() {
+        let (r, v0, b) = (0.045, 50.0, -0.35);
+        let mut q = 0.0;
+        let (mut t, mut i_a, mut v) = (Vec::new(), Vec::new(), Vec::new());
+        for k in 0..3000 {
+            let time = f64::from(k) * 0.1;
+            let current = 25.0 + 8.0 * (f64::from(k) * 0.05).sin();
+            if k > 0 {
+                q += 0.1 * 0.5 * (current + i_a[k as usize - 1]) / 3600.0;
+            }
+            t.push(time);
+            i_a.push(current);
+            v.push(v0 + b * q - r * current);
+        }
+        let fit = fit_pack_resistance(&t, &i_a, &v).unwrap();
+        assert!((fit.resistance_ohm - r).abs() < 1e-9, "{fit:?}");
+        assert!((fit.ocv_slope_v_per_ah - b).abs() < 1e-6, "{fit:?}");
+        let flat = vec![20.0; 3000];
+        assert!(fit_pack_resistance(&t, &flat, &v).is_err());
+    }
+}

@@ -6,8 +6,10 @@
 //!
 //! `P = K/c (vh x(Vn/vh, Vp/vh) + Vn) + k_p / c^1.5 + d1 v^2 + d2 v^3 + d3 v^4 + K v_z`
 //!
-//! (with the geometric angle of attack the `+ Vn` work term is absent, as in
-//! [`crate::four_term`]).
+//! With the geometric angle of attack the drag terms cancel: eq (8)'s `T Vn` already holds the
+//! drag work through the measured attitude ([`crate::four_term`], "Deviation"), so power does not
+//! identify drag. Fit drag from the force balance with [`super::drag`] instead; asking this fit
+//! for a drag constant on geometric samples is refused ([`FitError::DragNotInPower`]).
 //!
 //! | constant | meaning | unit |
 //! |---|---|---|
@@ -223,8 +225,9 @@ struct Pre {
     v: f64,
     vz: f64,
     measured: f64,
-    /// 1 with the paper's AoA (eq 8 as printed), 0 with the geometric one (P_ind = T v_i).
-    vn_work: f64,
+    /// 1 with the paper's AoA (eq 11 adds drag work), 0 with the geometric one (drag work is in
+    /// `T Vn` through the attitude).
+    drag_weight: f64,
 }
 
 /// Full lumped parameter vector in [`FitParameter::ALL`] order.
@@ -236,8 +239,11 @@ fn model_and_gradient(p: &Lumped, s: &Pre, want_gradient: bool) -> Option<(f64, 
     let b = s.vp / vh;
     let x = solve_normalised(a, b)?;
     let v = s.v;
-    let induced = vh * x + s.vn_work * s.vn;
-    let power = k * s.inv_c * induced + kp * s.inv_c15 + s.v2 * (d1 + v * (d2 + v * d3)) + k * s.vz;
+    let induced = vh * x + s.vn;
+    let power = k * s.inv_c * induced
+        + kp * s.inv_c15
+        + s.drag_weight * s.v2 * (d1 + v * (d2 + v * d3))
+        + k * s.vz;
     if !want_gradient {
         return Some((power, [0.0; 6]));
     }
@@ -251,9 +257,9 @@ fn model_and_gradient(p: &Lumped, s: &Pre, want_gradient: bool) -> Option<(f64, 
         s.inv_c * induced + s.vz,
         k * s.inv_c * (x - a * dx_da - b * dx_db),
         s.inv_c15,
-        s.v2,
-        s.v2 * v,
-        s.v2 * v * v,
+        s.drag_weight * s.v2,
+        s.drag_weight * s.v2 * v,
+        s.drag_weight * s.v2 * v * v,
     ];
     Some((power, grad))
 }
@@ -264,6 +270,10 @@ struct Problem<'a> {
     base: Lumped,
     free: &'a [FitParameter],
     scale: Lumped,
+    /// For the profile and drag constants that are held: their lumped value per unit `K`
+    /// (`kappa1 W^0.5`, `mu_k / W`), so the physical `kappa1`, `mu_k` stay the template's while
+    /// `K` (hence eta) moves. 0 for free constants and for `K`, `vh`.
+    tie: Lumped,
 }
 
 impl Problem<'_> {
@@ -278,6 +288,12 @@ impl Problem<'_> {
                 }
                 _ => u[j] * self.scale[i],
             };
+        }
+        let k = p[FitParameter::WeightOverEfficiency.index()];
+        for i in 2..6 {
+            if self.tie[i] != 0.0 {
+                p[i] = self.tie[i] * k;
+            }
         }
         p
     }
@@ -296,8 +312,12 @@ impl Problem<'_> {
                         for (col, &f) in self.free.iter().enumerate() {
                             let k = f.index();
                             j[(i, col)] = match f {
-                                FitParameter::WeightOverEfficiency
-                                | FitParameter::HoverInducedVelocity => grad[k] * p[k],
+                                FitParameter::WeightOverEfficiency => {
+                                    // K also moves the held constants tied to it.
+                                    let tied: f64 = (2..6).map(|t| grad[t] * self.tie[t]).sum();
+                                    (grad[k] + tied) * p[k]
+                                }
+                                FitParameter::HoverInducedVelocity => grad[k] * p[k],
                                 _ => grad[k] * self.scale[k],
                             };
                         }
@@ -371,7 +391,7 @@ pub fn fit_power_model(
             v,
             vz: st.climb_rate_mps,
             measured: s.measured_power_w,
-            vn_work: match st.aoa {
+            drag_weight: match st.aoa {
                 AoaInput::Paper => 1.0,
                 AoaInput::Geometric { .. } => 0.0,
             },
@@ -392,7 +412,16 @@ pub fn fit_power_model(
         .iter()
         .filter(|s| s.v > options.forward_flight_mps)
         .count();
+    let drag_in_power = pre.iter().filter(|s| s.drag_weight > 0.0).count();
     for &f in &free {
+        let drag = matches!(f, FitParameter::Mu1 | FitParameter::Mu2 | FitParameter::Mu3);
+        if drag && drag_in_power * 2 < pre.len() {
+            return Err(FitError::DragNotInPower {
+                parameter: f.name(),
+                geometric: pre.len() - drag_in_power,
+                total: pre.len(),
+            });
+        }
         let speed_dependent = matches!(
             f,
             FitParameter::Mu1
@@ -433,6 +462,16 @@ pub fn fit_power_model(
         mean_power / vmax.powi(4),
     ];
 
+    // Held profile and drag constants keep their physical value when K is free (see Problem::tie).
+    let mut tie: Lumped = [0.0; 6];
+    if free.contains(&FitParameter::WeightOverEfficiency) {
+        let physical = [0.0, 0.0, v.kappa1() * w.sqrt(), mu1 / w, mu2 / w, mu3 / w];
+        for (i, f) in FitParameter::ALL.iter().enumerate().skip(2) {
+            if !free.contains(f) {
+                tie[i] = physical[i];
+            }
+        }
+    }
     let mut iterations = 0;
     let mut u = DVector::from_iterator(
         free.len(),
@@ -449,6 +488,7 @@ pub fn fit_power_model(
             base,
             free: &free,
             scale,
+            tie,
         };
         let (r0, _) = problem.evaluate(&u, false);
         // argmin's Gauss-Newton line search measures cost as |r| but passes the gradient of
@@ -496,6 +536,7 @@ pub fn fit_power_model(
             base,
             free: &free,
             scale,
+            tie,
         };
         let (r, _) = problem.evaluate(&u, false);
         let mut sorted: Vec<f64> = r.iter().copied().collect();
@@ -523,6 +564,7 @@ pub fn fit_power_model(
         base,
         free: &free,
         scale,
+        tie,
     };
     let (r, j) = problem.evaluate(&u, true);
     let j = j.expect("requested");
@@ -630,6 +672,11 @@ mod tests {
     /// Synthetic flights of a vehicle: hover, forward flight 0-14 m/s with the pitch that balances
     /// drag, turns with roll, climbs and descents.
     fn flights(truth: &Vehicle, noise_w: f64) -> Vec<FitSample> {
+        flights_with(truth, noise_w, false)
+    }
+
+    /// As [`flights`]; `geometric` selects the exact angle of attack (drag then not in power).
+    fn flights_with(truth: &Vehicle, noise_w: f64, geometric: bool) -> Vec<FitSample> {
         let model = PowerModel::new(truth.clone());
         let mut out = Vec::new();
         let mut seed = 12345u64;
@@ -645,9 +692,14 @@ mod tests {
             let pitch = -(truth.drag().force_n(v) / truth.weight_n()).atan() + 0.05 * rand();
             let roll = 0.3 * rand();
             let climb = if i % 7 == 0 { 2.0 * rand() } else { 0.0 };
+            let direction = 0.2 * rand();
             let state = FlightState {
-                aoa: AoaInput::Geometric {
-                    air_direction_rad: 0.2 * rand(),
+                aoa: if geometric {
+                    AoaInput::Geometric {
+                        air_direction_rad: direction,
+                    }
+                } else {
+                    AoaInput::Paper
                 },
                 ..FlightState::new(v, roll, pitch, climb)
             };
@@ -754,6 +806,72 @@ mod tests {
             .collect();
         let e = fit_power_model(&truth, &level, &opts).unwrap_err();
         assert!(matches!(e, FitError::NotIdentifiable { .. }), "{e}");
+    }
+
+    #[test]
+    fn geometric_samples_identify_k_and_profile_but_refuse_drag() {
+        let truth = Vehicle::new(VehicleParams {
+            efficiency: 0.7,
+            ..m100_params()
+        })
+        .unwrap();
+        let data = flights_with(&truth, 0.0, true);
+        let e = fit_power_model(&truth, &data, &FitOptions::known_geometry()).unwrap_err();
+        assert!(matches!(e, FitError::DragNotInPower { .. }), "{e}");
+        let opts = FitOptions::known_geometry()
+            .without(FitParameter::Mu1)
+            .without(FitParameter::Mu2)
+            .without(FitParameter::Mu3);
+        let start = Vehicle::new(VehicleParams {
+            efficiency: 0.9,
+            kappa1_w_per_n1_5: 0.14,
+            ..m100_params()
+        })
+        .unwrap();
+        let fit = fit_power_model(&start, &data, &opts).unwrap();
+        assert!(
+            (fit.vehicle.efficiency - 0.7).abs() < 1e-6,
+            "{:?}",
+            fit.vehicle
+        );
+        assert!(
+            (fit.vehicle.kappa1_w_per_n1_5 - 0.275).abs() < 1e-5,
+            "{:?}",
+            fit.vehicle
+        );
+    }
+
+    #[test]
+    fn held_constants_keep_their_physical_values_when_eta_moves() {
+        // Regression: held drag and profile constants were held in lumped units (mu / eta), so
+        // their physical values drifted with the fitted eta.
+        let truth = Vehicle::new(VehicleParams {
+            efficiency: 0.7,
+            ..m100_params()
+        })
+        .unwrap();
+        let data = flights_with(&truth, 0.0, true);
+        let start = Vehicle::new(VehicleParams {
+            efficiency: 0.95,
+            ..m100_params()
+        })
+        .unwrap();
+        let opts = FitOptions {
+            free: vec![FitParameter::WeightOverEfficiency],
+            ..FitOptions::known_geometry()
+        };
+        let fit = fit_power_model(&start, &data, &opts).unwrap();
+        let (p, t) = (&fit.vehicle, truth.params());
+        assert!((p.efficiency - 0.7).abs() < 1e-6, "{p:?}");
+        assert!((p.mu1_n_s_per_m - t.mu1_n_s_per_m).abs() < 1e-12, "{p:?}");
+        assert!(
+            (p.mu3_n_s3_per_m3 - t.mu3_n_s3_per_m3).abs() < 1e-12,
+            "{p:?}"
+        );
+        assert!(
+            (p.kappa1_w_per_n1_5 - t.kappa1_w_per_n1_5).abs() < 1e-12,
+            "{p:?}"
+        );
     }
 
     #[test]

@@ -1,0 +1,335 @@
+//! `aloft validate`: the power model against measured power, per flight and per airspeed band, in
+//! the layout of the power seed's Table I, with the whole-flight energy error.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::Args;
+use serde::Serialize;
+
+use aloft::identify::{predict, validate_flight, AlignOptions, FlightValidation, AIRSPEED_BANDS};
+use aloft::power::PowerModel;
+
+use super::fit::{load_flights, AoaArg};
+use super::{load_vehicle, Format, Outcome};
+
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// Flight logs (CSV or MCAP).
+    #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
+    log: Vec<PathBuf>,
+    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
+    #[arg(long)]
+    profile: Option<String>,
+    /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    vehicle: String,
+    /// Re-estimate only the efficiency from the first S seconds of each flight, as a ground
+    /// station would in flight, and report the errors over the rest.
+    #[arg(long, value_name = "S")]
+    calibrate_first: Option<f64>,
+    /// Angle-of-attack model for the logged states.
+    #[arg(long, value_enum, default_value_t = AoaArg::Geometric)]
+    aoa: AoaArg,
+    /// Use this lag of power behind motion (s) instead of estimating it.
+    #[arg(long, allow_negative_numbers = true, value_name = "S")]
+    lag: Option<f64>,
+    /// Search window of the lag estimate, s.
+    #[arg(long, default_value_t = 10.0, value_name = "S")]
+    max_lag: f64,
+    /// Also write an SVG of measured against predicted power, one panel per flight.
+    #[arg(long, value_name = "SVG")]
+    plot: Option<PathBuf>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+/// Mean over flights of one Table I cell.
+#[derive(Serialize)]
+struct MeanBand {
+    airspeed_band_mps: &'static str,
+    flights: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    nrmse_percent: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct MeanRow {
+    dropped_term: &'static str,
+    nrmse_percent: f64,
+    bands: Vec<MeanBand>,
+}
+
+#[derive(Serialize)]
+struct Report {
+    vehicle: String,
+    flights: Vec<FlightValidation>,
+    /// Mean NRMSE over the flights, per dropped term and airspeed band (Table I layout).
+    table_i: Vec<MeanRow>,
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+fn file_name(p: &str) -> &str {
+    Path::new(p)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or(p)
+}
+
+pub fn run(args: ValidateArgs) -> Result<Outcome> {
+    let file = load_vehicle(&args.vehicle)?;
+    let model = PowerModel::new(file.power_vehicle()?);
+    let align = AlignOptions {
+        max_lag_s: args.max_lag,
+        lag_s: args.lag,
+        ..AlignOptions::default()
+    };
+    let flights = load_flights(
+        &args.log,
+        args.profile.as_deref(),
+        &align,
+        args.aoa == AoaArg::Geometric,
+    )?;
+    let mut results = Vec::new();
+    for (flight, _) in &flights {
+        eprintln!(
+            "aloft validate: {}: power lags motion by {:.2} s",
+            file_name(&flight.source),
+            flight.lag_s
+        );
+        results.push(validate_flight(&model, flight, args.calibrate_first)?);
+    }
+    if let Some(path) = &args.plot {
+        let series: Vec<(String, Vec<f64>, Vec<f64>, Vec<f64>)> = flights
+            .iter()
+            .map(|(f, _)| {
+                let predicted = predict(&model, f)?;
+                let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
+                Ok((
+                    file_name(&f.source).to_string(),
+                    f.times_s.clone(),
+                    measured,
+                    predicted,
+                ))
+            })
+            .collect::<Result<_>>()?;
+        plot(path, &series).with_context(|| format!("cannot write the plot {}", path.display()))?;
+    }
+    let table_i = results
+        .first()
+        .map(|first| {
+            first
+                .table_i
+                .iter()
+                .enumerate()
+                .map(|(row, r)| MeanRow {
+                    dropped_term: r.dropped_term,
+                    nrmse_percent: mean(results.iter().map(|f| f.table_i[row].nrmse_percent))
+                        .unwrap_or(f64::NAN),
+                    bands: AIRSPEED_BANDS
+                        .iter()
+                        .enumerate()
+                        .map(|(b, &(label, _, _))| {
+                            let cells: Vec<f64> = results
+                                .iter()
+                                .filter_map(|f| f.table_i[row].bands[b].nrmse_percent)
+                                .collect();
+                            MeanBand {
+                                airspeed_band_mps: label,
+                                flights: cells.len(),
+                                nrmse_percent: mean(cells.into_iter()),
+                            }
+                        })
+                        .collect(),
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let report = Report {
+        vehicle: file.name.clone(),
+        flights: results,
+        table_i,
+    };
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    match args.format {
+        Format::Json => super::output::write_json(&mut out, &report)?,
+        Format::Csv => {
+            let mut w = csv::Writer::from_writer(out);
+            w.write_record([
+                "file",
+                "duration_s",
+                "lag_s",
+                "measured_energy_wh",
+                "predicted_energy_wh",
+                "energy_error_percent",
+                "nrmse_percent",
+                "baseline_nrmse_percent",
+                "calibrated_energy_error_percent",
+                "calibrated_rmse_w",
+                "best_constant_rmse_w",
+            ])?;
+            for f in &report.flights {
+                let c = f.calibration.as_ref();
+                let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
+                w.write_record([
+                    f.file.clone(),
+                    f.duration_s.to_string(),
+                    f.lag_s.to_string(),
+                    f.measured_energy_wh.to_string(),
+                    f.predicted_energy_wh.to_string(),
+                    f.energy_error_percent.to_string(),
+                    f.nrmse_percent.to_string(),
+                    f.baseline_nrmse_percent.to_string(),
+                    opt(c.map(|c| c.energy_error_percent)),
+                    opt(c.map(|c| c.rmse_w)),
+                    opt(c.map(|c| c.best_constant_rmse_w)),
+                ])?;
+            }
+            w.flush()?;
+        }
+        Format::Table => render(&mut out, &report)?,
+    }
+    Ok(Outcome::Ok)
+}
+
+fn render(out: &mut impl Write, r: &Report) -> Result<()> {
+    writeln!(
+        out,
+        "aloft validate: vehicle {}, {} flight(s)",
+        r.vehicle,
+        r.flights.len()
+    )?;
+    writeln!(
+        out,
+        "  {:<40} {:>6} {:>6} {:>9} {:>9} {:>7} {:>7} {:>8}",
+        "flight", "min", "lag s", "meas Wh", "pred Wh", "err %", "NRMSE%", "const %"
+    )?;
+    for f in &r.flights {
+        writeln!(
+            out,
+            "  {:<40} {:>6.1} {:>6.2} {:>9.1} {:>9.1} {:>+7.2} {:>7.2} {:>8.2}",
+            file_name(&f.file),
+            f.duration_s / 60.0,
+            f.lag_s,
+            f.measured_energy_wh,
+            f.predicted_energy_wh,
+            f.energy_error_percent,
+            f.nrmse_percent,
+            f.baseline_nrmse_percent
+        )?;
+    }
+    if r.flights.iter().any(|f| f.calibration.is_some()) {
+        writeln!(
+            out,
+            "\nEfficiency re-estimated from the start of each flight; errors over the rest:"
+        )?;
+        writeln!(
+            out,
+            "  {:<40} {:>7} {:>7} {:>9} {:>9} {:>10}",
+            "flight", "window", "eta", "err %", "RMSE W", "const W"
+        )?;
+        for f in &r.flights {
+            if let Some(c) = &f.calibration {
+                writeln!(
+                    out,
+                    "  {:<40} {:>6.0}s {:>7.4} {:>+9.2} {:>9.1} {:>10.1}",
+                    file_name(&f.file),
+                    c.calibrate_s,
+                    c.efficiency,
+                    c.energy_error_percent,
+                    c.rmse_w,
+                    c.best_constant_rmse_w
+                )?;
+            }
+        }
+    }
+    writeln!(out, "\nMean NRMSE (%) with each term removed, by airspeed band in m/s (power seed Table I layout):")?;
+    write!(out, "  {:<10} {:>7}", "dropped", "all")?;
+    for (label, _, _) in AIRSPEED_BANDS {
+        write!(out, " {:>7}", label)?;
+    }
+    writeln!(out)?;
+    for row in &r.table_i {
+        write!(out, "  {:<10} {:>7.2}", row.dropped_term, row.nrmse_percent)?;
+        for b in &row.bands {
+            match b.nrmse_percent {
+                Some(x) => write!(out, " {:>7.2}", x)?,
+                None => write!(out, " {:>7}", "-")?,
+            }
+        }
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+type Series = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+
+fn plot(path: &Path, series: &[Series]) -> Result<()> {
+    use plotters::prelude::*;
+    let height = 260 * series.len().max(1) as u32;
+    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
+    root.fill(&WHITE)?;
+    for ((name, t, measured, predicted), area) in
+        series.iter().zip(root.split_evenly((series.len(), 1)))
+    {
+        if t.is_empty() {
+            continue;
+        }
+        let t0 = t[0];
+        let t1 = t[t.len() - 1].max(t0 + 1.0);
+        let hi = measured
+            .iter()
+            .chain(predicted)
+            .copied()
+            .fold(0.0, f64::max)
+            * 1.05;
+        let lo = measured
+            .iter()
+            .chain(predicted)
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+            * 0.95;
+        let mut chart = ChartBuilder::on(&area)
+            .caption(
+                format!("{name}: measured and predicted electrical power"),
+                ("sans-serif", 16),
+            )
+            .margin(10)
+            .x_label_area_size(35)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0.0..(t1 - t0), lo..hi)?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_desc("power (W)")
+            .draw()?;
+        chart
+            .draw_series(LineSeries::new(
+                t.iter().zip(measured).map(|(x, y)| (x - t0, *y)),
+                &BLUE,
+            ))?
+            .label("measured")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+        chart
+            .draw_series(LineSeries::new(
+                t.iter().zip(predicted).map(|(x, y)| (x - t0, *y)),
+                &RED,
+            ))?
+            .label("model")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+    }
+    root.present()?;
+    Ok(())
+}
