@@ -1,39 +1,26 @@
 //! `aloft fit`: identify the power model of a vehicle from flight logs.
 
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{bail, Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use serde::Serialize;
 
-use aloft::identify::{align_flight, force_samples, AlignOptions, AlignedFlight};
+use aloft::identify::force_samples;
 use aloft::power::fit::{DragFit, FitParameter};
-use aloft::power::{fit_drag, fit_power_model, AoaInput, FitOptions, PowerFit};
+use aloft::power::{fit_drag, fit_power_model, FitOptions, PowerFit};
 use aloft::propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
+use super::flights::{file_name, FlightLogs};
 use super::output::{self, Row};
 use super::{load_vehicle, Format, Outcome};
 
-/// Angle-of-attack model used to evaluate the logged states.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AoaArg {
-    /// Exact geometry from attitude and air velocity (drag work is in the attitude; drag is fitted
-    /// from the force balance).
-    Geometric,
-    /// The paper's eqs (3)-(4) (drag can be fitted from power).
-    Paper,
-}
-
 #[derive(Debug, Args)]
 pub struct FitArgs {
-    /// Flight logs (CSV or MCAP).
-    #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
-    log: Vec<PathBuf>,
-    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
-    #[arg(long)]
-    profile: Option<String>,
+    #[command(flatten)]
+    logs: FlightLogs,
     /// Vehicle to start from (its [power] table): built-in name or TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     vehicle_template: String,
@@ -45,15 +32,6 @@ pub struct FitArgs {
     /// acceleration, unless --aoa paper and mu* are listed here.
     #[arg(long, value_delimiter = ',', default_value = "k")]
     free: Vec<String>,
-    /// Angle-of-attack model for the logged states.
-    #[arg(long, value_enum, default_value_t = AoaArg::Geometric)]
-    aoa: AoaArg,
-    /// Use this lag of power behind motion (s) instead of estimating it.
-    #[arg(long, allow_negative_numbers = true, value_name = "S")]
-    lag: Option<f64>,
-    /// Search window of the lag estimate, s.
-    #[arg(long, default_value_t = 10.0, value_name = "S")]
-    max_lag: f64,
     /// Do not fit drag from the force balance (keep the template's mu1..mu3).
     #[arg(long)]
     no_drag: bool,
@@ -95,32 +73,6 @@ struct Report {
     output: String,
 }
 
-/// Read, align and summarise logs (shared with `aloft validate`).
-pub fn load_flights(
-    paths: &[PathBuf],
-    profile: Option<&str>,
-    align: &AlignOptions,
-    geometric: bool,
-) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>> {
-    let profile = profile
-        .map(aloft_logs::Profile::resolve)
-        .transpose()
-        .context("--profile")?;
-    let mut out = Vec::new();
-    for path in paths {
-        let log = aloft_logs::read_log(path, profile.as_ref(), &Default::default())
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let mut flight = align_flight(&log, align)?;
-        if !geometric {
-            for s in &mut flight.samples {
-                s.state.aoa = AoaInput::Paper;
-            }
-        }
-        out.push((flight, log));
-    }
-    Ok(out)
-}
-
 /// Pack resistance of one log, when it has voltage and current.
 pub fn pack_fit(log: &aloft_logs::Log) -> Option<PackResistanceFit> {
     let (mut t, mut i, mut v) = (Vec::new(), Vec::new(), Vec::new());
@@ -134,13 +86,6 @@ pub fn pack_fit(log: &aloft_logs::Log) -> Option<PackResistanceFit> {
     fit_pack_resistance(&t, &i, &v).ok()
 }
 
-fn file_name(p: &str) -> &str {
-    Path::new(p)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(p)
-}
-
 pub fn run(args: FitArgs) -> Result<Outcome> {
     let template = load_vehicle(&args.vehicle_template)?;
     let mut vehicle = template.power_vehicle()?;
@@ -148,17 +93,7 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
     for name in &args.free {
         free.push(parameter(name)?);
     }
-    let align = AlignOptions {
-        max_lag_s: args.max_lag,
-        lag_s: args.lag,
-        ..AlignOptions::default()
-    };
-    let flights = load_flights(
-        &args.log,
-        args.profile.as_deref(),
-        &align,
-        args.aoa == AoaArg::Geometric,
-    )?;
+    let flights = args.logs.load()?;
     let mut logs = Vec::new();
     let mut samples = Vec::new();
     let mut forces = Vec::new();
@@ -232,7 +167,7 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
     fitted.description = format!(
         "{} (fitted by aloft fit from {} log(s), RMSE {:.1} W, NRMSE {:.2} %)",
         template.description,
-        args.log.len(),
+        args.logs.log.len(),
         fit.rmse_w,
         100.0 * fit.nrmse
     );

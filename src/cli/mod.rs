@@ -3,6 +3,7 @@
 mod convert;
 mod endurance;
 mod fit;
+mod flights;
 mod log;
 mod mission;
 mod output;

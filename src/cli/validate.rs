@@ -8,20 +8,16 @@ use anyhow::{Context, Result};
 use clap::Args;
 use serde::Serialize;
 
-use aloft::identify::{predict, validate_flight, AlignOptions, FlightValidation, AIRSPEED_BANDS};
+use aloft::identify::{predict, validate_flight, FlightValidation, AIRSPEED_BANDS};
 use aloft::power::PowerModel;
 
-use super::fit::{load_flights, AoaArg};
+use super::flights::{file_name, FlightLogs};
 use super::{load_vehicle, Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
-    /// Flight logs (CSV or MCAP).
-    #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
-    log: Vec<PathBuf>,
-    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
-    #[arg(long)]
-    profile: Option<String>,
+    #[command(flatten)]
+    logs: FlightLogs,
     /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     vehicle: String,
@@ -29,15 +25,6 @@ pub struct ValidateArgs {
     /// station would in flight, and report the errors over the rest.
     #[arg(long, value_name = "S")]
     calibrate_first: Option<f64>,
-    /// Angle-of-attack model for the logged states.
-    #[arg(long, value_enum, default_value_t = AoaArg::Geometric)]
-    aoa: AoaArg,
-    /// Use this lag of power behind motion (s) instead of estimating it.
-    #[arg(long, allow_negative_numbers = true, value_name = "S")]
-    lag: Option<f64>,
-    /// Search window of the lag estimate, s.
-    #[arg(long, default_value_t = 10.0, value_name = "S")]
-    max_lag: f64,
     /// Also write an SVG of measured against predicted power, one panel per flight.
     #[arg(long, value_name = "SVG")]
     plot: Option<PathBuf>,
@@ -75,27 +62,10 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-fn file_name(p: &str) -> &str {
-    Path::new(p)
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or(p)
-}
-
 pub fn run(args: ValidateArgs) -> Result<Outcome> {
     let file = load_vehicle(&args.vehicle)?;
     let model = PowerModel::new(file.power_vehicle()?);
-    let align = AlignOptions {
-        max_lag_s: args.max_lag,
-        lag_s: args.lag,
-        ..AlignOptions::default()
-    };
-    let flights = load_flights(
-        &args.log,
-        args.profile.as_deref(),
-        &align,
-        args.aoa == AoaArg::Geometric,
-    )?;
+    let flights = args.logs.load()?;
     let mut results = Vec::new();
     for (flight, _) in &flights {
         eprintln!(

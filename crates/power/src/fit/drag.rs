@@ -66,7 +66,7 @@ pub fn fit_drag(
         }
         let e = [v[0] / speed, v[1] / speed];
         let t = thrust_axis_enu(s.roll_rad, s.pitch_rad, s.yaw_rad);
-        if !(t.z > 0.1) {
+        if t.z.is_nan() || t.z <= 0.1 {
             continue;
         }
         let a = s.acc_enu_mps2;

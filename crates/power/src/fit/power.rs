@@ -290,9 +290,9 @@ impl Problem<'_> {
             };
         }
         let k = p[FitParameter::WeightOverEfficiency.index()];
-        for i in 2..6 {
-            if self.tie[i] != 0.0 {
-                p[i] = self.tie[i] * k;
+        for (value, &tie) in p.iter_mut().zip(&self.tie).skip(2) {
+            if tie != 0.0 {
+                *value = tie * k;
             }
         }
         p
