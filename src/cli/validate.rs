@@ -76,7 +76,7 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
         results.push(validate_flight(&model, flight, args.calibrate_first)?);
     }
     if let Some(path) = &args.plot {
-        let series: Vec<(String, Vec<f64>, Vec<f64>, Vec<f64>)> = flights
+        let series: Vec<Series> = flights
             .iter()
             .map(|(f, _)| {
                 let predicted = predict(&model, f)?;
