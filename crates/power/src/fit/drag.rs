@@ -194,8 +194,8 @@ mod tests {
             });
         }
         let fit = fit_drag(m, g, &samples, 0.5, 5.0).unwrap();
-        for k in 0..3 {
-            assert!((fit.mu_n[k] - mu[k]).abs() < 1e-9, "{fit:?}");
+        for (got, want) in fit.mu_n.iter().zip(mu) {
+            assert!((got - want).abs() < 1e-9, "{fit:?}");
         }
         let _ = ned_to_enu(&V3::zeros());
     }
