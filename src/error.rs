@@ -121,6 +121,58 @@ pub enum Error {
     /// The power-model fit failed or was refused.
     #[error(transparent)]
     Fit(#[from] aloft_power::FitError),
+    /// The planner rejected an input (a wind, an endurance query, a mass). Boxed: the planner's
+    /// error is large and this enum travels in every `Result` of the facade.
+    #[error(transparent)]
+    Planner(Box<aloft_planner::PlannerError>),
+    /// A mission text (TOML or JSON) that does not parse or does not match the format.
+    #[error("invalid mission {origin}: {message}")]
+    MissionFormat {
+        /// Where the text came from (file path, `built-in demo`, `C caller`).
+        origin: String,
+        /// The parser's message (line, column and key).
+        message: String,
+    },
+    /// A mission that cannot be compiled or flown by this vehicle.
+    #[error("mission {origin} with {vehicle}: {source}")]
+    Mission {
+        /// Where the mission came from.
+        origin: String,
+        /// Vehicle name.
+        vehicle: String,
+        /// The planner's error.
+        source: Box<aloft_planner::PlannerError>,
+    },
+    /// A number outside its valid range in an option or a measured sample.
+    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    InvalidInput {
+        /// Option or field name, with its unit suffix.
+        name: &'static str,
+        /// The rejected value.
+        value: f64,
+        /// Unit of `value`.
+        unit: &'static str,
+        /// What a valid value looks like.
+        expected: &'static str,
+    },
+    /// An option document (JSON) that does not parse or has unknown keys.
+    #[error("invalid {what}: {message}")]
+    OptionsFormat {
+        /// Which document (`mission options`, `endurance options`, `flight state`).
+        what: &'static str,
+        /// The parser's message.
+        message: String,
+    },
+    /// The take-off mass exceeds the airframe's limit.
+    #[error("take-off mass {mass_kg:.3} kg (airframe + {battery} + payload) exceeds the vehicle's {max_kg:.3} kg limit")]
+    TooHeavy {
+        /// Take-off mass asked for, kg.
+        mass_kg: f64,
+        /// The airframe's limit, kg.
+        max_kg: f64,
+        /// The pack's name.
+        battery: String,
+    },
     /// The vehicle has no table for the model that was asked for.
     #[error("vehicle '{vehicle}' has no [{table}] table, which {needed_for} needs")]
     MissingTable {
@@ -131,4 +183,10 @@ pub enum Error {
         /// What needs it.
         needed_for: &'static str,
     },
+}
+
+impl From<aloft_planner::PlannerError> for Error {
+    fn from(e: aloft_planner::PlannerError) -> Self {
+        Error::Planner(Box::new(e))
+    }
 }

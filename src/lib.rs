@@ -7,6 +7,8 @@
 //! - [`power`]: the four-term power model (`aloft-power`).
 //! - [`propulsion`]: the propulsion chain (`aloft-propulsion`).
 //! - [`vehicle`]: vehicle files (TOML) and the built-in vehicles.
+//! - [`engine`]: the embedding facade for ground stations (vehicles, power, missions, endurance,
+//!   in-flight efficiency re-estimate); the C ABI of `aloft-ffi` wraps it.
 //! - [`batch`]: streaming CSV evaluation of the power model.
 //! - [`identify`]: flight logs to the power model: lag alignment, fit samples, validation.
 //!
@@ -22,10 +24,15 @@
 #![deny(clippy::float_cmp)]
 
 pub mod batch;
+pub mod engine;
 pub mod error;
 pub mod identify;
 pub mod vehicle;
 
 pub use aloft_power as power;
 pub use aloft_propulsion as propulsion;
+pub use engine::{
+    endurance, mission_summary, plan_mission, plan_mission_in, EnduranceOptions, EnduranceSummary,
+    InFlightEstimator, Mission, MissionOptions, MissionSummary, Plan, Vehicle,
+};
 pub use error::Error;

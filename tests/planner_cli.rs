@@ -198,3 +198,84 @@ fn endurance_json_has_the_contract_keys() {
     assert!(out.starts_with("airspeed_mps,ground_speed_mps,power_w,endurance_s,range_m"));
     assert_eq!(out.lines().count(), 1 + 18); // 0..=17 m/s
 }
+
+#[test]
+fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
+    let mcap = tmp("demo.mcap");
+    let csv = tmp("demo-for-mcap.csv");
+    let (code, _, err) = aloft(&[
+        "mission",
+        "--mcap",
+        mcap.to_str().unwrap(),
+        "--timeseries",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(&mcap).unwrap();
+    // MCAP magic at both ends (MCAP spec: 0x89 "MCAP0" CR LF).
+    let magic = b"\x89MCAP0\r\n";
+    assert!(bytes.len() > 2 * magic.len());
+    assert_eq!(&bytes[..magic.len()], magic);
+    assert_eq!(&bytes[bytes.len() - magic.len()..], magic);
+
+    // The samples as the CSV has them: one message per sample on each per-sample topic.
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let col = |k: &str| header.iter().position(|h| *h == k).unwrap();
+    let n = rows.len();
+    assert!(n > 4000);
+    let python_mcap = Command::new("python3")
+        .args(["-c", "import mcap"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !python_mcap {
+        eprintln!(
+            "python3 with the mcap package not found: the independent reader check is skipped"
+        );
+        return;
+    }
+    let k = n / 2;
+    let expect = serde_json::json!({
+        "topics": {
+            "/aloft/pose": {"count": n, "schema": "foxglove.PoseInFrame"},
+            "/aloft/state": {"count": n},
+            "/aloft/power": {"count": n, "schema": "aloft.PowerTerms"},
+            "/aloft/battery": {"count": n, "schema": "aloft.BatteryState"},
+            "/aloft/path": {"count": 1, "schema": "foxglove.PosesInFrame"},
+        },
+        "values": [
+            {"topic": "/aloft/power", "index": k, "path": "electrical_w",
+             "value": rows[k][col("power_w")], "tol": 1e-6 * rows[k][col("power_w")]},
+            {"topic": "/aloft/battery", "index": k, "path": "state_of_charge",
+             "value": rows[k][col("soc")], "tol": 1e-9},
+            {"topic": "/aloft/battery", "index": k, "path": "current_a",
+             "value": rows[k][col("current_a")], "tol": 1e-9 * rows[k][col("current_a")]},
+            {"topic": "/aloft/pose", "index": k, "path": "pose.position.x",
+             "value": rows[k][col("east_m")], "tol": 1e-9},
+            {"topic": "/aloft/path", "index": 0, "path": "poses.0.position.x", "value": 0.0, "tol": 1e-9},
+        ],
+    });
+    let expect_path = tmp("demo-mcap-expect.json");
+    std::fs::write(&expect_path, expect.to_string()).unwrap();
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/python/check_mcap.py");
+    let out = Command::new("python3")
+        .arg(script)
+        .arg(&mcap)
+        .arg(&expect_path)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "check_mcap.py: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

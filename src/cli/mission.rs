@@ -228,6 +228,46 @@ pub struct MissionArgs {
     /// Draw power and state of charge against time and the ground track to this SVG.
     #[arg(long, value_name = "SVG")]
     plot: Option<PathBuf>,
+    /// Write the mission's samples (pose, attitude, power terms, battery state) and the planned
+    /// path to this MCAP file (JSON messages with schemas, for Foxglove).
+    #[arg(long, value_name = "MCAP")]
+    mcap: Option<PathBuf>,
+    /// Replay a recorded flight instead of planning: predict its energy from the trajectory alone
+    /// (velocities and accelerations through the planner's trim and power model; no power data)
+    /// and print it next to the measured energy (integral of V x I over the same span).
+    #[arg(
+        long,
+        value_name = "LOG",
+        conflicts_with_all = ["mission", "timeseries", "plot", "mcap", "battery"]
+    )]
+    replay: Option<PathBuf>,
+    /// Log layout for --replay: kaist, px4 or a column-map TOML (default: detected).
+    #[arg(long, requires = "replay")]
+    profile: Option<String>,
+    /// Lag of the logged power behind the motion for --replay, s (default: estimated by
+    /// cross-correlating power with tilt). Only the measured side is shifted.
+    #[arg(
+        long,
+        requires = "replay",
+        allow_negative_numbers = true,
+        value_name = "S"
+    )]
+    lag: Option<f64>,
+    /// Acceleration for --replay: differentiated velocity (default) or the log's own.
+    #[arg(long, value_enum, default_value_t = AccelArg::Velocity)]
+    acceleration: AccelArg,
+    /// Window of the velocity difference for --acceleration velocity, s.
+    #[arg(long, default_value_t = 1.0, value_name = "S")]
+    acceleration_window: f64,
+}
+
+/// Where the replay takes the acceleration from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AccelArg {
+    /// Centred difference of the logged velocity over --acceleration-window.
+    Velocity,
+    /// The log's acceleration channel.
+    Log,
 }
 
 #[derive(Serialize)]
@@ -285,6 +325,9 @@ fn mmss(t: f64) -> String {
 }
 
 pub fn run(args: MissionArgs) -> Result<Outcome> {
+    if args.replay.is_some() {
+        return replay::run(&args);
+    }
     let file = load_vehicle(&args.vehicle)?;
     let (text, origin) = match &args.mission {
         Some(p) => (
@@ -344,7 +387,7 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
         ground_effect: !args.no_ground_effect,
         reserve_fraction: reserve_percent / 100.0,
         start_soc: args.start_percent / 100.0,
-        record_samples: args.timeseries.is_some() || args.plot.is_some(),
+        record_samples: args.timeseries.is_some() || args.plot.is_some() || args.mcap.is_some(),
         ..PlanOptions::default()
     };
     let report = plan(&aircraft, &battery, &mission, &wind, &options)
@@ -362,6 +405,10 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     if let Some(path) = &args.plot {
         plot(path, &spec.name, &report, mission.home_m())
             .with_context(|| format!("cannot draw {}", path.display()))?;
+    }
+    if let Some(path) = &args.mcap {
+        write_mcap(path, &report, &mission)
+            .with_context(|| format!("cannot write {}", path.display()))?;
     }
 
     let stdout = std::io::stdout();
@@ -574,6 +621,77 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     })
 }
 
+/// The mission as MCAP: every sample (pose, attitude, power terms, battery state) and the path
+/// through the mission's waypoints.
+fn write_mcap(path: &Path, report: &MissionReport, mission: &aloft_planner::Mission) -> Result<()> {
+    use aloft_logs::{Attitude, BatteryPoint, MissionSample, PathPoint, PowerTerms};
+    let mut energy_wh = 0.0;
+    let mut last_t = 0.0;
+    let samples: Vec<MissionSample> = report
+        .samples
+        .iter()
+        .map(|s| {
+            // Energy to the end of this step (samples are step midpoints; the step is twice the
+            // distance to the previous step's end).
+            let end_t = s.time_s + (s.time_s - last_t);
+            energy_wh += s.power_w * (end_t - last_t) / 3600.0;
+            last_t = end_t;
+            MissionSample {
+                time_s: s.time_s,
+                pos_enu_m: [s.east_m, s.north_m, s.up_m],
+                vel_enu_mps: [s.vel_east_mps, s.vel_north_mps, s.vel_up_mps],
+                attitude: Attitude {
+                    roll_rad: s.roll_deg.to_radians(),
+                    pitch_rad: s.pitch_deg.to_radians(),
+                    yaw_rad: s.yaw_deg.to_radians(),
+                },
+                power: PowerTerms {
+                    induced_w: s.induced_w.unwrap_or(0.0),
+                    parasitic_w: s.parasitic_w.unwrap_or(0.0),
+                    profile_w: s.profile_w.unwrap_or(0.0),
+                    climb_w: s.climb_w.unwrap_or(0.0),
+                    electrical_w: s.power_w,
+                },
+                battery: Some(BatteryPoint {
+                    voltage_v: s.voltage_v,
+                    current_a: s.current_a,
+                    state_of_charge: s.soc,
+                    energy_used_wh: energy_wh,
+                }),
+            }
+        })
+        .collect();
+    let mut path_points = vec![PathPoint {
+        pos_enu_m: mission.home_m(),
+        yaw_rad: None,
+    }];
+    for p in mission.pieces() {
+        let end = p.end_m();
+        let last = path_points[path_points.len() - 1].pos_enu_m;
+        let is_arc = matches!(p.shape, aloft_planner::trajectory::Shape::Arc { .. });
+        if is_arc || (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
+            // Arcs: 36 points per piece so the path shows the circle.
+            if is_arc {
+                let d = p.duration_s();
+                let n = 36;
+                for k in 1..=n {
+                    path_points.push(PathPoint {
+                        pos_enu_m: p.at(d * k as f64 / n as f64).pos_m,
+                        yaw_rad: None,
+                    });
+                }
+            } else {
+                path_points.push(PathPoint {
+                    pos_enu_m: end,
+                    yaw_rad: None,
+                });
+            }
+        }
+    }
+    aloft_logs::write_mission_mcap(path, &samples, &path_points)?;
+    Ok(())
+}
+
 fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Result<()> {
     use plotters::prelude::*;
     let s = &report.samples;
@@ -696,4 +814,266 @@ fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Resu
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// `aloft mission --replay`: the energy of a recorded flight from its trajectory alone.
+mod replay {
+    use std::io::Write as _;
+
+    use anyhow::{bail, Context, Result};
+    use serde::Serialize;
+
+    use aloft::identify::{align_flight, AlignOptions};
+    use aloft::power::ModelOptions;
+    use aloft_planner::{
+        differentiate_velocity, power_only_aircraft, replay, replay::trapezoid, ReplayPoint,
+    };
+
+    use super::super::output::{self, Row};
+    use super::super::{load_vehicle, Format, Outcome};
+    use super::{AccelArg, MissionArgs};
+
+    #[derive(Serialize)]
+    struct ReplayJson<'a> {
+        file: &'a str,
+        vehicle: &'a str,
+        mass_kg: f64,
+        points: usize,
+        duration_s: f64,
+        acceleration: &'static str,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        lag_s: Option<f64>,
+        predicted_energy_wh: f64,
+        predicted_mean_power_w: f64,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        measured_energy_wh: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        measured_mean_power_w: Option<f64>,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        energy_error_percent: Option<f64>,
+    }
+
+    /// Integral of the piecewise-linear `values(times)` over `[a, b]` (inside the data).
+    fn window_integral(times: &[f64], values: &[f64], a: f64, b: f64) -> f64 {
+        let interp = |t: f64| {
+            let i = times.partition_point(|&x| x <= t).clamp(1, times.len() - 1);
+            let (t0, t1) = (times[i - 1], times[i]);
+            let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
+            values[i - 1] + w * (values[i] - values[i - 1])
+        };
+        let (mut ts, mut vs) = (vec![a], vec![interp(a)]);
+        for (&t, &v) in times.iter().zip(values) {
+            if t > a && t < b {
+                ts.push(t);
+                vs.push(v);
+            }
+        }
+        ts.push(b);
+        vs.push(interp(b));
+        trapezoid(&ts, &vs)
+    }
+
+    pub fn run(args: &MissionArgs) -> Result<Outcome> {
+        let path = args.replay.as_ref().expect("--replay");
+        let file = load_vehicle(&args.vehicle)?;
+        let payload = args.payload_kg.unwrap_or(0.0);
+        if !(payload.is_finite() && payload >= 0.0) {
+            bail!("--payload-kg {payload}: expected a mass of 0 kg or more");
+        }
+        // The aircraft: with an airframe, airframe + default pack + payload; a vehicle known only
+        // by its [power] table (a fit) flies at that table's mass.
+        let (aircraft, mass_kg) = if file.airframe.is_some() {
+            let (aircraft, _) = file.aircraft(ModelOptions::default())?;
+            let pack = if file.batteries.is_empty() {
+                0.0
+            } else {
+                file.battery(None)?.mass_kg()
+            };
+            let m = aircraft.airframe().mass_kg() + pack + payload;
+            (aircraft, m)
+        } else {
+            let vehicle = file.power_vehicle()?;
+            let m = vehicle.mass_kg() + payload;
+            (
+                power_only_aircraft(vehicle, ModelOptions::default())
+                    .context("vehicle for replay")?,
+                m,
+            )
+        };
+        let pw = aircraft
+            .at_mass(mass_kg, args.aoa.model())
+            .context("vehicle mass")?;
+        let profile = args
+            .profile
+            .as_deref()
+            .map(aloft_logs::Profile::resolve)
+            .transpose()
+            .context("--profile")?;
+        let log = aloft_logs::read_log(path, profile.as_ref(), &Default::default())
+            .context("--replay")?;
+
+        // The trajectory: samples with a velocity, strictly increasing in time.
+        let mut times = Vec::new();
+        let mut vels = Vec::new();
+        let mut rows = Vec::new();
+        for s in &log.samples {
+            let Some(v) = s.vel_enu_mps else { continue };
+            if !s.time_s.is_finite() || times.last().is_some_and(|&t| s.time_s <= t) {
+                continue;
+            }
+            times.push(s.time_s);
+            vels.push(v);
+            rows.push(s);
+        }
+        if times.len() < 2 {
+            bail!(
+                "{}: fewer than two samples with a velocity: nothing to replay",
+                path.display()
+            );
+        }
+        let accs: Vec<[f64; 3]> = match args.acceleration {
+            AccelArg::Velocity => differentiate_velocity(&times, &vels, args.acceleration_window)
+                .context("--acceleration-window")?,
+            AccelArg::Log => rows
+                .iter()
+                .map(|s| s.acc_enu_mps2)
+                .collect::<Option<Vec<_>>>()
+                .with_context(|| {
+                    format!(
+                        "{}: the log has no acceleration on every velocity sample; use --acceleration velocity",
+                        path.display()
+                    )
+                })?,
+        };
+        let points: Vec<ReplayPoint> = rows
+            .iter()
+            .zip(&accs)
+            .map(|(s, a)| ReplayPoint {
+                time_s: s.time_s,
+                vel_enu_mps: s.vel_enu_mps.unwrap_or([0.0; 3]),
+                acc_enu_mps2: *a,
+                pos_enu_m: s.pos_enu_m.unwrap_or([0.0; 3]),
+                height_above_ground_m: None,
+                wind_enu_mps: s.wind_enu_mps,
+            })
+            .collect();
+        let (wind, wind_text) = args.wind.build(None).context("wind for the replay")?;
+        let report =
+            replay(&pw, &points, &wind).with_context(|| format!("replay of {}", path.display()))?;
+
+        // Measured: V x I of the same span, shifted by the lag of power behind motion.
+        let (pt, pp): (Vec<f64>, Vec<f64>) = log
+            .samples
+            .iter()
+            .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
+            .filter(|(t, p)| t.is_finite() && p.is_finite())
+            .unzip();
+        let monotonic = pt.windows(2).all(|w| w[1] >= w[0]);
+        let (lag_s, measured, predicted_wh, span_s) = if pt.len() >= 2 && monotonic {
+            let lag = match args.lag {
+                Some(l) => l,
+                None => match align_flight(&log, &AlignOptions::default()) {
+                    Ok(a) => a.lag_s,
+                    Err(e) => {
+                        eprintln!("aloft mission --replay: no lag estimate ({e}); using 0 s");
+                        0.0
+                    }
+                },
+            };
+            let a = times[0].max(pt[0] - lag);
+            let b = times[times.len() - 1].min(pt[pt.len() - 1] - lag);
+            if b <= a {
+                bail!(
+                    "{}: the power channel does not overlap the trajectory with a lag of {lag} s",
+                    path.display()
+                );
+            }
+            let measured_wh = window_integral(&pt, &pp, a + lag, b + lag) / 3600.0;
+            let predicted_wh = window_integral(&times, &report.power_w, a, b) / 3600.0;
+            (Some(lag), Some(measured_wh), predicted_wh, b - a)
+        } else {
+            (None, None, report.energy_wh, report.duration_s)
+        };
+        let error = measured.map(|m| 100.0 * (predicted_wh - m) / m);
+        let source = path.display().to_string();
+        let stdout = std::io::stdout();
+        let mut out = stdout.lock();
+        match args.format {
+            Format::Json => output::write_json(
+                &mut out,
+                &ReplayJson {
+                    file: &source,
+                    vehicle: &file.name,
+                    mass_kg,
+                    points: points.len(),
+                    duration_s: span_s,
+                    acceleration: match args.acceleration {
+                        AccelArg::Velocity => "velocity",
+                        AccelArg::Log => "log",
+                    },
+                    lag_s,
+                    predicted_energy_wh: predicted_wh,
+                    predicted_mean_power_w: predicted_wh * 3600.0 / span_s,
+                    measured_energy_wh: measured,
+                    measured_mean_power_w: measured.map(|m| m * 3600.0 / span_s),
+                    energy_error_percent: error,
+                },
+            )?,
+            Format::Table | Format::Csv => {
+                if args.format == Format::Csv {
+                    bail!("aloft mission --replay writes table or json");
+                }
+                writeln!(
+                    out,
+                    "Replay of {source}: {} trajectory points, {:.0} s, vehicle {} at {mass_kg:.3} kg",
+                    points.len(),
+                    span_s,
+                    file.name
+                )?;
+                writeln!(
+                    out,
+                    "Acceleration: {}; wind: {}",
+                    match args.acceleration {
+                        AccelArg::Velocity => format!(
+                            "differentiated velocity over {} s",
+                            args.acceleration_window
+                        ),
+                        AccelArg::Log => "the log's".to_string(),
+                    },
+                    if points.iter().any(|p| p.wind_enu_mps.is_some()) {
+                        "from the log".to_string()
+                    } else {
+                        wind_text
+                    }
+                )?;
+                writeln!(out)?;
+                let mut rows = vec![Row::new(
+                    "predicted energy (trajectory only)",
+                    format!("{predicted_wh:.1}"),
+                    "Wh",
+                )];
+                if let Some(m) = measured {
+                    rows.push(Row::new("measured energy (V x I)", format!("{m:.1}"), "Wh"));
+                    rows.push(Row::new(
+                        "error",
+                        format!("{:+.2}", error.unwrap_or(0.0)),
+                        "%",
+                    ));
+                    rows.push(Row::new(
+                        "lag of power behind motion",
+                        format!("{:.2}", lag_s.unwrap_or(0.0)),
+                        "s",
+                    ));
+                } else {
+                    rows.push(Row::new(
+                        "measured energy",
+                        "no power in the log".to_string(),
+                        "",
+                    ));
+                }
+                output::write_table(&mut out, "Replay", &rows)?;
+            }
+        }
+        Ok(Outcome::Ok)
+    }
 }

@@ -287,7 +287,11 @@ impl Battery {
     /// `None` when the pack cannot deliver that power (`V_oc^2 < 4 R P`).
     #[inline]
     pub fn draw(&self, power_w: f64, soc: f64) -> Option<PackDraw> {
-        let v_oc = self.ocv_v(soc);
+        self.draw_at_ocv(power_w, self.ocv_v(soc))
+    }
+
+    #[inline]
+    fn draw_at_ocv(&self, power_w: f64, v_oc: f64) -> Option<PackDraw> {
         let disc = v_oc * v_oc - 4.0 * self.resistance_ohm * power_w;
         if disc < 0.0 {
             return None;
@@ -297,6 +301,20 @@ impl Battery {
             current_a,
             terminal_v: v_oc - current_a * self.resistance_ohm,
         })
+    }
+
+    /// A cursor that follows the state of charge from `soc` through a discharge, giving the same
+    /// draws as [`Self::draw`] bit for bit with a shorter chain from one step to the next (the
+    /// table interval is kept between steps instead of being found again).
+    pub fn cursor(&self, soc: f64) -> PackCursor {
+        let mut c = PackCursor {
+            soc,
+            k: 0,
+            x_lo: f64::INFINITY,
+            x_hi: f64::NEG_INFINITY,
+        };
+        c.locate();
+        c
     }
 
     /// Energy the pack can deliver from `from_soc` down to `to_soc` with no resistive loss
@@ -315,6 +333,76 @@ impl Battery {
             sum += self.ocv_v(a + k as f64 * h);
         }
         sum * h * self.capacity_ah
+    }
+}
+
+/// State of charge during a discharge, with the open-circuit table interval it lies in
+/// (see [`Battery::cursor`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PackCursor {
+    soc: f64,
+    /// Table interval `[k, k + 1]` of `x = soc (points - 1)` while `x_lo <= x < x_hi`.
+    k: usize,
+    x_lo: f64,
+    x_hi: f64,
+}
+
+impl PackCursor {
+    /// Present state of charge.
+    #[inline]
+    pub fn soc(&self) -> f64 {
+        self.soc
+    }
+
+    /// Take `delta_soc` (a fraction of the capacity) from the pack.
+    #[inline]
+    pub fn discharge(&mut self, delta_soc: f64) {
+        self.soc -= delta_soc;
+    }
+
+    fn locate(&mut self) {
+        let n = (OCV_TABLE_POINTS - 1) as f64;
+        let x = self.soc.clamp(0.0, 1.0) * n;
+        self.k = (x as usize).min(OCV_TABLE_POINTS - 2);
+        // Valid while the unclamped x stays in [k, k + 1) (the last interval closed at 1), which is
+        // where `Battery::ocv_v` picks the same k with a clamp that does nothing.
+        self.x_lo = if self.soc >= 0.0 {
+            self.k as f64
+        } else {
+            f64::INFINITY
+        };
+        self.x_hi = if self.k == OCV_TABLE_POINTS - 2 {
+            n
+        } else {
+            self.k as f64 + 1.0
+        };
+    }
+
+    /// Open-circuit voltage at the present state of charge, V: equal to
+    /// `battery.ocv_v(self.soc())`, bit for bit.
+    #[inline]
+    pub fn ocv_v(&mut self, battery: &Battery) -> f64 {
+        let n = (OCV_TABLE_POINTS - 1) as f64;
+        let mut x = self.soc * n;
+        // The last interval is closed: `x_hi = n` is inside it.
+        if !(x >= self.x_lo && (x < self.x_hi || (x <= n && self.k == OCV_TABLE_POINTS - 2))) {
+            self.locate();
+            if !(self.soc >= 0.0 && self.soc <= 1.0) {
+                return battery.ocv_v(self.soc);
+            }
+            x = self.soc * n;
+        }
+        let t = &battery.ocv_table_v;
+        let k = self.k;
+        t[k] + (t[k + 1] - t[k]) * (x - k as f64)
+    }
+
+    /// Current and terminal voltage when the load draws `power_w` now: equal to
+    /// `battery.draw(power_w, self.soc())`, bit for bit.
+    #[inline]
+    pub fn draw(&mut self, battery: &Battery, power_w: f64) -> Option<PackDraw> {
+        let v_oc = self.ocv_v(battery);
+        battery.draw_at_ocv(power_w, v_oc)
     }
 }
 
@@ -338,6 +426,30 @@ mod tests {
             ocv_cell_v: None,
             max_current_a: None,
         }
+    }
+
+    #[test]
+    #[allow(clippy::float_cmp)] // the cursor promises the same bits as `draw`
+    fn cursor_draws_what_draw_draws_bit_for_bit_across_a_discharge() {
+        let b = tb47d().to_battery().unwrap();
+        let mut c = b.cursor(1.0);
+        let mut soc = 1.0;
+        let mut k = 0;
+        while soc > 0.02 {
+            let p = 150.0 + 100.0 * (k as f64 * 0.01).sin();
+            let d = b.draw(p, soc).unwrap();
+            let e = c.draw(&b, p).unwrap();
+            assert_eq!(d.current_a, e.current_a, "soc {soc}");
+            assert_eq!(d.terminal_v, e.terminal_v);
+            let dq = d.current_a * 0.37 / (b.capacity_ah() * 3600.0);
+            soc -= dq;
+            c.discharge(dq);
+            k += 1;
+        }
+        assert!(k > 1000);
+        // Outside [0, 1] the cursor falls back to the clamped table, as `ocv_v` does.
+        let mut c = b.cursor(-0.01);
+        assert_eq!(c.ocv_v(&b), b.ocv_v(-0.01));
     }
 
     #[test]

@@ -18,8 +18,9 @@
 //! - [`trim`]: thrust vector from the force balance, attitude, electrical power;
 //! - [`ground_effect`]: survey seed eq (35);
 //! - [`battery`]: charge counting, open-circuit voltage, resistance, cut-off;
-//! - [`plan`]: the sampled flight, feasibility, point of no return, summary;
-//! - [`queries`]: endurance and range.
+//! - [`mod@plan`]: the sampled flight, feasibility, point of no return, summary;
+//! - [`queries`]: endurance and range;
+//! - [`mod@replay`]: the energy of a recorded trajectory through the same physics.
 //!
 //! The power comes from `aloft-power` (the four-term model of the power seed) or from the
 //! propulsion chain of `aloft-propulsion`. The crate does no I/O: it takes text or data and
@@ -82,6 +83,7 @@ pub mod ground_effect;
 pub mod mission;
 pub mod plan;
 pub mod queries;
+pub mod replay;
 pub mod trajectory;
 pub mod trim;
 pub mod wind;
@@ -101,5 +103,6 @@ pub use queries::{
     best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,
     EnduranceQuery, EnduranceReport, SweepRow,
 };
-pub use trim::{attitude_rad, bank_rad, Trim};
+pub use replay::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint, ReplayReport};
+pub use trim::{attitude_rad, bank_rad, Trim, TRIM_BLOCK};
 pub use wind::{Gusts, MeanWind, Profile as WindProfile, Wind, WindGrid};

@@ -13,6 +13,18 @@
 //! the rotor height `altitude + rotor_height_m`, electrical power, pack current and terminal
 //! voltage ([`crate::battery`]), state of charge.
 //!
+//! # Evaluation order
+//! Steps are evaluated in blocks of 32: kinematics, wind and air velocity for the block, then the
+//! trims ([`Powered::trim_block`]: force balance for all, then the power model for all), then the
+//! pack step by step (its state of charge chains the steps). The results are those of the
+//! sample-by-sample loop: the trims bit for bit, orbit positions to 1e-13 m (a rotation table
+//! replaces `sincos` of a large angle on an arc's cruise, [`crate::trajectory::BlockSampler`]),
+//! the pack's charge step to one rounding (`I (h / Q)` instead of `I h / Q`). On a level line or
+//! a hold at cruise in a steady wind that depends on height alone the trim is computed once per
+//! stretch (its inputs are the same bits at every step); ground effect once per piece at a fixed
+//! height. A unit test checks that this hoisting leaves the report unchanged, every sample
+//! included.
+//!
 //! # Feasibility
 //! The mission is infeasible (a valid result, not an error) when the pack cannot deliver the power,
 //! the current exceeds the pack's rating, the terminal voltage falls below the cut-off, the usable
@@ -29,6 +41,11 @@
 //! at the midpoint state of charge of the return). The point of no return is the last check
 //! before the first one at which the return would end below the reserve; it is absent when every
 //! check passes.
+//!
+//! The checks run every `pnr_interval_s` (1 s), not every step: between two checks the vehicle
+//! moves at most `max_speed x 1 s` and the return it would fly changes by that much, so the point
+//! of no return is known to the interval, which is the resolution it is reported at. The checks
+//! cost under 1 % of a plan (bench `planner/mission/one_hour` against `one_hour_without_pnr`).
 
 use aloft_power::AoaModel;
 use serde::Serialize;
@@ -39,7 +56,8 @@ use crate::error::PlannerError;
 use crate::ground_effect::thrust_factor;
 use crate::mission::Mission;
 use crate::queries::best_range;
-use crate::trim::attitude_rad;
+use crate::trajectory::{BlockSampler, Kinematics, Piece, Shape};
+use crate::trim::{attitude_rad, Trim};
 use crate::wind::Wind;
 
 /// Options of a planning run.
@@ -128,6 +146,17 @@ pub struct Sample {
     pub voltage_v: f64,
     /// State of charge after the step.
     pub soc: f64,
+    /// Induced power, eq (8), W (four-term model only).
+    pub induced_w: Option<f64>,
+    /// Parasitic power, eq (11), W (four-term model only).
+    pub parasitic_w: Option<f64>,
+    /// Profile power, eq (12), W (four-term model only).
+    pub profile_w: Option<f64>,
+    /// Work of accelerating the vehicle with the geometric angle of attack, W (four-term model
+    /// only).
+    pub acceleration_w: Option<f64>,
+    /// Climb power, eq (13), W (four-term model only).
+    pub climb_w: Option<f64>,
 }
 
 /// Statistics of one mission segment.
@@ -350,6 +379,85 @@ pub fn plan(
     wind: &Wind,
     options: &PlanOptions,
 ) -> Result<MissionReport, PlannerError> {
+    plan_with(aircraft, battery, mission, wind, options, true)
+}
+
+/// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
+/// large enough that the loop overhead of a pass is negligible.
+const BLOCK: usize = 32;
+
+const ZERO_TRIM: Trim = Trim {
+    thrust_n: 0.0,
+    axis: [0.0; 3],
+    airspeed_mps: 0.0,
+    electrical_w: 0.0,
+};
+
+/// The height of a piece that stays at one height: a hold, an arc, or a level line (`dir_up = 0`,
+/// so the height `start_up + 0 s` is the start height exactly at every sample).
+fn fixed_height_m(piece: &Piece) -> Option<f64> {
+    match piece.shape {
+        Shape::Hold { pos_m } => Some(pos_m[2]),
+        Shape::Arc { up_m, .. } => Some(up_m),
+        Shape::Line { start_m, dir } => (dir[2] == 0.0).then_some(start_m[2]),
+    }
+}
+
+/// Whether every cruise sample of `piece` gives the trim the same inputs, bit for bit, in a wind
+/// that depends on height alone and not on time: a hold (`s = 0` throughout), or a level line
+/// (fixed height, so the same wind and ground effect; velocity `dir v_cruise`, acceleration
+/// `dir 0`, heading fixed). An arc turns its velocity, so its trim changes along the circle in
+/// any wind but calm; a line that climbs or descends changes height. Both take the per-sample
+/// path.
+fn steady_piece(piece: &Piece) -> bool {
+    !matches!(piece.shape, Shape::Arc { .. }) && fixed_height_m(piece).is_some()
+}
+
+/// The error of a sample whose trim is beyond the airframe's thrust or tilt.
+#[cold]
+#[inline(never)]
+fn beyond_limit(
+    trim: &Trim,
+    t: f64,
+    seg: usize,
+    kind: &'static str,
+    pos: [f64; 3],
+    max_thrust: f64,
+    airframe: &crate::airframe::Airframe,
+) -> PlannerError {
+    let thrust = trim.thrust_n > max_thrust;
+    PlannerError::BeyondVehicleLimit {
+        time_s: t,
+        index: seg + 1,
+        kind,
+        east_m: pos[0],
+        north_m: pos[1],
+        up_m: pos[2],
+        name: if thrust { "thrust" } else { "tilt" },
+        value: if thrust {
+            trim.thrust_n
+        } else {
+            trim.axis[2].clamp(-1.0, 1.0).acos().to_degrees()
+        },
+        limit: if thrust {
+            max_thrust
+        } else {
+            airframe.max_tilt_rad().to_degrees()
+        },
+        unit: if thrust { "N" } else { "deg" },
+    }
+}
+
+/// [`plan`], with the hoisting of steady stretches switchable (off: every sample takes the full
+/// path; the tests prove both give the same report).
+pub(crate) fn plan_with(
+    aircraft: &Aircraft,
+    battery: &Battery,
+    mission: &Mission,
+    wind: &Wind,
+    options: &PlanOptions,
+    hoist: bool,
+) -> Result<MissionReport, PlannerError> {
     let dt = crate::error::positive("time_step_s", options.time_step_s, "s")?;
     if !(options.reserve_fraction >= 0.0 && options.reserve_fraction < 1.0) {
         return Err(PlannerError::InvalidParameter {
@@ -394,6 +502,9 @@ pub fn plan(
     };
     let kinds = mission.segment_kinds();
     let home = mission.home_m();
+    let max_current = battery.max_current_a();
+    let cutoff_v = battery.cutoff_v();
+    let r_pack = battery.resistance_ohm();
 
     let mut acc = vec![Acc::default(); kinds.len()];
     let mut soc = options.start_soc;
@@ -418,6 +529,20 @@ pub fn plan(
         bins: vec![None; BEARING_BINS],
     };
 
+    // Work is done in blocks of up to BLOCK steps: pass A evaluates kinematics, wind, trim and
+    // power for the block (independent samples, so the CPU overlaps them); pass B runs the pack,
+    // whose state of charge chains one step to the next. An error found in pass A (a thrust
+    // beyond the airframe, a wind grid left) is raised only after pass B has flown the samples
+    // before it, so a battery that fails first is still reported as the result.
+    let mut kins = [Kinematics::default(); BLOCK];
+    let mut winds = [[0.0; 3]; BLOCK];
+    let mut v_airs = [[0.0; 3]; BLOCK];
+    let mut accs = [[0.0; 3]; BLOCK];
+    let mut fwds = [[0.0; 2]; BLOCK];
+    let mut ges = [1.0; BLOCK];
+    let mut trims = [ZERO_TRIM; BLOCK];
+    let steady_wind = wind.is_steady_and_level_uniform();
+    let mut cursor = battery.cursor(soc);
     'pieces: for piece in mission.pieces() {
         let pw = &powered[piece.mass_phase];
         let seg = piece.segment;
@@ -428,162 +553,235 @@ pub fn plan(
         a.reached = true;
         let mut seg_energy = 0.0;
         let mut seg_peak = a.peak_w;
-        for k in 0..n {
-            let tm = (k as f64 + 0.5) * h;
-            let t = t0 + tm;
-            let kin = piece.at(tm);
-            let w = match uniform_wind {
-                Some(w) => w,
-                None => wind
-                    .at(kin.pos_m, t)
-                    .ok_or_else(|| outside(wind, t, kin.pos_m))?,
-            };
-            let v_air = [
-                kin.vel_mps[0] - w[0],
-                kin.vel_mps[1] - w[1],
-                kin.vel_mps[2] - w[2],
-            ];
-            let ge = if options.ground_effect {
-                thrust_factor(r_rotor, kin.pos_m[2] + rotor_h)
+        let sampler = BlockSampler::new(piece, h, BLOCK);
+        // Ground effect depends on height alone: once per piece at a fixed height.
+        let ge_at = |up_m: f64| {
+            if options.ground_effect {
+                thrust_factor(r_rotor, up_m + rotor_h)
             } else {
                 1.0
-            };
-            let trim = pw.trim(kin.acc_mps2, v_air, kin.forward, ge)?;
-            if trim.thrust_n > max_thrust || trim.axis[2] < cos_tilt_max {
-                let thrust = trim.thrust_n > max_thrust;
-                return Err(PlannerError::BeyondVehicleLimit {
-                    time_s: t,
-                    index: seg + 1,
-                    kind: kinds[seg],
-                    east_m: kin.pos_m[0],
-                    north_m: kin.pos_m[1],
-                    up_m: kin.pos_m[2],
-                    name: if thrust { "thrust" } else { "tilt" },
-                    value: if thrust {
-                        trim.thrust_n
-                    } else {
-                        trim.axis[2].clamp(-1.0, 1.0).acos().to_degrees()
-                    },
-                    limit: if thrust {
-                        max_thrust
-                    } else {
-                        airframe.max_tilt_rad().to_degrees()
-                    },
-                    unit: if thrust { "N" } else { "deg" },
-                });
             }
-            let p = trim.electrical_w;
-            let draw = match battery.draw(p, soc) {
-                Some(d) if d.current_a <= battery.max_current_a() => d,
+        };
+        let piece_ge = fixed_height_m(piece).map(ge_at);
+        // Charge per ampere and step as a fraction of the capacity: a product on the pack's
+        // step-to-step chain instead of a division.
+        let dq = h / charge_as;
+        // Hoisting: on a constant-speed stretch of a level line or a hold, in a wind that depends
+        // on height alone and not on time, every input of the trim has the same value at every
+        // sample, bit for bit (see `steady_piece`), so the trim is computed once per stretch and
+        // reused for the blocks that lie wholly inside it.
+        let steady = hoist && steady_wind && steady_piece(piece);
+        let mut steady_trim: Option<Trim> = None;
+        let (cruise_from, cruise_to) = (piece.profile.t_accel_end_s, piece.profile.t_cruise_end_s);
+        let in_cruise = |k: usize| {
+            let tm = (k as f64 + 0.5) * h;
+            tm >= cruise_from && tm < cruise_to
+        };
+        let mut k0 = 0;
+        while k0 < n {
+            let m = (n - k0).min(BLOCK);
+            // Pass A1: kinematics, wind, air velocity, ground effect.
+            let mut valid = m;
+            let mut pending: Option<PlannerError> = None;
+            sampler.fill(k0, &mut kins[..m]);
+            for j in 0..m {
+                let kin = &kins[j];
+                let w = match uniform_wind {
+                    Some(w) => w,
+                    None => {
+                        let t = t0 + ((k0 + j) as f64 + 0.5) * h;
+                        match wind.at(kin.pos_m, t) {
+                            Some(w) => w,
+                            None => {
+                                pending = Some(outside(wind, t, kin.pos_m));
+                                valid = j;
+                                break;
+                            }
+                        }
+                    }
+                };
+                winds[j] = w;
+                v_airs[j] = [
+                    kin.vel_mps[0] - w[0],
+                    kin.vel_mps[1] - w[1],
+                    kin.vel_mps[2] - w[2],
+                ];
+                accs[j] = kin.acc_mps2;
+                fwds[j] = kin.forward;
+                ges[j] = match piece_ge {
+                    Some(g) => g,
+                    None => ge_at(kin.pos_m[2]),
+                };
+            }
+            // Pass A2: trim and power.
+            match steady_trim {
+                Some(st) if steady && valid > 0 && in_cruise(k0) && in_cruise(k0 + valid - 1) => {
+                    trims[..valid].fill(st);
+                }
                 _ => {
-                    shortfall = Some(Shortfall::PackLimit {
+                    if let Err((j, e)) = pw.trim_block(
+                        &accs[..valid],
+                        &v_airs[..valid],
+                        &fwds[..valid],
+                        &ges[..valid],
+                        &mut trims[..valid],
+                    ) {
+                        valid = j;
+                        pending = Some(e);
+                    }
+                    if steady && steady_trim.is_none() {
+                        steady_trim = (0..valid).find(|&j| in_cruise(k0 + j)).map(|j| trims[j]);
+                    }
+                }
+            }
+            // Pass A3: the airframe's limits.
+            for j in 0..valid {
+                let trim = &trims[j];
+                if trim.thrust_n > max_thrust || trim.axis[2] < cos_tilt_max {
+                    let t = t0 + ((k0 + j) as f64 + 0.5) * h;
+                    pending = Some(beyond_limit(
+                        trim,
+                        t,
+                        seg,
+                        kinds[seg],
+                        kins[j].pos_m,
+                        max_thrust,
+                        airframe,
+                    ));
+                    valid = j;
+                    break;
+                }
+            }
+            // Pass B: the pack, step by step.
+            for j in 0..valid {
+                let tm = ((k0 + j) as f64 + 0.5) * h;
+                let kin = kins[j];
+                let w = winds[j];
+                let trim = trims[j];
+                let t = t0 + tm;
+                let p = trim.electrical_w;
+                let draw = match cursor.draw(battery, p) {
+                    Some(d) if d.current_a <= max_current => d,
+                    _ => {
+                        shortfall = Some(Shortfall::PackLimit {
+                            time_s: t,
+                            segment: seg + 1,
+                            kind: kinds[seg],
+                            position_m: kin.pos_m,
+                            power_w: p,
+                        });
+                        a.duration_s += tm;
+                        a.distance_m += piece.profile.at(tm).0;
+                        soc = cursor.soc();
+                        break 'pieces;
+                    }
+                };
+                cursor.discharge(draw.current_a * dq);
+                let soc_now = cursor.soc();
+                seg_energy += p * h;
+                heat_j += draw.current_a * draw.current_a * r_pack * h;
+                seg_peak = seg_peak.max(p);
+                peak_a = peak_a.max(draw.current_a);
+                min_v = min_v.min(draw.terminal_v);
+                if options.record_samples {
+                    let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
+                    let terms = pw.power_terms(accs[j], v_airs[j], fwds[j], ges[j])?;
+                    samples.push(Sample {
                         time_s: t,
                         segment: seg + 1,
-                        kind: kinds[seg],
-                        position_m: kin.pos_m,
+                        east_m: kin.pos_m[0],
+                        north_m: kin.pos_m[1],
+                        up_m: kin.pos_m[2],
+                        vel_east_mps: kin.vel_mps[0],
+                        vel_north_mps: kin.vel_mps[1],
+                        vel_up_mps: kin.vel_mps[2],
+                        acc_east_mps2: kin.acc_mps2[0],
+                        acc_north_mps2: kin.acc_mps2[1],
+                        acc_up_mps2: kin.acc_mps2[2],
+                        wind_east_mps: w[0],
+                        wind_north_mps: w[1],
+                        airspeed_mps: trim.airspeed_mps,
+                        thrust_n: trim.thrust_n,
+                        roll_deg: roll.to_degrees(),
+                        pitch_deg: pitch.to_degrees(),
+                        yaw_deg: yaw.to_degrees().rem_euclid(360.0),
                         power_w: p,
+                        current_a: draw.current_a,
+                        voltage_v: draw.terminal_v,
+                        soc: soc_now,
+                        induced_w: terms.map(|b| b.induced_w),
+                        parasitic_w: terms.map(|b| b.parasitic_w),
+                        profile_w: terms.map(|b| b.profile_w),
+                        acceleration_w: terms.map(|b| b.acceleration_w),
+                        climb_w: terms.map(|b| b.climb_w),
                     });
-                    a.duration_s += tm;
-                    a.distance_m += piece.profile.at(tm).0;
+                }
+                if draw.terminal_v < cutoff_v || soc_now <= empty {
+                    shortfall = Some(if draw.terminal_v < cutoff_v {
+                        Shortfall::CutOffVoltage {
+                            time_s: t,
+                            segment: seg + 1,
+                            kind: kinds[seg],
+                            position_m: kin.pos_m,
+                            voltage_v: draw.terminal_v,
+                            cutoff_v,
+                        }
+                    } else {
+                        Shortfall::BatteryEmpty {
+                            time_s: t,
+                            segment: seg + 1,
+                            kind: kinds[seg],
+                            position_m: kin.pos_m,
+                        }
+                    });
+                    a.duration_s += tm + 0.5 * h;
+                    a.distance_m += piece.profile.at(tm + 0.5 * h).0;
+                    a.energy_j += seg_energy;
+                    a.peak_w = seg_peak;
+                    a.end_soc = soc_now;
+                    energy_j += seg_energy;
+                    peak_w = peak_w.max(seg_peak);
+                    soc = soc_now;
                     break 'pieces;
                 }
-            };
-            soc -= draw.current_a * h / charge_as;
-            let e = p * h;
-            seg_energy += e;
-            heat_j += draw.current_a * draw.current_a * battery.resistance_ohm() * h;
-            seg_peak = seg_peak.max(p);
-            peak_a = peak_a.max(draw.current_a);
-            min_v = min_v.min(draw.terminal_v);
-            if options.record_samples {
-                let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
-                samples.push(Sample {
-                    time_s: t,
-                    segment: seg + 1,
-                    east_m: kin.pos_m[0],
-                    north_m: kin.pos_m[1],
-                    up_m: kin.pos_m[2],
-                    vel_east_mps: kin.vel_mps[0],
-                    vel_north_mps: kin.vel_mps[1],
-                    vel_up_mps: kin.vel_mps[2],
-                    acc_east_mps2: kin.acc_mps2[0],
-                    acc_north_mps2: kin.acc_mps2[1],
-                    acc_up_mps2: kin.acc_mps2[2],
-                    wind_east_mps: w[0],
-                    wind_north_mps: w[1],
-                    airspeed_mps: trim.airspeed_mps,
-                    thrust_n: trim.thrust_n,
-                    roll_deg: roll.to_degrees(),
-                    pitch_deg: pitch.to_degrees(),
-                    yaw_deg: yaw.to_degrees().rem_euclid(360.0),
-                    power_w: p,
-                    current_a: draw.current_a,
-                    voltage_v: draw.terminal_v,
-                    soc,
-                });
-            }
-            let failed = if draw.terminal_v < battery.cutoff_v() {
-                Some(Shortfall::CutOffVoltage {
-                    time_s: t,
-                    segment: seg + 1,
-                    kind: kinds[seg],
-                    position_m: kin.pos_m,
-                    voltage_v: draw.terminal_v,
-                    cutoff_v: battery.cutoff_v(),
-                })
-            } else if soc <= empty {
-                Some(Shortfall::BatteryEmpty {
-                    time_s: t,
-                    segment: seg + 1,
-                    kind: kinds[seg],
-                    position_m: kin.pos_m,
-                })
-            } else {
-                None
-            };
-            if let Some(f) = failed {
-                shortfall = Some(f);
-                a.duration_s += tm + 0.5 * h;
-                a.distance_m += piece.profile.at(tm + 0.5 * h).0;
-                a.energy_j += seg_energy;
-                a.peak_w = seg_peak;
-                a.end_soc = soc;
-                energy_j += seg_energy;
-                peak_w = peak_w.max(seg_peak);
-                break 'pieces;
-            }
-            if !pnr_done && t >= next_check && kin.pos_m[2] > 0.0 {
-                next_check = t + options.pnr_interval_s;
-                let here = PointOfNoReturn {
-                    time_s: t,
-                    segment: seg + 1,
-                    position_m: kin.pos_m,
-                };
-                let ok = can_return(
-                    pw,
-                    battery,
-                    wind,
-                    &mut cache,
-                    piece.mass_phase,
-                    kin.pos_m,
-                    home,
-                    soc,
-                    empty + required,
-                    return_rate,
-                    charge_as,
-                );
-                if ok {
-                    last_ok = Some(here);
-                } else {
-                    pnr = Some(last_ok.unwrap_or(PointOfNoReturn {
-                        time_s: 0.0,
-                        segment: 1,
-                        position_m: home,
-                    }));
-                    pnr_done = true;
+                if !pnr_done && t >= next_check && kin.pos_m[2] > 0.0 {
+                    next_check = t + options.pnr_interval_s;
+                    let here = PointOfNoReturn {
+                        time_s: t,
+                        segment: seg + 1,
+                        position_m: kin.pos_m,
+                    };
+                    let ok = can_return(
+                        pw,
+                        battery,
+                        wind,
+                        &mut cache,
+                        piece.mass_phase,
+                        kin.pos_m,
+                        home,
+                        soc_now,
+                        empty + required,
+                        return_rate,
+                        charge_as,
+                    );
+                    if ok {
+                        last_ok = Some(here);
+                    } else {
+                        pnr = Some(last_ok.unwrap_or(PointOfNoReturn {
+                            time_s: 0.0,
+                            segment: 1,
+                            position_m: home,
+                        }));
+                        pnr_done = true;
+                    }
                 }
             }
+            if let Some(e) = pending {
+                return Err(e);
+            }
+            k0 += m;
         }
+        soc = cursor.soc();
         a.duration_s += dur;
         a.distance_m += piece.profile.length_m;
         a.energy_j += seg_energy;
@@ -734,4 +932,190 @@ fn can_return(
     let mid = soc - 0.5 * q0 / charge_as;
     let Some(q) = charge(mid) else { return false };
     soc - q / charge_as >= floor_soc
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::airframe::{Airframe, AirframeSpec};
+    use crate::battery::BatterySpec;
+    use crate::mission::MissionSpec;
+    use crate::wind::{Gusts, Profile};
+
+    fn m100() -> (Aircraft, Battery) {
+        let airframe = Airframe::new(AirframeSpec {
+            mass_kg: 1.755,
+            max_takeoff_mass_kg: 3.6,
+            max_thrust_n: None,
+            max_tilt_deg: 35.0,
+            max_speed_mps: 17.0,
+            max_climb_rate_mps: 5.0,
+            max_descent_rate_mps: 4.0,
+            acceleration_mps2: 2.0,
+            vertical_acceleration_mps2: 1.5,
+            yaw_rate_deg_s: 60.0,
+            rotor_height_m: 0.3,
+        })
+        .unwrap();
+        let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
+            mass_kg: 3.29,
+            gravity_mps2: 9.8066,
+            air_density_kg_m3: 1.225,
+            rotor_count: 4,
+            rotor_radius_m: 0.172,
+            disk_area: aloft_power::DiskArea::OneRotor,
+            mu1_n_s_per_m: 0.1816,
+            mu2_n_s2_per_m2: -0.02326,
+            mu3_n_s3_per_m3: 0.004045,
+            kappa1_w_per_n1_5: 0.275,
+            kappa2_w_s2_per_m2_n0_5: 0.0,
+            efficiency: 0.9703,
+        })
+        .unwrap();
+        let battery = BatterySpec {
+            name: "TB48D".into(),
+            default: true,
+            cells_series: 6,
+            capacity_mah: 5700.0,
+            nominal_v: 22.8,
+            energy_wh: 129.96,
+            mass_kg: 0.676,
+            internal_resistance_ohm: 0.04,
+            cutoff_cell_v: 3.0,
+            usable_fraction: 1.0,
+            ocv_soc: None,
+            ocv_cell_v: None,
+            max_current_a: None,
+        }
+        .to_battery()
+        .unwrap();
+        (
+            Aircraft::four_term(airframe, vehicle, Default::default()),
+            battery,
+        )
+    }
+
+    const SURVEY: &str = r#"
+        [[segment]]
+        kind = "take-off"
+        altitude_m = 30.0
+        climb_rate_mps = 2.0
+        [[segment]]
+        kind = "leg"
+        east_m = 400.0
+        north_m = 0.0
+        ground_speed_mps = 9.0
+        [[segment]]
+        kind = "hover"
+        duration_s = 20.0
+        [[segment]]
+        kind = "leg"
+        east_m = 400.0
+        north_m = 250.0
+        altitude_m = 45.0
+        ground_speed_mps = 7.0
+        [[segment]]
+        kind = "orbit"
+        centre_east_m = 400.0
+        centre_north_m = 150.0
+        radius_m = 100.0
+        ground_speed_mps = 6.0
+        direction = "clockwise"
+        laps = 1.0
+        [[segment]]
+        kind = "return"
+        ground_speed_mps = 9.0
+        [[segment]]
+        kind = "landing"
+        rate_mps = 1.0
+    "#;
+
+    #[test]
+    fn hoisting_steady_stretches_gives_the_per_sample_report_bit_for_bit() {
+        let (aircraft, battery) = m100();
+        let mission = MissionSpec::from_toml_str(SURVEY)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
+        let power_law = Profile::PowerLaw {
+            reference_height_m: 10.0,
+            exponent: 1.0 / 7.0,
+        };
+        for wind in [
+            Wind::calm(),
+            Wind::constant(6.0, 250.0).unwrap(),
+            Wind::profiled(5.0, 30.0, power_law).unwrap(),
+            Wind::constant(4.0, 90.0)
+                .unwrap()
+                .with_gusts(Gusts::new(1.0, 3).unwrap()),
+        ] {
+            for ground_effect in [true, false] {
+                let opts = PlanOptions {
+                    time_step_s: 0.05,
+                    record_samples: true,
+                    ground_effect,
+                    ..PlanOptions::default()
+                };
+                let fast = plan_with(&aircraft, &battery, &mission, &wind, &opts, true).unwrap();
+                let full = plan_with(&aircraft, &battery, &mission, &wind, &opts, false).unwrap();
+                assert!(fast.samples.len() > 1000);
+                // The hoisted trim is the per-sample trim of identical inputs: the reports
+                // (every sample included) are equal, not merely close.
+                assert!(fast == full, "{wind:?}, ground effect {ground_effect}");
+            }
+        }
+    }
+
+    #[test]
+    fn block_passes_match_the_sample_by_sample_trim() {
+        // The block path against `Powered::trim` and `Battery::draw` called per sample, over the
+        // recorded samples of a survey in wind.
+        let (aircraft, battery) = m100();
+        let mission = MissionSpec::from_toml_str(SURVEY)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
+        let wind = Wind::constant(6.0, 250.0).unwrap();
+        let opts = PlanOptions {
+            time_step_s: 0.05,
+            record_samples: true,
+            ..PlanOptions::default()
+        };
+        let r = plan(&aircraft, &battery, &mission, &wind, &opts).unwrap();
+        let pw = aircraft
+            .at_mass(r.takeoff_mass_kg, AoaModel::Geometric)
+            .unwrap();
+        let r_rotor = aircraft.rotor_radius_m();
+        let mut soc_before = opts.start_soc;
+        for s in &r.samples {
+            let w = wind.at([s.east_m, s.north_m, s.up_m], s.time_s).unwrap();
+            let fwd_rad = s.yaw_deg.to_radians();
+            let trim = pw
+                .trim(
+                    [s.acc_east_mps2, s.acc_north_mps2, s.acc_up_mps2],
+                    [
+                        s.vel_east_mps - w[0],
+                        s.vel_north_mps - w[1],
+                        s.vel_up_mps - w[2],
+                    ],
+                    [fwd_rad.sin(), fwd_rad.cos()],
+                    thrust_factor(r_rotor, s.up_m + aircraft.airframe().rotor_height_m()),
+                )
+                .unwrap();
+            // Orbit positions come from a rotation (1e-13 m), headings through degrees: 1e-9
+            // relative is far below any physical difference and far above rounding.
+            assert!(
+                (trim.electrical_w - s.power_w).abs() < 1e-9 * s.power_w,
+                "t = {}: {} vs {}",
+                s.time_s,
+                trim.electrical_w,
+                s.power_w
+            );
+            // The pack at the state of charge before the step: the same current to rounding.
+            let d = battery.draw(s.power_w, soc_before).unwrap();
+            assert!((d.current_a - s.current_a).abs() < 1e-12 * s.current_a);
+            assert!(s.soc < soc_before);
+            soc_before = s.soc;
+        }
+    }
 }

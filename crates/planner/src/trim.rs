@@ -38,10 +38,13 @@
 //! with the geometric inflow (see `aloft_power::four_term`, "Deviation"), so drag work is counted
 //! once, by eq (11).
 
-use aloft_power::{AoaModel, FlightCondition, Inflow};
+use aloft_power::{AoaModel, FlightCondition, Inflow, PowerBreakdown};
 
 use crate::aircraft::{Engine, Powered};
 use crate::error::PlannerError;
+
+/// Largest block [`Powered::trim_block`] takes.
+pub const TRIM_BLOCK: usize = 64;
 
 /// Result of a trim.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,22 +78,20 @@ pub fn bank_rad(axis: [f64; 3], forward: [f64; 2]) -> f64 {
     t_r.atan2(axis[2])
 }
 
+/// Thrust, axis and inflow of one sample before the power model (shared by [`Powered::trim`]
+/// and [`Powered::trim_block`], so both do the same arithmetic).
+#[derive(Debug, Clone, Copy)]
+struct Balance {
+    thrust_n: f64,
+    axis: [f64; 3],
+    airspeed_mps: f64,
+    inflow: Inflow,
+}
+
 impl Powered<'_> {
-    /// Trim for acceleration `acc_mps2` and air-relative velocity `vel_air_mps` (ENU), heading
-    /// along `forward`, with the ground-effect factor `ground_factor` = `T_inf / T` (1 away from
-    /// the ground).
-    ///
-    /// # Errors
-    /// A flight condition the power model rejects (non-finite values), or a thrust the propulsion
-    /// chain cannot make.
-    #[inline]
-    pub fn trim(
-        &self,
-        acc_mps2: [f64; 3],
-        vel_air_mps: [f64; 3],
-        forward: [f64; 2],
-        ground_factor: f64,
-    ) -> Result<Trim, PlannerError> {
+    /// The force balance and the inflow of one sample.
+    #[inline(always)]
+    fn balance(&self, acc_mps2: [f64; 3], vel_air_mps: [f64; 3], forward: [f64; 2]) -> Balance {
         let m = self.mass_kg;
         let [vx, vy, vz] = vel_air_mps;
         let speed = (vx * vx + vy * vy + vz * vz).sqrt();
@@ -106,35 +107,47 @@ impl Powered<'_> {
         let axis = [tx * inv, ty * inv, tz * inv];
         let vh2 = vx * vx + vy * vy;
         let vh = vh2.sqrt();
-        let electrical_w = match &self.engine {
+        let inflow = match self.aoa {
+            AoaModel::Geometric => {
+                let normal = vx * axis[0] + vy * axis[1];
+                Inflow {
+                    normal_mps: normal,
+                    parallel_mps: (vh2 - normal * normal).max(0.0).sqrt(),
+                }
+            }
+            AoaModel::Paper => {
+                let t_f = axis[0] * forward[0] + axis[1] * forward[1];
+                let t_r = axis[0] * forward[1] - axis[1] * forward[0];
+                let cos_roll = (1.0 - t_r * t_r).max(0.0).sqrt();
+                Inflow {
+                    normal_mps: if cos_roll > 0.0 {
+                        vh * t_r * (-t_f / cos_roll)
+                    } else {
+                        0.0
+                    },
+                    parallel_mps: vh * axis[2].max(0.0),
+                }
+            }
+        };
+        Balance {
+            thrust_n: thrust,
+            axis,
+            airspeed_mps: vh,
+            inflow,
+        }
+    }
+
+    /// Electrical power of a balanced sample with vertical air speed `vz` and ground-effect
+    /// factor `ground_factor`, W.
+    #[inline(always)]
+    fn power_of(&self, b: &Balance, vz: f64, ground_factor: f64) -> Result<f64, PlannerError> {
+        Ok(match &self.engine {
             Engine::FourTerm(model) => {
-                let inflow = match self.aoa {
-                    AoaModel::Geometric => {
-                        let normal = vx * axis[0] + vy * axis[1];
-                        Inflow {
-                            normal_mps: normal,
-                            parallel_mps: (vh2 - normal * normal).max(0.0).sqrt(),
-                        }
-                    }
-                    AoaModel::Paper => {
-                        let t_f = axis[0] * forward[0] + axis[1] * forward[1];
-                        let t_r = axis[0] * forward[1] - axis[1] * forward[0];
-                        let cos_roll = (1.0 - t_r * t_r).max(0.0).sqrt();
-                        Inflow {
-                            normal_mps: if cos_roll > 0.0 {
-                                vh * t_r * (-t_f / cos_roll)
-                            } else {
-                                0.0
-                            },
-                            parallel_mps: vh * axis[2].max(0.0),
-                        }
-                    }
-                };
                 model
                     .evaluate_condition(&FlightCondition {
-                        thrust_n: thrust * ground_factor,
-                        airspeed_mps: vh,
-                        inflow,
+                        thrust_n: b.thrust_n * ground_factor,
+                        airspeed_mps: b.airspeed_mps,
+                        inflow: b.inflow,
                         climb_rate_mps: vz,
                         aoa: self.aoa,
                     })?
@@ -142,7 +155,7 @@ impl Powered<'_> {
             }
             Engine::Chain(system) => {
                 let n = f64::from(system.rotor_count());
-                let rotor = system.rotor_at_thrust(thrust * ground_factor / n)?;
+                let rotor = system.rotor_at_thrust(b.thrust_n * ground_factor / n)?;
                 let supply = rotor.supply_power_w * n;
                 // Climb: the paper's eq (13) through the chain's shaft-to-supply efficiency.
                 let climb = if rotor.efficiency > 0.0 {
@@ -152,13 +165,109 @@ impl Powered<'_> {
                 };
                 (supply + climb).max(0.0)
             }
-        };
+        })
+    }
+
+    /// Trim for acceleration `acc_mps2` and air-relative velocity `vel_air_mps` (ENU), heading
+    /// along `forward`, with the ground-effect factor `ground_factor` = `T_inf / T` (1 away from
+    /// the ground).
+    ///
+    /// # Errors
+    /// A flight condition the power model rejects (non-finite values), or a thrust the propulsion
+    /// chain cannot make.
+    #[inline]
+    pub fn trim(
+        &self,
+        acc_mps2: [f64; 3],
+        vel_air_mps: [f64; 3],
+        forward: [f64; 2],
+        ground_factor: f64,
+    ) -> Result<Trim, PlannerError> {
+        let b = self.balance(acc_mps2, vel_air_mps, forward);
+        let electrical_w = self.power_of(&b, vel_air_mps[2], ground_factor)?;
         Ok(Trim {
-            thrust_n: thrust,
-            axis,
-            airspeed_mps: vh,
+            thrust_n: b.thrust_n,
+            axis: b.axis,
+            airspeed_mps: b.airspeed_mps,
             electrical_w,
         })
+    }
+
+    /// The four terms of the power model at a trim (same inputs as [`Self::trim`]); `None` when
+    /// the power comes from the propulsion chain, which has no such terms.
+    ///
+    /// # Errors
+    /// As [`Self::trim`].
+    pub fn power_terms(
+        &self,
+        acc_mps2: [f64; 3],
+        vel_air_mps: [f64; 3],
+        forward: [f64; 2],
+        ground_factor: f64,
+    ) -> Result<Option<PowerBreakdown>, PlannerError> {
+        let b = self.balance(acc_mps2, vel_air_mps, forward);
+        Ok(match &self.engine {
+            Engine::FourTerm(model) => Some(model.evaluate_condition(&FlightCondition {
+                thrust_n: b.thrust_n * ground_factor,
+                airspeed_mps: b.airspeed_mps,
+                inflow: b.inflow,
+                climb_rate_mps: vel_air_mps[2],
+                aoa: self.aoa,
+            })?),
+            Engine::Chain(_) => None,
+        })
+    }
+
+    /// [`Self::trim`] for a block of samples (all slices of the length of `out`, at most
+    /// [`TRIM_BLOCK`]): the same arithmetic, bit for bit, arranged in two passes (force balance,
+    /// then power) so that the CPU overlaps the independent samples instead of waiting on each
+    /// one's chain of square roots and divisions.
+    ///
+    /// # Errors
+    /// The index of the first sample [`Self::trim`] rejects, with its error; the samples before
+    /// it are written.
+    pub fn trim_block(
+        &self,
+        acc_mps2: &[[f64; 3]],
+        vel_air_mps: &[[f64; 3]],
+        forward: &[[f64; 2]],
+        ground_factor: &[f64],
+        out: &mut [Trim],
+    ) -> Result<(), (usize, PlannerError)> {
+        let n = out.len();
+        assert!(
+            n <= TRIM_BLOCK
+                && acc_mps2.len() == n
+                && vel_air_mps.len() == n
+                && forward.len() == n
+                && ground_factor.len() == n,
+            "trim_block: slices of one length up to TRIM_BLOCK"
+        );
+        let mut balances = [Balance {
+            thrust_n: 0.0,
+            axis: [0.0; 3],
+            airspeed_mps: 0.0,
+            inflow: Inflow {
+                normal_mps: 0.0,
+                parallel_mps: 0.0,
+            },
+        }; TRIM_BLOCK];
+        for j in 0..n {
+            balances[j] = self.balance(acc_mps2[j], vel_air_mps[j], forward[j]);
+        }
+        for j in 0..n {
+            let b = &balances[j];
+            let electrical_w = self
+                .power_of(b, vel_air_mps[j][2], ground_factor[j])
+                .map_err(|e| (j, e))?;
+            out[j] = Trim {
+                thrust_n: b.thrust_n,
+                axis: b.axis,
+                airspeed_mps: b.airspeed_mps,
+                electrical_w,
+            };
+        }
+        Ok(())
     }
 
     /// Electrical power in steady level flight with horizontal air velocity `vel_air_mps`

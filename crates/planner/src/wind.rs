@@ -394,6 +394,13 @@ impl Wind {
         Some(w)
     }
 
+    /// Whether the wind depends on height alone and not on time (constant or profiled, no
+    /// grid, no gusts): along a level path it is one value.
+    pub fn is_steady_and_level_uniform(&self) -> bool {
+        matches!(self.mean, MeanWind::Constant(_) | MeanWind::Profiled { .. })
+            && self.gusts.is_none()
+    }
+
     /// Whether the wind is the same everywhere and always (no profile, grid or gusts).
     pub fn is_uniform(&self) -> bool {
         matches!(self.mean, MeanWind::Constant(_)) && self.gusts.is_none()

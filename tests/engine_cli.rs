@@ -1,0 +1,148 @@
+//! `aloft::engine` is a drop-in for the CLI's JSON: for the same inputs its summaries serialise to
+//! exactly what `aloft mission --format json` and `aloft endurance --format json` print.
+
+use std::process::Command;
+
+use aloft::engine::{
+    endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle, WindProfileKind,
+    WindSpec,
+};
+
+fn cli(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .expect("run aloft");
+    assert!(
+        out.status.code() == Some(0) || out.status.code() == Some(1),
+        "aloft {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8")
+}
+
+fn wind(speed_mps: f64, from_deg: f64) -> Option<WindSpec> {
+    Some(WindSpec {
+        speed_mps,
+        from_deg,
+        profile: WindProfileKind::Uniform,
+        reference_height_m: None,
+        exponent: None,
+        roughness_m: None,
+        gust_std_mps: None,
+        gust_seed: None,
+    })
+}
+
+#[test]
+fn mission_summary_is_the_cli_json() {
+    let m100 = Vehicle::builtin("dji-m100").unwrap();
+    let cases: Vec<(Vec<&str>, MissionOptions)> = vec![
+        (vec![], MissionOptions::default()),
+        (
+            vec![
+                "--payload-kg",
+                "0.3",
+                "--wind-speed",
+                "4",
+                "--wind-from",
+                "120",
+                "--reserve-percent",
+                "30",
+                "--aoa",
+                "paper",
+            ],
+            MissionOptions {
+                payload_kg: Some(0.3),
+                wind: wind(4.0, 120.0),
+                reserve_percent: Some(30.0),
+                aoa: aloft::engine::AngleOfAttack::Paper,
+                ..MissionOptions::default()
+            },
+        ),
+        // Infeasible: the CLI exits 1 and still prints the summary, with a reason and the point
+        // of no return.
+        (
+            vec!["--start-percent", "45", "--no-ground-effect"],
+            MissionOptions {
+                start_percent: 45.0,
+                ground_effect: false,
+                ..MissionOptions::default()
+            },
+        ),
+    ];
+    for (args, options) in cases {
+        let mut full = vec!["mission", "--format", "json"];
+        full.extend(&args);
+        let expected = cli(&full);
+        let plan = plan_mission(&m100, &Mission::demo(), &options).unwrap();
+        assert_eq!(
+            format!("{}\n", plan.to_json().unwrap()),
+            expected,
+            "{args:?}"
+        );
+    }
+}
+
+#[test]
+fn infeasible_case_has_the_optional_keys() {
+    let m100 = Vehicle::builtin("dji-m100").unwrap();
+    let plan = plan_mission(
+        &m100,
+        &Mission::demo(),
+        &MissionOptions {
+            start_percent: 45.0,
+            ..MissionOptions::default()
+        },
+    )
+    .unwrap();
+    let s = plan.summary();
+    assert!(!s.feasible && s.reason.is_some());
+    assert!(s.point_of_no_return_s.is_some() && s.point_of_no_return.is_some());
+}
+
+#[test]
+fn endurance_summary_is_the_cli_json() {
+    let m100 = Vehicle::builtin("dji-m100").unwrap();
+    let cases: Vec<(Vec<&str>, EnduranceOptions)> = vec![
+        (vec![], EnduranceOptions::default()),
+        (
+            vec![
+                "--wind-speed",
+                "6",
+                "--wind-from",
+                "30",
+                "--course",
+                "45",
+                "--payload-kg",
+                "0.5",
+                "--reserve-percent",
+                "20",
+                "--orbit-radius",
+                "30",
+                "--orbit-speed",
+                "5",
+            ],
+            EnduranceOptions {
+                wind: wind(6.0, 30.0),
+                course_deg: 45.0,
+                payload_kg: 0.5,
+                reserve_percent: 20.0,
+                orbit_radius_m: Some(30.0),
+                orbit_speed_mps: Some(5.0),
+                ..EnduranceOptions::default()
+            },
+        ),
+    ];
+    for (args, options) in cases {
+        let mut full = vec!["endurance", "--format", "json"];
+        full.extend(&args);
+        let expected = cli(&full);
+        let got = endurance(&m100, &options).unwrap();
+        assert_eq!(
+            format!("{}\n", got.to_json().unwrap()),
+            expected,
+            "{args:?}"
+        );
+    }
+}
