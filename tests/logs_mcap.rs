@@ -418,6 +418,7 @@ fn mission() -> (Vec<MissionSample>, Vec<PathPoint>) {
                     induced_w: 300.0,
                     parasitic_w: 5.0,
                     profile_w: 20.0,
+                    acceleration_w: 0.0,
                     climb_w: 0.0,
                     electrical_w: 400.0 + t,
                 },

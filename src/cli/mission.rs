@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use serde::Serialize;
 
 use aloft::power::{AoaModel, ModelOptions};
 use aloft_planner::{
@@ -270,55 +269,6 @@ pub enum AccelArg {
     Log,
 }
 
-#[derive(Serialize)]
-struct SegmentJson {
-    index: usize,
-    kind: &'static str,
-    duration_s: f64,
-    distance_m: f64,
-    energy_wh: f64,
-    mean_power_w: f64,
-    peak_power_w: f64,
-    end_soc: f64,
-}
-
-#[derive(Serialize)]
-struct PnrJson {
-    point_of_no_return_east_m: f64,
-    point_of_no_return_north_m: f64,
-    point_of_no_return_up_m: f64,
-    point_of_no_return_segment: usize,
-}
-
-#[derive(Serialize)]
-struct MissionJson<'a> {
-    mission: &'a str,
-    vehicle: &'a str,
-    battery: &'a str,
-    feasible: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    reason: Option<String>,
-    takeoff_mass_kg: f64,
-    payload_kg: f64,
-    duration_s: f64,
-    distance_m: f64,
-    energy_wh: f64,
-    pack_heat_wh: f64,
-    start_soc: f64,
-    end_soc: f64,
-    min_voltage_v: f64,
-    peak_power_w: f64,
-    peak_current_a: f64,
-    mean_power_w: f64,
-    reserve_soc: f64,
-    required_reserve_soc: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    point_of_no_return_s: Option<f64>,
-    #[serde(flatten, skip_serializing_if = "Option::is_none")]
-    point_of_no_return: Option<PnrJson>,
-    segments: Vec<SegmentJson>,
-}
-
 fn mmss(t: f64) -> String {
     let s = t.max(0.0).round() as u64;
     format!("{}:{:02}", s / 60, s % 60)
@@ -420,56 +370,10 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     };
     match args.format {
         Format::Json => {
-            let pnr = report.point_of_no_return;
-            output::write_json(
-                &mut out,
-                &MissionJson {
-                    mission: name,
-                    vehicle: &file.name,
-                    battery: battery.name(),
-                    feasible: report.feasible,
-                    reason: report.shortfall.as_ref().map(|s| s.to_string()),
-                    takeoff_mass_kg: report.takeoff_mass_kg,
-                    payload_kg: payload,
-                    duration_s: report.duration_s,
-                    distance_m: report.distance_m,
-                    energy_wh: report.energy_wh,
-                    pack_heat_wh: report.pack_heat_wh,
-                    start_soc: report.start_soc,
-                    end_soc: report.end_soc,
-                    min_voltage_v: report.min_voltage_v,
-                    peak_power_w: report.peak_power_w,
-                    peak_current_a: report.peak_current_a,
-                    mean_power_w: if report.duration_s > 0.0 {
-                        report.energy_wh * 3600.0 / report.duration_s
-                    } else {
-                        0.0
-                    },
-                    reserve_soc: report.reserve_soc,
-                    required_reserve_soc: report.required_reserve_soc,
-                    point_of_no_return_s: pnr.map(|p| p.time_s),
-                    point_of_no_return: pnr.map(|p| PnrJson {
-                        point_of_no_return_east_m: p.position_m[0],
-                        point_of_no_return_north_m: p.position_m[1],
-                        point_of_no_return_up_m: p.position_m[2],
-                        point_of_no_return_segment: p.segment,
-                    }),
-                    segments: report
-                        .segments
-                        .iter()
-                        .map(|s| SegmentJson {
-                            index: s.index,
-                            kind: s.kind,
-                            duration_s: s.duration_s,
-                            distance_m: s.distance_m,
-                            energy_wh: s.energy_wh,
-                            mean_power_w: s.mean_power_w,
-                            peak_power_w: s.peak_power_w,
-                            end_soc: s.end_soc,
-                        })
-                        .collect(),
-                },
-            )?;
+            // One definition of the mission JSON, shared with the Rust and C APIs.
+            let summary =
+                aloft::engine::mission_summary(&report, name, &file.name, battery.name(), payload);
+            output::write_json(&mut out, &summary)?;
         }
         Format::Table | Format::Csv => {
             if args.format == Format::Csv {
@@ -649,6 +553,7 @@ fn write_mcap(path: &Path, report: &MissionReport, mission: &aloft_planner::Miss
                     induced_w: s.induced_w.unwrap_or(0.0),
                     parasitic_w: s.parasitic_w.unwrap_or(0.0),
                     profile_w: s.profile_w.unwrap_or(0.0),
+                    acceleration_w: s.acceleration_w.unwrap_or(0.0),
                     climb_w: s.climb_w.unwrap_or(0.0),
                     electrical_w: s.power_w,
                 },

@@ -40,7 +40,15 @@ pub fn write_table(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> io::R
 
 /// Write a serializable value as pretty JSON with a trailing newline.
 pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow::Result<()> {
-    serde_json::to_writer_pretty(&mut *out, value)?;
+    // An I/O failure inside serde_json (a closed pipe) comes back as an io::Error, so that
+    // `is_broken_pipe` recognises it and the run ends quietly.
+    serde_json::to_writer_pretty(&mut *out, value).map_err(|e| {
+        if e.is_io() {
+            anyhow::Error::from(io::Error::from(e))
+        } else {
+            anyhow::Error::from(e)
+        }
+    })?;
     writeln!(out)?;
     Ok(())
 }

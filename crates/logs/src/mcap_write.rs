@@ -8,7 +8,7 @@
 //! | `/aloft/pose` | `foxglove.PoseInFrame` | position and attitude |
 //! | `/aloft/state` | `aloft.VehicleState` | ENU position, velocity, roll/pitch/yaw (rad and deg), ground speed |
 //! | `/aloft/battery` | `aloft.BatteryState` | `voltage_v`, `current_a`, `power_w`, `charge_ah`, `state_of_charge`, `energy_used_wh` |
-//! | `/aloft/power` | `aloft.PowerTerms` | `induced_w`, `parasitic_w`, `profile_w`, `climb_w`, `electrical_w` |
+//! | `/aloft/power` | `aloft.PowerTerms` | `induced_w`, `parasitic_w`, `profile_w`, `acceleration_w`, `climb_w`, `electrical_w` |
 //! | `/aloft/path` | `foxglove.PosesInFrame` | the planned path, once |
 //!
 //! Every message has `timestamp` `{sec, nsec}`; the MCAP `log_time` is the same instant. Values that
@@ -47,6 +47,8 @@ pub struct PowerTerms {
     pub parasitic_w: f64,
     /// Profile power, W.
     pub profile_w: f64,
+    /// Work of accelerating the vehicle (exact angle of attack; see aloft_power::four_term), W.
+    pub acceleration_w: f64,
     /// Climb power, W.
     pub climb_w: f64,
     /// Electrical power drawn from the battery, W.
@@ -170,7 +172,15 @@ fn schema_for(name: &str) -> Value {
         _ => numbers(
             "aloft.PowerTerms",
             "Four-term power model: induced, parasitic, profile, climb (aerodynamic, W) and electrical power (W)",
-            &["time_s", "induced_w", "parasitic_w", "profile_w", "climb_w", "electrical_w"],
+            &[
+                "time_s",
+                "induced_w",
+                "parasitic_w",
+                "profile_w",
+                "acceleration_w",
+                "climb_w",
+                "electrical_w",
+            ],
             &[],
         ),
     }
@@ -389,6 +399,7 @@ impl<W: Write + Seek> McapWriter<W> {
             ("induced_w", p.induced_w),
             ("parasitic_w", p.parasitic_w),
             ("profile_w", p.profile_w),
+            ("acceleration_w", p.acceleration_w),
             ("climb_w", p.climb_w),
             ("electrical_w", p.electrical_w),
         ] {

@@ -255,6 +255,37 @@ impl Powered<'_> {
         for j in 0..n {
             balances[j] = self.balance(acc_mps2[j], vel_air_mps[j], forward[j]);
         }
+        if let Engine::FourTerm(model) = &self.engine {
+            // The whole block through the power model's batch path (passes that overlap in the
+            // CPU); on an error, the per-sample loop below finds and reports the failing sample.
+            let mut conditions = [FlightCondition::default(); TRIM_BLOCK];
+            for j in 0..n {
+                let b = &balances[j];
+                conditions[j] = FlightCondition {
+                    thrust_n: b.thrust_n * ground_factor[j],
+                    airspeed_mps: b.airspeed_mps,
+                    inflow: b.inflow,
+                    climb_rate_mps: vel_air_mps[j][2],
+                    aoa: self.aoa,
+                };
+            }
+            let mut powers = [PowerBreakdown::default(); TRIM_BLOCK];
+            if model
+                .evaluate_conditions(&conditions[..n], &mut powers[..n])
+                .is_ok()
+            {
+                for j in 0..n {
+                    let b = &balances[j];
+                    out[j] = Trim {
+                        thrust_n: b.thrust_n,
+                        axis: b.axis,
+                        airspeed_mps: b.airspeed_mps,
+                        electrical_w: powers[j].electrical_w,
+                    };
+                }
+                return Ok(());
+            }
+        }
         for j in 0..n {
             let b = &balances[j];
             let electrical_w = self

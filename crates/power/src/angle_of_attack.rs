@@ -42,7 +42,7 @@ pub enum AoaModel {
 }
 
 /// The freestream decomposed on the rotor disk.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Inflow {
     /// `Vn = v_inf sin(alpha)`, along the rotor axis in the direction of the induced flow, m/s.
     pub normal_mps: f64,

@@ -40,6 +40,7 @@ use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
 use crate::induced::{
     induced_power_w, induced_velocity_mps, solve_normalised, solve_normalised_fast,
+    solve_normalised_warm,
 };
 use crate::profile::profile_power_w;
 use crate::vehicle::Vehicle;
@@ -194,7 +195,7 @@ impl FlightState {
 }
 
 /// A fully resolved flight condition: thrust and inflow already known (the planner's input).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FlightCondition {
     /// Total thrust `T`, N.
     pub thrust_n: f64,
@@ -210,7 +211,7 @@ pub struct FlightCondition {
 }
 
 /// Every term of the model at one flight condition. Field names are the JSON contract.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct PowerBreakdown {
     /// Total thrust `T`, N.
     pub thrust_n: f64,
@@ -388,18 +389,54 @@ impl PowerModel {
         Ok(())
     }
 
+    /// Evaluate many resolved conditions into `out` (same length): [`Self::evaluate_condition`]
+    /// arranged in passes for throughput, as [`Self::evaluate_batch`]. Returns the first invalid
+    /// condition's error; `Ok(())` means every element of `out` was written.
+    pub fn evaluate_conditions(
+        &self,
+        conditions: &[FlightCondition],
+        out: &mut [PowerBreakdown],
+    ) -> Result<()> {
+        if conditions.len() != out.len() {
+            return Err(PowerError::SeriesLength {
+                estimate_len: out.len(),
+                measured_len: conditions.len(),
+            });
+        }
+        const CHUNK: usize = 64;
+        let inv_vh = self.vehicle.inverse_hover_induced_velocity();
+        let mut roots = [0.0f64; CHUNK];
+        // Conditions along a trajectory change little from one to the next: each root starts from
+        // the previous one (solve_normalised_warm), which usually needs one Halley step.
+        let mut previous = f64::NAN;
+        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            for (c, x) in cc.iter().zip(roots.iter_mut()) {
+                check_condition(c)?;
+                *x = solve_normalised_warm(
+                    c.inflow.normal_mps * inv_vh,
+                    c.inflow.parallel_mps * inv_vh,
+                    previous,
+                );
+                if x.is_finite() {
+                    previous = *x;
+                }
+            }
+            for ((c, &x), o) in cc.iter().zip(roots.iter()).zip(oc.iter_mut()) {
+                let vi = if x.is_nan() {
+                    self.induced_velocity(c)?
+                } else {
+                    x * self.vehicle.hover_induced_velocity_mps()
+                };
+                *o = self.assemble(c, vi);
+            }
+        }
+        Ok(())
+    }
+
     /// Evaluate a resolved flight condition (thrust and inflow given).
     #[inline]
     pub fn evaluate_condition(&self, c: &FlightCondition) -> Result<PowerBreakdown> {
-        if !(c.thrust_n.is_finite() && c.thrust_n >= 0.0) {
-            finite("thrust_n", c.thrust_n)?;
-            non_negative("thrust_n", c.thrust_n)?;
-        }
-        if !(c.airspeed_mps.is_finite() && c.airspeed_mps >= 0.0) {
-            finite("airspeed_mps", c.airspeed_mps)?;
-            non_negative("airspeed_mps", c.airspeed_mps)?;
-        }
-        finite("climb_rate_mps", c.climb_rate_mps)?;
+        check_condition(c)?;
         let vi = self.induced_velocity(c)?;
         Ok(self.assemble(c, vi))
     }
@@ -471,6 +508,22 @@ impl PowerModel {
             electrical_w: aero_w.max(0.0) * v.inverse_efficiency(),
         }
     }
+}
+
+/// Validate a resolved condition's thrust, airspeed and climb rate (the inflow is checked by the
+/// solver).
+#[inline(always)]
+fn check_condition(c: &FlightCondition) -> Result<()> {
+    if !(c.thrust_n.is_finite() && c.thrust_n >= 0.0) {
+        finite("thrust_n", c.thrust_n)?;
+        non_negative("thrust_n", c.thrust_n)?;
+    }
+    if !(c.airspeed_mps.is_finite() && c.airspeed_mps >= 0.0) {
+        finite("airspeed_mps", c.airspeed_mps)?;
+        non_negative("airspeed_mps", c.airspeed_mps)?;
+    }
+    finite("climb_rate_mps", c.climb_rate_mps)?;
+    Ok(())
 }
 
 /// Validate roll and pitch; return `cos(phi) cos(theta)`.
@@ -642,6 +695,44 @@ mod tests {
             m.evaluate_batch(&states[..3], &mut out).is_err(),
             "length mismatch"
         );
+    }
+
+    #[test]
+    fn conditions_in_a_batch_equal_single_evaluations() {
+        let m = PowerModel::new(m100());
+        let conditions: Vec<FlightCondition> = (0..500)
+            .map(|i| {
+                let f = f64::from(i) / 500.0;
+                let v = 20.0 * f;
+                let tilt = 0.6 * f;
+                FlightCondition {
+                    thrust_n: m.vehicle().weight_n() / tilt.cos(),
+                    airspeed_mps: v,
+                    inflow: Inflow {
+                        normal_mps: v * tilt.sin(),
+                        parallel_mps: v * tilt.cos(),
+                    },
+                    climb_rate_mps: 0.5 * (f * 9.0).sin(),
+                    aoa: if i % 2 == 0 {
+                        AoaModel::Geometric
+                    } else {
+                        AoaModel::Paper
+                    },
+                }
+            })
+            .collect();
+        let mut out = vec![m.evaluate_condition(&conditions[0]).unwrap(); conditions.len()];
+        m.evaluate_conditions(&conditions, &mut out).unwrap();
+        for (c, o) in conditions.iter().zip(&out) {
+            let single = m.evaluate_condition(c).unwrap();
+            // Both stop on the same residual bound (5e-13 in eq 9), possibly after a different
+            // number of steps: compare to 1e-11 relative.
+            assert!((single.electrical_w - o.electrical_w).abs() <= 1e-11 * single.electrical_w);
+        }
+        let mut bad = conditions.clone();
+        bad[300].thrust_n = f64::NAN;
+        let e = m.evaluate_conditions(&bad, &mut out).unwrap_err();
+        assert!(e.to_string().contains("thrust_n"), "{e}");
     }
 
     #[test]

@@ -93,10 +93,15 @@ pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
     if a >= 0.0 || 8.0 * b2 >= a * a {
         // g is increasing on x > 0: the positive root is unique. Fast path without data-dependent
         // branches: two Halley steps from the a = 0 root, then the same residual test as below.
-        let x = halley_step(halley_step(guess, a, b2), a, b2);
-        let s = x + a;
-        if x > 0.0 && (x * x * (s * s + b2) - 1.0).abs() <= 1e-12 {
-            return Some(x);
+        // Two steps reach the bound when |a| is small (the paper's inflow, slow flight); a third
+        // covers forward flight with the exact inflow (|a| up to about 0.5).
+        let mut x = halley_step(halley_step(guess, a, b2), a, b2);
+        for _ in 0..2 {
+            let s = x + a;
+            if x > 0.0 && (x * x * (s * s + b2) - 1.0).abs() <= 1e-12 {
+                return Some(x);
+            }
+            x = halley_step(x, a, b2);
         }
     }
     let (mut lo, mut hi) = if a >= 0.0 {
@@ -144,7 +149,7 @@ pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
     Some(x)
 }
 
-/// Branch-free fast path of [`solve_normalised`] for batches: the root where it is unique and two
+/// Branch-free fast path of [`solve_normalised`] for batches: the root where it is unique and three
 /// Halley steps from the `a = 0` root reach the residual bound, otherwise NaN (the caller then runs
 /// the safeguarded solver). Without data-dependent branches, consecutive calls overlap in the CPU.
 #[inline(always)]
@@ -152,7 +157,7 @@ pub(crate) fn solve_normalised_fast(a: f64, b: f64) -> f64 {
     let b2 = b * b;
     let c = a * a + b2;
     let guess = (2.0 / (c + (c * c + 4.0).sqrt())).sqrt();
-    let x = halley_step(halley_step(guess, a, b2), a, b2);
+    let x = halley_step(halley_step(halley_step(guess, a, b2), a, b2), a, b2);
     let s = x + a;
     let unique = (a >= 0.0) | (8.0 * b2 >= a * a);
     let converged = (x > 0.0) & ((x * x * (s * s + b2) - 1.0).abs() <= 1e-12);
@@ -161,6 +166,26 @@ pub(crate) fn solve_normalised_fast(a: f64, b: f64) -> f64 {
     } else {
         f64::NAN
     }
+}
+
+/// [`solve_normalised_fast`] started from `start`, a root of a nearby inflow (the previous sample
+/// of a trajectory): where the root is unique, one or two Halley steps from there usually reach the
+/// same residual bound; otherwise, or if they do not, the cold fast path runs. NaN as there.
+#[inline(always)]
+pub(crate) fn solve_normalised_warm(a: f64, b: f64, start: f64) -> f64 {
+    let b2 = b * b;
+    let unique = (a >= 0.0) | (8.0 * b2 >= a * a);
+    if unique && start > 0.0 {
+        let mut x = start;
+        for _ in 0..2 {
+            x = halley_step(x, a, b2);
+            let s = x + a;
+            if x > 0.0 && (x * x * (s * s + b2) - 1.0).abs() <= 1e-12 {
+                return x;
+            }
+        }
+    }
+    solve_normalised_fast(a, b)
 }
 
 /// One Halley step for `g(x) = x^2 ((x+a)^2 + b^2) = 1`.
@@ -265,6 +290,28 @@ mod tests {
         let v = induced_velocity_mps(0.0, 0.0, vh).unwrap();
         let p = induced_power_w(32.26, v, 0.0);
         assert!((p - 32.26 * vh).abs() < 1e-12 * p);
+    }
+
+    #[test]
+    fn warm_starts_land_on_the_cold_root() {
+        // A slowly varying inflow, as along a trajectory: the warm-started roots equal the cold
+        // ones to the residual bound (5e-13 relative in eq 9, so 1e-11 on the root).
+        let mut prev = f64::NAN;
+        for i in 0..2000 {
+            let t = f64::from(i) * 0.01;
+            let (a, b) = (0.3 * (t * 0.7).sin(), 1.5 + (t * 0.3).cos());
+            let warm = solve_normalised_warm(a, b, prev);
+            let cold = solve_normalised(a, b).unwrap();
+            assert!(
+                (warm - cold).abs() <= 1e-11 * cold,
+                "{a} {b}: {warm} vs {cold}"
+            );
+            prev = warm;
+        }
+        // A far start (another flight state) still converges or hands over to the cold path.
+        let x = solve_normalised_warm(0.1, 0.2, 3.0);
+        let cold = solve_normalised(0.1, 0.2).unwrap();
+        assert!((x - cold).abs() <= 1e-11 * cold);
     }
 
     #[test]
