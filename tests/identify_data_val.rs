@@ -58,7 +58,10 @@ fn args(words: &[&str], logs: &[String], rest: &[&str]) -> Vec<String> {
 
 /// Fit on 08-03, validate on 08-06 with a 120 s calibration window; the JSON of `aloft validate`.
 fn kaist_validation() -> serde_json::Value {
-    let tmp = std::env::temp_dir().join(format!("aloft-kaist-{}.toml", std::process::id()));
+    // One file per call: the tests run in parallel threads of one process.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let tmp = std::env::temp_dir().join(format!("aloft-kaist-{}-{call}.toml", std::process::id()));
     let template = format!(
         "{}/fixtures/vehicles/kaist-template.toml",
         env!("CARGO_MANIFEST_DIR")
