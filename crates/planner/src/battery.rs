@@ -409,24 +409,7 @@ impl PackCursor {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    pub(crate) fn tb47d() -> BatterySpec {
-        BatterySpec {
-            name: "TB47D".into(),
-            default: true,
-            cells_series: 6,
-            capacity_mah: 4500.0,
-            nominal_v: 22.2,
-            energy_wh: 99.9,
-            mass_kg: 0.6,
-            internal_resistance_ohm: 0.048,
-            cutoff_cell_v: 3.0,
-            usable_fraction: 1.0,
-            ocv_soc: None,
-            ocv_cell_v: None,
-            max_current_a: None,
-        }
-    }
+    use crate::test_support::tb47d;
 
     #[test]
     #[allow(clippy::float_cmp)] // the cursor promises the same bits as `draw`

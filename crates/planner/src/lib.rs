@@ -106,3 +106,6 @@ pub use queries::{
 pub use replay::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint, ReplayReport};
 pub use trim::{attitude_rad, bank_rad, Trim, TRIM_BLOCK};
 pub use wind::{Gusts, MeanWind, Profile as WindProfile, Wind, WindGrid};
+
+#[cfg(test)]
+mod test_support;

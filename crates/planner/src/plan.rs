@@ -937,62 +937,12 @@ fn can_return(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::airframe::{Airframe, AirframeSpec};
-    use crate::battery::BatterySpec;
     use crate::mission::MissionSpec;
+    use crate::test_support::{m100_aircraft, tb48d};
     use crate::wind::{Gusts, Profile};
 
     fn m100() -> (Aircraft, Battery) {
-        let airframe = Airframe::new(AirframeSpec {
-            mass_kg: 1.755,
-            max_takeoff_mass_kg: 3.6,
-            max_thrust_n: None,
-            max_tilt_deg: 35.0,
-            max_speed_mps: 17.0,
-            max_climb_rate_mps: 5.0,
-            max_descent_rate_mps: 4.0,
-            acceleration_mps2: 2.0,
-            vertical_acceleration_mps2: 1.5,
-            yaw_rate_deg_s: 60.0,
-            rotor_height_m: 0.3,
-        })
-        .unwrap();
-        let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
-            mass_kg: 3.29,
-            gravity_mps2: 9.8066,
-            air_density_kg_m3: 1.225,
-            rotor_count: 4,
-            rotor_radius_m: 0.172,
-            disk_area: aloft_power::DiskArea::OneRotor,
-            mu1_n_s_per_m: 0.1816,
-            mu2_n_s2_per_m2: -0.02326,
-            mu3_n_s3_per_m3: 0.004045,
-            kappa1_w_per_n1_5: 0.275,
-            kappa2_w_s2_per_m2_n0_5: 0.0,
-            efficiency: 0.9703,
-        })
-        .unwrap();
-        let battery = BatterySpec {
-            name: "TB48D".into(),
-            default: true,
-            cells_series: 6,
-            capacity_mah: 5700.0,
-            nominal_v: 22.8,
-            energy_wh: 129.96,
-            mass_kg: 0.676,
-            internal_resistance_ohm: 0.04,
-            cutoff_cell_v: 3.0,
-            usable_fraction: 1.0,
-            ocv_soc: None,
-            ocv_cell_v: None,
-            max_current_a: None,
-        }
-        .to_battery()
-        .unwrap();
-        (
-            Aircraft::four_term(airframe, vehicle, Default::default()),
-            battery,
-        )
+        (m100_aircraft(), tb48d().to_battery().unwrap())
     }
 
     const SURVEY: &str = r#"

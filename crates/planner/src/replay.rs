@@ -254,40 +254,11 @@ mod tests {
     use super::*;
     use crate::mission::MissionSpec;
     use crate::plan::{plan, PlanOptions};
-    use crate::BatterySpec;
+    use crate::test_support::{m100_aircraft, tb47d};
     use aloft_power::AoaModel;
 
     fn m100() -> Aircraft {
-        let airframe = Airframe::new(AirframeSpec {
-            mass_kg: 1.755,
-            max_takeoff_mass_kg: 3.6,
-            max_thrust_n: None,
-            max_tilt_deg: 35.0,
-            max_speed_mps: 17.0,
-            max_climb_rate_mps: 5.0,
-            max_descent_rate_mps: 4.0,
-            acceleration_mps2: 2.0,
-            vertical_acceleration_mps2: 1.5,
-            yaw_rate_deg_s: 60.0,
-            rotor_height_m: 0.3,
-        })
-        .unwrap();
-        let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
-            mass_kg: 3.29,
-            gravity_mps2: 9.8066,
-            air_density_kg_m3: 1.225,
-            rotor_count: 4,
-            rotor_radius_m: 0.172,
-            disk_area: aloft_power::DiskArea::OneRotor,
-            mu1_n_s_per_m: 0.1816,
-            mu2_n_s2_per_m2: -0.02326,
-            mu3_n_s3_per_m3: 0.004045,
-            kappa1_w_per_n1_5: 0.275,
-            kappa2_w_s2_per_m2_n0_5: 0.0,
-            efficiency: 0.9703,
-        })
-        .unwrap();
-        Aircraft::four_term(airframe, vehicle, Default::default())
+        m100_aircraft()
     }
 
     #[test]
@@ -296,23 +267,7 @@ mod tests {
         // points, integrated by the trapezoid instead of the midpoint rule. The two rules differ
         // only at the pieces' ends (a few of 2,000 steps): well within 0.5 %.
         let aircraft = m100();
-        let battery = BatterySpec {
-            name: "TB47D".into(),
-            default: true,
-            cells_series: 6,
-            capacity_mah: 4500.0,
-            nominal_v: 22.2,
-            energy_wh: 99.9,
-            mass_kg: 0.6,
-            internal_resistance_ohm: 0.048,
-            cutoff_cell_v: 3.0,
-            usable_fraction: 1.0,
-            ocv_soc: None,
-            ocv_cell_v: None,
-            max_current_a: None,
-        }
-        .to_battery()
-        .unwrap();
+        let battery = tb47d().to_battery().unwrap();
         let mission = MissionSpec::from_toml_str(
             r#"
             [[segment]]
