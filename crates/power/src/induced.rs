@@ -86,16 +86,12 @@ pub fn induced_velocity_mps(normal_mps: f64, parallel_mps: f64, hover_mps: f64) 
 #[inline]
 pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
     let b2 = b * b;
-    let c = a * a + b2;
-    // Root of x sqrt(x^2 + c) = 1, written without cancellation: exact when a = 0, and an upper
-    // bound of the root when a > 0 (since (x+a)^2 >= x^2 + a^2 there).
-    let guess = (2.0 / (c + (c * c + 4.0).sqrt())).sqrt();
     if a >= 0.0 || 8.0 * b2 >= a * a {
-        // g is increasing on x > 0: the positive root is unique. Fast path without data-dependent
-        // branches: two Halley steps from the a = 0 root, then the same residual test as below.
-        // Two steps reach the bound when |a| is small (the paper's inflow, slow flight); a third
-        // covers forward flight with the exact inflow (|a| up to about 0.5).
-        let mut x = halley_step(halley_step(guess, a, b2), a, b2);
+        // g is increasing on x > 0: the positive root is unique, and any positive x meeting the
+        // residual bound is it. Fast path: two Halley steps from the first-order guess reach the
+        // bound for |a| up to about 0.5 (forward flight with the exact inflow); up to two more
+        // cover the rest, and the safeguarded loop below anything left.
+        let mut x = halley_step(halley_step(corrected_guess(a, b2), a, b2), a, b2);
         for _ in 0..2 {
             let s = x + a;
             if x > 0.0 && (x * x * (s * s + b2) - 1.0).abs() <= 1e-12 {
@@ -104,6 +100,10 @@ pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
             x = halley_step(x, a, b2);
         }
     }
+    // The safeguarded path. Root of x sqrt(x^2 + c) = 1, written without cancellation: exact when
+    // a = 0, and an upper bound of the root when a > 0 (since (x+a)^2 >= x^2 + a^2 there).
+    let c = a * a + b2;
+    let guess = (2.0 / (c + (c * c + 4.0).sqrt())).sqrt();
     let (mut lo, mut hi) = if a >= 0.0 {
         (0.0, guess)
     } else {
@@ -149,15 +149,15 @@ pub(crate) fn solve_normalised(a: f64, b: f64) -> Option<f64> {
     Some(x)
 }
 
-/// Branch-free fast path of [`solve_normalised`] for batches: the root where it is unique and three
-/// Halley steps from the `a = 0` root reach the residual bound, otherwise NaN (the caller then runs
-/// the safeguarded solver). Without data-dependent branches, consecutive calls overlap in the CPU.
+/// Branch-free fast path of [`solve_normalised`] for batches: the root where it is unique and two
+/// Halley steps from [`corrected_guess`] reach the residual bound, otherwise NaN (the caller then
+/// runs the safeguarded solver). Without data-dependent branches, consecutive calls overlap in the
+/// CPU.
 #[inline(always)]
 pub(crate) fn solve_normalised_fast(a: f64, b: f64) -> f64 {
     let b2 = b * b;
-    let c = a * a + b2;
-    let guess = (2.0 / (c + (c * c + 4.0).sqrt())).sqrt();
-    let x = halley_step(halley_step(halley_step(guess, a, b2), a, b2), a, b2);
+    let start = corrected_guess(a, b2);
+    let x = halley_step(halley_step(start, a, b2), a, b2);
     let s = x + a;
     let unique = (a >= 0.0) | (8.0 * b2 >= a * a);
     let converged = (x > 0.0) & ((x * x * (s * s + b2) - 1.0).abs() <= 1e-12);
@@ -186,6 +186,23 @@ pub(crate) fn solve_normalised_warm(a: f64, b: f64, start: f64) -> f64 {
         }
     }
     solve_normalised_fast(a, b)
+}
+
+/// Starting point of the fast paths: the exact root for `a = 0`, `y0 = x0^2 = 2/(b^2 + sqrt(b^4 + 4))`,
+/// moved by the first-order term in `a`, `dx/da = -x0^2 / (2 x0^2 + b^2)` (implicit differentiation
+/// of the quartic at `a = 0`). Its error is of order `a^2`, so two Halley steps (cubic
+/// convergence) reach the residual bound for `|a|` up to about 0.5.
+#[inline(always)]
+fn corrected_guess(a: f64, b2: f64) -> f64 {
+    let y0 = 2.0 / (b2 + (b2 * b2 + 4.0).sqrt());
+    let x0 = y0.sqrt();
+    let x1 = x0 - a * y0 / (2.0 * y0 + b2);
+    // Far outside its range (large a) the correction can overshoot past zero: keep x0 then.
+    if x1 > 0.1 * x0 {
+        x1
+    } else {
+        x0
+    }
 }
 
 /// One Halley step for `g(x) = x^2 ((x+a)^2 + b^2) = 1`.
