@@ -306,13 +306,9 @@ pub const AIRSPEED_BANDS: [(&str, f64, f64); 6] = [
     ("9-", 9.0, f64::INFINITY),
 ];
 
+/// Energy of a power series, Wh (the planner's trapezoidal rule).
 fn trapezoid_wh(times: &[f64], power: &[f64]) -> f64 {
-    times
-        .windows(2)
-        .zip(power.windows(2))
-        .map(|(t, p)| (t[1] - t[0]) * 0.5 * (p[0] + p[1]))
-        .sum::<f64>()
-        / 3600.0
+    aloft_planner::replay::trapezoid(times, power) / 3600.0
 }
 
 fn nrmse_percent(est: &[f64], meas: &[f64]) -> Option<f64> {

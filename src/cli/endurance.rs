@@ -260,45 +260,27 @@ fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
         + 1.0;
     let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{name}: power curve (level flight, still air)"),
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..v_max, 0.0..p_max)?
-        .set_secondary_coord(0.0..v_max, 0.0..e_max);
-    chart
-        .configure_mesh()
-        .x_desc("airspeed (m/s)")
-        .y_desc("electrical power (W)")
-        .draw()?;
-    chart
-        .configure_secondary_axes()
-        .y_desc("endurance (min)")
-        .draw()?;
-    chart
-        .draw_series(LineSeries::new(
-            rows.iter().map(|r| (r.airspeed_mps, r.power_w)),
-            &RED,
-        ))?
-        .label("power (W)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .draw_secondary_series(LineSeries::new(
-            rows.iter().map(|r| (r.airspeed_mps, r.endurance_s / 60.0)),
-            &BLUE,
-        ))?
-        .label("endurance (min)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    let mut chart = super::plot::dual_lines(
+        &root,
+        format!("{name}: power curve (level flight, still air)"),
+        (0.0..v_max, "airspeed (m/s)"),
+        super::plot::Line {
+            desc: "electrical power (W)",
+            max: p_max,
+            color: RED,
+            points: rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect(),
+        },
+        super::plot::Line {
+            desc: "endurance (min)",
+            max: e_max,
+            color: BLUE,
+            points: rows
+                .iter()
+                .map(|r| (r.airspeed_mps, r.endurance_s / 60.0))
+                .collect(),
+        },
+    )?;
+    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     root.present()?;
     Ok(())
 }

@@ -609,40 +609,23 @@ fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Resu
     let t_max = s[s.len() - 1].time_s.max(1.0);
     let p_max = s.iter().map(|x| x.power_w).fold(0.0, f64::max) * 1.1 + 1.0;
     let pnr_t = report.point_of_no_return.map(|p| p.time_s);
-    let mut chart = ChartBuilder::on(&top)
-        .caption(
-            format!("{name}: electrical power and state of charge"),
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..t_max, 0.0..p_max)?
-        .set_secondary_coord(0.0..t_max, 0.0..100.0);
-    chart
-        .configure_mesh()
-        .x_desc("time (s)")
-        .y_desc("power (W)")
-        .draw()?;
-    chart
-        .configure_secondary_axes()
-        .y_desc("state of charge (%)")
-        .draw()?;
-    chart
-        .draw_series(LineSeries::new(
-            s.iter().map(|x| (x.time_s, x.power_w)),
-            &RED,
-        ))?
-        .label("power (W)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .draw_secondary_series(LineSeries::new(
-            s.iter().map(|x| (x.time_s, x.soc * 100.0)),
-            &BLUE,
-        ))?
-        .label("state of charge (%)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    let mut chart = super::plot::dual_lines(
+        &top,
+        format!("{name}: electrical power and state of charge"),
+        (0.0..t_max, "time (s)"),
+        super::plot::Line {
+            desc: "power (W)",
+            max: p_max,
+            color: RED,
+            points: s.iter().map(|x| (x.time_s, x.power_w)).collect(),
+        },
+        super::plot::Line {
+            desc: "state of charge (%)",
+            max: 100.0,
+            color: BLUE,
+            points: s.iter().map(|x| (x.time_s, x.soc * 100.0)).collect(),
+        },
+    )?;
     let floor = (report.empty_soc + report.required_reserve_soc) * 100.0;
     chart
         .draw_secondary_series(LineSeries::new(
@@ -660,12 +643,7 @@ fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Resu
             .label("point of no return")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    super::plot::legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
 
     // Ground track, equal scales.
     let (mut e0, mut e1, mut n0, mut n1) = (home[0], home[0], home[1], home[1]);

@@ -7,6 +7,7 @@ mod flights;
 mod log;
 mod mission;
 mod output;
+mod plot;
 mod power;
 mod propulsion;
 mod rotor;

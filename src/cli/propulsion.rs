@@ -250,45 +250,24 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
         * 1.1;
     let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
     root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{name}: flight time and power against take-off mass"),
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(60)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(x0..x1, 0.0..t_max)?
-        .set_secondary_coord(x0..x1, 0.0..p_max);
-    chart
-        .configure_mesh()
-        .x_desc("take-off mass (kg)")
-        .y_desc("flight time (min)")
-        .draw()?;
-    chart
-        .configure_secondary_axes()
-        .y_desc("power required (W)")
-        .draw()?;
-    chart
-        .draw_series(LineSeries::new(
-            ok.iter().map(|(m, h)| (*m, h.flight_time_min)),
-            &BLUE,
-        ))?
-        .label("flight time (min)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    chart
-        .draw_secondary_series(LineSeries::new(
-            ok.iter().map(|(m, h)| (*m, h.power_required_w)),
-            &RED,
-        ))?
-        .label("power required (W)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
+    let mut chart = super::plot::dual_lines(
+        &root,
+        format!("{name}: flight time and power against take-off mass"),
+        (x0..x1, "take-off mass (kg)"),
+        super::plot::Line {
+            desc: "flight time (min)",
+            max: t_max,
+            color: BLUE,
+            points: ok.iter().map(|(m, h)| (*m, h.flight_time_min)).collect(),
+        },
+        super::plot::Line {
+            desc: "power required (W)",
+            max: p_max,
+            color: RED,
+            points: ok.iter().map(|(m, h)| (*m, h.power_required_w)).collect(),
+        },
+    )?;
+    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     root.present()?;
     Ok(())
 }

@@ -96,6 +96,48 @@ pub struct AloftPlan {
     inner: Plan,
 }
 
+/// What the registry-checked handle functions need to know of a handle type.
+trait Handle: Sized {
+    /// The Rust value behind the handle.
+    type Inner;
+    /// Registry kind.
+    const KIND: Kind;
+    /// Magic number of a live handle.
+    const MAGIC: u64;
+    fn wrap(inner: Self::Inner) -> Self;
+    fn magic(&self) -> u64;
+    fn clear_magic(&mut self);
+    fn inner(&self) -> &Self::Inner;
+}
+
+macro_rules! handle {
+    ($t:ty, $inner:ty, $kind:expr, $magic:expr) => {
+        impl Handle for $t {
+            type Inner = $inner;
+            const KIND: Kind = $kind;
+            const MAGIC: u64 = $magic;
+            fn wrap(inner: $inner) -> Self {
+                Self {
+                    magic: $magic,
+                    inner,
+                }
+            }
+            fn magic(&self) -> u64 {
+                self.magic
+            }
+            fn clear_magic(&mut self) {
+                self.magic = 0;
+            }
+            fn inner(&self) -> &$inner {
+                &self.inner
+            }
+        }
+    };
+}
+
+handle!(AloftVehicle, Vehicle, Kind::Vehicle, VEHICLE_MAGIC);
+handle!(AloftPlan, Plan, Kind::Plan, PLAN_MAGIC);
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
     Vehicle,
@@ -267,48 +309,42 @@ fn give_string(s: String, out: &mut *mut c_char) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Borrow a live vehicle.
+/// Borrow the value behind a live handle.
 ///
 /// # Safety
-/// `v` is NULL or a pointer the caller got from aloft (checked against the registry before use).
-unsafe fn vehicle<'a>(v: *const AloftVehicle, name: &str) -> Result<&'a Vehicle, Failure> {
-    if v.is_null() {
+/// `h` is NULL or a pointer the caller got from aloft (checked against the registry before use).
+unsafe fn borrow<'a, H: Handle + 'a>(h: *const H, name: &str) -> Result<&'a H::Inner, Failure> {
+    if h.is_null() {
         return Err(Failure::new(
             AloftStatus::NullPointer,
             format!("{name} is NULL"),
         ));
     }
-    if live().get(&key(v)) != Some(&Kind::Vehicle) {
-        return Err(not_live(name, Kind::Vehicle));
+    if live().get(&key(h)) != Some(&H::KIND) {
+        return Err(not_live(name, H::KIND));
     }
-    // SAFETY: registered as a live vehicle, so it points to an AloftVehicle we allocated.
-    let h = unsafe { &*v };
-    if h.magic != VEHICLE_MAGIC {
-        return Err(not_live(name, Kind::Vehicle));
+    // SAFETY: registered as a live handle of this kind, so it points to an `H` we allocated.
+    let handle = unsafe { &*h };
+    if handle.magic() != H::MAGIC {
+        return Err(not_live(name, H::KIND));
     }
-    Ok(&h.inner)
+    Ok(handle.inner())
+}
+
+/// Borrow a live vehicle.
+///
+/// # Safety
+/// As [`borrow`].
+unsafe fn vehicle<'a>(v: *const AloftVehicle, name: &str) -> Result<&'a Vehicle, Failure> {
+    unsafe { borrow(v, name) }
 }
 
 /// Borrow a live plan.
 ///
 /// # Safety
-/// As [`vehicle`].
+/// As [`borrow`].
 unsafe fn plan<'a>(p: *const AloftPlan, name: &str) -> Result<&'a Plan, Failure> {
-    if p.is_null() {
-        return Err(Failure::new(
-            AloftStatus::NullPointer,
-            format!("{name} is NULL"),
-        ));
-    }
-    if live().get(&key(p)) != Some(&Kind::Plan) {
-        return Err(not_live(name, Kind::Plan));
-    }
-    // SAFETY: registered as a live plan.
-    let h = unsafe { &*p };
-    if h.magic != PLAN_MAGIC {
-        return Err(not_live(name, Kind::Plan));
-    }
-    Ok(&h.inner)
+    unsafe { borrow(p, name) }
 }
 
 /// Remove `ptr` from the registry if it is a live `kind`; true when it was.
@@ -323,12 +359,43 @@ fn unregister<T>(ptr: *const T, kind: Kind) -> bool {
     }
 }
 
-fn give_vehicle(v: Vehicle, out: &mut *mut AloftVehicle) {
-    let raw = Box::into_raw(Box::new(AloftVehicle {
-        magic: VEHICLE_MAGIC,
-        inner: v,
-    }));
-    *out = register(raw, Kind::Vehicle);
+/// Box `inner` as a registered handle into `*out`.
+fn give<H: Handle>(inner: H::Inner, out: &mut *mut H) {
+    *out = register(Box::into_raw(Box::new(H::wrap(inner))), H::KIND);
+}
+
+/// Release a handle: NULL is a no-op; a pointer that is not a live handle of this kind is an
+/// error and is not touched.
+///
+/// # Safety
+/// `h` is NULL or a pointer; it is checked against the registry before use.
+unsafe fn release<H: Handle>(h: *mut H, name: &str) -> Result<(), Failure> {
+    if h.is_null() {
+        return Ok(());
+    }
+    if !unregister(h, H::KIND) {
+        return Err(not_live(name, H::KIND));
+    }
+    // SAFETY: it was live and is now out of the registry: we own it, exactly once.
+    let mut b = unsafe { Box::from_raw(h) };
+    b.clear_magic();
+    drop(b);
+    Ok(())
+}
+
+/// A non-NULL scalar out-parameter, or `NullPointer` naming it.
+///
+/// # Safety
+/// `p` is NULL or a valid, writable pointer.
+unsafe fn out_value<'a, T>(p: *mut T, name: &str) -> Result<&'a mut T, Failure> {
+    if p.is_null() {
+        return Err(Failure::new(
+            AloftStatus::NullPointer,
+            format!("{name} (out pointer) is NULL"),
+        ));
+    }
+    // SAFETY: non-null, writable by the caller's contract.
+    Ok(unsafe { &mut *p })
 }
 
 fn parse_mission(mission: Option<&str>) -> Result<Mission, Failure> {
@@ -393,7 +460,7 @@ pub unsafe extern "C" fn aloft_vehicle_builtin(
         // SAFETY: the caller's contract.
         let out = unsafe { out_ptr(out, "out")? };
         let name = unsafe { text(name, "name")? };
-        give_vehicle(Vehicle::builtin(name)?, out);
+        give(Vehicle::builtin(name)?, out);
         Ok(())
     })
 }
@@ -411,7 +478,7 @@ pub unsafe extern "C" fn aloft_vehicle_from_toml(
         // SAFETY: the caller's contract.
         let out = unsafe { out_ptr(out, "out")? };
         let toml = unsafe { text(toml, "toml")? };
-        give_vehicle(
+        give(
             Vehicle::from_toml(toml, "vehicle text from the C caller")?,
             out,
         );
@@ -426,19 +493,8 @@ pub unsafe extern "C" fn aloft_vehicle_from_toml(
 /// `vehicle` is NULL or a pointer; it is checked against the registry before use.
 #[no_mangle]
 pub unsafe extern "C" fn aloft_vehicle_free(vehicle: *mut AloftVehicle) -> AloftStatus {
-    guard(|| {
-        if vehicle.is_null() {
-            return Ok(());
-        }
-        if !unregister(vehicle, Kind::Vehicle) {
-            return Err(not_live("vehicle", Kind::Vehicle));
-        }
-        // SAFETY: it was live and is now out of the registry: we own it, exactly once.
-        let mut b = unsafe { Box::from_raw(vehicle) };
-        b.magic = 0;
-        drop(b);
-        Ok(())
-    })
+    // SAFETY: checked against the registry before use.
+    guard(|| unsafe { release(vehicle, "vehicle") })
 }
 
 /// Electrical power of the four-term model in steady flight, W, into `*out_w`: airspeed in m/s,
@@ -459,20 +515,14 @@ pub unsafe extern "C" fn aloft_vehicle_power_w(
     guard(|| {
         // SAFETY: checked against the registry.
         let v = unsafe { self::vehicle(vehicle, "vehicle")? };
-        if out_w.is_null() {
-            return Err(Failure::new(
-                AloftStatus::NullPointer,
-                "out_w (out pointer) is NULL",
-            ));
-        }
+        let out_w = unsafe { out_value(out_w, "out_w")? };
         let p = v.power(&FlightState::new(
             airspeed_mps,
             roll_rad,
             pitch_rad,
             climb_rate_mps,
         ))?;
-        // SAFETY: non-null, writable by the caller's contract.
-        unsafe { *out_w = p.electrical_w };
+        *out_w = p.electrical_w;
         Ok(())
     })
 }
@@ -541,11 +591,7 @@ pub unsafe extern "C" fn aloft_mission_plan(
         let options =
             parse_mission_options(unsafe { optional_text(options_json, "options_json")? })?;
         let p = plan_mission(v, &mission, &options)?;
-        let raw = Box::into_raw(Box::new(AloftPlan {
-            magic: PLAN_MAGIC,
-            inner: p,
-        }));
-        *out = register(raw, Kind::Plan);
+        give(p, out);
         Ok(())
     })
 }
@@ -605,14 +651,8 @@ pub unsafe extern "C" fn aloft_plan_energy_wh(
     guard(|| {
         // SAFETY: checked against the registry.
         let p = unsafe { self::plan(plan, "plan")? };
-        if out_wh.is_null() {
-            return Err(Failure::new(
-                AloftStatus::NullPointer,
-                "out_wh (out pointer) is NULL",
-            ));
-        }
-        // SAFETY: non-null, writable by the caller's contract.
-        unsafe { *out_wh = p.energy_wh() };
+        let out_wh = unsafe { out_value(out_wh, "out_wh")? };
+        *out_wh = p.energy_wh();
         Ok(())
     })
 }
@@ -629,14 +669,8 @@ pub unsafe extern "C" fn aloft_plan_feasible(
     guard(|| {
         // SAFETY: checked against the registry.
         let p = unsafe { self::plan(plan, "plan")? };
-        if out_feasible.is_null() {
-            return Err(Failure::new(
-                AloftStatus::NullPointer,
-                "out_feasible (out pointer) is NULL",
-            ));
-        }
-        // SAFETY: non-null, writable by the caller's contract.
-        unsafe { *out_feasible = c_int::from(p.summary().feasible) };
+        let out_feasible = unsafe { out_value(out_feasible, "out_feasible")? };
+        *out_feasible = c_int::from(p.summary().feasible);
         Ok(())
     })
 }
@@ -648,19 +682,8 @@ pub unsafe extern "C" fn aloft_plan_feasible(
 /// `plan` is NULL or a pointer; it is checked against the registry before use.
 #[no_mangle]
 pub unsafe extern "C" fn aloft_plan_free(plan: *mut AloftPlan) -> AloftStatus {
-    guard(|| {
-        if plan.is_null() {
-            return Ok(());
-        }
-        if !unregister(plan, Kind::Plan) {
-            return Err(not_live("plan", Kind::Plan));
-        }
-        // SAFETY: it was live and is now out of the registry: we own it, exactly once.
-        let mut b = unsafe { Box::from_raw(plan) };
-        b.magic = 0;
-        drop(b);
-        Ok(())
-    })
+    // SAFETY: checked against the registry before use.
+    guard(|| unsafe { release(plan, "plan") })
 }
 
 /// Hover and orbit endurance, best-endurance and best-range speeds as JSON (exactly

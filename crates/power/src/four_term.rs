@@ -293,46 +293,10 @@ impl PowerModel {
     /// Validate a point query and resolve it: thrust from eq (5), inflow from the AoA model.
     #[inline(always)]
     fn point_condition(&self, state: &FlightState) -> Result<FlightCondition> {
-        // libm's sincos (musl's kernels) is about twice as fast as std's here, within 1 ulp.
-        let (sr, cr) = libm::sincos(state.roll_rad);
-        let (sp, cp) = libm::sincos(state.pitch_rad);
-        let tilt_cos = cr * cp;
-        // One comparison catches NaN angles and tilts of 90 deg or more; the checks that name the
-        // value run only on that cold path.
-        if tilt_cos.is_nan() || tilt_cos <= MIN_TILT_COSINE {
-            check_attitude(state.roll_rad, state.pitch_rad)?;
-        }
-        if !(state.airspeed_mps >= 0.0 && state.airspeed_mps.is_finite()) {
-            finite("airspeed_mps", state.airspeed_mps)?;
-            non_negative("airspeed_mps", state.airspeed_mps)?;
-        }
-        finite("climb_rate_mps", state.climb_rate_mps)?;
-        let v = state.airspeed_mps;
-        let (inflow, aoa) = match state.aoa {
-            AoaInput::Paper => (
-                Inflow {
-                    normal_mps: v * sr * sp,
-                    parallel_mps: v * tilt_cos,
-                },
-                AoaModel::Paper,
-            ),
-            AoaInput::Geometric { air_direction_rad } => {
-                finite("air_direction_rad", air_direction_rad)?;
-                let (sb, cb) = libm::sincos(air_direction_rad);
-                // Closed form of angle_of_attack::body_relative_inflow (tested equal there).
-                let normal = -v * (cb * cr * sp - sb * sr);
-                (
-                    Inflow {
-                        normal_mps: normal,
-                        parallel_mps: (v * v - normal * normal).max(0.0).sqrt(),
-                    },
-                    AoaModel::Geometric,
-                )
-            }
-        };
+        let (tilt_cos, inflow, aoa) = resolve_point(state)?;
         Ok(FlightCondition {
             thrust_n: self.vehicle.weight_n() / tilt_cos,
-            airspeed_mps: v,
+            airspeed_mps: state.airspeed_mps,
             inflow,
             climb_rate_mps: state.climb_rate_mps,
             aoa,
@@ -526,6 +490,51 @@ fn check_condition(c: &FlightCondition) -> Result<()> {
     Ok(())
 }
 
+/// Validate a point query and resolve what does not depend on the vehicle: `cos(phi) cos(theta)`
+/// (eq 5's divisor), the inflow of the selected angle-of-attack model, and that model.
+#[inline(always)]
+pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaModel)> {
+    // libm's sincos (musl's kernels) is about twice as fast as std's here, within 1 ulp.
+    let (sr, cr) = libm::sincos(state.roll_rad);
+    let (sp, cp) = libm::sincos(state.pitch_rad);
+    let tilt_cos = cr * cp;
+    // One comparison catches NaN angles and tilts of 90 deg or more; the checks that name the
+    // value run only on that cold path.
+    if tilt_cos.is_nan() || tilt_cos <= MIN_TILT_COSINE {
+        check_attitude(state.roll_rad, state.pitch_rad)?;
+    }
+    if !(state.airspeed_mps >= 0.0 && state.airspeed_mps.is_finite()) {
+        finite("airspeed_mps", state.airspeed_mps)?;
+        non_negative("airspeed_mps", state.airspeed_mps)?;
+    }
+    finite("climb_rate_mps", state.climb_rate_mps)?;
+    let v = state.airspeed_mps;
+    Ok(match state.aoa {
+        AoaInput::Paper => (
+            tilt_cos,
+            Inflow {
+                normal_mps: v * sr * sp,
+                parallel_mps: v * tilt_cos,
+            },
+            AoaModel::Paper,
+        ),
+        AoaInput::Geometric { air_direction_rad } => {
+            finite("air_direction_rad", air_direction_rad)?;
+            let (sb, cb) = libm::sincos(air_direction_rad);
+            // Closed form of angle_of_attack::body_relative_inflow (tested equal there).
+            let normal = -v * (cb * cr * sp - sb * sr);
+            (
+                tilt_cos,
+                Inflow {
+                    normal_mps: normal,
+                    parallel_mps: (v * v - normal * normal).max(0.0).sqrt(),
+                },
+                AoaModel::Geometric,
+            )
+        }
+    })
+}
+
 /// Validate roll and pitch; return `cos(phi) cos(theta)`.
 #[inline]
 pub(crate) fn check_attitude(roll_rad: f64, pitch_rad: f64) -> Result<f64> {
@@ -540,17 +549,6 @@ pub(crate) fn check_attitude(roll_rad: f64, pitch_rad: f64) -> Result<f64> {
         });
     }
     Ok(tilt_cos)
-}
-
-/// Validate a point query; return `cos(phi) cos(theta)`.
-#[inline]
-pub(crate) fn check_state(state: &FlightState) -> Result<f64> {
-    if !(state.airspeed_mps.is_finite() && state.airspeed_mps >= 0.0) {
-        finite("airspeed_mps", state.airspeed_mps)?;
-        non_negative("airspeed_mps", state.airspeed_mps)?;
-    }
-    finite("climb_rate_mps", state.climb_rate_mps)?;
-    check_attitude(state.roll_rad, state.pitch_rad)
 }
 
 #[cfg(test)]

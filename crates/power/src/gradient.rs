@@ -12,7 +12,7 @@
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::four_term::{check_state, AoaInput, FlightState, PowerModel};
+use crate::four_term::{AoaInput, FlightState, PowerModel};
 use crate::induced::induced_velocity_partials;
 
 /// Gradient of the electrical power `P_hat`.
@@ -33,8 +33,8 @@ struct D3([f64; 3]);
 impl PowerModel {
     /// Electrical power and its gradient with respect to airspeed, roll and pitch.
     pub fn electrical_gradient(&self, state: &FlightState) -> Result<PowerGradient> {
+        // Validates the state (and gives the terms the chain rule needs).
         let p = self.evaluate(state)?;
-        check_state(state)?;
         let v = state.airspeed_mps;
         let (sr, cr) = state.roll_rad.sin_cos();
         let (sp, cp) = state.pitch_rad.sin_cos();

@@ -111,12 +111,7 @@ pub fn fit_drag(
         .iter()
         .map(|&(v, y)| y - v * (c[0] + v * (c[1] + v * c[2])))
         .collect();
-    let mut sorted = residuals.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2];
-    let mut dev: Vec<f64> = residuals.iter().map(|r| (r - median).abs()).collect();
-    dev.sort_by(f64::total_cmp);
-    let robust_sd = 1.4826 * dev[dev.len() / 2];
+    let (median, robust_sd) = super::median_and_robust_sd(&residuals);
     let kept: Vec<(f64, f64)> = rows
         .iter()
         .zip(&residuals)

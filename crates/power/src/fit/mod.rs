@@ -12,3 +12,25 @@ pub use drag::{fit_drag, DragFit, ForceSample};
 pub use power::{
     fit_power_model, FitOptions, FitParameter, FitSample, FittedParameter, PowerFit, ProgressFn,
 };
+
+/// Median and robust standard deviation (1.4826 times the median absolute deviation) of
+/// `values`: the outlier rule of both fits.
+pub(crate) fn median_and_robust_sd(values: &[f64]) -> (f64, f64) {
+    let mut sorted = values.to_vec();
+    let median = median_of(&mut sorted);
+    let mut deviations: Vec<f64> = values.iter().map(|x| (x - median).abs()).collect();
+    (median, 1.4826 * median_of(&mut deviations))
+}
+
+/// Median of `v` (sorts it); 0 when empty.
+fn median_of(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

@@ -46,8 +46,9 @@ use argmin::solver::linesearch::BacktrackingLineSearch;
 use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
+use crate::angle_of_attack::AoaModel;
 use crate::error::FitError;
-use crate::four_term::{check_state, AoaInput, FlightState};
+use crate::four_term::{resolve_point, FlightState};
 use crate::induced::solve_normalised;
 use crate::vehicle::{DiskArea, Vehicle, VehicleParams};
 
@@ -357,7 +358,7 @@ pub fn fit_power_model(
     // Validate and precompute.
     let mut pre = Vec::with_capacity(samples.len());
     for (index, s) in samples.iter().enumerate() {
-        let tilt_cos = check_state(&s.state).map_err(|e| FitError::BadSample {
+        let (tilt_cos, inflow, aoa) = resolve_point(&s.state).map_err(|e| FitError::BadSample {
             index,
             message: e.to_string(),
         })?;
@@ -371,29 +372,19 @@ pub fn fit_power_model(
             });
         }
         let st = s.state;
-        let (sr, cr) = st.roll_rad.sin_cos();
-        let (sp, cp) = st.pitch_rad.sin_cos();
         let v = st.airspeed_mps;
-        let (vn, vp) = match st.aoa {
-            AoaInput::Paper => (v * sr * sp, v * cr * cp),
-            AoaInput::Geometric { air_direction_rad } => {
-                let (sb, cb) = air_direction_rad.sin_cos();
-                let vn = -v * (cb * cr * sp - sb * sr);
-                (vn, (v * v - vn * vn).max(0.0).sqrt())
-            }
-        };
         pre.push(Pre {
             inv_c: 1.0 / tilt_cos,
             inv_c15: tilt_cos.powf(-1.5),
-            vn,
-            vp,
+            vn: inflow.normal_mps,
+            vp: inflow.parallel_mps,
             v2: v * v,
             v,
             vz: st.climb_rate_mps,
             measured: s.measured_power_w,
-            drag_weight: match st.aoa {
-                AoaInput::Paper => 1.0,
-                AoaInput::Geometric { .. } => 0.0,
+            drag_weight: match aoa {
+                AoaModel::Paper => 1.0,
+                AoaModel::Geometric => 0.0,
             },
         });
     }
@@ -539,10 +530,8 @@ pub fn fit_power_model(
             tie,
         };
         let (r, _) = problem.evaluate(&u, false);
-        let mut sorted: Vec<f64> = r.iter().copied().collect();
-        let median = median_of(&mut sorted);
-        let mut dev: Vec<f64> = r.iter().map(|x| (x - median).abs()).collect();
-        let robust_sd = 1.4826 * median_of(&mut dev);
+        let residuals: Vec<f64> = r.iter().copied().collect();
+        let (median, robust_sd) = super::median_and_robust_sd(&residuals);
         if robust_sd <= 0.0 {
             break;
         }
@@ -635,18 +624,6 @@ pub fn fit_power_model(
     })
 }
 
-fn median_of(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 struct ProgressObserver {
     callback: ProgressFn,
     offset: u64,
@@ -666,6 +643,7 @@ impl<I: State<Float = f64>> argmin::core::observers::Observe<I> for ProgressObse
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::four_term::AoaInput;
     use crate::four_term::PowerModel;
     use crate::vehicle::tests::m100_params;
 
