@@ -14,20 +14,21 @@ use aloft_power::{AoaInput, FlightState, PowerBreakdown, PowerModel};
 use crate::error::Error;
 
 /// The result columns, in order (the same keys as `aloft power --format json`).
-pub const POWER_KEYS: [&str; 9] = [
+pub const POWER_KEYS: [&str; 10] = [
     "thrust_n",
     "induced_velocity_mps",
     "hover_induced_velocity_mps",
     "induced_w",
     "parasitic_w",
     "profile_w",
+    "acceleration_w",
     "climb_w",
     "aero_w",
     "electrical_w",
 ];
 
 /// The values of a result in [`POWER_KEYS`] order.
-pub fn power_values(p: &PowerBreakdown) -> [f64; 9] {
+pub fn power_values(p: &PowerBreakdown) -> [f64; 10] {
     [
         p.thrust_n,
         p.induced_velocity_mps,
@@ -35,6 +36,7 @@ pub fn power_values(p: &PowerBreakdown) -> [f64; 9] {
         p.induced_w,
         p.parasitic_w,
         p.profile_w,
+        p.acceleration_w,
         p.climb_w,
         p.aero_w,
         p.electrical_w,
@@ -189,15 +191,38 @@ mod tests {
         assert_eq!(n, 2);
         let text = String::from_utf8(out).unwrap();
         let mut lines = text.lines();
-        assert!(lines.next().unwrap().ends_with("note,thrust_n,induced_velocity_mps,hover_induced_velocity_mps,induced_w,parasitic_w,profile_w,climb_w,aero_w,electrical_w"));
+        assert!(lines.next().unwrap().ends_with("note,thrust_n,induced_velocity_mps,hover_induced_velocity_mps,induced_w,parasitic_w,profile_w,acceleration_w,climb_w,aero_w,electrical_w"));
         let hover: Vec<&str> = lines.next().unwrap().split(',').collect();
         assert_eq!(hover[3], "hover");
         let single = model()
             .evaluate(&FlightState::new(0.0, 0.0, 0.0, 0.0))
             .unwrap();
-        let electrical: f64 = hover[12].parse().unwrap();
+        let electrical: f64 = hover[13].parse().unwrap();
         // Shortest round-trip formatting: the value survives CSV exactly.
         assert_eq!(electrical.to_bits(), single.electrical_w.to_bits());
+    }
+
+    #[test]
+    fn the_columns_are_the_json_keys_in_order() {
+        // Regression: acceleration_w was added to PowerBreakdown (and its JSON) but not here.
+        let p = model()
+            .evaluate(&FlightState::new(6.0, 0.0, -0.1, 0.5))
+            .unwrap();
+        let json = serde_json::to_value(p).unwrap();
+        let keys: Vec<&str> = json
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        let mut sorted = POWER_KEYS.to_vec();
+        sorted.sort_unstable();
+        let mut json_sorted = keys.clone();
+        json_sorted.sort_unstable();
+        assert_eq!(sorted, json_sorted);
+        for (k, v) in POWER_KEYS.iter().zip(power_values(&p)) {
+            assert_eq!(json[k].as_f64().unwrap().to_bits(), v.to_bits(), "{k}");
+        }
     }
 
     #[test]

@@ -196,6 +196,11 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
                 Row::new("induced power (eq 8)", f1(p.induced_w), "W"),
                 Row::new("parasitic power (eq 11)", f1(p.parasitic_w), "W"),
                 Row::new("profile power (eq 12)", f1(p.profile_w), "W"),
+                Row::new(
+                    "acceleration work (eq 8, exact AoA)",
+                    f1(p.acceleration_w),
+                    "W",
+                ),
                 Row::new("climb power (eq 13)", f1(p.climb_w), "W"),
                 Row::new("aerodynamic total (eq 7)", f1(p.aero_w), "W"),
                 Row::new("electrical (eq 14)", f1(p.electrical_w), "W"),
