@@ -91,7 +91,7 @@ pub mod wind;
 pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
-pub use battery::{Battery, BatterySpec, PackDraw};
+pub use battery::{Battery, BatterySpec, PackCursor, PackDraw, PackStep};
 pub use error::PlannerError;
 pub use mission::{
     HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,

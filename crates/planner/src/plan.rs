@@ -51,7 +51,7 @@ use aloft_power::AoaModel;
 use serde::Serialize;
 
 use crate::aircraft::{Aircraft, Powered};
-use crate::battery::Battery;
+use crate::battery::{Battery, PackStep};
 use crate::error::PlannerError;
 use crate::ground_effect::thrust_factor;
 use crate::mission::Mission;
@@ -384,7 +384,7 @@ pub fn plan(
 
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
 /// large enough that the loop overhead of a pass is negligible.
-const BLOCK: usize = 32;
+const BLOCK: usize = 64;
 
 const ZERO_TRIM: Trim = Trim {
     thrust_n: 0.0,
@@ -541,6 +541,7 @@ pub(crate) fn plan_with(
     let mut fwds = [[0.0; 2]; BLOCK];
     let mut ges = [1.0; BLOCK];
     let mut trims = [ZERO_TRIM; BLOCK];
+    let mut steps = [PackStep::default(); BLOCK];
     let steady_wind = wind.is_steady_and_level_uniform();
     let mut cursor = battery.cursor(soc);
     'pieces: for piece in mission.pieces() {
@@ -652,7 +653,15 @@ pub(crate) fn plan_with(
                     break;
                 }
             }
-            // Pass B: the pack, step by step.
+            // Pass B: the pack. Its state of charge chains one step to the next; draw_block
+            // solves the block's chain at once (bit for bit the step-by-step result), then the
+            // loop below books each step in order.
+            let soc_at_block = cursor.soc();
+            let mut powers = [0.0; BLOCK];
+            for (p, t) in powers.iter_mut().zip(&trims[..valid]) {
+                *p = t.electrical_w;
+            }
+            let drawn = cursor.draw_block(battery, &powers[..valid], dq, &mut steps[..valid]);
             for j in 0..valid {
                 let tm = ((k0 + j) as f64 + 0.5) * h;
                 let kin = kins[j];
@@ -660,8 +669,8 @@ pub(crate) fn plan_with(
                 let trim = trims[j];
                 let t = t0 + tm;
                 let p = trim.electrical_w;
-                let draw = match cursor.draw(battery, p) {
-                    Some(d) if d.current_a <= max_current => d,
+                let draw = match steps.get(j) {
+                    Some(d) if j < drawn && d.current_a <= max_current => *d,
                     _ => {
                         shortfall = Some(Shortfall::PackLimit {
                             time_s: t,
@@ -672,12 +681,15 @@ pub(crate) fn plan_with(
                         });
                         a.duration_s += tm;
                         a.distance_m += piece.profile.at(tm).0;
-                        soc = cursor.soc();
+                        soc = if j == 0 {
+                            soc_at_block
+                        } else {
+                            steps[j - 1].soc_after
+                        };
                         break 'pieces;
                     }
                 };
-                cursor.discharge(draw.current_a * dq);
-                let soc_now = cursor.soc();
+                let soc_now = draw.soc_after;
                 seg_energy += p * h;
                 heat_j += draw.current_a * draw.current_a * r_pack * h;
                 seg_peak = seg_peak.max(p);

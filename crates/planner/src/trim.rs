@@ -40,6 +40,8 @@
 
 use aloft_power::{AoaModel, FlightCondition, Inflow, PowerBreakdown};
 
+use multiversion::multiversion;
+
 use crate::aircraft::{Engine, Powered};
 use crate::error::PlannerError;
 
@@ -80,12 +82,28 @@ pub fn bank_rad(axis: [f64; 3], forward: [f64; 2]) -> f64 {
 
 /// Thrust, axis and inflow of one sample before the power model (shared by [`Powered::trim`]
 /// and [`Powered::trim_block`], so both do the same arithmetic).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Balance {
     thrust_n: f64,
     axis: [f64; 3],
     airspeed_mps: f64,
     inflow: Inflow,
+}
+
+/// [`Powered::balance`] of every sample of a block (slices of one length): a loop with no
+/// data-dependent branch, which the compiler runs in vector lanes (see `aloft_power`'s batch
+/// module: the same arithmetic as one sample at a time, bit for bit, on any instruction set).
+#[multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
+fn balance_block<'a>(
+    powered: &Powered<'a>,
+    acc_mps2: &[[f64; 3]],
+    vel_air_mps: &[[f64; 3]],
+    forward: &[[f64; 2]],
+    out: &mut [Balance],
+) {
+    for (j, b) in out.iter_mut().enumerate() {
+        *b = powered.balance(acc_mps2[j], vel_air_mps[j], forward[j]);
+    }
 }
 
 impl Powered<'_> {
@@ -243,21 +261,11 @@ impl Powered<'_> {
                 && ground_factor.len() == n,
             "trim_block: slices of one length up to TRIM_BLOCK"
         );
-        let mut balances = [Balance {
-            thrust_n: 0.0,
-            axis: [0.0; 3],
-            airspeed_mps: 0.0,
-            inflow: Inflow {
-                normal_mps: 0.0,
-                parallel_mps: 0.0,
-            },
-        }; TRIM_BLOCK];
-        for j in 0..n {
-            balances[j] = self.balance(acc_mps2[j], vel_air_mps[j], forward[j]);
-        }
+        let mut balances = [Balance::default(); TRIM_BLOCK];
+        balance_block(self, acc_mps2, vel_air_mps, forward, &mut balances[..n]);
         if let Engine::FourTerm(model) = &self.engine {
-            // The whole block through the power model's batch path (passes that overlap in the
-            // CPU); on an error, the per-sample loop below finds and reports the failing sample.
+            // The whole block through the power model's batch path (vector lanes); on an error,
+            // the per-sample loop below finds and reports the failing sample.
             let mut conditions = [FlightCondition::default(); TRIM_BLOCK];
             for j in 0..n {
                 let b = &balances[j];
@@ -269,9 +277,9 @@ impl Powered<'_> {
                     aoa: self.aoa,
                 };
             }
-            let mut powers = [PowerBreakdown::default(); TRIM_BLOCK];
+            let mut watts = [0.0; TRIM_BLOCK];
             if model
-                .evaluate_conditions(&conditions[..n], &mut powers[..n])
+                .electrical_of_conditions(&conditions[..n], &mut watts[..n])
                 .is_ok()
             {
                 for j in 0..n {
@@ -280,7 +288,7 @@ impl Powered<'_> {
                         thrust_n: b.thrust_n,
                         axis: b.axis,
                         airspeed_mps: b.airspeed_mps,
-                        electrical_w: powers[j].electrical_w,
+                        electrical_w: watts[j],
                     };
                 }
                 return Ok(());

@@ -36,13 +36,12 @@
 use serde::Serialize;
 
 use crate::angle_of_attack::{AoaModel, Inflow};
+use crate::batch::{electrical_of_block, roots_of_block, Block, CHUNK};
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
-use crate::induced::{
-    induced_power_w, induced_velocity_mps, solve_normalised, solve_normalised_fast,
-    solve_normalised_warm,
-};
+use crate::induced::{induced_power_w, induced_velocity_mps, solve_normalised};
 use crate::profile::profile_power_w;
+use crate::trig::{sin_cos, sin_cos_pair};
 use crate::vehicle::Vehicle;
 
 /// One of the four terms of eq (7).
@@ -309,45 +308,21 @@ impl PowerModel {
     /// Results are identical to [`Self::evaluate`]; the work is arranged in passes over chunks so
     /// the CPU overlaps independent states (the throughput path).
     pub fn evaluate_batch(&self, states: &[FlightState], out: &mut [PowerBreakdown]) -> Result<()> {
-        if states.len() != out.len() {
-            return Err(PowerError::SeriesLength {
-                estimate_len: out.len(),
-                measured_len: states.len(),
-            });
-        }
-        const CHUNK: usize = 64;
-        let inv_vh = self.vehicle.inverse_hover_induced_velocity();
-        let mut conditions = [FlightCondition {
-            thrust_n: 0.0,
-            airspeed_mps: 0.0,
-            inflow: Inflow {
-                normal_mps: 0.0,
-                parallel_mps: 0.0,
-            },
-            climb_rate_mps: 0.0,
-            aoa: AoaModel::Paper,
-        }; CHUNK];
+        check_lengths(states.len(), out.len())?;
+        let mut conditions = [FlightCondition::default(); CHUNK];
+        let mut block = Block::new();
         let mut roots = [0.0f64; CHUNK];
         for (sc, oc) in states.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             // Pass 1: validation, trigonometry, thrust and inflow.
-            for (s, c) in sc.iter().zip(conditions.iter_mut()) {
+            for (j, (s, c)) in sc.iter().zip(conditions.iter_mut()).enumerate() {
                 *c = self.point_condition(s)?;
+                block.set(j, c);
             }
-            // Pass 2: the quartic, branch-free where the root is unique.
-            for (c, x) in conditions.iter().zip(roots.iter_mut()).take(sc.len()) {
-                *x = solve_normalised_fast(
-                    c.inflow.normal_mps * inv_vh,
-                    c.inflow.parallel_mps * inv_vh,
-                );
-            }
-            // Pass 3: the terms; the rare states the fast path left out take the safeguarded solver.
+            // Pass 2: the quartic over the block in vector lanes (crate::batch).
+            roots_of_block(self, &block, &mut roots);
+            // Pass 3: the terms.
             for ((c, &x), o) in conditions.iter().zip(roots.iter()).zip(oc.iter_mut()) {
-                let vi = if x.is_nan() {
-                    self.induced_velocity(c)?
-                } else {
-                    x * self.vehicle.hover_induced_velocity_mps()
-                };
-                *o = self.assemble(c, vi);
+                *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
             }
         }
         Ok(())
@@ -361,40 +336,64 @@ impl PowerModel {
         conditions: &[FlightCondition],
         out: &mut [PowerBreakdown],
     ) -> Result<()> {
-        if conditions.len() != out.len() {
-            return Err(PowerError::SeriesLength {
-                estimate_len: out.len(),
-                measured_len: conditions.len(),
-            });
-        }
-        const CHUNK: usize = 64;
-        let inv_vh = self.vehicle.inverse_hover_induced_velocity();
+        check_lengths(conditions.len(), out.len())?;
+        let mut block = Block::new();
         let mut roots = [0.0f64; CHUNK];
-        // Conditions along a trajectory change little from one to the next: each root starts from
-        // the previous one (solve_normalised_warm), which usually needs one Halley step.
-        let mut previous = f64::NAN;
         for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            for (c, x) in cc.iter().zip(roots.iter_mut()) {
+            for (j, c) in cc.iter().enumerate() {
                 check_condition(c)?;
-                *x = solve_normalised_warm(
-                    c.inflow.normal_mps * inv_vh,
-                    c.inflow.parallel_mps * inv_vh,
-                    previous,
-                );
-                if x.is_finite() {
-                    previous = *x;
-                }
+                block.set(j, c);
             }
+            roots_of_block(self, &block, &mut roots);
             for ((c, &x), o) in cc.iter().zip(roots.iter()).zip(oc.iter_mut()) {
-                let vi = if x.is_nan() {
-                    self.induced_velocity(c)?
-                } else {
-                    x * self.vehicle.hover_induced_velocity_mps()
-                };
-                *o = self.assemble(c, vi);
+                *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
             }
         }
         Ok(())
+    }
+
+    /// [`Self::evaluate_conditions`] keeping only the electrical power, W: the terms too run in
+    /// vector lanes (the planner's path).
+    pub fn electrical_of_conditions(
+        &self,
+        conditions: &[FlightCondition],
+        out: &mut [f64],
+    ) -> Result<()> {
+        check_lengths(conditions.len(), out.len())?;
+        let mut block = Block::new();
+        let mut roots = [0.0f64; CHUNK];
+        let mut watts = [0.0f64; CHUNK];
+        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+            for (j, c) in cc.iter().enumerate() {
+                check_condition(c)?;
+                block.set(j, c);
+            }
+            electrical_of_block(self, &block, &mut roots, &mut watts);
+            for (((c, &x), &w), o) in cc
+                .iter()
+                .zip(roots.iter())
+                .zip(watts.iter())
+                .zip(oc.iter_mut())
+            {
+                *o = if x.is_nan() {
+                    self.assemble(c, self.induced_velocity(c)?).electrical_w
+                } else {
+                    w
+                };
+            }
+        }
+        Ok(())
+    }
+
+    /// `v_i` from a block root `x = v_i / vh`, or from the safeguarded solver where the fast path
+    /// left it (NaN).
+    #[inline(always)]
+    fn root_or_safeguarded(&self, c: &FlightCondition, x: f64) -> Result<f64> {
+        if x.is_nan() {
+            self.induced_velocity(c)
+        } else {
+            Ok(x * self.vehicle.hover_induced_velocity_mps())
+        }
     }
 
     /// Evaluate a resolved flight condition (thrust and inflow given).
@@ -424,43 +423,56 @@ impl PowerModel {
 
     /// The four terms and totals, eqs (7), (8), (11)-(14), for a resolved condition and `v_i`.
     #[inline(always)]
-    fn assemble(&self, c: &FlightCondition, vi: f64) -> PowerBreakdown {
+    pub(crate) fn assemble(&self, c: &FlightCondition, vi: f64) -> PowerBreakdown {
+        self.terms_at(
+            c.thrust_n,
+            c.airspeed_mps,
+            c.inflow.normal_mps,
+            c.inflow.parallel_mps,
+            c.climb_rate_mps,
+            c.aoa == AoaModel::Geometric,
+            vi,
+        )
+    }
+
+    /// [`Self::assemble`] from the condition's fields. Written with selects, not branches, so the
+    /// block kernels (crate::batch) run it in vector lanes.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn terms_at(
+        &self,
+        thrust_n: f64,
+        airspeed_mps: f64,
+        normal_mps: f64,
+        parallel_mps: f64,
+        climb_rate_mps: f64,
+        geometric: bool,
+        vi: f64,
+    ) -> PowerBreakdown {
         let v = &self.vehicle;
-        let opts = &self.options;
-        let drag_work_w = v.drag().parasitic_power_w(c.airspeed_mps);
-        let (induced_w, acceleration_w) = if opts.terms.induced {
-            match c.aoa {
-                AoaModel::Paper => (induced_power_w(c.thrust_n, vi, c.inflow.normal_mps), 0.0),
-                AoaModel::Geometric => (
-                    induced_power_w(c.thrust_n, vi, 0.0),
-                    c.thrust_n * c.inflow.normal_mps - drag_work_w,
-                ),
-            }
-        } else {
-            (0.0, 0.0)
-        };
-        let parasitic_w = if opts.terms.parasitic {
-            drag_work_w
-        } else {
-            0.0
-        };
-        let profile_on = opts.terms.profile
-            && opts
-                .profile_cutoff_mps
-                .is_none_or(|cut| c.airspeed_mps <= cut);
-        let profile_w = if profile_on {
-            profile_power_w(v.kappa1(), v.kappa2(), c.thrust_n, c.inflow.parallel_mps)
-        } else {
-            0.0
-        };
-        let climb_w = if opts.terms.climb {
-            climb_power_w(v.weight_n(), c.climb_rate_mps)
-        } else {
-            0.0
-        };
+        let terms = &self.options.terms;
+        let only = |on: bool, w: f64| if on { w } else { 0.0 };
+        let drag_work_w = v.drag().parasitic_power_w(airspeed_mps);
+        // Eq (8) as printed with the paper's inflow; with the geometric one its T Vn part is the
+        // drag work (booked by eq 11) plus the acceleration work (see the module docs).
+        let induced_w = only(
+            terms.induced,
+            induced_power_w(thrust_n, vi, only(!geometric, normal_mps)),
+        );
+        let acceleration_w = only(
+            terms.induced & geometric,
+            thrust_n * normal_mps - drag_work_w,
+        );
+        let parasitic_w = only(terms.parasitic, drag_work_w);
+        let cutoff = self.options.profile_cutoff_mps.unwrap_or(f64::INFINITY);
+        let profile_w = only(
+            terms.profile & (airspeed_mps <= cutoff),
+            profile_power_w(v.kappa1(), v.kappa2(), thrust_n, parallel_mps),
+        );
+        let climb_w = only(terms.climb, climb_power_w(v.weight_n(), climb_rate_mps));
         let aero_w = induced_w + acceleration_w + parasitic_w + profile_w + climb_w;
         PowerBreakdown {
-            thrust_n: c.thrust_n,
+            thrust_n,
             induced_velocity_mps: vi,
             hover_induced_velocity_mps: v.hover_induced_velocity_mps(),
             induced_w,
@@ -471,6 +483,18 @@ impl PowerModel {
             aero_w,
             electrical_w: aero_w.max(0.0) * v.inverse_efficiency(),
         }
+    }
+}
+
+/// A batch's output must have the length of its input.
+fn check_lengths(input_len: usize, output_len: usize) -> Result<()> {
+    if input_len == output_len {
+        Ok(())
+    } else {
+        Err(PowerError::SeriesLength {
+            estimate_len: output_len,
+            measured_len: input_len,
+        })
     }
 }
 
@@ -494,21 +518,18 @@ fn check_condition(c: &FlightCondition) -> Result<()> {
 /// (eq 5's divisor), the inflow of the selected angle-of-attack model, and that model.
 #[inline(always)]
 pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaModel)> {
-    // libm's sincos (musl's kernels) is about twice as fast as std's here, within 1 ulp.
-    let (sr, cr) = libm::sincos(state.roll_rad);
-    let (sp, cp) = libm::sincos(state.pitch_rad);
+    let ((sr, cr), (sp, cp)) = sin_cos_pair(state.roll_rad, state.pitch_rad);
     let tilt_cos = cr * cp;
-    // One comparison catches NaN angles and tilts of 90 deg or more; the checks that name the
-    // value run only on that cold path.
-    if tilt_cos.is_nan() || tilt_cos <= MIN_TILT_COSINE {
-        check_attitude(state.roll_rad, state.pitch_rad)?;
-    }
-    if !(state.airspeed_mps >= 0.0 && state.airspeed_mps.is_finite()) {
-        finite("airspeed_mps", state.airspeed_mps)?;
-        non_negative("airspeed_mps", state.airspeed_mps)?;
-    }
-    finite("climb_rate_mps", state.climb_rate_mps)?;
     let v = state.airspeed_mps;
+    // One test on the hot path: the tilt is below 90 deg (false for NaN angles), the airspeed is
+    // finite and not negative, the climb rate finite. The checks that name the value run only
+    // when it fails.
+    let valid = (tilt_cos > MIN_TILT_COSINE)
+        & (0.0..f64::INFINITY).contains(&v)
+        & (state.climb_rate_mps.abs() < f64::INFINITY);
+    if !valid {
+        check_point(state)?;
+    }
     Ok(match state.aoa {
         AoaInput::Paper => (
             tilt_cos,
@@ -520,7 +541,7 @@ pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaMode
         ),
         AoaInput::Geometric { air_direction_rad } => {
             finite("air_direction_rad", air_direction_rad)?;
-            let (sb, cb) = libm::sincos(air_direction_rad);
+            let (sb, cb) = sin_cos(air_direction_rad);
             // Closed form of angle_of_attack::body_relative_inflow (tested equal there).
             let normal = -v * (cb * cr * sp - sb * sr);
             (
@@ -533,6 +554,18 @@ pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaMode
             )
         }
     })
+}
+
+/// The checks of a point query's attitude, airspeed and climb rate that name the offending value
+/// (the cold path of [`resolve_point`]).
+#[cold]
+#[inline(never)]
+fn check_point(state: &FlightState) -> Result<()> {
+    check_attitude(state.roll_rad, state.pitch_rad)?;
+    finite("airspeed_mps", state.airspeed_mps)?;
+    non_negative("airspeed_mps", state.airspeed_mps)?;
+    finite("climb_rate_mps", state.climb_rate_mps)?;
+    Ok(())
 }
 
 /// Validate roll and pitch; return `cos(phi) cos(theta)`.
@@ -673,17 +706,10 @@ mod tests {
         let mut out = vec![m.evaluate(&states[0]).unwrap(); states.len()];
         m.evaluate_batch(&states, &mut out).unwrap();
         for (s, o) in states.iter().zip(&out) {
+            // Both paths return the first Halley iterate that meets the residual bound, and the
+            // vector lanes do the scalar code's IEEE operations: the same bits.
             let single = m.evaluate(s).unwrap();
-            // The fast path may stop at a different (equally converged) iterate than the
-            // safeguarded loop: both satisfy eq (9) to 5e-13, so compare to 1e-11 relative.
-            assert!(
-                (single.electrical_w - o.electrical_w).abs() <= 1e-11 * single.electrical_w,
-                "{s:?}"
-            );
-            assert!(
-                (single.induced_velocity_mps - o.induced_velocity_mps).abs()
-                    <= 1e-11 * single.induced_velocity_mps
-            );
+            assert_eq!(single, *o, "{s:?}");
         }
         // A bad state stops the batch with its error.
         let mut bad = states.clone();
@@ -706,9 +732,18 @@ mod tests {
                 FlightCondition {
                     thrust_n: m.vehicle().weight_n() / tilt.cos(),
                     airspeed_mps: v,
-                    inflow: Inflow {
-                        normal_mps: v * tilt.sin(),
-                        parallel_mps: v * tilt.cos(),
+                    // Every 7th a slow descent through the disk (Vn < 0, Vp small): the quartic
+                    // has three positive roots there and the fast path steps aside.
+                    inflow: if i % 7 == 0 {
+                        Inflow {
+                            normal_mps: -4.0 * f,
+                            parallel_mps: 0.1 * f,
+                        }
+                    } else {
+                        Inflow {
+                            normal_mps: v * tilt.sin(),
+                            parallel_mps: v * tilt.cos(),
+                        }
                     },
                     climb_rate_mps: 0.5 * (f * 9.0).sin(),
                     aoa: if i % 2 == 0 {
@@ -721,16 +756,37 @@ mod tests {
             .collect();
         let mut out = vec![m.evaluate_condition(&conditions[0]).unwrap(); conditions.len()];
         m.evaluate_conditions(&conditions, &mut out).unwrap();
-        for (c, o) in conditions.iter().zip(&out) {
+        let mut watts = vec![0.0; conditions.len()];
+        m.electrical_of_conditions(&conditions, &mut watts).unwrap();
+        let mut left_to_the_safeguarded_solver = 0;
+        for ((c, o), w) in conditions.iter().zip(&out).zip(&watts) {
+            // The same bits as one at a time: the same iterate, the same IEEE operations in the
+            // vector lanes (which here run AVX2 or AVX-512 where the CPU has them).
             let single = m.evaluate_condition(c).unwrap();
-            // Both stop on the same residual bound (5e-13 in eq 9), possibly after a different
-            // number of steps: compare to 1e-11 relative.
-            assert!((single.electrical_w - o.electrical_w).abs() <= 1e-11 * single.electrical_w);
+            assert_eq!(single, *o, "{c:?}");
+            assert_eq!(single.electrical_w.to_bits(), w.to_bits(), "{c:?}");
+            let vh = m.vehicle().hover_induced_velocity_mps();
+            if crate::induced::solve_normalised_fast(
+                c.inflow.normal_mps / vh,
+                c.inflow.parallel_mps / vh,
+            )
+            .is_nan()
+            {
+                left_to_the_safeguarded_solver += 1;
+            }
         }
+        // The descents below reach the lanes the fast path leaves out.
+        assert!(
+            left_to_the_safeguarded_solver > 10,
+            "{left_to_the_safeguarded_solver}"
+        );
         let mut bad = conditions.clone();
         bad[300].thrust_n = f64::NAN;
         let e = m.evaluate_conditions(&bad, &mut out).unwrap_err();
         assert!(e.to_string().contains("thrust_n"), "{e}");
+        let e = m.electrical_of_conditions(&bad, &mut watts).unwrap_err();
+        assert!(e.to_string().contains("thrust_n"), "{e}");
+        assert!(m.electrical_of_conditions(&bad[..3], &mut watts).is_err());
     }
 
     #[test]

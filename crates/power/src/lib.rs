@@ -40,6 +40,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod angle_of_attack;
+mod batch;
 pub mod climb;
 pub mod drag;
 pub mod efficiency;
@@ -50,6 +51,7 @@ pub mod gradient;
 pub mod induced;
 pub mod metrics;
 pub mod profile;
+mod trig;
 pub mod vehicle;
 
 pub use angle_of_attack::{AoaModel, Inflow};
