@@ -379,7 +379,7 @@ pub fn plan(
     wind: &Wind,
     options: &PlanOptions,
 ) -> Result<MissionReport, PlannerError> {
-    plan_with(aircraft, battery, mission, wind, options, true)
+    plan_with(aircraft, battery, mission, wind, options, true, true)
 }
 
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
@@ -448,6 +448,313 @@ fn beyond_limit(
     }
 }
 
+/// Steps of a piece at time step `dt` and the step that divides it evenly, s.
+fn piece_steps(piece: &Piece, dt: f64) -> (usize, f64) {
+    let dur = piece.duration_s();
+    let n = ((dur / dt) - 1e-9).ceil().max(1.0) as usize;
+    (n, dur / n as f64)
+}
+
+/// Missions with at least this many steps run pass A on a second thread (below it, starting the
+/// thread costs more than it saves).
+const THREADED_FROM_STEPS: usize = 4096;
+
+/// Blocks handed from pass A's thread to pass B at a time.
+const BLOCKS_PER_CHUNK: usize = 32;
+
+/// Pass A's results for one block: everything pass B reads.
+struct BlockA {
+    /// First step of the block in its piece (a check that both passes walk the same blocks).
+    k0: usize,
+    /// Steps in the block.
+    m: usize,
+    /// Steps pass A completed: `m`, or the index of the step that raised `pending`.
+    valid: usize,
+    /// The error that stopped pass A in this block.
+    pending: Option<PlannerError>,
+    kins: [Kinematics; BLOCK],
+    winds: [[f64; 3]; BLOCK],
+    v_airs: [[f64; 3]; BLOCK],
+    accs: [[f64; 3]; BLOCK],
+    fwds: [[f64; 2]; BLOCK],
+    ges: [f64; BLOCK],
+    trims: [Trim; BLOCK],
+}
+
+impl BlockA {
+    const EMPTY: BlockA = BlockA {
+        k0: 0,
+        m: 0,
+        valid: 0,
+        pending: None,
+        kins: [Kinematics::ZERO; BLOCK],
+        winds: [[0.0; 3]; BLOCK],
+        v_airs: [[0.0; 3]; BLOCK],
+        accs: [[0.0; 3]; BLOCK],
+        fwds: [[0.0; 2]; BLOCK],
+        ges: [1.0; BLOCK],
+        trims: [ZERO_TRIM; BLOCK],
+    };
+}
+
+/// State of pass A within the piece it is on.
+struct PieceA {
+    sampler: BlockSampler,
+    n: usize,
+    h: f64,
+    /// Ground-effect factor when the piece stays at one height.
+    piece_ge: Option<f64>,
+    /// Whether the piece's cruise may reuse one trim (see `steady_piece`).
+    steady: bool,
+    steady_trim: Option<Trim>,
+}
+
+/// Pass A of [`plan_with`]: kinematics, wind, trim, power and the airframe's limits for every
+/// block of the mission in order. Nothing here depends on the pack, so it may run ahead of pass B
+/// on another thread; both walk the same blocks.
+struct PassA<'p, 'a> {
+    pieces: &'p [Piece],
+    powered: &'p [Powered<'a>],
+    wind: &'p Wind,
+    uniform_wind: Option<[f64; 3]>,
+    steady_wind: bool,
+    hoist: bool,
+    ground_effect: bool,
+    r_rotor: f64,
+    rotor_h: f64,
+    max_thrust: f64,
+    cos_tilt_max: f64,
+    kinds: &'p [&'static str],
+    airframe: &'p crate::airframe::Airframe,
+    dt: f64,
+    /// Piece being walked, its next step and its start time.
+    index: usize,
+    k0: usize,
+    t0: f64,
+    piece: Option<PieceA>,
+}
+
+impl PassA<'_, '_> {
+    fn ground_factor(&self, up_m: f64) -> f64 {
+        if self.ground_effect {
+            thrust_factor(self.r_rotor, up_m + self.rotor_h)
+        } else {
+            1.0
+        }
+    }
+
+    /// Fill `out` with the next block; `false` when the mission is done.
+    fn next_block(&mut self, out: &mut BlockA) -> bool {
+        loop {
+            let Some(piece) = self.pieces.get(self.index) else {
+                return false;
+            };
+            if self.piece.is_none() {
+                let (n, h) = piece_steps(piece, self.dt);
+                // Ground effect depends on height alone: once per piece at a fixed height.
+                let piece_ge = fixed_height_m(piece).map(|up| self.ground_factor(up));
+                // Hoisting: on a constant-speed stretch of a level line or a hold, in a wind that
+                // depends on height alone and not on time, every input of the trim has the same
+                // value at every sample, bit for bit (see `steady_piece`), so the trim is computed
+                // once per stretch and reused for the blocks that lie wholly inside it.
+                self.piece = Some(PieceA {
+                    sampler: BlockSampler::new(piece, h, BLOCK),
+                    n,
+                    h,
+                    piece_ge,
+                    steady: self.hoist && self.steady_wind && steady_piece(piece),
+                    steady_trim: None,
+                });
+            }
+            let pa = self.piece.as_ref().expect("set above");
+            if self.k0 < pa.n {
+                break;
+            }
+            self.t0 += piece.duration_s();
+            self.index += 1;
+            self.k0 = 0;
+            self.piece = None;
+        }
+        let piece = &self.pieces[self.index];
+        let mut pa = self.piece.take().expect("set in the loop");
+        self.fill(piece, &mut pa, out);
+        self.k0 += out.m;
+        self.piece = Some(pa);
+        true
+    }
+
+    /// Pass A over the block at `self.k0` of `piece`.
+    fn fill(&self, piece: &Piece, pa: &mut PieceA, out: &mut BlockA) {
+        let (k0, h, t0) = (self.k0, pa.h, self.t0);
+        let m = (pa.n - k0).min(BLOCK);
+        let seg = piece.segment;
+        let pw = &self.powered[piece.mass_phase];
+        let (cruise_from, cruise_to) = (piece.profile.t_accel_end_s, piece.profile.t_cruise_end_s);
+        let in_cruise = |k: usize| {
+            let tm = (k as f64 + 0.5) * h;
+            tm >= cruise_from && tm < cruise_to
+        };
+        out.k0 = k0;
+        out.m = m;
+        out.pending = None;
+        // Pass A1: kinematics, wind, air velocity, ground effect.
+        let mut valid = m;
+        pa.sampler.fill(k0, &mut out.kins[..m]);
+        for j in 0..m {
+            let kin = &out.kins[j];
+            let w = match self.uniform_wind {
+                Some(w) => w,
+                None => {
+                    let t = t0 + ((k0 + j) as f64 + 0.5) * h;
+                    match self.wind.at(kin.pos_m, t) {
+                        Some(w) => w,
+                        None => {
+                            out.pending = Some(outside(self.wind, t, kin.pos_m));
+                            valid = j;
+                            break;
+                        }
+                    }
+                }
+            };
+            out.winds[j] = w;
+            out.v_airs[j] = [
+                kin.vel_mps[0] - w[0],
+                kin.vel_mps[1] - w[1],
+                kin.vel_mps[2] - w[2],
+            ];
+            out.accs[j] = kin.acc_mps2;
+            out.fwds[j] = kin.forward;
+            out.ges[j] = match pa.piece_ge {
+                Some(g) => g,
+                None => self.ground_factor(kin.pos_m[2]),
+            };
+        }
+        // Pass A2: trim and power.
+        match pa.steady_trim {
+            Some(st) if pa.steady && valid > 0 && in_cruise(k0) && in_cruise(k0 + valid - 1) => {
+                out.trims[..valid].fill(st);
+            }
+            _ => {
+                if let Err((j, e)) = pw.trim_block(
+                    &out.accs[..valid],
+                    &out.v_airs[..valid],
+                    &out.fwds[..valid],
+                    &out.ges[..valid],
+                    &mut out.trims[..valid],
+                ) {
+                    valid = j;
+                    out.pending = Some(e);
+                }
+                if pa.steady && pa.steady_trim.is_none() {
+                    pa.steady_trim = (0..valid)
+                        .find(|&j| in_cruise(k0 + j))
+                        .map(|j| out.trims[j]);
+                }
+            }
+        }
+        // Pass A3: the airframe's limits.
+        for j in 0..valid {
+            let trim = &out.trims[j];
+            if trim.thrust_n > self.max_thrust || trim.axis[2] < self.cos_tilt_max {
+                let t = t0 + ((k0 + j) as f64 + 0.5) * h;
+                out.pending = Some(beyond_limit(
+                    trim,
+                    t,
+                    seg,
+                    self.kinds[seg],
+                    out.kins[j].pos_m,
+                    self.max_thrust,
+                    self.airframe,
+                ));
+                valid = j;
+                break;
+            }
+        }
+        out.valid = valid;
+    }
+}
+
+/// Where pass B takes its blocks from: pass A run in line, or pass A's thread. (One per plan, so
+/// the size of the in-line variant does not matter.)
+#[allow(clippy::large_enum_variant)]
+enum Feed<'p, 'a> {
+    Inline {
+        pass: PassA<'p, 'a>,
+        block: Box<BlockA>,
+    },
+    Threaded {
+        full: std::sync::mpsc::Receiver<(Vec<BlockA>, usize)>,
+        empty: std::sync::mpsc::Sender<Vec<BlockA>>,
+        chunk: Vec<BlockA>,
+        len: usize,
+        next: usize,
+    },
+}
+
+impl<'p, 'a: 'p> Feed<'p, 'a> {
+    /// Start pass A on a thread of `scope`, handing chunks of blocks over a channel (and getting
+    /// the used chunks back, so no block is copied or reallocated).
+    fn threaded<'s>(scope: &'s std::thread::Scope<'s, '_>, mut pass: PassA<'p, 'a>) -> Self
+    where
+        'p: 's,
+    {
+        let (full_tx, full) = std::sync::mpsc::sync_channel::<(Vec<BlockA>, usize)>(2);
+        let (empty, empty_rx) = std::sync::mpsc::channel::<Vec<BlockA>>();
+        scope.spawn(move || loop {
+            let mut chunk = empty_rx.try_recv().unwrap_or_else(|_| {
+                std::iter::repeat_with(|| BlockA::EMPTY)
+                    .take(BLOCKS_PER_CHUNK)
+                    .collect()
+            });
+            let mut len = 0;
+            while len < BLOCKS_PER_CHUNK && pass.next_block(&mut chunk[len]) {
+                len += 1;
+            }
+            // Pass B hung up (it stopped early) or the mission is done.
+            if full_tx.send((chunk, len)).is_err() || len < BLOCKS_PER_CHUNK {
+                return;
+            }
+        });
+        Feed::Threaded {
+            full,
+            empty,
+            chunk: Vec::new(),
+            len: 0,
+            next: 0,
+        }
+    }
+
+    /// The next block; pass B asks only for blocks the mission has.
+    fn next(&mut self) -> &mut BlockA {
+        match self {
+            Feed::Inline { pass, block } => {
+                let more = pass.next_block(block);
+                debug_assert!(more, "pass B asked past the mission's end");
+                block
+            }
+            Feed::Threaded {
+                full,
+                empty,
+                chunk,
+                len,
+                next,
+            } => {
+                if *next == *len {
+                    let used = std::mem::take(chunk);
+                    if !used.is_empty() {
+                        // Pass A may have finished: then nobody takes it back.
+                        let _ = empty.send(used);
+                    }
+                    (*chunk, *len) = full.recv().expect("pass A's thread ended early");
+                    *next = 0;
+                }
+                *next += 1;
+                &mut chunk[*next - 1]
+            }
+        }
+    }
+}
+
 /// [`plan`], with the hoisting of steady stretches switchable (off: every sample takes the full
 /// path; the tests prove both give the same report).
 pub(crate) fn plan_with(
@@ -457,6 +764,7 @@ pub(crate) fn plan_with(
     wind: &Wind,
     options: &PlanOptions,
     hoist: bool,
+    parallel: bool,
 ) -> Result<MissionReport, PlannerError> {
     let dt = crate::error::positive("time_step_s", options.time_step_s, "s")?;
     if !(options.reserve_fraction >= 0.0 && options.reserve_fraction < 1.0) {
@@ -529,280 +837,228 @@ pub(crate) fn plan_with(
         bins: vec![None; BEARING_BINS],
     };
 
-    // Work is done in blocks of up to BLOCK steps: pass A evaluates kinematics, wind, trim and
-    // power for the block (independent samples, so the CPU overlaps them); pass B runs the pack,
-    // whose state of charge chains one step to the next. An error found in pass A (a thrust
-    // beyond the airframe, a wind grid left) is raised only after pass B has flown the samples
-    // before it, so a battery that fails first is still reported as the result.
-    let mut kins = [Kinematics::default(); BLOCK];
-    let mut winds = [[0.0; 3]; BLOCK];
-    let mut v_airs = [[0.0; 3]; BLOCK];
-    let mut accs = [[0.0; 3]; BLOCK];
-    let mut fwds = [[0.0; 2]; BLOCK];
-    let mut ges = [1.0; BLOCK];
-    let mut trims = [ZERO_TRIM; BLOCK];
+    // Work is done in blocks of up to BLOCK steps: pass A ([`PassA`]) evaluates kinematics, wind,
+    // trim and power for a block (independent samples, so the CPU overlaps them); pass B runs the
+    // pack, whose state of charge chains one step to the next. On a long mission pass A runs on a
+    // second thread, blocks ahead of pass B. An error found in pass A (a thrust beyond the
+    // airframe, a wind grid left) is raised only after pass B has flown the samples before it, so
+    // a battery that fails first is still reported as the result.
+    let pass_a = PassA {
+        pieces: mission.pieces(),
+        powered: &powered,
+        wind,
+        uniform_wind,
+        steady_wind: wind.is_steady_and_level_uniform(),
+        hoist,
+        ground_effect: options.ground_effect,
+        r_rotor,
+        rotor_h,
+        max_thrust,
+        cos_tilt_max,
+        kinds,
+        airframe,
+        dt,
+        index: 0,
+        k0: 0,
+        t0: 0.0,
+        piece: None,
+    };
+    let total_steps: usize = mission.pieces().iter().map(|p| piece_steps(p, dt).0).sum();
+    let threaded = parallel
+        && total_steps >= THREADED_FROM_STEPS
+        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
     let mut steps = [PackStep::default(); BLOCK];
-    let steady_wind = wind.is_steady_and_level_uniform();
     let mut cursor = battery.cursor(soc);
-    'pieces: for piece in mission.pieces() {
-        let pw = &powered[piece.mass_phase];
-        let seg = piece.segment;
-        let dur = piece.duration_s();
-        let n = ((dur / dt) - 1e-9).ceil().max(1.0) as usize;
-        let h = dur / n as f64;
-        let a = &mut acc[seg];
-        a.reached = true;
-        let mut seg_energy = 0.0;
-        let mut seg_peak = a.peak_w;
-        let sampler = BlockSampler::new(piece, h, BLOCK);
-        // Ground effect depends on height alone: once per piece at a fixed height.
-        let ge_at = |up_m: f64| {
-            if options.ground_effect {
-                thrust_factor(r_rotor, up_m + rotor_h)
-            } else {
-                1.0
+    std::thread::scope(|scope| -> Result<(), PlannerError> {
+        let mut feed = if threaded {
+            Feed::threaded(scope, pass_a)
+        } else {
+            Feed::Inline {
+                pass: pass_a,
+                block: Box::new(BlockA::EMPTY),
             }
         };
-        let piece_ge = fixed_height_m(piece).map(ge_at);
-        // Charge per ampere and step as a fraction of the capacity: a product on the pack's
-        // step-to-step chain instead of a division.
-        let dq = h / charge_as;
-        // Hoisting: on a constant-speed stretch of a level line or a hold, in a wind that depends
-        // on height alone and not on time, every input of the trim has the same value at every
-        // sample, bit for bit (see `steady_piece`), so the trim is computed once per stretch and
-        // reused for the blocks that lie wholly inside it.
-        let steady = hoist && steady_wind && steady_piece(piece);
-        let mut steady_trim: Option<Trim> = None;
-        let (cruise_from, cruise_to) = (piece.profile.t_accel_end_s, piece.profile.t_cruise_end_s);
-        let in_cruise = |k: usize| {
-            let tm = (k as f64 + 0.5) * h;
-            tm >= cruise_from && tm < cruise_to
-        };
-        let mut k0 = 0;
-        while k0 < n {
-            let m = (n - k0).min(BLOCK);
-            // Pass A1: kinematics, wind, air velocity, ground effect.
-            let mut valid = m;
-            let mut pending: Option<PlannerError> = None;
-            sampler.fill(k0, &mut kins[..m]);
-            for j in 0..m {
-                let kin = &kins[j];
-                let w = match uniform_wind {
-                    Some(w) => w,
-                    None => {
-                        let t = t0 + ((k0 + j) as f64 + 0.5) * h;
-                        match wind.at(kin.pos_m, t) {
-                            Some(w) => w,
-                            None => {
-                                pending = Some(outside(wind, t, kin.pos_m));
-                                valid = j;
-                                break;
-                            }
+        'pieces: for piece in mission.pieces() {
+            let pw = &powered[piece.mass_phase];
+            let seg = piece.segment;
+            let dur = piece.duration_s();
+            let (n, h) = piece_steps(piece, dt);
+            let a = &mut acc[seg];
+            a.reached = true;
+            let mut seg_energy = 0.0;
+            let mut seg_peak = a.peak_w;
+            // Charge per ampere and step as a fraction of the capacity: a product on the pack's
+            // step-to-step chain instead of a division.
+            let dq = h / charge_as;
+            let mut k0 = 0;
+            while k0 < n {
+                let block = feed.next();
+                debug_assert_eq!(block.k0, k0);
+                let m = block.m;
+                let valid = block.valid;
+                let pending = block.pending.take();
+                let BlockA {
+                    ref kins,
+                    ref winds,
+                    ref v_airs,
+                    ref accs,
+                    ref fwds,
+                    ref ges,
+                    ref trims,
+                    ..
+                } = *block;
+                // Pass B: the pack. Its state of charge chains one step to the next; draw_block
+                // solves the block's chain at once (bit for bit the step-by-step result), then the
+                // loop below books each step in order.
+                let soc_at_block = cursor.soc();
+                let mut powers = [0.0; BLOCK];
+                for (p, t) in powers.iter_mut().zip(&trims[..valid]) {
+                    *p = t.electrical_w;
+                }
+                let drawn = cursor.draw_block(battery, &powers[..valid], dq, &mut steps[..valid]);
+                for j in 0..valid {
+                    let tm = ((k0 + j) as f64 + 0.5) * h;
+                    let kin = kins[j];
+                    let w = winds[j];
+                    let trim = trims[j];
+                    let t = t0 + tm;
+                    let p = trim.electrical_w;
+                    let draw = match steps.get(j) {
+                        Some(d) if j < drawn && d.current_a <= max_current => *d,
+                        _ => {
+                            shortfall = Some(Shortfall::PackLimit {
+                                time_s: t,
+                                segment: seg + 1,
+                                kind: kinds[seg],
+                                position_m: kin.pos_m,
+                                power_w: p,
+                            });
+                            a.duration_s += tm;
+                            a.distance_m += piece.profile.at(tm).0;
+                            soc = if j == 0 {
+                                soc_at_block
+                            } else {
+                                steps[j - 1].soc_after
+                            };
+                            break 'pieces;
                         }
-                    }
-                };
-                winds[j] = w;
-                v_airs[j] = [
-                    kin.vel_mps[0] - w[0],
-                    kin.vel_mps[1] - w[1],
-                    kin.vel_mps[2] - w[2],
-                ];
-                accs[j] = kin.acc_mps2;
-                fwds[j] = kin.forward;
-                ges[j] = match piece_ge {
-                    Some(g) => g,
-                    None => ge_at(kin.pos_m[2]),
-                };
-            }
-            // Pass A2: trim and power.
-            match steady_trim {
-                Some(st) if steady && valid > 0 && in_cruise(k0) && in_cruise(k0 + valid - 1) => {
-                    trims[..valid].fill(st);
-                }
-                _ => {
-                    if let Err((j, e)) = pw.trim_block(
-                        &accs[..valid],
-                        &v_airs[..valid],
-                        &fwds[..valid],
-                        &ges[..valid],
-                        &mut trims[..valid],
-                    ) {
-                        valid = j;
-                        pending = Some(e);
-                    }
-                    if steady && steady_trim.is_none() {
-                        steady_trim = (0..valid).find(|&j| in_cruise(k0 + j)).map(|j| trims[j]);
-                    }
-                }
-            }
-            // Pass A3: the airframe's limits.
-            for j in 0..valid {
-                let trim = &trims[j];
-                if trim.thrust_n > max_thrust || trim.axis[2] < cos_tilt_max {
-                    let t = t0 + ((k0 + j) as f64 + 0.5) * h;
-                    pending = Some(beyond_limit(
-                        trim,
-                        t,
-                        seg,
-                        kinds[seg],
-                        kins[j].pos_m,
-                        max_thrust,
-                        airframe,
-                    ));
-                    valid = j;
-                    break;
-                }
-            }
-            // Pass B: the pack. Its state of charge chains one step to the next; draw_block
-            // solves the block's chain at once (bit for bit the step-by-step result), then the
-            // loop below books each step in order.
-            let soc_at_block = cursor.soc();
-            let mut powers = [0.0; BLOCK];
-            for (p, t) in powers.iter_mut().zip(&trims[..valid]) {
-                *p = t.electrical_w;
-            }
-            let drawn = cursor.draw_block(battery, &powers[..valid], dq, &mut steps[..valid]);
-            for j in 0..valid {
-                let tm = ((k0 + j) as f64 + 0.5) * h;
-                let kin = kins[j];
-                let w = winds[j];
-                let trim = trims[j];
-                let t = t0 + tm;
-                let p = trim.electrical_w;
-                let draw = match steps.get(j) {
-                    Some(d) if j < drawn && d.current_a <= max_current => *d,
-                    _ => {
-                        shortfall = Some(Shortfall::PackLimit {
+                    };
+                    let soc_now = draw.soc_after;
+                    seg_energy += p * h;
+                    heat_j += draw.current_a * draw.current_a * r_pack * h;
+                    seg_peak = seg_peak.max(p);
+                    peak_a = peak_a.max(draw.current_a);
+                    min_v = min_v.min(draw.terminal_v);
+                    if options.record_samples {
+                        let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
+                        let terms = pw.power_terms(accs[j], v_airs[j], fwds[j], ges[j])?;
+                        samples.push(Sample {
                             time_s: t,
                             segment: seg + 1,
-                            kind: kinds[seg],
-                            position_m: kin.pos_m,
+                            east_m: kin.pos_m[0],
+                            north_m: kin.pos_m[1],
+                            up_m: kin.pos_m[2],
+                            vel_east_mps: kin.vel_mps[0],
+                            vel_north_mps: kin.vel_mps[1],
+                            vel_up_mps: kin.vel_mps[2],
+                            acc_east_mps2: kin.acc_mps2[0],
+                            acc_north_mps2: kin.acc_mps2[1],
+                            acc_up_mps2: kin.acc_mps2[2],
+                            wind_east_mps: w[0],
+                            wind_north_mps: w[1],
+                            airspeed_mps: trim.airspeed_mps,
+                            thrust_n: trim.thrust_n,
+                            roll_deg: roll.to_degrees(),
+                            pitch_deg: pitch.to_degrees(),
+                            yaw_deg: yaw.to_degrees().rem_euclid(360.0),
                             power_w: p,
+                            current_a: draw.current_a,
+                            voltage_v: draw.terminal_v,
+                            soc: soc_now,
+                            induced_w: terms.map(|b| b.induced_w),
+                            parasitic_w: terms.map(|b| b.parasitic_w),
+                            profile_w: terms.map(|b| b.profile_w),
+                            acceleration_w: terms.map(|b| b.acceleration_w),
+                            climb_w: terms.map(|b| b.climb_w),
                         });
-                        a.duration_s += tm;
-                        a.distance_m += piece.profile.at(tm).0;
-                        soc = if j == 0 {
-                            soc_at_block
+                    }
+                    if draw.terminal_v < cutoff_v || soc_now <= empty {
+                        shortfall = Some(if draw.terminal_v < cutoff_v {
+                            Shortfall::CutOffVoltage {
+                                time_s: t,
+                                segment: seg + 1,
+                                kind: kinds[seg],
+                                position_m: kin.pos_m,
+                                voltage_v: draw.terminal_v,
+                                cutoff_v,
+                            }
                         } else {
-                            steps[j - 1].soc_after
-                        };
+                            Shortfall::BatteryEmpty {
+                                time_s: t,
+                                segment: seg + 1,
+                                kind: kinds[seg],
+                                position_m: kin.pos_m,
+                            }
+                        });
+                        a.duration_s += tm + 0.5 * h;
+                        a.distance_m += piece.profile.at(tm + 0.5 * h).0;
+                        a.energy_j += seg_energy;
+                        a.peak_w = seg_peak;
+                        a.end_soc = soc_now;
+                        energy_j += seg_energy;
+                        peak_w = peak_w.max(seg_peak);
+                        soc = soc_now;
                         break 'pieces;
                     }
-                };
-                let soc_now = draw.soc_after;
-                seg_energy += p * h;
-                heat_j += draw.current_a * draw.current_a * r_pack * h;
-                seg_peak = seg_peak.max(p);
-                peak_a = peak_a.max(draw.current_a);
-                min_v = min_v.min(draw.terminal_v);
-                if options.record_samples {
-                    let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
-                    let terms = pw.power_terms(accs[j], v_airs[j], fwds[j], ges[j])?;
-                    samples.push(Sample {
-                        time_s: t,
-                        segment: seg + 1,
-                        east_m: kin.pos_m[0],
-                        north_m: kin.pos_m[1],
-                        up_m: kin.pos_m[2],
-                        vel_east_mps: kin.vel_mps[0],
-                        vel_north_mps: kin.vel_mps[1],
-                        vel_up_mps: kin.vel_mps[2],
-                        acc_east_mps2: kin.acc_mps2[0],
-                        acc_north_mps2: kin.acc_mps2[1],
-                        acc_up_mps2: kin.acc_mps2[2],
-                        wind_east_mps: w[0],
-                        wind_north_mps: w[1],
-                        airspeed_mps: trim.airspeed_mps,
-                        thrust_n: trim.thrust_n,
-                        roll_deg: roll.to_degrees(),
-                        pitch_deg: pitch.to_degrees(),
-                        yaw_deg: yaw.to_degrees().rem_euclid(360.0),
-                        power_w: p,
-                        current_a: draw.current_a,
-                        voltage_v: draw.terminal_v,
-                        soc: soc_now,
-                        induced_w: terms.map(|b| b.induced_w),
-                        parasitic_w: terms.map(|b| b.parasitic_w),
-                        profile_w: terms.map(|b| b.profile_w),
-                        acceleration_w: terms.map(|b| b.acceleration_w),
-                        climb_w: terms.map(|b| b.climb_w),
-                    });
-                }
-                if draw.terminal_v < cutoff_v || soc_now <= empty {
-                    shortfall = Some(if draw.terminal_v < cutoff_v {
-                        Shortfall::CutOffVoltage {
+                    if !pnr_done && t >= next_check && kin.pos_m[2] > 0.0 {
+                        next_check = t + options.pnr_interval_s;
+                        let here = PointOfNoReturn {
                             time_s: t,
                             segment: seg + 1,
-                            kind: kinds[seg],
                             position_m: kin.pos_m,
-                            voltage_v: draw.terminal_v,
-                            cutoff_v,
+                        };
+                        let ok = can_return(
+                            pw,
+                            battery,
+                            wind,
+                            &mut cache,
+                            piece.mass_phase,
+                            kin.pos_m,
+                            home,
+                            soc_now,
+                            empty + required,
+                            return_rate,
+                            charge_as,
+                        );
+                        if ok {
+                            last_ok = Some(here);
+                        } else {
+                            pnr = Some(last_ok.unwrap_or(PointOfNoReturn {
+                                time_s: 0.0,
+                                segment: 1,
+                                position_m: home,
+                            }));
+                            pnr_done = true;
                         }
-                    } else {
-                        Shortfall::BatteryEmpty {
-                            time_s: t,
-                            segment: seg + 1,
-                            kind: kinds[seg],
-                            position_m: kin.pos_m,
-                        }
-                    });
-                    a.duration_s += tm + 0.5 * h;
-                    a.distance_m += piece.profile.at(tm + 0.5 * h).0;
-                    a.energy_j += seg_energy;
-                    a.peak_w = seg_peak;
-                    a.end_soc = soc_now;
-                    energy_j += seg_energy;
-                    peak_w = peak_w.max(seg_peak);
-                    soc = soc_now;
-                    break 'pieces;
-                }
-                if !pnr_done && t >= next_check && kin.pos_m[2] > 0.0 {
-                    next_check = t + options.pnr_interval_s;
-                    let here = PointOfNoReturn {
-                        time_s: t,
-                        segment: seg + 1,
-                        position_m: kin.pos_m,
-                    };
-                    let ok = can_return(
-                        pw,
-                        battery,
-                        wind,
-                        &mut cache,
-                        piece.mass_phase,
-                        kin.pos_m,
-                        home,
-                        soc_now,
-                        empty + required,
-                        return_rate,
-                        charge_as,
-                    );
-                    if ok {
-                        last_ok = Some(here);
-                    } else {
-                        pnr = Some(last_ok.unwrap_or(PointOfNoReturn {
-                            time_s: 0.0,
-                            segment: 1,
-                            position_m: home,
-                        }));
-                        pnr_done = true;
                     }
                 }
+                if let Some(e) = pending {
+                    return Err(e);
+                }
+                k0 += m;
             }
-            if let Some(e) = pending {
-                return Err(e);
-            }
-            k0 += m;
+            soc = cursor.soc();
+            a.duration_s += dur;
+            a.distance_m += piece.profile.length_m;
+            a.energy_j += seg_energy;
+            a.peak_w = seg_peak;
+            a.end_soc = soc;
+            energy_j += seg_energy;
+            peak_w = peak_w.max(seg_peak);
+            t0 += dur;
         }
-        soc = cursor.soc();
-        a.duration_s += dur;
-        a.distance_m += piece.profile.length_m;
-        a.energy_j += seg_energy;
-        a.peak_w = seg_peak;
-        a.end_soc = soc;
-        energy_j += seg_energy;
-        peak_w = peak_w.max(seg_peak);
-        t0 += dur;
-    }
+        Ok(())
+    })?;
 
     let duration_s: f64 = acc.iter().map(|a| a.duration_s).sum();
     let reserve_soc = (soc - empty).max(0.0);
@@ -993,6 +1249,52 @@ mod tests {
     "#;
 
     #[test]
+    fn pass_a_on_its_own_thread_gives_the_same_report() {
+        // At a 10 ms step the survey has over 4096 steps, so `plan` runs pass A on a second
+        // thread; the report must be the in-line one exactly, samples included, whether the
+        // mission completes, the pack runs out part-way, or pass A meets an error.
+        let (aircraft, battery) = m100();
+        let mission = MissionSpec::from_toml_str(SURVEY)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
+        let steps: usize = mission
+            .pieces()
+            .iter()
+            .map(|p| piece_steps(p, 0.01).0)
+            .sum();
+        assert!(steps >= THREADED_FROM_STEPS, "{steps}");
+        let mut errors = 0;
+        for (start_soc, wind_mps) in [(1.0, 6.0), (0.12, 6.0), (1.0, 16.0)] {
+            let wind = Wind::constant(wind_mps, 250.0).unwrap();
+            let opts = PlanOptions {
+                time_step_s: 0.01,
+                record_samples: true,
+                start_soc,
+                ..PlanOptions::default()
+            };
+            let threaded = plan_with(&aircraft, &battery, &mission, &wind, &opts, true, true);
+            let inline = plan_with(&aircraft, &battery, &mission, &wind, &opts, true, false);
+            match (threaded, inline) {
+                (Ok(t), Ok(i)) => {
+                    assert_eq!(t, i, "start {start_soc}, wind {wind_mps}");
+                    if start_soc < 1.0 {
+                        assert!(!t.feasible && t.samples.len() < steps);
+                    }
+                }
+                (Err(t), Err(i)) => {
+                    // 16 m/s is beyond the M100's tilt on the upwind leg.
+                    assert!(wind_mps > 10.0 && t.to_string().contains("tilt"), "{t}");
+                    assert_eq!(t.to_string(), i.to_string());
+                    errors += 1;
+                }
+                (t, i) => panic!("threaded {t:?} against in line {i:?}"),
+            }
+        }
+        assert_eq!(errors, 1);
+    }
+
+    #[test]
     fn hoisting_steady_stretches_matches_the_per_sample_report() {
         let (aircraft, battery) = m100();
         let mission = MissionSpec::from_toml_str(SURVEY)
@@ -1018,32 +1320,14 @@ mod tests {
                     ground_effect,
                     ..PlanOptions::default()
                 };
-                let fast = plan_with(&aircraft, &battery, &mission, &wind, &opts, true).unwrap();
-                let full = plan_with(&aircraft, &battery, &mission, &wind, &opts, false).unwrap();
+                let fast =
+                    plan_with(&aircraft, &battery, &mission, &wind, &opts, true, true).unwrap();
+                let full =
+                    plan_with(&aircraft, &battery, &mission, &wind, &opts, false, true).unwrap();
                 assert!(fast.samples.len() > 1000);
-                // The hoisted trim is the per-sample trim of identical inputs. The per-sample path
-                // solves eq (9) in batches warm-started from the previous sample, which can stop
-                // on a different iterate than a cold solve; both meet the solver's 5e-13 residual
-                // bound, so the reports agree to 1e-9 relative (not bit for bit) and in structure
-                // exactly.
-                let close =
-                    |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-12);
-                assert_eq!(fast.samples.len(), full.samples.len());
-                assert_eq!(fast.segments.len(), full.segments.len());
-                assert!(
-                    close(fast.energy_wh, full.energy_wh),
-                    "{wind:?} {ground_effect}"
-                );
-                assert!(close(fast.end_soc, full.end_soc));
-                assert!(close(fast.min_voltage_v, full.min_voltage_v));
-                assert!(close(fast.duration_s, full.duration_s));
-                for (a, b) in fast.samples.iter().zip(&full.samples) {
-                    assert!(
-                        close(a.power_w, b.power_w) && close(a.soc, b.soc),
-                        "{a:?} vs {b:?}"
-                    );
-                    assert_eq!(a.segment, b.segment);
-                }
+                // The hoisted trim is the per-sample trim of identical inputs, computed by the
+                // same block path: the reports are the same, bit for bit.
+                assert_eq!(fast, full, "{wind:?} {ground_effect}");
             }
         }
     }

@@ -137,6 +137,16 @@ pub struct Kinematics {
     pub forward: [f64; 2],
 }
 
+impl Kinematics {
+    /// All zero (the `Default`, usable in constants).
+    pub const ZERO: Kinematics = Kinematics {
+        pos_m: [0.0; 3],
+        vel_mps: [0.0; 3],
+        acc_mps2: [0.0; 3],
+        forward: [0.0; 2],
+    };
+}
+
 /// One piece of a compiled mission.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Piece {

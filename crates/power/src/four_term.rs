@@ -502,14 +502,25 @@ fn check_lengths(input_len: usize, output_len: usize) -> Result<()> {
 /// solver).
 #[inline(always)]
 fn check_condition(c: &FlightCondition) -> Result<()> {
-    if !(c.thrust_n.is_finite() && c.thrust_n >= 0.0) {
-        finite("thrust_n", c.thrust_n)?;
-        non_negative("thrust_n", c.thrust_n)?;
+    // One test on the hot path; the checks that name the value only when it fails.
+    let valid = (0.0..f64::INFINITY).contains(&c.thrust_n)
+        & (0.0..f64::INFINITY).contains(&c.airspeed_mps)
+        & (c.climb_rate_mps.abs() < f64::INFINITY);
+    if valid {
+        Ok(())
+    } else {
+        condition_error(c)
     }
-    if !(c.airspeed_mps.is_finite() && c.airspeed_mps >= 0.0) {
-        finite("airspeed_mps", c.airspeed_mps)?;
-        non_negative("airspeed_mps", c.airspeed_mps)?;
-    }
+}
+
+/// The error naming the first invalid value of a condition [`check_condition`] rejected.
+#[cold]
+#[inline(never)]
+fn condition_error(c: &FlightCondition) -> Result<()> {
+    finite("thrust_n", c.thrust_n)?;
+    non_negative("thrust_n", c.thrust_n)?;
+    finite("airspeed_mps", c.airspeed_mps)?;
+    non_negative("airspeed_mps", c.airspeed_mps)?;
     finite("climb_rate_mps", c.climb_rate_mps)?;
     Ok(())
 }
