@@ -87,18 +87,6 @@ fn bench_mission(c: &mut Criterion) {
     let mut g = c.benchmark_group("planner/mission");
     g.throughput(Throughput::Elements(samples));
     g.sample_size(20);
-    g.bench_function("one_hour", |b| {
-        b.iter(|| {
-            plan(
-                black_box(&aircraft),
-                black_box(&battery),
-                black_box(&mission),
-                black_box(&wind),
-                black_box(&opts),
-            )
-            .expect("plan")
-        })
-    });
     let no_pnr = PlanOptions {
         point_of_no_return: false,
         ..opts
@@ -107,30 +95,24 @@ fn bench_mission(c: &mut Criterion) {
         second_thread: false,
         ..opts
     };
-    g.bench_function("one_hour_one_thread", |b| {
-        b.iter(|| {
-            plan(
-                black_box(&aircraft),
-                black_box(&battery),
-                black_box(&mission),
-                black_box(&wind),
-                black_box(&one_thread),
-            )
-            .expect("plan")
-        })
-    });
-    g.bench_function("one_hour_without_pnr", |b| {
-        b.iter(|| {
-            plan(
-                black_box(&aircraft),
-                black_box(&battery),
-                black_box(&mission),
-                black_box(&wind),
-                black_box(&no_pnr),
-            )
-            .expect("plan")
-        })
-    });
+    for (name, options) in [
+        ("one_hour", opts),
+        ("one_hour_one_thread", one_thread),
+        ("one_hour_without_pnr", no_pnr),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                plan(
+                    black_box(&aircraft),
+                    black_box(&battery),
+                    black_box(&mission),
+                    black_box(&wind),
+                    black_box(&options),
+                )
+                .expect("plan")
+            })
+        });
+    }
     g.finish();
 }
 

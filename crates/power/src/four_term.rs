@@ -311,19 +311,14 @@ impl PowerModel {
         check_lengths(states.len(), out.len())?;
         let mut conditions = [FlightCondition::default(); CHUNK];
         let mut block = Block::new();
-        let mut roots = [0.0f64; CHUNK];
         for (sc, oc) in states.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             // Pass 1: validation, trigonometry, thrust and inflow.
             for (j, (s, c)) in sc.iter().zip(conditions.iter_mut()).enumerate() {
                 *c = self.point_condition(s)?;
                 block.set(j, c);
             }
-            // Pass 2: the quartic over the block in vector lanes (crate::batch).
-            roots_of_block(self, &block, &mut roots);
-            // Pass 3: the terms.
-            for ((c, &x), o) in conditions.iter().zip(roots.iter()).zip(oc.iter_mut()) {
-                *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
-            }
+            // Passes 2 and 3: the quartic over the block in vector lanes, then the terms.
+            self.terms_of_block(&conditions, &block, oc)?;
         }
         Ok(())
     }
@@ -338,16 +333,29 @@ impl PowerModel {
     ) -> Result<()> {
         check_lengths(conditions.len(), out.len())?;
         let mut block = Block::new();
-        let mut roots = [0.0f64; CHUNK];
         for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
             for (j, c) in cc.iter().enumerate() {
                 check_condition(c)?;
                 block.set(j, c);
             }
-            roots_of_block(self, &block, &mut roots);
-            for ((c, &x), o) in cc.iter().zip(roots.iter()).zip(oc.iter_mut()) {
-                *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
-            }
+            self.terms_of_block(cc, &block, oc)?;
+        }
+        Ok(())
+    }
+
+    /// The roots of a block in vector lanes (crate::batch), then the terms of each condition of
+    /// `conditions` (the block's, in order) into `out`.
+    #[inline(always)]
+    fn terms_of_block(
+        &self,
+        conditions: &[FlightCondition],
+        block: &Block,
+        out: &mut [PowerBreakdown],
+    ) -> Result<()> {
+        let mut roots = [0.0f64; CHUNK];
+        roots_of_block(self, block, &mut roots);
+        for ((c, &x), o) in conditions.iter().zip(roots.iter()).zip(out.iter_mut()) {
+            *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
         }
         Ok(())
     }
