@@ -518,6 +518,7 @@ impl BlockA {
 }
 
 /// State of pass A within the piece it is on.
+#[derive(Clone)]
 struct PieceA {
     sampler: BlockSampler,
     n: usize,
@@ -532,6 +533,7 @@ struct PieceA {
 /// Pass A of [`plan_with`]: kinematics, wind, trim, power and the airframe's limits for every
 /// block of the mission in order. Nothing here depends on the pack, so it may run ahead of pass B
 /// on another thread; both walk the same blocks.
+#[derive(Clone)]
 struct PassA<'p, 'a> {
     pieces: &'p [Piece],
     powered: &'p [Powered<'a>],
@@ -714,13 +716,15 @@ enum Feed<'p, 'a> {
 impl<'p, 'a: 'p> Feed<'p, 'a> {
     /// Start pass A on a thread of `scope`, handing chunks of blocks over a channel (and getting
     /// the used chunks back, so no block is copied or reallocated).
-    fn threaded<'s>(scope: &'s std::thread::Scope<'s, '_>, mut pass: PassA<'p, 'a>) -> Self
+    /// `None` when the thread cannot be started (pass A then runs in line).
+    fn threaded<'s>(scope: &'s std::thread::Scope<'s, '_>, mut pass: PassA<'p, 'a>) -> Option<Self>
     where
         'p: 's,
     {
         let (full_tx, full) = std::sync::mpsc::sync_channel::<(Vec<BlockA>, usize)>(2);
         let (empty, empty_rx) = std::sync::mpsc::channel::<Vec<BlockA>>();
-        scope.spawn(move || loop {
+        let worker = std::thread::Builder::new().name("aloft-pass-a".into());
+        let started = worker.spawn_scoped(scope, move || loop {
             let mut chunk = empty_rx.try_recv().unwrap_or_else(|_| {
                 std::iter::repeat_with(|| BlockA::EMPTY)
                     .take(BLOCKS_PER_CHUNK)
@@ -735,13 +739,13 @@ impl<'p, 'a: 'p> Feed<'p, 'a> {
                 return;
             }
         });
-        Feed::Threaded {
+        started.ok().map(|_| Feed::Threaded {
             full,
             empty,
             chunk: Vec::new(),
             len: 0,
             next: 0,
-        }
+        })
     }
 
     /// The next block; pass B asks only for blocks the mission has.
@@ -890,14 +894,15 @@ pub(crate) fn plan_with(
     let mut steps = [PackStep::default(); BLOCK];
     let mut cursor = battery.cursor(soc);
     std::thread::scope(|scope| -> Result<(), PlannerError> {
-        let mut feed = if threaded {
-            Feed::threaded(scope, pass_a)
+        let started = if threaded {
+            Feed::threaded(scope, pass_a.clone())
         } else {
-            Feed::Inline {
-                pass: pass_a,
-                block: Box::new(BlockA::EMPTY),
-            }
+            None
         };
+        let mut feed = started.unwrap_or_else(|| Feed::Inline {
+            pass: pass_a,
+            block: Box::new(BlockA::EMPTY),
+        });
         'pieces: for piece in mission.pieces() {
             let pw = &powered[piece.mass_phase];
             let seg = piece.segment;
