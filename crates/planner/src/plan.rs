@@ -50,7 +50,7 @@
 //! The checks run every `pnr_interval_s` (1 s), not every step: between two checks the vehicle
 //! moves at most `max_speed x 1 s` and the return it would fly changes by that much, so the point
 //! of no return is known to the interval, which is the resolution it is reported at. On the
-//! one-hour bench mission the checks take about 1 ms of the 14.5 ms a single thread needs (108
+//! one-hour bench mission the checks take about 1 ms of the 14 ms a single thread needs (108
 //! bearing bins priced, 3609 checks), which the second thread hides (bench
 //! `planner/mission/one_hour` against `one_hour_without_pnr`).
 
