@@ -430,8 +430,8 @@ impl PackCursor {
     /// converge fast (the current barely depends on the state of charge within a block); a block is
     /// accepted only when a sweep reproduces the previous sweep's currents exactly, which makes the
     /// states of charge satisfy the step-by-step recurrence exactly. A block that does not settle
-    /// within a few sweeps, crosses an interval of the open-circuit table, or contains a step the
-    /// pack cannot deliver is flown step by step.
+    /// within a few sweeps, reaches beyond the open-circuit table's interval below its start's, or
+    /// contains a step the pack cannot deliver is flown step by step.
     pub fn draw_block(
         &mut self,
         battery: &Battery,
@@ -504,11 +504,15 @@ impl PackCursor {
         let Some(first) = battery.draw_at_ocv(power_w[0], v0) else {
             return false;
         };
+        // The states of charge from the currents: the step-by-step chain's subtractions.
+        let chain = |current: &[f64; LANES], soc: &mut [f64; LANES + 1]| {
+            for j in 0..m {
+                soc[j + 1] = soc[j] - current[j] * charge_per_amp;
+            }
+        };
+        let mut current = [first.current_a; LANES];
         let mut soc = [self.soc; LANES + 1];
-        for j in 0..m {
-            soc[j + 1] = soc[j] - first.current_a * charge_per_amp;
-        }
-        let mut current = [0.0; LANES];
+        chain(&current, &mut soc);
         let mut previous = [f64::NAN; LANES];
         let mut terminal = [0.0; LANES];
         for _ in 0..MAX_SWEEPS {
@@ -531,9 +535,7 @@ impl PackCursor {
                 self.soc = soc[m];
                 return true;
             }
-            for j in 0..m {
-                soc[j + 1] = soc[j] - current[j] * charge_per_amp;
-            }
+            chain(&current, &mut soc);
             previous = current;
         }
         false

@@ -334,10 +334,7 @@ impl PowerModel {
         check_lengths(conditions.len(), out.len())?;
         let mut block = Block::new();
         for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            for (j, c) in cc.iter().enumerate() {
-                check_condition(c)?;
-                block.set(j, c);
-            }
+            load_block(cc, &mut block)?;
             self.terms_of_block(cc, &block, oc)?;
         }
         Ok(())
@@ -372,10 +369,7 @@ impl PowerModel {
         let mut roots = [0.0f64; CHUNK];
         let mut watts = [0.0f64; CHUNK];
         for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            for (j, c) in cc.iter().enumerate() {
-                check_condition(c)?;
-                block.set(j, c);
-            }
+            load_block(cc, &mut block)?;
             electrical_of_block(self, &block, &mut roots, &mut watts);
             for (((c, &x), &w), o) in cc
                 .iter()
@@ -384,7 +378,8 @@ impl PowerModel {
                 .zip(oc.iter_mut())
             {
                 *o = if x.is_nan() {
-                    self.assemble(c, self.induced_velocity(c)?).electrical_w
+                    self.assemble(c, self.root_or_safeguarded(c, x)?)
+                        .electrical_w
                 } else {
                     w
                 };
@@ -494,6 +489,16 @@ impl PowerModel {
     }
 }
 
+/// Validate up to [`CHUNK`] resolved conditions and lay them out in `block`'s lanes.
+#[inline(always)]
+fn load_block(conditions: &[FlightCondition], block: &mut Block) -> Result<()> {
+    for (j, c) in conditions.iter().enumerate() {
+        check_condition(c)?;
+        block.set(j, c);
+    }
+    Ok(())
+}
+
 /// A batch's output must have the length of its input.
 fn check_lengths(input_len: usize, output_len: usize) -> Result<()> {
     if input_len == output_len {
@@ -527,9 +532,14 @@ fn check_condition(c: &FlightCondition) -> Result<()> {
 fn condition_error(c: &FlightCondition) -> Result<()> {
     finite("thrust_n", c.thrust_n)?;
     non_negative("thrust_n", c.thrust_n)?;
-    finite("airspeed_mps", c.airspeed_mps)?;
-    non_negative("airspeed_mps", c.airspeed_mps)?;
-    finite("climb_rate_mps", c.climb_rate_mps)?;
+    check_speeds(c.airspeed_mps, c.climb_rate_mps)
+}
+
+/// The airspeed (finite, not negative) and the climb rate (finite), naming the bad value.
+fn check_speeds(airspeed_mps: f64, climb_rate_mps: f64) -> Result<()> {
+    finite("airspeed_mps", airspeed_mps)?;
+    non_negative("airspeed_mps", airspeed_mps)?;
+    finite("climb_rate_mps", climb_rate_mps)?;
     Ok(())
 }
 
@@ -581,10 +591,7 @@ pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaMode
 #[inline(never)]
 fn check_point(state: &FlightState) -> Result<()> {
     check_attitude(state.roll_rad, state.pitch_rad)?;
-    finite("airspeed_mps", state.airspeed_mps)?;
-    non_negative("airspeed_mps", state.airspeed_mps)?;
-    finite("climb_rate_mps", state.climb_rate_mps)?;
-    Ok(())
+    check_speeds(state.airspeed_mps, state.climb_rate_mps)
 }
 
 /// Validate roll and pitch; return `cos(phi) cos(theta)`.
