@@ -84,7 +84,6 @@ pub(crate) fn electrical_of_block(
     electrical_w: &mut [f64; CHUNK],
 ) {
     let inv_vh = model.vehicle().inverse_hover_induced_velocity();
-    let vh = model.vehicle().hover_induced_velocity_mps();
     for j in 0..CHUNK {
         let x = solve_normalised_fast(block.normal_mps[j] * inv_vh, block.parallel_mps[j] * inv_vh);
         roots[j] = x;
@@ -96,7 +95,7 @@ pub(crate) fn electrical_of_block(
                 block.parallel_mps[j],
                 block.climb_rate_mps[j],
                 block.geometric[j],
-                x * vh,
+                x,
             )
             .electrical_w;
     }
