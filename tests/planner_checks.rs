@@ -370,7 +370,9 @@ fn bad_missions_are_clear_errors() {
 fn thrust_or_tilt_beyond_the_vehicle_and_an_uncovering_grid_are_errors() {
     // 15 m/s into a 12 m/s headwind: 27 m/s airspeed needs far more than 35 deg of tilt.
     let e = run(
-        OUT_AND_BACK.replace("8.0", "15.0").as_str(),
+        OUT_AND_BACK
+            .replace("ground_speed_mps = 10.0", "ground_speed_mps = 15.0")
+            .as_str(),
         &Wind::constant(12.0, 90.0).unwrap(),
         &PlanOptions::default(),
     )
@@ -397,25 +399,10 @@ fn thrust_or_tilt_beyond_the_vehicle_and_an_uncovering_grid_are_errors() {
 
 #[test]
 fn an_infeasible_mission_says_where_the_battery_runs_out_and_has_a_point_of_no_return() {
-    let far = r#"
-[[segment]]
-kind = "take-off"
-altitude_m = 30.0
-climb_rate_mps = 2.0
-[[segment]]
-kind = "leg"
-east_m = 7000.0
-north_m = 0.0
-ground_speed_mps = 10.0
-[[segment]]
-kind = "return"
-ground_speed_mps = 10.0
-[[segment]]
-kind = "landing"
-rate_mps = 1.0
-"#;
+    // The same out-and-back, 7 km out.
+    let far = OUT_AND_BACK.replace("east_m = 800.0", "east_m = 7000.0");
     let r = run(
-        far,
+        &far,
         &Wind::constant(4.0, 90.0).unwrap(),
         &PlanOptions::default(),
     )

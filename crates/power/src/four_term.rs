@@ -39,7 +39,7 @@ use crate::angle_of_attack::{AoaModel, Inflow};
 use crate::batch::{electrical_of_block, roots_of_block, Block, CHUNK};
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
-use crate::induced::{induced_velocity_mps, solve_normalised};
+use crate::induced::{induced_power_of_root_w, induced_velocity_mps, solve_normalised};
 use crate::profile::profile_power_w;
 use crate::trig::{sin_cos, sin_cos_pair};
 use crate::vehicle::Vehicle;
@@ -469,11 +469,9 @@ impl PowerModel {
         let drag_work_w = v.drag().parasitic_power_w(airspeed_mps);
         // Eq (8) as printed with the paper's inflow; with the geometric one its T Vn part is the
         // drag work (booked by eq 11) plus the acceleration work (see the module docs).
-        // T (v_i + Vn) as x (T vh) + T Vn: the factors not waiting for the root are multiplied
-        // first, so one multiply-add follows the solver.
         let induced_w = only(
             terms.induced,
-            x * (thrust_n * vh) + thrust_n * only(!geometric, normal_mps),
+            induced_power_of_root_w(thrust_n, x, vh, only(!geometric, normal_mps)),
         );
         let acceleration_w = only(
             terms.induced & geometric,

@@ -278,6 +278,20 @@ pub fn induced_power_w(thrust_n: f64, induced_mps: f64, normal_mps: f64) -> f64 
     thrust_n * (induced_mps + normal_mps)
 }
 
+/// Eq (8) from the normalised root `x = v_i / vh`: `T (v_i + Vn)` written as `x (T vh) + T Vn`,
+/// W. The factors that do not wait for the root are multiplied first, so one multiply-add follows
+/// the solver (the form [`crate::PowerModel`] uses; [`induced_power_w`] is the same equation from
+/// `v_i`).
+#[inline(always)]
+pub(crate) fn induced_power_of_root_w(
+    thrust_n: f64,
+    x: f64,
+    hover_mps: f64,
+    normal_mps: f64,
+) -> f64 {
+    x * (thrust_n * hover_mps) + thrust_n * normal_mps
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -388,6 +402,12 @@ mod tests {
         let v = induced_velocity_mps(0.0, 0.0, vh).unwrap();
         let p = induced_power_w(32.26, v, 0.0);
         assert!((p - 32.26 * vh).abs() < 1e-12 * p);
+        // The model's form from the normalised root is the same equation.
+        for (x, vn) in [(1.0, 0.0), (0.8, 1.5), (1.3, -2.0)] {
+            let a = induced_power_of_root_w(32.26, x, vh, vn);
+            let b = induced_power_w(32.26, x * vh, vn);
+            assert!((a - b).abs() < 1e-14 * b.abs(), "{a} vs {b}");
+        }
     }
 
     #[test]
