@@ -1,0 +1,29 @@
+//! # aloft-core: what every aloft crate shares
+//!
+//! One home for the constants and the numerics the model crates, the log readers and the engine
+//! all use, so each is written once:
+//!
+//! - [`STANDARD_GRAVITY_MPS2`] and [`ISA_SEA_LEVEL_DENSITY_KG_M3`], the defaults of vehicle files
+//!   and the unit `g` of log columns;
+//! - [`Trapezoid`] and [`trapezoid`], the trapezoid rule for energies (power over time) and any
+//!   other integral of sampled data, sample by sample or over slices.
+//!
+//! The crate has no dependencies and does no I/O.
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod integrate;
+
+pub use integrate::{trapezoid, Trapezoid};
+
+/// Standard gravity `g0`, m/s^2 (CGPM 1901; ISO 80000-3). The default when a vehicle file does
+/// not give its own, and the unit `g` of accelerations in logs.
+pub const STANDARD_GRAVITY_MPS2: f64 = 9.806_65;
+
+/// Air density of the ICAO standard atmosphere at sea level (15 C, 101 325 Pa), kg/m^3. The
+/// default when a vehicle file does not give its own.
+pub const ISA_SEA_LEVEL_DENSITY_KG_M3: f64 = 1.225;
+
+/// Seconds per hour: joules to watt-hours, ampere-seconds to ampere-hours.
+pub const SECONDS_PER_HOUR: f64 = 3600.0;
