@@ -13,7 +13,7 @@ pub enum Error {
     #[error(transparent)]
     Propulsion(#[from] aloft_propulsion::PropulsionError),
     /// A vehicle name that is not built in.
-    #[error("unknown vehicle '{name}': built-in vehicles are {known}")]
+    #[error("unknown vehicle '{name}': neither a built-in vehicle ({known}) nor a vehicle file")]
     UnknownVehicle {
         /// The name asked for.
         name: String,
@@ -86,6 +86,25 @@ pub enum Error {
         /// The log reader's error.
         source: Box<aloft_logs::LogError>,
     },
+    /// A log file that cannot be opened, read or written (the message names the file).
+    #[error(transparent)]
+    LogFile(Box<aloft_logs::LogError>),
+    /// A log without the channel a request needs.
+    #[error("{origin}: {needed_for} needs {channel}, which the log does not have")]
+    MissingChannel {
+        /// File.
+        origin: String,
+        /// What needs it (an option).
+        needed_for: &'static str,
+        /// The channel, in words.
+        channel: &'static str,
+    },
+    /// A log with no decodable samples.
+    #[error("{origin}: the log holds no decodable samples")]
+    EmptyLog {
+        /// File.
+        origin: String,
+    },
     /// A log without electrical power (no voltage and current, no power column).
     #[error(
         "{origin}: no electrical power in this log (no voltage and current, no power channel)"
@@ -125,6 +144,14 @@ pub enum Error {
     /// error is large and this enum travels in every `Result` of the facade.
     #[error(transparent)]
     Planner(Box<aloft_planner::PlannerError>),
+    /// A wind the planner rejects (a speed, a profile, a field, gusts).
+    #[error("{origin}: {source}")]
+    Wind {
+        /// Which wind: `wind options`, `wind field <file>`, `gusts`.
+        origin: String,
+        /// The planner's error.
+        source: Box<aloft_planner::PlannerError>,
+    },
     /// A mission text (TOML or JSON) that does not parse or does not match the format.
     #[error("invalid mission {origin}: {message}")]
     MissionFormat {
@@ -163,6 +190,96 @@ pub enum Error {
         /// The parser's message.
         message: String,
     },
+    /// The propulsion chain cannot hover as asked.
+    #[error("{request}: {source}")]
+    Hover {
+        /// What was asked (`payload_kg 3`, `takeoff_mass_kg 9`).
+        request: String,
+        /// The chain's error.
+        source: aloft_propulsion::PropulsionError,
+    },
+    /// A rotor whose values the transient model rejects.
+    #[error("invalid rotor: {source}")]
+    Rotor {
+        /// The model's error.
+        source: aloft_propulsion::PropulsionError,
+    },
+    /// A rotor name that is neither built in nor a file.
+    #[error("unknown rotor '{name}': not a built-in rotor ({known}) and no such file")]
+    UnknownRotor {
+        /// The name asked for.
+        name: String,
+        /// The built-in names, comma-separated.
+        known: String,
+    },
+    /// A rotor file that does not parse.
+    #[error("invalid rotor description {origin}: {message}")]
+    RotorFormat {
+        /// File or built-in name.
+        origin: String,
+        /// The parser's message.
+        message: String,
+    },
+    /// A value given neither as an option nor in a file.
+    #[error("missing {flag}: {hint}")]
+    MissingValue {
+        /// The option that gives it.
+        flag: &'static str,
+        /// Where else it may come from.
+        hint: &'static str,
+    },
+    /// A name that is not among the known ones.
+    #[error("unknown {what} '{name}' (known: {known})")]
+    UnknownName {
+        /// What kind of name.
+        what: &'static str,
+        /// The name given.
+        name: String,
+        /// The known names.
+        known: &'static str,
+    },
+    /// Drag could not be fitted from the force balance.
+    #[error("drag from the force balance: {source}")]
+    Drag {
+        /// The fit's error.
+        source: aloft_power::FitError,
+    },
+    /// A log with too little trajectory to replay.
+    #[error("{origin}: fewer than two samples with a velocity: nothing to replay")]
+    NothingToReplay {
+        /// File.
+        origin: String,
+    },
+    /// The planner could not replay a trajectory.
+    #[error("replay of {origin}: {source}")]
+    Replay {
+        /// File.
+        origin: String,
+        /// The planner's error.
+        source: Box<aloft_planner::PlannerError>,
+    },
+    /// The power channel of a log does not overlap its trajectory.
+    #[error("{origin}: the power channel does not overlap the trajectory with a lag of {lag_s} s")]
+    NoOverlap {
+        /// File.
+        origin: String,
+        /// Lag applied, s.
+        lag_s: f64,
+    },
+    /// Options that contradict each other (the message says which and why).
+    #[error("{message}")]
+    Contradiction {
+        /// Which options, and why they cannot go together.
+        message: String,
+    },
+    /// A flight state the power model rejects.
+    #[error("invalid flight state ({state}): {source}")]
+    FlightState {
+        /// The state's values with their names and units.
+        state: String,
+        /// The model's error.
+        source: aloft_power::PowerError,
+    },
     /// The take-off mass exceeds the airframe's limit.
     #[error("take-off mass {mass_kg:.3} kg (airframe + {battery} + payload) exceeds the vehicle's {max_kg:.3} kg limit")]
     TooHeavy {
@@ -188,5 +305,11 @@ pub enum Error {
 impl From<aloft_planner::PlannerError> for Error {
     fn from(e: aloft_planner::PlannerError) -> Self {
         Error::Planner(Box::new(e))
+    }
+}
+
+impl From<aloft_logs::LogError> for Error {
+    fn from(e: aloft_logs::LogError) -> Self {
+        Error::LogFile(Box::new(e))
     }
 }

@@ -308,7 +308,7 @@ pub const AIRSPEED_BANDS: [(&str, f64, f64); 6] = [
 
 /// Energy of a power series, Wh (the planner's trapezoidal rule).
 fn trapezoid_wh(times: &[f64], power: &[f64]) -> f64 {
-    aloft_planner::replay::trapezoid(times, power) / 3600.0
+    aloft_core::trapezoid(times, power) / 3600.0
 }
 
 fn nrmse_percent(est: &[f64], meas: &[f64]) -> Option<f64> {
@@ -355,6 +355,32 @@ pub fn validate_flight(
     let predicted_energy_wh = trapezoid_wh(t, &predicted);
     let mean = measured.iter().sum::<f64>() / measured.len() as f64;
     let constant = vec![mean; measured.len()];
+    let table_i = ablation_rows(model, flight, &measured)?;
+    let calibration = match calibrate_first_s {
+        None => None,
+        Some(window) => Some(calibrate(model, flight, &measured, &predicted, window)?),
+    };
+    Ok(FlightValidation {
+        file: flight.source.clone(),
+        duration_s: t[t.len() - 1] - t[0],
+        lag_s: flight.lag_s,
+        measured_energy_wh,
+        predicted_energy_wh,
+        energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
+        nrmse_percent: nrmse_percent(&predicted, &measured).unwrap_or(f64::NAN),
+        baseline_nrmse_percent: nrmse_percent(&constant, &measured).unwrap_or(f64::NAN),
+        samples: measured.len(),
+        table_i,
+        calibration,
+    })
+}
+
+/// The Table I rows: the full model and each term dropped, per airspeed band.
+fn ablation_rows(
+    model: &PowerModel,
+    flight: &AlignedFlight,
+    measured: &[f64],
+) -> Result<Vec<AblationRow>, Error> {
     let mut table_i = Vec::new();
     for (name, term) in [
         ("none", None),
@@ -382,7 +408,7 @@ pub fn validate_flight(
                 let (e, m): (Vec<f64>, Vec<f64>) = flight
                     .samples
                     .iter()
-                    .zip(est.iter().zip(&measured))
+                    .zip(est.iter().zip(measured))
                     .filter(|(s, _)| s.state.airspeed_mps >= lo && s.state.airspeed_mps < hi)
                     .map(|(_, (e, m))| (*e, *m))
                     .unzip();
@@ -395,53 +421,47 @@ pub fn validate_flight(
             .collect();
         table_i.push(AblationRow {
             dropped_term: name,
-            nrmse_percent: nrmse_percent(&est, &measured).unwrap_or(f64::NAN),
+            nrmse_percent: nrmse_percent(&est, measured).unwrap_or(f64::NAN),
             bands,
         });
     }
-    let calibration = match calibrate_first_s {
-        None => None,
-        Some(window) => {
-            let split = t.partition_point(|&x| x < t[0] + window);
-            if split < 2 || split + 2 > t.len() {
-                return Err(Error::CalibrationWindow {
-                    origin: flight.source.clone(),
-                    window_s: window,
-                    duration_s: t[t.len() - 1] - t[0],
-                });
-            }
-            // Electrical power is aero power / eta: rescaling by the ratio of energies over the
-            // window is the least-biased re-estimate of eta from that window.
-            let scale = trapezoid_wh(&t[..split], &measured[..split])
-                / trapezoid_wh(&t[..split], &predicted[..split]);
-            let efficiency = model.vehicle().efficiency() / scale;
-            let rest_pred: Vec<f64> = predicted[split..].iter().map(|p| p * scale).collect();
-            let rest_meas = &measured[split..];
-            let measured_energy_wh = trapezoid_wh(&t[split..], rest_meas);
-            let predicted_energy_wh = trapezoid_wh(&t[split..], &rest_pred);
-            let rest_mean = rest_meas.iter().sum::<f64>() / rest_meas.len() as f64;
-            Some(Calibration {
-                calibrate_s: window,
-                efficiency,
-                measured_energy_wh,
-                predicted_energy_wh,
-                energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
-                rmse_w: metrics::rmse(&rest_pred, rest_meas)?,
-                best_constant_rmse_w: metrics::rmse(&vec![rest_mean; rest_meas.len()], rest_meas)?,
-            })
-        }
-    };
-    Ok(FlightValidation {
-        file: flight.source.clone(),
-        duration_s: t[t.len() - 1] - t[0],
-        lag_s: flight.lag_s,
+    Ok(table_i)
+}
+
+/// The efficiency re-estimated from the first `window` seconds and the errors over the rest.
+fn calibrate(
+    model: &PowerModel,
+    flight: &AlignedFlight,
+    measured: &[f64],
+    predicted: &[f64],
+    window: f64,
+) -> Result<Calibration, Error> {
+    let t = &flight.times_s;
+    let split = t.partition_point(|&x| x < t[0] + window);
+    if split < 2 || split + 2 > t.len() {
+        return Err(Error::CalibrationWindow {
+            origin: flight.source.clone(),
+            window_s: window,
+            duration_s: t[t.len() - 1] - t[0],
+        });
+    }
+    // Electrical power is aero power / eta: rescaling by the ratio of energies over the
+    // window is the least-biased re-estimate of eta from that window.
+    let scale = trapezoid_wh(&t[..split], &measured[..split])
+        / trapezoid_wh(&t[..split], &predicted[..split]);
+    let efficiency = model.vehicle().efficiency() / scale;
+    let rest_pred: Vec<f64> = predicted[split..].iter().map(|p| p * scale).collect();
+    let rest_meas = &measured[split..];
+    let measured_energy_wh = trapezoid_wh(&t[split..], rest_meas);
+    let predicted_energy_wh = trapezoid_wh(&t[split..], &rest_pred);
+    let rest_mean = rest_meas.iter().sum::<f64>() / rest_meas.len() as f64;
+    Ok(Calibration {
+        calibrate_s: window,
+        efficiency,
         measured_energy_wh,
         predicted_energy_wh,
         energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
-        nrmse_percent: nrmse_percent(&predicted, &measured).unwrap_or(f64::NAN),
-        baseline_nrmse_percent: nrmse_percent(&constant, &measured).unwrap_or(f64::NAN),
-        samples: measured.len(),
-        table_i,
-        calibration,
+        rmse_w: metrics::rmse(&rest_pred, rest_meas)?,
+        best_constant_rmse_w: metrics::rmse(&vec![rest_mean; rest_meas.len()], rest_meas)?,
     })
 }

@@ -9,7 +9,6 @@
 //! - [`vehicle`]: vehicle files (TOML) and the built-in vehicles.
 //! - [`engine`]: the embedding facade for ground stations (vehicles, power, missions, endurance,
 //!   in-flight efficiency re-estimate); the C ABI of `aloft-ffi` wraps it.
-//! - [`batch`]: streaming CSV evaluation of the power model.
 //! - [`identify`]: flight logs to the power model: lag alignment, fit samples, validation.
 //!
 //! ```
@@ -23,7 +22,6 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
-pub mod batch;
 pub mod engine;
 pub mod error;
 pub mod identify;

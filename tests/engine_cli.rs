@@ -56,7 +56,7 @@ fn mission_summary_is_the_cli_json() {
                 payload_kg: Some(0.3),
                 wind: wind(4.0, 120.0),
                 reserve_percent: Some(30.0),
-                aoa: aloft::engine::AngleOfAttack::Paper,
+                aoa: aloft::engine::AoaModel::Paper,
                 ..MissionOptions::default()
             },
         ),

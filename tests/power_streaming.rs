@@ -79,7 +79,7 @@ fn batch_memory_does_not_grow_with_the_input() {
         pending: Vec::new(),
         pos: 0,
     };
-    aloft::batch::power_csv(&model, warm, &mut sink, "warm-up").unwrap();
+    aloft::engine::power_csv(&model, warm, &mut sink, "warm-up").unwrap();
     let Some(before) = peak_rss_kb() else {
         panic!("/proc/self/status has no VmHWM: this test needs Linux");
     };
@@ -91,7 +91,7 @@ fn batch_memory_does_not_grow_with_the_input() {
         pending: Vec::new(),
         pos: 0,
     };
-    let n = aloft::batch::power_csv(&model, input, &mut sink, "generated").unwrap();
+    let n = aloft::engine::power_csv(&model, input, &mut sink, "generated").unwrap();
     let after = peak_rss_kb().unwrap();
     assert_eq!(n, rows);
     // About 49 MB of output went through; holding it (or the 6 MB input) would raise the peak by

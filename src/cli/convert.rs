@@ -4,9 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
 
-use aloft_logs::{open_log, McapWriter};
+use aloft::engine::convert_log;
 
 use super::log::ReadOptions;
 use super::output::{self, Row};
@@ -26,61 +25,8 @@ pub struct ConvertArgs {
     format: Format,
 }
 
-#[derive(Serialize)]
-struct TopicCount {
-    topic: String,
-    messages: u64,
-}
-
-#[derive(Serialize)]
-struct ConvertJson {
-    input: String,
-    output: String,
-    samples: u64,
-    topics: Vec<TopicCount>,
-}
-
 pub fn run(args: ConvertArgs) -> Result<Outcome> {
-    let profile = args.read.profile()?;
-    let mut reader = open_log(&args.log, profile.as_ref(), &args.read.mcap())?;
-    // Read the first sample before creating the output, so a bad input leaves no empty file.
-    let first = match reader.next() {
-        Some(s) => s?,
-        None => anyhow::bail!("{}: the log holds no decodable samples", args.log.display()),
-    };
-    let mut w = McapWriter::create(&args.output)?;
-    if let Some(t) = reader.start_time_s().filter(|t| *t > 0.0) {
-        w.set_start_ns((t * 1e9).round() as u64);
-    }
-    w.write_sample(0, &first)?;
-    let mut n = 1u64;
-    let result = (|| -> Result<()> {
-        for s in reader.by_ref() {
-            w.write_sample(n as usize, &s?)?;
-            n += 1;
-        }
-        Ok(())
-    })();
-    if let Err(e) = result {
-        // Do not leave a half-written file that looks valid.
-        drop(w);
-        let _ = std::fs::remove_file(&args.output);
-        return Err(e);
-    }
-    let summary = w.finish()?;
-    let json = ConvertJson {
-        input: args.log.display().to_string(),
-        output: args.output.display().to_string(),
-        samples: n,
-        topics: summary
-            .messages
-            .iter()
-            .map(|(t, m)| TopicCount {
-                topic: t.clone(),
-                messages: *m,
-            })
-            .collect(),
-    };
+    let json = convert_log(&args.log, &args.read.options(), &args.output)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
@@ -101,11 +47,9 @@ pub fn run(args: ConvertArgs) -> Result<Outcome> {
             )?;
         }
     }
-    let time = reader.time_report();
-    if !time.is_clean() {
+    if let Some((gaps, backwards)) = json.time_notes {
         eprintln!(
-            "aloft: note: the input's time base has {} gap(s) and {} non-monotonic step(s); they are kept as they are",
-            time.gap_count, time.non_monotonic_count
+            "aloft: note: the input's time base has {gaps} gap(s) and {backwards} non-monotonic step(s); they are kept as they are"
         );
     }
     Ok(Outcome::Ok)

@@ -6,14 +6,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use aloft::power::ModelOptions;
-use aloft_planner::{endurance, sweep_speed, EnduranceQuery, SweepRow};
+use aloft::engine::{
+    endurance, power_curve, AoaModel, EnduranceOptions, EnduranceSummary, PowerCurve, SweepRow,
+    Vehicle,
+};
 
-use super::mission::{AoaArg, WindArgs};
+use super::args::{aoa_parser, SteadyWindArgs};
 use super::output::{self, Row};
-use super::{load_vehicle, Format, Outcome, DEFAULT_VEHICLE_ARG};
+use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
 
 #[derive(Debug, Args)]
 pub struct EnduranceArgs {
@@ -27,7 +28,7 @@ pub struct EnduranceArgs {
     #[arg(long, default_value_t = 0.0, value_name = "KG")]
     payload_kg: f64,
     #[command(flatten)]
-    wind: WindArgs,
+    wind: SteadyWindArgs,
     /// Course of the range query, degrees clockwise from north.
     #[arg(
         long,
@@ -46,8 +47,8 @@ pub struct EnduranceArgs {
     #[arg(long, value_name = "M/S", requires = "orbit_radius")]
     orbit_speed: Option<f64>,
     /// Angle-of-attack model of the power model.
-    #[arg(long, value_enum, default_value_t = AoaArg::Geometric)]
-    aoa: AoaArg,
+    #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
+    aoa: AoaModel,
     /// The power curve instead: power, endurance and range against airspeed, in steps of this
     /// many m/s up to the vehicle's maximum speed.
     #[arg(long, value_name = "STEP_M/S")]
@@ -60,192 +61,164 @@ pub struct EnduranceArgs {
     format: Format,
 }
 
-#[derive(Serialize)]
-struct EnduranceJson<'a> {
-    vehicle: &'a str,
-    battery: &'a str,
-    takeoff_mass_kg: f64,
-    #[serde(flatten)]
-    report: aloft_planner::EnduranceReport,
+impl EnduranceArgs {
+    fn options(&self) -> EnduranceOptions {
+        EnduranceOptions {
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            wind: self.wind.spec(),
+            course_deg: self.course,
+            reserve_percent: self.reserve_percent,
+            orbit_radius_m: self.orbit_radius,
+            orbit_speed_mps: self.orbit_speed,
+            aoa: self.aoa,
+        }
+    }
 }
 
 pub fn run(args: EnduranceArgs) -> Result<Outcome> {
-    let file = load_vehicle(&args.vehicle)?;
-    let (aircraft, notes) = file.aircraft(ModelOptions::default())?;
-    let battery = file.battery(args.battery.as_deref())?;
-    if !(args.payload_kg.is_finite() && args.payload_kg >= 0.0) {
-        bail!(
-            "--payload-kg {}: expected a mass, not negative",
-            args.payload_kg
-        );
-    }
-    let mass = aircraft.airframe().mass_kg() + battery.mass_kg() + args.payload_kg;
-    if mass > aircraft.airframe().max_takeoff_mass_kg() {
-        bail!(
-            "take-off mass {mass:.3} kg (airframe + {} + payload) exceeds the vehicle's {:.3} kg limit",
-            battery.name(),
-            aircraft.airframe().max_takeoff_mass_kg()
-        );
-    }
-    let powered = aircraft.at_mass(mass, args.aoa.model())?;
-    let (wind, wind_text) = args.wind.build(None)?;
-    if args.wind.wind_field.is_some() || args.wind.gust_std.is_some() {
-        bail!("aloft endurance takes a constant wind (--wind-speed, --wind-from); a field or gusts belong to a mission");
-    }
-    if !(0.0..100.0).contains(&args.reserve_percent) {
-        bail!(
-            "--reserve-percent {}: expected [0, 100)",
-            args.reserve_percent
-        );
-    }
-    // The wind at 10 m stands for the query's wind (a profile is evaluated there).
-    let w = wind.mean_at([0.0, 0.0, 10.0]).unwrap_or([0.0; 3]);
-    let c = args.course.to_radians();
-    let query = EnduranceQuery {
-        wind_mps: [w[0], w[1]],
-        course: [c.sin(), c.cos()],
-        start_soc: 1.0,
-        reserve_fraction: args.reserve_percent / 100.0,
-        orbit: args.orbit_radius.zip(args.orbit_speed),
-    };
+    let vehicle = Vehicle::load(&args.vehicle)?;
+    let options = args.options();
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if let Some(step) = args.sweep_speed {
-        let vmax = aircraft.airframe().max_speed_mps();
-        let rows = sweep_speed(&powered, &battery, &query, vmax, step)?;
+        let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
-            plot_sweep(p, &file.name, &rows)
+            plot_sweep(p, &curve.context.vehicle, &curve.rows)
                 .with_context(|| format!("cannot draw {}", p.display()))?;
         }
         match args.format {
-            Format::Json => output::write_json(&mut out, &rows)?,
-            Format::Csv => {
-                let mut w = csv::Writer::from_writer(out);
-                w.write_record([
-                    "airspeed_mps",
-                    "ground_speed_mps",
-                    "power_w",
-                    "endurance_s",
-                    "range_m",
-                ])?;
-                for r in &rows {
-                    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
-                    w.write_record([
-                        r.airspeed_mps.to_string(),
-                        opt(r.ground_speed_mps),
-                        r.power_w.to_string(),
-                        r.endurance_s.to_string(),
-                        opt(r.range_m),
-                    ])?;
-                }
-                w.flush()?;
-            }
-            Format::Table => {
-                writeln!(
-                    out,
-                    "{} with {}, {:.3} kg, wind {wind_text}, course {:.0} deg: power curve",
-                    file.name,
-                    battery.name(),
-                    mass,
-                    args.course
-                )?;
-                writeln!(
-                    out,
-                    "  {:>9} {:>9} {:>9} {:>10} {:>9}",
-                    "airspeed", "ground", "power", "endurance", "range"
-                )?;
-                writeln!(
-                    out,
-                    "  {:>9} {:>9} {:>9} {:>10} {:>9}",
-                    "m/s", "m/s", "W", "min", "km"
-                )?;
-                for r in &rows {
-                    let g = r
-                        .ground_speed_mps
-                        .map(|v| format!("{v:.1}"))
-                        .unwrap_or_else(|| "-".into());
-                    let rng = r
-                        .range_m
-                        .map(|v| format!("{:.2}", v / 1000.0))
-                        .unwrap_or_else(|| "-".into());
-                    writeln!(
-                        out,
-                        "  {:>9.1} {:>9} {:>9.0} {:>10.1} {:>9}",
-                        r.airspeed_mps,
-                        g,
-                        r.power_w,
-                        r.endurance_s / 60.0,
-                        rng
-                    )?;
-                }
-            }
+            Format::Json => output::write_json(&mut out, &curve)?,
+            Format::Csv => write_curve_csv(out, &curve.rows)?,
+            Format::Table => write_curve_table(&mut out, &curve, args.course)?,
         }
         return Ok(Outcome::Ok);
     }
-    let r = endurance(&powered, &battery, &query)?;
+    if args.format == Format::Csv {
+        bail!("aloft endurance writes table or json (csv with --sweep-speed)");
+    }
+    let summary = endurance(&vehicle, &options)?;
     match args.format {
-        Format::Json => output::write_json(
-            &mut out,
-            &EnduranceJson {
-                vehicle: &file.name,
-                battery: battery.name(),
-                takeoff_mass_kg: mass,
-                report: r,
-            },
-        )?,
-        Format::Csv => bail!("aloft endurance writes table or json (csv with --sweep-speed)"),
-        Format::Table => {
-            let title = format!(
-                "{} with {} ({} Wh), take-off mass {:.3} kg, wind {wind_text}, reserve {:.0} %",
-                file.name,
-                battery.name(),
-                battery.rated_energy_wh(),
-                mass,
-                args.reserve_percent
-            );
-            let min = |s: f64| format!("{:.1}", s / 60.0);
-            let mut rows = vec![
-                Row::new("hover power", format!("{:.0}", r.hover_power_w), "W"),
-                Row::new("hover endurance", min(r.hover_endurance_s), "min"),
-                Row::new(
-                    "best-endurance airspeed",
-                    format!("{:.1}", r.max_endurance_speed_mps),
-                    "m/s",
-                ),
-                Row::new(
-                    "  power there",
-                    format!("{:.0}", r.max_endurance_power_w),
-                    "W",
-                ),
-                Row::new("  endurance", min(r.max_endurance_s), "min"),
-                Row::new(
-                    "best-range airspeed",
-                    format!("{:.1}", r.max_range_speed_mps),
-                    "m/s",
-                ),
-                Row::new(
-                    "  ground speed on course",
-                    format!("{:.1}", r.max_range_ground_speed_mps),
-                    "m/s",
-                ),
-                Row::new("  power there", format!("{:.0}", r.max_range_power_w), "W"),
-                Row::new(
-                    "  range on course",
-                    format!("{:.2}", r.max_range_m / 1000.0),
-                    "km",
-                ),
-            ];
-            if let (Some(p), Some(e)) = (r.orbit_power_w, r.orbit_endurance_s) {
-                rows.push(Row::new("orbit power", format!("{p:.0}"), "W"));
-                rows.push(Row::new("orbit endurance", min(e), "min"));
-            }
-            output::write_table(&mut out, &title, &rows)?;
-            for n in notes {
-                writeln!(out, "  note: {n}")?;
-            }
-        }
+        Format::Json => output::write_json(&mut out, &summary)?,
+        Format::Csv | Format::Table => write_table(&mut out, &summary, args.reserve_percent)?,
     }
     Ok(Outcome::Ok)
+}
+
+fn write_curve_csv(out: impl Write, rows: &[SweepRow]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record([
+        "airspeed_mps",
+        "ground_speed_mps",
+        "power_w",
+        "endurance_s",
+        "range_m",
+    ])?;
+    for r in rows {
+        let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+        w.write_record([
+            r.airspeed_mps.to_string(),
+            opt(r.ground_speed_mps),
+            r.power_w.to_string(),
+            r.endurance_s.to_string(),
+            opt(r.range_m),
+        ])?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) -> Result<()> {
+    let c = &curve.context;
+    writeln!(
+        out,
+        "{} with {}, {:.3} kg, wind {}, course {:.0} deg: power curve",
+        c.vehicle, c.battery, c.takeoff_mass_kg, c.wind, course_deg
+    )?;
+    writeln!(
+        out,
+        "  {:>9} {:>9} {:>9} {:>10} {:>9}",
+        "airspeed", "ground", "power", "endurance", "range"
+    )?;
+    writeln!(
+        out,
+        "  {:>9} {:>9} {:>9} {:>10} {:>9}",
+        "m/s", "m/s", "W", "min", "km"
+    )?;
+    for r in &curve.rows {
+        let g = r
+            .ground_speed_mps
+            .map(|v| format!("{v:.1}"))
+            .unwrap_or_else(|| "-".into());
+        let rng = r
+            .range_m
+            .map(|v| format!("{:.2}", v / 1000.0))
+            .unwrap_or_else(|| "-".into());
+        writeln!(
+            out,
+            "  {:>9.1} {:>9} {:>9.0} {:>10.1} {:>9}",
+            r.airspeed_mps,
+            g,
+            r.power_w,
+            r.endurance_s / 60.0,
+            rng
+        )?;
+    }
+    Ok(())
+}
+
+fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64) -> Result<()> {
+    let r = &s.report;
+    let title = format!(
+        "{} with {} ({} Wh), take-off mass {:.3} kg, wind {}, reserve {:.0} %",
+        s.vehicle,
+        s.battery,
+        s.context.battery_energy_wh,
+        s.takeoff_mass_kg,
+        s.context.wind,
+        reserve_percent
+    );
+    let min = |s: f64| format!("{:.1}", s / 60.0);
+    let mut rows = vec![
+        Row::new("hover power", format!("{:.0}", r.hover_power_w), "W"),
+        Row::new("hover endurance", min(r.hover_endurance_s), "min"),
+        Row::new(
+            "best-endurance airspeed",
+            format!("{:.1}", r.max_endurance_speed_mps),
+            "m/s",
+        ),
+        Row::new(
+            "  power there",
+            format!("{:.0}", r.max_endurance_power_w),
+            "W",
+        ),
+        Row::new("  endurance", min(r.max_endurance_s), "min"),
+        Row::new(
+            "best-range airspeed",
+            format!("{:.1}", r.max_range_speed_mps),
+            "m/s",
+        ),
+        Row::new(
+            "  ground speed on course",
+            format!("{:.1}", r.max_range_ground_speed_mps),
+            "m/s",
+        ),
+        Row::new("  power there", format!("{:.0}", r.max_range_power_w), "W"),
+        Row::new(
+            "  range on course",
+            format!("{:.2}", r.max_range_m / 1000.0),
+            "km",
+        ),
+    ];
+    if let (Some(p), Some(e)) = (r.orbit_power_w, r.orbit_endurance_s) {
+        rows.push(Row::new("orbit power", format!("{p:.0}"), "W"));
+        rows.push(Row::new("orbit endurance", min(e), "min"));
+    }
+    output::write_table(out, &title, &rows)?;
+    for n in &s.context.notes {
+        writeln!(out, "  note: {n}")?;
+    }
+    Ok(())
 }
 
 fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {

@@ -3,14 +3,10 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
-use serde::Serialize;
 
-use aloft_logs::{
-    estimate_lag_s, open_log, resample_uniform, Channel, InfoAccumulator, LogFormat, McapOptions,
-    McapTime, Profile, TimeReport,
-};
+use aloft::engine::{log_info, LogFormat, LogInfo, LogReadOptions};
 
 use super::output::{self, Row};
 use super::{Format, Outcome};
@@ -48,24 +44,14 @@ pub struct ReadOptions {
 }
 
 impl ReadOptions {
-    pub fn profile(&self) -> Result<Option<Profile>> {
-        self.profile
-            .as_deref()
-            .map(Profile::resolve)
-            .transpose()
-            .map_err(Into::into)
-    }
-
-    pub fn mcap(&self) -> McapOptions {
-        let mut o = McapOptions {
+    /// The engine's read options.
+    pub fn options(&self) -> LogReadOptions {
+        LogReadOptions {
+            profile: self.profile.clone(),
             topics: self.topics.clone(),
-            ..McapOptions::default()
-        };
-        if self.header_time {
-            o.time = McapTime::HeaderStamp;
+            header_time: self.header_time,
+            battery_current_positive: self.battery_current_positive,
         }
-        o.decode.battery_current_positive_discharging = self.battery_current_positive;
-        o
     }
 }
 
@@ -83,89 +69,6 @@ struct InfoArgs {
     format: Format,
 }
 
-#[derive(Serialize)]
-struct ChannelJson {
-    channel: Channel,
-    samples: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    rate_hz: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct TopicJson {
-    topic: String,
-    schema: String,
-    message_encoding: String,
-    messages: u64,
-    decoded: u64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    rate_hz: Option<f64>,
-    used_for: Vec<Channel>,
-}
-
-#[derive(Serialize)]
-struct TimeJson {
-    #[serde(skip_serializing_if = "Option::is_none")]
-    nominal_period_s: Option<f64>,
-    gap_count: u64,
-    non_monotonic_count: u64,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    gaps: Vec<aloft_logs::sample::Gap>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    non_monotonic: Vec<aloft_logs::sample::NonMonotonic>,
-}
-
-impl From<&TimeReport> for TimeJson {
-    fn from(r: &TimeReport) -> Self {
-        Self {
-            nominal_period_s: r.nominal_period_s,
-            gap_count: r.gap_count,
-            non_monotonic_count: r.non_monotonic_count,
-            gaps: r.gaps.iter().take(10).copied().collect(),
-            non_monotonic: r.non_monotonic.iter().take(10).copied().collect(),
-        }
-    }
-}
-
-#[derive(Serialize)]
-struct LagJson {
-    lag_s: f64,
-    correlation: f64,
-    correlation_at_zero: f64,
-    at_window_edge: bool,
-}
-
-#[derive(Serialize)]
-struct InfoJson {
-    file: String,
-    format: LogFormat,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    profile: Option<String>,
-    samples: u64,
-    duration_s: f64,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    start_time_s: Option<f64>,
-    channels: Vec<ChannelJson>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    columns: Option<Vec<String>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    topics: Option<Vec<TopicJson>>,
-    power_available: bool,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    energy_wh: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    mean_power_w: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    max_power_w: Option<f64>,
-    time: TimeJson,
-    /// Values left out as isolated contradictions (e.g. power far from V x I on one row).
-    dropped_values: u64,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    dropped: Vec<aloft_logs::DroppedValue>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    lag: Option<LagJson>,
-}
-
 pub fn run(args: LogArgs) -> Result<Outcome> {
     match args.command {
         LogCommand::Info(a) => info(a),
@@ -173,120 +76,35 @@ pub fn run(args: LogArgs) -> Result<Outcome> {
 }
 
 fn info(args: InfoArgs) -> Result<Outcome> {
-    let profile = args.read.profile()?;
-    let mut reader = open_log(&args.file, profile.as_ref(), &args.read.mcap())?;
-    let mut acc = InfoAccumulator::new();
-    let (mut tp, mut p, mut tv, mut v) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for s in reader.by_ref() {
-        let s = s?;
-        acc.push(&s);
-        if args.lag.is_some() {
-            if let Some(w) = s.electrical_power_w() {
-                tp.push(s.time_s);
-                p.push(w);
-            }
-            if let Some(u) = s.vel_enu_mps {
-                tv.push(s.time_s);
-                v.push(u[0].hypot(u[1]));
-            }
-        }
-    }
-    let stats = acc.finish();
-    let time = reader.time_report();
-    let (dropped_values, mut dropped) = reader.dropped();
-    dropped.truncate(10);
-    let lag = match args.lag {
-        None => None,
-        Some(max) => {
-            let file = args.file.display().to_string();
-            if p.is_empty() {
-                anyhow::bail!("{file}: --lag needs power data (voltage and current), which the log does not have");
-            }
-            if v.is_empty() {
-                anyhow::bail!("{file}: --lag needs velocity data, which the log does not have");
-            }
-            let dt = time.nominal_period_s.unwrap_or(0.1);
-            let (t0p, pu) = resample_uniform(&tp, &p, dt)?;
-            let (t0v, vu) = resample_uniform(&tv, &v, dt)?;
-            // Align both grids on their common span.
-            let off_p = ((t0v - t0p) / dt).round().max(0.0) as usize;
-            let off_v = ((t0p - t0v) / dt).round().max(0.0) as usize;
-            let n = pu
-                .len()
-                .saturating_sub(off_p)
-                .min(vu.len().saturating_sub(off_v));
-            let e = estimate_lag_s(&pu[off_p..off_p + n], &vu[off_v..off_v + n], dt, max)
-                .context("lag estimation")?;
-            Some(LagJson {
-                lag_s: e.lag_s,
-                correlation: e.correlation,
-                correlation_at_zero: e.correlation_at_zero,
-                at_window_edge: e.at_window_edge,
-            })
-        }
-    };
-    let json = InfoJson {
-        file: args.file.display().to_string(),
-        format: reader.format(),
-        profile: match reader.format() {
-            LogFormat::Mcap => None,
-            LogFormat::Px4Csv => Some("px4".into()),
-            LogFormat::Csv => Some(profile.map_or("kaist".into(), |p| p.name())),
-        },
-        samples: stats.samples,
-        duration_s: stats.duration_s,
-        start_time_s: reader.start_time_s(),
-        channels: stats
-            .channels
-            .iter()
-            .map(|c| ChannelJson {
-                channel: c.channel,
-                samples: c.samples,
-                rate_hz: c.rate_hz(),
-            })
-            .collect(),
-        columns: reader.columns().map(|c| c.to_vec()),
-        topics: reader.topics().map(|t| {
-            t.iter()
-                .map(|t| TopicJson {
-                    topic: t.topic.clone(),
-                    schema: t.schema.clone(),
-                    message_encoding: t.message_encoding.clone(),
-                    messages: t.messages,
-                    decoded: t.decoded,
-                    rate_hz: t.rate_hz(),
-                    used_for: t.used_for.clone(),
-                })
-                .collect()
-        }),
-        power_available: stats.energy_wh.is_some() || stats.mean_power_w.is_some(),
-        energy_wh: stats.energy_wh,
-        mean_power_w: stats.mean_power_w,
-        max_power_w: stats.max_power_w,
-        time: TimeJson::from(&time),
-        dropped_values,
-        dropped,
-        lag,
-    };
+    let info = log_info(&args.file, &args.read.options(), args.lag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
-        Format::Json => output::write_json(&mut out, &json)?,
-        Format::Table | Format::Csv => write_table(&mut out, &json)?,
+        Format::Json => output::write_json(&mut out, &info)?,
+        Format::Table | Format::Csv => write_table(&mut out, &info)?,
     }
     Ok(Outcome::Ok)
 }
 
-fn write_table(out: &mut impl Write, j: &InfoJson) -> Result<()> {
+fn write_table(out: &mut impl Write, j: &LogInfo) -> Result<()> {
+    output::write_table(out, &title(j), &summary_rows(j))?;
+    write_contents(out, j)?;
+    write_time_notes(out, j)
+}
+
+fn title(j: &LogInfo) -> String {
     let fmt = match j.format {
         LogFormat::Csv => "CSV",
         LogFormat::Px4Csv => "PX4 CSV tables",
         LogFormat::Mcap => "MCAP",
     };
-    let title = match &j.profile {
+    match &j.profile {
         Some(p) => format!("{} ({fmt}, profile {p})", j.file),
         None => format!("{} ({fmt})", j.file),
-    };
+    }
+}
+
+fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
     let mut rows = vec![
         Row::new("samples", j.samples.to_string(), ""),
         Row::new("duration", format!("{:.2}", j.duration_s), "s"),
@@ -337,7 +155,11 @@ fn write_table(out: &mut impl Write, j: &InfoJson) -> Result<()> {
             "s",
         ));
     }
-    output::write_table(out, &title, &rows)?;
+    rows
+}
+
+/// Channels, and the CSV columns or MCAP topics they came from.
+fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     writeln!(out, "channels")?;
     for c in &j.channels {
         let rate = c.rate_hz.map_or("-".into(), |r| format!("{r:.2} Hz"));
@@ -368,6 +190,11 @@ fn write_table(out: &mut impl Write, j: &InfoJson) -> Result<()> {
             )?;
         }
     }
+    Ok(())
+}
+
+/// The first gaps, dropped values and backward steps of the time base.
+fn write_time_notes(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     for g in j.time.gaps.iter().take(5) {
         writeln!(
             out,

@@ -1,5 +1,8 @@
-//! Argument parsing and dispatch. Each subcommand lives in its own module.
+//! Argument parsing and dispatch. Each subcommand lives in its own module and does three things:
+//! its arguments become an engine request (`aloft::engine`), the engine answers, and the answer is
+//! rendered as a table, JSON or CSV. Exit codes are decided here, once.
 
+mod args;
 mod convert;
 mod endurance;
 mod fit;
@@ -10,17 +13,14 @@ mod output;
 mod plot;
 mod power;
 mod propulsion;
+mod replay;
 mod rotor;
 mod validate;
 mod vehicles;
 
-use std::path::Path;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
 use clap::{Parser, Subcommand, ValueEnum};
-
-use aloft::vehicle::{VehicleFile, DEFAULT_VEHICLE};
 
 /// Energy and feasibility of multirotor flights.
 ///
@@ -96,31 +96,27 @@ pub fn main() -> ExitCode {
         Ok(Outcome::Failed) => ExitCode::from(1),
         Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("aloft: error: {e:#}");
+            eprintln!("aloft: error: {}", message(&e));
             ExitCode::from(2)
         }
     }
 }
 
-/// Load a vehicle by built-in name or from a TOML file.
-pub fn load_vehicle(name_or_path: &str) -> Result<VehicleFile> {
-    if aloft::vehicle::builtin_names().contains(&name_or_path) {
-        return Ok(VehicleFile::builtin(name_or_path)?);
+/// The error and its causes on one line, each cause once: engine errors already say their
+/// cause in their own message, so a cause whose text is already there is not repeated.
+fn message(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if text.is_empty() {
+            text = c;
+        } else if !text.contains(&c) {
+            text.push_str(": ");
+            text.push_str(&c);
+        }
     }
-    let path = Path::new(name_or_path);
-    if path.exists() {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read vehicle file {}", path.display()))?;
-        return Ok(VehicleFile::from_toml_str(
-            &text,
-            &path.display().to_string(),
-        )?);
-    }
-    anyhow::bail!(
-        "unknown vehicle '{name_or_path}': not a built-in vehicle ({}) and no such file",
-        aloft::vehicle::builtin_names().join(", ")
-    )
+    text
 }
 
 /// The default vehicle name, for clap defaults.
-pub const DEFAULT_VEHICLE_ARG: &str = DEFAULT_VEHICLE;
+pub const DEFAULT_VEHICLE_ARG: &str = aloft::engine::DEFAULT_VEHICLE;

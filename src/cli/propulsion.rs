@@ -6,12 +6,11 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use aloft::propulsion::{mass_range_kg, HoverResult};
+use aloft::engine::{hover, hover_sweep, HoverRequest, HoverResult, SweepPoint, Vehicle};
 
 use super::output::{self, Row};
-use super::{load_vehicle, Format, Outcome};
+use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct PropulsionArgs {
@@ -40,138 +39,32 @@ pub struct PropulsionArgs {
     format: Format,
 }
 
-/// One point of a sweep: the result, or why that mass cannot hover.
-#[derive(Serialize)]
-struct SweepPoint {
-    takeoff_mass_kg: f64,
-    #[serde(flatten, skip_serializing_if = "Option::is_none")]
-    result: Option<HoverResult>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    error: Option<String>,
-}
-
 pub fn run(args: PropulsionArgs) -> Result<Outcome> {
-    let file = load_vehicle(&args.vehicle)?;
-    let system = file.propulsion_system()?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
+    let vehicle = Vehicle::load(&args.vehicle)?;
     if let Some(spec) = &args.sweep_takeoff_mass {
-        let parts: Vec<&str> = spec.split(':').collect();
-        let [from, to, step] = parts.as_slice() else {
-            bail!("--sweep-takeoff-mass '{spec}': expected FROM:TO:STEP in kg, e.g. 7:13:0.5");
-        };
-        let num = |s: &str, what: &str| -> Result<f64> {
-            s.trim().parse::<f64>().with_context(|| {
-                format!("--sweep-takeoff-mass '{spec}': {what} '{s}' is not a number")
-            })
-        };
-        let masses = mass_range_kg(num(from, "FROM")?, num(to, "TO")?, num(step, "STEP")?)
+        let (from, to, step) = parse_range(spec)?;
+        let sweep = hover_sweep(&vehicle, from, to, step)
             .with_context(|| format!("--sweep-takeoff-mass '{spec}'"))?;
-        let points: Vec<SweepPoint> = system
-            .sweep_takeoff_mass(&masses)
-            .into_iter()
-            .zip(&masses)
-            .map(|(r, &m)| match r {
-                Ok(h) => SweepPoint {
-                    takeoff_mass_kg: m,
-                    result: Some(h),
-                    error: None,
-                },
-                Err(e) => SweepPoint {
-                    takeoff_mass_kg: m,
-                    result: None,
-                    error: Some(e.to_string()),
-                },
-            })
-            .collect();
         if let Some(path) = &args.plot {
-            plot_sweep(path, &file.name, &points)
+            plot_sweep(path, vehicle.name(), &sweep.points)
                 .with_context(|| format!("cannot write the plot {}", path.display()))?;
         }
+        let stdout = std::io::stdout();
+        let mut out = stdout.lock();
         match args.format {
-            Format::Json => output::write_json(&mut out, &points)?,
-            Format::Csv => {
-                let mut w = csv::Writer::from_writer(out);
-                w.write_record([
-                    "takeoff_mass_kg",
-                    "thrust_per_rotor_n",
-                    "rotor_speed_rpm",
-                    "motor_current_a",
-                    "pack_current_a",
-                    "power_required_w",
-                    "power_drawn_w",
-                    "battery_heat_w",
-                    "flight_time_min",
-                    "error",
-                ])?;
-                for p in &points {
-                    let mut row = vec![p.takeoff_mass_kg.to_string()];
-                    match &p.result {
-                        Some(h) => row.extend(
-                            [
-                                h.thrust_per_rotor_n,
-                                h.rotor_speed_rpm,
-                                h.motor_current_a,
-                                h.pack_current_a,
-                                h.power_required_w,
-                                h.power_drawn_w,
-                                h.battery_heat_w,
-                                h.flight_time_min,
-                            ]
-                            .map(|v| v.to_string()),
-                        ),
-                        None => row.extend(std::iter::repeat_n(String::new(), 8)),
-                    }
-                    row.push(p.error.clone().unwrap_or_default());
-                    w.write_record(&row)?;
-                }
-                w.flush()?;
-            }
-            Format::Table => {
-                writeln!(
-                    out,
-                    "{}: hover across take-off mass (propulsion seed Fig. 13)",
-                    file.name
-                )?;
-                writeln!(
-                    out,
-                    "{:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  rotor rpm",
-                    "mass kg", "power W", "drawn W", "pack A", "heat W", "time min"
-                )?;
-                for p in &points {
-                    match &p.result {
-                        Some(h) => writeln!(
-                            out,
-                            "{:>9.2} {:>9.0} {:>9.0} {:>9.2} {:>9.0} {:>9.2}  {:.0}",
-                            p.takeoff_mass_kg,
-                            h.power_required_w,
-                            h.power_drawn_w,
-                            h.pack_current_a,
-                            h.battery_heat_w,
-                            h.flight_time_min,
-                            h.rotor_speed_rpm
-                        )?,
-                        None => writeln!(
-                            out,
-                            "{:>9.2}  cannot hover: {}",
-                            p.takeoff_mass_kg,
-                            p.error.as_deref().unwrap_or_default()
-                        )?,
-                    }
-                }
-            }
+            Format::Json => output::write_json(&mut out, &sweep)?,
+            Format::Csv => write_sweep_csv(out, &sweep.points)?,
+            Format::Table => write_sweep_table(&mut out, vehicle.name(), &sweep.points)?,
         }
         return Ok(Outcome::Ok);
     }
-
-    let h = match args.takeoff_mass_kg {
-        Some(m) => system
-            .hover_at_takeoff_mass(m)
-            .with_context(|| format!("--takeoff-mass-kg {m}"))?,
-        None => system
-            .hover_with_payload(args.payload_kg)
-            .with_context(|| format!("--payload-kg {}", args.payload_kg))?,
+    let request = match args.takeoff_mass_kg {
+        Some(m) => HoverRequest::TakeoffMass(m),
+        None => HoverRequest::Payload(args.payload_kg),
     };
+    let h = hover(&vehicle, request)?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
     match args.format {
         Format::Json => output::write_json(&mut out, &h)?,
         Format::Csv => {
@@ -179,53 +72,143 @@ pub fn run(args: PropulsionArgs) -> Result<Outcome> {
             w.serialize(h)?;
             w.flush()?;
         }
-        Format::Table => {
-            let title = format!(
-                "{}: hover at {:.3} kg take-off mass ({} rotors, {} packs)",
-                file.name, h.takeoff_mass_kg, h.rotor_count, h.pack_count
-            );
-            let rows = vec![
-                Row::new(
-                    "thrust per rotor",
-                    format!("{:.2}", h.thrust_per_rotor_n),
-                    "N",
-                ),
-                Row::new("rotor speed", format!("{:.0}", h.rotor_speed_rpm), "rpm"),
-                Row::new("rotor torque", format!("{:.3}", h.torque_nm), "N m"),
-                Row::new("motor current", format!("{:.2}", h.motor_current_a), "A"),
-                Row::new("motor voltage", format!("{:.2}", h.motor_voltage_v), "V"),
-                Row::new("pack current", format!("{:.2}", h.pack_current_a), "A"),
-                Row::new(
-                    "pack terminal voltage",
-                    format!("{:.2}", h.pack_terminal_voltage_v),
-                    "V",
-                ),
-                Row::new(
-                    "power required (all motors)",
-                    format!("{:.0}", h.power_required_w),
-                    "W",
-                ),
-                Row::new(
-                    "power drawn from packs",
-                    format!("{:.0}", h.power_drawn_w),
-                    "W",
-                ),
-                Row::new("heat in packs", format!("{:.0}", h.battery_heat_w), "W"),
-                Row::new("flight time", format!("{:.2}", h.flight_time_min), "min"),
-            ];
-            output::write_table(&mut out, &title, &rows)?;
-            if h.motor_voltage_v > h.pack_terminal_voltage_v {
-                writeln!(
-                    out,
-                    "  note: the motor needs {:.2} V but the pack delivers {:.2} V at this current ({:.1} % over full throttle)",
-                    h.motor_voltage_v,
-                    h.pack_terminal_voltage_v,
-                    100.0 * (h.motor_voltage_v / h.pack_terminal_voltage_v - 1.0)
-                )?;
-            }
-        }
+        Format::Table => write_table(&mut out, vehicle.name(), &h)?,
     }
     Ok(Outcome::Ok)
+}
+
+/// `FROM:TO:STEP` in kg.
+fn parse_range(spec: &str) -> Result<(f64, f64, f64)> {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [from, to, step] = parts.as_slice() else {
+        bail!("--sweep-takeoff-mass '{spec}': expected FROM:TO:STEP in kg, e.g. 7:13:0.5");
+    };
+    let num = |s: &str, what: &str| -> Result<f64> {
+        s.trim()
+            .parse::<f64>()
+            .with_context(|| format!("--sweep-takeoff-mass '{spec}': {what} '{s}' is not a number"))
+    };
+    Ok((num(from, "FROM")?, num(to, "TO")?, num(step, "STEP")?))
+}
+
+fn write_sweep_csv(out: impl Write, points: &[SweepPoint]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record([
+        "takeoff_mass_kg",
+        "thrust_per_rotor_n",
+        "rotor_speed_rpm",
+        "motor_current_a",
+        "pack_current_a",
+        "power_required_w",
+        "power_drawn_w",
+        "battery_heat_w",
+        "flight_time_min",
+        "error",
+    ])?;
+    for p in points {
+        let mut row = vec![p.takeoff_mass_kg.to_string()];
+        match &p.result {
+            Some(h) => row.extend(
+                [
+                    h.thrust_per_rotor_n,
+                    h.rotor_speed_rpm,
+                    h.motor_current_a,
+                    h.pack_current_a,
+                    h.power_required_w,
+                    h.power_drawn_w,
+                    h.battery_heat_w,
+                    h.flight_time_min,
+                ]
+                .map(|v| v.to_string()),
+            ),
+            None => row.extend(std::iter::repeat_n(String::new(), 8)),
+        }
+        row.push(p.error.clone().unwrap_or_default());
+        w.write_record(&row)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+fn write_sweep_table(out: &mut impl Write, name: &str, points: &[SweepPoint]) -> Result<()> {
+    writeln!(
+        out,
+        "{name}: hover across take-off mass (propulsion seed Fig. 13)"
+    )?;
+    writeln!(
+        out,
+        "{:>9} {:>9} {:>9} {:>9} {:>9} {:>9}  rotor rpm",
+        "mass kg", "power W", "drawn W", "pack A", "heat W", "time min"
+    )?;
+    for p in points {
+        match &p.result {
+            Some(h) => writeln!(
+                out,
+                "{:>9.2} {:>9.0} {:>9.0} {:>9.2} {:>9.0} {:>9.2}  {:.0}",
+                p.takeoff_mass_kg,
+                h.power_required_w,
+                h.power_drawn_w,
+                h.pack_current_a,
+                h.battery_heat_w,
+                h.flight_time_min,
+                h.rotor_speed_rpm
+            )?,
+            None => writeln!(
+                out,
+                "{:>9.2}  cannot hover: {}",
+                p.takeoff_mass_kg,
+                p.error.as_deref().unwrap_or_default()
+            )?,
+        }
+    }
+    Ok(())
+}
+
+fn write_table(out: &mut impl Write, name: &str, h: &HoverResult) -> Result<()> {
+    let title = format!(
+        "{}: hover at {:.3} kg take-off mass ({} rotors, {} packs)",
+        name, h.takeoff_mass_kg, h.rotor_count, h.pack_count
+    );
+    let rows = vec![
+        Row::new(
+            "thrust per rotor",
+            format!("{:.2}", h.thrust_per_rotor_n),
+            "N",
+        ),
+        Row::new("rotor speed", format!("{:.0}", h.rotor_speed_rpm), "rpm"),
+        Row::new("rotor torque", format!("{:.3}", h.torque_nm), "N m"),
+        Row::new("motor current", format!("{:.2}", h.motor_current_a), "A"),
+        Row::new("motor voltage", format!("{:.2}", h.motor_voltage_v), "V"),
+        Row::new("pack current", format!("{:.2}", h.pack_current_a), "A"),
+        Row::new(
+            "pack terminal voltage",
+            format!("{:.2}", h.pack_terminal_voltage_v),
+            "V",
+        ),
+        Row::new(
+            "power required (all motors)",
+            format!("{:.0}", h.power_required_w),
+            "W",
+        ),
+        Row::new(
+            "power drawn from packs",
+            format!("{:.0}", h.power_drawn_w),
+            "W",
+        ),
+        Row::new("heat in packs", format!("{:.0}", h.battery_heat_w), "W"),
+        Row::new("flight time", format!("{:.2}", h.flight_time_min), "min"),
+    ];
+    output::write_table(out, &title, &rows)?;
+    if h.motor_voltage_v > h.pack_terminal_voltage_v {
+        writeln!(
+            out,
+            "  note: the motor needs {:.2} V but the pack delivers {:.2} V at this current ({:.1} % over full throttle)",
+            h.motor_voltage_v,
+            h.pack_terminal_voltage_v,
+            100.0 * (h.motor_voltage_v / h.pack_terminal_voltage_v - 1.0)
+        )?;
+    }
+    Ok(())
 }
 
 fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Result<()> {

@@ -6,18 +6,16 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::Args;
-use serde::Serialize;
 
-use aloft::identify::{predict, validate_flight, FlightValidation, AIRSPEED_BANDS};
-use aloft::power::PowerModel;
+use aloft::engine::{validate_logs, PowerSeries, ValidateReport, ValidateRequest, Vehicle};
 
-use super::flights::{file_name, FlightLogs};
-use super::{load_vehicle, Format, Outcome};
+use super::flights::{file_name, FlightLogArgs};
+use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
     #[command(flatten)]
-    logs: FlightLogs,
+    logs: FlightLogArgs,
     /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     vehicle: String,
@@ -33,143 +31,73 @@ pub struct ValidateArgs {
     format: Format,
 }
 
-/// Mean over flights of one Table I cell.
-#[derive(Serialize)]
-struct MeanBand {
-    airspeed_band_mps: &'static str,
-    flights: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    nrmse_percent: Option<f64>,
-}
-
-#[derive(Serialize)]
-struct MeanRow {
-    dropped_term: &'static str,
-    nrmse_percent: f64,
-    bands: Vec<MeanBand>,
-}
-
-#[derive(Serialize)]
-struct Report {
-    vehicle: String,
-    flights: Vec<FlightValidation>,
-    /// Mean NRMSE over the flights, per dropped term and airspeed band (Table I layout).
-    table_i: Vec<MeanRow>,
-}
-
-fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
-    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-}
-
 pub fn run(args: ValidateArgs) -> Result<Outcome> {
-    let file = load_vehicle(&args.vehicle)?;
-    let model = PowerModel::new(file.power_vehicle()?);
-    let flights = args.logs.load()?;
-    let mut results = Vec::new();
-    for (flight, _) in &flights {
+    let vehicle = Vehicle::load(&args.vehicle)?;
+    let request = ValidateRequest {
+        logs: args.logs.logs(),
+        calibrate_first_s: args.calibrate_first,
+        series: args.plot.is_some(),
+    };
+    let answer = validate_logs(&vehicle, &request)?;
+    for f in &answer.report.flights {
         eprintln!(
             "aloft validate: {}: power lags motion by {:.2} s",
-            file_name(&flight.source),
-            flight.lag_s
+            file_name(&f.file),
+            f.lag_s
         );
-        results.push(validate_flight(&model, flight, args.calibrate_first)?);
     }
     if let Some(path) = &args.plot {
-        let series: Vec<Series> = flights
-            .iter()
-            .map(|(f, _)| {
-                let predicted = predict(&model, f)?;
-                let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
-                Ok((
-                    file_name(&f.source).to_string(),
-                    f.times_s.clone(),
-                    measured,
-                    predicted,
-                ))
-            })
-            .collect::<Result<_>>()?;
-        plot(path, &series).with_context(|| format!("cannot write the plot {}", path.display()))?;
+        plot(path, &answer.series)
+            .with_context(|| format!("cannot write the plot {}", path.display()))?;
     }
-    let table_i = results
-        .first()
-        .map(|first| {
-            first
-                .table_i
-                .iter()
-                .enumerate()
-                .map(|(row, r)| MeanRow {
-                    dropped_term: r.dropped_term,
-                    nrmse_percent: mean(results.iter().map(|f| f.table_i[row].nrmse_percent))
-                        .unwrap_or(f64::NAN),
-                    bands: AIRSPEED_BANDS
-                        .iter()
-                        .enumerate()
-                        .map(|(b, &(label, _, _))| {
-                            let cells: Vec<f64> = results
-                                .iter()
-                                .filter_map(|f| f.table_i[row].bands[b].nrmse_percent)
-                                .collect();
-                            MeanBand {
-                                airspeed_band_mps: label,
-                                flights: cells.len(),
-                                nrmse_percent: mean(cells.into_iter()),
-                            }
-                        })
-                        .collect(),
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    let report = Report {
-        vehicle: file.name.clone(),
-        flights: results,
-        table_i,
-    };
+    let report = &answer.report;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
-        Format::Json => super::output::write_json(&mut out, &report)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.write_record([
-                "file",
-                "duration_s",
-                "lag_s",
-                "measured_energy_wh",
-                "predicted_energy_wh",
-                "energy_error_percent",
-                "nrmse_percent",
-                "baseline_nrmse_percent",
-                "calibrated_energy_error_percent",
-                "calibrated_rmse_w",
-                "best_constant_rmse_w",
-            ])?;
-            for f in &report.flights {
-                let c = f.calibration.as_ref();
-                let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
-                w.write_record([
-                    f.file.clone(),
-                    f.duration_s.to_string(),
-                    f.lag_s.to_string(),
-                    f.measured_energy_wh.to_string(),
-                    f.predicted_energy_wh.to_string(),
-                    f.energy_error_percent.to_string(),
-                    f.nrmse_percent.to_string(),
-                    f.baseline_nrmse_percent.to_string(),
-                    opt(c.map(|c| c.energy_error_percent)),
-                    opt(c.map(|c| c.rmse_w)),
-                    opt(c.map(|c| c.best_constant_rmse_w)),
-                ])?;
-            }
-            w.flush()?;
-        }
-        Format::Table => render(&mut out, &report)?,
+        Format::Json => super::output::write_json(&mut out, report)?,
+        Format::Csv => write_csv(out, report)?,
+        Format::Table => render(&mut out, report)?,
     }
     Ok(Outcome::Ok)
 }
 
-fn render(out: &mut impl Write, r: &Report) -> Result<()> {
+fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record([
+        "file",
+        "duration_s",
+        "lag_s",
+        "measured_energy_wh",
+        "predicted_energy_wh",
+        "energy_error_percent",
+        "nrmse_percent",
+        "baseline_nrmse_percent",
+        "calibrated_energy_error_percent",
+        "calibrated_rmse_w",
+        "best_constant_rmse_w",
+    ])?;
+    for f in &report.flights {
+        let c = f.calibration.as_ref();
+        let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
+        w.write_record([
+            f.file.clone(),
+            f.duration_s.to_string(),
+            f.lag_s.to_string(),
+            f.measured_energy_wh.to_string(),
+            f.predicted_energy_wh.to_string(),
+            f.energy_error_percent.to_string(),
+            f.nrmse_percent.to_string(),
+            f.baseline_nrmse_percent.to_string(),
+            opt(c.map(|c| c.energy_error_percent)),
+            opt(c.map(|c| c.rmse_w)),
+            opt(c.map(|c| c.best_constant_rmse_w)),
+        ])?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
     writeln!(
         out,
         "aloft validate: vehicle {}, {} flight(s)",
@@ -222,8 +150,13 @@ fn render(out: &mut impl Write, r: &Report) -> Result<()> {
     }
     writeln!(out, "\nMean NRMSE (%) with each term removed, by airspeed band in m/s (power seed Table I layout):")?;
     write!(out, "  {:<10} {:>7}", "dropped", "all")?;
-    for (label, _, _) in AIRSPEED_BANDS {
-        write!(out, " {:>7}", label)?;
+    for b in r
+        .table_i
+        .first()
+        .map(|row| row.bands.as_slice())
+        .unwrap_or_default()
+    {
+        write!(out, " {:>7}", b.airspeed_band_mps)?;
     }
     writeln!(out)?;
     for row in &r.table_i {
@@ -239,9 +172,7 @@ fn render(out: &mut impl Write, r: &Report) -> Result<()> {
     Ok(())
 }
 
-type Series = (String, Vec<f64>, Vec<f64>, Vec<f64>);
-
-fn plot(path: &Path, series: &[Series]) -> Result<()> {
+fn plot(path: &Path, series: &[PowerSeries]) -> Result<()> {
     use plotters::prelude::*;
     let height = 260 * series.len().max(1) as u32;
     let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
@@ -268,7 +199,10 @@ fn plot(path: &Path, series: &[Series]) -> Result<()> {
             * 0.95;
         let mut chart = ChartBuilder::on(&area)
             .caption(
-                format!("{name}: measured and predicted electrical power"),
+                format!(
+                    "{}: measured and predicted electrical power",
+                    file_name(name)
+                ),
                 ("sans-serif", 16),
             )
             .margin(10)

@@ -2,9 +2,9 @@
 
 use std::io::Write;
 
+use aloft::engine::list_vehicles;
 use anyhow::Result;
 use clap::Args;
-use serde::Serialize;
 
 use super::{output, Format, Outcome};
 
@@ -15,36 +15,8 @@ pub struct VehiclesArgs {
     format: Format,
 }
 
-#[derive(Serialize)]
-struct Entry {
-    name: &'static str,
-    description: String,
-    mass_kg: Option<f64>,
-    models: Vec<&'static str>,
-}
-
 pub fn run(args: VehiclesArgs) -> Result<Outcome> {
-    let mut entries = Vec::new();
-    for b in aloft::vehicle::BUILTIN_VEHICLES {
-        let f = aloft::vehicle::VehicleFile::builtin(b.name)?;
-        let mut models = Vec::new();
-        if f.power.is_some() {
-            models.push("power");
-        }
-        if f.propulsion.is_some() {
-            models.push("propulsion");
-        }
-        entries.push(Entry {
-            name: b.name,
-            description: f.description.clone(),
-            mass_kg: f
-                .power
-                .as_ref()
-                .map(|p| p.mass_kg)
-                .or(f.propulsion.as_ref().map(|p| p.empty_mass_kg)),
-            models,
-        });
-    }
+    let entries = list_vehicles()?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {

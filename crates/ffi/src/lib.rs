@@ -49,9 +49,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{LazyLock, Mutex, MutexGuard};
 
 use aloft::engine::{
-    endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Plan, Vehicle,
+    endurance, plan_mission, power_point, EnduranceOptions, FlightState, Mission, MissionOptions,
+    Plan, PowerQuery, Vehicle,
 };
-use aloft::power::FlightState;
 use aloft::Error;
 
 /// Result of every fallible call. `ALOFT_STATUS_OK` (0) is success; see
@@ -556,13 +556,14 @@ pub unsafe extern "C" fn aloft_vehicle_power_json(
         let state = unsafe { text(state_json, "state_json")? };
         let s: StateJson = serde_json::from_str(state)
             .map_err(|e| Failure::new(AloftStatus::Parse, format!("invalid flight state: {e}")))?;
-        let p = v.power(&FlightState::new(
-            s.airspeed_mps,
-            s.roll_deg.to_radians(),
-            s.pitch_deg.to_radians(),
-            s.climb_rate_mps,
-        ))?;
-        let json = serde_json::to_string_pretty(&p)
+        let query = PowerQuery {
+            airspeed_mps: s.airspeed_mps,
+            roll_deg: s.roll_deg,
+            pitch_deg: s.pitch_deg,
+            climb_rate_mps: s.climb_rate_mps,
+            ..PowerQuery::default()
+        };
+        let json = serde_json::to_string_pretty(&power_point(v, &query)?)
             .map_err(|e| Failure::new(AloftStatus::InvalidInput, e.to_string()))?;
         give_string(json, out)
     })

@@ -32,7 +32,8 @@
 use nalgebra::{Rotation3, Vector3};
 
 /// Which angle-of-attack model the power model uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum AoaModel {
     /// The paper's eqs (3)-(4), from roll and pitch only.
     #[default]

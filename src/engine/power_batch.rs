@@ -76,22 +76,7 @@ pub fn power_csv<R: Read, W: Write>(
         .headers()
         .map_err(|e| csv_error(origin, 0, e))?
         .clone();
-    let column = |name: &str| headers.iter().position(|h| h == name);
-    let found = || headers.iter().collect::<Vec<_>>().join(",");
-    let mut required = [0usize; 3];
-    for (slot, name) in required
-        .iter_mut()
-        .zip(["airspeed_mps", "roll_deg", "pitch_deg"])
-    {
-        *slot = column(name).ok_or_else(|| Error::ColumnMissing {
-            column: name,
-            origin: origin.to_string(),
-            found: found(),
-        })?;
-    }
-    let climb_col = column("climb_rate_mps");
-    let dir_col = column("air_direction_deg");
-
+    let columns = Columns::find(&headers, origin)?;
     let mut writer = csv::Writer::from_writer(output);
     let mut header: Vec<&str> = headers.iter().collect();
     header.extend(POWER_KEYS);
@@ -109,6 +94,57 @@ pub fn power_csv<R: Read, W: Write>(
             Err(e) => return Err(csv_error(origin, row + 1, e)),
         }
         row += 1;
+        let state = columns.state(&record, origin, row)?;
+        let p = model.evaluate(&state).map_err(|e| Error::BadRow {
+            origin: origin.to_string(),
+            row,
+            source: e,
+        })?;
+        write_row(&mut writer, &record, &p, &mut text).map_err(|e| csv_error(origin, row, e))?;
+    }
+    writer.flush().map_err(|e| Error::Io {
+        origin: origin.to_string(),
+        source: e,
+    })?;
+    Ok(row as u64)
+}
+
+/// Where the state's fields are in the input.
+struct Columns {
+    airspeed: usize,
+    roll: usize,
+    pitch: usize,
+    climb: Option<usize>,
+    direction: Option<usize>,
+}
+
+impl Columns {
+    /// The required and optional columns of a header.
+    fn find(headers: &csv::StringRecord, origin: &str) -> Result<Self, Error> {
+        let column = |name: &str| headers.iter().position(|h| h == name);
+        let required = |name: &'static str| {
+            column(name).ok_or_else(|| Error::ColumnMissing {
+                column: name,
+                origin: origin.to_string(),
+                found: headers.iter().collect::<Vec<_>>().join(","),
+            })
+        };
+        Ok(Self {
+            airspeed: required("airspeed_mps")?,
+            roll: required("roll_deg")?,
+            pitch: required("pitch_deg")?,
+            climb: column("climb_rate_mps"),
+            direction: column("air_direction_deg"),
+        })
+    }
+
+    /// The flight state of one row (a non-empty direction selects the geometric angle of attack).
+    fn state(
+        &self,
+        record: &csv::StringRecord,
+        origin: &str,
+        row: usize,
+    ) -> Result<FlightState, Error> {
         let field = |idx: usize, name: &'static str| -> Result<f64, Error> {
             let raw = record.get(idx).unwrap_or("");
             raw.parse::<f64>().map_err(|_| Error::BadValue {
@@ -124,49 +160,42 @@ pub fn power_csv<R: Read, W: Write>(
                 _ => Ok(None),
             }
         };
-        let airspeed = field(required[0], "airspeed_mps")?;
-        let roll = field(required[1], "roll_deg")?;
-        let pitch = field(required[2], "pitch_deg")?;
-        let climb = optional(climb_col, "climb_rate_mps")?.unwrap_or(0.0);
-        let aoa = match optional(dir_col, "air_direction_deg")? {
+        let airspeed = field(self.airspeed, "airspeed_mps")?;
+        let roll = field(self.roll, "roll_deg")?;
+        let pitch = field(self.pitch, "pitch_deg")?;
+        let climb = optional(self.climb, "climb_rate_mps")?.unwrap_or(0.0);
+        let aoa = match optional(self.direction, "air_direction_deg")? {
             Some(d) => AoaInput::Geometric {
                 air_direction_rad: d.to_radians(),
             },
             None => AoaInput::Paper,
         };
-        let state = FlightState {
+        Ok(FlightState {
             airspeed_mps: airspeed,
             roll_rad: roll.to_radians(),
             pitch_rad: pitch.to_radians(),
             climb_rate_mps: climb,
             aoa,
-        };
-        let p = model.evaluate(&state).map_err(|e| Error::BadRow {
-            origin: origin.to_string(),
-            row,
-            source: e,
-        })?;
-        for f in record.iter() {
-            writer
-                .write_field(f)
-                .map_err(|e| csv_error(origin, row, e))?;
-        }
-        for v in power_values(&p) {
-            text.clear();
-            write!(text, "{v}").expect("writing to a String cannot fail");
-            writer
-                .write_field(&text)
-                .map_err(|e| csv_error(origin, row, e))?;
-        }
-        writer
-            .write_record(None::<&[u8]>)
-            .map_err(|e| csv_error(origin, row, e))?;
+        })
     }
-    writer.flush().map_err(|e| Error::Io {
-        origin: origin.to_string(),
-        source: e,
-    })?;
-    Ok(row as u64)
+}
+
+/// The input row followed by the result's values (shortest round-trip formatting).
+fn write_row<W: Write>(
+    writer: &mut csv::Writer<W>,
+    record: &csv::StringRecord,
+    p: &PowerBreakdown,
+    text: &mut String,
+) -> Result<(), csv::Error> {
+    for f in record.iter() {
+        writer.write_field(f)?;
+    }
+    for v in power_values(p) {
+        text.clear();
+        write!(text, "{v}").expect("writing to a String cannot fail");
+        writer.write_field(&*text)?;
+    }
+    writer.write_record(None::<&[u8]>)
 }
 
 #[cfg(test)]

@@ -1,0 +1,87 @@
+//! `aloft mission --replay`: the energy of a recorded flight from its trajectory alone.
+
+use anyhow::{bail, Result};
+
+use aloft::engine::{replay_log, ReplayAcceleration, ReplayAnswer, ReplayRequest, Vehicle};
+
+use super::mission::{AccelArg, MissionArgs};
+use super::output::{self, Row};
+use super::{Format, Outcome};
+
+pub fn run(args: &MissionArgs) -> Result<Outcome> {
+    let Some(log) = &args.replay else {
+        bail!("--replay needs a log");
+    };
+    if args.format == Format::Csv {
+        bail!("aloft mission --replay writes table or json");
+    }
+    if args.wind.wind_field.is_some() || args.wind.gust_std.is_some() {
+        bail!("--replay takes a steady wind (--wind-speed, --wind-from) for logs without one; a field or gusts belong to a planned mission");
+    }
+    let vehicle = Vehicle::load(&args.vehicle)?;
+    let request = ReplayRequest {
+        log: log.clone(),
+        profile: args.profile.clone(),
+        payload_kg: args.payload_kg.unwrap_or(0.0),
+        lag_s: args.lag,
+        acceleration: match args.acceleration {
+            AccelArg::Velocity => ReplayAcceleration::Velocity,
+            AccelArg::Log => ReplayAcceleration::Log,
+        },
+        acceleration_window_s: args.acceleration_window,
+        aoa: args.aoa,
+        wind: args.wind.steady.spec(),
+    };
+    let answer = replay_log(&vehicle, &request)?;
+    for n in &answer.context.notes {
+        eprintln!("aloft mission --replay: {n}");
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Table | Format::Csv => write_table(&mut out, &answer)?,
+    }
+    Ok(Outcome::Ok)
+}
+
+fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
+    writeln!(
+        out,
+        "Replay of {}: {} trajectory points, {:.0} s, vehicle {} at {:.3} kg",
+        a.file, a.points, a.duration_s, a.vehicle, a.mass_kg
+    )?;
+    writeln!(
+        out,
+        "Acceleration: {}; wind: {}",
+        a.context.acceleration, a.context.wind
+    )?;
+    writeln!(out)?;
+    let mut rows = vec![Row::new(
+        "predicted energy (trajectory only)",
+        format!("{:.1}", a.predicted_energy_wh),
+        "Wh",
+    )];
+    match a.measured_energy_wh {
+        Some(m) => {
+            rows.push(Row::new("measured energy (V x I)", format!("{m:.1}"), "Wh"));
+            rows.push(Row::new(
+                "error",
+                format!("{:+.2}", a.energy_error_percent.unwrap_or(0.0)),
+                "%",
+            ));
+            rows.push(Row::new(
+                "lag of power behind motion",
+                format!("{:.2}", a.lag_s.unwrap_or(0.0)),
+                "s",
+            ));
+        }
+        None => rows.push(Row::new(
+            "measured energy",
+            "no power in the log".to_string(),
+            "",
+        )),
+    }
+    output::write_table(out, "Replay", &rows)?;
+    Ok(())
+}

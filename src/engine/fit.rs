@@ -1,0 +1,258 @@
+//! Identification: the power model of a vehicle fitted to flight logs (lag alignment,
+//! Gauss-Newton on the lumped constants, drag from the force balance, pack resistance), written
+//! as a vehicle file.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use serde::Serialize;
+
+use aloft_power::fit::{DragFit, FitParameter, ForceSample, PowerFit};
+use aloft_power::{fit_drag, fit_power_model, FitOptions, FitSample};
+use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
+
+use super::logs::FlightLogs;
+use super::vehicles::Vehicle;
+use crate::error::Error;
+use crate::identify::force_samples;
+use crate::vehicle::VehicleFile;
+
+/// A callback for long fits: Gauss-Newton iteration and residual norm (W).
+pub type FitProgress = Arc<dyn Fn(u64, f64) + Send + Sync>;
+
+/// A fit request (the options of `aloft fit`).
+#[derive(Clone)]
+pub struct FitRequest {
+    /// The logs and how to align them.
+    pub logs: FlightLogs,
+    /// Lumped constants to fit (default: `k`, weight over efficiency).
+    pub free: Vec<FitParameter>,
+    /// Keep the template's drag instead of fitting it from the force balance.
+    pub no_drag: bool,
+    /// Where the fitted vehicle file is written (`None`: not written).
+    pub output: Option<PathBuf>,
+    /// Called at each Gauss-Newton iteration.
+    pub progress: Option<FitProgress>,
+}
+
+impl Default for FitRequest {
+    fn default() -> Self {
+        Self {
+            logs: FlightLogs::default(),
+            free: vec![FitParameter::WeightOverEfficiency],
+            no_drag: false,
+            output: None,
+            progress: None,
+        }
+    }
+}
+
+/// A fit parameter by the name the command line uses: `k` (also `eta`, `efficiency`), `vh`,
+/// `profile` (`kappa1`), `mu1`, `mu2`, `mu3`.
+///
+/// # Errors
+/// [`Error::UnknownName`] for any other name.
+pub fn fit_parameter(name: &str) -> Result<FitParameter, Error> {
+    Ok(match name.trim().to_ascii_lowercase().as_str() {
+        "k" | "eta" | "efficiency" => FitParameter::WeightOverEfficiency,
+        "vh" => FitParameter::HoverInducedVelocity,
+        "profile" | "kappa1" => FitParameter::Profile,
+        "mu1" => FitParameter::Mu1,
+        "mu2" => FitParameter::Mu2,
+        "mu3" => FitParameter::Mu3,
+        other => {
+            return Err(Error::UnknownName {
+                what: "--free parameter",
+                name: other.to_string(),
+                known: "k, vh, profile, mu1, mu2, mu3",
+            })
+        }
+    })
+}
+
+/// One log of a fit: its alignment and pack.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogFitReport {
+    /// The file.
+    pub file: String,
+    /// Lag of power behind motion applied, s.
+    pub lag_s: f64,
+    /// Correlation of power with tilt at that lag (absent when the lag was given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag_correlation: Option<f64>,
+    /// Aligned samples.
+    pub samples: usize,
+    /// Motion samples left out.
+    pub skipped: usize,
+    /// Pack internal resistance from voltage and current, when logged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pack: Option<PackResistanceFit>,
+}
+
+/// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FitAnswer {
+    /// Per log.
+    pub logs: Vec<LogFitReport>,
+    /// The power-model fit.
+    pub power: PowerFit,
+    /// Drag from the force balance, when fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drag: Option<DragFit>,
+    /// Where the vehicle file was written (empty when it was not).
+    pub output: String,
+    /// The fitted vehicle file (TOML with the statistics in a comment header; not in the JSON).
+    #[serde(skip)]
+    pub vehicle_toml: String,
+    /// Notes for the reader (e.g. why drag was not fitted; not in the JSON).
+    #[serde(skip)]
+    pub notes: Vec<String>,
+}
+
+/// Fit the power model of `template` to the request's logs: align each log, fit drag from the
+/// force balance (unless asked not to, or asked of power), fit the free constants by
+/// Gauss-Newton, fit each pack's resistance, and write the template with its `[power]` table
+/// replaced.
+///
+/// # Errors
+/// Unreadable logs, logs without power or motion, a template without `[power]`, a fit the data
+/// cannot identify, an output that cannot be written.
+pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
+    let mut vehicle = template.power_model()?.vehicle().clone();
+    let flights = request.logs.load()?;
+    let mut logs = Vec::new();
+    let mut samples: Vec<FitSample> = Vec::new();
+    let mut forces: Vec<ForceSample> = Vec::new();
+    for (flight, log) in &flights {
+        samples.extend_from_slice(&flight.samples);
+        forces.extend(force_samples(log));
+        logs.push(LogFitReport {
+            file: flight.source.clone(),
+            lag_s: flight.lag_s,
+            lag_correlation: flight.lag_correlation,
+            samples: flight.samples.len(),
+            skipped: flight.skipped,
+            pack: pack_fit(log),
+        });
+    }
+    let mut notes = Vec::new();
+    let drag = drag_fit(request, &forces, &mut notes, &mut vehicle)?;
+    let mut options = FitOptions::known_geometry();
+    options.free = request.free.clone();
+    if let Some(p) = &request.progress {
+        let p = p.clone();
+        options.progress = Some(Arc::new(move |i, cost| p(i, cost)));
+    }
+    let power = fit_power_model(&vehicle, &samples, &options)?;
+    let vehicle_toml =
+        fitted_vehicle_toml(template.file(), &power, drag.as_ref(), &logs, &vehicle)?;
+    if let Some(path) = &request.output {
+        std::fs::write(path, &vehicle_toml).map_err(|source| Error::Io {
+            origin: format!("cannot write {}", path.display()),
+            source,
+        })?;
+    }
+    Ok(FitAnswer {
+        logs,
+        power,
+        drag,
+        output: request
+            .output
+            .as_ref()
+            .map(|p| p.display().to_string())
+            .unwrap_or_default(),
+        vehicle_toml,
+        notes,
+    })
+}
+
+/// Pack resistance of one log, when it has voltage and current.
+fn pack_fit(log: &aloft_logs::Log) -> Option<PackResistanceFit> {
+    let (mut t, mut i, mut v) = (Vec::new(), Vec::new(), Vec::new());
+    for s in &log.samples {
+        if let (Some(cur), Some(vol)) = (s.current_a, s.voltage_v) {
+            t.push(s.time_s);
+            i.push(cur);
+            v.push(vol);
+        }
+    }
+    fit_pack_resistance(&t, &i, &v).ok()
+}
+
+/// Drag from the force balance, unless asked not to or asked of power; the fitted drag replaces
+/// the vehicle's.
+fn drag_fit(
+    request: &FitRequest,
+    forces: &[ForceSample],
+    notes: &mut Vec<String>,
+    vehicle: &mut aloft_power::Vehicle,
+) -> Result<Option<DragFit>, Error> {
+    let drag_in_free = request
+        .free
+        .iter()
+        .any(|p| matches!(p, FitParameter::Mu1 | FitParameter::Mu2 | FitParameter::Mu3));
+    if request.no_drag || drag_in_free {
+        return Ok(None);
+    }
+    if forces.is_empty() {
+        notes.push(
+            "the logs carry no acceleration: drag (mu1..mu3) kept from the template".to_string(),
+        );
+        return Ok(None);
+    }
+    let d = fit_drag(vehicle.mass_kg(), vehicle.gravity_mps2(), forces, 1.0, 5.0)
+        .map_err(|source| Error::Drag { source })?;
+    let mut p = vehicle.params().clone();
+    [p.mu1_n_s_per_m, p.mu2_n_s2_per_m2, p.mu3_n_s3_per_m3] = d.mu_n;
+    *vehicle = aloft_power::Vehicle::new(p)?;
+    Ok(Some(d))
+}
+
+/// The fitted vehicle file: the template with its `[power]` table replaced and the statistics in
+/// a comment header.
+fn fitted_vehicle_toml(
+    template: &VehicleFile,
+    fit: &PowerFit,
+    drag: Option<&DragFit>,
+    logs: &[LogFitReport],
+    vehicle: &aloft_power::Vehicle,
+) -> Result<String, Error> {
+    let mut fitted = template.clone();
+    fitted.name = format!("{}-fitted", template.name);
+    fitted.description = format!(
+        "{} (fitted by aloft fit from {} log(s), RMSE {:.1} W, NRMSE {:.2} %)",
+        template.description,
+        logs.len(),
+        fit.rmse_w,
+        100.0 * fit.nrmse
+    );
+    fitted.power = Some(fit.vehicle.clone());
+    let mut text = String::new();
+    text.push_str(
+        "# Written by `aloft fit`. Fitted constants (lumped; see aloft_power::fit::power):\n",
+    );
+    for p in &fit.parameters {
+        text.push_str(&format!(
+            "#   {} = {:.6e} +/- {:.2e} {}\n",
+            p.name, p.value, p.std_error, p.unit
+        ));
+    }
+    if let Some(d) = drag {
+        text.push_str(&format!(
+            "# Drag from the force balance ({} samples, mass {} kg): mu = {:.4}, {:.5}, {:.6} (+/- {:.2e}, {:.2e}, {:.2e})\n",
+            d.samples_used, vehicle.mass_kg(), d.mu_n[0], d.mu_n[1], d.mu_n[2], d.std_error[0], d.std_error[1], d.std_error[2]
+        ));
+    }
+    for l in logs {
+        text.push_str(&format!(
+            "# Log {}: lag {:.2} s, {} samples\n",
+            l.file, l.lag_s, l.samples
+        ));
+    }
+    let body = toml::to_string(&fitted).map_err(|e| Error::VehicleFormat {
+        origin: fitted.name.clone(),
+        message: e.to_string(),
+    })?;
+    text.push_str(&body);
+    Ok(text)
+}

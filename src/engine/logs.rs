@@ -1,0 +1,449 @@
+//! Flight logs: what a log holds ([`log_info`]), a log as MCAP ([`convert_log`]), and the logs
+//! a fit or a validation reads ([`FlightLogs`]).
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use aloft_logs::sample::{Gap, NonMonotonic};
+use aloft_logs::{
+    estimate_lag_s, open_log, resample_uniform, Channel, DroppedValue, InfoAccumulator, LogFormat,
+    LogReader, McapOptions, McapTime, McapWriter, Profile, TimeReport,
+};
+use aloft_power::AoaModel;
+
+use crate::error::Error;
+use crate::identify::{align_flight, AlignOptions, AlignedFlight};
+
+/// How to read a log: the CSV profile and the MCAP options (the options every log command
+/// shares).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LogReadOptions {
+    /// CSV profile: `kaist`, `px4`, or a column-map TOML file; `None`: recognised from the file.
+    pub profile: Option<String>,
+    /// MCAP: decode only these topics; empty: chosen by message type.
+    pub topics: Vec<String>,
+    /// MCAP: use the header stamps instead of the recording's log time.
+    pub header_time: bool,
+    /// MCAP: `sensor_msgs/BatteryState` current positive while discharging.
+    pub battery_current_positive: bool,
+}
+
+impl LogReadOptions {
+    fn profile(&self) -> Result<Option<Profile>, Error> {
+        Ok(self.profile.as_deref().map(Profile::resolve).transpose()?)
+    }
+
+    fn mcap(&self) -> McapOptions {
+        let mut o = McapOptions {
+            topics: self.topics.clone(),
+            ..McapOptions::default()
+        };
+        if self.header_time {
+            o.time = McapTime::HeaderStamp;
+        }
+        o.decode.battery_current_positive_discharging = self.battery_current_positive;
+        o
+    }
+
+    /// Open `path` as a stream of samples.
+    fn open(&self, path: &Path) -> Result<(LogReader, Option<Profile>), Error> {
+        let profile = self.profile()?;
+        let reader = open_log(path, profile.as_ref(), &self.mcap())?;
+        Ok((reader, profile))
+    }
+}
+
+/// One channel of a log: how many samples and at what rate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogChannel {
+    /// The channel.
+    pub channel: Channel,
+    /// Samples that carry it.
+    pub samples: u64,
+    /// Mean rate, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_hz: Option<f64>,
+}
+
+/// One MCAP topic.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogTopic {
+    /// Topic name.
+    pub topic: String,
+    /// Schema name.
+    pub schema: String,
+    /// Message encoding.
+    pub message_encoding: String,
+    /// Messages on the topic.
+    pub messages: u64,
+    /// Messages decoded.
+    pub decoded: u64,
+    /// Mean rate, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_hz: Option<f64>,
+    /// Channels it fed.
+    pub used_for: Vec<Channel>,
+}
+
+/// The regularity of a log's time base (the first ten gaps and backward steps).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogTime {
+    /// The typical sample period, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_period_s: Option<f64>,
+    /// Gaps longer than three periods.
+    pub gap_count: u64,
+    /// Steps backwards in time.
+    pub non_monotonic_count: u64,
+    /// The first gaps.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub gaps: Vec<Gap>,
+    /// The first backward steps.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub non_monotonic: Vec<NonMonotonic>,
+}
+
+impl From<&TimeReport> for LogTime {
+    fn from(r: &TimeReport) -> Self {
+        Self {
+            nominal_period_s: r.nominal_period_s,
+            gap_count: r.gap_count,
+            non_monotonic_count: r.non_monotonic_count,
+            gaps: r.gaps.iter().take(10).copied().collect(),
+            non_monotonic: r.non_monotonic.iter().take(10).copied().collect(),
+        }
+    }
+}
+
+/// The lag of power behind ground speed, by cross-correlation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LagInfo {
+    /// Lag, s.
+    pub lag_s: f64,
+    /// Correlation at the lag.
+    pub correlation: f64,
+    /// Correlation at zero lag.
+    pub correlation_at_zero: f64,
+    /// True when the best lag is at the edge of the search window.
+    pub at_window_edge: bool,
+}
+
+/// What a log holds: the JSON of `aloft log info --format json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogInfo {
+    /// The file.
+    pub file: String,
+    /// Its format.
+    pub format: LogFormat,
+    /// The CSV profile used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile: Option<String>,
+    /// Samples read.
+    pub samples: u64,
+    /// Time from the first to the last sample, s.
+    pub duration_s: f64,
+    /// Time of the first sample in the log's own clock, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_time_s: Option<f64>,
+    /// Channels found.
+    pub channels: Vec<LogChannel>,
+    /// CSV columns.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub columns: Option<Vec<String>>,
+    /// MCAP topics.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub topics: Option<Vec<LogTopic>>,
+    /// Whether the log has electrical power (voltage and current, or a power channel).
+    pub power_available: bool,
+    /// Energy used (trapezoid of V x I), Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub energy_wh: Option<f64>,
+    /// Mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_power_w: Option<f64>,
+    /// Largest power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_power_w: Option<f64>,
+    /// Regularity of the time base.
+    pub time: LogTime,
+    /// Values left out as isolated contradictions (e.g. power far from V x I on one row).
+    pub dropped_values: u64,
+    /// The first ten of them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dropped: Vec<DroppedValue>,
+    /// With a lag search: the lag of power behind ground speed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag: Option<LagInfo>,
+}
+
+/// Power and ground-speed series kept for the lag search.
+#[derive(Default)]
+struct LagSeries {
+    power_t: Vec<f64>,
+    power_w: Vec<f64>,
+    speed_t: Vec<f64>,
+    speed_mps: Vec<f64>,
+}
+
+/// Summarise the log at `path`: duration, rates, channels or topics, energy used, the regularity
+/// of the time base; with `lag_window_s`, the lag of power behind ground speed searched within
+/// +-that many seconds.
+///
+/// # Errors
+/// A log that cannot be opened or decoded; a lag search on a log without power or velocity.
+pub fn log_info(
+    path: &Path,
+    options: &LogReadOptions,
+    lag_window_s: Option<f64>,
+) -> Result<LogInfo, Error> {
+    let (mut reader, profile) = options.open(path)?;
+    let mut acc = InfoAccumulator::new();
+    let mut series = LagSeries::default();
+    for s in reader.by_ref() {
+        let s = s?;
+        acc.push(&s);
+        if lag_window_s.is_some() {
+            if let Some(w) = s.electrical_power_w() {
+                series.power_t.push(s.time_s);
+                series.power_w.push(w);
+            }
+            if let Some(u) = s.vel_enu_mps {
+                series.speed_t.push(s.time_s);
+                series.speed_mps.push(u[0].hypot(u[1]));
+            }
+        }
+    }
+    let stats = acc.finish();
+    let time = reader.time_report();
+    let (dropped_values, mut dropped) = reader.dropped();
+    dropped.truncate(10);
+    let file = path.display().to_string();
+    let lag = match lag_window_s {
+        None => None,
+        Some(max) => Some(lag_of(&file, &series, time.nominal_period_s, max)?),
+    };
+    Ok(LogInfo {
+        format: reader.format(),
+        profile: match reader.format() {
+            LogFormat::Mcap => None,
+            LogFormat::Px4Csv => Some("px4".into()),
+            LogFormat::Csv => Some(profile.map_or("kaist".into(), |p| p.name())),
+        },
+        samples: stats.samples,
+        duration_s: stats.duration_s,
+        start_time_s: reader.start_time_s(),
+        channels: stats
+            .channels
+            .iter()
+            .map(|c| LogChannel {
+                channel: c.channel,
+                samples: c.samples,
+                rate_hz: c.rate_hz(),
+            })
+            .collect(),
+        columns: reader.columns().map(|c| c.to_vec()),
+        topics: reader.topics().map(|t| t.iter().map(topic).collect()),
+        power_available: stats.energy_wh.is_some() || stats.mean_power_w.is_some(),
+        energy_wh: stats.energy_wh,
+        mean_power_w: stats.mean_power_w,
+        max_power_w: stats.max_power_w,
+        time: LogTime::from(&time),
+        dropped_values,
+        dropped,
+        lag,
+        file,
+    })
+}
+
+fn topic(t: &aloft_logs::TopicInfo) -> LogTopic {
+    LogTopic {
+        topic: t.topic.clone(),
+        schema: t.schema.clone(),
+        message_encoding: t.message_encoding.clone(),
+        messages: t.messages,
+        decoded: t.decoded,
+        rate_hz: t.rate_hz(),
+        used_for: t.used_for.clone(),
+    }
+}
+
+/// The lag of power behind ground speed: both series resampled on one grid over their common
+/// span, then cross-correlated.
+fn lag_of(
+    file: &str,
+    s: &LagSeries,
+    nominal_period_s: Option<f64>,
+    max_lag_s: f64,
+) -> Result<LagInfo, Error> {
+    if s.power_w.is_empty() {
+        return Err(Error::MissingChannel {
+            origin: file.to_string(),
+            needed_for: "--lag",
+            channel: "power data (voltage and current)",
+        });
+    }
+    if s.speed_mps.is_empty() {
+        return Err(Error::MissingChannel {
+            origin: file.to_string(),
+            needed_for: "--lag",
+            channel: "velocity data",
+        });
+    }
+    let dt = nominal_period_s.unwrap_or(0.1);
+    let (t0p, pu) = resample_uniform(&s.power_t, &s.power_w, dt)?;
+    let (t0v, vu) = resample_uniform(&s.speed_t, &s.speed_mps, dt)?;
+    // Align both grids on their common span.
+    let off_p = ((t0v - t0p) / dt).round().max(0.0) as usize;
+    let off_v = ((t0p - t0v) / dt).round().max(0.0) as usize;
+    let n = pu
+        .len()
+        .saturating_sub(off_p)
+        .min(vu.len().saturating_sub(off_v));
+    let e = estimate_lag_s(&pu[off_p..off_p + n], &vu[off_v..off_v + n], dt, max_lag_s).map_err(
+        |e| Error::Log {
+            origin: "lag estimation".to_string(),
+            source: Box::new(e),
+        },
+    )?;
+    Ok(LagInfo {
+        lag_s: e.lag_s,
+        correlation: e.correlation,
+        correlation_at_zero: e.correlation_at_zero,
+        at_window_edge: e.at_window_edge,
+    })
+}
+
+/// Messages written to one topic by [`convert_log`].
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TopicCount {
+    /// Topic name.
+    pub topic: String,
+    /// Messages written.
+    pub messages: u64,
+}
+
+/// The answer of [`convert_log`] (the JSON of `aloft convert --format json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ConvertSummary {
+    /// The log read.
+    pub input: String,
+    /// The MCAP file written.
+    pub output: String,
+    /// Samples converted.
+    pub samples: u64,
+    /// Messages per topic.
+    pub topics: Vec<TopicCount>,
+    /// Gaps and backward steps of the input's time base, kept as they are (not part of the JSON).
+    #[serde(skip)]
+    pub time_notes: Option<(u64, u64)>,
+}
+
+/// Convert the log at `input` to MCAP (JSON with JSON Schemas) at `output`. The first sample is
+/// read before the output is created, so a bad input leaves no file; a failure while converting
+/// removes the half-written file.
+///
+/// # Errors
+/// A log that cannot be opened or decoded, holds no samples, or an output that cannot be
+/// written.
+pub fn convert_log(
+    input: &Path,
+    options: &LogReadOptions,
+    output: &Path,
+) -> Result<ConvertSummary, Error> {
+    let (mut reader, _) = options.open(input)?;
+    let first = match reader.next() {
+        Some(s) => s?,
+        None => {
+            return Err(Error::EmptyLog {
+                origin: input.display().to_string(),
+            })
+        }
+    };
+    let mut w = McapWriter::create(output)?;
+    if let Some(t) = reader.start_time_s().filter(|t| *t > 0.0) {
+        w.set_start_ns((t * 1e9).round() as u64);
+    }
+    w.write_sample(0, &first)?;
+    let mut n = 1u64;
+    let result = (|| -> Result<(), Error> {
+        for s in reader.by_ref() {
+            w.write_sample(n as usize, &s?)?;
+            n += 1;
+        }
+        Ok(())
+    })();
+    if let Err(e) = result {
+        // Do not leave a half-written file that looks valid.
+        drop(w);
+        let _ = std::fs::remove_file(output);
+        return Err(e);
+    }
+    let summary = w.finish()?;
+    let time = reader.time_report();
+    Ok(ConvertSummary {
+        input: input.display().to_string(),
+        output: output.display().to_string(),
+        samples: n,
+        topics: summary
+            .messages
+            .iter()
+            .map(|(t, m)| TopicCount {
+                topic: t.clone(),
+                messages: *m,
+            })
+            .collect(),
+        time_notes: (!time.is_clean()).then_some((time.gap_count, time.non_monotonic_count)),
+    })
+}
+
+/// The flight logs a fit or a validation reads, and how to align power with motion in them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlightLogs {
+    /// The log files (CSV or MCAP).
+    pub logs: Vec<PathBuf>,
+    /// CSV profile: `kaist`, `px4` or a column-map TOML; `None`: recognised from the file.
+    pub profile: Option<String>,
+    /// Angle-of-attack model for the logged states.
+    pub aoa: AoaModel,
+    /// Use this lag of power behind motion instead of estimating it, s.
+    pub lag_s: Option<f64>,
+    /// Search window of the lag estimate, s.
+    pub max_lag_s: f64,
+}
+
+impl Default for FlightLogs {
+    fn default() -> Self {
+        Self {
+            logs: Vec::new(),
+            profile: None,
+            aoa: AoaModel::Geometric,
+            lag_s: None,
+            max_lag_s: 10.0,
+        }
+    }
+}
+
+impl FlightLogs {
+    /// Read every log, align power with motion, and set the angle-of-attack model.
+    pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
+        let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;
+        let align = AlignOptions {
+            max_lag_s: self.max_lag_s,
+            lag_s: self.lag_s,
+            ..AlignOptions::default()
+        };
+        let mut out = Vec::new();
+        for path in &self.logs {
+            let log = aloft_logs::read_log(path, profile.as_ref(), &Default::default())?;
+            let mut flight = align_flight(&log, &align)?;
+            if self.aoa == AoaModel::Paper {
+                for s in &mut flight.samples {
+                    s.state.aoa = aloft_power::AoaInput::Paper;
+                }
+            }
+            out.push((flight, log));
+        }
+        Ok(out)
+    }
+}

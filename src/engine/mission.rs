@@ -1,0 +1,589 @@
+//! Missions: load one (a file, text, the built-in demo), plan it with a vehicle, and what the
+//! plan answers (summary, samples, what is left after a time, files for other tools).
+
+use std::path::{Path, PathBuf};
+
+use aloft_core::Trapezoid;
+use serde::{Deserialize, Serialize};
+
+use aloft_planner::{Battery, MissionReport, MissionSpec, PlanOptions, Wind, WindSpec};
+use aloft_power::AoaModel;
+
+use super::files::read_text_file;
+use super::summary::{mission_summary, MissionSummary};
+use super::vehicles::Vehicle;
+use super::wind::{mission_wind, GustSpec};
+use crate::error::Error;
+
+/// The built-in demonstration mission (identical to `fixtures/missions/demo-survey.toml`): four
+/// survey lines and a two-lap orbit in a 6 m/s breeze.
+pub const DEMO_MISSION: &str = include_str!("../../fixtures/missions/demo-survey.toml");
+
+/// Origin the CLI gives the built-in demonstration mission (its name when the file has none).
+pub const DEMO_ORIGIN: &str = "built-in demo";
+
+/// A mission to plan: the parsed mission file and where it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mission {
+    spec: MissionSpec,
+    origin: String,
+}
+
+impl Mission {
+    /// The mission file at `path` (TOML, or JSON when its first non-blank character is `{`), or
+    /// the built-in demonstration mission when `path` is `None`.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read, [`Error::MissionFormat`] when it does not
+    /// parse.
+    pub fn load(path: Option<&Path>) -> Result<Self, Error> {
+        match path {
+            None => Ok(Self::demo()),
+            Some(p) => {
+                let text = read_text_file(p, "mission file")?;
+                Self::from_text(&text, &p.display().to_string())
+            }
+        }
+    }
+
+    /// The built-in demonstration mission ([`DEMO_MISSION`]).
+    pub fn demo() -> Self {
+        // Parsed once per call; the text is compiled in and checked by a unit test.
+        match MissionSpec::from_toml_str(DEMO_MISSION) {
+            Ok(spec) => Self {
+                spec,
+                origin: DEMO_ORIGIN.to_string(),
+            },
+            // Unreachable for the committed fixture; an empty mission fails cleanly at planning.
+            Err(_) => Self {
+                spec: MissionSpec {
+                    name: String::new(),
+                    description: String::new(),
+                    payload_kg: 0.0,
+                    reserve_percent: None,
+                    time_step_s: None,
+                    home: Default::default(),
+                    wind: None,
+                    segments: Vec::new(),
+                },
+                origin: DEMO_ORIGIN.to_string(),
+            },
+        }
+    }
+
+    /// A mission from TOML text (the mission file format); `origin` names it in messages and is
+    /// the mission's name in the summary when the file has no `name`.
+    ///
+    /// # Errors
+    /// [`Error::MissionFormat`] with the parser's line, column and key.
+    pub fn from_toml(text: &str, origin: &str) -> Result<Self, Error> {
+        let spec = MissionSpec::from_toml_str(text).map_err(|e| Error::MissionFormat {
+            origin: origin.to_string(),
+            message: match e {
+                aloft_planner::PlannerError::MissionFormat { message } => message,
+                other => other.to_string(),
+            },
+        })?;
+        Ok(Self {
+            spec,
+            origin: origin.to_string(),
+        })
+    }
+
+    /// A mission from JSON text: the mission file's structure, e.g.
+    /// `{"name": "m", "segment": [{"kind": "take-off", "altitude_m": 20, "climb_rate_mps": 2}, ...]}`.
+    ///
+    /// # Errors
+    /// [`Error::MissionFormat`] with the parser's line, column and key.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, Error> {
+        let spec: MissionSpec = serde_json::from_str(text).map_err(|e| Error::MissionFormat {
+            origin: origin.to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(Self {
+            spec,
+            origin: origin.to_string(),
+        })
+    }
+
+    /// JSON when the first non-blank character is `{`, TOML otherwise.
+    ///
+    /// # Errors
+    /// As [`Mission::from_json`] or [`Mission::from_toml`].
+    pub fn from_text(text: &str, origin: &str) -> Result<Self, Error> {
+        if text.trim_start().starts_with('{') {
+            Self::from_json(text, origin)
+        } else {
+            Self::from_toml(text, origin)
+        }
+    }
+
+    /// The mission as JSON text that [`Mission::from_json`] reads back.
+    ///
+    /// # Errors
+    /// [`Error::OptionsFormat`] if serialisation fails (non-finite numbers cannot occur in a
+    /// parsed mission, so in practice it does not).
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string(&self.spec).map_err(|e| Error::OptionsFormat {
+            what: "mission",
+            message: e.to_string(),
+        })
+    }
+
+    /// The parsed mission file.
+    pub fn spec(&self) -> &MissionSpec {
+        &self.spec
+    }
+
+    /// Where it came from.
+    pub fn origin(&self) -> &str {
+        &self.origin
+    }
+
+    /// The name the summary reports: the file's `name`, else the origin.
+    pub fn display_name(&self) -> &str {
+        if self.spec.name.is_empty() {
+            &self.origin
+        } else {
+            &self.spec.name
+        }
+    }
+}
+
+/// Options of [`plan_mission`]: the options of `aloft mission` (JSON keys as the field names;
+/// every key optional, unknown keys rejected).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MissionOptions {
+    /// Battery pack by name (default: the vehicle's default pack).
+    pub battery: Option<String>,
+    /// Payload at take-off, kg (overrides the mission file's).
+    pub payload_kg: Option<f64>,
+    /// Wind, as a mission file's `[wind]` table (overrides the mission file's; default: the
+    /// mission file's, else still air).
+    pub wind: Option<WindSpec>,
+    /// Gridded wind field: a CSV file with columns `x_m,y_m,z_m,u_mps,v_mps,w_mps` (east, north,
+    /// up), interpolated trilinearly; it replaces `wind` and the mission file's wind.
+    pub wind_field: Option<PathBuf>,
+    /// Seeded gusts added to whichever wind the mission flies in.
+    pub gusts: Option<GustSpec>,
+    /// Reserve required at landing, percent of the usable capacity (default: the mission's, else 20).
+    pub reserve_percent: Option<f64>,
+    /// State of charge at take-off, percent (default 100).
+    pub start_percent: f64,
+    /// Sampling step, s (default: the mission's, else 0.1).
+    pub time_step_s: Option<f64>,
+    /// Angle-of-attack model (default geometric).
+    pub aoa: AoaModel,
+    /// Ground effect near the ground, survey eq (35) (default true).
+    pub ground_effect: bool,
+    /// Keep every sample in the [`Plan`] (needed by [`Plan::remaining`]; default false).
+    pub record_samples: bool,
+}
+
+impl Default for MissionOptions {
+    fn default() -> Self {
+        Self {
+            battery: None,
+            payload_kg: None,
+            wind: None,
+            wind_field: None,
+            gusts: None,
+            reserve_percent: None,
+            start_percent: 100.0,
+            time_step_s: None,
+            aoa: AoaModel::Geometric,
+            ground_effect: true,
+            record_samples: false,
+        }
+    }
+}
+
+impl MissionOptions {
+    /// Options from JSON text, e.g. `{"payload_kg": 0.5, "wind": {"speed_mps": 5, "from_deg": 270}}`.
+    ///
+    /// # Errors
+    /// [`Error::OptionsFormat`] for malformed JSON or unknown keys.
+    pub fn from_json(text: &str) -> Result<Self, Error> {
+        serde_json::from_str(text).map_err(|e| Error::OptionsFormat {
+            what: "mission options",
+            message: e.to_string(),
+        })
+    }
+}
+
+/// A planned mission: the planner's report, its summary and what it was planned for.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    report: MissionReport,
+    summary: MissionSummary,
+    context: PlanContext,
+    compiled: aloft_planner::Mission,
+}
+
+/// What a plan was computed for, in the words and figures a reader wants beside the answer
+/// (the table's header and notes; not part of the JSON).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanContext {
+    /// Where the mission came from (a path, `built-in demo`).
+    pub origin: String,
+    /// The mission file's one-line description.
+    pub description: String,
+    /// The pack flown.
+    pub battery: PackDescription,
+    /// The wind in words (and where it came from).
+    pub wind: String,
+    /// Notes on how the vehicle is modelled.
+    pub notes: Vec<String>,
+    /// Angle-of-attack model of the power model.
+    pub aoa: AoaModel,
+    /// Whether ground effect was applied near the ground.
+    pub ground_effect: bool,
+}
+
+/// The figures of a pack a reader sees: name, cells, capacity, energy, resistance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PackDescription {
+    /// Pack name.
+    pub name: String,
+    /// Cells in series.
+    pub cells_series: u32,
+    /// Rated capacity, mAh.
+    pub capacity_mah: f64,
+    /// Rated energy, Wh.
+    pub energy_wh: f64,
+    /// Internal resistance, ohm.
+    pub resistance_ohm: f64,
+}
+
+impl PackDescription {
+    fn of(b: &Battery) -> Self {
+        Self {
+            name: b.name().to_string(),
+            cells_series: b.cells_series(),
+            capacity_mah: b.capacity_ah() * 1000.0,
+            energy_wh: b.rated_energy_wh(),
+            resistance_ohm: b.resistance_ohm(),
+        }
+    }
+}
+
+/// What is left of a planned mission after a given time (see [`Plan::remaining`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Remaining {
+    /// Flight time left, s.
+    pub duration_s: f64,
+    /// Electrical energy the rest of the mission draws, Wh.
+    pub energy_wh: f64,
+    /// State of charge the rest of the mission uses, fraction of the capacity.
+    pub soc_used: f64,
+}
+
+impl Plan {
+    /// What the plan was computed for (header and notes of the table).
+    pub fn context(&self) -> &PlanContext {
+        &self.context
+    }
+
+    /// Home, east-north-up metres.
+    pub fn home_m(&self) -> [f64; 3] {
+        self.compiled.home_m()
+    }
+
+    /// The compiled mission (trajectory pieces), for writers of the planned path.
+    pub(crate) fn compiled(&self) -> &aloft_planner::Mission {
+        &self.compiled
+    }
+
+    /// The summary (the CLI's JSON).
+    pub fn summary(&self) -> &MissionSummary {
+        &self.summary
+    }
+
+    /// The planner's full report (samples only with [`MissionOptions::record_samples`]).
+    pub fn report(&self) -> &MissionReport {
+        &self.report
+    }
+
+    /// Electrical energy of the whole mission, Wh.
+    pub fn energy_wh(&self) -> f64 {
+        self.report.energy_wh
+    }
+
+    /// The summary as pretty JSON, identical to `aloft mission --format json` without its final
+    /// newline.
+    ///
+    /// # Errors
+    /// As [`MissionSummary::to_json`].
+    pub fn to_json(&self) -> Result<String, Error> {
+        self.summary.to_json()
+    }
+
+    /// What the mission still costs after `time_s` into the flight: the samples after it,
+    /// integrated by the trapezoid rule, the sample at `time_s` interpolated linearly. A ground
+    /// station adds it to what it has measured so far; the state of charge used is the plan's
+    /// (charge counting at the plan's voltages), a first-order estimate of the measured pack's.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] when the plan holds no samples (plan with
+    /// [`MissionOptions::record_samples`]) or `time_s` is not finite or negative.
+    pub fn remaining(&self, time_s: f64) -> Result<Remaining, Error> {
+        let s = &self.report.samples;
+        if s.len() < 2 {
+            return Err(Error::InvalidInput {
+                name: "samples",
+                value: s.len() as f64,
+                unit: "",
+                expected: "a plan with recorded samples (MissionOptions::record_samples)",
+            });
+        }
+        if !(time_s.is_finite() && time_s >= 0.0) {
+            return Err(Error::InvalidInput {
+                name: "time_s",
+                value: time_s,
+                unit: "s",
+                expected: "a finite time since take-off, not negative",
+            });
+        }
+        let end = &s[s.len() - 1];
+        if time_s >= end.time_s {
+            return Ok(Remaining {
+                duration_s: 0.0,
+                energy_wh: 0.0,
+                soc_used: 0.0,
+            });
+        }
+        let k = s.partition_point(|x| x.time_s <= time_s);
+        // Values at `time_s`: before the first sample, the first sample's.
+        let (p0, soc0) = if k == 0 {
+            (s[0].power_w, s[0].soc)
+        } else {
+            let (a, b) = (&s[k - 1], &s[k]);
+            let f = (time_s - a.time_s) / (b.time_s - a.time_s);
+            (
+                a.power_w + f * (b.power_w - a.power_w),
+                a.soc + f * (b.soc - a.soc),
+            )
+        };
+        let mut energy_j = Trapezoid::new();
+        energy_j.push(time_s.max(s[0].time_s), p0);
+        for x in &s[k..] {
+            energy_j.push(x.time_s, x.power_w);
+        }
+        Ok(Remaining {
+            duration_s: (self.report.duration_s - time_s).max(0.0),
+            energy_wh: energy_j.integral() / 3600.0,
+            soc_used: (soc0 - end.soc).max(0.0),
+        })
+    }
+}
+
+/// Plan `mission` with `vehicle` as `aloft mission` does, in the wind the options and the
+/// mission decide (see the wind precedence in the engine's docs).
+///
+/// # Errors
+/// An unknown pack, a mission the vehicle cannot fly (speed or mass beyond its limits, segments
+/// out of order), invalid options (reserve outside `[0, 100)` percent, start outside `(0, 100]`),
+/// an invalid or unreadable wind. An infeasible mission (reserve not held) is not an error: the
+/// summary says so.
+pub fn plan_mission(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+) -> Result<Plan, Error> {
+    let (wind, wind_text) = mission_wind(options, mission, vehicle)?;
+    plan_in(vehicle, mission, options, &wind, wind_text)
+}
+
+/// [`plan_mission`] in a wind built by the caller, which replaces the options' and the mission
+/// file's.
+///
+/// # Errors
+/// As [`plan_mission`].
+pub fn plan_mission_in(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    wind: &Wind,
+) -> Result<Plan, Error> {
+    plan_in(
+        vehicle,
+        mission,
+        options,
+        wind,
+        "given by the caller".to_string(),
+    )
+}
+
+/// The steps of a plan: the pack, the compiled mission, the planner's options, the flight, the
+/// summary.
+fn plan_in(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    wind: &Wind,
+    wind_text: String,
+) -> Result<Plan, Error> {
+    let aircraft = vehicle.aircraft()?;
+    let battery = vehicle.battery(options.battery.as_deref())?;
+    let in_mission = |e| Error::Mission {
+        origin: mission.origin.clone(),
+        vehicle: vehicle.name().to_string(),
+        source: Box::new(e),
+    };
+    let compiled = mission
+        .spec
+        .compile(aircraft.airframe(), battery.mass_kg(), options.payload_kg)
+        .map_err(in_mission)?;
+    let plan_options = planner_options(options, &mission.spec)?;
+    let report = aloft_planner::plan(aircraft, &battery, &compiled, wind, &plan_options)
+        .map_err(in_mission)?;
+    let payload = compiled.payloads_kg().first().copied().unwrap_or(0.0);
+    let summary = mission_summary(
+        &report,
+        mission.display_name(),
+        vehicle.name(),
+        battery.name(),
+        payload,
+    );
+    let context = PlanContext {
+        origin: mission.origin.clone(),
+        description: mission.spec.description.clone(),
+        battery: PackDescription::of(&battery),
+        wind: wind_text,
+        notes: vehicle.notes(),
+        aoa: options.aoa,
+        ground_effect: options.ground_effect,
+    };
+    Ok(Plan {
+        report,
+        summary,
+        context,
+        compiled,
+    })
+}
+
+/// The planner's options: the request's, else the mission file's, else the defaults (reserve
+/// 20 %, time step 0.1 s).
+fn planner_options(options: &MissionOptions, spec: &MissionSpec) -> Result<PlanOptions, Error> {
+    let reserve_percent = options
+        .reserve_percent
+        .or(spec.reserve_percent)
+        .unwrap_or(20.0);
+    if !(0.0..100.0).contains(&reserve_percent) {
+        return Err(Error::InvalidInput {
+            name: "reserve_percent",
+            value: reserve_percent,
+            unit: "%",
+            expected: "a percentage in [0, 100)",
+        });
+    }
+    Ok(PlanOptions {
+        time_step_s: options.time_step_s.or(spec.time_step_s).unwrap_or(0.1),
+        aoa: options.aoa,
+        ground_effect: options.ground_effect,
+        reserve_fraction: reserve_percent / 100.0,
+        start_soc: options.start_percent / 100.0,
+        record_samples: options.record_samples,
+        ..PlanOptions::default()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::{endurance, EnduranceOptions, FlightState};
+
+    #[test]
+    fn demo_mission_parses() {
+        let m = MissionSpec::from_toml_str(DEMO_MISSION).unwrap();
+        assert!(!m.segments.is_empty());
+        assert_eq!(Mission::demo().display_name(), "demo-survey");
+    }
+
+    #[test]
+    fn mission_json_round_trips_to_the_same_plan() {
+        let v = Vehicle::builtin("dji-m100").unwrap();
+        let demo = Mission::demo();
+        let again = Mission::from_text(&demo.to_json().unwrap(), DEMO_ORIGIN).unwrap();
+        assert_eq!(demo, again);
+        let a = plan_mission(&v, &demo, &MissionOptions::default()).unwrap();
+        let b = plan_mission(&v, &again, &MissionOptions::default()).unwrap();
+        assert_eq!(a.to_json().unwrap(), b.to_json().unwrap());
+    }
+
+    #[test]
+    fn summary_json_reads_back() {
+        let v = Vehicle::builtin("dji-m100").unwrap();
+        let p = plan_mission(&v, &Mission::demo(), &MissionOptions::default()).unwrap();
+        let back: MissionSummary = serde_json::from_str(&p.to_json().unwrap()).unwrap();
+        assert_eq!(&back, p.summary());
+    }
+
+    #[test]
+    fn remaining_is_the_whole_mission_at_zero_and_nothing_at_the_end() {
+        let v = Vehicle::builtin("dji-m100").unwrap();
+        let opts = MissionOptions {
+            record_samples: true,
+            ..MissionOptions::default()
+        };
+        let p = plan_mission(&v, &Mission::demo(), &opts).unwrap();
+        let all = p.remaining(0.0).unwrap();
+        // Trapezoid over 0.1 s samples against the planner's own integration: 0.5 % covers the
+        // first half-step and the quadrature difference.
+        assert!(
+            (all.energy_wh / p.energy_wh() - 1.0).abs() < 5e-3,
+            "{all:?}"
+        );
+        let s = &p.report().start_soc;
+        assert!((all.soc_used - (s - p.summary().end_soc)).abs() < 5e-3);
+        let half = p.remaining(p.summary().duration_s / 2.0).unwrap();
+        assert!(half.energy_wh > 0.2 * all.energy_wh && half.energy_wh < 0.8 * all.energy_wh);
+        let none = p.remaining(1e9).unwrap();
+        assert!(none.energy_wh.abs() < 1e-12);
+        assert!(p.remaining(f64::NAN).is_err());
+        let unrecorded = plan_mission(&v, &Mission::demo(), &MissionOptions::default()).unwrap();
+        assert!(unrecorded.remaining(1.0).is_err());
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        assert!(matches!(
+            Vehicle::builtin("nope"),
+            Err(Error::UnknownVehicle { .. })
+        ));
+        assert!(matches!(
+            Vehicle::from_toml("name = ", "t"),
+            Err(Error::VehicleFormat { .. })
+        ));
+        assert!(matches!(
+            Mission::from_text("{\"segment\": 3}", "t"),
+            Err(Error::MissionFormat { .. })
+        ));
+        assert!(matches!(
+            Mission::from_text("[[segment]]\nkind = 1", "t"),
+            Err(Error::MissionFormat { .. })
+        ));
+        assert!(MissionOptions::from_json("{\"bogus\": 1}").is_err());
+        let v = Vehicle::builtin("dji-m100").unwrap();
+        let bad = MissionOptions {
+            reserve_percent: Some(120.0),
+            ..Default::default()
+        };
+        assert!(plan_mission(&v, &Mission::demo(), &bad).is_err());
+        let heavy = MissionOptions {
+            payload_kg: Some(50.0),
+            ..Default::default()
+        };
+        assert!(matches!(
+            plan_mission(&v, &Mission::demo(), &heavy),
+            Err(Error::Mission { .. })
+        ));
+        let e = EnduranceOptions {
+            payload_kg: f64::NAN,
+            ..Default::default()
+        };
+        assert!(endurance(&v, &e).is_err());
+        assert!(v.power(&FlightState::new(f64::NAN, 0.0, 0.0, 0.0)).is_err());
+    }
+}

@@ -1,0 +1,119 @@
+//! The one front door: requests in, answers out.
+//!
+//! Everything that reaches aloft from outside goes through this module: the `aloft` command line
+//! (which only parses arguments into these requests and renders the answers), the C ABI of
+//! `aloft-ffi`, embedding programs (a ground station in Rust), and the Python package. None of
+//! them composes a pipeline of its own, so for the same request they give the same answer, bit
+//! for bit. The answers serialise (serde) to the JSON of `aloft <command> --format json`.
+//!
+//! | concern | requests | answer | file |
+//! |---|---|---|---|
+//! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`] | [`Vehicle`], [`list_vehicles`] | `vehicles.rs` |
+//! | missions | [`Mission::load`] + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
+//! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
+//! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`] | [`EnduranceSummary`], [`PowerCurve`] | `endurance.rs` |
+//! | power | [`PowerQuery`] → [`power_point`]; [`power_csv`] | [`PowerAnswer`] | `power.rs`, `power_batch.rs` |
+//! | propulsion | [`hover`], [`hover_sweep`], [`RotorRequest`] → [`rotor_response`] | [`HoverResult`], [`HoverSweep`], [`RotorAnswer`] | `propulsion.rs` |
+//! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
+//! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `fit.rs`, `validate.rs` |
+//! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `estimator.rs` |
+//!
+//! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
+//! else the options' wind, else the mission file's, else still air; gusts on top), the reserve
+//! (the options', else the mission's, else 20 %), the time step (the options', else the
+//! mission's, else 0.1 s).
+//!
+//! Frame and units: as the planner, east-north-up metres about the home point, SI units with the
+//! unit in every name, degrees only in names ending in `_deg`.
+//!
+//! Every type here is `Send + Sync` (checked at compile time below), no function panics on bad
+//! input, and every fallible function returns [`crate::Error`].
+//!
+//! ```
+//! use aloft::engine::{plan_mission, Mission, MissionOptions, Vehicle};
+//! let m100 = Vehicle::builtin("dji-m100")?;
+//! let plan = plan_mission(&m100, &Mission::demo(), &MissionOptions::default())?;
+//! assert!(plan.summary().feasible);
+//! let json = plan.to_json()?; // identical to `aloft mission --format json`
+//! assert!(json.contains("\"energy_wh\""));
+//! # Ok::<(), aloft::Error>(())
+//! ```
+
+mod endurance;
+mod estimator;
+mod files;
+mod fit;
+mod logs;
+mod mission;
+mod mission_outputs;
+mod power;
+mod power_batch;
+mod propulsion;
+mod replay;
+mod summary;
+mod validate;
+mod vehicles;
+mod wind;
+
+pub use endurance::{
+    endurance, power_curve, CurveContext, EnduranceContext, EnduranceOptions, EnduranceSummary,
+    PowerCurve,
+};
+pub use estimator::InFlightEstimator;
+pub use files::read_text_file;
+pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
+pub use logs::{
+    convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
+    LogReadOptions, LogTime, LogTopic, TopicCount,
+};
+pub use mission::{
+    plan_mission, plan_mission_in, Mission, MissionOptions, PackDescription, Plan, PlanContext,
+    Remaining, DEMO_MISSION, DEMO_ORIGIN,
+};
+pub use power::{
+    power_csv_file, power_model, power_point, PowerAnswer, PowerContext, PowerGradientDeg,
+    PowerQuery,
+};
+pub use power_batch::{power_csv, power_values, POWER_KEYS};
+pub use propulsion::{
+    hover, hover_sweep, rotor_response, HoverRequest, HoverSweep, RotorAnswer, RotorOverrides,
+    RotorRequest, SweepPoint, BUILTIN_ROTORS,
+};
+pub use replay::{replay_log, ReplayAcceleration, ReplayAnswer, ReplayContext, ReplayRequest};
+pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
+pub use validate::{
+    validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,
+};
+pub use vehicles::{list_vehicles, Vehicle, VehicleEntry};
+
+/// The vehicle every command uses when none is named.
+pub use crate::vehicle::DEFAULT_VEHICLE;
+pub use wind::{describe_wind_spec, GustSpec};
+
+/// Model types that appear in requests and answers, re-exported so callers of the engine (the
+/// command line among them) need no model crate.
+pub use aloft_logs::{sample::Gap, sample::NonMonotonic, Channel, DroppedValue, LogFormat};
+pub use aloft_planner::{
+    EnduranceReport, MissionReport, PointOfNoReturn, Sample, SegmentReport, Shortfall, SweepRow,
+    Wind, WindProfileKind, WindSpec,
+};
+pub use aloft_power::fit::{DragFit, FitParameter, PowerFit};
+pub use aloft_power::{AoaModel, FlightState, PowerBreakdown, Term, Terms};
+pub use aloft_propulsion::fit::battery::PackResistanceFit;
+pub use aloft_propulsion::{EscProtocol, HoverResult, RotorSpec, RotorTransientResult};
+
+// Everything a ground station shares between threads is Send + Sync.
+const _: () = {
+    const fn send_sync<T: Send + Sync>() {}
+    send_sync::<Vehicle>();
+    send_sync::<Mission>();
+    send_sync::<MissionOptions>();
+    send_sync::<Plan>();
+    send_sync::<MissionSummary>();
+    send_sync::<EnduranceOptions>();
+    send_sync::<EnduranceSummary>();
+    send_sync::<InFlightEstimator>();
+    send_sync::<PowerQuery>();
+    send_sync::<PowerAnswer>();
+    send_sync::<crate::Error>();
+};

@@ -1,0 +1,206 @@
+//! Power of one flight state from the four-term model ([`power_point`]), with the ablation and
+//! hybrid options of the power seed, the angle-of-attack choice and the gradient; and the same
+//! for a CSV of states streamed from a file ([`power_csv_file`]).
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter};
+use std::path::Path;
+
+use serde::Serialize;
+
+use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown, PowerModel};
+use aloft_power::{Term, Terms};
+
+use super::power_batch::power_csv;
+use super::vehicles::Vehicle;
+use crate::error::Error;
+
+/// A point query of the power model (the options of `aloft power`). Angles in degrees.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PowerQuery {
+    /// Airspeed, m/s (horizontal, as the paper assumes).
+    pub airspeed_mps: f64,
+    /// Roll, deg (positive right side down).
+    pub roll_deg: f64,
+    /// Pitch, deg (positive nose up).
+    pub pitch_deg: f64,
+    /// Vertical speed, m/s, positive up.
+    pub climb_rate_mps: f64,
+    /// Terms removed (the ablation rows of the paper's Table I).
+    pub without: Vec<Term>,
+    /// Hybrid model: drop the profile term above this airspeed, m/s.
+    pub profile_cutoff_mps: Option<f64>,
+    /// Angle-of-attack model; default the paper's, or geometric when `air_direction_deg` is given.
+    pub aoa: Option<AoaModel>,
+    /// Direction of the air-relative velocity from the nose, deg (selects the geometric model).
+    pub air_direction_deg: Option<f64>,
+    /// Also compute the gradient of electrical power.
+    pub gradient: bool,
+}
+
+/// The gradient of electrical power with respect to airspeed, roll and pitch (per degree).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PowerGradientDeg {
+    /// dP/d airspeed, W per m/s.
+    pub d_airspeed_w_per_mps: f64,
+    /// dP/d roll, W per degree.
+    pub d_roll_w_per_deg: f64,
+    /// dP/d pitch, W per degree.
+    pub d_pitch_w_per_deg: f64,
+}
+
+/// The answer of [`power_point`]: every term, and the gradient when asked (the JSON of
+/// `aloft power --format json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PowerAnswer {
+    /// Every term of the model.
+    #[serde(flatten)]
+    pub power: PowerBreakdown,
+    /// The gradient, when asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub electrical_gradient: Option<PowerGradientDeg>,
+    /// What was evaluated, in words (not part of the JSON).
+    #[serde(skip)]
+    pub context: PowerContext,
+}
+
+/// What a power answer was computed for (not part of the JSON).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PowerContext {
+    /// Vehicle name.
+    pub vehicle: String,
+    /// The model's efficiency `eta`.
+    pub efficiency: f64,
+    /// The angle-of-attack model in words.
+    pub aoa: String,
+    /// Names of the removed terms.
+    pub removed: Vec<&'static str>,
+}
+
+/// The four-term model of `vehicle` with terms removed and an optional profile cutoff.
+///
+/// # Errors
+/// No `[power]` table, or an invalid cutoff.
+pub fn power_model(
+    vehicle: &Vehicle,
+    without: &[Term],
+    profile_cutoff_mps: Option<f64>,
+) -> Result<PowerModel, Error> {
+    let options = ModelOptions {
+        terms: Terms::all_but(without),
+        profile_cutoff_mps,
+    };
+    Ok(PowerModel::with_options(
+        vehicle.power_model()?.vehicle().clone(),
+        options,
+    )?)
+}
+
+/// Every term of the four-term model (power seed eqs 3-14) at one flight state.
+///
+/// # Errors
+/// No `[power]` table; a contradictory angle-of-attack choice (geometric without a direction,
+/// the paper's with one); a state the model rejects (negative airspeed, tilt of 90 deg or more).
+pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer, Error> {
+    let model = power_model(vehicle, &query.without, query.profile_cutoff_mps)?;
+    let aoa = aoa_input(query.aoa, query.air_direction_deg)?;
+    let state = FlightState {
+        airspeed_mps: query.airspeed_mps,
+        roll_rad: query.roll_deg.to_radians(),
+        pitch_rad: query.pitch_deg.to_radians(),
+        climb_rate_mps: query.climb_rate_mps,
+        aoa,
+    };
+    let invalid = |source| Error::FlightState {
+        state: format!(
+            "airspeed_mps {}, roll_deg {}, pitch_deg {}, climb_rate_mps {}",
+            query.airspeed_mps, query.roll_deg, query.pitch_deg, query.climb_rate_mps
+        ),
+        source,
+    };
+    let power = model.evaluate(&state).map_err(invalid)?;
+    let electrical_gradient = if query.gradient {
+        let g = model.electrical_gradient(&state).map_err(invalid)?;
+        Some(PowerGradientDeg {
+            d_airspeed_w_per_mps: g.d_airspeed_w_per_mps,
+            d_roll_w_per_deg: g.d_roll_w_per_rad.to_radians(),
+            d_pitch_w_per_deg: g.d_pitch_w_per_rad.to_radians(),
+        })
+    } else {
+        None
+    };
+    Ok(PowerAnswer {
+        power,
+        electrical_gradient,
+        context: PowerContext {
+            vehicle: vehicle.name().to_string(),
+            efficiency: model.vehicle().efficiency(),
+            aoa: match aoa {
+                AoaInput::Paper => "paper eqs 3-4".to_string(),
+                AoaInput::Geometric { .. } => format!(
+                    "geometric, air from {:.1} deg off the nose",
+                    query.air_direction_deg.unwrap_or_default()
+                ),
+            },
+            removed: query.without.iter().map(|t| t.name()).collect(),
+        },
+    })
+}
+
+/// The angle of attack of a point query: the paper's unless a direction of the air-relative
+/// velocity is given (a point query has no such direction otherwise).
+fn aoa_input(aoa: Option<AoaModel>, air_direction_deg: Option<f64>) -> Result<AoaInput, Error> {
+    match (aoa, air_direction_deg) {
+        (Some(AoaModel::Geometric), None) => Err(Error::Contradiction {
+            message: "--aoa geometric needs --air-direction-deg: a point query has no air-velocity direction otherwise".to_string(),
+        }),
+        (Some(AoaModel::Paper), Some(d)) => Err(Error::Contradiction {
+            message: format!("--air-direction-deg {d} selects the geometric angle of attack; it contradicts --aoa paper"),
+        }),
+        (_, Some(d)) => Ok(AoaInput::Geometric {
+            air_direction_rad: d.to_radians(),
+        }),
+        (_, None) => Ok(AoaInput::Paper),
+    }
+}
+
+/// Stream the CSV of states at `input` through the model of `vehicle` (terms removed, cutoff)
+/// into `output`, or standard output when `None`, one row at a time (see [`power_csv`]).
+/// Returns the number of rows.
+///
+/// # Errors
+/// As [`power_csv`], and files that cannot be opened or created.
+pub fn power_csv_file(
+    vehicle: &Vehicle,
+    without: &[Term],
+    profile_cutoff_mps: Option<f64>,
+    input: &Path,
+    output: Option<&Path>,
+) -> Result<u64, Error> {
+    let model = power_model(vehicle, without, profile_cutoff_mps)?;
+    let file = File::open(input).map_err(|source| Error::Io {
+        origin: format!("cannot open {}", input.display()),
+        source,
+    })?;
+    let reader = BufReader::with_capacity(1 << 16, file);
+    let origin = input.display().to_string();
+    match output {
+        Some(p) => {
+            let sink = File::create(p).map_err(|source| Error::Io {
+                origin: format!("cannot create {}", p.display()),
+                source,
+            })?;
+            power_csv(
+                &model,
+                reader,
+                BufWriter::with_capacity(1 << 16, sink),
+                &origin,
+            )
+        }
+        None => {
+            let stdout = std::io::stdout();
+            let sink = BufWriter::with_capacity(1 << 16, stdout.lock());
+            power_csv(&model, reader, sink, &origin)
+        }
+    }
+}

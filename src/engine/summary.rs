@@ -1,0 +1,168 @@
+//! The mission answer's JSON contract: [`MissionSummary`] serialises to exactly what
+//! `aloft mission --format json` prints (the C ABI and the Python package return the same).
+
+use serde::{Deserialize, Serialize};
+
+use aloft_planner::MissionReport;
+
+use crate::error::Error;
+
+/// One segment of a [`MissionSummary`] (keys as `aloft mission --format json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegmentSummary {
+    /// Segment number, from 1.
+    pub index: usize,
+    /// Segment kind (`take-off`, `leg`, `orbit`, ...).
+    pub kind: String,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Distance flown, m.
+    pub distance_m: f64,
+    /// Electrical energy drawn from the pack, Wh.
+    pub energy_wh: f64,
+    /// Mean electrical power, W.
+    pub mean_power_w: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// State of charge at the end of the segment, fraction.
+    pub end_soc: f64,
+}
+
+/// Where the point of no return lies (flattened into the [`MissionSummary`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PointOfNoReturnSummary {
+    /// East of home, m.
+    pub point_of_no_return_east_m: f64,
+    /// North of home, m.
+    pub point_of_no_return_north_m: f64,
+    /// Above home, m.
+    pub point_of_no_return_up_m: f64,
+    /// Segment it lies in, from 1.
+    pub point_of_no_return_segment: usize,
+}
+
+/// The summary of a planned mission: its JSON is exactly that of `aloft mission --format json`
+/// (same keys in the same order, same values; absent values omitted). The keys are documented in
+/// the README's JSON section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MissionSummary {
+    /// Mission name (the file's `name`, else its origin).
+    pub mission: String,
+    /// Vehicle name.
+    pub vehicle: String,
+    /// Battery pack name.
+    pub battery: String,
+    /// True when the mission can be flown and lands with the reserve.
+    pub feasible: bool,
+    /// Why not, when not feasible.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// Take-off mass, kg.
+    pub takeoff_mass_kg: f64,
+    /// Payload at take-off, kg.
+    pub payload_kg: f64,
+    /// Flight time, s.
+    pub duration_s: f64,
+    /// Distance flown, m.
+    pub distance_m: f64,
+    /// Electrical energy drawn from the pack, Wh.
+    pub energy_wh: f64,
+    /// Heat in the pack's internal resistance, Wh.
+    pub pack_heat_wh: f64,
+    /// State of charge at take-off.
+    pub start_soc: f64,
+    /// State of charge at the end.
+    pub end_soc: f64,
+    /// Lowest pack voltage, V.
+    pub min_voltage_v: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// Peak pack current, A.
+    pub peak_current_a: f64,
+    /// Mean electrical power, W.
+    pub mean_power_w: f64,
+    /// Usable fraction left at landing.
+    pub reserve_soc: f64,
+    /// Usable fraction required at landing.
+    pub required_reserve_soc: f64,
+    /// Time of the point of no return, s (absent when there is none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_of_no_return_s: Option<f64>,
+    /// Where it lies (absent when there is none).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub point_of_no_return: Option<PointOfNoReturnSummary>,
+    /// Per segment.
+    pub segments: Vec<SegmentSummary>,
+}
+
+impl MissionSummary {
+    /// Pretty JSON, as the CLI prints it (without the CLI's trailing newline).
+    ///
+    /// # Errors
+    /// [`Error::OptionsFormat`] if serialisation fails (it does not for finite numbers).
+    pub fn to_json(&self) -> Result<String, Error> {
+        serde_json::to_string_pretty(self).map_err(|e| Error::OptionsFormat {
+            what: "mission summary",
+            message: e.to_string(),
+        })
+    }
+}
+
+/// The summary of `report`, as `aloft mission --format json` prints it: `mission_name` is the
+/// mission file's name (else its origin), `payload_kg` the take-off payload of the compiled
+/// mission (`mission.payloads_kg()[0]`).
+pub fn mission_summary(
+    report: &MissionReport,
+    mission_name: &str,
+    vehicle_name: &str,
+    battery_name: &str,
+    payload_kg: f64,
+) -> MissionSummary {
+    let pnr = report.point_of_no_return;
+    MissionSummary {
+        mission: mission_name.to_string(),
+        vehicle: vehicle_name.to_string(),
+        battery: battery_name.to_string(),
+        feasible: report.feasible,
+        reason: report.shortfall.as_ref().map(|s| s.to_string()),
+        takeoff_mass_kg: report.takeoff_mass_kg,
+        payload_kg,
+        duration_s: report.duration_s,
+        distance_m: report.distance_m,
+        energy_wh: report.energy_wh,
+        pack_heat_wh: report.pack_heat_wh,
+        start_soc: report.start_soc,
+        end_soc: report.end_soc,
+        min_voltage_v: report.min_voltage_v,
+        peak_power_w: report.peak_power_w,
+        peak_current_a: report.peak_current_a,
+        mean_power_w: if report.duration_s > 0.0 {
+            report.energy_wh * 3600.0 / report.duration_s
+        } else {
+            0.0
+        },
+        reserve_soc: report.reserve_soc,
+        required_reserve_soc: report.required_reserve_soc,
+        point_of_no_return_s: pnr.map(|p| p.time_s),
+        point_of_no_return: pnr.map(|p| PointOfNoReturnSummary {
+            point_of_no_return_east_m: p.position_m[0],
+            point_of_no_return_north_m: p.position_m[1],
+            point_of_no_return_up_m: p.position_m[2],
+            point_of_no_return_segment: p.segment,
+        }),
+        segments: report
+            .segments
+            .iter()
+            .map(|s| SegmentSummary {
+                index: s.index,
+                kind: s.kind.to_string(),
+                duration_s: s.duration_s,
+                distance_m: s.distance_m,
+                energy_wh: s.energy_wh,
+                mean_power_w: s.mean_power_w,
+                peak_power_w: s.peak_power_w,
+                end_soc: s.end_soc,
+            })
+            .collect(),
+    }
+}

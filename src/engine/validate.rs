@@ -1,0 +1,142 @@
+//! Validation: a vehicle's power model against measured power, per flight and per airspeed band
+//! in the layout of the power seed's Table I, with the whole-flight energy error and, optionally,
+//! an in-flight re-calibration of the efficiency.
+
+use serde::Serialize;
+
+use super::logs::FlightLogs;
+use super::vehicles::Vehicle;
+use crate::error::Error;
+use crate::identify::{predict, validate_flight, FlightValidation, AIRSPEED_BANDS};
+
+/// A validation request (the options of `aloft validate`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct ValidateRequest {
+    /// The logs and how to align them.
+    pub logs: FlightLogs,
+    /// Re-estimate the efficiency from the first this many seconds of each flight, s.
+    pub calibrate_first_s: Option<f64>,
+    /// Also return the measured and predicted power of every flight (for a plot).
+    pub series: bool,
+}
+
+/// Mean over flights of one Table I cell.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MeanBand {
+    /// Airspeed band, m/s.
+    pub airspeed_band_mps: &'static str,
+    /// Flights with samples in the band.
+    pub flights: usize,
+    /// Mean NRMSE, percent (absent when no flight has samples there).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nrmse_percent: Option<f64>,
+}
+
+/// Mean over flights of one Table I row.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MeanRow {
+    /// The dropped term (`none`, `parasitic`, `profile`, `induced`, `climb`).
+    pub dropped_term: &'static str,
+    /// Mean whole-flight NRMSE, percent.
+    pub nrmse_percent: f64,
+    /// Per airspeed band.
+    pub bands: Vec<MeanBand>,
+}
+
+/// The JSON of `aloft validate --format json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ValidateReport {
+    /// Vehicle name.
+    pub vehicle: String,
+    /// Per flight.
+    pub flights: Vec<FlightValidation>,
+    /// Mean NRMSE over the flights, per dropped term and airspeed band (Table I layout).
+    pub table_i: Vec<MeanRow>,
+}
+
+/// Measured and predicted power of one flight: name, times (s), measured (W), predicted (W).
+pub type PowerSeries = (String, Vec<f64>, Vec<f64>, Vec<f64>);
+
+/// The answer of [`validate_logs`]: the report and, when asked, the power series.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ValidateAnswer {
+    /// The report (the JSON).
+    pub report: ValidateReport,
+    /// Per flight, when [`ValidateRequest::series`] is set.
+    pub series: Vec<PowerSeries>,
+}
+
+/// Validate `vehicle`'s power model on the request's logs.
+///
+/// # Errors
+/// Unreadable logs, logs without power or motion, a vehicle without `[power]`, a calibration
+/// window that does not fit a flight.
+pub fn validate_logs(
+    vehicle: &Vehicle,
+    request: &ValidateRequest,
+) -> Result<ValidateAnswer, Error> {
+    let model = vehicle.power_model()?;
+    let flights = request.logs.load()?;
+    let results = flights
+        .iter()
+        .map(|(f, _)| validate_flight(model, f, request.calibrate_first_s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let series = if request.series {
+        flights
+            .iter()
+            .map(|(f, _)| {
+                let predicted = predict(model, f)?;
+                let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
+                Ok((f.source.clone(), f.times_s.clone(), measured, predicted))
+            })
+            .collect::<Result<_, Error>>()?
+    } else {
+        Vec::new()
+    };
+    let table_i = mean_table_i(&results);
+    Ok(ValidateAnswer {
+        report: ValidateReport {
+            vehicle: vehicle.name().to_string(),
+            flights: results,
+            table_i,
+        },
+        series,
+    })
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+/// The Table I cells averaged over the flights.
+fn mean_table_i(results: &[FlightValidation]) -> Vec<MeanRow> {
+    let Some(first) = results.first() else {
+        return Vec::new();
+    };
+    first
+        .table_i
+        .iter()
+        .enumerate()
+        .map(|(row, r)| MeanRow {
+            dropped_term: r.dropped_term,
+            nrmse_percent: mean(results.iter().map(|f| f.table_i[row].nrmse_percent))
+                .unwrap_or(f64::NAN),
+            bands: AIRSPEED_BANDS
+                .iter()
+                .enumerate()
+                .map(|(b, &(label, _, _))| {
+                    let cells: Vec<f64> = results
+                        .iter()
+                        .filter_map(|f| f.table_i[row].bands[b].nrmse_percent)
+                        .collect();
+                    MeanBand {
+                        airspeed_band_mps: label,
+                        flights: cells.len(),
+                        nrmse_percent: mean(cells.into_iter()),
+                    }
+                })
+                .collect(),
+        })
+        .collect()
+}

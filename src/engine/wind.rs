@@ -1,0 +1,184 @@
+//! Which wind a request flies in, decided in one place, and the words that describe it.
+//!
+//! A mission flies in, by precedence: a gridded field ([`MissionOptions::wind_field`]), else the
+//! options' wind ([`MissionOptions::wind`]), else the mission file's `[wind]`, else still air.
+//! Gusts ([`MissionOptions::gusts`]) are added on top of whichever it is (replacing gusts the
+//! chosen wind carries). The endurance queries take a steady wind only.
+//!
+//! [`MissionOptions::wind_field`]: super::MissionOptions::wind_field
+//! [`MissionOptions::wind`]: super::MissionOptions::wind
+//! [`MissionOptions::gusts`]: super::MissionOptions::gusts
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use aloft_planner::{Gusts, Wind, WindGrid, WindProfileKind, WindSpec};
+
+use super::mission::{Mission, MissionOptions};
+use super::vehicles::Vehicle;
+use crate::error::Error;
+
+/// Seeded gusts added to a mission's wind: a standard deviation per horizontal axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GustSpec {
+    /// Standard deviation per horizontal axis, m/s.
+    pub std_mps: f64,
+    /// Seed of the gust sequence (default 1).
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+/// A `[wind]` table in words: `6.0 m/s from 250 deg at 10 m, power law exponent 0.143`, with
+/// its gusts when it has them.
+pub fn describe_wind_spec(w: &WindSpec) -> String {
+    let profile = match w.profile {
+        WindProfileKind::Uniform => String::new(),
+        WindProfileKind::PowerLaw => format!(
+            " at {:.0} m, power law exponent {:.3}",
+            w.reference_height_m.unwrap_or(10.0),
+            w.exponent.unwrap_or(1.0 / 7.0)
+        ),
+        WindProfileKind::Log => format!(
+            " at {:.0} m, log profile z0 {} m",
+            w.reference_height_m.unwrap_or(10.0),
+            w.roughness_m.unwrap_or(0.03)
+        ),
+    };
+    let gusts = match w.gust_std_mps {
+        Some(g) => format!(", gusts {g:.1} m/s std"),
+        None => String::new(),
+    };
+    format!(
+        "{:.1} m/s from {:.0} deg{profile}{gusts}",
+        w.speed_mps, w.from_deg
+    )
+}
+
+/// The wind of a mission request and its description (see the module docs for the precedence).
+///
+/// # Errors
+/// An unreadable or invalid wind field, an invalid wind in the options or the mission file, an
+/// invalid gust spread.
+pub(crate) fn mission_wind(
+    options: &MissionOptions,
+    mission: &Mission,
+    vehicle: &Vehicle,
+) -> Result<(Wind, String), Error> {
+    let (wind, text) = if let Some(path) = &options.wind_field {
+        field(path)?
+    } else if let Some(w) = &options.wind {
+        (steady(w)?, describe_wind_spec(w))
+    } else if let Some(w) = &mission.spec().wind {
+        let wind = w.to_wind().map_err(|e| Error::Mission {
+            origin: format!("{}: [wind]", mission.origin()),
+            vehicle: vehicle.name().to_string(),
+            source: Box::new(e),
+        })?;
+        (
+            wind,
+            format!("{} (from the mission file)", describe_wind_spec(w)),
+        )
+    } else {
+        (Wind::calm(), "still air".to_string())
+    };
+    match options.gusts {
+        None => Ok((wind, text)),
+        Some(g) => {
+            let gusts = Gusts::new(g.std_mps, g.seed).map_err(|e| Error::Wind {
+                origin: "gusts".to_string(),
+                source: Box::new(e),
+            })?;
+            Ok((
+                wind.with_gusts(gusts),
+                format!("{text}, gusts {:.1} m/s std (seed {})", g.std_mps, g.seed),
+            ))
+        }
+    }
+}
+
+/// A steady wind from a `[wind]` table given in options.
+///
+/// # Errors
+/// [`Error::Wind`] for a speed, direction or profile the planner rejects.
+pub(crate) fn steady(w: &WindSpec) -> Result<Wind, Error> {
+    w.to_wind().map_err(|e| Error::Wind {
+        origin: "wind options".to_string(),
+        source: Box::new(e),
+    })
+}
+
+/// A gridded wind field from its CSV file, with its extent in words.
+fn field(path: &Path) -> Result<(Wind, String), Error> {
+    let grid = read_wind_grid(path)?;
+    let (lo, hi) = grid.bounds_m();
+    Ok((
+        Wind::grid(grid),
+        format!(
+            "gridded field {} (E {:.0}..{:.0} m, N {:.0}..{:.0} m, up {:.0}..{:.0} m)",
+            path.display(),
+            lo[0],
+            hi[0],
+            lo[1],
+            hi[1],
+            lo[2],
+            hi[2]
+        ),
+    ))
+}
+
+/// The columns of a wind-field CSV, in the order the planner takes them.
+const GRID_COLUMNS: [&str; 6] = ["x_m", "y_m", "z_m", "u_mps", "v_mps", "w_mps"];
+
+/// Read a wind-field CSV (columns [`GRID_COLUMNS`], east-north-up) into the planner's grid.
+fn read_wind_grid(path: &Path) -> Result<WindGrid, Error> {
+    let origin = path.display().to_string();
+    let csv_error = |row: usize, e: csv::Error| Error::Csv {
+        origin: origin.clone(),
+        row,
+        message: e.to_string(),
+    };
+    let file = std::fs::File::open(path).map_err(|source| Error::Io {
+        origin: format!("cannot open wind field {origin}"),
+        source,
+    })?;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(std::io::BufReader::new(file));
+    let headers = reader.headers().map_err(|e| csv_error(0, e))?.clone();
+    let mut cols = [0usize; 6];
+    for (c, name) in cols.iter_mut().zip(GRID_COLUMNS) {
+        *c = headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| Error::ColumnMissing {
+                column: name,
+                origin: origin.clone(),
+                found: headers.iter().collect::<Vec<_>>().join(","),
+            })?;
+    }
+    let mut rows = Vec::new();
+    for (k, rec) in reader.records().enumerate() {
+        let rec = rec.map_err(|e| csv_error(k + 1, e))?;
+        let mut row = [0.0; 6];
+        for (slot, (&c, name)) in row.iter_mut().zip(cols.iter().zip(GRID_COLUMNS)) {
+            let raw = rec.get(c).unwrap_or("");
+            *slot = raw.parse().map_err(|_| Error::BadValue {
+                origin: origin.clone(),
+                row: k + 1,
+                column: name,
+                value: raw.to_string(),
+            })?;
+        }
+        rows.push(row);
+    }
+    WindGrid::from_rows(&rows).map_err(|e| Error::Wind {
+        origin: format!("wind field {origin}"),
+        source: Box::new(e),
+    })
+}

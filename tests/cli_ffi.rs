@@ -1,0 +1,194 @@
+//! One front door: the command line and the C ABI call the same engine, so for the same request
+//! they print the same JSON, byte for byte (the CLI adds only a final newline). Each case is a
+//! set of CLI flags and the C ABI's options document that asks for the same thing.
+
+use std::ffi::{c_char, CStr, CString};
+use std::process::Command;
+
+use aloft_ffi::{
+    aloft_endurance_json, aloft_mission_json, aloft_string_free, aloft_vehicle_builtin,
+    aloft_vehicle_free, aloft_vehicle_power_json, AloftStatus, AloftVehicle,
+};
+
+fn cli(args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .expect("run aloft");
+    assert!(
+        out.status.code() == Some(0) || out.status.code() == Some(1),
+        "aloft {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).expect("UTF-8");
+    text.strip_suffix('\n')
+        .expect("a final newline")
+        .to_string()
+}
+
+/// A built-in vehicle through the C ABI, freed on drop.
+struct CVehicle(*mut AloftVehicle);
+
+impl CVehicle {
+    fn builtin(name: &str) -> Self {
+        let name = CString::new(name).unwrap();
+        let mut v: *mut AloftVehicle = std::ptr::null_mut();
+        // SAFETY: a NUL-terminated name and a writable out pointer.
+        assert_eq!(
+            unsafe { aloft_vehicle_builtin(name.as_ptr(), &mut v) },
+            AloftStatus::Ok
+        );
+        Self(v)
+    }
+}
+
+impl Drop for CVehicle {
+    fn drop(&mut self) {
+        // SAFETY: a live handle from aloft_vehicle_builtin, freed once.
+        unsafe { aloft_vehicle_free(self.0) };
+    }
+}
+
+/// Call an ABI function that writes a string, take the string and free it.
+fn take(call: impl FnOnce(*mut *mut c_char) -> AloftStatus) -> String {
+    let mut out: *mut c_char = std::ptr::null_mut();
+    let status = call(&mut out);
+    assert_eq!(status, AloftStatus::Ok);
+    // SAFETY: aloft returned a NUL-terminated string, freed once below.
+    let text = unsafe { CStr::from_ptr(out) }.to_str().unwrap().to_string();
+    // SAFETY: as above.
+    unsafe { aloft_string_free(out) };
+    text
+}
+
+fn ffi_mission(vehicle: &CVehicle, mission: Option<&str>, options: &str) -> String {
+    let mission = mission.map(|m| CString::new(m).unwrap());
+    let options = CString::new(options).unwrap();
+    take(|out| {
+        // SAFETY: a live vehicle, NUL-terminated texts (or NULL for the demo), an out pointer.
+        unsafe {
+            aloft_mission_json(
+                vehicle.0,
+                mission.as_ref().map_or(std::ptr::null(), |m| m.as_ptr()),
+                options.as_ptr(),
+                out,
+            )
+        }
+    })
+}
+
+#[test]
+fn mission_answers_are_the_same_bytes() {
+    let m100 = CVehicle::builtin("dji-m100");
+    let example = std::fs::read_to_string("fixtures/missions/example.toml").unwrap();
+    let grid = std::env::temp_dir().join("aloft-cli-ffi-grid.csv");
+    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps\n");
+    for x in [-1000.0, 1000.0] {
+        for y in [-1000.0, 1000.0] {
+            for z in [0.0, 200.0] {
+                text.push_str(&format!("{x},{y},{z},2,-1,0\n"));
+            }
+        }
+    }
+    std::fs::write(&grid, text).unwrap();
+    let grid = grid.display().to_string();
+    let cases: Vec<(Vec<&str>, Option<&str>, String)> = vec![
+        (vec![], None, "{}".into()),
+        (
+            vec!["--payload-kg", "0.4", "--reserve-percent", "30", "--aoa", "paper"],
+            None,
+            r#"{"payload_kg": 0.4, "reserve_percent": 30, "aoa": "paper"}"#.into(),
+        ),
+        (
+            vec!["--wind-speed", "5", "--wind-from", "200", "--wind-profile", "power-law"],
+            None,
+            r#"{"wind": {"speed_mps": 5, "from_deg": 200, "profile": "power-law", "reference_height_m": 10, "exponent": 0.14285714285714285}}"#.into(),
+        ),
+        (
+            vec!["--wind-speed", "2", "--wind-from", "0", "--gust-std", "0.5", "--gust-seed", "7", "--no-ground-effect"],
+            None,
+            r#"{"wind": {"speed_mps": 2, "from_deg": 0}, "gusts": {"std_mps": 0.5, "seed": 7}, "ground_effect": false}"#.into(),
+        ),
+        (
+            vec!["--wind-field", &grid, "--time-step", "0.05", "--start-percent", "90"],
+            None,
+            format!(r#"{{"wind_field": "{grid}", "time_step_s": 0.05, "start_percent": 90}}"#),
+        ),
+        (
+            vec!["fixtures/missions/example.toml", "--battery", "TB48D"],
+            Some(example.as_str()),
+            r#"{"battery": "TB48D"}"#.into(),
+        ),
+    ];
+    for (flags, mission, options) in cases {
+        let mut args = vec!["mission", "--format", "json"];
+        args.extend(&flags);
+        assert_eq!(
+            cli(&args),
+            ffi_mission(&m100, mission, &options),
+            "aloft {args:?} against options {options}"
+        );
+    }
+}
+
+#[test]
+fn endurance_and_power_answers_are_the_same_bytes() {
+    let m100 = CVehicle::builtin("dji-m100");
+    let cases: [(&[&str], &str); 3] = [
+        (&[], "{}"),
+        (
+            &[
+                "--wind-speed",
+                "6",
+                "--wind-from",
+                "90",
+                "--course",
+                "45",
+                "--reserve-percent",
+                "20",
+            ],
+            r#"{"wind": {"speed_mps": 6, "from_deg": 90}, "course_deg": 45, "reserve_percent": 20}"#,
+        ),
+        (
+            &[
+                "--orbit-radius",
+                "40",
+                "--orbit-speed",
+                "5",
+                "--payload-kg",
+                "0.3",
+                "--aoa",
+                "paper",
+            ],
+            r#"{"orbit_radius_m": 40, "orbit_speed_mps": 5, "payload_kg": 0.3, "aoa": "paper"}"#,
+        ),
+    ];
+    for (flags, options) in cases {
+        let mut args = vec!["endurance", "--format", "json"];
+        args.extend(flags);
+        let options_c = CString::new(options).unwrap();
+        // SAFETY: a live vehicle, a NUL-terminated options document, an out pointer.
+        let ffi = take(|out| unsafe { aloft_endurance_json(m100.0, options_c.as_ptr(), out) });
+        assert_eq!(cli(&args), ffi, "aloft {args:?} against options {options}");
+    }
+    let state = CString::new(
+        r#"{"airspeed_mps": 7.5, "roll_deg": 2, "pitch_deg": -9, "climb_rate_mps": 0.5}"#,
+    )
+    .unwrap();
+    // SAFETY: a live vehicle, a NUL-terminated state document, an out pointer.
+    let ffi = take(|out| unsafe { aloft_vehicle_power_json(m100.0, state.as_ptr(), out) });
+    let args = [
+        "power",
+        "--airspeed",
+        "7.5",
+        "--roll",
+        "2",
+        "--pitch",
+        "-9",
+        "--climb-rate",
+        "0.5",
+        "--format",
+        "json",
+    ];
+    assert_eq!(cli(&args), ffi);
+}
