@@ -1,0 +1,106 @@
+//! Missions: the TOML description (serde, units in the keys, unknown keys rejected) and its
+//! compilation into trajectory pieces for one airframe.
+//!
+//! ```toml
+//! name = "survey"
+//! payload_kg = 0.0            # payload at take-off (optional)
+//! reserve_percent = 20.0      # reserve of usable capacity required at landing (optional)
+//! time_step_s = 0.1           # sampling step (optional)
+//!
+//! [home]                      # east_m/north_m, or latitude_deg/longitude_deg
+//! east_m = 0.0
+//! north_m = 0.0
+//!
+//! [[segment]]
+//! kind = "take-off"
+//! altitude_m = 30.0
+//! climb_rate_mps = 2.5
+//!
+//! [[segment]]
+//! kind = "leg"                # to a waypoint: east_m/north_m or latitude_deg/longitude_deg
+//! east_m = 200.0
+//! north_m = 0.0
+//! altitude_m = 30.0           # optional: keep the present altitude
+//! ground_speed_mps = 8.0
+//! payload_after_kg = 0.0      # optional: payload after this waypoint (a delivery)
+//!
+//! [[segment]]
+//! kind = "orbit"
+//! centre_east_m = 100.0
+//! centre_north_m = 100.0
+//! radius_m = 25.0
+//! ground_speed_mps = 5.0
+//! direction = "clockwise"     # or "counter-clockwise", seen from above
+//! laps = 2.0                  # or duration_s
+//!
+//! [[segment]]
+//! kind = "hover"
+//! duration_s = 30.0
+//!
+//! [[segment]]
+//! kind = "return"             # straight back over home at the present altitude
+//! ground_speed_mps = 8.0
+//!
+//! [[segment]]
+//! kind = "descent"            # vertical, to a lower altitude
+//! altitude_m = 10.0
+//! rate_mps = 2.0
+//!
+//! [[segment]]
+//! kind = "landing"
+//! rate_mps = 1.0
+//! ```
+//!
+//! Altitudes are heights above the home point; the ground is flat at height 0.
+//!
+//! # Compilation
+//! Every segment is flown from rest to rest (see [`crate::trajectory`]); before a leg, a return
+//! or an orbit the vehicle yaws to the new heading at the airframe's yaw rate, hovering. An orbit
+//! starts with a straight transit from the present position to the nearest point of its circle.
+//! Legs that change altitude keep the commanded ground speed; the vertical rate that implies must
+//! be within the airframe's climb or descent limit.
+
+mod checks;
+mod compile;
+mod spec;
+
+pub use spec::{HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec};
+
+use crate::trajectory::Piece;
+
+/// A mission compiled for an airframe: trajectory pieces and the payload of each mass phase.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mission {
+    name: String,
+    home_m: [f64; 3],
+    pieces: Vec<Piece>,
+    kinds: Vec<&'static str>,
+    payloads_kg: Vec<f64>,
+}
+
+impl Mission {
+    /// Name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Home, ENU m (height 0).
+    pub fn home_m(&self) -> [f64; 3] {
+        self.home_m
+    }
+    /// Trajectory pieces in order.
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+    /// Kind of each mission segment.
+    pub fn segment_kinds(&self) -> &[&'static str] {
+        &self.kinds
+    }
+    /// Payload of each mass phase, kg.
+    pub fn payloads_kg(&self) -> &[f64] {
+        &self.payloads_kg
+    }
+    /// Total duration, s.
+    pub fn duration_s(&self) -> f64 {
+        self.pieces.iter().map(Piece::duration_s).sum()
+    }
+}
