@@ -1,6 +1,22 @@
-//! Missions: the TOML description (serde, units in the keys, unknown keys rejected) and its
-//! compilation into trajectory pieces for one airframe.
+//! Missions: what to fly (the mission spec and its file format) and its compilation into
+//! trajectory pieces for one airframe.
 //!
+//! - `spec.rs`: [`MissionSpec`] and its parts, plain data with public fields; the TOML reader
+//!   [`MissionSpec::from_toml_str`] (serde, units in the keys, unknown keys rejected);
+//! - `compile.rs`: [`MissionSpec::compile`], a compiler with one method per segment kind;
+//! - `checks.rs`: the checks of segment values and the resolver of points;
+//! - here: the compiled [`Mission`].
+//!
+//! # Mission sources
+//! Every mission source produces a [`MissionSpec`]: the TOML file read here, the same structure in
+//! JSON (read by the engine through serde), and the importers of operator formats (QGroundControl
+//! `.plan`, Mission Planner `.waypoints`), which build the spec in code from its public fields. A
+//! source only translates its format into segments; it knows no airframe and flies nothing.
+//! [`MissionSpec::compile`] is the one place where segments become trajectory pieces, so a mission
+//! is flown the same whatever it was written in. A new kind of segment is a new [`SegmentSpec`]
+//! variant and one more method of the compiler.
+//!
+//! # The mission file
 //! ```toml
 //! name = "survey"
 //! payload_kg = 0.0            # payload at take-off (optional)
@@ -54,11 +70,21 @@
 //! Altitudes are heights above the home point; the ground is flat at height 0.
 //!
 //! # Compilation
-//! Every segment is flown from rest to rest (see [`crate::trajectory`]); before a leg, a return
-//! or an orbit the vehicle yaws to the new heading at the airframe's yaw rate, hovering. An orbit
-//! starts with a straight transit from the present position to the nearest point of its circle.
-//! Legs that change altitude keep the commanded ground speed; the vertical rate that implies must
-//! be within the airframe's climb or descent limit.
+//! The mission as a whole is checked first: at least one segment; a home point given at most one
+//! way (`east_m`/`north_m` or `latitude_deg`/`longitude_deg`; by default the origin); a take-off
+//! payload that is not negative, with a take-off mass within the airframe's limit. The segments are
+//! then compiled in order, and the first error found wins (within a segment, in the order its
+//! method checks).
+//!
+//! The vehicle starts on the ground at home, nose north. A take-off must start on the ground,
+//! every other kind in the air, and the mission must end on the ground. Every segment is flown
+//! from rest to rest (see [`crate::trajectory`]); before a leg, a return or an orbit the vehicle
+//! yaws to the new heading at the airframe's yaw rate, hovering. An orbit starts with a straight
+//! transit from the present position to the nearest point of its circle, and its load in still
+//! air, `v^2 / r`, must be within `g tan(max tilt)`. Legs that change altitude keep the commanded
+//! ground speed; the vertical rate that implies must be within the airframe's climb or descent
+//! limit (a purely vertical leg flies at that limit). A `payload_after_kg` starts a new mass
+//! phase after its segment, checked against the take-off mass limit.
 
 mod checks;
 mod compile;
@@ -68,13 +94,19 @@ pub use spec::{HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKi
 
 use crate::trajectory::Piece;
 
-/// A mission compiled for an airframe: trajectory pieces and the payload of each mass phase.
+/// A mission compiled for an airframe ([`MissionSpec::compile`]): trajectory pieces and the
+/// payload of each mass phase.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mission {
+    /// The spec's name.
     name: String,
+    /// Home, ENU m (height 0).
     home_m: [f64; 3],
+    /// Trajectory pieces in order; each names its segment and mass phase.
     pieces: Vec<Piece>,
+    /// The kind of each segment, as written.
     kinds: Vec<&'static str>,
+    /// The payload of each mass phase, kg: the take-off payload, then one per change.
     payloads_kg: Vec<f64>,
 }
 

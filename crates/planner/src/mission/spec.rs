@@ -217,7 +217,8 @@ impl WindSpec {
     }
 }
 
-/// A mission file.
+/// A mission: what every mission source produces (see [Mission sources](super#mission-sources))
+/// and [`MissionSpec::compile`] flies. Its serde form is the mission file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MissionSpec {
