@@ -6,6 +6,8 @@
 //! straight path, a vertical one) are methods too, so a new kind is one more method built from
 //! them and one more arm in [`Compiler::segment`].
 
+use aloft_core::STANDARD_GRAVITY_MPS2;
+
 use super::checks::{home_position_m, Points, Seg};
 use super::{Mission, MissionSpec, OrbitDirection, SegmentSpec};
 use crate::airframe::Airframe;
@@ -91,13 +93,12 @@ impl<'a> Compiler<'a> {
         home_m: [f64; 3],
         start_payload_kg: f64,
     ) -> Result<Self, PlannerError> {
-        let g = 9.80665;
         let compiler = Self {
             airframe,
             battery_mass_kg,
             points,
             home_m,
-            max_centripetal_mps2: g * airframe.max_tilt_rad().tan(),
+            max_centripetal_mps2: STANDARD_GRAVITY_MPS2 * airframe.max_tilt_rad().tan(),
             seg: Seg {
                 index: 0,
                 kind: "mission",
