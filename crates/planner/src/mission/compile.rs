@@ -67,7 +67,7 @@ struct Compiler<'a> {
     home_m: [f64; 3],
     /// The steepest turn in still air, `g tan(max tilt)`, m/s^2.
     max_centripetal_mps2: f64,
-    /// The segment being compiled.
+    /// The segment being compiled (before the first, a placeholder that names the mission).
     seg: Seg,
     /// Where the vehicle is, ENU m.
     pos_m: [f64; 3],

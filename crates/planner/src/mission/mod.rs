@@ -136,3 +136,108 @@ impl Mission {
         self.pieces.iter().map(Piece::duration_s).sum()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::m100_airframe;
+
+    #[test]
+    fn the_default_spec_is_the_empty_file() {
+        assert_eq!(
+            MissionSpec::from_toml_str("").unwrap(),
+            MissionSpec::default()
+        );
+    }
+
+    /// The contract of every mission source: a spec built in code is the spec the file reader
+    /// makes, and it compiles to the same pieces, bit for bit (`Mission` compares its f64s exactly).
+    #[test]
+    fn a_spec_built_in_code_flies_as_the_same_file() {
+        let text = r#"
+            name = "coded"
+            payload_kg = 0.5
+            [home]
+            latitude_deg = 47.3769
+            longitude_deg = 8.5417
+            [[segment]]
+            kind = "take-off"
+            altitude_m = 20.0
+            climb_rate_mps = 2.0
+            [[segment]]
+            kind = "leg"
+            latitude_deg = 47.379
+            longitude_deg = 8.545
+            ground_speed_mps = 8.0
+            payload_after_kg = 0.0
+            [[segment]]
+            kind = "orbit"
+            centre_east_m = 100.0
+            centre_north_m = 100.0
+            radius_m = 25.0
+            ground_speed_mps = 4.0
+            direction = "clockwise"
+            laps = 1.5
+            [[segment]]
+            kind = "return"
+            ground_speed_mps = 8.0
+            [[segment]]
+            kind = "landing"
+            rate_mps = 1.0
+        "#;
+        let coded = MissionSpec {
+            name: "coded".into(),
+            payload_kg: 0.5,
+            home: HomeSpec {
+                latitude_deg: Some(47.3769),
+                longitude_deg: Some(8.5417),
+                ..HomeSpec::default()
+            },
+            segments: vec![
+                SegmentSpec::TakeOff {
+                    altitude_m: 20.0,
+                    climb_rate_mps: 2.0,
+                },
+                SegmentSpec::Leg {
+                    east_m: None,
+                    north_m: None,
+                    latitude_deg: Some(47.379),
+                    longitude_deg: Some(8.545),
+                    altitude_m: None,
+                    ground_speed_mps: 8.0,
+                    payload_after_kg: Some(0.0),
+                },
+                SegmentSpec::Orbit {
+                    centre_east_m: Some(100.0),
+                    centre_north_m: Some(100.0),
+                    centre_latitude_deg: None,
+                    centre_longitude_deg: None,
+                    altitude_m: None,
+                    radius_m: 25.0,
+                    ground_speed_mps: 4.0,
+                    direction: OrbitDirection::Clockwise,
+                    laps: Some(1.5),
+                    duration_s: None,
+                },
+                SegmentSpec::Return {
+                    ground_speed_mps: 8.0,
+                },
+                SegmentSpec::Landing {
+                    rate_mps: 1.0,
+                    payload_after_kg: None,
+                },
+            ],
+            ..MissionSpec::default()
+        };
+        let read = MissionSpec::from_toml_str(text).unwrap();
+        assert_eq!(coded, read);
+        let airframe = m100_airframe();
+        let mission = coded.compile(&airframe, 0.6, None).unwrap();
+        assert_eq!(mission, read.compile(&airframe, 0.6, None).unwrap());
+        assert_eq!(mission.payloads_kg(), [0.5, 0.0]);
+        assert_eq!(
+            mission.segment_kinds(),
+            ["take-off", "leg", "orbit", "return", "landing"]
+        );
+    }
+}

@@ -218,8 +218,9 @@ impl WindSpec {
 }
 
 /// A mission: what every mission source produces (see [Mission sources](super#mission-sources))
-/// and [`MissionSpec::compile`] flies. Its serde form is the mission file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// and [`MissionSpec::compile`] flies. Its serde form is the mission file; its [`Default`] is the
+/// empty file (every optional key at its default, no segments).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MissionSpec {
     /// Short name.
