@@ -12,7 +12,8 @@
 //! direction the wind blows FROM, clockwise from north.
 //!
 //! ## Models, one per file
-//! - [`mission`]: the mission file and its compilation into trajectory pieces;
+//! - [`mission`]: the mission spec (what every mission source produces, the mission file) and its
+//!   compilation into trajectory pieces;
 //! - [`trajectory`]: closed-form kinematics (trapezoidal speed, lines, arcs, holds);
 //! - [`wind`]: constant, power-law and logarithmic profiles, gridded field, seeded gusts;
 //! - [`trim`]: thrust vector from the force balance, attitude, electrical power;

@@ -1,0 +1,204 @@
+//! Checks of a mission's values and the point resolver. Each error names what it is about: the
+//! segment (numbered from 1) and its kind, the key, the value with its unit, and what was expected.
+
+use super::HomeSpec;
+use crate::error::PlannerError;
+use crate::geodesy::LocalFrame;
+
+/// The segment a check is about: its place in the mission (from 0) and its kind as written.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Seg {
+    /// Index in the mission's segments, from 0 (errors number segments from 1).
+    pub(super) index: usize,
+    /// Kind as written in the file (`leg`, `orbit`, ...).
+    pub(super) kind: &'static str,
+}
+
+impl Seg {
+    /// A value of this segment is invalid in itself.
+    pub(super) fn invalid(
+        self,
+        name: &'static str,
+        value: f64,
+        unit: &'static str,
+        expected: &'static str,
+    ) -> PlannerError {
+        PlannerError::InvalidSegment {
+            index: self.index + 1,
+            kind: self.kind,
+            name,
+            value,
+            unit,
+            expected,
+        }
+    }
+
+    /// This segment cannot be flown here, for `reason`.
+    pub(super) fn out_of_order(self, reason: &'static str) -> PlannerError {
+        PlannerError::SegmentOrder {
+            index: self.index + 1,
+            kind: self.kind,
+            reason,
+        }
+    }
+
+    /// `value` itself when it is positive and finite; heights (keys naming an altitude) say they
+    /// must be above the ground.
+    pub(super) fn positive(
+        self,
+        name: &'static str,
+        value: f64,
+        unit: &'static str,
+    ) -> Result<f64, PlannerError> {
+        if value.is_finite() && value > 0.0 {
+            Ok(value)
+        } else if name.contains("altitude") {
+            Err(self.invalid(
+                name,
+                value,
+                unit,
+                "the height above home must be above the ground (positive)",
+            ))
+        } else {
+            Err(self.invalid(name, value, unit, "must be positive and finite"))
+        }
+    }
+
+    /// `value` is within the vehicle's `limit`.
+    pub(super) fn within(
+        self,
+        name: &'static str,
+        value: f64,
+        limit: f64,
+        unit: &'static str,
+    ) -> Result<(), PlannerError> {
+        // 1e-9 relative: a value typed equal to the limit passes despite rounding.
+        if value > limit * (1.0 + 1e-9) {
+            Err(PlannerError::Unreachable {
+                index: self.index + 1,
+                kind: self.kind,
+                name,
+                value,
+                limit,
+                unit,
+            })
+        } else {
+            Ok(())
+        }
+    }
+
+    /// The payload after this segment, when given: finite and not negative.
+    pub(super) fn payload_after(
+        self,
+        payload_kg: Option<f64>,
+    ) -> Result<Option<f64>, PlannerError> {
+        match payload_kg {
+            Some(v) if !(v.is_finite() && v >= 0.0) => Err(self.invalid(
+                "payload_after_kg",
+                v,
+                "kg",
+                "must be finite and not negative",
+            )),
+            other => Ok(other),
+        }
+    }
+}
+
+/// The home point in local metres: `east_m`/`north_m` when given (each defaults to 0), the origin
+/// when the home is in latitude/longitude; height 0.
+///
+/// # Errors
+/// [`PlannerError::InvalidParameter`] for a coordinate that is not finite.
+pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError> {
+    let home_m = [home.east_m.unwrap_or(0.0), home.north_m.unwrap_or(0.0), 0.0];
+    for (v, name) in [(home_m[0], "home east_m"), (home_m[1], "home north_m")] {
+        if !v.is_finite() {
+            return Err(PlannerError::InvalidParameter {
+                name,
+                value: v,
+                unit: "m",
+                expected: "a finite coordinate",
+            });
+        }
+    }
+    Ok(home_m)
+}
+
+/// Resolves points given in either local metres or latitude/longitude.
+pub(super) struct Points {
+    /// The local frame about a home given in latitude/longitude; none for a home in metres.
+    frame: Option<LocalFrame>,
+}
+
+impl Points {
+    /// The resolver for a mission with this home point.
+    ///
+    /// # Errors
+    /// [`PlannerError::InvalidParameter`] for a latitude/longitude that is out of range or not
+    /// finite, or a home given both ways or by half a pair.
+    pub(super) fn for_home(home: &HomeSpec) -> Result<Self, PlannerError> {
+        let frame =
+            match (
+                home.east_m,
+                home.north_m,
+                home.latitude_deg,
+                home.longitude_deg,
+            ) {
+                (None, None, Some(la), Some(lo)) => {
+                    if !(la.is_finite() && la.abs() < 90.0 && lo.is_finite()) {
+                        return Err(PlannerError::InvalidParameter {
+                            name: "home latitude_deg",
+                            value: la,
+                            unit: "deg",
+                            expected: "a latitude within (-90, 90) and a finite longitude",
+                        });
+                    }
+                    Some(LocalFrame::new(la, lo))
+                }
+                (_, _, None, None) => None,
+                _ => return Err(PlannerError::InvalidParameter {
+                    name: "home latitude_deg",
+                    value: home.latitude_deg.unwrap_or(f64::NAN),
+                    unit: "deg",
+                    expected:
+                        "home as east_m/north_m or as latitude_deg/longitude_deg, not both or half",
+                }),
+            };
+        Ok(Self { frame })
+    }
+
+    /// The local east/north metres of a point given as `[east, north, latitude, longitude]`
+    /// (exactly one pair), with the keys of those four in `names` for the errors.
+    pub(super) fn resolve(
+        &self,
+        seg: Seg,
+        given: [Option<f64>; 4],
+        names: [&'static str; 4],
+    ) -> Result<[f64; 2], PlannerError> {
+        match given {
+            [Some(e), Some(n), None, None] => {
+                for (v, name) in [(e, names[0]), (n, names[1])] {
+                    if !v.is_finite() {
+                        return Err(seg.invalid(name, v, "m", "must be finite"));
+                    }
+                }
+                Ok([e, n])
+            }
+            [None, None, Some(la), Some(lo)] => {
+                let frame = self.frame.ok_or(seg.out_of_order(
+                    "a point in latitude/longitude needs the home point in latitude/longitude",
+                ))?;
+                if !(la.is_finite() && la.abs() < 90.0) {
+                    return Err(seg.invalid(names[2], la, "deg", "must be within (-90, 90)"));
+                }
+                if !lo.is_finite() {
+                    return Err(seg.invalid(names[3], lo, "deg", "must be finite"));
+                }
+                Ok(frame.to_local_m(la, lo))
+            }
+            _ => Err(seg.out_of_order(
+                "give the point as east_m and north_m, or as latitude_deg and longitude_deg (exactly one pair)",
+            )),
+        }
+    }
+}

@@ -1,0 +1,599 @@
+//! Compilation of a [`MissionSpec`] into the trajectory pieces of a [`Mission`].
+//!
+//! [`MissionSpec::compile`] checks the mission as a whole (segments, home, take-off payload and
+//! mass), then folds the segments through a [`Compiler`], which keeps where the vehicle is and
+//! compiles each segment kind in its own method. Shared steps (the yaw turn before a path, a
+//! straight path, a vertical one) are methods too, so a new kind is one more method built from
+//! them and one more arm in [`Compiler::segment`].
+
+use aloft_core::STANDARD_GRAVITY_MPS2;
+
+use super::checks::{home_position_m, Points, Seg};
+use super::{Mission, MissionSpec, OrbitDirection, SegmentSpec};
+use crate::airframe::Airframe;
+use crate::error::PlannerError;
+use crate::trajectory::{Piece, Profile, Shape};
+
+impl MissionSpec {
+    /// Validate and compile for `airframe`. `payload_kg` overrides the file's take-off payload.
+    ///
+    /// # Errors
+    /// No segments; a segment with a negative, zero or non-finite value where a positive one is
+    /// needed; an altitude below the ground; a speed, rate or turn load beyond the airframe's
+    /// limits; segments in an order that cannot be flown (a leg before take-off, ending in the air);
+    /// a take-off mass above the airframe's limit.
+    pub fn compile(
+        &self,
+        airframe: &Airframe,
+        battery_mass_kg: f64,
+        payload_kg: Option<f64>,
+    ) -> Result<Mission, PlannerError> {
+        if self.segments.is_empty() {
+            return Err(PlannerError::EmptyMission);
+        }
+        let points = Points::for_home(&self.home)?;
+        let home_m = home_position_m(&self.home)?;
+        let start_payload_kg = payload_kg.unwrap_or(self.payload_kg);
+        crate::error::non_negative("payload_kg", start_payload_kg, "kg")?;
+        let mut compiler =
+            Compiler::new(airframe, battery_mass_kg, points, home_m, start_payload_kg)?;
+        for (index, segment) in self.segments.iter().enumerate() {
+            compiler.segment(index, segment)?;
+        }
+        compiler.finish(&self.name)
+    }
+}
+
+/// Keys of a leg's waypoint, in the order [`Points::resolve`] takes them.
+const WAYPOINT_KEYS: [&str; 4] = ["east_m", "north_m", "latitude_deg", "longitude_deg"];
+
+/// Keys of an orbit's centre, in the order [`Points::resolve`] takes them.
+const CENTRE_KEYS: [&str; 4] = [
+    "centre_east_m",
+    "centre_north_m",
+    "centre_latitude_deg",
+    "centre_longitude_deg",
+];
+
+/// Turns the segments of one mission, in order, into trajectory pieces for one airframe.
+struct Compiler<'a> {
+    /// The vehicle's limits and rates.
+    airframe: &'a Airframe,
+    /// Battery mass, kg (for the take-off mass check).
+    battery_mass_kg: f64,
+    /// Resolves waypoints and centres to local metres.
+    points: Points,
+    /// Home, ENU m (height 0).
+    home_m: [f64; 3],
+    /// The steepest turn in still air, `g tan(max tilt)`, m/s^2.
+    max_centripetal_mps2: f64,
+    /// The segment being compiled (before the first, a placeholder that names the mission).
+    seg: Seg,
+    /// Where the vehicle is, ENU m.
+    pos_m: [f64; 3],
+    /// Where its nose points: unit east-north vector.
+    heading: [f64; 2],
+    /// In the air (between a take-off and a landing).
+    airborne: bool,
+    /// The pieces so far.
+    pieces: Vec<Piece>,
+    /// The kind of each segment so far.
+    kinds: Vec<&'static str>,
+    /// The payload of each mass phase so far, kg (a phase ends where a segment changes it).
+    payloads_kg: Vec<f64>,
+}
+
+impl<'a> Compiler<'a> {
+    /// A vehicle on the ground at home, nose north, with the take-off payload (checked against
+    /// the take-off mass limit).
+    fn new(
+        airframe: &'a Airframe,
+        battery_mass_kg: f64,
+        points: Points,
+        home_m: [f64; 3],
+        start_payload_kg: f64,
+    ) -> Result<Self, PlannerError> {
+        let compiler = Self {
+            airframe,
+            battery_mass_kg,
+            points,
+            home_m,
+            max_centripetal_mps2: STANDARD_GRAVITY_MPS2 * airframe.max_tilt_rad().tan(),
+            seg: Seg {
+                index: 0,
+                kind: "mission",
+            },
+            pos_m: home_m,
+            heading: [0.0, 1.0],
+            airborne: false,
+            pieces: Vec::new(),
+            kinds: Vec::new(),
+            payloads_kg: vec![start_payload_kg],
+        };
+        compiler.check_take_off_mass(start_payload_kg)?;
+        Ok(compiler)
+    }
+
+    /// Compile segment `index` (from 0): the one place each kind is sent to its method.
+    fn segment(&mut self, index: usize, spec: &SegmentSpec) -> Result<(), PlannerError> {
+        self.seg = Seg {
+            index,
+            kind: spec.kind(),
+        };
+        self.kinds.push(spec.kind());
+        match *spec {
+            SegmentSpec::TakeOff {
+                altitude_m,
+                climb_rate_mps,
+            } => self.take_off(altitude_m, climb_rate_mps),
+            SegmentSpec::Leg {
+                east_m,
+                north_m,
+                latitude_deg,
+                longitude_deg,
+                altitude_m,
+                ground_speed_mps,
+                payload_after_kg,
+            } => self.leg(
+                [east_m, north_m, latitude_deg, longitude_deg],
+                altitude_m,
+                ground_speed_mps,
+                payload_after_kg,
+            ),
+            SegmentSpec::Return { ground_speed_mps } => self.return_home(ground_speed_mps),
+            SegmentSpec::Orbit {
+                centre_east_m,
+                centre_north_m,
+                centre_latitude_deg,
+                centre_longitude_deg,
+                altitude_m,
+                radius_m,
+                ground_speed_mps,
+                direction,
+                laps,
+                duration_s,
+            } => self.orbit(
+                [
+                    centre_east_m,
+                    centre_north_m,
+                    centre_latitude_deg,
+                    centre_longitude_deg,
+                ],
+                altitude_m,
+                radius_m,
+                ground_speed_mps,
+                direction,
+                (laps, duration_s),
+            ),
+            SegmentSpec::Hover {
+                duration_s,
+                payload_after_kg,
+            } => self.hover(duration_s, payload_after_kg),
+            SegmentSpec::Descent {
+                altitude_m,
+                rate_mps,
+            } => self.descent(altitude_m, rate_mps),
+            SegmentSpec::Landing {
+                rate_mps,
+                payload_after_kg,
+            } => self.landing(rate_mps, payload_after_kg),
+        }
+    }
+
+    /// The compiled mission, once the vehicle is back on the ground.
+    fn finish(self, name: &str) -> Result<Mission, PlannerError> {
+        if self.airborne {
+            return Err(self
+                .seg
+                .out_of_order("the mission ends in the air: add a landing"));
+        }
+        Ok(Mission {
+            name: name.to_string(),
+            home_m: self.home_m,
+            pieces: self.pieces,
+            kinds: self.kinds,
+            payloads_kg: self.payloads_kg,
+        })
+    }
+
+    // ---- One method per segment kind ----
+
+    /// `take-off`: a vertical climb from the ground.
+    fn take_off(&mut self, altitude_m: f64, climb_rate_mps: f64) -> Result<(), PlannerError> {
+        let seg = self.seg;
+        if self.airborne {
+            return Err(seg.out_of_order("the vehicle is already in the air"));
+        }
+        seg.positive("altitude_m", altitude_m, "m")?;
+        seg.positive("climb_rate_mps", climb_rate_mps, "m/s")?;
+        seg.within(
+            "climb_rate_mps",
+            climb_rate_mps,
+            self.airframe.max_climb_rate_mps(),
+            "m/s",
+        )?;
+        self.vertical_to(altitude_m, climb_rate_mps);
+        self.airborne = true;
+        Ok(())
+    }
+
+    /// `leg`: yaw, then straight to a waypoint at a horizontal ground speed.
+    fn leg(
+        &mut self,
+        waypoint: [Option<f64>; 4],
+        altitude_m: Option<f64>,
+        ground_speed_mps: f64,
+        payload_after_kg: Option<f64>,
+    ) -> Result<(), PlannerError> {
+        let seg = self.seg;
+        self.need_air()?;
+        let [east_m, north_m] = self.points.resolve(seg, waypoint, WAYPOINT_KEYS)?;
+        let up_m = altitude_m.unwrap_or(self.pos_m[2]);
+        seg.positive("altitude_m", up_m, "m")?;
+        seg.positive("ground_speed_mps", ground_speed_mps, "m/s")?;
+        self.within_max_speed(ground_speed_mps)?;
+        self.straight_to([east_m, north_m, up_m], ground_speed_mps)?;
+        self.change_payload(payload_after_kg)
+    }
+
+    /// `return`: yaw, then straight back over home at the present height.
+    fn return_home(&mut self, ground_speed_mps: f64) -> Result<(), PlannerError> {
+        self.need_air()?;
+        self.seg
+            .positive("ground_speed_mps", ground_speed_mps, "m/s")?;
+        self.within_max_speed(ground_speed_mps)?;
+        let to_m = [self.home_m[0], self.home_m[1], self.pos_m[2]];
+        self.straight_to(to_m, ground_speed_mps)
+    }
+
+    /// `orbit`: a straight transit to the nearest point of the circle, a yaw to its tangent, then
+    /// the arc (`laps_or_duration_s`: exactly one of the laps and the time on the circle).
+    fn orbit(
+        &mut self,
+        centre: [Option<f64>; 4],
+        altitude_m: Option<f64>,
+        radius_m: f64,
+        ground_speed_mps: f64,
+        direction: OrbitDirection,
+        laps_or_duration_s: (Option<f64>, Option<f64>),
+    ) -> Result<(), PlannerError> {
+        let seg = self.seg;
+        self.need_air()?;
+        let centre_m = self.points.resolve(seg, centre, CENTRE_KEYS)?;
+        seg.positive("radius_m", radius_m, "m")?;
+        seg.positive("ground_speed_mps", ground_speed_mps, "m/s")?;
+        let up_m = altitude_m.unwrap_or(self.pos_m[2]);
+        seg.positive("altitude_m", up_m, "m")?;
+        self.within_max_speed(ground_speed_mps)?;
+        // Centripetal load in still air: v^2 / r <= g tan(tilt_max).
+        seg.within(
+            "centripetal acceleration v^2/r",
+            ground_speed_mps * ground_speed_mps / radius_m,
+            self.max_centripetal_mps2,
+            "m/s^2",
+        )?;
+        let length_m = self.orbit_length_m(radius_m, ground_speed_mps, laps_or_duration_s)?;
+        let phi0_rad = self.transit_to_circle(centre_m, radius_m, up_m, ground_speed_mps)?;
+        let sign = match direction {
+            OrbitDirection::CounterClockwise => 1.0,
+            OrbitDirection::Clockwise => -1.0,
+        };
+        let tangent = [-sign * phi0_rad.sin(), sign * phi0_rad.cos()];
+        self.yaw_to(tangent);
+        self.fly_arc(
+            Shape::Arc {
+                centre_m,
+                radius_m,
+                up_m,
+                phi0_rad,
+                sign,
+            },
+            Profile::rest_to_rest(
+                length_m,
+                ground_speed_mps,
+                self.airframe.acceleration_mps2(),
+            ),
+            tangent,
+        );
+        Ok(())
+    }
+
+    /// `hover`: hold in place.
+    fn hover(
+        &mut self,
+        duration_s: f64,
+        payload_after_kg: Option<f64>,
+    ) -> Result<(), PlannerError> {
+        self.need_air()?;
+        self.seg.positive("duration_s", duration_s, "s")?;
+        self.push(
+            Shape::Hold { pos_m: self.pos_m },
+            Profile::hold(duration_s),
+            self.heading,
+        );
+        self.change_payload(payload_after_kg)
+    }
+
+    /// `descent`: vertical, to a lower height.
+    fn descent(&mut self, altitude_m: f64, rate_mps: f64) -> Result<(), PlannerError> {
+        let seg = self.seg;
+        self.need_air()?;
+        seg.positive("altitude_m", altitude_m, "m")?;
+        seg.positive("rate_mps", rate_mps, "m/s")?;
+        seg.within(
+            "rate_mps",
+            rate_mps,
+            self.airframe.max_descent_rate_mps(),
+            "m/s",
+        )?;
+        if altitude_m >= self.pos_m[2] {
+            return Err(seg.invalid(
+                "altitude_m",
+                altitude_m,
+                "m",
+                "a descent must end below the present height",
+            ));
+        }
+        self.vertical_to(altitude_m, rate_mps);
+        Ok(())
+    }
+
+    /// `landing`: vertical, to the ground.
+    fn landing(
+        &mut self,
+        rate_mps: f64,
+        payload_after_kg: Option<f64>,
+    ) -> Result<(), PlannerError> {
+        let seg = self.seg;
+        self.need_air()?;
+        seg.positive("rate_mps", rate_mps, "m/s")?;
+        seg.within(
+            "rate_mps",
+            rate_mps,
+            self.airframe.max_descent_rate_mps(),
+            "m/s",
+        )?;
+        self.vertical_to(0.0, rate_mps);
+        self.airborne = false;
+        self.change_payload(payload_after_kg)
+    }
+
+    // ---- Steps the kinds share ----
+
+    /// Every kind but a take-off needs the vehicle in the air.
+    fn need_air(&self) -> Result<(), PlannerError> {
+        if self.airborne {
+            Ok(())
+        } else {
+            Err(self
+                .seg
+                .out_of_order("the vehicle is on the ground: take off first"))
+        }
+    }
+
+    /// A commanded ground speed is within the airframe's maximum speed.
+    fn within_max_speed(&self, ground_speed_mps: f64) -> Result<(), PlannerError> {
+        self.seg.within(
+            "ground_speed_mps",
+            ground_speed_mps,
+            self.airframe.max_speed_mps(),
+            "m/s",
+        )
+    }
+
+    /// The payload changes after this segment when `payload_after_kg` is given: a new mass phase,
+    /// within the take-off mass limit.
+    fn change_payload(&mut self, payload_after_kg: Option<f64>) -> Result<(), PlannerError> {
+        if let Some(p) = self.seg.payload_after(payload_after_kg)? {
+            self.check_take_off_mass(p)?;
+            self.payloads_kg.push(p);
+        }
+        Ok(())
+    }
+
+    /// Airframe, battery and `payload_kg` together are within the maximum take-off mass.
+    fn check_take_off_mass(&self, payload_kg: f64) -> Result<(), PlannerError> {
+        let m = self.airframe.mass_kg() + self.battery_mass_kg + payload_kg;
+        if m > self.airframe.max_takeoff_mass_kg() * (1.0 + 1e-9) {
+            return Err(PlannerError::Unreachable {
+                index: 0,
+                kind: "mission",
+                name: "take-off mass (airframe + battery + payload)",
+                value: m,
+                limit: self.airframe.max_takeoff_mass_kg(),
+                unit: "kg",
+            });
+        }
+        Ok(())
+    }
+
+    /// The mass phase pieces are in now: the number of payload changes so far.
+    fn mass_phase(&self) -> usize {
+        self.payloads_kg.len() - 1
+    }
+
+    /// Add a piece of the present segment, unless it takes no time.
+    fn push(&mut self, shape: Shape, profile: Profile, forward: [f64; 2]) {
+        if profile.duration_s > 0.0 {
+            self.pieces.push(Piece {
+                shape,
+                profile,
+                segment: self.seg.index,
+                mass_phase: self.mass_phase(),
+                forward,
+            });
+        }
+    }
+
+    /// Yaw in place, hovering at the airframe's yaw rate, until the nose points along `to` (a
+    /// unit east-north vector). Turns under 1e-6 rad take no piece.
+    fn yaw_to(&mut self, to: [f64; 2]) {
+        let turn = turn_rad(self.heading, to);
+        if turn > 1e-6 {
+            self.push(
+                Shape::Hold { pos_m: self.pos_m },
+                Profile::hold(turn / self.airframe.yaw_rate_radps()),
+                self.heading,
+            );
+        }
+        self.heading = to;
+    }
+
+    /// A straight path from here to `to_m` with a horizontal ground speed, from rest to rest;
+    /// yaws first when the path has a horizontal part. Nothing when `to_m` is here.
+    fn straight_to(&mut self, to_m: [f64; 3], ground_speed_mps: f64) -> Result<(), PlannerError> {
+        let pos = self.pos_m;
+        let d = [to_m[0] - pos[0], to_m[1] - pos[1], to_m[2] - pos[2]];
+        let h = d[0].hypot(d[1]);
+        let len = (h * h + d[2] * d[2]).sqrt();
+        if len < 1e-9 {
+            return Ok(());
+        }
+        let (path_speed, path_acc) = if h > 1e-9 {
+            self.yaw_to([d[0] / h, d[1] / h]);
+            self.sloped_speed_and_acceleration(d, h, len, ground_speed_mps)?
+        } else {
+            // Vertical leg: the ground speed does not apply; use the rate limit.
+            let v = if d[2] > 0.0 {
+                self.airframe.max_climb_rate_mps()
+            } else {
+                self.airframe.max_descent_rate_mps()
+            };
+            (v, self.airframe.vertical_acceleration_mps2())
+        };
+        self.push(
+            Shape::Line {
+                start_m: pos,
+                dir: [d[0] / len, d[1] / len, d[2] / len],
+            },
+            Profile::rest_to_rest(len, path_speed, path_acc),
+            self.heading,
+        );
+        self.pos_m = to_m;
+        Ok(())
+    }
+
+    /// Speed and acceleration along a path `d` (m) with horizontal length `h` and length `len`
+    /// flown at a horizontal ground speed: the vertical rate that implies must be within the
+    /// climb or descent limit, and neither acceleration limit is exceeded.
+    fn sloped_speed_and_acceleration(
+        &self,
+        d: [f64; 3],
+        h: f64,
+        len: f64,
+        ground_speed_mps: f64,
+    ) -> Result<(f64, f64), PlannerError> {
+        let a_h = self.airframe.acceleration_mps2();
+        let a_v = self.airframe.vertical_acceleration_mps2();
+        let vz = ground_speed_mps * d[2].abs() / h;
+        let (vlim, name) = if d[2] >= 0.0 {
+            (self.airframe.max_climb_rate_mps(), "climb rate of the leg")
+        } else {
+            (
+                self.airframe.max_descent_rate_mps(),
+                "descent rate of the leg",
+            )
+        };
+        self.seg.within(name, vz, vlim, "m/s")?;
+        let acc = if d[2].abs() > 1e-9 {
+            (a_h * len / h).min(a_v * len / d[2].abs())
+        } else {
+            a_h
+        };
+        Ok((ground_speed_mps * len / h, acc))
+    }
+
+    /// A vertical path from here to height `to_z_m` at `rate_mps`, from rest to rest.
+    fn vertical_to(&mut self, to_z_m: f64, rate_mps: f64) {
+        let pos = self.pos_m;
+        let len = (to_z_m - pos[2]).abs();
+        if len > 0.0 {
+            self.push(
+                Shape::Line {
+                    start_m: pos,
+                    dir: [0.0, 0.0, (to_z_m - pos[2]).signum()],
+                },
+                Profile::rest_to_rest(len, rate_mps, self.airframe.vertical_acceleration_mps2()),
+                self.heading,
+            );
+        }
+        self.pos_m[2] = to_z_m;
+    }
+
+    /// Length of an orbit's arc, m: `laps` whole circles, or what a trapezoid speed profile
+    /// covers in `duration_s` (exactly one of the two).
+    fn orbit_length_m(
+        &self,
+        radius_m: f64,
+        ground_speed_mps: f64,
+        (laps, duration_s): (Option<f64>, Option<f64>),
+    ) -> Result<f64, PlannerError> {
+        let seg = self.seg;
+        match (laps, duration_s) {
+            (Some(l), None) => Ok(seg.positive("laps", l, "")? * std::f64::consts::TAU * radius_m),
+            (None, Some(d)) => {
+                let d = seg.positive("duration_s", d, "s")?;
+                // Trapezoid time L / v + v / a = d.
+                let l =
+                    ground_speed_mps * (d - ground_speed_mps / self.airframe.acceleration_mps2());
+                if l <= 0.0 {
+                    return Err(seg.invalid(
+                        "duration_s",
+                        d,
+                        "s",
+                        "too short to reach the orbit speed and stop again",
+                    ));
+                }
+                Ok(l)
+            }
+            _ => Err(seg.out_of_order("give exactly one of laps and duration_s")),
+        }
+    }
+
+    /// Straight from here to the nearest point of the circle (centre `centre_m`, radius
+    /// `radius_m`, height `up_m`); returns that point's angle from east, rad (0 from the centre).
+    fn transit_to_circle(
+        &mut self,
+        centre_m: [f64; 2],
+        radius_m: f64,
+        up_m: f64,
+        ground_speed_mps: f64,
+    ) -> Result<f64, PlannerError> {
+        let rel = [self.pos_m[0] - centre_m[0], self.pos_m[1] - centre_m[1]];
+        let dist = rel[0].hypot(rel[1]);
+        let phi0_rad = if dist > 1e-9 {
+            rel[1].atan2(rel[0])
+        } else {
+            0.0
+        };
+        let entry_m = [
+            centre_m[0] + radius_m * phi0_rad.cos(),
+            centre_m[1] + radius_m * phi0_rad.sin(),
+            up_m,
+        ];
+        self.straight_to(entry_m, ground_speed_mps)?;
+        Ok(phi0_rad)
+    }
+
+    /// Fly an arc piece (always added, whatever its duration); the vehicle ends at its end,
+    /// heading along the tangent there.
+    fn fly_arc(&mut self, shape: Shape, profile: Profile, forward: [f64; 2]) {
+        let arc = Piece {
+            shape,
+            profile,
+            segment: self.seg.index,
+            mass_phase: self.mass_phase(),
+            forward,
+        };
+        self.pos_m = arc.end_m();
+        self.heading = arc.at(arc.duration_s()).forward;
+        self.pieces.push(arc);
+    }
+}
+
+/// Heading change (absolute, rad) from `from` to `to` (unit east-north vectors).
+fn turn_rad(from: [f64; 2], to: [f64; 2]) -> f64 {
+    let cross = from[0] * to[1] - from[1] * to[0];
+    let dot = from[0] * to[0] + from[1] * to[1];
+    cross.atan2(dot).abs()
+}
