@@ -56,16 +56,7 @@ impl Mission {
             },
             // Unreachable for the committed fixture; an empty mission fails cleanly at planning.
             Err(_) => Self {
-                spec: MissionSpec {
-                    name: String::new(),
-                    description: String::new(),
-                    payload_kg: 0.0,
-                    reserve_percent: None,
-                    time_step_s: None,
-                    home: Default::default(),
-                    wind: None,
-                    segments: Vec::new(),
-                },
+                spec: MissionSpec::default(),
                 origin: DEMO_ORIGIN.to_string(),
             },
         }
