@@ -23,7 +23,7 @@ use multiversion::multiversion;
 
 use crate::angle_of_attack::AoaModel;
 use crate::four_term::{FlightCondition, PowerModel};
-use crate::induced::solve_normalised_fast;
+use crate::quartic::solve_normalised_fast;
 
 /// Conditions per block.
 pub(crate) const CHUNK: usize = 64;

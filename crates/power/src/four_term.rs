@@ -39,8 +39,9 @@ use crate::angle_of_attack::{AoaModel, Inflow};
 use crate::batch::{electrical_of_block, roots_of_block, Block, CHUNK};
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
-use crate::induced::{induced_power_of_root_w, induced_velocity_mps, solve_normalised};
+use crate::induced::{induced_power_of_root_w, induced_velocity_mps};
 use crate::profile::profile_power_w;
+use crate::quartic::solve_normalised;
 use crate::trig::{sin_cos, sin_cos_pair};
 use crate::vehicle::Vehicle;
 
@@ -862,7 +863,7 @@ mod tests {
             assert_eq!(single, *o, "{c:?}");
             assert_eq!(single.electrical_w.to_bits(), w.to_bits(), "{c:?}");
             let vh = m.vehicle().hover_induced_velocity_mps();
-            if crate::induced::solve_normalised_fast(
+            if crate::quartic::solve_normalised_fast(
                 c.inflow.normal_mps / vh,
                 c.inflow.parallel_mps / vh,
             )

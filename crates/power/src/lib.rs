@@ -51,6 +51,7 @@ pub mod gradient;
 pub mod induced;
 pub mod metrics;
 pub mod profile;
+mod quartic;
 mod trig;
 pub mod vehicle;
 

@@ -49,7 +49,7 @@ use serde::Serialize;
 use crate::angle_of_attack::AoaModel;
 use crate::error::FitError;
 use crate::four_term::{resolve_point, FlightState};
-use crate::induced::solve_normalised;
+use crate::quartic::solve_normalised;
 use crate::vehicle::{DiskArea, Vehicle, VehicleParams};
 
 /// One measured sample: the flight state and the measured electrical power.
