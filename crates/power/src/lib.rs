@@ -40,7 +40,6 @@
 #![deny(clippy::float_cmp)]
 
 pub mod angle_of_attack;
-mod batch;
 pub mod climb;
 pub mod drag;
 pub mod efficiency;
@@ -49,10 +48,10 @@ pub mod fit;
 pub mod four_term;
 pub mod gradient;
 pub mod induced;
+mod kernels;
 pub mod metrics;
 pub mod profile;
 mod quartic;
-mod trig;
 pub mod vehicle;
 
 pub use angle_of_attack::{AoaModel, Inflow};

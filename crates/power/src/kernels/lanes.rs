@@ -1,4 +1,5 @@
-//! The vector path of the four-term model's batch evaluations.
+//! The vector lanes of the four-term model's batch evaluations (their entry points are in
+//! `batch.rs`).
 //!
 //! [`crate::PowerModel::evaluate_batch`], [`crate::PowerModel::evaluate_conditions`] and
 //! [`crate::PowerModel::electrical_of_conditions`] work in blocks of [`CHUNK`] resolved conditions,
