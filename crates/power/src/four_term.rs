@@ -31,10 +31,11 @@
 //! # The plain evaluation and its fast paths
 //! This file is the model as it reads: the types, the plain evaluation of a point query
 //! (`PowerModel::evaluate_inline`: thrust and inflow, the quartic, the terms) and of a resolved
-//! condition ([`PowerModel::evaluate_condition`]), and the terms themselves. The public [`PowerModel::evaluate`] (a run-time dispatched build of
-//! `evaluate_inline`) and the batch entry points ([`PowerModel::evaluate_batch`],
-//! [`PowerModel::evaluate_conditions`], [`PowerModel::electrical_of_conditions`]) are `impl
-//! PowerModel` blocks in `kernels/`, each tested bit for bit against the plain path here.
+//! condition ([`PowerModel::evaluate_condition`]), and the terms themselves. The public
+//! [`PowerModel::evaluate`] (a run-time dispatched build of `evaluate_inline`) and the batch
+//! entry points ([`PowerModel::evaluate_batch`], [`PowerModel::evaluate_conditions`],
+//! [`PowerModel::electrical_of_conditions`]) are `impl PowerModel` blocks in `kernels/`, each
+//! tested bit for bit against the plain path here.
 //!
 //! # Deviation: no regeneration
 //! Eq (14) can go negative in a steep descent where the climb term outweighs the others; a

@@ -48,8 +48,8 @@ impl PowerModel {
         Ok(())
     }
 
-    /// The roots of a block in vector lanes (`kernels/lanes.rs`), then the terms of each condition of
-    /// `conditions` (the block's, in order) into `out`.
+    /// The roots of a block in vector lanes (`kernels/lanes.rs`), then the terms of each
+    /// condition of `conditions` (the block's, in order) into `out`.
     #[inline(always)]
     fn terms_of_block(
         &self,
