@@ -30,9 +30,15 @@
 //! the frame aloft's missions use.
 
 use nalgebra::{Rotation3, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::PowerError;
 
 /// Which angle-of-attack model the power model uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+///
+/// Written `paper` or `geometric` everywhere: in files (serde), on the command line
+/// ([`std::str::FromStr`]) and in output ([`std::fmt::Display`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum AoaModel {
     /// The paper's eqs (3)-(4), from roll and pitch only.
@@ -40,6 +46,40 @@ pub enum AoaModel {
     Paper,
     /// The exact angle between the air-relative velocity and the rotor plane.
     Geometric,
+}
+
+impl AoaModel {
+    /// Both models, the default first.
+    pub const ALL: [AoaModel; 2] = [AoaModel::Paper, AoaModel::Geometric];
+
+    /// The name in files, on the command line and in output: `paper` or `geometric`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AoaModel::Paper => "paper",
+            AoaModel::Geometric => "geometric",
+        }
+    }
+}
+
+impl std::fmt::Display for AoaModel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for AoaModel {
+    type Err = PowerError;
+
+    /// `paper` or `geometric` (exactly, as in files); anything else is
+    /// [`PowerError::UnknownAoaModel`], naming what was found and what is accepted.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| PowerError::UnknownAoaModel {
+                found: s.to_string(),
+            })
+    }
 }
 
 /// The freestream decomposed on the rotor disk.
@@ -128,6 +168,42 @@ pub fn body_relative_inflow(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn aoa_model_names_agree_in_files_arguments_and_output() {
+        for m in AoaModel::ALL {
+            // serde (files), Display (output) and FromStr (arguments) use the same word.
+            let json = serde_json::to_string(&m).unwrap();
+            assert_eq!(json, format!("\"{m}\""));
+            assert_eq!(serde_json::from_str::<AoaModel>(&json).unwrap(), m);
+            assert_eq!(m.to_string().parse::<AoaModel>().unwrap(), m);
+        }
+        assert_eq!("paper".parse::<AoaModel>().unwrap(), AoaModel::Paper);
+        assert_eq!(
+            "geometric".parse::<AoaModel>().unwrap(),
+            AoaModel::Geometric
+        );
+        assert_eq!(AoaModel::default(), AoaModel::Paper);
+    }
+
+    #[test]
+    fn unknown_aoa_model_names_what_was_found_and_what_is_accepted() {
+        for bad in ["exact", "Paper", " paper", ""] {
+            let e = bad.parse::<AoaModel>().unwrap_err();
+            assert_eq!(
+                e,
+                PowerError::UnknownAoaModel {
+                    found: bad.to_string()
+                }
+            );
+            let message = e.to_string();
+            assert!(message.contains(&format!("'{bad}'")), "{message}");
+            for m in AoaModel::ALL {
+                assert!(message.contains(m.name()), "{message} should offer {m}");
+            }
+        }
+        assert!(serde_json::from_str::<AoaModel>("\"exact\"").is_err());
+    }
 
     fn close(a: f64, b: f64) -> bool {
         // Trigonometric round-off through a rotation matrix: a few ulp of the airspeed.

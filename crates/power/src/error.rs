@@ -85,6 +85,12 @@ pub enum PowerError {
         /// Hover induced velocity `vh`, m/s.
         hover_mps: f64,
     },
+    /// A name that is not an angle-of-attack model ([`crate::AoaModel`]'s `FromStr`).
+    #[error("unknown angle-of-attack model '{found}': expected paper or geometric")]
+    UnknownAoaModel {
+        /// The text received.
+        found: String,
+    },
     /// Two series that must be compared sample by sample have different lengths or are empty.
     #[error(
         "series lengths differ or are empty: {estimate_len} estimates, {measured_len} measurements"

@@ -28,6 +28,15 @@
 //! horizontal air velocity), so eq (13) carries the climb work once. Removing the induced term
 //! (ablation) removes `acceleration_w` with it, as eq (8) contains both.
 //!
+//! # The plain evaluation and its fast paths
+//! This file is the model as it reads: the types, the plain evaluation of a point query
+//! (`PowerModel::evaluate_inline`: thrust and inflow, the quartic, the terms) and of a resolved
+//! condition ([`PowerModel::evaluate_condition`]), and the terms themselves. The public
+//! [`PowerModel::evaluate`] (a run-time dispatched build of `evaluate_inline`) and the batch
+//! entry points ([`PowerModel::evaluate_batch`], [`PowerModel::evaluate_conditions`],
+//! [`PowerModel::electrical_of_conditions`]) are `impl PowerModel` blocks in `kernels/`, each
+//! tested bit for bit against the plain path here.
+//!
 //! # Deviation: no regeneration
 //! Eq (14) can go negative in a steep descent where the climb term outweighs the others; a
 //! multirotor's ESCs do not regenerate, so `electrical_w` is floored at 0 (the aerodynamic total
@@ -36,12 +45,12 @@
 use serde::Serialize;
 
 use crate::angle_of_attack::{AoaModel, Inflow};
-use crate::batch::{electrical_of_block, roots_of_block, Block, CHUNK};
 use crate::climb::climb_power_w;
 use crate::error::{finite, non_negative, PowerError, Result};
-use crate::induced::{induced_power_of_root_w, induced_velocity_mps, solve_normalised};
+use crate::induced::{induced_power_of_root_w, induced_velocity_mps};
+use crate::kernels::trig::{sin_cos, sin_cos_pair};
 use crate::profile::profile_power_w;
-use crate::trig::{sin_cos, sin_cos_pair};
+use crate::quartic::solve_normalised;
 use crate::vehicle::Vehicle;
 
 /// One of the four terms of eq (7).
@@ -281,19 +290,10 @@ impl PowerModel {
         Ok(self.vehicle.weight_n() / tilt_cos)
     }
 
-    /// Evaluate a point query: thrust from eq (5), inflow from the selected angle-of-attack model.
-    ///
-    /// On x86-64 CPUs with AVX2 this runs a build of the same code for that instruction set
-    /// (chosen once, at the first call): its three-operand instructions leave out the register
-    /// copies of the baseline build, about a tenth faster. The results are the same bits.
-    #[inline]
-    pub fn evaluate(&self, state: &FlightState) -> Result<PowerBreakdown> {
-        evaluate_point(self, state)
-    }
-
-    /// The body of [`Self::evaluate`], inlined into each instruction-set build of it.
+    /// The plain evaluation of a point query: the body of [`Self::evaluate`], inlined into each
+    /// instruction-set build of it (`kernels/dispatch.rs`).
     #[inline(always)]
-    fn evaluate_inline(&self, state: &FlightState) -> Result<PowerBreakdown> {
+    pub(crate) fn evaluate_inline(&self, state: &FlightState) -> Result<PowerBreakdown> {
         let c = self.point_condition(state)?;
         let x = self.induced_velocity(&c)?;
         Ok(self.assemble(&c, x))
@@ -301,7 +301,7 @@ impl PowerModel {
 
     /// Validate a point query and resolve it: thrust from eq (5), inflow from the AoA model.
     #[inline(always)]
-    fn point_condition(&self, state: &FlightState) -> Result<FlightCondition> {
+    pub(crate) fn point_condition(&self, state: &FlightState) -> Result<FlightCondition> {
         let (tilt_cos, inflow, aoa) = resolve_point(state)?;
         Ok(FlightCondition {
             thrust_n: self.vehicle.weight_n() / tilt_cos,
@@ -310,102 +310,6 @@ impl PowerModel {
             climb_rate_mps: state.climb_rate_mps,
             aoa,
         })
-    }
-
-    /// Evaluate many point queries into `out` (same length), stopping at the first invalid state.
-    ///
-    /// Returns the first invalid state's error; `Ok(())` means every element of `out` was written.
-    /// Results are identical to [`Self::evaluate`]; the work is arranged in passes over chunks so
-    /// the CPU overlaps independent states (the throughput path).
-    pub fn evaluate_batch(&self, states: &[FlightState], out: &mut [PowerBreakdown]) -> Result<()> {
-        check_lengths(states.len(), out.len())?;
-        let mut conditions = [FlightCondition::default(); CHUNK];
-        let mut block = Block::new();
-        for (sc, oc) in states.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            // Pass 1: validation, trigonometry, thrust and inflow.
-            for (j, (s, c)) in sc.iter().zip(conditions.iter_mut()).enumerate() {
-                *c = self.point_condition(s)?;
-                block.set(j, c);
-            }
-            // Passes 2 and 3: the quartic over the block in vector lanes, then the terms.
-            self.terms_of_block(&conditions, &block, oc)?;
-        }
-        Ok(())
-    }
-
-    /// Evaluate many resolved conditions into `out` (same length): [`Self::evaluate_condition`]
-    /// arranged in passes for throughput, as [`Self::evaluate_batch`]. Returns the first invalid
-    /// condition's error; `Ok(())` means every element of `out` was written.
-    pub fn evaluate_conditions(
-        &self,
-        conditions: &[FlightCondition],
-        out: &mut [PowerBreakdown],
-    ) -> Result<()> {
-        check_lengths(conditions.len(), out.len())?;
-        let mut block = Block::new();
-        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            load_block(cc, &mut block)?;
-            self.terms_of_block(cc, &block, oc)?;
-        }
-        Ok(())
-    }
-
-    /// The roots of a block in vector lanes (crate::batch), then the terms of each condition of
-    /// `conditions` (the block's, in order) into `out`.
-    #[inline(always)]
-    fn terms_of_block(
-        &self,
-        conditions: &[FlightCondition],
-        block: &Block,
-        out: &mut [PowerBreakdown],
-    ) -> Result<()> {
-        let mut roots = [0.0f64; CHUNK];
-        roots_of_block(self, block, &mut roots);
-        for ((c, &x), o) in conditions.iter().zip(roots.iter()).zip(out.iter_mut()) {
-            *o = self.assemble(c, self.root_or_safeguarded(c, x)?);
-        }
-        Ok(())
-    }
-
-    /// [`Self::evaluate_conditions`] keeping only the electrical power, W: the terms too run in
-    /// vector lanes (the planner's path).
-    pub fn electrical_of_conditions(
-        &self,
-        conditions: &[FlightCondition],
-        out: &mut [f64],
-    ) -> Result<()> {
-        check_lengths(conditions.len(), out.len())?;
-        let mut block = Block::new();
-        let mut roots = [0.0f64; CHUNK];
-        let mut watts = [0.0f64; CHUNK];
-        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            load_block(cc, &mut block)?;
-            electrical_of_block(self, &block, &mut roots, &mut watts);
-            for (((c, &x), &w), o) in cc
-                .iter()
-                .zip(roots.iter())
-                .zip(watts.iter())
-                .zip(oc.iter_mut())
-            {
-                *o = if x.is_nan() {
-                    self.assemble(c, self.root_or_safeguarded(c, x)?)
-                        .electrical_w
-                } else {
-                    w
-                };
-            }
-        }
-        Ok(())
-    }
-
-    /// A block root `x = v_i / vh`, or the safeguarded solver's where the fast path left it (NaN).
-    #[inline(always)]
-    fn root_or_safeguarded(&self, c: &FlightCondition, x: f64) -> Result<f64> {
-        if x.is_nan() {
-            self.induced_velocity(c)
-        } else {
-            Ok(x)
-        }
     }
 
     /// Evaluate a resolved flight condition (thrust and inflow given).
@@ -418,7 +322,7 @@ impl PowerModel {
 
     /// Induced velocity of eq (9) for a resolved condition, as `x = v_i / vh`.
     #[inline(always)]
-    fn induced_velocity(&self, c: &FlightCondition) -> Result<f64> {
+    pub(crate) fn induced_velocity(&self, c: &FlightCondition) -> Result<f64> {
         let v = &self.vehicle;
         if c.inflow.normal_mps.is_finite() && c.inflow.parallel_mps >= 0.0 {
             let a = c.inflow.normal_mps * v.inverse_hover_induced_velocity();
@@ -449,7 +353,7 @@ impl PowerModel {
     }
 
     /// [`Self::assemble`] from the condition's fields. Written with selects, not branches, so the
-    /// block kernels (crate::batch) run it in vector lanes.
+    /// block kernels (`kernels/lanes.rs`) run it in vector lanes.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn terms_at(
@@ -501,41 +405,10 @@ impl PowerModel {
     }
 }
 
-/// [`PowerModel::evaluate`], dispatched at run time to a build for the best instruction set the
-/// CPU has. Each build performs the same IEEE operations (Rust never fuses a multiply and an add
-/// on its own), so the results do not depend on the build (test
-/// `dispatched_point_queries_equal_the_baseline_build`).
-#[multiversion::multiversion(targets("x86_64+avx2+fma"))]
-fn evaluate_point(model: &PowerModel, state: &FlightState) -> Result<PowerBreakdown> {
-    model.evaluate_inline(state)
-}
-
-/// Validate up to [`CHUNK`] resolved conditions and lay them out in `block`'s lanes.
-#[inline(always)]
-fn load_block(conditions: &[FlightCondition], block: &mut Block) -> Result<()> {
-    for (j, c) in conditions.iter().enumerate() {
-        check_condition(c)?;
-        block.set(j, c);
-    }
-    Ok(())
-}
-
-/// A batch's output must have the length of its input.
-fn check_lengths(input_len: usize, output_len: usize) -> Result<()> {
-    if input_len == output_len {
-        Ok(())
-    } else {
-        Err(PowerError::SeriesLength {
-            estimate_len: output_len,
-            measured_len: input_len,
-        })
-    }
-}
-
 /// Validate a resolved condition's thrust, airspeed and climb rate (the inflow is checked by the
 /// solver).
 #[inline(always)]
-fn check_condition(c: &FlightCondition) -> Result<()> {
+pub(crate) fn check_condition(c: &FlightCondition) -> Result<()> {
     // One test on the hot path; the checks that name the value only when it fails.
     let valid = (0.0..f64::INFINITY).contains(&c.thrust_n)
         & (0.0..f64::INFINITY).contains(&c.airspeed_mps)
@@ -728,161 +601,6 @@ mod tests {
             let e = m.evaluate(&s).unwrap_err().to_string();
             assert!(e.contains(name), "{e} should name {name}");
         }
-    }
-
-    /// `n` point queries spread over airspeed (0 to `max_speed`), roll and pitch (within
-    /// `max_tilt`) and climb rate (within `max_climb`), every `geometric_every`-th with the exact
-    /// angle of attack.
-    fn varied_states(
-        n: u32,
-        max_speed: f64,
-        max_tilt: f64,
-        max_climb: f64,
-        geometric_every: u32,
-    ) -> Vec<FlightState> {
-        (0..n)
-            .map(|i| {
-                let f = f64::from(i) / f64::from(n);
-                let mut s = FlightState::new(
-                    max_speed * f,
-                    (f * 97.0).sin() * max_tilt,
-                    (f * 53.0).cos() * max_tilt,
-                    max_climb * (2.0 * f - 1.0),
-                );
-                if i % geometric_every == 0 {
-                    s.aoa = AoaInput::Geometric {
-                        air_direction_rad: f * 7.0 - 3.5,
-                    };
-                }
-                s
-            })
-            .collect()
-    }
-
-    #[test]
-    fn batch_equals_single_evaluations_bit_for_bit() {
-        let m = PowerModel::new(m100());
-        let states = varied_states(1000, 30.0, 0.7, 2.0, 3);
-        let mut out = vec![m.evaluate(&states[0]).unwrap(); states.len()];
-        m.evaluate_batch(&states, &mut out).unwrap();
-        for (s, o) in states.iter().zip(&out) {
-            // Both paths return the first Halley iterate that meets the residual bound, and the
-            // vector lanes do the scalar code's IEEE operations: the same bits.
-            let single = m.evaluate(s).unwrap();
-            assert_eq!(single, *o, "{s:?}");
-        }
-        // A bad state stops the batch with its error.
-        let mut bad = states.clone();
-        bad[700].roll_rad = f64::NAN;
-        assert!(m.evaluate_batch(&bad, &mut out).is_err());
-        assert!(
-            m.evaluate_batch(&states[..3], &mut out).is_err(),
-            "length mismatch"
-        );
-    }
-
-    #[test]
-    fn dispatched_point_queries_equal_the_baseline_build() {
-        // `evaluate` runs the AVX2 build on CPUs that have it; `evaluate_inline` called here is
-        // compiled for the baseline target. Same bits, and the same errors.
-        let m = PowerModel::new(m100());
-        let mut checked = 0;
-        for (i, mut s) in varied_states(3000, 35.0, 1.2, 3.0, 4)
-            .into_iter()
-            .enumerate()
-        {
-            // Attitudes beyond 45 deg (libm's sin and cos) and some invalid airspeeds too.
-            if i % 97 == 0 {
-                s.airspeed_mps = -1.0;
-            }
-            match (m.evaluate(&s), m.evaluate_inline(&s)) {
-                (Ok(p), Ok(q)) => {
-                    for (x, y) in [
-                        (p.electrical_w, q.electrical_w),
-                        (p.aero_w, q.aero_w),
-                        (p.induced_w, q.induced_w),
-                        (p.induced_velocity_mps, q.induced_velocity_mps),
-                        (p.profile_w, q.profile_w),
-                        (p.thrust_n, q.thrust_n),
-                    ] {
-                        assert_eq!(x.to_bits(), y.to_bits(), "{s:?}");
-                    }
-                    assert_eq!(p, q);
-                    checked += 1;
-                }
-                (Err(e), Err(g)) => assert_eq!(e.to_string(), g.to_string()),
-                (p, q) => panic!("{s:?}: {p:?} vs {q:?}"),
-            }
-        }
-        assert!(checked > 2500, "{checked}");
-    }
-
-    #[test]
-    fn conditions_in_a_batch_equal_single_evaluations() {
-        let m = PowerModel::new(m100());
-        let conditions: Vec<FlightCondition> = (0..500)
-            .map(|i| {
-                let f = f64::from(i) / 500.0;
-                let v = 20.0 * f;
-                let tilt = 0.6 * f;
-                FlightCondition {
-                    thrust_n: m.vehicle().weight_n() / tilt.cos(),
-                    airspeed_mps: v,
-                    // Every 7th a slow descent through the disk (Vn < 0, Vp small): the quartic
-                    // has three positive roots there and the fast path steps aside.
-                    inflow: if i % 7 == 0 {
-                        Inflow {
-                            normal_mps: -4.0 * f,
-                            parallel_mps: 0.1 * f,
-                        }
-                    } else {
-                        Inflow {
-                            normal_mps: v * tilt.sin(),
-                            parallel_mps: v * tilt.cos(),
-                        }
-                    },
-                    climb_rate_mps: 0.5 * (f * 9.0).sin(),
-                    aoa: if i % 2 == 0 {
-                        AoaModel::Geometric
-                    } else {
-                        AoaModel::Paper
-                    },
-                }
-            })
-            .collect();
-        let mut out = vec![m.evaluate_condition(&conditions[0]).unwrap(); conditions.len()];
-        m.evaluate_conditions(&conditions, &mut out).unwrap();
-        let mut watts = vec![0.0; conditions.len()];
-        m.electrical_of_conditions(&conditions, &mut watts).unwrap();
-        let mut left_to_the_safeguarded_solver = 0;
-        for ((c, o), w) in conditions.iter().zip(&out).zip(&watts) {
-            // The same bits as one at a time: the same iterate, the same IEEE operations in the
-            // vector lanes (which here run AVX2 or AVX-512 where the CPU has them).
-            let single = m.evaluate_condition(c).unwrap();
-            assert_eq!(single, *o, "{c:?}");
-            assert_eq!(single.electrical_w.to_bits(), w.to_bits(), "{c:?}");
-            let vh = m.vehicle().hover_induced_velocity_mps();
-            if crate::induced::solve_normalised_fast(
-                c.inflow.normal_mps / vh,
-                c.inflow.parallel_mps / vh,
-            )
-            .is_nan()
-            {
-                left_to_the_safeguarded_solver += 1;
-            }
-        }
-        // The descents below reach the lanes the fast path leaves out.
-        assert!(
-            left_to_the_safeguarded_solver > 10,
-            "{left_to_the_safeguarded_solver}"
-        );
-        let mut bad = conditions.clone();
-        bad[300].thrust_n = f64::NAN;
-        let e = m.evaluate_conditions(&bad, &mut out).unwrap_err();
-        assert!(e.to_string().contains("thrust_n"), "{e}");
-        let e = m.electrical_of_conditions(&bad, &mut watts).unwrap_err();
-        assert!(e.to_string().contains("thrust_n"), "{e}");
-        assert!(m.electrical_of_conditions(&bad[..3], &mut watts).is_err());
     }
 
     #[test]

@@ -15,6 +15,47 @@
 //!
 //! Angle of attack: the paper's approximation (3)-(4) or exact geometry ([`angle_of_attack`]).
 //!
+//! ## Layout
+//! One model per file; the machinery that makes them fast lives apart, in `kernels/`.
+//! - [`four_term`]: the model, eqs (5), (7), (14): its types ([`FlightState`],
+//!   [`FlightCondition`], [`PowerBreakdown`], [`Terms`], [`ModelOptions`], [`AoaInput`]), the
+//!   plain evaluation and the terms;
+//! - [`induced`]: induced velocity and power, eqs (8)-(10);
+//! - `quartic.rs` (private): the solver of eq (9)'s normalised quartic (start, Halley steps, the
+//!   branch-free fast path, the safeguarded fallback);
+//! - [`drag`]: cubic drag (6) and parasitic power (11);
+//! - [`profile`]: profile power (12);
+//! - [`climb`]: climb power (13);
+//! - [`angle_of_attack`]: the inflow from the paper's eqs (3)-(4) or exact geometry;
+//! - [`vehicle`]: the validated vehicle, with the disk area of eq (10);
+//! - [`efficiency`]: `eta` of eq (14) from measured power (section IV-E and a calibration);
+//! - [`gradient`]: the analytic gradient of the electrical power (section VI-B);
+//! - [`metrics`]: RMSE and NRMSE, as the paper's Table I scores a model;
+//! - [`fit`]: identification: the lumped constants from measured power, drag (6) from the force
+//!   balance;
+//! - [`error`]: [`PowerError`] and [`FitError`];
+//! - `kernels/` (private): the fast paths below, each beside the plain version it must equal.
+//!
+//! ## Fast paths
+//! Each fast path does the plain version's IEEE operations in the same order and is tested
+//! against it bit for bit (details in `kernels/mod.rs`, "advice for hackers"):
+//! - [`PowerModel::evaluate`]: a run-time dispatched AVX2 build (`kernels/dispatch.rs`) of the
+//!   plain `PowerModel::evaluate_inline` (`four_term.rs`); test
+//!   `kernels::dispatch::tests::dispatched_point_queries_equal_the_baseline_build`.
+//! - [`PowerModel::evaluate_batch`], [`PowerModel::evaluate_conditions`],
+//!   [`PowerModel::electrical_of_conditions`]: passes over blocks, the quartic and the terms in
+//!   vector lanes (`kernels/batch.rs`, `kernels/lanes.rs`), against [`PowerModel::evaluate`] and
+//!   [`PowerModel::evaluate_condition`] one at a time; tests
+//!   `kernels::batch::tests::batch_equals_single_evaluations_bit_for_bit` and
+//!   `kernels::batch::tests::conditions_in_a_batch_equal_single_evaluations`.
+//! - The quartic's branch-free `solve_normalised_fast` (`quartic.rs`, run in the lanes) against
+//!   the checked `solve_normalised`; tests
+//!   `quartic::tests::scalar_and_lane_solvers_return_the_same_root` and
+//!   `quartic::tests::settled_first_step_meets_the_residual_bound`.
+//! - `sin_cos` (`kernels/trig.rs`): polynomials within +-45 deg. Not a copy of a plain version
+//!   but part of the model's numbers (every path uses it); held within 2 ulp of the standard
+//!   library by `kernels::trig::tests`.
+//!
 //! ## Frames and units
 //! SI everywhere, angles in radians, the unit in every name. Attitude is roll/pitch/yaw of a
 //! forward-right-down body relative to north-east-down (positive pitch nose up, as the paper's
@@ -40,7 +81,6 @@
 #![deny(clippy::float_cmp)]
 
 pub mod angle_of_attack;
-mod batch;
 pub mod climb;
 pub mod drag;
 pub mod efficiency;
@@ -49,9 +89,10 @@ pub mod fit;
 pub mod four_term;
 pub mod gradient;
 pub mod induced;
+mod kernels;
 pub mod metrics;
 pub mod profile;
-mod trig;
+mod quartic;
 pub mod vehicle;
 
 pub use angle_of_attack::{AoaModel, Inflow};

@@ -1,15 +1,11 @@
 //! The vehicle as the four-term power model sees it: mass, air, rotors, drag, profile and efficiency.
 
+use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
 use serde::{Deserialize, Serialize};
 
 use crate::drag::CubicDrag;
 use crate::error::{finite, non_negative, positive, PowerError, Result};
 use crate::induced::hover_induced_velocity_mps;
-
-/// Standard gravity, m/s^2 (the default when a vehicle file does not give one).
-pub const STANDARD_GRAVITY_MPS2: f64 = 9.80665;
-/// ISA sea-level air density, kg/m^3 (the default when a vehicle file does not give one).
-pub const ISA_SEA_LEVEL_DENSITY_KG_M3: f64 = 1.225;
 
 /// Which rotor disk area the hover induced velocity of eq (10) divides the weight by.
 ///
@@ -63,9 +59,12 @@ pub struct VehicleParams {
     pub efficiency: f64,
 }
 
+/// Standard gravity (aloft-core's), the default when a vehicle file does not give one, m/s^2.
 fn default_gravity() -> f64 {
     STANDARD_GRAVITY_MPS2
 }
+/// ISA sea-level density (aloft-core's), the default when a vehicle file does not give one,
+/// kg/m^3.
 fn default_density() -> f64 {
     ISA_SEA_LEVEL_DENSITY_KG_M3
 }

@@ -49,7 +49,7 @@ use serde::Serialize;
 use crate::angle_of_attack::AoaModel;
 use crate::error::FitError;
 use crate::four_term::{resolve_point, FlightState};
-use crate::induced::solve_normalised;
+use crate::quartic::solve_normalised;
 use crate::vehicle::{DiskArea, Vehicle, VehicleParams};
 
 /// One measured sample: the flight state and the measured electrical power.
@@ -355,41 +355,83 @@ pub fn fit_power_model(
     samples: &[FitSample],
     options: &FitOptions,
 ) -> Result<PowerFit, FitError> {
-    // Validate and precompute.
-    let mut pre = Vec::with_capacity(samples.len());
-    for (index, s) in samples.iter().enumerate() {
-        let (tilt_cos, inflow, aoa) = resolve_point(&s.state).map_err(|e| FitError::BadSample {
-            index,
-            message: e.to_string(),
-        })?;
-        if !(s.measured_power_w.is_finite() && s.measured_power_w > 0.0) {
-            return Err(FitError::BadSample {
-                index,
-                message: format!(
-                    "measured_power_w must be finite and positive, got {}",
-                    s.measured_power_w
-                ),
-            });
-        }
-        let st = s.state;
-        let v = st.airspeed_mps;
-        pre.push(Pre {
-            inv_c: 1.0 / tilt_cos,
-            inv_c15: tilt_cos.powf(-1.5),
-            vn: inflow.normal_mps,
-            vp: inflow.parallel_mps,
-            v2: v * v,
-            v,
-            vz: st.climb_rate_mps,
-            measured: s.measured_power_w,
-            drag_weight: match aoa {
-                AoaModel::Paper => 1.0,
-                AoaModel::Geometric => 0.0,
-            },
-        });
-    }
+    let pre = precompute_samples(samples)?;
     let mut free = options.free.clone();
     free.dedup();
+    check_data_identifies(&pre, &free, options)?;
+    let coordinates = Coordinates::new(template, &pre, &free);
+    let solved = solve_with_outlier_pass(&coordinates, &free, pre, options)?;
+    let solution = standard_errors(
+        &coordinates.problem(&solved.used, &free),
+        &solved.u,
+        options.max_relative_std_error,
+    )?;
+    let vehicle = params_from_lumped(template, &solution.lumped)?;
+    let n = solved.used.len();
+    let mean_used = solved.used.iter().map(|s| s.measured).sum::<f64>() / n as f64;
+    let rmse_w = (solution.ssr / n as f64).sqrt();
+    Ok(PowerFit {
+        vehicle,
+        parameters: solution.parameters,
+        rmse_w,
+        nrmse: rmse_w / mean_used,
+        samples_used: n,
+        outliers_rejected: solved.outliers,
+        iterations: solved.iterations,
+    })
+}
+
+/// Validate every sample and precompute what does not depend on the parameters.
+fn precompute_samples(samples: &[FitSample]) -> Result<Vec<Pre>, FitError> {
+    samples
+        .iter()
+        .enumerate()
+        .map(|(index, s)| precompute_sample(index, s))
+        .collect()
+}
+
+/// [`Pre`] of one sample (`index` names it in errors): its attitude and inflow resolved as the
+/// model resolves a point query, its measured power finite and positive.
+fn precompute_sample(index: usize, s: &FitSample) -> Result<Pre, FitError> {
+    let (tilt_cos, inflow, aoa) = resolve_point(&s.state).map_err(|e| FitError::BadSample {
+        index,
+        message: e.to_string(),
+    })?;
+    if !(s.measured_power_w.is_finite() && s.measured_power_w > 0.0) {
+        return Err(FitError::BadSample {
+            index,
+            message: format!(
+                "measured_power_w must be finite and positive, got {}",
+                s.measured_power_w
+            ),
+        });
+    }
+    let st = s.state;
+    let v = st.airspeed_mps;
+    Ok(Pre {
+        inv_c: 1.0 / tilt_cos,
+        inv_c15: tilt_cos.powf(-1.5),
+        vn: inflow.normal_mps,
+        vp: inflow.parallel_mps,
+        v2: v * v,
+        v,
+        vz: st.climb_rate_mps,
+        measured: s.measured_power_w,
+        drag_weight: match aoa {
+            AoaModel::Paper => 1.0,
+            AoaModel::Geometric => 0.0,
+        },
+    })
+}
+
+/// Refuse up front what the data cannot identify: too few samples for the free constants, drag
+/// from samples whose power does not hold it (geometric angle of attack), and drag or a free `vh`
+/// without enough forward flight.
+fn check_data_identifies(
+    pre: &[Pre],
+    free: &[FitParameter],
+    options: &FitOptions,
+) -> Result<(), FitError> {
     let required = 10 * free.len().max(1);
     if pre.len() < required {
         return Err(FitError::TooFewSamples {
@@ -404,7 +446,7 @@ pub fn fit_power_model(
         .filter(|s| s.v > options.forward_flight_mps)
         .count();
     let drag_in_power = pre.iter().filter(|s| s.drag_weight > 0.0).count();
-    for &f in &free {
+    for &f in free {
         let drag = matches!(f, FitParameter::Mu1 | FitParameter::Mu2 | FitParameter::Mu3);
         if drag && drag_in_power * 2 < pre.len() {
             return Err(FitError::DragNotInPower {
@@ -429,31 +471,88 @@ pub fn fit_power_model(
             });
         }
     }
+    Ok(())
+}
 
+/// The fixed parts of the least-squares problem: where it starts, how its free coordinates are
+/// scaled, and how held constants follow `K` (see [`Problem`]).
+#[derive(Debug, Clone, Copy)]
+struct Coordinates {
+    base: Lumped,
+    scale: Lumped,
+    tie: Lumped,
+}
+
+impl Coordinates {
+    /// The template's lumped constants, the scales from the samples' power and speed, and the
+    /// ties of the held constants.
+    fn new(template: &Vehicle, pre: &[Pre], free: &[FitParameter]) -> Self {
+        Self {
+            base: lumped_of_template(template),
+            scale: scales(pre),
+            tie: ties_to_k(template, free),
+        }
+    }
+
+    /// The problem over `samples` with these coordinates.
+    fn problem<'a>(&self, samples: &'a [Pre], free: &'a [FitParameter]) -> Problem<'a> {
+        Problem {
+            samples,
+            base: self.base,
+            free,
+            scale: self.scale,
+            tie: self.tie,
+        }
+    }
+
+    /// The starting point in scaled coordinates: the template's values.
+    fn start(&self, free: &[FitParameter]) -> DVector<f64> {
+        DVector::from_iterator(
+            free.len(),
+            free.iter().map(|f| match f {
+                FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => 0.0,
+                _ => self.base[f.index()] / self.scale[f.index()],
+            }),
+        )
+    }
+}
+
+/// The template's lumped constants (module docs): `K = W/eta`, `vh`, `k_p`, `d_k = mu_k/eta`.
+fn lumped_of_template(template: &Vehicle) -> Lumped {
     let v = template;
     let eta = v.efficiency();
     let w = v.weight_n();
     let (mu1, mu2, mu3) = v.drag().coefficients();
-    let base: Lumped = [
+    [
         w / eta,
         v.hover_induced_velocity_mps(),
         v.kappa1() * w.powf(1.5) / eta,
         mu1 / eta,
         mu2 / eta,
         mu3 / eta,
-    ];
+    ]
+}
+
+/// Scales of the linear constants: the mean measured power, per power of the top speed for drag.
+fn scales(pre: &[Pre]) -> Lumped {
     let mean_power = pre.iter().map(|s| s.measured).sum::<f64>() / pre.len() as f64;
     let vmax = pre.iter().map(|s| s.v).fold(1.0, f64::max);
-    let scale: Lumped = [
+    [
         1.0,
         1.0,
         mean_power,
         mean_power / vmax.powi(2),
         mean_power / vmax.powi(3),
         mean_power / vmax.powi(4),
-    ];
+    ]
+}
 
-    // Held profile and drag constants keep their physical value when K is free (see Problem::tie).
+/// Held profile and drag constants keep their physical value when K is free (see
+/// [`Problem::tie`]): their lumped value per unit `K`; 0 for the rest.
+fn ties_to_k(template: &Vehicle, free: &[FitParameter]) -> Lumped {
+    let v = template;
+    let w = v.weight_n();
+    let (mu1, mu2, mu3) = v.drag().coefficients();
     let mut tie: Lumped = [0.0; 6];
     if free.contains(&FitParameter::WeightOverEfficiency) {
         let physical = [0.0, 0.0, v.kappa1() * w.sqrt(), mu1 / w, mu2 / w, mu3 / w];
@@ -463,118 +562,155 @@ pub fn fit_power_model(
             }
         }
     }
+    tie
+}
+
+/// Where the fit ended: the scaled free vector, the samples kept, how many were dropped as
+/// outliers, and the Gauss-Newton iterations of both passes.
+struct Solved {
+    u: DVector<f64>,
+    used: Vec<Pre>,
+    outliers: usize,
+    iterations: u64,
+}
+
+/// Fit all samples; with [`FitOptions::outlier_sigma`], drop the outliers once and fit again
+/// from there.
+fn solve_with_outlier_pass(
+    coordinates: &Coordinates,
+    free: &[FitParameter],
+    samples: Vec<Pre>,
+    options: &FitOptions,
+) -> Result<Solved, FitError> {
     let mut iterations = 0;
-    let mut u = DVector::from_iterator(
-        free.len(),
-        free.iter().map(|f| match f {
-            FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => 0.0,
-            _ => base[f.index()] / scale[f.index()],
-        }),
-    );
-    let mut used = pre.clone();
+    let mut u = coordinates.start(free);
+    let mut used = samples;
     let mut outliers = 0;
     for pass in 0..2 {
-        let problem = Problem {
-            samples: &used,
-            base,
-            free: &free,
-            scale,
-            tie,
-        };
-        let (r0, _) = problem.evaluate(&u, false);
-        // argmin's Gauss-Newton line search measures cost as |r| but passes the gradient of
-        // |r|^2 / 2 (J^T r), so Armijo's sufficient decrease is scaled by |r|: a full Gauss-Newton
-        // step passes only for c <= 1/(2|r|), and with c = 1e-4 a fit of large residuals stalls at
-        // its start. A tiny c keeps the test as "the cost must fall".
-        let linesearch = BacktrackingLineSearch::new(ArmijoCondition::new(1e-12).map_err(|e| {
-            FitError::Solver {
-                message: e.to_string(),
-            }
-        })?);
-        let solver = GaussNewtonLS::new(linesearch)
-            .with_tolerance(1e-10 * r0.norm().max(1e-300))
-            .map_err(|e| FitError::Solver {
-                message: e.to_string(),
-            })?;
-        let mut executor = Executor::new(problem, solver)
-            .configure(|s| s.param(u.clone()).max_iters(options.max_iterations));
-        if let Some(cb) = &options.progress {
-            executor = executor.add_observer(
-                ProgressObserver {
-                    callback: cb.clone(),
-                    offset: iterations,
-                },
-                argmin::core::observers::ObserverMode::Always,
-            );
-        }
-        let result = executor.run().map_err(|e| FitError::Solver {
-            message: e.to_string(),
-        })?;
-        let state = result.state();
-        iterations += state.get_iter();
-        u = state
-            .get_best_param()
-            .cloned()
-            .ok_or_else(|| FitError::Solver {
-                message: "no parameter returned".to_string(),
-            })?;
+        let (best, taken) =
+            gauss_newton(coordinates.problem(&used, free), &u, iterations, options)?;
+        iterations += taken;
+        u = best;
         let Some(sigma) = options.outlier_sigma.filter(|_| pass == 0) else {
             break;
         };
         // Drop outliers once, then refit.
-        let problem = Problem {
-            samples: &used,
-            base,
-            free: &free,
-            scale,
-            tie,
+        let Some(keep) = without_outliers(&coordinates.problem(&used, free), &u, sigma) else {
+            break;
         };
-        let (r, _) = problem.evaluate(&u, false);
-        let residuals: Vec<f64> = r.iter().copied().collect();
-        let (median, robust_sd) = super::median_and_robust_sd(&residuals);
-        if robust_sd <= 0.0 {
-            break;
-        }
-        let keep: Vec<Pre> = used
-            .iter()
-            .zip(r.iter())
-            .filter(|(_, &ri)| (ri - median).abs() <= sigma * robust_sd)
-            .map(|(s, _)| *s)
-            .collect();
         outliers = used.len() - keep.len();
-        if outliers == 0 {
-            break;
-        }
         used = keep;
     }
+    Ok(Solved {
+        u,
+        used,
+        outliers,
+        iterations,
+    })
+}
 
-    let problem = Problem {
-        samples: &used,
-        base,
-        free: &free,
-        scale,
-        tie,
-    };
-    let (r, j) = problem.evaluate(&u, true);
+/// One Gauss-Newton run (argmin, backtracking line search) from `u`: the best parameters and the
+/// iterations taken. `done` counts the iterations of earlier passes, for the progress callback.
+fn gauss_newton(
+    problem: Problem<'_>,
+    u: &DVector<f64>,
+    done: u64,
+    options: &FitOptions,
+) -> Result<(DVector<f64>, u64), FitError> {
+    let (r0, _) = problem.evaluate(u, false);
+    // argmin's Gauss-Newton line search measures cost as |r| but passes the gradient of
+    // |r|^2 / 2 (J^T r), so Armijo's sufficient decrease is scaled by |r|: a full Gauss-Newton
+    // step passes only for c <= 1/(2|r|), and with c = 1e-4 a fit of large residuals stalls at
+    // its start. A tiny c keeps the test as "the cost must fall".
+    let linesearch =
+        BacktrackingLineSearch::new(ArmijoCondition::new(1e-12).map_err(|e| FitError::Solver {
+            message: e.to_string(),
+        })?);
+    let solver = GaussNewtonLS::new(linesearch)
+        .with_tolerance(1e-10 * r0.norm().max(1e-300))
+        .map_err(|e| FitError::Solver {
+            message: e.to_string(),
+        })?;
+    let mut executor = Executor::new(problem, solver)
+        .configure(|s| s.param(u.clone()).max_iters(options.max_iterations));
+    if let Some(cb) = &options.progress {
+        executor = executor.add_observer(
+            ProgressObserver {
+                callback: cb.clone(),
+                offset: done,
+            },
+            argmin::core::observers::ObserverMode::Always,
+        );
+    }
+    let result = executor.run().map_err(|e| FitError::Solver {
+        message: e.to_string(),
+    })?;
+    let state = result.state();
+    let taken = state.get_iter();
+    let best = state
+        .get_best_param()
+        .cloned()
+        .ok_or_else(|| FitError::Solver {
+            message: "no parameter returned".to_string(),
+        })?;
+    Ok((best, taken))
+}
+
+/// The samples of `problem` whose residual at `u` lies within `sigma` robust standard deviations
+/// of the median residual; `None` when none is dropped (or the residuals have no spread).
+fn without_outliers(problem: &Problem<'_>, u: &DVector<f64>, sigma: f64) -> Option<Vec<Pre>> {
+    let (r, _) = problem.evaluate(u, false);
+    let residuals: Vec<f64> = r.iter().copied().collect();
+    let (median, robust_sd) = super::median_and_robust_sd(&residuals);
+    if robust_sd <= 0.0 {
+        return None;
+    }
+    let keep: Vec<Pre> = problem
+        .samples
+        .iter()
+        .zip(r.iter())
+        .filter(|(_, &ri)| (ri - median).abs() <= sigma * robust_sd)
+        .map(|(s, _)| *s)
+        .collect();
+    (keep.len() < problem.samples.len()).then_some(keep)
+}
+
+/// The fitted constants at the solution: all six lumped values, the free ones with standard
+/// errors, and the sum of squared residuals.
+struct Solution {
+    lumped: Lumped,
+    parameters: Vec<FittedParameter>,
+    ssr: f64,
+}
+
+/// Standard errors at `u`, `sigma^2 (J^T J)^-1` with `sigma^2 = SSR/(n - p)`; refuses a free
+/// constant whose standard error exceeds `max_relative_std_error` times its magnitude (or is
+/// infinite: the information matrix is singular along it).
+fn standard_errors(
+    problem: &Problem<'_>,
+    u: &DVector<f64>,
+    max_relative_std_error: f64,
+) -> Result<Solution, FitError> {
+    let (r, j) = problem.evaluate(u, true);
     let j = j.expect("requested");
-    let n = used.len();
-    let dof = (n - free.len()).max(1);
+    let n = problem.samples.len();
+    let dof = (n - problem.free.len()).max(1);
     let ssr = r.norm_squared();
     let sigma2 = ssr / dof as f64;
     let info = j.transpose() * &j;
-    let lumped = problem.lumped(&u);
+    let lumped = problem.lumped(u);
     let covariance = info.clone().try_inverse();
     let mut parameters = Vec::new();
-    for (col, &f) in free.iter().enumerate() {
+    for (col, &f) in problem.free.iter().enumerate() {
         let k = f.index();
         let value = lumped[k];
         let var_u = covariance.as_ref().map_or(f64::INFINITY, |c| c[(col, col)]);
         let se_u = (sigma2 * var_u).max(0.0).sqrt();
         let std_error = match f {
             FitParameter::WeightOverEfficiency | FitParameter::HoverInducedVelocity => value * se_u,
-            _ => se_u * scale[k],
+            _ => se_u * problem.scale[k],
         };
-        if !std_error.is_finite() || std_error > options.max_relative_std_error * value.abs() {
+        if !std_error.is_finite() || std_error > max_relative_std_error * value.abs() {
             return Err(FitError::NotIdentifiable {
                 parameter: f.name(),
                 value,
@@ -589,9 +725,19 @@ pub fn fit_power_model(
             unit: f.unit(),
         });
     }
+    Ok(Solution {
+        lumped,
+        parameters,
+        ssr,
+    })
+}
 
-    // Map the lumped constants back to the template's parameters.
-    let [k, vh, kp, d1, d2, d3] = lumped;
+/// Map the lumped constants back to the template's parameters (module docs): `eta = W/K`, the
+/// rotor radius from `vh` through eq (10), `kappa1 = k_p eta / W^1.5`, `mu_k = d_k eta`.
+fn params_from_lumped(template: &Vehicle, lumped: &Lumped) -> Result<VehicleParams, FitError> {
+    let v = template;
+    let w = v.weight_n();
+    let [k, vh, kp, d1, d2, d3] = *lumped;
     let efficiency = w / k;
     if efficiency > 1.0 {
         return Err(FitError::EfficiencyAboveOne {
@@ -611,17 +757,7 @@ pub fn fit_power_model(
     params.mu1_n_s_per_m = d1 * efficiency;
     params.mu2_n_s2_per_m2 = d2 * efficiency;
     params.mu3_n_s3_per_m3 = d3 * efficiency;
-    let mean_used = used.iter().map(|s| s.measured).sum::<f64>() / n as f64;
-    let rmse_w = (ssr / n as f64).sqrt();
-    Ok(PowerFit {
-        vehicle: params,
-        parameters,
-        rmse_w,
-        nrmse: rmse_w / mean_used,
-        samples_used: n,
-        outliers_rejected: outliers,
-        iterations,
-    })
+    Ok(params)
 }
 
 struct ProgressObserver {

@@ -1,4 +1,5 @@
-//! The vector path of the four-term model's batch evaluations.
+//! The vector lanes of the four-term model's batch evaluations (their entry points are in
+//! `batch.rs`).
 //!
 //! [`crate::PowerModel::evaluate_batch`], [`crate::PowerModel::evaluate_conditions`] and
 //! [`crate::PowerModel::electrical_of_conditions`] work in blocks of [`CHUNK`] resolved conditions,
@@ -23,7 +24,7 @@ use multiversion::multiversion;
 
 use crate::angle_of_attack::AoaModel;
 use crate::four_term::{FlightCondition, PowerModel};
-use crate::induced::solve_normalised_fast;
+use crate::quartic::solve_normalised_fast;
 
 /// Conditions per block.
 pub(crate) const CHUNK: usize = 64;
