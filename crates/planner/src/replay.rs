@@ -97,15 +97,6 @@ pub fn power_only_aircraft(
     Ok(Aircraft::four_term(airframe, vehicle, options))
 }
 
-/// Trapezoidal integral of `values` over `times_s`, in value-seconds.
-pub fn trapezoid(times_s: &[f64], values: &[f64]) -> f64 {
-    times_s
-        .windows(2)
-        .zip(values.windows(2))
-        .map(|(t, v)| 0.5 * (v[0] + v[1]) * (t[1] - t[0]))
-        .sum()
-}
-
 /// Acceleration as the centred difference of the velocity over `window_s`:
 /// `a(t) = (v(t + w/2) - v(t - w/2)) / w` with `v` interpolated linearly and the window shortened
 /// (one-sided) at the ends. `times_s` must be increasing.
@@ -238,7 +229,7 @@ pub fn replay(
     }
     let times: Vec<f64> = points.iter().map(|p| p.time_s).collect();
     let duration_s = times[times.len() - 1] - times[0];
-    let energy_j = trapezoid(&times, &power_w);
+    let energy_j = aloft_core::trapezoid(&times, &power_w);
     Ok(ReplayReport {
         duration_s,
         energy_wh: energy_j / 3600.0,
