@@ -126,44 +126,35 @@ impl<'a> CdrReader<'a> {
         Ok(self.take(1)?[0])
     }
 
+    /// A number of `N` bytes, aligned, in the message's byte order.
+    #[inline]
+    fn number<const N: usize, T>(
+        &mut self,
+        from_le: fn([u8; N]) -> T,
+        from_be: fn([u8; N]) -> T,
+    ) -> Result<T, CdrError> {
+        let a = self.array::<N>()?;
+        Ok(if self.little { from_le(a) } else { from_be(a) })
+    }
+
     /// `uint32`.
     pub fn u32(&mut self) -> Result<u32, CdrError> {
-        let a = self.array::<4>()?;
-        Ok(if self.little {
-            u32::from_le_bytes(a)
-        } else {
-            u32::from_be_bytes(a)
-        })
+        self.number(u32::from_le_bytes, u32::from_be_bytes)
     }
 
     /// `int32`.
     pub fn i32(&mut self) -> Result<i32, CdrError> {
-        let a = self.array::<4>()?;
-        Ok(if self.little {
-            i32::from_le_bytes(a)
-        } else {
-            i32::from_be_bytes(a)
-        })
+        self.number(i32::from_le_bytes, i32::from_be_bytes)
     }
 
     /// `float32`.
     pub fn f32(&mut self) -> Result<f32, CdrError> {
-        let a = self.array::<4>()?;
-        Ok(if self.little {
-            f32::from_le_bytes(a)
-        } else {
-            f32::from_be_bytes(a)
-        })
+        self.number(f32::from_le_bytes, f32::from_be_bytes)
     }
 
     /// `float64`.
     pub fn f64(&mut self) -> Result<f64, CdrError> {
-        let a = self.array::<8>()?;
-        Ok(if self.little {
-            f64::from_le_bytes(a)
-        } else {
-            f64::from_be_bytes(a)
-        })
+        self.number(f64::from_le_bytes, f64::from_be_bytes)
     }
 
     /// `n` consecutive `float64` (a fixed array, or the elements of a sequence).
@@ -253,32 +244,31 @@ impl CdrWriter {
         self
     }
 
+    /// The little-endian bytes of a number, aligned to their size.
+    fn number<const N: usize>(&mut self, bytes: [u8; N]) -> &mut Self {
+        self.align(N);
+        self.buf.extend_from_slice(&bytes);
+        self
+    }
+
     /// `uint32`.
     pub fn u32(&mut self, v: u32) -> &mut Self {
-        self.align(4);
-        self.buf.extend_from_slice(&v.to_le_bytes());
-        self
+        self.number(v.to_le_bytes())
     }
 
     /// `int32`.
     pub fn i32(&mut self, v: i32) -> &mut Self {
-        self.align(4);
-        self.buf.extend_from_slice(&v.to_le_bytes());
-        self
+        self.number(v.to_le_bytes())
     }
 
     /// `float32`.
     pub fn f32(&mut self, v: f32) -> &mut Self {
-        self.align(4);
-        self.buf.extend_from_slice(&v.to_le_bytes());
-        self
+        self.number(v.to_le_bytes())
     }
 
     /// `float64`.
     pub fn f64(&mut self, v: f64) -> &mut Self {
-        self.align(8);
-        self.buf.extend_from_slice(&v.to_le_bytes());
-        self
+        self.number(v.to_le_bytes())
     }
 
     /// `string`.

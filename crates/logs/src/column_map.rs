@@ -169,7 +169,7 @@ pub enum RateUnit {
     /// Metre per second squared (accelerations).
     #[serde(rename = "m/s^2")]
     MetrePerS2,
-    /// Standard gravity (accelerations), 9.80665 m/s^2.
+    /// Standard gravity (accelerations), [`aloft_core::STANDARD_GRAVITY_MPS2`] = 9.80665 m/s^2.
     #[serde(rename = "g")]
     G,
 }
@@ -182,7 +182,7 @@ impl RateUnit {
             RateUnit::CentimetrePerS => 1e-2,
             RateUnit::KilometrePerH => 1.0 / 3.6,
             RateUnit::Knot => 1852.0 / 3600.0,
-            RateUnit::G => 9.806_65,
+            RateUnit::G => aloft_core::STANDARD_GRAVITY_MPS2,
         }
     }
 }
@@ -467,10 +467,7 @@ impl ColumnMap {
 
     /// Read and parse a TOML map file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        let text = std::fs::read_to_string(path).map_err(LogError::reading(path))?;
         Self::from_toml_str(&text, path)
     }
 

@@ -6,11 +6,14 @@
 //! and column. Values outside physical ranges are reported as [`LogError::Implausible`], which is
 //! how a wrong unit in a map shows up.
 
+use std::f64::consts::{FRAC_PI_2, PI};
 use std::fs::File;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 
-use crate::column_map::{AttitudeColumns, ColumnMap, Frame, PositionColumns, VectorColumns};
+use crate::column_map::{
+    AttitudeColumns, ColumnMap, Frame, PositionColumns, ScalarColumn, VectorColumns,
+};
 use crate::error::{LogError, Result};
 use crate::frame::{
     attitude_from_enu_flu_quat, attitude_from_ned_frd_quat, geodetic_to_enu, ned_to_enu,
@@ -19,6 +22,90 @@ use crate::sample::{Attitude, DroppedValue, GeoOrigin, Sample, TimeChecker, Time
 
 /// Longest accepted step between consecutive time stamps, s: a longer step means a wrong time unit.
 const MAX_STEP_S: f64 = 86_400.0;
+
+/// The range a channel's value must lie in, after conversion to SI; a value outside it is
+/// [`LogError::Implausible`] (usually a wrong unit in the column map).
+struct Plausible {
+    channel: &'static str,
+    lo: f64,
+    hi: f64,
+    unit: &'static str,
+    expected: &'static str,
+}
+
+const VOLTAGE: Plausible = Plausible {
+    channel: "voltage",
+    lo: 0.0,
+    hi: 1000.0,
+    unit: "V",
+    expected: "0 to 1000 V",
+};
+const CURRENT: Plausible = Plausible {
+    channel: "current",
+    lo: -500.0,
+    hi: 2000.0,
+    unit: "A",
+    expected: "-500 to 2000 A",
+};
+const CHARGE: Plausible = Plausible {
+    channel: "charge",
+    lo: -1000.0,
+    hi: 10_000.0,
+    unit: "Ah",
+    expected: "-1000 to 10000 Ah",
+};
+/// Checked on the largest component of a local position.
+const LOCAL_POSITION: Plausible = Plausible {
+    channel: "position",
+    lo: 0.0,
+    hi: 1e6,
+    unit: "m",
+    expected: "within 1000 km",
+};
+const LATITUDE: Plausible = Plausible {
+    channel: "latitude",
+    lo: -FRAC_PI_2,
+    hi: FRAC_PI_2,
+    unit: "rad",
+    expected: "-pi/2 to pi/2 rad",
+};
+const LONGITUDE: Plausible = Plausible {
+    channel: "longitude",
+    lo: -2.0 * PI,
+    hi: 2.0 * PI,
+    unit: "rad",
+    expected: "-2 pi to 2 pi rad",
+};
+/// Checked on the norm of the vector, as are acceleration and wind.
+const VELOCITY: Plausible = Plausible {
+    channel: "velocity",
+    lo: 0.0,
+    hi: 150.0,
+    unit: "m/s",
+    expected: "below 150 m/s",
+};
+const ACCELERATION: Plausible = Plausible {
+    channel: "acceleration",
+    lo: 0.0,
+    hi: 500.0,
+    unit: "m/s^2",
+    expected: "below 500 m/s^2",
+};
+const WIND: Plausible = Plausible {
+    channel: "wind",
+    lo: 0.0,
+    hi: 100.0,
+    unit: "m/s",
+    expected: "below 100 m/s",
+};
+/// Logged unit quaternions are normalised to float precision; 10 % slack.
+const QUATERNION_NORM: Plausible = Plausible {
+    channel: "quaternion norm",
+    lo: 0.9,
+    hi: 1.1,
+    unit: "",
+    expected: "close to 1",
+};
 
 #[derive(Debug, Clone, Copy)]
 struct Col {
@@ -75,10 +162,7 @@ pub struct CsvSamples<R: Read> {
 impl CsvSamples<BufReader<File>> {
     /// Open a CSV file with a column map. Fails when a mapped column is missing from the header.
     pub fn open(path: &Path, map: &ColumnMap) -> Result<Self> {
-        let file = File::open(path).map_err(|cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        let file = File::open(path).map_err(LogError::reading(path))?;
         Self::from_reader(BufReader::with_capacity(1 << 16, file), path, map)
     }
 }
@@ -166,18 +250,24 @@ impl<R: Read> CsvSamples<R> {
         self.checker.clone().finish()
     }
 
+    /// [`LogError::ParseValue`] for `text` in `column` of the current row.
+    fn parse_error(&self, column: &str, text: String) -> LogError {
+        LogError::ParseValue {
+            path: self.path.clone(),
+            row: self.row,
+            column: column.to_string(),
+            text,
+        }
+    }
+
     fn field(&self, col: Col, name: &str) -> Result<Option<f64>> {
         let raw = self.record.get(col.index).unwrap_or(b"");
         let text = trim(raw);
         if text.is_empty() {
             return Ok(None);
         }
-        let s = std::str::from_utf8(text).map_err(|_| LogError::ParseValue {
-            path: self.path.clone(),
-            row: self.row,
-            column: name.to_string(),
-            text: String::from_utf8_lossy(text).into_owned(),
-        })?;
+        let s = std::str::from_utf8(text)
+            .map_err(|_| self.parse_error(name, String::from_utf8_lossy(text).into_owned()))?;
         match s.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(Some(v * col.factor)),
             Ok(_) => Ok(None),
@@ -189,12 +279,7 @@ impl<R: Read> CsvSamples<R> {
                         0.0
                     }));
                 }
-                Err(LogError::ParseValue {
-                    path: self.path.clone(),
-                    row: self.row,
-                    column: name.to_string(),
-                    text: s.to_string(),
-                })
+                Err(self.parse_error(name, s.to_string()))
             }
         }
     }
@@ -231,17 +316,9 @@ impl<R: Read> CsvSamples<R> {
         }
     }
 
-    fn check_range(
-        &self,
-        channel: &'static str,
-        value: f64,
-        lo: f64,
-        hi: f64,
-        unit: &'static str,
-        expected: &'static str,
-    ) -> Result<()> {
-        if value < lo || value > hi {
-            return Err(self.implausible(channel, value, unit, expected));
+    fn check_range(&self, value: f64, range: &Plausible) -> Result<()> {
+        if value < range.lo || value > range.hi {
+            return Err(self.implausible(range.channel, value, range.unit, range.expected));
         }
         Ok(())
     }
@@ -253,17 +330,37 @@ impl<R: Read> CsvSamples<R> {
         }
     }
 
+    /// The current row as a sample: its time, then the battery, position, velocity,
+    /// acceleration, wind and attitude channels, checked in that order (the first implausible
+    /// value is the error).
     fn parse_row(&mut self) -> Result<Sample> {
         let m = std::sync::Arc::clone(&self.map);
-        let t_abs = self
-            .field(m.time, &m.time_name)?
-            .ok_or_else(|| LogError::ParseValue {
-                path: self.path.clone(),
-                row: self.row,
-                column: m.time_name.clone(),
-                text: String::from_utf8_lossy(self.record.get(m.time.index).unwrap_or(b""))
-                    .into_owned(),
-            })?;
+        let mut s = Sample {
+            time_s: self.row_time_s(&m)?,
+            ..Sample::default()
+        };
+        self.read_battery(&m, &mut s)?;
+        s.pos_enu_m = self.position_enu(m.position)?;
+        s.vel_enu_mps = self.world_vector(m.velocity, &VELOCITY)?;
+        s.acc_enu_mps2 = self.world_vector(m.acceleration, &ACCELERATION)?;
+        s.wind_enu_mps = self.world_vector(m.wind, &WIND)?;
+        s.attitude = self.attitude(m.attitude.as_ref())?;
+        Ok(s)
+    }
+
+    /// Time of the row since the first row, s, after checking the step from the previous row.
+    fn row_time_s(&mut self, m: &Compiled) -> Result<f64> {
+        let t_abs = self.field(m.time, &m.time_name)?.ok_or_else(|| {
+            let raw = self.record.get(m.time.index).unwrap_or(b"");
+            self.parse_error(&m.time_name, String::from_utf8_lossy(raw).into_owned())
+        })?;
+        self.check_time_step(t_abs)?;
+        self.prev_abs_s = Some(t_abs);
+        let start = *self.start_abs_s.get_or_insert(t_abs);
+        Ok(t_abs - start)
+    }
+
+    fn check_time_step(&self, t_abs: f64) -> Result<()> {
         if let Some(prev) = self.prev_abs_s {
             if (t_abs - prev).abs() > MAX_STEP_S {
                 return Err(self.implausible(
@@ -274,175 +371,173 @@ impl<R: Read> CsvSamples<R> {
                 ));
             }
         }
-        self.prev_abs_s = Some(t_abs);
-        let start = *self.start_abs_s.get_or_insert(t_abs);
-        let mut s = Sample {
-            time_s: t_abs - start,
-            ..Sample::default()
-        };
-        if let Some(c) = m.voltage {
-            s.voltage_v = self.field(c, self.name_of(c))?;
-            if let Some(v) = s.voltage_v {
-                self.check_range("voltage", v, 0.0, 1000.0, "V", "0 to 1000 V")?;
-            }
-        }
-        if let Some(c) = m.current {
-            s.current_a = self.field(c, self.name_of(c))?;
-            if let Some(v) = s.current_a {
-                self.check_range("current", v, -500.0, 2000.0, "A", "-500 to 2000 A")?;
-            }
-        }
+        Ok(())
+    }
+
+    /// Voltage, current, power (checked against V x I) and charge.
+    fn read_battery(&mut self, m: &Compiled, s: &mut Sample) -> Result<()> {
+        s.voltage_v = self.scalar(m.voltage, &VOLTAGE)?;
+        s.current_a = self.scalar(m.current, &CURRENT)?;
         if let Some(c) = m.power {
-            s.power_w = self.field(c, self.name_of(c))?;
-            if let (Some(p), Some(v), Some(i)) = (s.power_w, s.voltage_v, s.current_a) {
-                // A logged power within 20 % (+5 W for noise at idle) of V x I. On the first row
-                // that has all three, a mismatch is a wrong unit or scale (e.g. KAIST's 10 x V x I
-                // without scale = 0.1) and an error; later, an isolated mismatch is a sensor
-                // glitch (the KAIST logs have 10 rows with a 16-bit overflowed power): the power
-                // value is dropped and reported.
-                if (p - v * i).abs() > 0.2 * (v * i).abs() + 5.0 {
-                    if !self.power_checked {
-                        return Err(self.implausible(
-                            "power",
-                            p,
-                            "W",
-                            "within 20 % of voltage x current",
-                        ));
-                    }
-                    self.dropped_count += 1;
-                    if self.dropped.len() < TimeChecker::MAX_EVENTS {
-                        self.dropped.push(DroppedValue {
-                            row: self.row,
-                            channel: "power",
-                            value: p,
-                        });
-                    }
-                    s.power_w = None;
-                }
-                self.power_checked = true;
+            s.power_w = self.power_w(c, s.voltage_v, s.current_a)?;
+        }
+        s.charge_ah = self.scalar(m.charge, &CHARGE)?;
+        Ok(())
+    }
+
+    fn scalar(&self, col: Option<Col>, range: &Plausible) -> Result<Option<f64>> {
+        let Some(c) = col else {
+            return Ok(None);
+        };
+        let value = self.field(c, self.name_of(c))?;
+        if let Some(v) = value {
+            self.check_range(v, range)?;
+        }
+        Ok(value)
+    }
+
+    /// The logged power, when it agrees with V x I within 20 % (+5 W for noise at idle). On the
+    /// first row that has all three, a mismatch is a wrong unit or scale (e.g. KAIST's 10 x V x I
+    /// without scale = 0.1) and an error; later, an isolated mismatch is a sensor glitch (the
+    /// KAIST logs have 10 rows with a 16-bit overflowed power): the power value is dropped and
+    /// reported.
+    fn power_w(
+        &mut self,
+        col: Col,
+        voltage_v: Option<f64>,
+        current_a: Option<f64>,
+    ) -> Result<Option<f64>> {
+        let power_w = self.field(col, self.name_of(col))?;
+        let (Some(p), Some(v), Some(i)) = (power_w, voltage_v, current_a) else {
+            return Ok(power_w);
+        };
+        let mut kept = power_w;
+        if (p - v * i).abs() > 0.2 * (v * i).abs() + 5.0 {
+            if !self.power_checked {
+                return Err(self.implausible("power", p, "W", "within 20 % of voltage x current"));
+            }
+            self.record_dropped("power", p);
+            kept = None;
+        }
+        self.power_checked = true;
+        Ok(kept)
+    }
+
+    fn record_dropped(&mut self, channel: &'static str, value: f64) {
+        self.dropped_count += 1;
+        if self.dropped.len() < TimeChecker::MAX_EVENTS {
+            self.dropped.push(DroppedValue {
+                row: self.row,
+                channel,
+                value,
+            });
+        }
+    }
+
+    fn position_enu(&mut self, mapped: Option<([Col; 3], PosKind)>) -> Result<Option<[f64; 3]>> {
+        let Some((cols, kind)) = mapped else {
+            return Ok(None);
+        };
+        let Some(p) = self.vec3(&cols)? else {
+            return Ok(None);
+        };
+        match kind {
+            PosKind::Local(frame) => self.local_position_enu(p, frame).map(Some),
+            PosKind::Geodetic { angle } => self.geodetic_position_enu(p, angle).map(Some),
+        }
+    }
+
+    fn local_position_enu(&self, p: [f64; 3], frame: Frame) -> Result<[f64; 3]> {
+        let p = self.frame_vec(p, frame);
+        let r = p.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        self.check_range(r, &LOCAL_POSITION)?;
+        Ok(p)
+    }
+
+    /// ENU position relative to the first fix, which becomes the origin.
+    fn geodetic_position_enu(&mut self, p: [f64; 3], angle: f64) -> Result<[f64; 3]> {
+        let (lat, lon, alt) = (p[0] * angle, p[1] * angle, p[2]);
+        self.check_range(lat, &LATITUDE)?;
+        self.check_range(lon, &LONGITUDE)?;
+        let o = *self.origin.get_or_insert(GeoOrigin {
+            lat_rad: lat,
+            lon_rad: lon,
+            alt_m: alt,
+        });
+        Ok(geodetic_to_enu(&o, lat, lon, alt))
+    }
+
+    /// A velocity, acceleration or wind vector in ENU, its norm checked against `range`.
+    fn world_vector(
+        &self,
+        mapped: Option<([Col; 3], Frame)>,
+        range: &Plausible,
+    ) -> Result<Option<[f64; 3]>> {
+        let Some((cols, frame)) = mapped else {
+            return Ok(None);
+        };
+        let Some(v) = self.vec3(&cols)? else {
+            return Ok(None);
+        };
+        let v = self.frame_vec(v, frame);
+        self.check_range(norm(v), range)?;
+        Ok(Some(v))
+    }
+
+    fn attitude(&self, mapped: Option<&(Vec<Col>, AttKind)>) -> Result<Option<Attitude>> {
+        match mapped {
+            None => Ok(None),
+            Some((cols, AttKind::Euler)) => self.euler_attitude(cols),
+            Some((cols, AttKind::Quat(frame))) => self.quaternion_attitude(cols, *frame),
+        }
+    }
+
+    fn euler_attitude(&self, cols: &[Col]) -> Result<Option<Attitude>> {
+        let Some(a) = self.vec3(&[cols[0], cols[1], cols[2]])? else {
+            return Ok(None);
+        };
+        // 1e-6 rad of slack for angles logged at exactly +-pi.
+        for (ch, v, lim) in [
+            ("roll", a[0], PI),
+            ("pitch", a[1], PI / 2.0),
+            ("yaw", a[2], 2.0 * PI),
+        ] {
+            if v.abs() > lim + 1e-6 {
+                return Err(self.implausible(
+                    ch,
+                    v,
+                    "rad",
+                    "|roll| <= pi, |pitch| <= pi/2, |yaw| <= 2 pi",
+                ));
             }
         }
-        if let Some(c) = m.charge {
-            s.charge_ah = self.field(c, self.name_of(c))?;
-            if let Some(v) = s.charge_ah {
-                self.check_range("charge", v, -1000.0, 10_000.0, "Ah", "-1000 to 10000 Ah")?;
+        Ok(Some(Attitude {
+            roll_rad: a[0],
+            pitch_rad: a[1],
+            yaw_rad: wrap_pi(a[2]),
+        }))
+    }
+
+    /// Attitude from a unit quaternion (every component is read, so a bad one is reported even
+    /// after an empty one).
+    fn quaternion_attitude(&self, cols: &[Col], frame: Frame) -> Result<Option<Attitude>> {
+        let mut q = [0.0; 4];
+        let mut ok = true;
+        for (o, c) in q.iter_mut().zip(cols.iter()) {
+            match self.field(*c, self.name_of(*c))? {
+                Some(v) => *o = v,
+                None => ok = false,
             }
         }
-        if let Some((cols, kind)) = m.position {
-            if let Some(p) = self.vec3(&cols)? {
-                match kind {
-                    PosKind::Local(frame) => {
-                        let p = self.frame_vec(p, frame);
-                        let r = p.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-                        self.check_range("position", r, 0.0, 1e6, "m", "within 1000 km")?;
-                        s.pos_enu_m = Some(p);
-                    }
-                    PosKind::Geodetic { angle } => {
-                        let (lat, lon, alt) = (p[0] * angle, p[1] * angle, p[2]);
-                        self.check_range(
-                            "latitude",
-                            lat,
-                            -std::f64::consts::FRAC_PI_2,
-                            std::f64::consts::FRAC_PI_2,
-                            "rad",
-                            "-pi/2 to pi/2 rad",
-                        )?;
-                        self.check_range(
-                            "longitude",
-                            lon,
-                            -2.0 * std::f64::consts::PI,
-                            2.0 * std::f64::consts::PI,
-                            "rad",
-                            "-2 pi to 2 pi rad",
-                        )?;
-                        let o = *self.origin.get_or_insert(GeoOrigin {
-                            lat_rad: lat,
-                            lon_rad: lon,
-                            alt_m: alt,
-                        });
-                        s.pos_enu_m = Some(geodetic_to_enu(&o, lat, lon, alt));
-                    }
-                }
-            }
+        if !ok {
+            return Ok(None);
         }
-        if let Some((cols, frame)) = m.velocity {
-            if let Some(v) = self.vec3(&cols)? {
-                let v = self.frame_vec(v, frame);
-                self.check_range("velocity", norm(v), 0.0, 150.0, "m/s", "below 150 m/s")?;
-                s.vel_enu_mps = Some(v);
-            }
-        }
-        if let Some((cols, frame)) = m.acceleration {
-            if let Some(v) = self.vec3(&cols)? {
-                let v = self.frame_vec(v, frame);
-                self.check_range(
-                    "acceleration",
-                    norm(v),
-                    0.0,
-                    500.0,
-                    "m/s^2",
-                    "below 500 m/s^2",
-                )?;
-                s.acc_enu_mps2 = Some(v);
-            }
-        }
-        if let Some((cols, frame)) = m.wind {
-            if let Some(v) = self.vec3(&cols)? {
-                let v = self.frame_vec(v, frame);
-                self.check_range("wind", norm(v), 0.0, 100.0, "m/s", "below 100 m/s")?;
-                s.wind_enu_mps = Some(v);
-            }
-        }
-        if let Some((cols, kind)) = &m.attitude {
-            match kind {
-                AttKind::Euler => {
-                    let c3 = [cols[0], cols[1], cols[2]];
-                    if let Some(a) = self.vec3(&c3)? {
-                        let pi = std::f64::consts::PI;
-                        // 1e-6 rad of slack for angles logged at exactly +-pi.
-                        for (ch, v, lim) in [
-                            ("roll", a[0], pi),
-                            ("pitch", a[1], pi / 2.0),
-                            ("yaw", a[2], 2.0 * pi),
-                        ] {
-                            if v.abs() > lim + 1e-6 {
-                                return Err(self.implausible(
-                                    ch,
-                                    v,
-                                    "rad",
-                                    "|roll| <= pi, |pitch| <= pi/2, |yaw| <= 2 pi",
-                                ));
-                            }
-                        }
-                        s.attitude = Some(Attitude {
-                            roll_rad: a[0],
-                            pitch_rad: a[1],
-                            yaw_rad: wrap_pi(a[2]),
-                        });
-                    }
-                }
-                AttKind::Quat(frame) => {
-                    let mut q = [0.0; 4];
-                    let mut ok = true;
-                    for (o, c) in q.iter_mut().zip(cols.iter()) {
-                        match self.field(*c, self.name_of(*c))? {
-                            Some(v) => *o = v,
-                            None => ok = false,
-                        }
-                    }
-                    if ok {
-                        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-                        // Logged unit quaternions are normalised to float precision; 10 % slack.
-                        self.check_range("quaternion norm", n, 0.9, 1.1, "", "close to 1")?;
-                        s.attitude = match frame {
-                            Frame::Ned => attitude_from_ned_frd_quat(q),
-                            Frame::Enu => attitude_from_enu_flu_quat(q),
-                        };
-                    }
-                }
-            }
-        }
-        Ok(s)
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        self.check_range(n, &QUATERNION_NORM)?;
+        Ok(match frame {
+            Frame::Ned => attitude_from_ned_frd_quat(q),
+            Frame::Enu => attitude_from_enu_flu_quat(q),
+        })
     }
 }
 
@@ -487,104 +582,136 @@ fn csv_error(path: &Path, e: &csv::Error) -> LogError {
     }
 }
 
-fn compile(map: &ColumnMap, columns: &[String], path: &Path) -> Result<Compiled> {
-    let mut names = Vec::new();
-    let mut find = |name: &str, channel: &'static str, factor: f64| -> Result<Col> {
-        match columns.iter().position(|c| c == name) {
+/// Finds the columns of a map in the header, channel by channel (the first missing column is
+/// the error), and keeps the names of those found.
+struct ColumnFinder<'a> {
+    columns: &'a [String],
+    path: &'a Path,
+    names: Vec<String>,
+}
+
+impl ColumnFinder<'_> {
+    fn find(&mut self, name: &str, channel: &'static str, factor: f64) -> Result<Col> {
+        match self.columns.iter().position(|c| c == name) {
             Some(index) => {
-                names.push(name.to_string());
+                self.names.push(name.to_string());
                 Ok(Col { index, factor })
             }
             None => Err(LogError::ColumnMissing {
-                path: path.to_path_buf(),
+                path: self.path.to_path_buf(),
                 column: name.to_string(),
                 channel,
-                header: header_list(columns),
+                header: header_list(self.columns),
             }),
         }
-    };
-    let time = find(&map.time.column, "time", map.time.unit.factor())?;
-    let mut scalar = |c: &Option<crate::column_map::ScalarColumn>, ch: &'static str| {
+    }
+
+    /// Three columns in order, each with its channel name and factor.
+    fn three(
+        &mut self,
+        names: &[String; 3],
+        channels: [&'static str; 3],
+        factors: [f64; 3],
+    ) -> Result<[Col; 3]> {
+        Ok([
+            self.find(&names[0], channels[0], factors[0])?,
+            self.find(&names[1], channels[1], factors[1])?,
+            self.find(&names[2], channels[2], factors[2])?,
+        ])
+    }
+
+    fn scalar(&mut self, c: &Option<ScalarColumn>, channel: &'static str) -> Result<Option<Col>> {
         c.as_ref()
-            .map(|c| find(&c.column, ch, ColumnMap::scalar_factor(c)))
+            .map(|c| self.find(&c.column, channel, ColumnMap::scalar_factor(c)))
             .transpose()
-    };
-    let voltage = scalar(&map.voltage, "voltage")?;
-    let current = scalar(&map.current, "current")?;
-    let power = scalar(&map.power, "power")?;
-    let charge = scalar(&map.charge, "charge")?;
-    let mut vector =
-        |v: &Option<VectorColumns>, ch: &'static str| -> Result<Option<([Col; 3], Frame)>> {
-            match v {
-                None => Ok(None),
-                Some(v) => {
-                    let f = v.unit.factor();
-                    Ok(Some((
-                        [
-                            find(&v.columns[0], ch, f)?,
-                            find(&v.columns[1], ch, f)?,
-                            find(&v.columns[2], ch, f)?,
-                        ],
-                        v.frame,
-                    )))
-                }
-            }
+    }
+
+    fn vector(
+        &mut self,
+        v: &Option<VectorColumns>,
+        channel: &'static str,
+    ) -> Result<Option<([Col; 3], Frame)>> {
+        let Some(v) = v else {
+            return Ok(None);
         };
-    let velocity = vector(&map.velocity, "velocity")?;
-    let acceleration = vector(&map.acceleration, "acceleration")?;
-    let wind = vector(&map.wind, "wind")?;
-    let position = match &map.position {
-        None => None,
-        Some(PositionColumns::Local {
-            columns: c,
-            frame,
-            unit,
-        }) => {
-            let f = unit.factor();
-            Some((
-                [
-                    find(&c[0], "position", f)?,
-                    find(&c[1], "position", f)?,
-                    find(&c[2], "position", f)?,
-                ],
-                PosKind::Local(*frame),
-            ))
-        }
-        Some(PositionColumns::Geodetic {
-            columns: c,
-            angle_unit,
-            unit,
-        }) => Some((
-            [
-                find(&c[0], "latitude", 1.0)?,
-                find(&c[1], "longitude", 1.0)?,
-                find(&c[2], "altitude", unit.factor())?,
-            ],
-            PosKind::Geodetic {
-                angle: angle_unit.factor(),
-            },
-        )),
+        let f = v.unit.factor();
+        Ok(Some((
+            self.three(&v.columns, [channel; 3], [f; 3])?,
+            v.frame,
+        )))
+    }
+
+    fn position(&mut self, p: &Option<PositionColumns>) -> Result<Option<([Col; 3], PosKind)>> {
+        Ok(match p {
+            None => None,
+            Some(PositionColumns::Local {
+                columns,
+                frame,
+                unit,
+            }) => {
+                let f = unit.factor();
+                Some((
+                    self.three(columns, ["position"; 3], [f; 3])?,
+                    PosKind::Local(*frame),
+                ))
+            }
+            Some(PositionColumns::Geodetic {
+                columns,
+                angle_unit,
+                unit,
+            }) => Some((
+                self.three(
+                    columns,
+                    ["latitude", "longitude", "altitude"],
+                    [1.0, 1.0, unit.factor()],
+                )?,
+                PosKind::Geodetic {
+                    angle: angle_unit.factor(),
+                },
+            )),
+        })
+    }
+
+    fn attitude(&mut self, a: &Option<AttitudeColumns>) -> Result<Option<(Vec<Col>, AttKind)>> {
+        Ok(match a {
+            None => None,
+            Some(AttitudeColumns::Euler { columns, unit }) => {
+                let f = unit.factor();
+                Some((
+                    self.three(columns, ["roll", "pitch", "yaw"], [f; 3])?
+                        .to_vec(),
+                    AttKind::Euler,
+                ))
+            }
+            Some(AttitudeColumns::Quaternion { columns, frame }) => Some((
+                columns
+                    .iter()
+                    .map(|n| self.find(n, "attitude", 1.0))
+                    .collect::<Result<Vec<_>>>()?,
+                AttKind::Quat(*frame),
+            )),
+        })
+    }
+}
+
+/// The map's columns located in the header, in the order time, battery, velocity,
+/// acceleration, wind, position, attitude.
+fn compile(map: &ColumnMap, columns: &[String], path: &Path) -> Result<Compiled> {
+    let mut finder = ColumnFinder {
+        columns,
+        path,
+        names: Vec::new(),
     };
-    let attitude = match &map.attitude {
-        None => None,
-        Some(AttitudeColumns::Euler { columns: c, unit }) => {
-            let f = unit.factor();
-            Some((
-                vec![
-                    find(&c[0], "roll", f)?,
-                    find(&c[1], "pitch", f)?,
-                    find(&c[2], "yaw", f)?,
-                ],
-                AttKind::Euler,
-            ))
-        }
-        Some(AttitudeColumns::Quaternion { columns: c, frame }) => Some((
-            c.iter()
-                .map(|n| find(n, "attitude", 1.0))
-                .collect::<Result<Vec<_>>>()?,
-            AttKind::Quat(*frame),
-        )),
-    };
+    let time = finder.find(&map.time.column, "time", map.time.unit.factor())?;
+    let voltage = finder.scalar(&map.voltage, "voltage")?;
+    let current = finder.scalar(&map.current, "current")?;
+    let power = finder.scalar(&map.power, "power")?;
+    let charge = finder.scalar(&map.charge, "charge")?;
+    let velocity = finder.vector(&map.velocity, "velocity")?;
+    let acceleration = finder.vector(&map.acceleration, "acceleration")?;
+    let wind = finder.vector(&map.wind, "wind")?;
+    let position = finder.position(&map.position)?;
+    let attitude = finder.attitude(&map.attitude)?;
     Ok(Compiled {
         time,
         time_name: map.time.column.clone(),
@@ -597,7 +724,7 @@ fn compile(map: &ColumnMap, columns: &[String], path: &Path) -> Result<Compiled>
         acceleration,
         attitude,
         wind,
-        names,
+        names: finder.names,
     })
 }
 

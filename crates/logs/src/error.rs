@@ -1,6 +1,6 @@
 //! The crate's typed error: every variant names the file, row, column, topic or channel at fault.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
@@ -226,6 +226,16 @@ pub enum LogError {
         /// The value.
         value: f64,
     },
+}
+
+impl LogError {
+    /// The [`LogError::Io`] of reading `path`, for `map_err`.
+    pub(crate) fn reading(path: &Path) -> impl FnOnce(std::io::Error) -> LogError + '_ {
+        move |cause| LogError::Io {
+            path: path.to_path_buf(),
+            cause,
+        }
+    }
 }
 
 /// Result with a [`LogError`].

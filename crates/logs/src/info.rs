@@ -1,5 +1,6 @@
 //! A summary of a log, accumulated while streaming: duration, per-channel rates, energy.
 
+use aloft_core::{trapezoid, SECONDS_PER_HOUR};
 use serde::Serialize;
 
 use crate::sample::{Channel, Sample};
@@ -77,36 +78,47 @@ impl InfoAccumulator {
         self.t_min = Some(self.t_min.map_or(t, |m| m.min(t)));
         self.t_max = Some(self.t_max.map_or(t, |m| m.max(t)));
         for c in Channel::ALL {
-            if !c.present_in(s) {
-                continue;
-            }
-            match self.stats.iter_mut().find(|x| x.channel == c) {
-                Some(x) => {
-                    x.samples += 1;
-                    x.first_s = x.first_s.min(t);
-                    x.last_s = x.last_s.max(t);
-                }
-                None => self.stats.push(ChannelStats {
-                    channel: c,
-                    samples: 1,
-                    first_s: t,
-                    last_s: t,
-                }),
+            if c.present_in(s) {
+                self.count_channel(c, t);
             }
         }
         if let Some(p) = s.electrical_power_w() {
-            self.power_samples += 1;
-            self.power_sum_w += p;
-            self.power_max_w = Some(self.power_max_w.map_or(p, |m| m.max(p)));
-            if let Some((t0, p0)) = self.last_power {
-                if t > t0 {
-                    self.energy_j += 0.5 * (p + p0) * (t - t0);
-                } else {
-                    self.skipped_steps += 1;
-                }
-            }
-            self.last_power = Some((t, p));
+            self.add_power(t, p);
         }
+    }
+
+    fn count_channel(&mut self, c: Channel, t: f64) {
+        match self.stats.iter_mut().find(|x| x.channel == c) {
+            Some(x) => {
+                x.samples += 1;
+                x.first_s = x.first_s.min(t);
+                x.last_s = x.last_s.max(t);
+            }
+            None => self.stats.push(ChannelStats {
+                channel: c,
+                samples: 1,
+                first_s: t,
+                last_s: t,
+            }),
+        }
+    }
+
+    /// Power statistics, and the energy of the step from the previous power sample.
+    fn add_power(&mut self, t: f64, p: f64) {
+        self.power_samples += 1;
+        self.power_sum_w += p;
+        self.power_max_w = Some(self.power_max_w.map_or(p, |m| m.max(p)));
+        if let Some((t0, p0)) = self.last_power {
+            if t > t0 {
+                // One panel of the trapezoid rule at a time: a step where time does not
+                // increase is skipped and the next panel starts from it, which a single
+                // streaming `Trapezoid` cannot express.
+                self.energy_j += trapezoid(&[t0, t], &[p0, p]);
+            } else {
+                self.skipped_steps += 1;
+            }
+        }
+        self.last_power = Some((t, p));
     }
 
     /// The summary.
@@ -119,7 +131,7 @@ impl InfoAccumulator {
                 _ => 0.0,
             },
             channels: self.stats,
-            energy_wh: (self.power_samples > 1).then(|| self.energy_j / 3600.0),
+            energy_wh: (self.power_samples > 1).then(|| self.energy_j / SECONDS_PER_HOUR),
             mean_power_w: (self.power_samples > 0)
                 .then(|| self.power_sum_w / self.power_samples as f64),
             max_power_w: self.power_max_w,

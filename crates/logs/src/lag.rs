@@ -75,13 +75,41 @@ pub fn estimate_lag_s(
     dt_s: f64,
     max_lag_s: f64,
 ) -> Result<LagEstimate> {
-    if !(dt_s.is_finite() && dt_s > 0.0) {
+    let k_max = search_window(power, motion_proxy, dt_s, max_lag_s)?;
+    let n = power.len();
+    let p = detrend(power);
+    let m = detrend(motion_proxy);
+    let zero = lagged_pearson(&p, &m, 0);
+    let km = k_max as i64;
+    let cs: Vec<f64> = (-km..=km).map(|k| lagged_pearson(&p, &m, k)).collect();
+    if cs.iter().all(|c| c.abs() < 1e-300) {
         return Err(LogError::InvalidArgument {
-            name: "dt_s",
-            value: dt_s,
-            reason: "must be finite and positive",
+            name: "series variance",
+            value: 0.0,
+            reason: "a series is constant (after detrending): no lag can be estimated",
         });
     }
+    let (best, &c) = cs
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .unwrap_or((k_max, &0.0));
+    let mut lag = best as f64 - km as f64;
+    if let Some(offset) = parabola_peak_offset(&cs, best) {
+        lag += offset;
+    }
+    Ok(LagEstimate {
+        lag_s: lag * dt_s,
+        correlation: c,
+        correlation_at_zero: zero,
+        samples: n,
+        at_window_edge: best == 0 || best + 1 == cs.len(),
+    })
+}
+
+/// Checks the arguments of [`estimate_lag_s`] and returns the search window in samples.
+fn search_window(power: &[f64], motion_proxy: &[f64], dt_s: f64, max_lag_s: f64) -> Result<usize> {
+    check_step(dt_s)?;
     if !(max_lag_s.is_finite() && max_lag_s >= 0.0) {
         return Err(LogError::InvalidArgument {
             name: "max_lag_s",
@@ -112,53 +140,11 @@ pub fn estimate_lag_s(
             reason: "the series must be at least twice the search window and 10 samples long",
         });
     }
-    let p = detrend(power);
-    let m = detrend(motion_proxy);
-    let corr_at = |k: i64| -> f64 {
-        if k >= 0 {
-            let k = k as usize;
-            pearson(&p[k..], &m[..n - k])
-        } else {
-            let k = (-k) as usize;
-            pearson(&p[..n - k], &m[k..])
-        }
-    };
-    let zero = corr_at(0);
-    let km = k_max as i64;
-    let cs: Vec<f64> = (-km..=km).map(corr_at).collect();
-    if cs.iter().all(|c| c.abs() < 1e-300) {
-        return Err(LogError::InvalidArgument {
-            name: "series variance",
-            value: 0.0,
-            reason: "a series is constant (after detrending): no lag can be estimated",
-        });
-    }
-    let (best, &c) = cs
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.total_cmp(b.1))
-        .unwrap_or((k_max, &0.0));
-    let mut lag = best as f64 - km as f64;
-    if best > 0 && best + 1 < cs.len() {
-        let (y0, y1, y2) = (cs[best - 1], c, cs[best + 1]);
-        let den = y0 - 2.0 * y1 + y2;
-        if den < 0.0 {
-            lag += (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5);
-        }
-    }
-    Ok(LagEstimate {
-        lag_s: lag * dt_s,
-        correlation: c,
-        correlation_at_zero: zero,
-        samples: n,
-        at_window_edge: best == 0 || best + 1 == cs.len(),
-    })
+    Ok(k_max)
 }
 
-/// Linear interpolation of `(times_s, values)` onto a uniform grid of step `dt_s` from the first
-/// time to the last. Samples whose time does not increase are skipped (they are reported by the
-/// log's [`crate::TimeReport`]). Returns the grid's start time and the values.
-pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f64, Vec<f64>)> {
+/// A sampling step must be finite and positive.
+fn check_step(dt_s: f64) -> Result<()> {
     if !(dt_s.is_finite() && dt_s > 0.0) {
         return Err(LogError::InvalidArgument {
             name: "dt_s",
@@ -166,6 +152,37 @@ pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f
             reason: "must be finite and positive",
         });
     }
+    Ok(())
+}
+
+/// Correlation of `p[i + k]` with `m[i]` over their overlap.
+fn lagged_pearson(p: &[f64], m: &[f64], k: i64) -> f64 {
+    let n = p.len();
+    if k >= 0 {
+        let k = k as usize;
+        pearson(&p[k..], &m[..n - k])
+    } else {
+        let k = (-k) as usize;
+        pearson(&p[..n - k], &m[k..])
+    }
+}
+
+/// Where the parabola through `cs[best]` and its two neighbours peaks, relative to `best`
+/// (within half a sample); `None` at the window's edge or without a maximum.
+fn parabola_peak_offset(cs: &[f64], best: usize) -> Option<f64> {
+    if best == 0 || best + 1 >= cs.len() {
+        return None;
+    }
+    let (y0, y1, y2) = (cs[best - 1], cs[best], cs[best + 1]);
+    let den = y0 - 2.0 * y1 + y2;
+    (den < 0.0).then(|| (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5))
+}
+
+/// Linear interpolation of `(times_s, values)` onto a uniform grid of step `dt_s` from the first
+/// time to the last. Samples whose time does not increase are skipped (they are reported by the
+/// log's [`crate::TimeReport`]). Returns the grid's start time and the values.
+pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f64, Vec<f64>)> {
+    check_step(dt_s)?;
     let pts: Vec<(f64, f64)> = {
         let mut v: Vec<(f64, f64)> = Vec::with_capacity(times_s.len());
         for (t, y) in times_s.iter().zip(values) {

@@ -24,11 +24,12 @@ use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use mcap::records::MessageHeader;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use serde::Serialize;
 
 use crate::error::{LogError, Result};
-use crate::ros::{decode_cdr, decode_json, MessageKind, RosDecodeOptions, SUPPORTED};
+use crate::ros::{decode_cdr, decode_json, Decoded, MessageKind, RosDecodeOptions, SUPPORTED};
 use crate::sample::{Channel, Sample, TimeChecker, TimeReport};
 
 /// Largest record (or chunk) accepted, bytes.
@@ -82,6 +83,17 @@ impl TopicInfo {
         let (a, b) = self.log_time_range_ns?;
         (self.messages > 1 && b > a).then(|| (self.messages - 1) as f64 / ((b - a) as f64 * 1e-9))
     }
+
+    /// Count a message logged at `log_time_ns`; returns its 0-based index on the topic.
+    fn count_message(&mut self, log_time_ns: u64) -> u64 {
+        let index = self.messages;
+        self.messages += 1;
+        self.log_time_range_ns = Some(match self.log_time_range_ns {
+            None => (log_time_ns, log_time_ns),
+            Some((a, b)) => (a.min(log_time_ns), b.max(log_time_ns)),
+        });
+        index
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,7 +102,7 @@ enum Encoding {
     Json,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Copy)]
 struct ChanState {
     info: usize,
     decoder: Option<(MessageKind, Encoding)>,
@@ -101,9 +113,16 @@ struct ChanState {
 
 /// Samples of one MCAP file, decoded message by message.
 pub struct McapSamples<R: Read> {
-    path: PathBuf,
     input: R,
     reader: LinearReader,
+    records: RecordDecoder,
+    done: bool,
+}
+
+/// The sans-I/O half of [`McapSamples`]: what the records seen so far say (schemas, channels,
+/// topics, the time base), and the decoding of the next record into a sample.
+struct RecordDecoder {
+    path: PathBuf,
     options: McapOptions,
     schemas: HashMap<u16, (String, String)>,
     channels: HashMap<u16, ChanState>,
@@ -113,16 +132,12 @@ pub struct McapSamples<R: Read> {
     start_log_time_ns: Option<u64>,
     checker: TimeChecker,
     messages: u64,
-    done: bool,
 }
 
 impl McapSamples<std::io::BufReader<File>> {
     /// Open a file.
     pub fn open(path: &Path, options: McapOptions) -> Result<Self> {
-        let f = File::open(path).map_err(|cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        let f = File::open(path).map_err(LogError::reading(path))?;
         Ok(Self::from_reader(
             std::io::BufReader::with_capacity(1 << 16, f),
             path,
@@ -175,54 +190,123 @@ impl<R: Read> McapSamples<R> {
             LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT),
         );
         Self {
-            path: path.to_path_buf(),
             input,
             reader,
-            options,
-            schemas: HashMap::new(),
-            channels: HashMap::new(),
-            topics: Vec::new(),
-            claimed: HashMap::new(),
-            start_s: None,
-            start_log_time_ns: None,
-            checker: TimeChecker::new(),
-            messages: 0,
+            records: RecordDecoder {
+                path: path.to_path_buf(),
+                options,
+                schemas: HashMap::new(),
+                channels: HashMap::new(),
+                topics: Vec::new(),
+                claimed: HashMap::new(),
+                start_s: None,
+                start_log_time_ns: None,
+                checker: TimeChecker::new(),
+                messages: 0,
+            },
             done: false,
         }
     }
 
     /// The topics seen so far (all of them once the stream is exhausted), in order of appearance.
     pub fn topics(&self) -> &[TopicInfo] {
-        &self.topics
+        &self.records.topics
     }
 
     /// Messages read so far, on all topics.
     pub fn messages(&self) -> u64 {
-        self.messages
+        self.records.messages
     }
 
     /// Absolute time of the first decoded sample, s (Unix time for most recorders).
     pub fn start_time_s(&self) -> Option<f64> {
-        self.start_s
+        self.records.start_s
     }
 
     /// Time report of the decoded samples so far.
     pub fn time_report(&self) -> TimeReport {
-        self.checker.clone().finish()
+        self.records.checker.clone().finish()
     }
 
     /// The channels that are being decoded and from which topic.
     pub fn claimed(&self) -> Vec<(Channel, String)> {
-        let mut v: Vec<(Channel, String)> = self
+        let records = &self.records;
+        let mut v: Vec<(Channel, String)> = records
             .claimed
             .iter()
             .filter_map(|(c, id)| {
-                let st = self.channels.get(id)?;
-                Some((*c, self.topics[st.info].topic.clone()))
+                let st = records.channels.get(id)?;
+                Some((*c, records.topics[st.info].topic.clone()))
             })
             .collect();
         v.sort();
         v
+    }
+
+    /// The next sample: feed the reader until a record decodes into one, or the file ends.
+    fn step(&mut self) -> Result<Option<Sample>> {
+        loop {
+            let event = match self.reader.next_event() {
+                None => {
+                    self.done = true;
+                    self.records.finish_checks()?;
+                    return Ok(None);
+                }
+                Some(event) => event.map_err(|e| self.records.mcap_error(e))?,
+            };
+            match event {
+                LinearReadEvent::ReadRequest(n) => self.fill(n)?,
+                LinearReadEvent::Record { opcode, data } => {
+                    if let Some(s) = self.records.on_record(opcode, data)? {
+                        return Ok(Some(s));
+                    }
+                }
+            }
+        }
+    }
+
+    /// Hand the reader up to `n` bytes of input (0 at the end of the input).
+    fn fill(&mut self, n: usize) -> Result<()> {
+        let buf = self.reader.insert(n);
+        let got = loop {
+            match self.input.read(buf) {
+                Ok(k) => break k,
+                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+                Err(cause) => return Err(LogError::reading(&self.records.path)(cause)),
+            }
+        };
+        self.reader.notify_read(got);
+        Ok(())
+    }
+}
+
+impl RecordDecoder {
+    /// [`LogError::Mcap`] after the messages read so far.
+    fn mcap_error(&self, cause: mcap::McapError) -> LogError {
+        LogError::Mcap {
+            path: self.path.clone(),
+            messages: self.messages,
+            cause,
+        }
+    }
+
+    /// One record: schemas and new channels are remembered; a message on a decoded topic is a
+    /// sample.
+    fn on_record(&mut self, opcode: u8, data: &[u8]) -> Result<Option<Sample>> {
+        match mcap::parse_record(opcode, data).map_err(|e| self.mcap_error(e))? {
+            mcap::records::Record::Schema { header, .. } => {
+                self.schemas
+                    .insert(header.id, (header.name, header.encoding));
+            }
+            mcap::records::Record::Channel(ch) if !self.channels.contains_key(&ch.id) => {
+                self.add_channel(ch)?;
+            }
+            mcap::records::Record::Message { header, data } => {
+                return self.on_message(&header, &data);
+            }
+            _ => {}
+        }
+        Ok(None)
     }
 
     fn add_channel(&mut self, ch: mcap::records::Channel) -> Result<()> {
@@ -275,6 +359,81 @@ impl<R: Read> McapSamples<R> {
         Ok(())
     }
 
+    /// A message: counted on its topic, and decoded into a sample when the topic feeds a
+    /// channel.
+    fn on_message(&mut self, header: &MessageHeader, data: &[u8]) -> Result<Option<Sample>> {
+        self.messages += 1;
+        let Some(&st) = self.channels.get(&header.channel_id) else {
+            return Err(LogError::Mcap {
+                path: self.path.clone(),
+                messages: self.messages - 1,
+                cause: mcap::McapError::UnknownChannel(header.sequence, header.channel_id),
+            });
+        };
+        let index = self.topics[st.info].count_message(header.log_time);
+        let Some((kind, encoding)) = st.decoder else {
+            return Ok(None);
+        };
+        let decoded = self.decode(st.info, index, kind, encoding, data)?;
+        self.topics[st.info].decoded += 1;
+        let mut s = decoded.sample;
+        mask(&mut s, &st.keep);
+        s.time_s = self.sample_time_s(header.log_time, decoded.stamp_s);
+        self.checker.push(s.time_s);
+        Ok(Some(s))
+    }
+
+    /// Decode message `index` of topic `info`.
+    fn decode(
+        &self,
+        info: usize,
+        index: u64,
+        kind: MessageKind,
+        encoding: Encoding,
+        data: &[u8],
+    ) -> Result<Decoded> {
+        let info = &self.topics[info];
+        match encoding {
+            Encoding::Cdr => {
+                decode_cdr(kind, data, self.options.decode).map_err(|cause| LogError::Cdr {
+                    path: self.path.clone(),
+                    topic: info.topic.clone(),
+                    index,
+                    schema: info.schema.clone(),
+                    cause,
+                })
+            }
+            Encoding::Json => decode_json(kind, data, self.options.decode).map_err(|message| {
+                LogError::JsonMessage {
+                    path: self.path.clone(),
+                    topic: info.topic.clone(),
+                    index,
+                    message,
+                }
+            }),
+        }
+    }
+
+    /// Time of a sample since the first decoded one, s, on the clock the options choose.
+    fn sample_time_s(&mut self, log_time_ns: u64, stamp_s: Option<f64>) -> f64 {
+        let t_abs = match (self.options.time, stamp_s) {
+            (McapTime::HeaderStamp, Some(t)) => t,
+            _ => log_time_ns as f64 * 1e-9,
+        };
+        if self.start_log_time_ns.is_none() {
+            self.start_log_time_ns = Some(log_time_ns);
+        }
+        let start = *self.start_s.get_or_insert(t_abs);
+        match self.options.time {
+            // Integer nanoseconds: no loss of resolution for Unix times.
+            McapTime::LogTime => {
+                let t0 = self.start_log_time_ns.unwrap_or(log_time_ns);
+                (i128::from(log_time_ns) - i128::from(t0)) as f64 * 1e-9
+            }
+            McapTime::HeaderStamp => t_abs - start,
+        }
+    }
+
     fn finish_checks(&self) -> Result<()> {
         for t in &self.options.topics {
             if !self.topics.iter().any(|i| i.topic == *t) {
@@ -297,130 +456,6 @@ impl<R: Read> McapSamples<R> {
             });
         }
         Ok(())
-    }
-
-    fn step(&mut self) -> Result<Option<Sample>> {
-        loop {
-            let event = match self.reader.next_event() {
-                None => {
-                    self.done = true;
-                    self.finish_checks()?;
-                    return Ok(None);
-                }
-                Some(Err(e)) => {
-                    let e = LogError::Mcap {
-                        path: self.path.clone(),
-                        messages: self.messages,
-                        cause: e,
-                    };
-                    return Err(e);
-                }
-                Some(Ok(ev)) => ev,
-            };
-            match event {
-                LinearReadEvent::ReadRequest(n) => {
-                    let buf = self.reader.insert(n);
-                    let got = loop {
-                        match self.input.read(buf) {
-                            Ok(k) => break k,
-                            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                            Err(cause) => {
-                                return Err(LogError::Io {
-                                    path: self.path.clone(),
-                                    cause,
-                                })
-                            }
-                        }
-                    };
-                    self.reader.notify_read(got);
-                }
-                LinearReadEvent::Record { opcode, data } => {
-                    let record = match mcap::parse_record(opcode, data) {
-                        Ok(r) => r,
-                        Err(e) => {
-                            return Err(LogError::Mcap {
-                                path: self.path.clone(),
-                                messages: self.messages,
-                                cause: e,
-                            })
-                        }
-                    };
-                    match record {
-                        mcap::records::Record::Schema { header, .. } => {
-                            self.schemas
-                                .insert(header.id, (header.name, header.encoding));
-                        }
-                        mcap::records::Record::Channel(ch)
-                            if !self.channels.contains_key(&ch.id) =>
-                        {
-                            self.add_channel(ch)?;
-                        }
-                        mcap::records::Record::Message { header, data } => {
-                            self.messages += 1;
-                            let Some(st) = self.channels.get(&header.channel_id) else {
-                                return Err(LogError::Mcap {
-                                    path: self.path.clone(),
-                                    messages: self.messages - 1,
-                                    cause: mcap::McapError::UnknownChannel(
-                                        header.sequence,
-                                        header.channel_id,
-                                    ),
-                                });
-                            };
-                            let info = &mut self.topics[st.info];
-                            let index = info.messages;
-                            info.messages += 1;
-                            info.log_time_range_ns = Some(match info.log_time_range_ns {
-                                None => (header.log_time, header.log_time),
-                                Some((a, b)) => (a.min(header.log_time), b.max(header.log_time)),
-                            });
-                            let Some((kind, enc)) = st.decoder else {
-                                continue;
-                            };
-                            let decoded = match enc {
-                                Encoding::Cdr => decode_cdr(kind, &data, self.options.decode)
-                                    .map_err(|cause| LogError::Cdr {
-                                        path: self.path.clone(),
-                                        topic: info.topic.clone(),
-                                        index,
-                                        schema: info.schema.clone(),
-                                        cause,
-                                    }),
-                                Encoding::Json => decode_json(kind, &data, self.options.decode)
-                                    .map_err(|message| LogError::JsonMessage {
-                                        path: self.path.clone(),
-                                        topic: info.topic.clone(),
-                                        index,
-                                        message,
-                                    }),
-                            }?;
-                            info.decoded += 1;
-                            let mut s = decoded.sample;
-                            mask(&mut s, &st.keep);
-                            let t_abs = match (self.options.time, decoded.stamp_s) {
-                                (McapTime::HeaderStamp, Some(t)) => t,
-                                _ => header.log_time as f64 * 1e-9,
-                            };
-                            if self.start_log_time_ns.is_none() {
-                                self.start_log_time_ns = Some(header.log_time);
-                            }
-                            let start = *self.start_s.get_or_insert(t_abs);
-                            s.time_s = match self.options.time {
-                                // Integer nanoseconds: no loss of resolution for Unix times.
-                                McapTime::LogTime => {
-                                    let t0 = self.start_log_time_ns.unwrap_or(header.log_time);
-                                    (i128::from(header.log_time) - i128::from(t0)) as f64 * 1e-9
-                                }
-                                McapTime::HeaderStamp => t_abs - start,
-                            };
-                            self.checker.push(s.time_s);
-                            return Ok(Some(s));
-                        }
-                        _ => {}
-                    }
-                }
-            }
-        }
     }
 }
 

@@ -91,31 +91,19 @@ fn is_mcap(path: &Path) -> Result<bool> {
     if !path.is_file() {
         return Ok(false);
     }
-    let mut f = File::open(path).map_err(|cause| LogError::Io {
-        path: path.to_path_buf(),
-        cause,
-    })?;
+    let mut f = File::open(path).map_err(LogError::reading(path))?;
     let mut head = [0u8; 8];
-    let n = f.read(&mut head).map_err(|cause| LogError::Io {
-        path: path.to_path_buf(),
-        cause,
-    })?;
+    let n = f.read(&mut head).map_err(LogError::reading(path))?;
     Ok(n == 8 && head == MCAP_MAGIC)
 }
 
 fn first_line(path: &Path) -> Result<String> {
-    let f = File::open(path).map_err(|cause| LogError::Io {
-        path: path.to_path_buf(),
-        cause,
-    })?;
+    let f = File::open(path).map_err(LogError::reading(path))?;
     let mut line = String::new();
     // A header longer than 64 KiB is not a layout we know; read at most that much.
     BufReader::new(f.take(1 << 16))
         .read_line(&mut line)
-        .map_err(|cause| LogError::Io {
-            path: path.to_path_buf(),
-            cause,
-        })?;
+        .map_err(LogError::reading(path))?;
     Ok(line.trim_end().to_string())
 }
 

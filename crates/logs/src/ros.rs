@@ -13,15 +13,13 @@
 //! convention unless [`RosDecodeOptions::battery_current_positive_discharging`] is set (some
 //! drivers publish the opposite sign). NaN fields (unmeasured) leave the channel empty.
 
+use aloft_core::STANDARD_GRAVITY_MPS2;
 use serde_json::Value;
 
 use crate::cdr::{CdrError, CdrReader};
 use crate::frame::{mat_ned_frd_to_euler, Mat3};
 use crate::frame::{mat_vec, ned_to_enu, quat_to_mat, ros_quat_to_mat_ned_frd};
 use crate::sample::{Attitude, Channel, Sample};
-
-/// Standard gravity, m/s^2.
-const G_MPS2: f64 = 9.806_65;
 
 /// Message types aloft decodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -199,10 +197,32 @@ fn imu(frame_id: &str, q: [f64; 4], orientation_cov0: f64, acc: [f64; 3]) -> Sam
     if let Some((r, att)) = orientation(q, frame_id) {
         s.attitude = Some(att);
         let mut a = body_to_enu(&r, acc, is_ned(frame_id));
-        a[2] -= G_MPS2;
+        a[2] -= STANDARD_GRAVITY_MPS2;
         s.acc_enu_mps2 = finite3(a);
     }
     s
+}
+
+/// `PoseStamped`: position and orientation in the header's frame.
+fn pose(frame_id: &str, pos: [f64; 3], q: [f64; 4]) -> Sample {
+    Sample {
+        pos_enu_m: finite3(world_vec(pos, frame_id)),
+        attitude: orientation(q, frame_id).map(|(_, a)| a),
+        ..Sample::default()
+    }
+}
+
+/// `TwistStamped`: the linear velocity, when the header's frame is a world frame (a body-frame
+/// twist cannot be rotated without an attitude).
+fn twist(frame_id: &str, lin: [f64; 3]) -> Sample {
+    Sample {
+        vel_enu_mps: if is_world(frame_id) {
+            finite3(world_vec(lin, frame_id))
+        } else {
+            None
+        },
+        ..Sample::default()
+    }
 }
 
 fn header<'a>(r: &mut CdrReader<'a>) -> Result<(Option<f64>, &'a str), CdrError> {
@@ -221,67 +241,66 @@ pub fn decode_cdr(
     let mut r = CdrReader::new(data)?;
     let (stamp_s, frame_id) = header(&mut r)?;
     let sample = match kind {
-        MessageKind::BatteryState => {
-            let voltage = r.f32()? as f64;
-            let _temperature = r.f32()?;
-            let current = r.f32()? as f64;
-            let charge = r.f32()? as f64;
-            let _capacity = r.f32()?;
-            let _design = r.f32()?;
-            let _percentage = r.f32()?;
-            let _status = r.u8()?;
-            let _health = r.u8()?;
-            let _technology = r.u8()?;
-            let _present = r.u8()?;
-            r.skip_f32_sequence()?; // cell_voltage
-            r.skip_f32_sequence()?; // cell_temperature
-            r.string()?; // location
-            r.string()?; // serial_number
-            battery(voltage, current, charge, opts, true)
-        }
+        MessageKind::BatteryState => cdr_battery_state(&mut r, opts)?,
         MessageKind::PoseStamped => {
             let pos = r.f64s::<3>()?;
             let q = r.f64s::<4>()?;
-            Sample {
-                pos_enu_m: finite3(world_vec(pos, frame_id)),
-                attitude: orientation(q, frame_id).map(|(_, a)| a),
-                ..Sample::default()
-            }
+            pose(frame_id, pos, q)
         }
         MessageKind::TwistStamped => {
             let lin = r.f64s::<3>()?;
             let _ang = r.f64s::<3>()?;
-            Sample {
-                vel_enu_mps: if is_world(frame_id) {
-                    finite3(world_vec(lin, frame_id))
-                } else {
-                    None
-                },
-                ..Sample::default()
-            }
+            twist(frame_id, lin)
         }
-        MessageKind::Odometry => {
-            let child = r.string()?;
-            let pos = r.f64s::<3>()?;
-            let q = r.f64s::<4>()?;
-            r.skip_f64s(36)?;
-            let lin = r.f64s::<3>()?;
-            let _ang = r.f64s::<3>()?;
-            r.skip_f64s(36)?;
-            odometry(frame_id, child, pos, q, lin)
-        }
-        MessageKind::Imu => {
-            let q = r.f64s::<4>()?;
-            let cov = r.f64s::<9>()?;
-            let _w = r.f64s::<3>()?;
-            r.skip_f64s(9)?;
-            let acc = r.f64s::<3>()?;
-            r.skip_f64s(9)?;
-            imu(frame_id, q, cov[0], acc)
-        }
+        MessageKind::Odometry => cdr_odometry(&mut r, frame_id)?,
+        MessageKind::Imu => cdr_imu(&mut r, frame_id)?,
         MessageKind::AloftState => return Err(CdrError::Encapsulation(0xffff)),
     };
     Ok(Decoded { stamp_s, sample })
+}
+
+/// The body of a `sensor_msgs/BatteryState` after its header (every field is read, so a
+/// truncated message is an error).
+fn cdr_battery_state(r: &mut CdrReader<'_>, opts: RosDecodeOptions) -> Result<Sample, CdrError> {
+    let voltage = r.f32()? as f64;
+    let _temperature = r.f32()?;
+    let current = r.f32()? as f64;
+    let charge = r.f32()? as f64;
+    let _capacity = r.f32()?;
+    let _design = r.f32()?;
+    let _percentage = r.f32()?;
+    let _status = r.u8()?;
+    let _health = r.u8()?;
+    let _technology = r.u8()?;
+    let _present = r.u8()?;
+    r.skip_f32_sequence()?; // cell_voltage
+    r.skip_f32_sequence()?; // cell_temperature
+    r.string()?; // location
+    r.string()?; // serial_number
+    Ok(battery(voltage, current, charge, opts, true))
+}
+
+/// The body of a `nav_msgs/Odometry` after its header.
+fn cdr_odometry(r: &mut CdrReader<'_>, frame_id: &str) -> Result<Sample, CdrError> {
+    let child = r.string()?;
+    let pos = r.f64s::<3>()?;
+    let q = r.f64s::<4>()?;
+    r.skip_f64s(36)?;
+    let lin = r.f64s::<3>()?;
+    let _ang = r.f64s::<3>()?;
+    r.skip_f64s(36)?;
+    Ok(odometry(frame_id, child, pos, q, lin))
+}
+
+/// The body of a `sensor_msgs/Imu` after its header.
+fn cdr_imu(r: &mut CdrReader<'_>, frame_id: &str) -> Result<Sample, CdrError> {
+    let q = r.f64s::<4>()?;
+    let cov = r.f64s::<9>()?;
+    let _w = r.f64s::<3>()?;
+    r.skip_f64s(9)?;
+    let acc = r.f64s::<3>()?;
+    r.skip_f64s(9)?;
+    Ok(imu(frame_id, q, cov[0], acc))
 }
 
 fn num(v: &Value, path: &[&str]) -> Result<f64, String> {
@@ -301,10 +320,20 @@ fn num(v: &Value, path: &[&str]) -> Result<f64, String> {
     }
 }
 
-fn vec3(v: &Value, path: &[&str]) -> Result<[f64; 3], String> {
+/// The top-level number `key`, NaN (unmeasured) when the field is absent.
+fn optional_num(v: &Value, key: &str) -> Result<f64, String> {
+    v.get(key).map_or(Ok(f64::NAN), |_| num(v, &[key]))
+}
+
+/// The numbers `keys` of the object at `path`.
+fn components<const N: usize>(
+    v: &Value,
+    path: &[&str],
+    keys: [&str; N],
+) -> Result<[f64; N], String> {
     let mut p: Vec<&str> = path.to_vec();
-    let mut out = [0.0; 3];
-    for (o, k) in out.iter_mut().zip(["x", "y", "z"]) {
+    let mut out = [0.0; N];
+    for (o, k) in out.iter_mut().zip(keys) {
         p.push(k);
         *o = num(v, &p)?;
         p.pop();
@@ -312,15 +341,12 @@ fn vec3(v: &Value, path: &[&str]) -> Result<[f64; 3], String> {
     Ok(out)
 }
 
+fn vec3(v: &Value, path: &[&str]) -> Result<[f64; 3], String> {
+    components(v, path, ["x", "y", "z"])
+}
+
 fn quat(v: &Value, path: &[&str]) -> Result<[f64; 4], String> {
-    let mut p: Vec<&str> = path.to_vec();
-    let mut out = [0.0; 4];
-    for (o, k) in out.iter_mut().zip(["x", "y", "z", "w"]) {
-        p.push(k);
-        *o = num(v, &p)?;
-        p.pop();
-    }
-    Ok(out)
+    components(v, path, ["x", "y", "z", "w"])
 }
 
 fn json_stamp(v: &Value) -> (Option<f64>, String) {
@@ -356,104 +382,105 @@ pub fn decode_json(
     let v: Value = serde_json::from_slice(data).map_err(|e| format!("invalid JSON: {e}"))?;
     let (stamp_s, frame_id) = json_stamp(&v);
     let sample = match kind {
-        MessageKind::BatteryState => {
-            if v.get("voltage_v").is_some() {
-                let mut s = battery(
-                    num(&v, &["voltage_v"])?,
-                    num(&v, &["current_a"])?,
-                    v.get("charge_ah")
-                        .map_or(Ok(f64::NAN), |_| num(&v, &["charge_ah"]))?,
-                    opts,
-                    false,
-                );
-                s.power_w = v
-                    .get("power_w")
-                    .map(|_| num(&v, &["power_w"]))
-                    .transpose()?
-                    .and_then(finite);
-                s
-            } else {
-                battery(
-                    num(&v, &["voltage"])?,
-                    num(&v, &["current"])?,
-                    v.get("charge")
-                        .map_or(Ok(f64::NAN), |_| num(&v, &["charge"]))?,
-                    opts,
-                    true,
-                )
-            }
-        }
-        MessageKind::PoseStamped => {
-            let pos = vec3(&v, &["pose", "position"])?;
-            let q = quat(&v, &["pose", "orientation"])?;
-            Sample {
-                pos_enu_m: finite3(world_vec(pos, &frame_id)),
-                attitude: orientation(q, &frame_id).map(|(_, a)| a),
-                ..Sample::default()
-            }
-        }
-        MessageKind::TwistStamped => {
-            let lin = vec3(&v, &["twist", "linear"])?;
-            Sample {
-                vel_enu_mps: if is_world(&frame_id) {
-                    finite3(world_vec(lin, &frame_id))
-                } else {
-                    None
-                },
-                ..Sample::default()
-            }
-        }
-        MessageKind::Odometry => {
-            let child = v
-                .get("child_frame_id")
-                .and_then(Value::as_str)
-                .unwrap_or("");
-            odometry(
-                &frame_id,
-                child,
-                vec3(&v, &["pose", "pose", "position"])?,
-                quat(&v, &["pose", "pose", "orientation"])?,
-                vec3(&v, &["twist", "twist", "linear"])?,
-            )
-        }
-        MessageKind::Imu => {
-            let cov0 = v
-                .get("orientation_covariance")
-                .and_then(|c| c.get(0))
-                .and_then(Value::as_f64)
-                .unwrap_or(0.0);
-            imu(
-                &frame_id,
-                quat(&v, &["orientation"])?,
-                cov0,
-                vec3(&v, &["linear_acceleration"])?,
-            )
-        }
-        // Every field of aloft.VehicleState but the timestamp is optional.
-        MessageKind::AloftState => Sample {
-            pos_enu_m: match v.get("position_enu_m") {
-                Some(_) => finite3(vec3(&v, &["position_enu_m"])?),
-                None => None,
-            },
-            vel_enu_mps: match v.get("velocity_enu_mps") {
-                Some(_) => finite3(vec3(&v, &["velocity_enu_mps"])?),
-                None => None,
-            },
-            attitude: match v.get("roll_rad") {
-                Some(_) => Some(Attitude {
-                    roll_rad: num(&v, &["roll_rad"])?,
-                    pitch_rad: num(&v, &["pitch_rad"])?,
-                    yaw_rad: num(&v, &["yaw_rad"])?,
-                })
-                .filter(|a| {
-                    a.roll_rad.is_finite() && a.pitch_rad.is_finite() && a.yaw_rad.is_finite()
-                }),
-                None => None,
-            },
-            ..Sample::default()
-        },
+        MessageKind::BatteryState => json_battery_state(&v, opts)?,
+        MessageKind::PoseStamped => pose(
+            &frame_id,
+            vec3(&v, &["pose", "position"])?,
+            quat(&v, &["pose", "orientation"])?,
+        ),
+        MessageKind::TwistStamped => twist(&frame_id, vec3(&v, &["twist", "linear"])?),
+        MessageKind::Odometry => json_odometry(&v, &frame_id)?,
+        MessageKind::Imu => json_imu(&v, &frame_id)?,
+        MessageKind::AloftState => json_aloft_state(&v)?,
     };
     Ok(Decoded { stamp_s, sample })
+}
+
+/// `aloft.BatteryState` (SI field names, current positive while discharging, optional power) or
+/// `sensor_msgs/BatteryState` field names with the ROS sign.
+fn json_battery_state(v: &Value, opts: RosDecodeOptions) -> Result<Sample, String> {
+    if v.get("voltage_v").is_none() {
+        return json_battery_fields(v, ["voltage", "current", "charge"], opts, true);
+    }
+    let mut s = json_battery_fields(v, ["voltage_v", "current_a", "charge_ah"], opts, false)?;
+    s.power_w = finite(optional_num(v, "power_w")?);
+    Ok(s)
+}
+
+/// Voltage, current and (optional) charge from the fields named `keys`.
+fn json_battery_fields(
+    v: &Value,
+    keys: [&str; 3],
+    opts: RosDecodeOptions,
+    ros_sign: bool,
+) -> Result<Sample, String> {
+    Ok(battery(
+        num(v, &[keys[0]])?,
+        num(v, &[keys[1]])?,
+        optional_num(v, keys[2])?,
+        opts,
+        ros_sign,
+    ))
+}
+
+fn json_odometry(v: &Value, frame_id: &str) -> Result<Sample, String> {
+    let child = v
+        .get("child_frame_id")
+        .and_then(Value::as_str)
+        .unwrap_or("");
+    Ok(odometry(
+        frame_id,
+        child,
+        vec3(v, &["pose", "pose", "position"])?,
+        quat(v, &["pose", "pose", "orientation"])?,
+        vec3(v, &["twist", "twist", "linear"])?,
+    ))
+}
+
+fn json_imu(v: &Value, frame_id: &str) -> Result<Sample, String> {
+    let cov0 = v
+        .get("orientation_covariance")
+        .and_then(|c| c.get(0))
+        .and_then(Value::as_f64)
+        .unwrap_or(0.0);
+    Ok(imu(
+        frame_id,
+        quat(v, &["orientation"])?,
+        cov0,
+        vec3(v, &["linear_acceleration"])?,
+    ))
+}
+
+/// `aloft.VehicleState`: every field but the timestamp is optional.
+fn json_aloft_state(v: &Value) -> Result<Sample, String> {
+    Ok(Sample {
+        pos_enu_m: optional_vec3(v, "position_enu_m")?,
+        vel_enu_mps: optional_vec3(v, "velocity_enu_mps")?,
+        attitude: optional_euler(v)?,
+        ..Sample::default()
+    })
+}
+
+/// The vector `key` when present and finite.
+fn optional_vec3(v: &Value, key: &str) -> Result<Option<[f64; 3]>, String> {
+    match v.get(key) {
+        Some(_) => Ok(finite3(vec3(v, &[key])?)),
+        None => Ok(None),
+    }
+}
+
+/// `roll_rad`, `pitch_rad`, `yaw_rad` when present and finite.
+fn optional_euler(v: &Value) -> Result<Option<Attitude>, String> {
+    if v.get("roll_rad").is_none() {
+        return Ok(None);
+    }
+    let a = Attitude {
+        roll_rad: num(v, &["roll_rad"])?,
+        pitch_rad: num(v, &["pitch_rad"])?,
+        yaw_rad: num(v, &["yaw_rad"])?,
+    };
+    Ok(Some(a)
+        .filter(|a| a.roll_rad.is_finite() && a.pitch_rad.is_finite() && a.yaw_rad.is_finite()))
 }
 
 #[cfg(test)]
@@ -572,7 +599,7 @@ mod tests {
         for _ in 0..9 {
             w.f64(0.0);
         }
-        for v in [0.0, 0.0, G_MPS2] {
+        for v in [0.0, 0.0, STANDARD_GRAVITY_MPS2] {
             w.f64(v);
         }
         for _ in 0..9 {

@@ -27,7 +27,9 @@
 //! is ill-behaved at small currents); [`Battery::resistance_in_valid_range`] reports whether a
 //! current lies inside it.
 
-use crate::error::{fraction, non_negative, positive, resistance, voltage, PropulsionError};
+use crate::error::{
+    current_limit, finite, fraction, non_negative, positive, resistance, voltage, PropulsionError,
+};
 
 /// Full-charge cell voltage used by the seed (eq 30), V.
 pub const SEED_FULL_CELL_V: f64 = 4.1;
@@ -74,6 +76,73 @@ impl InternalResistance {
             }
         }
     }
+
+    /// Check the model: a constant resistance must be finite and positive; eq (17) needs finite
+    /// coefficients, a valid current range and a positive resistance over all of it.
+    pub(crate) fn validate(&self) -> Result<(), PropulsionError> {
+        match *self {
+            InternalResistance::Constant { resistance_ohm } => {
+                let r = resistance("battery internal_resistance_ohm", resistance_ohm)?;
+                if r <= 0.0 {
+                    return Err(PropulsionError::InvalidResistance {
+                        name: "battery internal_resistance_ohm (must be > 0)",
+                        resistance_ohm: r,
+                    });
+                }
+                Ok(())
+            }
+            InternalResistance::Logarithmic {
+                r1_ohm,
+                r2_ohm_a,
+                r3_ohm_a,
+                min_current_a,
+                max_current_a,
+            } => {
+                finite("battery r1_ohm", r1_ohm, "ohm or ohm A")?;
+                finite("battery r2_ohm_a", r2_ohm_a, "ohm or ohm A")?;
+                finite("battery r3_ohm_a", r3_ohm_a, "ohm or ohm A")?;
+                check_eq17_range(min_current_a, max_current_a)?;
+                check_eq17_positive(r1_ohm, r2_ohm_a, r3_ohm_a, min_current_a, max_current_a)
+            }
+        }
+    }
+}
+
+/// The current range where eq (17) is trusted: positive, finite, and not empty.
+fn check_eq17_range(min_current_a: f64, max_current_a: f64) -> Result<(), PropulsionError> {
+    positive("battery eq17 min_current_a", min_current_a, "A")?;
+    positive("battery eq17 max_current_a", max_current_a, "A")?;
+    if max_current_a <= min_current_a {
+        return Err(PropulsionError::InvalidParameter {
+            name: "battery eq17 max_current_a",
+            value: max_current_a,
+            unit: "A",
+            expected: "a current above eq17 min_current_a",
+        });
+    }
+    Ok(())
+}
+
+/// Eq (17) must give a positive resistance over its valid range (checked at 65 currents).
+fn check_eq17_positive(
+    r1_ohm: f64,
+    r2_ohm_a: f64,
+    r3_ohm_a: f64,
+    min_current_a: f64,
+    max_current_a: f64,
+) -> Result<(), PropulsionError> {
+    let n = 64;
+    for k in 0..=n {
+        let i = min_current_a + (max_current_a - min_current_a) * k as f64 / n as f64;
+        let r = eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i);
+        if r.is_nan() || r <= 0.0 {
+            return Err(PropulsionError::InvalidResistance {
+                name: "battery eq17 resistance within its valid range",
+                resistance_ohm: r,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Seed eq (17) without clamping: `r1 + r2 ln(I)/I + r3/I`, ohm.
@@ -94,6 +163,40 @@ pub struct Battery {
     max_current_a: f64,
     max_power_w: f64,
     current_at_max_power_a: f64,
+}
+
+fn check_cell_counts(cells_series: u32, cells_parallel: u32) -> Result<(), PropulsionError> {
+    if cells_series == 0 {
+        return Err(PropulsionError::InvalidCount {
+            name: "battery cells_series",
+            count: cells_series,
+            expected: "at least one cell in series",
+        });
+    }
+    if cells_parallel == 0 {
+        return Err(PropulsionError::InvalidCount {
+            name: "battery cells_parallel",
+            count: cells_parallel,
+            expected: "at least one cell in parallel",
+        });
+    }
+    Ok(())
+}
+
+/// Full-charge and nominal cell voltages: each valid, the nominal not above the full charge.
+fn check_cell_voltages(
+    full_cell_v: f64,
+    nominal_cell_v: f64,
+) -> Result<(f64, f64), PropulsionError> {
+    let full_cell_v = voltage("battery full_charge_cell_v", full_cell_v)?;
+    let nominal_cell_v = voltage("battery nominal_cell_v", nominal_cell_v)?;
+    if nominal_cell_v > full_cell_v {
+        return Err(PropulsionError::InvalidVoltage {
+            name: "battery nominal_cell_v (above full_charge_cell_v)",
+            voltage_v: nominal_cell_v,
+        });
+    }
+    Ok((full_cell_v, nominal_cell_v))
 }
 
 impl Battery {
@@ -117,20 +220,7 @@ impl Battery {
         resistance_model: InternalResistance,
         max_current_a: f64,
     ) -> Result<Self, PropulsionError> {
-        if cells_series == 0 {
-            return Err(PropulsionError::InvalidCount {
-                name: "battery cells_series",
-                count: cells_series,
-                expected: "at least one cell in series",
-            });
-        }
-        if cells_parallel == 0 {
-            return Err(PropulsionError::InvalidCount {
-                name: "battery cells_parallel",
-                count: cells_parallel,
-                expected: "at least one cell in parallel",
-            });
-        }
+        check_cell_counts(cells_series, cells_parallel)?;
         let capacity_ah = positive("battery capacity_ah", capacity_ah, "A h")?;
         let effective_capacity = fraction(
             "battery effective_capacity_fraction",
@@ -138,77 +228,9 @@ impl Battery {
             false,
             true,
         )?;
-        let full_cell_v = voltage("battery full_charge_cell_v", full_cell_v)?;
-        let nominal_cell_v = voltage("battery nominal_cell_v", nominal_cell_v)?;
-        if nominal_cell_v > full_cell_v {
-            return Err(PropulsionError::InvalidVoltage {
-                name: "battery nominal_cell_v (above full_charge_cell_v)",
-                voltage_v: nominal_cell_v,
-            });
-        }
-        match resistance_model {
-            InternalResistance::Constant { resistance_ohm } => {
-                let r = resistance("battery internal_resistance_ohm", resistance_ohm)?;
-                if r <= 0.0 {
-                    return Err(PropulsionError::InvalidResistance {
-                        name: "battery internal_resistance_ohm (must be > 0)",
-                        resistance_ohm: r,
-                    });
-                }
-            }
-            InternalResistance::Logarithmic {
-                r1_ohm,
-                r2_ohm_a,
-                r3_ohm_a,
-                min_current_a,
-                max_current_a,
-            } => {
-                for (name, v) in [
-                    ("battery r1_ohm", r1_ohm),
-                    ("battery r2_ohm_a", r2_ohm_a),
-                    ("battery r3_ohm_a", r3_ohm_a),
-                ] {
-                    if !v.is_finite() {
-                        return Err(PropulsionError::InvalidParameter {
-                            name,
-                            value: v,
-                            unit: "ohm or ohm A",
-                            expected: "a finite number",
-                        });
-                    }
-                }
-                positive("battery eq17 min_current_a", min_current_a, "A")?;
-                positive("battery eq17 max_current_a", max_current_a, "A")?;
-                if max_current_a <= min_current_a {
-                    return Err(PropulsionError::InvalidParameter {
-                        name: "battery eq17 max_current_a",
-                        value: max_current_a,
-                        unit: "A",
-                        expected: "a current above eq17 min_current_a",
-                    });
-                }
-                // The resistance must stay positive over the valid range.
-                let n = 64;
-                for k in 0..=n {
-                    let i = min_current_a + (max_current_a - min_current_a) * k as f64 / n as f64;
-                    let r = eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i);
-                    if r.is_nan() || r <= 0.0 {
-                        return Err(PropulsionError::InvalidResistance {
-                            name: "battery eq17 resistance within its valid range",
-                            resistance_ohm: r,
-                        });
-                    }
-                }
-            }
-        }
-        if max_current_a.is_nan() || max_current_a <= 0.0 {
-            return Err(PropulsionError::InvalidParameter {
-                name: "battery max_current_a",
-                value: max_current_a,
-                unit: "A",
-                expected: "a positive current (or infinity for no limit)",
-            });
-        }
+        let (full_cell_v, nominal_cell_v) = check_cell_voltages(full_cell_v, nominal_cell_v)?;
+        resistance_model.validate()?;
+        let max_current_a = current_limit("battery max_current_a", max_current_a)?;
         let mut b = Self {
             cells_series,
             cells_parallel,

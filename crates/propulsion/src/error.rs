@@ -151,22 +151,43 @@ pub enum PropulsionError {
     },
 }
 
-/// Check that `value` is finite and strictly positive.
-pub(crate) fn positive(
+/// `value` when `ok`, else [`PropulsionError::InvalidParameter`] saying what was `expected`.
+fn parameter(
     name: &'static str,
     value: f64,
     unit: &'static str,
+    ok: bool,
+    expected: &'static str,
 ) -> Result<f64, PropulsionError> {
-    if value.is_finite() && value > 0.0 {
+    if ok {
         Ok(value)
     } else {
         Err(PropulsionError::InvalidParameter {
             name,
             value,
             unit,
-            expected: "a positive finite number",
+            expected,
         })
     }
+}
+
+/// Check that `value` is finite.
+pub(crate) fn finite(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PropulsionError> {
+    parameter(name, value, unit, value.is_finite(), "a finite number")
+}
+
+/// Check that `value` is finite and strictly positive.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PropulsionError> {
+    let ok = value.is_finite() && value > 0.0;
+    parameter(name, value, unit, ok, "a positive finite number")
 }
 
 /// Check that `value` is finite and not negative.
@@ -175,16 +196,20 @@ pub(crate) fn non_negative(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(PropulsionError::InvalidParameter {
-            name,
-            value,
-            unit,
-            expected: "a non-negative finite number",
-        })
-    }
+    let ok = value.is_finite() && value >= 0.0;
+    parameter(name, value, unit, ok, "a non-negative finite number")
+}
+
+/// Check a rated current limit: positive, infinity for none.
+pub(crate) fn current_limit(name: &'static str, current_a: f64) -> Result<f64, PropulsionError> {
+    let ok = !(current_a.is_nan() || current_a <= 0.0);
+    parameter(
+        name,
+        current_a,
+        "A",
+        ok,
+        "a positive current (or infinity for no limit)",
+    )
 }
 
 /// Check a fraction in `[0, 1)` (losses) or `(0, 1]` (coefficients).

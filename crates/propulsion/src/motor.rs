@@ -24,7 +24,7 @@
 //! It is derived here as the seed describes it, dividing eq (8) by the armature voltage of
 //! eq (3): `I_r = P_r / V_a = K_v (K_1 + K_2 N)`.
 
-use crate::error::{kv, non_negative, resistance, PropulsionError};
+use crate::error::{current_limit, kv, non_negative, resistance, PropulsionError};
 use std::f64::consts::PI;
 
 /// Newton metres per ounce-force inch.
@@ -102,14 +102,7 @@ impl Motor {
                 non_negative("motor k2_w_per_rpm2", k2_w_per_rpm2, "W/rpm^2")?;
             }
         }
-        if max_current_a.is_nan() || max_current_a <= 0.0 {
-            return Err(PropulsionError::InvalidParameter {
-                name: "motor max_current_a",
-                value: max_current_a,
-                unit: "A",
-                expected: "a positive current (or infinity for no limit)",
-            });
-        }
+        current_limit("motor max_current_a", max_current_a)?;
         Ok(Self {
             kv_rpm_per_v,
             armature_resistance_ohm,

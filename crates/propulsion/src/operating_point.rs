@@ -22,11 +22,6 @@ use crate::propeller::Propeller;
 use serde::Serialize;
 use std::f64::consts::PI;
 
-/// Standard gravity, m/s^2.
-pub const STANDARD_GRAVITY_MPS2: f64 = 9.806_65;
-/// ISA sea-level air density, kg/m^3.
-pub const ISA_SEA_LEVEL_RHO_KG_M3: f64 = 1.225;
-
 /// A multirotor propulsion system: identical rotors (propeller + motor + ESC) fed by identical
 /// packs.
 #[derive(Debug, Clone, PartialEq)]
@@ -349,6 +344,7 @@ mod tests {
     use super::*;
     use crate::battery::InternalResistance;
     use crate::motor::motor_with_no_load_current;
+    use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
 
     fn system() -> PropulsionSystem {
         PropulsionSystem::new(
@@ -375,7 +371,7 @@ mod tests {
             4,
             7.484,
             STANDARD_GRAVITY_MPS2,
-            ISA_SEA_LEVEL_RHO_KG_M3,
+            ISA_SEA_LEVEL_DENSITY_KG_M3,
         )
         .unwrap()
     }

@@ -34,7 +34,7 @@
 //! adjustment of the nominal thrust: the installed rotor makes `(1 - loss)` of the stand thrust
 //! at the same speed, so the stand must produce `T / (1 - loss)`.
 
-use crate::error::{fraction, positive, PropulsionError};
+use crate::error::{finite, fraction, positive, PropulsionError};
 use std::f64::consts::PI;
 
 /// Metres per inch.
@@ -130,22 +130,8 @@ impl Propeller {
         ct_per_krpm: f64,
         cp_per_krpm: f64,
     ) -> Result<Self, PropulsionError> {
-        if !ct_per_krpm.is_finite() {
-            return Err(PropulsionError::InvalidParameter {
-                name: "ct_per_krpm",
-                value: ct_per_krpm,
-                unit: "1/krpm",
-                expected: "a finite number",
-            });
-        }
-        if !cp_per_krpm.is_finite() {
-            return Err(PropulsionError::InvalidParameter {
-                name: "cp_per_krpm",
-                value: cp_per_krpm,
-                unit: "1/krpm",
-                expected: "a finite number",
-            });
-        }
+        finite("ct_per_krpm", ct_per_krpm, "1/krpm")?;
+        finite("cp_per_krpm", cp_per_krpm, "1/krpm")?;
         self.ct_per_krpm = ct_per_krpm;
         self.cp_per_krpm = cp_per_krpm;
         Ok(self)

@@ -36,11 +36,13 @@
 //! internal_resistance_ohm = 0.07      # or r1_ohm, r2_ohm_a, r3_ohm_a + eq17_{min,max}_current_a
 //! ```
 
+use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
+
 use crate::battery::{Battery, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V};
 use crate::error::{mass, positive, PropulsionError};
 use crate::esc::Esc;
 use crate::motor::{Motor, RotationalLoss};
-use crate::operating_point::{PropulsionSystem, ISA_SEA_LEVEL_RHO_KG_M3, STANDARD_GRAVITY_MPS2};
+use crate::operating_point::PropulsionSystem;
 use crate::propeller::{Propeller, M_PER_IN};
 use crate::transient::{
     kt_from_kv, motor_inertia_kgm2, prop_inertia_kgm2, EscProtocol, RotorTransient,
@@ -52,7 +54,7 @@ fn default_gravity() -> f64 {
     STANDARD_GRAVITY_MPS2
 }
 fn default_rho() -> f64 {
-    ISA_SEA_LEVEL_RHO_KG_M3
+    ISA_SEA_LEVEL_DENSITY_KG_M3
 }
 fn default_one() -> u32 {
     1

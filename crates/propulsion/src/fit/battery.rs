@@ -8,6 +8,7 @@
 use super::{check_columns, minimize, rmse};
 use crate::battery::{eq17_resistance_ohm, InternalResistance};
 use crate::error::PropulsionError;
+use aloft_core::{trapezoid, SECONDS_PER_HOUR};
 
 /// Result of an eq (17) fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -180,8 +181,8 @@ pub fn fit_pack_resistance(
     let mut rows = Vec::with_capacity(n);
     for i in 0..n {
         if i > 0 {
-            charge_ah +=
-                (time_s[i] - time_s[i - 1]) * 0.5 * (current_a[i] + current_a[i - 1]) / 3600.0;
+            // The charge at each sample, one trapezoid panel at a time, in A h.
+            charge_ah += trapezoid(&time_s[i - 1..=i], &current_a[i - 1..=i]) / SECONDS_PER_HOUR;
         }
         let x = Vector3::new(1.0, charge_ah, -current_a[i]);
         xtx += x * x.transpose();

@@ -61,6 +61,30 @@ fn range(v: &[f64]) -> (f64, f64) {
         })
 }
 
+/// Minimises `cost(&[c0, slope])` over `C_0` and, when `speed_dependent`, the slope per
+/// 1000 rpm (from `x0` with initial steps `step`); otherwise over `C_0` alone, the slope 0.
+fn fit_coefficient(
+    name: &'static str,
+    cost: impl Fn(&[f64]) -> f64,
+    x0: [f64; 2],
+    step: [f64; 2],
+    speed_dependent: bool,
+) -> Result<[f64; 2], PropulsionError> {
+    if speed_dependent {
+        let (p, _) = minimize(name, cost, &x0, &step, 2000)?;
+        Ok([p[0], p[1]])
+    } else {
+        let (p, _) = minimize(
+            name,
+            |q: &[f64]| cost(&[q[0], 0.0]),
+            &x0[..1],
+            &step[..1],
+            1000,
+        )?;
+        Ok([p[0], 0.0])
+    }
+}
+
 /// Fits a static coefficient table (`RPM CT CP`, e.g. UIUC `*_static_*.txt`).
 ///
 /// # Errors
@@ -76,40 +100,8 @@ pub fn fit_static_table(
         &[("speed_rpm", speed_rpm), ("ct", ct), ("cp", cp)],
         if speed_dependent { 3 } else { 2 },
     )?;
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / n as f64;
-    let fit_one = |y: &[f64], name: &'static str| -> Result<(f64, f64, f64), PropulsionError> {
-        let x0 = [mean(y), 0.0];
-        let cost = |p: &[f64]| {
-            let slope = if speed_dependent { p[1] } else { 0.0 };
-            speed_rpm
-                .iter()
-                .zip(y)
-                .map(|(&s, &v)| (p[0] + slope * s / 1000.0 - v).powi(2))
-                .sum::<f64>()
-        };
-        let step = [0.1 * x0[0].abs().max(1e-3), 0.01 * x0[0].abs().max(1e-3)];
-        let (p, _) = if speed_dependent {
-            minimize(name, cost, &x0, &step, 2000)?
-        } else {
-            let (p, c) = minimize(
-                name,
-                |q: &[f64]| cost(&[q[0], 0.0]),
-                &x0[..1],
-                &step[..1],
-                1000,
-            )?;
-            (vec![p[0], 0.0], c)
-        };
-        let r = rmse(
-            speed_rpm
-                .iter()
-                .zip(y)
-                .map(|(&s, &v)| p[0] + p[1] * s / 1000.0 - v),
-        );
-        Ok((p[0], p[1], r))
-    };
-    let (ct0, cts, rct) = fit_one(ct, "propeller C_T")?;
-    let (cp0, cps, rcp) = fit_one(cp, "propeller C_P")?;
+    let (ct0, cts, rct) = fit_table_column(speed_rpm, ct, "propeller C_T", speed_dependent)?;
+    let (cp0, cps, rcp) = fit_table_column(speed_rpm, cp, "propeller C_P", speed_dependent)?;
     let (lo, hi) = range(speed_rpm);
     Ok(PropellerFit {
         ct: ct0,
@@ -123,6 +115,37 @@ pub fn fit_static_table(
         max_speed_rpm: hi,
     })
 }
+
+/// `C_0 + slope N/1000` fitted to one coefficient column `y` of a table, from its mean:
+/// `(C_0, slope, RMSE)`.
+fn fit_table_column(
+    speed_rpm: &[f64],
+    y: &[f64],
+    name: &'static str,
+    speed_dependent: bool,
+) -> Result<(f64, f64, f64), PropulsionError> {
+    let x0 = [y.iter().sum::<f64>() / speed_rpm.len() as f64, 0.0];
+    let cost = |p: &[f64]| {
+        let slope = if speed_dependent { p[1] } else { 0.0 };
+        speed_rpm
+            .iter()
+            .zip(y)
+            .map(|(&s, &v)| (p[0] + slope * s / 1000.0 - v).powi(2))
+            .sum::<f64>()
+    };
+    let step = [0.1 * x0[0].abs().max(1e-3), 0.01 * x0[0].abs().max(1e-3)];
+    let p = fit_coefficient(name, cost, x0, step, speed_dependent)?;
+    let r = rmse(
+        speed_rpm
+            .iter()
+            .zip(y)
+            .map(|(&s, &v)| p[0] + p[1] * s / 1000.0 - v),
+    );
+    Ok((p[0], p[1], r))
+}
+
+/// A thrust-stand row: speed (rpm), thrust (N), torque (N m).
+type StandRow = (f64, f64, f64);
 
 /// Fits `C_T`, `C_P` to a thrust-stand run (speed, thrust, torque). Rows with zero or negative
 /// speed are skipped (stand at rest). Residuals are in N and N m.
@@ -148,7 +171,39 @@ pub fn fit_thrust_stand(
     )?;
     let d = positive("diameter_m", diameter_m, "m")?;
     let rho = positive("air_density_kg_m3", rho_kg_m3, "kg/m^3")?;
-    let rows: Vec<(f64, f64, f64)> = speed_rpm
+    let rows = moving_rows(speed_rpm, thrust_n, torque_nm, speed_dependent)?;
+    // Thrust over C_T and torque over C_P at a speed: T = C_T rho n^2 D^4, Q = C_P rho n^2 D^5 / 2 pi.
+    let kt = |s: f64| rho * (s / 60.0).powi(2) * d.powi(4);
+    let kq = |s: f64| rho * (s / 60.0).powi(2) * d.powi(5) / (2.0 * PI);
+    let thrust = |r: &StandRow| r.1;
+    let torque = |r: &StandRow| r.2;
+    let (ct, cts, rt) =
+        fit_stand_column(&rows, kt, thrust, "propeller C_T (stand)", speed_dependent)?;
+    let (cp, cps, rq) =
+        fit_stand_column(&rows, kq, torque, "propeller C_P (stand)", speed_dependent)?;
+    let speeds: Vec<f64> = rows.iter().map(|r| r.0).collect();
+    let (lo, hi) = range(&speeds);
+    Ok(PropellerFit {
+        ct,
+        cp,
+        ct_per_krpm: cts,
+        cp_per_krpm: cps,
+        rmse_thrust: rt,
+        rmse_power: rq,
+        points: rows.len(),
+        min_speed_rpm: lo,
+        max_speed_rpm: hi,
+    })
+}
+
+/// The rows with the rotor turning (speed > 0): at least 2, or 3 when speed dependent.
+fn moving_rows(
+    speed_rpm: &[f64],
+    thrust_n: &[f64],
+    torque_nm: &[f64],
+    speed_dependent: bool,
+) -> Result<Vec<StandRow>, PropulsionError> {
+    let rows: Vec<StandRow> = speed_rpm
         .iter()
         .zip(thrust_n)
         .zip(torque_nm)
@@ -163,55 +218,38 @@ pub fn fit_thrust_stand(
             required,
         });
     }
-    let kt = |s: f64| rho * (s / 60.0).powi(2) * d.powi(4);
-    let kq = |s: f64| rho * (s / 60.0).powi(2) * d.powi(5) / (2.0 * PI);
-    // Closed-form least squares of the constant model as the starting point.
-    let ct0 = rows.iter().map(|r| r.1 * kt(r.0)).sum::<f64>()
-        / rows.iter().map(|r| kt(r.0).powi(2)).sum::<f64>();
-    let cp0 = rows.iter().map(|r| r.2 * kq(r.0)).sum::<f64>()
-        / rows.iter().map(|r| kq(r.0).powi(2)).sum::<f64>();
-    let fit = |c0: f64, f: &dyn Fn(f64) -> f64, col: usize, name: &'static str| {
-        let y = |r: &(f64, f64, f64)| if col == 1 { r.1 } else { r.2 };
-        let cost = |p: &[f64]| {
-            let slope = if speed_dependent { p[1] } else { 0.0 };
-            rows.iter()
-                .map(|r| ((p[0] + slope * r.0 / 1000.0) * f(r.0) - y(r)).powi(2))
-                .sum::<f64>()
-        };
-        let res = if speed_dependent {
-            minimize(name, cost, &[c0, 0.0], &[0.1 * c0, 0.01 * c0], 2000)?
-        } else {
-            let (p, c) = minimize(
-                name,
-                |q: &[f64]| cost(&[q[0], 0.0]),
-                &[c0],
-                &[0.1 * c0],
-                1000,
-            )?;
-            (vec![p[0], 0.0], c)
-        };
-        let p = res.0;
-        let r = rmse(
-            rows.iter()
-                .map(|r| (p[0] + p[1] * r.0 / 1000.0) * f(r.0) - y(r)),
-        );
-        Ok::<_, PropulsionError>((p[0], p[1], r))
+    Ok(rows)
+}
+
+/// `(C_0 + slope N/1000) f(N)` fitted to the stand column `y` (thrust or torque), from the
+/// closed-form least squares of the constant model: `(C_0, slope, RMSE)`.
+fn fit_stand_column(
+    rows: &[StandRow],
+    f: impl Fn(f64) -> f64,
+    y: impl Fn(&StandRow) -> f64,
+    name: &'static str,
+    speed_dependent: bool,
+) -> Result<(f64, f64, f64), PropulsionError> {
+    let c0 = rows.iter().map(|r| y(r) * f(r.0)).sum::<f64>()
+        / rows.iter().map(|r| f(r.0).powi(2)).sum::<f64>();
+    let cost = |p: &[f64]| {
+        let slope = if speed_dependent { p[1] } else { 0.0 };
+        rows.iter()
+            .map(|r| ((p[0] + slope * r.0 / 1000.0) * f(r.0) - y(r)).powi(2))
+            .sum::<f64>()
     };
-    let (ct, cts, rt) = fit(ct0, &kt, 1, "propeller C_T (stand)")?;
-    let (cp, cps, rq) = fit(cp0, &kq, 2, "propeller C_P (stand)")?;
-    let speeds: Vec<f64> = rows.iter().map(|r| r.0).collect();
-    let (lo, hi) = range(&speeds);
-    Ok(PropellerFit {
-        ct,
-        cp,
-        ct_per_krpm: cts,
-        cp_per_krpm: cps,
-        rmse_thrust: rt,
-        rmse_power: rq,
-        points: rows.len(),
-        min_speed_rpm: lo,
-        max_speed_rpm: hi,
-    })
+    let p = fit_coefficient(
+        name,
+        cost,
+        [c0, 0.0],
+        [0.1 * c0, 0.01 * c0],
+        speed_dependent,
+    )?;
+    let r = rmse(
+        rows.iter()
+            .map(|r| (p[0] + p[1] * r.0 / 1000.0) * f(r.0) - y(r)),
+    );
+    Ok((p[0], p[1], r))
 }
 
 #[cfg(test)]
