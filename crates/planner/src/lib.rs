@@ -81,6 +81,7 @@ pub mod error;
 pub mod geodesy;
 pub mod ground_effect;
 pub mod mission;
+pub mod pack_cursor;
 pub mod plan;
 pub mod queries;
 pub mod replay;
@@ -91,11 +92,12 @@ pub mod wind;
 pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
-pub use battery::{Battery, BatterySpec, PackCursor, PackDraw, PackStep};
+pub use battery::{Battery, BatterySpec, PackDraw};
 pub use error::PlannerError;
 pub use mission::{
     HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
 };
+pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{
     plan, MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
 };
