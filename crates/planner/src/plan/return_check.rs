@@ -1,5 +1,5 @@
 //! The return check: the point of no return (the design is in the module docs of
-//! [`crate::plan`], "Point of no return").
+//! [`mod@crate::plan`], "Point of no return").
 //!
 //! [`ReturnCheck::due`] says whether a check is due (airborne, `pnr_interval_s` after the last,
 //! none failed yet); [`ReturnCheck::check`] prices the straight return home from the present
