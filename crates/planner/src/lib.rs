@@ -18,10 +18,52 @@
 //! - [`wind`]: constant, power-law and logarithmic profiles, gridded field, seeded gusts;
 //! - [`trim`]: thrust vector from the force balance, attitude, electrical power;
 //! - [`ground_effect`]: survey seed eq (35);
-//! - [`battery`]: charge counting, open-circuit voltage, resistance, cut-off;
-//! - [`mod@plan`]: the sampled flight, feasibility, point of no return, summary;
+//! - [`battery`]: the pack model: charge counting, open-circuit voltage, resistance, cut-off;
+//! - [`pack_cursor`]: the pack model followed through a discharge, a block of steps at a time;
+//! - [`mod@plan`]: the sampled flight, feasibility, point of no return, summary, in named parts
+//!   (`plan/`, in the order data flows): `sampler.rs` (pass A: kinematics, wind, trim, power and
+//!   limits of each block of samples), `feed.rs` (the blocks to the pack pass, from a second
+//!   thread or in line), the pack pass itself in `mod.rs`, `ledger.rs` (energy, heat, peaks,
+//!   voltage and state of charge per segment and per mission), `return_check.rs` (the point of no
+//!   return), `report.rs` (the options and the report types);
 //! - [`queries`]: endurance and range;
 //! - [`mod@replay`]: the energy of a recorded trajectory through the same physics.
+//!
+//! ## Fast paths
+//! A mission of an hour at 10 ms is 360,000 samples, so the loop has fast paths. Each is kept
+//! beside a plain reference and tested against it bit for bit:
+//! - **Block trims in vector lanes**: [`Powered::trim_block`] runs the force balance of a block
+//!   of samples in `trim::balance_block` (`#[multiversion]` AVX2 and AVX-512 builds), then the
+//!   four-term model's batch path. Reference: [`Powered::trim`] of each sample. Test:
+//!   `plan::sampler::tests::block_trims_are_the_per_sample_trims_bit_for_bit` (every sample of a
+//!   survey in calm, steady and gusty wind); the batch power path on its own in `aloft-power`,
+//!   `four_term::tests::conditions_in_a_batch_equal_single_evaluations`.
+//! - **Hoisting of steady stretches** (`plan/sampler.rs`): on a level line or a hold at cruise in
+//!   a steady wind that depends on height alone, one trim per stretch, and ground effect once per
+//!   piece at a fixed height. Reference: every sample through the block path
+//!   (`plan_with(.., hoist = false, ..)`). Test:
+//!   `plan::sampler::tests::hoisting_steady_stretches_matches_the_per_sample_report` (the whole
+//!   report, samples included, in four winds, with and without ground effect).
+//! - **The pack cursor** ([`pack_cursor`]): [`PackCursor::draw`] keeps the open-circuit table's
+//!   interval between steps. Reference: [`Battery::draw`]. Test:
+//!   `pack_cursor::tests::cursor_draws_what_draw_draws_bit_for_bit_across_a_discharge`.
+//!   [`PackCursor::draw_block`] solves a block of 64 steps by fixed-point sweeps in vector lanes
+//!   (`#[multiversion]`), accepted only when a sweep gives the previous sweep's currents bit for
+//!   bit, else flown step by step. Reference: [`PackCursor::draw`] then
+//!   [`PackCursor::discharge`], step by step. Test:
+//!   `pack_cursor::tests::draw_block_is_the_step_by_step_discharge_bit_for_bit`.
+//! - **The second thread** (`plan/feed.rs`, [`PlanOptions::second_thread`]): pass A runs on a
+//!   scoped thread ahead of the pack pass on missions of 4096 steps or more. Reference: pass A in
+//!   line. Test: `plan::feed::tests::pass_a_on_its_own_thread_gives_the_same_report` (a mission
+//!   that completes, one whose pack runs out, one that pass A stops with an error).
+//!
+//! Two departures from the sample-by-sample loop are not bit for bit, and are bounded instead: on
+//! an arc's cruise [`trajectory::BlockSampler`] turns the position by a rotation table instead of
+//! `sincos` of a large angle (positions to 1e-10 m over 3400 s of orbit,
+//! `trajectory::block_tests::block_sampler_matches_piece_at_on_a_long_orbit`), and the pack's
+//! charge step is `I (h / Q)` instead of `I h / Q`; the plan's samples agree with per-sample
+//! [`Powered::trim`] and [`Battery::draw`] to 1e-9 relative
+//! (`plan::tests::block_passes_match_the_sample_by_sample_trim`).
 //!
 //! The power comes from `aloft-power` (the four-term model of the power seed) or from the
 //! propulsion chain of `aloft-propulsion`. The crate does no I/O: it takes text or data and
@@ -82,6 +124,7 @@ pub mod error;
 pub mod geodesy;
 pub mod ground_effect;
 pub mod mission;
+pub mod pack_cursor;
 pub mod plan;
 pub mod queries;
 pub mod replay;
@@ -92,11 +135,12 @@ pub mod wind;
 pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
-pub use battery::{Battery, BatterySpec, PackCursor, PackDraw, PackStep};
+pub use battery::{Battery, BatterySpec, PackDraw};
 pub use error::PlannerError;
 pub use mission::{
     HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
 };
+pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{
     plan, MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
 };

@@ -1,0 +1,347 @@
+//! What a planning run is asked and what it answers: the options, the report per mission and
+//! per segment, the time series, why a mission falls short, the point of no return.
+
+use aloft_power::AoaModel;
+use serde::Serialize;
+
+use crate::airframe::Airframe;
+use crate::battery::Battery;
+use crate::error::PlannerError;
+
+/// Options of a planning run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanOptions {
+    /// Largest sampling step, s (default 0.1).
+    pub time_step_s: f64,
+    /// Angle-of-attack model (default geometric).
+    pub aoa: AoaModel,
+    /// Apply ground effect near the ground (default true).
+    pub ground_effect: bool,
+    /// Reserve required at landing, fraction of the usable capacity (default 0.2).
+    pub reserve_fraction: f64,
+    /// State of charge at take-off (default 1).
+    pub start_soc: f64,
+    /// Keep every sample for a time series (default false: the hot loop stores nothing).
+    pub record_samples: bool,
+    /// Compute the point of no return (default true).
+    pub point_of_no_return: bool,
+    /// Interval of the point-of-no-return checks, s (default 1).
+    pub pnr_interval_s: f64,
+    /// Descent rate of the priced return, m/s (default: 2 m/s or the airframe's limit if lower).
+    pub return_descent_rate_mps: Option<f64>,
+    /// On a mission of 4096 steps or more, and a CPU with two cores or more, compute kinematics,
+    /// trim and power on a second thread ahead of the pack (default true). The report is the same
+    /// bit for bit either way.
+    pub second_thread: bool,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self {
+            time_step_s: 0.1,
+            aoa: AoaModel::Geometric,
+            ground_effect: true,
+            reserve_fraction: 0.2,
+            start_soc: 1.0,
+            record_samples: false,
+            point_of_no_return: true,
+            pnr_interval_s: 1.0,
+            return_descent_rate_mps: None,
+            second_thread: true,
+        }
+    }
+}
+
+/// One sample of the time series (at the midpoint of an integration step).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    /// Mission time, s.
+    pub time_s: f64,
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// East, m.
+    pub east_m: f64,
+    /// North, m.
+    pub north_m: f64,
+    /// Height above home, m.
+    pub up_m: f64,
+    /// Ground velocity east, m/s.
+    pub vel_east_mps: f64,
+    /// Ground velocity north, m/s.
+    pub vel_north_mps: f64,
+    /// Ground velocity up, m/s.
+    pub vel_up_mps: f64,
+    /// Acceleration east, m/s^2.
+    pub acc_east_mps2: f64,
+    /// Acceleration north, m/s^2.
+    pub acc_north_mps2: f64,
+    /// Acceleration up, m/s^2.
+    pub acc_up_mps2: f64,
+    /// Wind east, m/s.
+    pub wind_east_mps: f64,
+    /// Wind north, m/s.
+    pub wind_north_mps: f64,
+    /// Horizontal airspeed, m/s.
+    pub airspeed_mps: f64,
+    /// Thrust, N.
+    pub thrust_n: f64,
+    /// Roll, deg.
+    pub roll_deg: f64,
+    /// Pitch, deg.
+    pub pitch_deg: f64,
+    /// Heading, deg clockwise from north.
+    pub yaw_deg: f64,
+    /// Electrical power, W.
+    pub power_w: f64,
+    /// Pack current, A.
+    pub current_a: f64,
+    /// Pack terminal voltage, V.
+    pub voltage_v: f64,
+    /// State of charge after the step.
+    pub soc: f64,
+    /// Induced power, eq (8), W (four-term model only).
+    pub induced_w: Option<f64>,
+    /// Parasitic power, eq (11), W (four-term model only).
+    pub parasitic_w: Option<f64>,
+    /// Profile power, eq (12), W (four-term model only).
+    pub profile_w: Option<f64>,
+    /// Work of accelerating the vehicle with the geometric angle of attack, W (four-term model
+    /// only).
+    pub acceleration_w: Option<f64>,
+    /// Climb power, eq (13), W (four-term model only).
+    pub climb_w: Option<f64>,
+}
+
+/// Statistics of one mission segment.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentReport {
+    /// Segment number, from 1.
+    pub index: usize,
+    /// Kind (`take-off`, `leg`, `orbit`, `hover`, `return`, `descent`, `landing`).
+    pub kind: &'static str,
+    /// Duration flown, s.
+    pub duration_s: f64,
+    /// Path length flown, m.
+    pub distance_m: f64,
+    /// Electrical energy, W h.
+    pub energy_wh: f64,
+    /// Mean electrical power, W.
+    pub mean_power_w: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// State of charge at the end of the segment.
+    pub end_soc: f64,
+}
+
+/// Why a valid mission cannot be flown with this pack.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "cause", rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum Shortfall {
+    /// The usable charge ran out in flight.
+    BatteryEmpty {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+    },
+    /// The terminal voltage fell below the cut-off.
+    CutOffVoltage {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+        /// Terminal voltage, V.
+        voltage_v: f64,
+        /// Cut-off, V.
+        cutoff_v: f64,
+    },
+    /// The pack cannot deliver the power (`V_oc^2 < 4 R P`) or its rated current.
+    PackLimit {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+        /// Power asked, W.
+        power_w: f64,
+    },
+    /// The mission lands with less than the reserve.
+    Reserve {
+        /// Usable charge left at landing, fraction of capacity.
+        reserve_soc: f64,
+        /// Reserve required, fraction of capacity.
+        required_soc: f64,
+    },
+}
+
+impl std::fmt::Display for Shortfall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let at = |f: &mut std::fmt::Formatter<'_>, t: f64, seg: usize, kind: &str, p: [f64; 3]| {
+            write!(
+                f,
+                "at t = {t:.1} s ({}:{:04.1}) in segment {seg} ({kind}), {:.0} m east, {:.0} m north, {:.0} m up",
+                (t / 60.0).floor(),
+                t % 60.0,
+                p[0],
+                p[1],
+                p[2]
+            )
+        };
+        match self {
+            Shortfall::BatteryEmpty {
+                time_s,
+                segment,
+                kind,
+                position_m,
+            } => {
+                write!(f, "the battery runs out ")?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::CutOffVoltage {
+                time_s,
+                segment,
+                kind,
+                position_m,
+                voltage_v,
+                cutoff_v,
+            } => {
+                write!(
+                    f,
+                    "the pack voltage falls to {voltage_v:.2} V, below the {cutoff_v:.2} V cut-off, "
+                )?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::PackLimit {
+                time_s,
+                segment,
+                kind,
+                position_m,
+                power_w,
+            } => {
+                write!(
+                    f,
+                    "the pack cannot deliver {power_w:.0} W (its power or current limit) "
+                )?;
+                at(f, *time_s, *segment, kind, *position_m)
+            }
+            Shortfall::Reserve {
+                reserve_soc,
+                required_soc,
+            } => write!(
+                f,
+                "it lands with {:.1} % of the capacity usable, below the required reserve of {:.1} %",
+                reserve_soc * 100.0,
+                required_soc * 100.0
+            ),
+        }
+    }
+}
+
+/// The point of no return.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PointOfNoReturn {
+    /// Mission time, s.
+    pub time_s: f64,
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// Position, ENU m.
+    pub position_m: [f64; 3],
+}
+
+/// The result of a planning run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissionReport {
+    /// Whether the mission can be flown with the reserve.
+    pub feasible: bool,
+    /// Why not.
+    pub shortfall: Option<Shortfall>,
+    /// Take-off mass, kg.
+    pub takeoff_mass_kg: f64,
+    /// Duration flown, s.
+    pub duration_s: f64,
+    /// Path length flown, m.
+    pub distance_m: f64,
+    /// Electrical energy delivered to the load, W h.
+    pub energy_wh: f64,
+    /// Heat in the pack's internal resistance, W h.
+    pub pack_heat_wh: f64,
+    /// State of charge at take-off.
+    pub start_soc: f64,
+    /// State of charge at the end.
+    pub end_soc: f64,
+    /// Lowest terminal voltage, V.
+    pub min_voltage_v: f64,
+    /// Peak electrical power, W.
+    pub peak_power_w: f64,
+    /// Peak pack current, A.
+    pub peak_current_a: f64,
+    /// State of charge at which the usable charge is exhausted (`1 - usable_fraction`).
+    pub empty_soc: f64,
+    /// Usable charge left at the end, fraction of capacity (`end_soc - empty_soc`).
+    pub reserve_soc: f64,
+    /// Reserve required, fraction of capacity.
+    pub required_reserve_soc: f64,
+    /// Point of no return, when some part of the mission is past it.
+    pub point_of_no_return: Option<PointOfNoReturn>,
+    /// Per segment, in order (segments not reached are absent).
+    pub segments: Vec<SegmentReport>,
+    /// Samples, when recorded.
+    pub samples: Vec<Sample>,
+}
+
+/// The options of a run once checked: the numbers the loop runs with.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CheckedOptions {
+    /// Largest sampling step, s.
+    pub(super) time_step_s: f64,
+    /// Descent rate of the priced return, m/s.
+    pub(super) return_descent_rate_mps: f64,
+}
+
+impl PlanOptions {
+    /// Check the options against the pack and the airframe, in the order the errors are reported.
+    pub(super) fn check(
+        &self,
+        battery: &Battery,
+        airframe: &Airframe,
+    ) -> Result<CheckedOptions, PlannerError> {
+        let dt = crate::error::positive("time_step_s", self.time_step_s, "s")?;
+        if !(self.reserve_fraction >= 0.0 && self.reserve_fraction < 1.0) {
+            return Err(PlannerError::InvalidParameter {
+                name: "reserve_fraction",
+                value: self.reserve_fraction,
+                unit: "",
+                expected: "a fraction in [0, 1)",
+            });
+        }
+        if !(self.start_soc > battery.empty_soc() && self.start_soc <= 1.0) {
+            return Err(PlannerError::InvalidParameter {
+                name: "start_soc",
+                value: self.start_soc,
+                unit: "",
+                expected: "a fraction in (empty point, 1]",
+            });
+        }
+        crate::error::positive("pnr_interval_s", self.pnr_interval_s, "s")?;
+        let return_rate = match self.return_descent_rate_mps {
+            Some(r) => crate::error::positive("return_descent_rate_mps", r, "m/s")?,
+            None => airframe.max_descent_rate_mps().min(2.0),
+        };
+        Ok(CheckedOptions {
+            time_step_s: dt,
+            return_descent_rate_mps: return_rate,
+        })
+    }
+}
