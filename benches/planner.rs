@@ -18,7 +18,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use aloft::power::ModelOptions;
 use aloft::vehicle::VehicleFile;
 use aloft_planner::{
-    endurance, plan, AoaModel, BatterySpec, EnduranceQuery, MissionSpec, PlanOptions, Wind,
+    endurance, plan, AoaModel, BatterySpec, EnduranceQuery, MissionSpec, Pack, PlanOptions, Wind,
 };
 
 /// One hour: take-off, a leg, a long orbit, a leg back, landing (3600 s in total within a second).
@@ -52,22 +52,18 @@ fn bench_mission(c: &mut Criterion) {
     let f = VehicleFile::builtin("dji-m100").expect("built-in");
     let (aircraft, _) = f.aircraft(ModelOptions::default()).expect("aircraft");
     // A pack big enough for an hour (a bench workload, not a real pack): 6S 40 Ah at TB47D's mass.
-    let battery = BatterySpec {
+    let battery = Pack::new(&BatterySpec {
         name: "bench-40Ah".into(),
         default: false,
         cells_series: 6,
         capacity_mah: 40_000.0,
-        nominal_v: 22.2,
-        energy_wh: 888.0,
-        mass_kg: 0.6,
-        internal_resistance_ohm: 0.01,
-        cutoff_cell_v: 3.0,
-        usable_fraction: 1.0,
-        ocv_soc: None,
-        ocv_cell_v: None,
-        max_current_a: None,
-    }
-    .to_battery()
+        nominal_v: Some(22.2),
+        energy_wh: Some(888.0),
+        mass_kg: Some(0.6),
+        internal_resistance_ohm: Some(0.01),
+        cutoff_cell_v: Some(3.0),
+        ..BatterySpec::default()
+    })
     .expect("pack");
     let mission = MissionSpec::from_toml_str(ONE_HOUR)
         .expect("mission")

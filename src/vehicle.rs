@@ -101,7 +101,7 @@ impl VehicleFile {
             aloft_planner::Airframe::new(a.clone()).map_err(planner_error)?;
         }
         for (k, b) in file.batteries.iter().enumerate() {
-            b.to_battery().map_err(planner_error)?;
+            aloft_planner::Pack::new(b).map_err(planner_error)?;
             if file.batteries[..k].iter().any(|o| o.name == b.name) {
                 return Err(Error::VehicleFormat {
                     origin: origin.to_string(),
@@ -142,7 +142,7 @@ impl VehicleFile {
 
     /// A pack by name (case-insensitive), or the default pack (the one marked `default`, else the
     /// first).
-    pub fn battery(&self, name: Option<&str>) -> Result<aloft_planner::Battery, Error> {
+    pub fn battery(&self, name: Option<&str>) -> Result<aloft_planner::Pack, Error> {
         if self.batteries.is_empty() {
             return Err(Error::MissingTable {
                 vehicle: self.name.clone(),
@@ -168,7 +168,7 @@ impl VehicleFile {
                 .find(|b| b.default)
                 .unwrap_or(&self.batteries[0]),
         };
-        spec.to_battery().map_err(|e| Error::VehicleFormat {
+        aloft_planner::Pack::new(spec).map_err(|e| Error::VehicleFormat {
             origin: self.name.clone(),
             message: e.to_string(),
         })

@@ -3,14 +3,14 @@
 use aloft::power::ModelOptions;
 use aloft::vehicle::VehicleFile;
 use aloft_planner::{
-    bank_rad, best_range, plan, Aircraft, AoaModel, Battery, MissionSpec, PlanOptions,
+    bank_rad, best_range, plan, Aircraft, AoaModel, Pack, MissionSpec, PlanOptions,
     PlannerError, Shortfall, Wind, WindGrid,
 };
 use proptest::prelude::*;
 
 const DEMO: &str = include_str!("../fixtures/missions/demo-survey.toml");
 
-fn m100() -> (Aircraft, Battery) {
+fn m100() -> (Aircraft, Pack) {
     let f = VehicleFile::builtin("dji-m100").unwrap();
     let (a, _) = f.aircraft(ModelOptions::default()).unwrap();
     (a, f.battery(None).unwrap())

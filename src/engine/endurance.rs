@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{Battery, EnduranceQuery, EnduranceReport, Powered, SweepRow, Wind, WindSpec};
+use aloft_planner::{Pack, EnduranceQuery, EnduranceReport, Powered, SweepRow, Wind, WindSpec};
 use aloft_power::AoaModel;
 
 use super::vehicles::Vehicle;
@@ -16,7 +16,7 @@ use crate::error::Error;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EnduranceOptions {
-    /// Battery pack by name (default: the vehicle's default pack).
+    /// Pack pack by name (default: the vehicle's default pack).
     pub battery: Option<String>,
     /// Payload, kg (default 0).
     pub payload_kg: f64,
@@ -67,7 +67,7 @@ impl EnduranceOptions {
 pub struct EnduranceSummary {
     /// Vehicle name.
     pub vehicle: String,
-    /// Battery pack name.
+    /// Pack pack name.
     pub battery: String,
     /// Take-off mass, kg.
     pub takeoff_mass_kg: f64,
@@ -119,7 +119,7 @@ pub struct PowerCurve {
 pub struct CurveContext {
     /// Vehicle name.
     pub vehicle: String,
-    /// Battery pack name.
+    /// Pack pack name.
     pub battery: String,
     /// Take-off mass, kg.
     pub takeoff_mass_kg: f64,
@@ -178,7 +178,7 @@ pub fn power_curve(
 /// The vehicle at its take-off mass, its pack and the query of one set of options.
 struct Setup<'a> {
     powered: Powered<'a>,
-    battery: Battery,
+    battery: Pack,
     mass_kg: f64,
     query: EnduranceQuery,
     wind_text: String,
@@ -210,7 +210,7 @@ impl<'a> Setup<'a> {
 }
 
 /// Airframe + pack + payload, checked against the airframe's limit.
-fn takeoff_mass_kg(vehicle: &Vehicle, battery: &Battery, payload_kg: f64) -> Result<f64, Error> {
+fn takeoff_mass_kg(vehicle: &Vehicle, battery: &Pack, payload_kg: f64) -> Result<f64, Error> {
     if !(payload_kg.is_finite() && payload_kg >= 0.0) {
         return Err(Error::InvalidInput {
             name: "payload_kg",

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use aloft_core::Trapezoid;
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{Battery, MissionReport, MissionSpec, PlanOptions, Wind, WindSpec};
+use aloft_planner::{Pack, MissionReport, MissionSpec, PlanOptions, Wind, WindSpec};
 use aloft_power::AoaModel;
 
 use super::files::read_text_file;
@@ -146,7 +146,7 @@ impl Mission {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MissionOptions {
-    /// Battery pack by name (default: the vehicle's default pack).
+    /// Pack pack by name (default: the vehicle's default pack).
     pub battery: Option<String>,
     /// Payload at take-off, kg (overrides the mission file's).
     pub payload_kg: Option<f64>,
@@ -248,7 +248,7 @@ pub struct PackDescription {
 }
 
 impl PackDescription {
-    fn of(b: &Battery) -> Self {
+    fn of(b: &Pack) -> Self {
         Self {
             name: b.name().to_string(),
             cells_series: b.cells_series(),

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use aloft_planner::{Aircraft, Battery};
+use aloft_planner::{Aircraft, Pack};
 use aloft_power::{FlightState, ModelOptions, PowerBreakdown, PowerModel};
 
 use super::files::read_text_file;
@@ -145,7 +145,7 @@ impl Vehicle {
     ///
     /// # Errors
     /// No `[[battery]]` table, or no pack of that name (the message lists the packs).
-    pub fn battery(&self, name: Option<&str>) -> Result<Battery, Error> {
+    pub fn battery(&self, name: Option<&str>) -> Result<Pack, Error> {
         self.file.battery(name)
     }
 

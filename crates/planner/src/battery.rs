@@ -1,4 +1,4 @@
-//! Battery pack for mission integration: charge counting, open-circuit voltage, internal
+//! Pack pack for mission integration: charge counting, open-circuit voltage, internal
 //! resistance, usable fraction, cut-off voltage.
 //!
 //! | symbol | meaning | unit |
@@ -33,64 +33,23 @@
 //! terminal voltage fall along a mission.
 //!
 //! # Fast path
-//! [`Battery::draw`] is the plain model. A mission draws from the pack through a [`PackCursor`]
+//! [`Pack::draw`] is the plain model. A mission draws from the pack through a [`PackCursor`]
 //! ([`crate::pack_cursor`]), which gives the same draws bit for bit with a shorter chain from one
 //! step to the next, and solves a block of steps at once.
 
 use aloft_propulsion::OcvCurve;
-use serde::{Deserialize, Serialize};
 
 use crate::error::PlannerError;
 
 pub use crate::pack_cursor::{PackCursor, PackStep};
-
-fn default_usable() -> f64 {
-    1.0
-}
-
-/// A `[[battery]]` table of a vehicle file. Units are in the key names; unknown keys are rejected.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BatterySpec {
-    /// Name used on the command line (`--battery`).
-    pub name: String,
-    /// The vehicle's default pack (at most one per vehicle; else the first).
-    #[serde(default)]
-    pub default: bool,
-    /// Cells in series.
-    pub cells_series: u32,
-    /// Rated capacity, mA h.
-    pub capacity_mah: f64,
-    /// Rated (nominal) pack voltage, V.
-    pub nominal_v: f64,
-    /// Rated energy, W h (checked against `capacity x nominal voltage` within 1 %).
-    pub energy_wh: f64,
-    /// Pack mass, kg.
-    pub mass_kg: f64,
-    /// Pack internal resistance, ohm (0 allowed: an ideal source).
-    pub internal_resistance_ohm: f64,
-    /// Cut-off voltage per cell under load, V.
-    pub cutoff_cell_v: f64,
-    /// Fraction of the rated capacity that may be drawn, in `(0, 1]` (default 1).
-    #[serde(default = "default_usable")]
-    pub usable_fraction: f64,
-    /// Open-circuit curve: state-of-charge points in `[0, 1]`, increasing (default: typical LiPo).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ocv_soc: Option<Vec<f64>>,
-    /// Open-circuit curve: cell voltage at each `ocv_soc` point, V.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ocv_cell_v: Option<Vec<f64>>,
-    /// Rated continuous current, A (default: no limit).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub max_current_a: Option<f64>,
-}
+pub use aloft_propulsion::BatterySpec;
 
 /// Points of the uniform open-circuit table (0.5 % of state of charge apart).
 pub(crate) const OCV_TABLE_POINTS: usize = 201;
 
 /// A validated pack.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Battery {
+pub struct Pack {
     name: String,
     cells_series: u32,
     capacity_ah: f64,
@@ -115,7 +74,7 @@ pub struct PackDraw {
 }
 
 /// The pack model.
-impl Battery {
+impl Pack {
     /// Pack open-circuit voltage at state of charge `soc` (clamped to `[0, 1]`), V.
     #[inline]
     pub fn ocv_v(&self, soc: f64) -> f64 {
@@ -182,7 +141,7 @@ impl Battery {
 }
 
 /// What the pack is.
-impl Battery {
+impl Pack {
     /// Name of the pack.
     pub fn name(&self) -> &str {
         &self.name
@@ -249,22 +208,28 @@ impl Battery {
     }
 }
 
-impl BatterySpec {
-    /// Validate and build the pack model.
+impl Pack {
+    /// The pack a mission flies with, from its description: validated, with its open-circuit table.
     ///
     /// # Errors
     /// Zero cells, non-positive capacity, voltage, energy or mass, a rated energy that disagrees
     /// with capacity x voltage by more than 1 %, a negative resistance, a cut-off outside the
     /// open-circuit curve, a usable fraction outside `(0, 1]`, an invalid curve.
-    pub fn to_battery(&self) -> Result<Battery, PlannerError> {
+    pub fn new(spec: &BatterySpec) -> Result<Pack, PlannerError> {
         let bad = |key: &'static str, value: f64, unit: &'static str, expected: &'static str| {
             PlannerError::InvalidBattery {
-                name: self.name.clone(),
+                name: spec.name.clone(),
                 key,
                 value,
                 unit,
                 expected,
             }
+        };
+        let need = |key: &'static str, value: Option<f64>| {
+            value.ok_or_else(|| PlannerError::MissingBatteryKey {
+                name: spec.name.clone(),
+                key,
+            })
         };
         let pos = |key, v: f64, unit| {
             if v.is_finite() && v > 0.0 {
@@ -273,13 +238,13 @@ impl BatterySpec {
                 Err(bad(key, v, unit, "a positive finite number"))
             }
         };
-        if self.cells_series == 0 {
+        if spec.cells_series == 0 {
             return Err(bad("cells_series", 0.0, "", "at least one cell"));
         }
-        let capacity_ah = pos("capacity_mah", self.capacity_mah, "mA h")? / 1000.0;
-        let nominal_v = pos("nominal_v", self.nominal_v, "V")?;
-        let energy_wh = pos("energy_wh", self.energy_wh, "W h")?;
-        let mass_kg = pos("mass_kg", self.mass_kg, "kg")?;
+        let capacity_ah = pos("capacity_mah", spec.capacity_mah, "mA h")? / 1000.0;
+        let nominal_v = pos("nominal_v", need("nominal_v", spec.nominal_v)?, "V")?;
+        let energy_wh = pos("energy_wh", need("energy_wh", spec.energy_wh)?, "W h")?;
+        let mass_kg = pos("mass_kg", need("mass_kg", spec.mass_kg)?, "kg")?;
         // Rated energy is printed rounded; 1 % covers rounding of three significant figures.
         if (energy_wh / (capacity_ah * nominal_v) - 1.0).abs() > 0.01 {
             return Err(bad(
@@ -289,7 +254,7 @@ impl BatterySpec {
                 "within 1 % of capacity x nominal voltage",
             ));
         }
-        let r = self.internal_resistance_ohm;
+        let r = need("internal_resistance_ohm", spec.internal_resistance_ohm)?;
         if !(r.is_finite() && r >= 0.0) {
             return Err(bad(
                 "internal_resistance_ohm",
@@ -298,11 +263,11 @@ impl BatterySpec {
                 "a finite resistance, not negative",
             ));
         }
-        let u = self.usable_fraction;
+        let u = spec.usable_fraction;
         if !(u.is_finite() && u > 0.0 && u <= 1.0) {
             return Err(bad("usable_fraction", u, "", "a fraction in (0, 1]"));
         }
-        let curve = match (&self.ocv_soc, &self.ocv_cell_v) {
+        let curve = match (&spec.ocv_soc, &spec.ocv_cell_v) {
             (None, None) => OcvCurve::typical_lipo(),
             (Some(s), Some(v)) => OcvCurve::new(s.clone(), v.clone())?,
             (Some(_), None) | (None, Some(_)) => {
@@ -314,8 +279,8 @@ impl BatterySpec {
                 ))
             }
         };
-        let cells = f64::from(self.cells_series);
-        let cut = self.cutoff_cell_v;
+        let cells = f64::from(spec.cells_series);
+        let cut = need("cutoff_cell_v", spec.cutoff_cell_v)?;
         if !(cut.is_finite() && cut > 0.0 && cut < curve.cell_v(1.0)) {
             return Err(bad(
                 "cutoff_cell_v",
@@ -324,16 +289,16 @@ impl BatterySpec {
                 "positive and below the full-charge cell voltage",
             ));
         }
-        let max_current_a = match self.max_current_a {
+        let max_current_a = match spec.max_current_a {
             Some(i) => pos("max_current_a", i, "A")?,
             None => f64::INFINITY,
         };
         let ocv_table_v = (0..OCV_TABLE_POINTS)
             .map(|k| cells * curve.cell_v(k as f64 / (OCV_TABLE_POINTS - 1) as f64))
             .collect();
-        Ok(Battery {
-            name: self.name.clone(),
-            cells_series: self.cells_series,
+        Ok(Pack {
+            name: spec.name.clone(),
+            cells_series: spec.cells_series,
             capacity_ah,
             nominal_v,
             energy_wh,
@@ -354,7 +319,7 @@ mod tests {
 
     #[test]
     fn draw_delivers_the_power() {
-        let b = tb47d().to_battery().unwrap();
+        let b = Pack::new(&tb47d()).unwrap();
         for (p, s) in [(50.0, 0.9), (450.0, 0.5), (900.0, 0.1)] {
             let d = b.draw(p, s).unwrap();
             // terminal power equals demand up to rounding of the closed-form root
@@ -367,7 +332,7 @@ mod tests {
 
     #[test]
     fn ocv_table_matches_the_curve() {
-        let b = tb47d().to_battery().unwrap();
+        let b = Pack::new(&tb47d()).unwrap();
         let c = OcvCurve::typical_lipo();
         for s in [0.0, 0.03, 0.5, 0.77, 1.0] {
             // the table holds the curve's nodes (every 5 %) exactly, so linear interpolation agrees
@@ -380,17 +345,17 @@ mod tests {
     #[test]
     fn bad_packs_are_named() {
         let mut s = tb47d();
-        s.energy_wh = 120.0;
-        let e = s.to_battery().unwrap_err().to_string();
+        s.energy_wh = Some(120.0);
+        let e = Pack::new(&s).unwrap_err().to_string();
         assert!(e.contains("energy_wh") && e.contains("120"), "{e}");
         let mut s = tb47d();
         s.usable_fraction = 1.5;
-        assert!(s.to_battery().unwrap_err().to_string().contains("usable"));
+        assert!(Pack::new(&s).unwrap_err().to_string().contains("usable"));
         let mut s = tb47d();
-        s.internal_resistance_ohm = -0.1;
-        assert!(s.to_battery().is_err());
+        s.internal_resistance_ohm = Some(-0.1);
+        assert!(Pack::new(&s).is_err());
         let mut s = tb47d();
-        s.cutoff_cell_v = 4.5;
-        assert!(s.to_battery().is_err());
+        s.cutoff_cell_v = Some(4.5);
+        assert!(Pack::new(&s).is_err());
     }
 }

@@ -138,6 +138,14 @@ pub enum PlannerError {
         /// What is expected.
         expected: &'static str,
     },
+    /// A battery description without a key the mission planner needs.
+    #[error("battery '{name}': {key} is missing, and the mission planner needs it")]
+    MissingBatteryKey {
+        /// Pack name.
+        name: String,
+        /// The missing key.
+        key: &'static str,
+    },
     /// The speed search of a query found no airspeed that can be flown.
     #[error("no airspeed between {min_mps:.1} and {max_mps:.1} m/s can make headway along the course in this wind")]
     NoHeadway {

@@ -45,7 +45,7 @@
 //!   `plan::sampler::tests::hoisting_steady_stretches_matches_the_per_sample_report` (the whole
 //!   report, samples included, in four winds, with and without ground effect).
 //! - **The pack cursor** ([`pack_cursor`]): [`PackCursor::draw`] keeps the open-circuit table's
-//!   interval between steps. Reference: [`Battery::draw`]. Test:
+//!   interval between steps. Reference: [`Pack::draw`]. Test:
 //!   `pack_cursor::tests::cursor_draws_what_draw_draws_bit_for_bit_across_a_discharge`.
 //!   [`PackCursor::draw_block`] solves a block of 64 steps by fixed-point sweeps in vector lanes
 //!   (`#[multiversion]`), accepted only when a sweep gives the previous sweep's currents bit for
@@ -62,7 +62,7 @@
 //! `sincos` of a large angle (positions to 1e-10 m over 3400 s of orbit,
 //! `trajectory::block_tests::block_sampler_matches_piece_at_on_a_long_orbit`), and the pack's
 //! charge step is `I (h / Q)` instead of `I h / Q`; the plan's samples agree with per-sample
-//! [`Powered::trim`] and [`Battery::draw`] to 1e-9 relative
+//! [`Powered::trim`] and [`Pack::draw`] to 1e-9 relative
 //! (`plan::tests::block_passes_match_the_sample_by_sample_trim`).
 //!
 //! The power comes from `aloft-power` (the four-term model of the power seed) or from the
@@ -85,12 +85,12 @@
 //!     kappa1_w_per_n1_5: 0.275, kappa2_w_s2_per_m2_n0_5: 0.0, efficiency: 0.9703,
 //! })?;
 //! let aircraft = Aircraft::four_term(airframe, vehicle, Default::default());
-//! let battery = BatterySpec {
+//! let battery = Pack::new(&BatterySpec {
 //!     name: "TB47D".into(), default: true, cells_series: 6, capacity_mah: 4500.0,
-//!     nominal_v: 22.2, energy_wh: 99.9, mass_kg: 0.6, internal_resistance_ohm: 0.048,
-//!     cutoff_cell_v: 3.0, usable_fraction: 1.0, ocv_soc: None, ocv_cell_v: None,
-//!     max_current_a: None,
-//! }.to_battery()?;
+//!     nominal_v: Some(22.2), energy_wh: Some(99.9), mass_kg: Some(0.6),
+//!     internal_resistance_ohm: Some(0.048), cutoff_cell_v: Some(3.0),
+//!     ..BatterySpec::default()
+//! })?;
 //! let mission = MissionSpec::from_toml_str(r#"
 //!     [[segment]]
 //!     kind = "take-off"
@@ -135,7 +135,7 @@ pub mod wind;
 pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
-pub use battery::{Battery, BatterySpec, PackDraw};
+pub use battery::{Pack, BatterySpec, PackDraw};
 pub use error::PlannerError;
 pub use mission::{
     HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,

@@ -1,6 +1,6 @@
 //! The pack cursor: the pack model of [`crate::battery`] followed through a discharge, fast.
 //!
-//! [`Battery::draw`] is the plain reference: the open-circuit voltage at the state of charge (a
+//! [`Pack::draw`] is the plain reference: the open-circuit voltage at the state of charge (a
 //! table lookup), the current that delivers the power, the terminal voltage. A mission calls it
 //! once per sample with the state of charge the step before left, so each step waits on the one
 //! before through a square root and a division. Two fast paths make that chain shorter, each
@@ -8,7 +8,7 @@
 //!
 //! - [`PackCursor`] keeps the table interval of the present state of charge between steps instead
 //!   of finding it again ([`PackCursor::draw`], [`PackCursor::ocv_v`]); tested against
-//!   [`Battery::draw`] over a whole discharge
+//!   [`Pack::draw`] over a whole discharge
 //!   (`cursor_draws_what_draw_draws_bit_for_bit_across_a_discharge`).
 //! - [`PackCursor::draw_block`] solves a block of up to 64 steps at once by fixed-point sweeps in
 //!   vector lanes, and accepts a block only when a sweep reproduces the previous one's currents
@@ -18,7 +18,7 @@
 
 use multiversion::multiversion;
 
-use crate::battery::{Battery, PackDraw, OCV_TABLE_POINTS};
+use crate::battery::{Pack, PackDraw, OCV_TABLE_POINTS};
 
 /// One step of [`PackCursor::draw_block`]: the draw and the state of charge after it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -32,7 +32,7 @@ pub struct PackStep {
 }
 
 /// State of charge during a discharge, with the open-circuit table interval it lies in
-/// (see [`Battery::cursor`]).
+/// (see [`Pack::cursor`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PackCursor {
     soc: f64,
@@ -43,7 +43,7 @@ pub struct PackCursor {
 }
 
 impl PackCursor {
-    /// A cursor at `soc`, located in its table interval ([`Battery::cursor`]).
+    /// A cursor at `soc`, located in its table interval ([`Pack::cursor`]).
     pub(crate) fn new(soc: f64) -> Self {
         let mut c = PackCursor {
             soc,
@@ -72,7 +72,7 @@ impl PackCursor {
         let x = self.soc.clamp(0.0, 1.0) * n;
         self.k = (x as usize).min(OCV_TABLE_POINTS - 2);
         // Valid while the unclamped x stays in [k, k + 1) (the last interval closed at 1), which is
-        // where `Battery::ocv_v` picks the same k with a clamp that does nothing.
+        // where `Pack::ocv_v` picks the same k with a clamp that does nothing.
         self.x_lo = if self.soc >= 0.0 {
             self.k as f64
         } else {
@@ -88,7 +88,7 @@ impl PackCursor {
     /// Open-circuit voltage at the present state of charge, V: equal to
     /// `battery.ocv_v(self.soc())`, bit for bit.
     #[inline]
-    pub fn ocv_v(&mut self, battery: &Battery) -> f64 {
+    pub fn ocv_v(&mut self, battery: &Pack) -> f64 {
         let n = (OCV_TABLE_POINTS - 1) as f64;
         let mut x = self.soc * n;
         // The last interval is closed: `x_hi = n` is inside it.
@@ -107,7 +107,7 @@ impl PackCursor {
     /// Current and terminal voltage when the load draws `power_w` now: equal to
     /// `battery.draw(power_w, self.soc())`, bit for bit.
     #[inline]
-    pub fn draw(&mut self, battery: &Battery, power_w: f64) -> Option<PackDraw> {
+    pub fn draw(&mut self, battery: &Pack, power_w: f64) -> Option<PackDraw> {
         let v_oc = self.ocv_v(battery);
         battery.draw_at_ocv(power_w, v_oc)
     }
@@ -129,7 +129,7 @@ impl PackCursor {
     /// contains a step the pack cannot deliver is flown step by step.
     pub fn draw_block(
         &mut self,
-        battery: &Battery,
+        battery: &Pack,
         power_w: &[f64],
         charge_per_amp: f64,
         out: &mut [PackStep],
@@ -166,7 +166,7 @@ impl PackCursor {
     /// the cursor unchanged) when the block must be flown step by step.
     fn sweep_block(
         &mut self,
-        battery: &Battery,
+        battery: &Pack,
         power_w: &[f64],
         charge_per_amp: f64,
         out: &mut [PackStep],
@@ -250,8 +250,8 @@ struct Lanes {
     resistance_ohm: f64,
 }
 
-/// The draw of every lane at its state of charge `soc[j]`: the arithmetic of `Battery::ocv_v`
-/// (which [`PackCursor::ocv_v`] reproduces) and `Battery::draw_at_ocv`, operation for operation,
+/// The draw of every lane at its state of charge `soc[j]`: the arithmetic of `Pack::ocv_v`
+/// (which [`PackCursor::ocv_v`] reproduces) and `Pack::draw_at_ocv`, operation for operation,
 /// with no data-dependent branch (so in vector lanes; see `aloft_power`'s batch module). `false`
 /// when a lane's state of charge leaves [0, 1] or the two intervals, or the pack cannot deliver
 /// its power (unused lanes hold 0 W at the block's start, which always pass).
@@ -273,7 +273,7 @@ fn currents_of_lanes(
     let mut ok = true;
     for j in 0..LANES {
         let x = soc[j] * n;
-        // Battery::ocv_v's interval, min(floor(x), n - 1), as a float.
+        // Pack::ocv_v's interval, min(floor(x), n - 1), as a float.
         let kx = x.floor().min(n - 1.0);
         let at_k = kx == k_at;
         let inside = (soc[j] >= 0.0) & (soc[j] <= 1.0) & (at_k | (kx == k_below));
@@ -298,7 +298,7 @@ mod tests {
     #[test]
     #[allow(clippy::float_cmp)] // the cursor promises the same bits as `draw`
     fn cursor_draws_what_draw_draws_bit_for_bit_across_a_discharge() {
-        let b = tb47d().to_battery().unwrap();
+        let b = Pack::new(&tb47d()).unwrap();
         let mut c = b.cursor(1.0);
         let mut soc = 1.0;
         let mut k = 0;
@@ -320,7 +320,7 @@ mod tests {
     }
 
     /// Step by step with `draw` and `discharge`: the reference `draw_block` must reproduce.
-    fn step_by_step(b: &Battery, soc: f64, power: &[f64], dq: f64) -> (Vec<PackStep>, f64) {
+    fn step_by_step(b: &Pack, soc: f64, power: &[f64], dq: f64) -> (Vec<PackStep>, f64) {
         let mut c = b.cursor(soc);
         let mut steps = Vec::new();
         for &p in power {
@@ -337,7 +337,7 @@ mod tests {
 
     #[test]
     fn draw_block_is_the_step_by_step_discharge_bit_for_bit() {
-        let b = tb47d().to_battery().unwrap();
+        let b = Pack::new(&tb47d()).unwrap();
         // Small steps (a 10 ms sample), large ones (1 s, so blocks cross table intervals and
         // need many sweeps), and a power that jumps.
         for dq in [0.01 / (4.5 * 3600.0), 1.0 / (4.5 * 3600.0)] {

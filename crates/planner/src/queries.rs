@@ -7,7 +7,7 @@
 //! crabs into the cross wind). Then:
 //!
 //! - endurance at power `P`: the time the pack takes to go from the start state of charge to the
-//!   empty point plus the reserve, `sum dQ / I(P, s)` with `I` from [`Battery::draw`];
+//!   empty point plus the reserve, `sum dQ / I(P, s)` with `I` from [`Pack::draw`];
 //! - best endurance: `argmin_v P(v)` (in the air mass; wind does not change it);
 //! - best range along the course: `argmin_v P(v) / v_g(v)` (energy per metre over the ground),
 //!   range = endurance at that power x `v_g`;
@@ -22,7 +22,7 @@ use argmin::solver::brent::BrentOpt;
 use serde::Serialize;
 
 use crate::aircraft::Powered;
-use crate::battery::Battery;
+use crate::battery::Pack;
 use crate::error::PlannerError;
 
 /// Points of the bracketing scan.
@@ -150,7 +150,7 @@ pub fn best_range(
 /// The state of charge is stepped on the nodes of the open-circuit table (0.5 %) and the current
 /// taken at each sub-interval's midpoint; with no resistance `1/I = V_oc/P` is linear on each
 /// sub-interval and the midpoint rule is exact.
-pub fn endurance_at_power_s(battery: &Battery, power_w: f64, start_soc: f64, stop_soc: f64) -> f64 {
+pub fn endurance_at_power_s(battery: &Pack, power_w: f64, start_soc: f64, stop_soc: f64) -> f64 {
     if power_w.is_nan() || power_w.is_infinite() {
         return 0.0;
     }
@@ -227,7 +227,7 @@ pub struct EnduranceQuery {
 }
 
 /// State of charge at which the queries stop: the empty point plus the reserve.
-pub fn stop_soc(battery: &Battery, reserve_fraction: f64) -> f64 {
+pub fn stop_soc(battery: &Pack, reserve_fraction: f64) -> f64 {
     battery.empty_soc() + reserve_fraction * battery.usable_fraction()
 }
 
@@ -273,7 +273,7 @@ pub fn orbit_power_w(
 /// `[0, 1)`, no headway along the course, an orbit the model rejects.
 pub fn endurance(
     p: &Powered<'_>,
-    battery: &Battery,
+    battery: &Pack,
     q: &EnduranceQuery,
 ) -> Result<EnduranceReport, PlannerError> {
     let norm = q.course[0].hypot(q.course[1]);
@@ -360,7 +360,7 @@ pub struct SweepRow {
 /// A non-positive step or maximum, more than 10 000 rows, a condition the model rejects.
 pub fn sweep_speed(
     p: &Powered<'_>,
-    battery: &Battery,
+    battery: &Pack,
     q: &EnduranceQuery,
     max_airspeed_mps: f64,
     step_mps: f64,

@@ -258,7 +258,7 @@ mod tests {
         // points, integrated by the trapezoid instead of the midpoint rule. The two rules differ
         // only at the pieces' ends (a few of 2,000 steps): well within 0.5 %.
         let aircraft = m100();
-        let battery = tb47d().to_battery().unwrap();
+        let battery = crate::Pack::new(&tb47d()).unwrap();
         let mission = MissionSpec::from_toml_str(
             r#"
             [[segment]]

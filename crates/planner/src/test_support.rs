@@ -49,15 +49,12 @@ pub(crate) fn tb47d() -> BatterySpec {
         default: true,
         cells_series: 6,
         capacity_mah: 4500.0,
-        nominal_v: 22.2,
-        energy_wh: 99.9,
-        mass_kg: 0.6,
-        internal_resistance_ohm: 0.048,
-        cutoff_cell_v: 3.0,
-        usable_fraction: 1.0,
-        ocv_soc: None,
-        ocv_cell_v: None,
-        max_current_a: None,
+        nominal_v: Some(22.2),
+        energy_wh: Some(99.9),
+        mass_kg: Some(0.6),
+        internal_resistance_ohm: Some(0.048),
+        cutoff_cell_v: Some(3.0),
+        ..BatterySpec::default()
     }
 }
 
@@ -66,10 +63,10 @@ pub(crate) fn tb48d() -> BatterySpec {
     BatterySpec {
         name: "TB48D".into(),
         capacity_mah: 5700.0,
-        nominal_v: 22.8,
-        energy_wh: 129.96,
-        mass_kg: 0.676,
-        internal_resistance_ohm: 0.04,
+        nominal_v: Some(22.8),
+        energy_wh: Some(129.96),
+        mass_kg: Some(0.676),
+        internal_resistance_ohm: Some(0.04),
         ..tb47d()
     }
 }

@@ -22,6 +22,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod battery;
+pub mod battery_spec;
 pub mod error;
 pub mod esc;
 pub mod fit;
@@ -32,6 +33,7 @@ pub mod spec;
 pub mod transient;
 
 pub use battery::{Battery, InternalResistance, OcvCurve};
+pub use battery_spec::BatterySpec;
 pub use error::PropulsionError;
 pub use esc::Esc;
 pub use motor::{Motor, RotationalLoss};

@@ -29,16 +29,16 @@
 //! [propulsion.battery]
 //! cells_series = 5
 //! cells_parallel = 4
-//! capacity_ah = 8.0
+//! capacity_mah = 8000.0
 //! effective_capacity_fraction = 0.9
 //! full_charge_cell_v = 4.1
-//! nominal_cell_v = 3.7
+//! nominal_v = 18.5
 //! internal_resistance_ohm = 0.07      # or r1_ohm, r2_ohm_a, r3_ohm_a + eq17_{min,max}_current_a
 //! ```
 
 use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
 
-use crate::battery::{Battery, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V};
+use crate::battery_spec::BatterySpec;
 use crate::error::{mass, positive, PropulsionError};
 use crate::esc::Esc;
 use crate::motor::{Motor, RotationalLoss};
@@ -55,15 +55,6 @@ fn default_gravity() -> f64 {
 }
 fn default_rho() -> f64 {
     ISA_SEA_LEVEL_DENSITY_KG_M3
-}
-fn default_one() -> u32 {
-    1
-}
-fn default_full_cell() -> f64 {
-    SEED_FULL_CELL_V
-}
-fn default_nominal_cell() -> f64 {
-    SEED_NOMINAL_CELL_V
 }
 
 /// The `[propulsion]` table of a vehicle file.
@@ -149,48 +140,6 @@ pub struct EscSpec {
     pub resistance_ohm: f64,
 }
 
-/// `[propulsion.battery]`: one pack.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BatterySpec {
-    /// Cells in series.
-    pub cells_series: u32,
-    /// Cells in parallel (default 1).
-    #[serde(default = "default_one")]
-    pub cells_parallel: u32,
-    /// Rated capacity, A h.
-    pub capacity_ah: f64,
-    /// Effective-capacity coefficient `C_e`.
-    pub effective_capacity_fraction: f64,
-    /// Full-charge cell voltage, V (default 4.1, seed eq 30).
-    #[serde(default = "default_full_cell")]
-    pub full_charge_cell_v: f64,
-    /// Nominal cell voltage, V (default 3.7, seed eq 31).
-    #[serde(default = "default_nominal_cell")]
-    pub nominal_cell_v: f64,
-    /// Constant pack internal resistance, ohm (or the eq 17 keys).
-    #[serde(default)]
-    pub internal_resistance_ohm: Option<f64>,
-    /// `r_1` of eq (17), ohm.
-    #[serde(default)]
-    pub r1_ohm: Option<f64>,
-    /// `r_2` of eq (17), ohm A.
-    #[serde(default)]
-    pub r2_ohm_a: Option<f64>,
-    /// `r_3` of eq (17), ohm A.
-    #[serde(default)]
-    pub r3_ohm_a: Option<f64>,
-    /// Lower end of eq (17)'s valid current range, A.
-    #[serde(default)]
-    pub eq17_min_current_a: Option<f64>,
-    /// Upper end of eq (17)'s valid current range, A.
-    #[serde(default)]
-    pub eq17_max_current_a: Option<f64>,
-    /// Rated continuous pack current, A (default none).
-    #[serde(default)]
-    pub max_current_a: Option<f64>,
-}
-
 impl PropellerSpec {
     /// Validated [`Propeller`].
     ///
@@ -251,52 +200,6 @@ impl EscSpec {
     }
 }
 
-impl BatterySpec {
-    /// Validated [`Battery`].
-    ///
-    /// # Errors
-    /// Invalid values, or neither/both resistance forms.
-    pub fn into_model(self) -> Result<Battery, PropulsionError> {
-        let r = match (
-            self.internal_resistance_ohm,
-            self.r1_ohm,
-            self.r2_ohm_a,
-            self.r3_ohm_a,
-            self.eq17_min_current_a,
-            self.eq17_max_current_a,
-        ) {
-            (Some(r), None, None, None, None, None) => InternalResistance::Constant {
-                resistance_ohm: r,
-            },
-            (None, Some(r1), Some(r2), Some(r3), Some(lo), Some(hi)) => {
-                InternalResistance::Logarithmic {
-                    r1_ohm: r1,
-                    r2_ohm_a: r2,
-                    r3_ohm_a: r3,
-                    min_current_a: lo,
-                    max_current_a: hi,
-                }
-            }
-            _ => {
-                return Err(PropulsionError::ConflictingKeys {
-                    table: "propulsion.battery",
-                    problem: "give either internal_resistance_ohm, or all of r1_ohm, r2_ohm_a, r3_ohm_a, eq17_min_current_a, eq17_max_current_a",
-                })
-            }
-        };
-        Battery::new(
-            self.cells_series,
-            self.cells_parallel,
-            self.capacity_ah,
-            self.effective_capacity_fraction,
-            self.full_charge_cell_v,
-            self.nominal_cell_v,
-            r,
-            self.max_current_a.unwrap_or(f64::INFINITY),
-        )
-    }
-}
-
 impl PropulsionSpec {
     /// Validated [`PropulsionSystem`].
     ///
@@ -307,7 +210,7 @@ impl PropulsionSpec {
             self.propeller.into_model()?,
             self.motor.into_model()?,
             self.esc.into_model()?,
-            self.battery.into_model()?,
+            self.battery.to_seed_model()?,
             self.rotor_count,
             self.packs_count,
             mass("empty_mass_kg", self.empty_mass_kg)?,

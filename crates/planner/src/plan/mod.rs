@@ -86,7 +86,7 @@ mod test_mission;
 use std::ops::ControlFlow;
 
 use crate::aircraft::{Aircraft, Powered};
-use crate::battery::{Battery, PackCursor, PackStep};
+use crate::battery::{Pack, PackCursor, PackStep};
 use crate::error::PlannerError;
 use crate::mission::Mission;
 use crate::trajectory::Piece;
@@ -110,7 +110,7 @@ const BLOCK: usize = 64;
 /// the route, a flight condition the power model rejects.
 pub fn plan(
     aircraft: &Aircraft,
-    battery: &Battery,
+    battery: &Pack,
     mission: &Mission,
     wind: &Wind,
     options: &PlanOptions,
@@ -130,7 +130,7 @@ pub fn plan(
 /// path; the tests prove both give the same report) and the second thread allowed or not.
 pub(crate) fn plan_with(
     aircraft: &Aircraft,
-    battery: &Battery,
+    battery: &Pack,
     mission: &Mission,
     wind: &Wind,
     options: &PlanOptions,
@@ -161,7 +161,7 @@ pub(crate) fn plan_with(
 /// The vehicle at the take-off mass of each mass phase of the mission (airframe, pack, payload).
 fn powered_by_mass_phase<'a>(
     aircraft: &'a Aircraft,
-    battery: &Battery,
+    battery: &Pack,
     mission: &Mission,
     options: &PlanOptions,
 ) -> Result<Vec<Powered<'a>>, PlannerError> {
@@ -178,7 +178,7 @@ fn powered_by_mass_phase<'a>(
 struct PackPass<'p, 'a> {
     mission: &'p Mission,
     powered: &'p [Powered<'a>],
-    battery: &'p Battery,
+    battery: &'p Pack,
     dt: f64,
     record_samples: bool,
     /// Pack capacity, A s.
@@ -206,7 +206,7 @@ struct PieceRun<'r, 'a> {
 
 impl<'p, 'a> PackPass<'p, 'a> {
     fn new(
-        battery: &'p Battery,
+        battery: &'p Pack,
         mission: &'p Mission,
         powered: &'p [Powered<'a>],
         wind: &'p Wind,
@@ -419,7 +419,7 @@ mod tests {
 
     #[test]
     fn block_passes_match_the_sample_by_sample_trim() {
-        // The block path against `Powered::trim` and `Battery::draw` called per sample, over the
+        // The block path against `Powered::trim` and `Pack::draw` called per sample, over the
         // recorded samples of a survey in wind.
         let (aircraft, battery) = m100();
         let mission = MissionSpec::from_toml_str(SURVEY)

@@ -5,7 +5,7 @@ use aloft_power::AoaModel;
 use serde::Serialize;
 
 use crate::airframe::Airframe;
-use crate::battery::Battery;
+use crate::battery::Pack;
 use crate::error::PlannerError;
 
 /// Options of a planning run.
@@ -314,7 +314,7 @@ impl PlanOptions {
     /// Check the options against the pack and the airframe, in the order the errors are reported.
     pub(super) fn check(
         &self,
-        battery: &Battery,
+        battery: &Pack,
         airframe: &Airframe,
     ) -> Result<CheckedOptions, PlannerError> {
         let dt = crate::error::positive("time_step_s", self.time_step_s, "s")?;

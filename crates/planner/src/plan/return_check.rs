@@ -9,7 +9,7 @@
 //! that failed.
 
 use crate::aircraft::Powered;
-use crate::battery::Battery;
+use crate::battery::Pack;
 use crate::queries::best_range;
 use crate::wind::Wind;
 
@@ -64,7 +64,7 @@ impl ReturnCache {
 
 /// The checks of one run and what they found.
 pub(super) struct ReturnCheck<'p> {
-    battery: &'p Battery,
+    battery: &'p Pack,
     wind: &'p Wind,
     home: [f64; 3],
     /// State of charge the return must land at or above: empty point plus reserve.
@@ -84,7 +84,7 @@ impl<'p> ReturnCheck<'p> {
     /// The checks to `home` with `battery` in `wind`, down to `floor_soc`, descending at
     /// `descent_rate` m/s; none when `options` ask for no point of no return.
     pub(super) fn new(
-        battery: &'p Battery,
+        battery: &'p Pack,
         wind: &'p Wind,
         home: [f64; 3],
         options: &PlanOptions,

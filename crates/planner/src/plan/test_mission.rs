@@ -1,12 +1,12 @@
 //! The fixture the plan's tests fly: the M100 with a TB48D and a survey with every kind of piece.
 
 use crate::aircraft::Aircraft;
-use crate::battery::Battery;
+use crate::battery::Pack;
 use crate::test_support::{m100_aircraft, tb48d};
 
 /// The M100 and its TB48D pack.
-pub(super) fn m100() -> (Aircraft, Battery) {
-    (m100_aircraft(), tb48d().to_battery().unwrap())
+pub(super) fn m100() -> (Aircraft, Pack) {
+    (m100_aircraft(), Pack::new(&tb48d()).unwrap())
 }
 
 /// A survey: take-off, a leg, a hover, a climbing leg, an orbit, the return, the landing.
