@@ -18,7 +18,8 @@
 //! mass_kg = 1.755
 //! # ...
 //!
-//! [[battery]]    # packs for missions, one table each: aloft_planner::BatterySpec
+//! [[battery]]    # packs for missions, one table each: aloft_propulsion::BatterySpec, the same
+//!                # description [propulsion.battery] uses
 //! name = "TB47D"
 //! default = true
 //! # ...

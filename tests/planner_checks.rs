@@ -3,8 +3,8 @@
 use aloft::power::ModelOptions;
 use aloft::vehicle::VehicleFile;
 use aloft_planner::{
-    bank_rad, best_range, plan, Aircraft, AoaModel, Pack, MissionSpec, PlanOptions,
-    PlannerError, Shortfall, Wind, WindGrid,
+    bank_rad, best_range, plan, Aircraft, AoaModel, MissionSpec, Pack, PlanOptions, PlannerError,
+    Shortfall, Wind, WindGrid,
 };
 use proptest::prelude::*;
 

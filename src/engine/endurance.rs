@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{Pack, EnduranceQuery, EnduranceReport, Powered, SweepRow, Wind, WindSpec};
+use aloft_planner::{EnduranceQuery, EnduranceReport, Pack, Powered, SweepRow, Wind, WindSpec};
 use aloft_power::AoaModel;
 
 use super::vehicles::Vehicle;

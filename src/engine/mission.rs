@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use aloft_core::Trapezoid;
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{Pack, MissionReport, MissionSpec, PlanOptions, Wind, WindSpec};
+use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Wind, WindSpec};
 use aloft_power::AoaModel;
 
 use super::files::read_text_file;

@@ -135,7 +135,7 @@ pub mod wind;
 pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
-pub use battery::{Pack, BatterySpec, PackDraw};
+pub use battery::{BatterySpec, Pack, PackDraw};
 pub use error::PlannerError;
 pub use mission::{
     HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,

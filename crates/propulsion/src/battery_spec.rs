@@ -154,12 +154,12 @@ impl BatterySpec {
     /// A missing `effective_capacity_fraction`, neither or both resistance forms, values the model
     /// rejects.
     pub fn to_seed_model(&self) -> Result<Battery, PropulsionError> {
-        let effective = self
-            .effective_capacity_fraction
-            .ok_or(PropulsionError::ConflictingKeys {
-                table: "propulsion.battery",
-                problem: "give effective_capacity_fraction (C_e of seed eq 31)",
-            })?;
+        let effective =
+            self.effective_capacity_fraction
+                .ok_or(PropulsionError::ConflictingKeys {
+                    table: "propulsion.battery",
+                    problem: "give effective_capacity_fraction (C_e of seed eq 31)",
+                })?;
         let nominal_cell_v = match self.nominal_v {
             Some(v) if self.cells_series > 0 => v / f64::from(self.cells_series),
             _ => SEED_NOMINAL_CELL_V,
