@@ -6,15 +6,19 @@
 //! - [`STANDARD_GRAVITY_MPS2`] and [`ISA_SEA_LEVEL_DENSITY_KG_M3`], the defaults of vehicle files
 //!   and the unit `g` of log columns;
 //! - [`Trapezoid`] and [`trapezoid`], the trapezoid rule for energies (power over time) and any
-//!   other integral of sampled data, sample by sample or over slices.
+//!   other integral of sampled data, sample by sample or over slices;
+//! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
+//!   before it is opened, so it cannot block), with a size limit for whole-file inputs.
 //!
-//! The crate has no dependencies and does no I/O.
+//! The crate has no dependencies; its only I/O is the opening of input files in [`input`].
 
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod input;
 pub mod integrate;
 
+pub use input::{open_regular_file, read_regular_text};
 pub use integrate::{trapezoid, Trapezoid};
 
 /// Standard gravity `g0`, m/s^2 (CGPM 1901; ISO 80000-3). The default when a vehicle file does
