@@ -38,6 +38,14 @@ pub enum Error {
         /// The header that was found, comma-separated.
         found: String,
     },
+    /// A CSV header that names a column twice.
+    #[error("{origin}: the column '{column}' appears twice in the header")]
+    DuplicateColumn {
+        /// The repeated name.
+        column: String,
+        /// File or stream name.
+        origin: String,
+    },
     /// A field that must be a number is not.
     #[error("{origin}: row {row}: {column} = '{value}' is not a number")]
     BadValue {

@@ -8,6 +8,18 @@ use clap::Args;
 
 use aloft::engine::{AoaModel, GustSpec, WindProfileKind, WindSpec};
 
+/// Every numeric flag: a finite number (`nan`, `inf` and overflowing text like `1e999` are
+/// refused here with the flag's name; the engine checks each value's physical range and unit).
+pub fn finite() -> impl TypedValueParser<Value = f64> {
+    clap::builder::StringValueParser::new().try_map(|text: String| {
+        match text.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            Ok(_) => Err("not a finite number".to_string()),
+            Err(_) => Err("not a number".to_string()),
+        }
+    })
+}
+
 /// `--aoa geometric|paper`, parsed into the engine's [`AoaModel`].
 pub fn aoa_parser() -> impl TypedValueParser<Value = AoaModel> {
     PossibleValuesParser::new([
@@ -39,10 +51,10 @@ fn profile_parser() -> impl TypedValueParser<Value = WindProfileKind> {
 #[derive(Debug, Args)]
 pub struct SteadyWindArgs {
     /// Wind speed in m/s (at the reference height when a profile is given).
-    #[arg(long, value_name = "M/S", requires = "wind_from")]
+    #[arg(value_parser = finite(), long, value_name = "M/S", requires = "wind_from")]
     pub wind_speed: Option<f64>,
     /// Direction the wind blows FROM, degrees clockwise from north (270 = a westerly).
-    #[arg(
+    #[arg(value_parser = finite(), 
         long,
         value_name = "DEG",
         allow_negative_numbers = true,
@@ -53,13 +65,13 @@ pub struct SteadyWindArgs {
     #[arg(long, value_parser = profile_parser(), requires = "wind_speed")]
     pub wind_profile: Option<WindProfileKind>,
     /// Reference height of the profile, m.
-    #[arg(long, default_value_t = 10.0, value_name = "M")]
+    #[arg(value_parser = finite(), long, default_value_t = 10.0, value_name = "M")]
     pub wind_reference_height: f64,
     /// Power-law exponent.
-    #[arg(long, default_value_t = 1.0 / 7.0)]
+    #[arg(value_parser = finite(), long, default_value_t = 1.0 / 7.0)]
     pub wind_exponent: f64,
     /// Roughness length of the log profile, m (0.03 open grass, 0.1-0.25 crops and hedges).
-    #[arg(long, default_value_t = 0.03, value_name = "M")]
+    #[arg(value_parser = finite(), long, default_value_t = 0.03, value_name = "M")]
     pub wind_roughness: f64,
 }
 
@@ -93,7 +105,7 @@ pub struct MissionWindArgs {
     #[arg(long, value_name = "CSV", conflicts_with_all = ["wind_speed", "wind_profile"])]
     pub wind_field: Option<PathBuf>,
     /// Add seeded gusts with this standard deviation per horizontal axis, m/s.
-    #[arg(long, value_name = "M/S")]
+    #[arg(value_parser = finite(), long, value_name = "M/S")]
     pub gust_std: Option<f64>,
     /// Seed of the gusts.
     #[arg(long, default_value_t = 1)]

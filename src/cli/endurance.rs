@@ -25,12 +25,12 @@ pub struct EnduranceArgs {
     #[arg(long)]
     battery: Option<String>,
     /// Payload, kg.
-    #[arg(long, default_value_t = 0.0, value_name = "KG")]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG")]
     payload_kg: f64,
     #[command(flatten)]
     wind: SteadyWindArgs,
     /// Course of the range query, degrees clockwise from north.
-    #[arg(
+    #[arg(value_parser = super::args::finite(), 
         long,
         default_value_t = 0.0,
         value_name = "DEG",
@@ -38,20 +38,20 @@ pub struct EnduranceArgs {
     )]
     course: f64,
     /// Reserve kept, percent of the usable capacity.
-    #[arg(long, default_value_t = 0.0, value_name = "PERCENT")]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "PERCENT")]
     reserve_percent: f64,
     /// Orbit radius for the orbit-endurance query, m.
-    #[arg(long, value_name = "M", requires = "orbit_speed")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "M", requires = "orbit_speed")]
     orbit_radius: Option<f64>,
     /// Orbit ground speed, m/s.
-    #[arg(long, value_name = "M/S", requires = "orbit_radius")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "M/S", requires = "orbit_radius")]
     orbit_speed: Option<f64>,
     /// Angle-of-attack model of the power model.
     #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
     aoa: AoaModel,
     /// The power curve instead: power, endurance and range against airspeed, in steps of this
     /// many m/s up to the vehicle's maximum speed.
-    #[arg(long, value_name = "STEP_M/S")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "STEP_M/S")]
     sweep_speed: Option<f64>,
     /// With --sweep-speed: also draw the curve to this SVG.
     #[arg(long, value_name = "SVG", requires = "sweep_speed")]

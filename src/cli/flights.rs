@@ -23,10 +23,10 @@ pub struct FlightLogArgs {
     #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
     pub aoa: AoaModel,
     /// Use this lag of power behind motion (s) instead of estimating it.
-    #[arg(long, allow_negative_numbers = true, value_name = "S")]
+    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true, value_name = "S")]
     pub lag: Option<f64>,
     /// Search window of the lag estimate, s.
-    #[arg(long, default_value_t = 10.0, value_name = "S")]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 10.0, value_name = "S")]
     pub max_lag: f64,
 }
 

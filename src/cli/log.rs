@@ -62,7 +62,7 @@ struct InfoArgs {
     #[command(flatten)]
     read: ReadOptions,
     /// Also estimate the lag of power behind ground speed by cross-correlation (search +-N s).
-    #[arg(long, value_name = "MAX_S")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "MAX_S")]
     lag: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]

@@ -10,7 +10,8 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 
 use aloft::engine::{
-    plan_mission, AoaModel, Mission, MissionOptions, MissionReport, Plan, Vehicle,
+    plan_mission_with, AoaModel, Mission, MissionOptions, MissionOutputs, MissionReport, Plan,
+    Sample, Vehicle,
 };
 
 use super::args::{aoa_parser, MissionWindArgs};
@@ -29,18 +30,18 @@ pub struct MissionArgs {
     #[arg(long)]
     pub battery: Option<String>,
     /// Payload at take-off, kg (overrides the mission file).
-    #[arg(long, value_name = "KG")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "KG")]
     pub payload_kg: Option<f64>,
     #[command(flatten)]
     pub wind: MissionWindArgs,
     /// Reserve required at landing, percent of the usable capacity (default: the mission's, else 20).
-    #[arg(long, value_name = "PERCENT")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "PERCENT")]
     pub reserve_percent: Option<f64>,
     /// State of charge at take-off, percent.
-    #[arg(long, default_value_t = 100.0, value_name = "PERCENT")]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 100.0, value_name = "PERCENT")]
     pub start_percent: f64,
     /// Sampling step, s (default: the mission's, else 0.1).
-    #[arg(long, value_name = "S")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "S")]
     pub time_step: Option<f64>,
     /// Angle-of-attack model of the power model.
     #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
@@ -76,7 +77,7 @@ pub struct MissionArgs {
     pub profile: Option<String>,
     /// Lag of the logged power behind the motion for --replay, s (default: estimated by
     /// cross-correlating power with tilt). Only the measured side is shifted.
-    #[arg(
+    #[arg(value_parser = super::args::finite(), 
         long,
         requires = "replay",
         allow_negative_numbers = true,
@@ -87,7 +88,7 @@ pub struct MissionArgs {
     #[arg(long, value_enum, default_value_t = AccelArg::Velocity)]
     pub acceleration: AccelArg,
     /// Window of the velocity difference for --acceleration velocity, s.
-    #[arg(long, default_value_t = 1.0, value_name = "S")]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 1.0, value_name = "S")]
     pub acceleration_window: f64,
 }
 
@@ -114,7 +115,16 @@ impl MissionArgs {
             time_step_s: self.time_step,
             aoa: self.aoa,
             ground_effect: !self.no_ground_effect,
-            record_samples: self.timeseries.is_some() || self.plot.is_some() || self.mcap.is_some(),
+            record_samples: false,
+        }
+    }
+
+    /// The files to write as the flight is flown.
+    fn outputs(&self) -> MissionOutputs {
+        MissionOutputs {
+            timeseries: self.timeseries.clone(),
+            mcap: self.mcap.clone(),
+            plot: self.plot.is_some(),
         }
     }
 }
@@ -128,8 +138,18 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     }
     let vehicle = Vehicle::load(&args.vehicle)?;
     let mission = Mission::load(args.mission.as_deref())?;
-    let plan = plan_mission(&vehicle, &mission, &args.options())?;
-    write_files(&args, &plan, mission.spec().name.as_str())?;
+    let plan = plan_mission_with(&vehicle, &mission, &args.options(), &args.outputs())?;
+    if let Some(path) = &args.plot {
+        let name = mission.spec().name.as_str();
+        plot(
+            path,
+            name,
+            plan.report(),
+            plan.plot_samples(),
+            plan.home_m(),
+        )
+        .with_context(|| format!("cannot draw {}", path.display()))?;
+    }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
@@ -141,21 +161,6 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     } else {
         Outcome::Failed
     })
-}
-
-/// The files asked for beside the answer: time series, chart, MCAP.
-fn write_files(args: &MissionArgs, plan: &Plan, name: &str) -> Result<()> {
-    if let Some(path) = &args.timeseries {
-        plan.write_timeseries(path)?;
-    }
-    if let Some(path) = &args.plot {
-        plot(path, name, plan.report(), plan.home_m())
-            .with_context(|| format!("cannot draw {}", path.display()))?;
-    }
-    if let Some(path) = &args.mcap {
-        plan.write_mcap(path)?;
-    }
-    Ok(())
 }
 
 /// Minutes and seconds, `m:ss`.
@@ -301,16 +306,22 @@ fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
 }
 
 /// Power and state of charge against time, and the ground track with the point of no return.
-fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Result<()> {
+fn plot(
+    path: &Path,
+    name: &str,
+    report: &MissionReport,
+    samples: &[Sample],
+    home: [f64; 3],
+) -> Result<()> {
     use plotters::prelude::*;
-    if report.samples.is_empty() {
+    if samples.is_empty() {
         bail!("no samples to plot");
     }
     let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(400);
-    plot_power(&top, name, report)?;
-    plot_track(&bottom, report, home)?;
+    plot_power(&top, name, report, samples)?;
+    plot_track(&bottom, report, samples, home)?;
     root.present()?;
     Ok(())
 }
@@ -318,9 +329,8 @@ fn plot(path: &Path, name: &str, report: &MissionReport, home: [f64; 3]) -> Resu
 type Area<'a> =
     plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
 
-fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport) -> Result<()> {
+fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample]) -> Result<()> {
     use plotters::prelude::*;
-    let s = &report.samples;
     let t_max = s[s.len() - 1].time_s.max(1.0);
     let p_max = s.iter().map(|x| x.power_w).fold(0.0, f64::max) * 1.1 + 1.0;
     let mut chart = super::plot::dual_lines(
@@ -361,9 +371,8 @@ fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport) -> Result<()>
     Ok(())
 }
 
-fn plot_track(area: &Area<'_>, report: &MissionReport, home: [f64; 3]) -> Result<()> {
+fn plot_track(area: &Area<'_>, report: &MissionReport, s: &[Sample], home: [f64; 3]) -> Result<()> {
     use plotters::prelude::*;
-    let s = &report.samples;
     // Ground track, equal scales.
     let (mut e0, mut e1, mut n0, mut n1) = (home[0], home[0], home[1], home[1]);
     for x in s {

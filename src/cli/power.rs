@@ -21,30 +21,30 @@ pub struct PowerArgs {
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
     vehicle: String,
     /// Airspeed in m/s: the speed of the vehicle relative to the air (horizontal, as the paper assumes).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     airspeed: f64,
     /// Roll in degrees (positive: right side down).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     roll: f64,
     /// Pitch in degrees (positive: nose up; forward flight pitches the nose down, e.g. -8).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     pitch: f64,
     /// Vertical speed in m/s, positive up (only the climb term, eq 13, uses it).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     climb_rate: f64,
     /// Remove terms from the model (the ablation rows of the paper's Table I), comma-separated:
     /// induced, parasitic, profile, climb.
     #[arg(long, value_delimiter = ',', value_name = "TERMS")]
     without: Vec<Term>,
     /// Hybrid model: drop the profile term above this airspeed, m/s (the paper's conclusion).
-    #[arg(long, value_name = "M/S")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "M/S")]
     profile_cutoff: Option<f64>,
     /// Angle-of-attack model. Default: paper, or geometric when --air-direction-deg is given.
     #[arg(long, value_parser = aoa_parser())]
     aoa: Option<AoaModel>,
     /// Direction of the air-relative velocity in degrees from the nose (0 forward, 90 to the
     /// right); selects the geometric angle of attack.
-    #[arg(long, allow_negative_numbers = true, value_name = "DEG")]
+    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true, value_name = "DEG")]
     air_direction_deg: Option<f64>,
     /// Also report the gradient of electrical power with respect to airspeed, roll and pitch.
     #[arg(long)]

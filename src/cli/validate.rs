@@ -21,7 +21,7 @@ pub struct ValidateArgs {
     vehicle: String,
     /// Re-estimate only the efficiency from the first S seconds of each flight, as a ground
     /// station would in flight, and report the errors over the rest.
-    #[arg(long, value_name = "S")]
+    #[arg(value_parser = super::args::finite(), long, value_name = "S")]
     calibrate_first: Option<f64>,
     /// Also write an SVG of measured against predicted power, one panel per flight.
     #[arg(long, value_name = "SVG")]

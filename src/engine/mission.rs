@@ -6,10 +6,11 @@ use std::path::{Path, PathBuf};
 use aloft_core::Trapezoid;
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Wind, WindSpec};
+use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Wind, WindSpec};
 use aloft_power::AoaModel;
 
 use super::files::read_text_file;
+use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use super::summary::{mission_summary, MissionSummary};
 use super::vehicles::Vehicle;
 use super::wind::{mission_wind, GustSpec};
@@ -210,6 +211,7 @@ pub struct Plan {
     summary: MissionSummary,
     context: PlanContext,
     compiled: aloft_planner::Mission,
+    plot_samples: Vec<Sample>,
 }
 
 /// What a plan was computed for, in the words and figures a reader wants beside the answer
@@ -281,9 +283,10 @@ impl Plan {
         self.compiled.home_m()
     }
 
-    /// The compiled mission (trajectory pieces), for writers of the planned path.
-    pub(crate) fn compiled(&self) -> &aloft_planner::Mission {
-        &self.compiled
+    /// The samples kept for a chart ([`MissionOutputs::plot`]): all of a short flight, an evenly
+    /// decimated selection of a long one (at most [`PLOT_SAMPLES`](super::PLOT_SAMPLES)).
+    pub fn plot_samples(&self) -> &[Sample] {
+        &self.plot_samples
     }
 
     /// The summary (the CLI's JSON).
@@ -382,8 +385,23 @@ pub fn plan_mission(
     mission: &Mission,
     options: &MissionOptions,
 ) -> Result<Plan, Error> {
+    plan_mission_with(vehicle, mission, options, &MissionOutputs::default())
+}
+
+/// [`plan_mission`], writing the files of `outputs` (time series, MCAP) and keeping a chart's
+/// samples as the flight is flown, so that memory does not grow with the flight. After a failed
+/// run the files it created are removed.
+///
+/// # Errors
+/// As [`plan_mission`], and files that cannot be created or written.
+pub fn plan_mission_with(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    outputs: &MissionOutputs,
+) -> Result<Plan, Error> {
     let (wind, wind_text) = mission_wind(options, mission, vehicle)?;
-    plan_in(vehicle, mission, options, &wind, wind_text)
+    plan_in(vehicle, mission, options, (&wind, wind_text), outputs)
 }
 
 /// [`plan_mission`] in a wind built by the caller, which replaces the options' and the mission
@@ -397,23 +415,18 @@ pub fn plan_mission_in(
     options: &MissionOptions,
     wind: &Wind,
 ) -> Result<Plan, Error> {
-    plan_in(
-        vehicle,
-        mission,
-        options,
-        wind,
-        "given by the caller".to_string(),
-    )
+    let wind = (wind, "given by the caller".to_string());
+    plan_in(vehicle, mission, options, wind, &MissionOutputs::default())
 }
 
-/// The steps of a plan: the pack, the compiled mission, the planner's options, the flight, the
-/// summary.
+/// The steps of a plan: the pack, the compiled mission, the planner's options, the flight (into
+/// the outputs), the summary.
 fn plan_in(
     vehicle: &Vehicle,
     mission: &Mission,
     options: &MissionOptions,
-    wind: &Wind,
-    wind_text: String,
+    (wind, wind_text): (&Wind, String),
+    outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
     let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
@@ -427,8 +440,32 @@ fn plan_in(
         .compile(aircraft.airframe(), battery.mass_kg(), options.payload_kg)
         .map_err(in_mission)?;
     let plan_options = planner_options(options, &mission.spec)?;
-    let report = aloft_planner::plan(aircraft, &battery, &compiled, wind, &plan_options)
-        .map_err(in_mission)?;
+    let (report, plot_samples) = if outputs.any() {
+        let keep_all = plan_options.record_samples;
+        let mut sink = OutputSink::create(outputs, path_points(&compiled), keep_all)?;
+        match aloft_planner::plan_into(
+            aircraft,
+            &battery,
+            &compiled,
+            wind,
+            &plan_options,
+            &mut sink,
+        ) {
+            Ok(mut report) => {
+                let (plot, all) = sink.finish()?;
+                report.samples = all;
+                (report, plot)
+            }
+            Err(e) => {
+                sink.discard();
+                return Err(sink.take_failure().unwrap_or_else(|| in_mission(e)));
+            }
+        }
+    } else {
+        let report = aloft_planner::plan(aircraft, &battery, &compiled, wind, &plan_options)
+            .map_err(in_mission)?;
+        (report, Vec::new())
+    };
     let payload = compiled.payloads_kg().first().copied().unwrap_or(0.0);
     let summary = mission_summary(
         &report,
@@ -451,6 +488,7 @@ fn plan_in(
         summary,
         context,
         compiled,
+        plot_samples,
     })
 }
 

@@ -1,122 +1,360 @@
-//! A plan's samples as files other tools read: a CSV time series, and MCAP (the samples and the
-//! planned path) that Foxglove displays. Both need a plan made with
-//! [`MissionOptions::record_samples`](super::MissionOptions::record_samples).
+//! A plan's samples as files other tools read, written as the flight is flown so that memory does
+//! not grow with the flight: a CSV time series, MCAP (the samples and the planned path) that
+//! Foxglove displays, and a decimated copy for a chart.
 
-use std::path::Path;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::PathBuf;
 
-use aloft_logs::{Attitude, BatteryPoint, MissionSample, PathPoint, PowerTerms};
+use aloft_logs::{Attitude, BatteryPoint, McapWriter, MissionSample, PathPoint, PowerTerms};
 use aloft_planner::trajectory::Shape;
-use aloft_planner::Sample;
+use aloft_planner::{PlannerError, Sample, SampleSink};
 
-use super::mission::Plan;
 use crate::error::Error;
 
 /// Points drawn per arc of the planned path, so the path shows the circle.
 const ARC_POINTS: usize = 36;
 
-impl Plan {
-    /// Write every sample (time, segment, position, velocity, acceleration, wind, airspeed,
-    /// thrust, attitude, power and its terms, current, voltage, state of charge) as CSV.
-    ///
-    /// # Errors
-    /// [`Error::Io`] or [`Error::Csv`] naming the file when it cannot be written.
-    pub fn write_timeseries(&self, path: &Path) -> Result<(), Error> {
-        let origin = path.display().to_string();
-        let csv_error = |e: csv::Error| Error::Csv {
-            origin: origin.clone(),
-            row: 0,
-            message: e.to_string(),
+/// Most samples kept for a chart: a flight with more is decimated (every 2nd, 4th, ... sample),
+/// keeping between half this number and this number.
+pub const PLOT_SAMPLES: usize = 10_000;
+
+/// The files a mission run writes beside its answer.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct MissionOutputs {
+    /// Every sample as CSV (time, segment, position, velocity, acceleration, wind, airspeed,
+    /// thrust, attitude, power and its terms, current, voltage, state of charge).
+    pub timeseries: Option<PathBuf>,
+    /// The samples (pose, attitude, power terms, battery state) and the planned path as MCAP.
+    pub mcap: Option<PathBuf>,
+    /// Keep a decimated copy of the samples for a chart ([`super::Plan::plot_samples`]).
+    pub plot: bool,
+}
+
+impl MissionOutputs {
+    /// Whether any output wants the samples.
+    pub fn any(&self) -> bool {
+        self.timeseries.is_some() || self.mcap.is_some() || self.plot
+    }
+}
+
+/// The sink the planner streams a run's samples into: one writer per output asked for.
+pub(crate) struct OutputSink {
+    csv: Option<(csv::Writer<BufWriter<File>>, PathBuf)>,
+    mcap: Option<McapStream>,
+    plot: Option<Decimator>,
+    /// Every sample, when the plan keeps them ([`super::MissionOptions::record_samples`]).
+    all: Option<Vec<Sample>>,
+    created: Vec<PathBuf>,
+    /// The first failure, with the file it names (the planner only sees that the sink failed).
+    failure: Option<Error>,
+}
+
+impl OutputSink {
+    /// Create the files asked for; `path_points` is the planned path for MCAP; `keep_all` keeps
+    /// every sample too.
+    pub(crate) fn create(
+        outputs: &MissionOutputs,
+        path_points: Vec<PathPoint>,
+        keep_all: bool,
+    ) -> Result<Self, Error> {
+        let mut sink = Self {
+            csv: None,
+            mcap: None,
+            plot: outputs.plot.then(Decimator::default),
+            all: keep_all.then(Vec::new),
+            created: Vec::new(),
+            failure: None,
         };
-        let file = std::fs::File::create(path).map_err(|source| Error::Io {
-            origin: format!("cannot create {origin}"),
-            source,
-        })?;
-        let mut w = csv::Writer::from_writer(std::io::BufWriter::new(file));
-        for s in &self.report().samples {
-            w.serialize(s).map_err(csv_error)?;
+        if let Some(path) = &outputs.timeseries {
+            let file = File::create(path).map_err(|source| Error::Io {
+                origin: format!("cannot create {}", path.display()),
+                source,
+            })?;
+            sink.created.push(path.clone());
+            sink.csv = Some((csv::Writer::from_writer(BufWriter::new(file)), path.clone()));
         }
-        w.flush().map_err(|source| Error::Io {
-            origin: origin.clone(),
-            source,
-        })
+        if let Some(path) = &outputs.mcap {
+            let writer = McapWriter::create(path).map_err(|e| Error::Log {
+                origin: format!("cannot write {}", path.display()),
+                source: Box::new(e),
+            });
+            let writer = match writer {
+                Ok(w) => w,
+                Err(e) => {
+                    sink.discard();
+                    return Err(e);
+                }
+            };
+            sink.created.push(path.clone());
+            sink.mcap = Some(McapStream::new(writer, path.clone(), path_points));
+        }
+        Ok(sink)
     }
 
-    /// Write the samples (pose, attitude, power terms, battery state) and the path through the
-    /// mission's waypoints as MCAP.
-    ///
-    /// # Errors
-    /// [`Error::Log`] naming the file when it cannot be written.
-    pub fn write_mcap(&self, path: &Path) -> Result<(), Error> {
-        let samples = mcap_samples(&self.report().samples);
-        let path_points = self.path_points();
-        aloft_logs::write_mission_mcap(path, &samples, &path_points).map_err(|e| Error::Log {
-            origin: format!("cannot write {}", path.display()),
+    /// Flush and close the files; the decimated samples for a chart and, when kept, all of them.
+    pub(crate) fn finish(mut self) -> Result<(Vec<Sample>, Vec<Sample>), Error> {
+        if let Some((mut w, path)) = self.csv.take() {
+            w.flush().map_err(|source| Error::Io {
+                origin: format!("cannot write {}", path.display()),
+                source,
+            })?;
+        }
+        if let Some(m) = self.mcap.take() {
+            m.finish()?;
+        }
+        let plot = self.plot.take().map(|d| d.samples).unwrap_or_default();
+        Ok((plot, self.all.take().unwrap_or_default()))
+    }
+
+    /// Remove the files created (after a failed run, so no half-written file looks valid).
+    pub(crate) fn discard(&mut self) {
+        self.csv = None;
+        self.mcap = None;
+        for p in self.created.drain(..) {
+            let _ = std::fs::remove_file(p);
+        }
+    }
+
+    /// The failure that stopped the run, when the sink was the cause.
+    pub(crate) fn take_failure(&mut self) -> Option<Error> {
+        self.failure.take()
+    }
+
+    fn fail(&mut self, e: Error) -> PlannerError {
+        let message = e.to_string();
+        self.failure = Some(e);
+        PlannerError::Output { message }
+    }
+}
+
+impl SampleSink for OutputSink {
+    fn take(&mut self, s: &Sample) -> Result<(), PlannerError> {
+        if let Some((w, path)) = &mut self.csv {
+            if let Err(e) = w.serialize(s) {
+                let e = Error::Csv {
+                    origin: path.display().to_string(),
+                    row: 0,
+                    message: e.to_string(),
+                };
+                return Err(self.fail(e));
+            }
+        }
+        if let Some(m) = &mut self.mcap {
+            if let Err(e) = m.write(s) {
+                return Err(self.fail(e));
+            }
+        }
+        if let Some(d) = &mut self.plot {
+            d.push(s);
+        }
+        if let Some(all) = &mut self.all {
+            all.push(*s);
+        }
+        Ok(())
+    }
+}
+
+/// A mission's MCAP as it is flown: the planned path at the first sample's time, then every
+/// sample with the energy used to the end of its step.
+struct McapStream {
+    writer: McapWriter<BufWriter<File>>,
+    path: PathBuf,
+    path_points: Vec<PathPoint>,
+    index: usize,
+    energy_wh: f64,
+    last_t: f64,
+}
+
+impl McapStream {
+    fn new(
+        writer: McapWriter<BufWriter<File>>,
+        path: PathBuf,
+        path_points: Vec<PathPoint>,
+    ) -> Self {
+        Self {
+            writer,
+            path,
+            path_points,
+            index: 0,
+            energy_wh: 0.0,
+            last_t: 0.0,
+        }
+    }
+
+    fn error(&self, e: aloft_logs::LogError) -> Error {
+        Error::Log {
+            origin: format!("cannot write {}", self.path.display()),
+            source: Box::new(e),
+        }
+    }
+
+    fn write(&mut self, s: &Sample) -> Result<(), Error> {
+        if self.index == 0 && !self.path_points.is_empty() {
+            let points = std::mem::take(&mut self.path_points);
+            self.writer
+                .write_path(s.time_s, &points)
+                .map_err(|e| self.error(e))?;
+        }
+        // Energy to the end of this step (samples are step midpoints; the step is twice the
+        // distance to the previous step's end).
+        let end_t = s.time_s + (s.time_s - self.last_t);
+        self.energy_wh += s.power_w * (end_t - self.last_t) / 3600.0;
+        self.last_t = end_t;
+        let sample = mcap_sample(s, self.energy_wh);
+        self.writer
+            .write_mission_sample(self.index, &sample)
+            .map_err(|e| self.error(e))?;
+        self.index += 1;
+        Ok(())
+    }
+
+    fn finish(self) -> Result<(), Error> {
+        let path = self.path.display().to_string();
+        self.writer.finish().map_err(|e| Error::Log {
+            origin: format!("cannot write {path}"),
             source: Box::new(e),
         })?;
         Ok(())
     }
+}
 
-    /// The planned path: home, then the end of every piece that moves, and points along arcs.
-    fn path_points(&self) -> Vec<PathPoint> {
-        let mission = self.compiled();
-        let point = |pos_enu_m| PathPoint {
-            pos_enu_m,
-            yaw_rad: None,
-        };
-        let mut points = vec![point(mission.home_m())];
-        for p in mission.pieces() {
-            let end = p.end_m();
-            let last = points[points.len() - 1].pos_enu_m;
-            let is_arc = matches!(p.shape, Shape::Arc { .. });
-            if is_arc {
-                let d = p.duration_s();
-                for k in 1..=ARC_POINTS {
-                    points.push(point(p.at(d * k as f64 / ARC_POINTS as f64).pos_m));
-                }
-            } else if (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
-                points.push(point(end));
-            }
-        }
-        points
+/// One planner sample as the MCAP writer's.
+fn mcap_sample(s: &Sample, energy_used_wh: f64) -> MissionSample {
+    MissionSample {
+        time_s: s.time_s,
+        pos_enu_m: [s.east_m, s.north_m, s.up_m],
+        vel_enu_mps: [s.vel_east_mps, s.vel_north_mps, s.vel_up_mps],
+        attitude: Attitude {
+            roll_rad: s.roll_deg.to_radians(),
+            pitch_rad: s.pitch_deg.to_radians(),
+            yaw_rad: s.yaw_deg.to_radians(),
+        },
+        power: PowerTerms {
+            induced_w: s.induced_w.unwrap_or(0.0),
+            parasitic_w: s.parasitic_w.unwrap_or(0.0),
+            profile_w: s.profile_w.unwrap_or(0.0),
+            acceleration_w: s.acceleration_w.unwrap_or(0.0),
+            climb_w: s.climb_w.unwrap_or(0.0),
+            electrical_w: s.power_w,
+        },
+        battery: Some(BatteryPoint {
+            voltage_v: s.voltage_v,
+            current_a: s.current_a,
+            state_of_charge: s.soc,
+            energy_used_wh,
+        }),
     }
 }
 
-/// The planner's samples as the MCAP writer's, with the energy used to the end of each step.
-fn mcap_samples(samples: &[Sample]) -> Vec<MissionSample> {
-    let mut energy_wh = 0.0;
-    let mut last_t = 0.0;
-    samples
-        .iter()
-        .map(|s| {
-            // Energy to the end of this step (samples are step midpoints; the step is twice the
-            // distance to the previous step's end).
-            let end_t = s.time_s + (s.time_s - last_t);
-            energy_wh += s.power_w * (end_t - last_t) / 3600.0;
-            last_t = end_t;
-            MissionSample {
-                time_s: s.time_s,
-                pos_enu_m: [s.east_m, s.north_m, s.up_m],
-                vel_enu_mps: [s.vel_east_mps, s.vel_north_mps, s.vel_up_mps],
-                attitude: Attitude {
-                    roll_rad: s.roll_deg.to_radians(),
-                    pitch_rad: s.pitch_deg.to_radians(),
-                    yaw_rad: s.yaw_deg.to_radians(),
-                },
-                power: PowerTerms {
-                    induced_w: s.induced_w.unwrap_or(0.0),
-                    parasitic_w: s.parasitic_w.unwrap_or(0.0),
-                    profile_w: s.profile_w.unwrap_or(0.0),
-                    acceleration_w: s.acceleration_w.unwrap_or(0.0),
-                    climb_w: s.climb_w.unwrap_or(0.0),
-                    electrical_w: s.power_w,
-                },
-                battery: Some(BatteryPoint {
-                    voltage_v: s.voltage_v,
-                    current_a: s.current_a,
-                    state_of_charge: s.soc,
-                    energy_used_wh: energy_wh,
-                }),
+/// Every `stride`-th sample, the stride doubling (and every other kept sample dropped) whenever
+/// [`PLOT_SAMPLES`] are held: bounded memory, evenly spaced samples, all of them for a short flight.
+#[derive(Default)]
+struct Decimator {
+    samples: Vec<Sample>,
+    stride: usize,
+    seen: usize,
+}
+
+impl Decimator {
+    fn push(&mut self, s: &Sample) {
+        let stride = self.stride.max(1);
+        if self.seen % stride == 0 {
+            if self.samples.len() == PLOT_SAMPLES {
+                let mut k = 0;
+                self.samples.retain(|_| {
+                    k += 1;
+                    k % 2 == 1
+                });
+                self.stride = stride * 2;
             }
-        })
-        .collect()
+            if self.seen % self.stride.max(1) == 0 {
+                self.samples.push(*s);
+            }
+        }
+        self.seen += 1;
+    }
+}
+
+/// The planned path of a compiled mission: home, then the end of every piece that moves, and
+/// points along arcs.
+pub(crate) fn path_points(mission: &aloft_planner::Mission) -> Vec<PathPoint> {
+    let point = |pos_enu_m| PathPoint {
+        pos_enu_m,
+        yaw_rad: None,
+    };
+    let mut points = vec![point(mission.home_m())];
+    for p in mission.pieces() {
+        let end = p.end_m();
+        let last = points[points.len() - 1].pos_enu_m;
+        if matches!(p.shape, Shape::Arc { .. }) {
+            let d = p.duration_s();
+            for k in 1..=ARC_POINTS {
+                points.push(point(p.at(d * k as f64 / ARC_POINTS as f64).pos_m));
+            }
+        } else if (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
+            points.push(point(end));
+        }
+    }
+    points
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(t: f64) -> Sample {
+        Sample {
+            time_s: t,
+            segment: 1,
+            east_m: 0.0,
+            north_m: 0.0,
+            up_m: 0.0,
+            vel_east_mps: 0.0,
+            vel_north_mps: 0.0,
+            vel_up_mps: 0.0,
+            acc_east_mps2: 0.0,
+            acc_north_mps2: 0.0,
+            acc_up_mps2: 0.0,
+            wind_east_mps: 0.0,
+            wind_north_mps: 0.0,
+            airspeed_mps: 0.0,
+            thrust_n: 0.0,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            yaw_deg: 0.0,
+            power_w: 0.0,
+            current_a: 0.0,
+            voltage_v: 0.0,
+            soc: 1.0,
+            induced_w: None,
+            parasitic_w: None,
+            profile_w: None,
+            acceleration_w: None,
+            climb_w: None,
+        }
+    }
+
+    #[test]
+    fn the_decimator_keeps_short_flights_whole_and_long_ones_bounded_and_even() {
+        let mut d = Decimator::default();
+        for k in 0..PLOT_SAMPLES {
+            d.push(&sample(k as f64));
+        }
+        assert_eq!(d.samples.len(), PLOT_SAMPLES);
+        let mut d = Decimator::default();
+        let n = 1_000_003;
+        for k in 0..n {
+            d.push(&sample(k as f64));
+        }
+        assert!(d.samples.len() <= PLOT_SAMPLES && d.samples.len() >= PLOT_SAMPLES / 2);
+        // Evenly spaced: every kept sample is a multiple of the final stride apart.
+        let step = d.samples[1].time_s - d.samples[0].time_s;
+        assert!(step >= 2.0);
+        for w in d.samples.windows(2) {
+            assert!((w[1].time_s - w[0].time_s - step).abs() < 1e-9);
+        }
+        // And they reach the end of the flight within one stride.
+        assert!(n as f64 - 1.0 - d.samples.last().unwrap().time_s < step);
+    }
 }

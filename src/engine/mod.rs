@@ -67,9 +67,10 @@ pub use logs::{
     LogReadOptions, LogTime, LogTopic, TopicCount,
 };
 pub use mission::{
-    plan_mission, plan_mission_in, Mission, MissionOptions, PackDescription, Plan, PlanContext,
-    Remaining, DEMO_MISSION, DEMO_ORIGIN,
+    plan_mission, plan_mission_in, plan_mission_with, Mission, MissionOptions, PackDescription,
+    Plan, PlanContext, Remaining, DEMO_MISSION, DEMO_ORIGIN,
 };
+pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
 pub use power::{
     power_csv_file, power_model, power_point, PowerAnswer, PowerContext, PowerGradientDeg,
     PowerQuery,

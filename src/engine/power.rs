@@ -11,6 +11,7 @@ use serde::Serialize;
 use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown, PowerModel};
 use aloft_power::{Term, Terms};
 
+use super::files::open_input_file;
 use super::power_batch::power_csv;
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -178,10 +179,7 @@ pub fn power_csv_file(
     output: Option<&Path>,
 ) -> Result<u64, Error> {
     let model = power_model(vehicle, without, profile_cutoff_mps)?;
-    let file = File::open(input).map_err(|source| Error::Io {
-        origin: format!("cannot open {}", input.display()),
-        source,
-    })?;
+    let file = open_input_file(input, "CSV of states")?;
     let reader = BufReader::with_capacity(1 << 16, file);
     let origin = input.display().to_string();
     match output {

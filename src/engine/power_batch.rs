@@ -11,6 +11,7 @@ use std::io::{Read, Write};
 
 use aloft_power::{AoaInput, FlightState, PowerBreakdown, PowerModel};
 
+use super::files::check_csv_header;
 use crate::error::Error;
 
 /// The result columns, in order (the same keys as `aloft power --format json`).
@@ -76,6 +77,7 @@ pub fn power_csv<R: Read, W: Write>(
         .headers()
         .map_err(|e| csv_error(origin, 0, e))?
         .clone();
+    check_csv_header(&headers, origin)?;
     let columns = Columns::find(&headers, origin)?;
     let mut writer = csv::Writer::from_writer(output);
     let mut header: Vec<&str> = headers.iter().collect();

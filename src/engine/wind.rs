@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::{Gusts, Wind, WindGrid, WindProfileKind, WindSpec};
 
+use super::files::{check_csv_header, read_text_file};
 use super::mission::{Mission, MissionOptions};
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -143,14 +144,12 @@ fn read_wind_grid(path: &Path) -> Result<WindGrid, Error> {
         row,
         message: e.to_string(),
     };
-    let file = std::fs::File::open(path).map_err(|source| Error::Io {
-        origin: format!("cannot open wind field {origin}"),
-        source,
-    })?;
+    let text = read_text_file(path, "wind field")?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(std::io::BufReader::new(file));
+        .from_reader(text.as_bytes());
     let headers = reader.headers().map_err(|e| csv_error(0, e))?.clone();
+    check_csv_header(&headers, &origin)?;
     let mut cols = [0usize; 6];
     for (c, name) in cols.iter_mut().zip(GRID_COLUMNS) {
         *c = headers

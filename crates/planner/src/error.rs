@@ -138,6 +138,24 @@ pub enum PlannerError {
         /// What is expected.
         expected: &'static str,
     },
+    /// A flight that would take more steps than the limit (a tiny time step, a huge hold).
+    #[error("the flight takes more than {limit} samples at a time step of {time_step_s} s (stopped at t = {flown_s:.0} s of flight): raise the time step (--time-step) to at least {suggested_time_step_s:.3e} s")]
+    TooManySamples {
+        /// The limit on samples (steps).
+        limit: u64,
+        /// The time step asked for, s.
+        time_step_s: f64,
+        /// Mission time reached when the limit was hit, s.
+        flown_s: f64,
+        /// A time step at which the whole mission fits the limit, s.
+        suggested_time_step_s: f64,
+    },
+    /// A sample sink failed (a file that cannot be written).
+    #[error("{message}")]
+    Output {
+        /// What failed.
+        message: String,
+    },
     /// A battery description without a key the mission planner needs.
     #[error("battery '{name}': {key} is missing, and the mission planner needs it")]
     MissingBatteryKey {

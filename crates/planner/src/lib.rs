@@ -142,7 +142,8 @@ pub use mission::{
 };
 pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{
-    plan, MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
+    plan, plan_into, MissionReport, NoSamples, PlanOptions, PointOfNoReturn, Sample, SampleSink,
+    SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
 };
 pub use queries::{
     best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,

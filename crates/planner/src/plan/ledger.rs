@@ -51,7 +51,6 @@ pub(super) struct Ledger<'p> {
     peak_w: f64,
     peak_a: f64,
     shortfall: Option<Shortfall>,
-    samples: Vec<Sample>,
     /// Pack resistance, ohm (for the heat).
     r_pack: f64,
     start_soc: f64,
@@ -61,21 +60,15 @@ pub(super) struct Ledger<'p> {
 
 impl<'p> Ledger<'p> {
     /// An empty ledger for `mission` from `options.start_soc`, with a pack of resistance `r_pack`
-    /// that is empty at `empty_soc` and must keep `required_soc` above it; room for the samples
-    /// at time step `dt` when they are recorded.
+    /// that is empty at `empty_soc` and must keep `required_soc` above it.
     pub(super) fn new(
         mission: &'p Mission,
         options: &PlanOptions,
-        dt: f64,
         r_pack: f64,
         empty_soc: f64,
         required_soc: f64,
     ) -> Self {
         let kinds = mission.segment_kinds();
-        let mut samples = Vec::new();
-        if options.record_samples {
-            samples.reserve((mission.duration_s() / dt) as usize + mission.pieces().len());
-        }
         Ledger {
             kinds,
             segments: vec![SegmentTotals::default(); kinds.len()],
@@ -86,7 +79,6 @@ impl<'p> Ledger<'p> {
             peak_w: 0.0,
             peak_a: 0.0,
             shortfall: None,
-            samples,
             r_pack,
             start_soc: options.start_soc,
             empty_soc,
@@ -121,21 +113,20 @@ impl<'p> Ledger<'p> {
         self.min_v = self.min_v.min(step.terminal_v);
     }
 
-    /// Record sample `j` of `block` (pass A's values, the pack's `step`) at mission time `t` in
-    /// segment `segment` (from 0), with the four terms of the power model when it has them.
-    pub(super) fn record(
-        &mut self,
+    /// Sample `j` of `block` (pass A's values, the pack's `step`) at mission time `t` in segment
+    /// `segment` (from 0), with the four terms of the power model when it has them.
+    pub(super) fn sample(
         pw: &Powered<'_>,
         block: &BlockA,
         j: usize,
         t: f64,
         segment: usize,
         step: &PackStep,
-    ) -> Result<(), PlannerError> {
+    ) -> Result<Sample, PlannerError> {
         let (kin, w, trim) = (block.kins[j], block.winds[j], block.trims[j]);
         let (roll, pitch, yaw) = attitude_rad(trim.axis, kin.forward);
         let terms = pw.power_terms(block.accs[j], block.v_airs[j], block.fwds[j], block.ges[j])?;
-        self.samples.push(Sample {
+        Ok(Sample {
             time_s: t,
             segment: segment + 1,
             east_m: kin.pos_m[0],
@@ -163,8 +154,7 @@ impl<'p> Ledger<'p> {
             profile_w: terms.map(|b| b.profile_w),
             acceleration_w: terms.map(|b| b.acceleration_w),
             climb_w: terms.map(|b| b.climb_w),
-        });
-        Ok(())
+        })
     }
 
     /// The piece flown to its end, leaving the pack at `soc`.
@@ -254,7 +244,7 @@ impl<'p> Ledger<'p> {
             required_reserve_soc: required,
             point_of_no_return,
             segments,
-            samples: self.samples,
+            samples: Vec::new(),
         }
     }
 

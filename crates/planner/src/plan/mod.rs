@@ -97,17 +97,22 @@ use report::CheckedOptions;
 use return_check::ReturnCheck;
 use sampler::{piece_steps, BlockA, PassA};
 
-pub use report::{MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall};
+pub use report::{
+    MissionReport, NoSamples, PlanOptions, PointOfNoReturn, Sample, SampleSink, SegmentReport,
+    Shortfall, DEFAULT_MAX_SAMPLES,
+};
 
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
 /// large enough that the loop overhead of a pass is negligible.
 const BLOCK: usize = 64;
 
-/// Fly `mission` with `aircraft` and `battery` in `wind`.
+/// Fly `mission` with `aircraft` and `battery` in `wind`; the report holds every sample when
+/// [`PlanOptions::record_samples`] asks for them.
 ///
 /// # Errors
 /// Invalid options, a thrust or tilt beyond the airframe's limit, a wind grid that does not cover
-/// the route, a flight condition the power model rejects.
+/// the route, a flight condition the power model rejects, a flight longer than
+/// [`PlanOptions::max_samples`] steps.
 pub fn plan(
     aircraft: &Aircraft,
     battery: &Pack,
@@ -126,6 +131,23 @@ pub fn plan(
     )
 }
 
+/// [`plan`] with every sample handed to `sink` as it is flown (memory does not grow with the
+/// flight); the report's `samples` stay empty.
+///
+/// # Errors
+/// As [`plan`], and what the sink returns.
+pub fn plan_into(
+    aircraft: &Aircraft,
+    battery: &Pack,
+    mission: &Mission,
+    wind: &Wind,
+    options: &PlanOptions,
+    sink: &mut dyn SampleSink,
+) -> Result<MissionReport, PlannerError> {
+    let threads = (true, options.second_thread);
+    fly(aircraft, battery, mission, wind, options, threads, sink)
+}
+
 /// [`plan`], with the hoisting of steady stretches switchable (off: every sample takes the full
 /// path; the tests prove both give the same report) and the second thread allowed or not.
 pub(crate) fn plan_with(
@@ -136,6 +158,44 @@ pub(crate) fn plan_with(
     options: &PlanOptions,
     hoist: bool,
     parallel: bool,
+) -> Result<MissionReport, PlannerError> {
+    if !options.record_samples {
+        let threads = (hoist, parallel);
+        return fly(
+            aircraft,
+            battery,
+            mission,
+            wind,
+            options,
+            threads,
+            &mut NoSamples,
+        );
+    }
+    let mut samples = Vec::new();
+    let threads = (hoist, parallel);
+    let mut report = fly(
+        aircraft,
+        battery,
+        mission,
+        wind,
+        options,
+        threads,
+        &mut samples,
+    )?;
+    report.samples = samples;
+    Ok(report)
+}
+
+/// The steps of a flight: check the options, the vehicle per mass phase, pass A (the sampler),
+/// pass B (the pack pass), fed in line or from a second thread, and the report.
+fn fly(
+    aircraft: &Aircraft,
+    battery: &Pack,
+    mission: &Mission,
+    wind: &Wind,
+    options: &PlanOptions,
+    (hoist, parallel): (bool, bool),
+    sink: &mut dyn SampleSink,
 ) -> Result<MissionReport, PlannerError> {
     let checked = options.check(battery, aircraft.airframe())?;
     let powered = powered_by_mass_phase(aircraft, battery, mission, options)?;
@@ -154,7 +214,7 @@ pub(crate) fn plan_with(
     // after pass B has flown the samples before it, so a battery that fails first is still
     // reported as the result.
     let threaded = feed::second_thread(parallel, pass_a.total_steps());
-    feed::run(pass_a, threaded, |blocks| pass_b.fly(blocks))?;
+    feed::run(pass_a, threaded, |blocks| pass_b.fly(blocks, sink))?;
     Ok(pass_b.report())
 }
 
@@ -180,7 +240,9 @@ struct PackPass<'p, 'a> {
     powered: &'p [Powered<'a>],
     battery: &'p Pack,
     dt: f64,
-    record_samples: bool,
+    /// Steps flown so far, and the most allowed.
+    steps_flown: u64,
+    max_steps: u64,
     /// Pack capacity, A s.
     charge_as: f64,
     max_current_a: f64,
@@ -222,14 +284,15 @@ impl<'p, 'a> PackPass<'p, 'a> {
             powered,
             battery,
             dt,
-            record_samples: options.record_samples,
+            steps_flown: 0,
+            max_steps: options.max_samples,
             charge_as: battery.capacity_ah() * 3600.0,
             max_current_a: battery.max_current_a(),
             cutoff_v: battery.cutoff_v(),
             empty_soc: empty,
             cursor: battery.cursor(options.start_soc),
             steps: [PackStep::default(); BLOCK],
-            ledger: Ledger::new(mission, options, dt, r_pack, empty, required),
+            ledger: Ledger::new(mission, options, r_pack, empty, required),
             way_home: ReturnCheck::new(
                 battery,
                 wind,
@@ -242,10 +305,14 @@ impl<'p, 'a> PackPass<'p, 'a> {
     }
 
     /// Fly the mission's pieces in order on the blocks of `feed`, until the end or the pack fails.
-    fn fly(&mut self, feed: &mut feed::Feed<'_, '_>) -> Result<(), PlannerError> {
+    fn fly(
+        &mut self,
+        feed: &mut feed::Feed<'_, '_>,
+        sink: &mut dyn SampleSink,
+    ) -> Result<(), PlannerError> {
         let mut t0 = 0.0;
         for piece in self.mission.pieces() {
-            if self.fly_piece(feed, piece, t0)?.is_break() {
+            if self.fly_piece(feed, piece, t0, sink)?.is_break() {
                 break;
             }
             t0 += piece.duration_s();
@@ -260,6 +327,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
         feed: &mut feed::Feed<'_, '_>,
         piece: &'p Piece,
         t0: f64,
+        sink: &mut dyn SampleSink,
     ) -> Result<ControlFlow<()>, PlannerError> {
         let (n, h) = piece_steps(piece, self.dt);
         let mut run = PieceRun {
@@ -277,7 +345,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
             let block = feed.next();
             debug_assert_eq!(block.k0, run.k0);
             let pending = block.pending.take();
-            if self.fly_block(block, &mut run)?.is_break() {
+            if self.fly_block(block, &mut run, sink)?.is_break() {
                 return Ok(ControlFlow::Break(()));
             }
             if let Some(e) = pending {
@@ -296,7 +364,10 @@ impl<'p, 'a> PackPass<'p, 'a> {
         &mut self,
         block: &BlockA,
         run: &mut PieceRun<'_, '_>,
+        sink: &mut dyn SampleSink,
     ) -> Result<ControlFlow<()>, PlannerError> {
+        self.count_steps(block.valid, run.t0 + run.k0 as f64 * run.h)?;
+        let record = sink.wants_samples();
         let seg = run.piece.segment;
         let soc_at_block = self.cursor.soc();
         let drawn = self.draw_block(block, run.dq);
@@ -324,8 +395,8 @@ impl<'p, 'a> PackPass<'p, 'a> {
                 return Ok(ControlFlow::Break(()));
             };
             self.ledger.book(&mut tally, p, run.h, &draw);
-            if self.record_samples {
-                self.ledger.record(run.pw, block, j, t, seg, &draw)?;
+            if record {
+                sink.take(&Ledger::sample(run.pw, block, j, t, seg, &draw)?)?;
             }
             if let Some(why) = self.pack_failure(&draw, t, seg, pos) {
                 let end_s = tm + 0.5 * run.h;
@@ -345,6 +416,22 @@ impl<'p, 'a> PackPass<'p, 'a> {
         }
         run.tally = tally;
         Ok(ControlFlow::Continue(()))
+    }
+
+    /// Count `steps` more steps from mission time `t_s`; more than [`PlanOptions::max_samples`]
+    /// in all is an error that says the time step to use instead.
+    fn count_steps(&mut self, steps: usize, t_s: f64) -> Result<(), PlannerError> {
+        self.steps_flown += steps as u64;
+        if self.steps_flown <= self.max_steps {
+            return Ok(());
+        }
+        let duration_s = self.mission.duration_s();
+        Err(PlannerError::TooManySamples {
+            limit: self.max_steps,
+            time_step_s: self.dt,
+            flown_s: t_s,
+            suggested_time_step_s: duration_s / self.max_steps as f64,
+        })
     }
 
     /// Draw the power of `block`'s steps from the pack, `dq` of the capacity per ampere and step,

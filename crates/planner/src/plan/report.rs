@@ -21,7 +21,8 @@ pub struct PlanOptions {
     pub reserve_fraction: f64,
     /// State of charge at take-off (default 1).
     pub start_soc: f64,
-    /// Keep every sample for a time series (default false: the hot loop stores nothing).
+    /// Keep every sample in the report (default false: the hot loop stores nothing). To stream
+    /// the samples instead, fly with [`super::plan_into`] and a [`SampleSink`].
     pub record_samples: bool,
     /// Compute the point of no return (default true).
     pub point_of_no_return: bool,
@@ -33,6 +34,50 @@ pub struct PlanOptions {
     /// trim and power on a second thread ahead of the pack (default true). The report is the same
     /// bit for bit either way.
     pub second_thread: bool,
+    /// Most steps a flight may take (default [`DEFAULT_MAX_SAMPLES`]): a flight that would take
+    /// more stops with [`PlannerError::TooManySamples`], which says the time step to use instead.
+    /// The limit bounds the time of a run whatever its inputs (a tiny time step, a huge hold).
+    pub max_samples: u64,
+}
+
+/// The default limit on the steps of one flight: ten million, 11.6 days of flight at the default
+/// 0.1 s step, a 24-hour flight at 10 ms; about half a second of planning (several seconds when
+/// every sample is written out).
+pub const DEFAULT_MAX_SAMPLES: u64 = 10_000_000;
+
+/// Where the samples of a flight go as they are flown, one at a time, so that memory does not grow
+/// with the flight (a file writer, a decimating plot buffer), or all of them (`Vec<Sample>`).
+pub trait SampleSink {
+    /// Whether the sink takes samples at all (the flight then does not compute them).
+    fn wants_samples(&self) -> bool {
+        true
+    }
+    /// Take the next sample, in time order; an error stops the flight and is returned.
+    ///
+    /// # Errors
+    /// Whatever the sink cannot do (a file that cannot be written), as
+    /// [`PlannerError::Output`].
+    fn take(&mut self, sample: &Sample) -> Result<(), PlannerError>;
+}
+
+impl SampleSink for Vec<Sample> {
+    fn take(&mut self, sample: &Sample) -> Result<(), PlannerError> {
+        self.push(*sample);
+        Ok(())
+    }
+}
+
+/// A sink that takes no samples.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoSamples;
+
+impl SampleSink for NoSamples {
+    fn wants_samples(&self) -> bool {
+        false
+    }
+    fn take(&mut self, _sample: &Sample) -> Result<(), PlannerError> {
+        Ok(())
+    }
 }
 
 impl Default for PlanOptions {
@@ -48,6 +93,7 @@ impl Default for PlanOptions {
             pnr_interval_s: 1.0,
             return_descent_rate_mps: None,
             second_thread: true,
+            max_samples: DEFAULT_MAX_SAMPLES,
         }
     }
 }
