@@ -54,7 +54,7 @@ pub struct SteadyWindArgs {
     #[arg(value_parser = finite(), long, value_name = "M/S", requires = "wind_from")]
     pub wind_speed: Option<f64>,
     /// Direction the wind blows FROM, degrees clockwise from north (270 = a westerly).
-    #[arg(value_parser = finite(), 
+    #[arg(value_parser = finite(),
         long,
         value_name = "DEG",
         allow_negative_numbers = true,

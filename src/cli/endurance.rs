@@ -30,7 +30,7 @@ pub struct EnduranceArgs {
     #[command(flatten)]
     wind: SteadyWindArgs,
     /// Course of the range query, degrees clockwise from north.
-    #[arg(value_parser = super::args::finite(), 
+    #[arg(value_parser = super::args::finite(),
         long,
         default_value_t = 0.0,
         value_name = "DEG",

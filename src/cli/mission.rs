@@ -77,7 +77,7 @@ pub struct MissionArgs {
     pub profile: Option<String>,
     /// Lag of the logged power behind the motion for --replay, s (default: estimated by
     /// cross-correlating power with tilt). Only the measured side is shifted.
-    #[arg(value_parser = super::args::finite(), 
+    #[arg(value_parser = super::args::finite(),
         long,
         requires = "replay",
         allow_negative_numbers = true,

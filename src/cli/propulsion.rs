@@ -18,7 +18,7 @@ pub struct PropulsionArgs {
     #[arg(long, default_value = "aec-quadrotor")]
     vehicle: String,
     /// Payload in kg, added to the vehicle's empty mass.
-    #[arg(value_parser = super::args::finite(), 
+    #[arg(value_parser = super::args::finite(),
         long,
         default_value_t = 0.0,
         allow_negative_numbers = true,
