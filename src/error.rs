@@ -38,6 +38,19 @@ pub enum Error {
         /// The header that was found, comma-separated.
         found: String,
     },
+    /// An answer that would carry a number that is not finite (an overflow the input checks did
+    /// not foresee): refused rather than printed as `null` or `inf`.
+    #[error("{answer}: {field} would be {value}, not a finite number, for {request}")]
+    NonFinite {
+        /// Which answer.
+        answer: &'static str,
+        /// The field, as a path (`segments.3.energy_wh`).
+        field: String,
+        /// The value.
+        value: f64,
+        /// The inputs that led to it.
+        request: String,
+    },
     /// A CSV header that names a column twice.
     #[error("{origin}: the column '{column}' appears twice in the header")]
     DuplicateColumn {

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use aloft_planner::{EnduranceQuery, EnduranceReport, Pack, Powered, SweepRow, Wind, WindSpec};
 use aloft_power::AoaModel;
 
+use super::finite::finite;
 use super::vehicles::Vehicle;
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
@@ -137,17 +138,21 @@ pub struct CurveContext {
 pub fn endurance(vehicle: &Vehicle, options: &EnduranceOptions) -> Result<EnduranceSummary, Error> {
     let setup = Setup::new(vehicle, options)?;
     let report = aloft_planner::endurance(&setup.powered, &setup.battery, &setup.query)?;
-    Ok(EnduranceSummary {
-        vehicle: vehicle.name().to_string(),
-        battery: setup.battery.name().to_string(),
-        takeoff_mass_kg: setup.mass_kg,
-        report,
-        context: EnduranceContext {
-            battery_energy_wh: setup.battery.rated_energy_wh(),
-            wind: setup.wind_text,
-            notes: vehicle.notes(),
+    finite(
+        EnduranceSummary {
+            vehicle: vehicle.name().to_string(),
+            battery: setup.battery.name().to_string(),
+            takeoff_mass_kg: setup.mass_kg,
+            report,
+            context: EnduranceContext {
+                battery_energy_wh: setup.battery.rated_energy_wh(),
+                wind: setup.wind_text,
+                notes: vehicle.notes(),
+            },
         },
-    })
+        "endurance",
+        || format!("vehicle {} with {:?}", vehicle.name(), options),
+    )
 }
 
 /// Power, endurance and range against airspeed in steps of `step_mps` up to the vehicle's
@@ -164,15 +169,25 @@ pub fn power_curve(
     let vmax = vehicle.aircraft()?.airframe().max_speed_mps();
     let rows =
         aloft_planner::sweep_speed(&setup.powered, &setup.battery, &setup.query, vmax, step_mps)?;
-    Ok(PowerCurve {
-        rows,
-        context: CurveContext {
-            vehicle: vehicle.name().to_string(),
-            battery: setup.battery.name().to_string(),
-            takeoff_mass_kg: setup.mass_kg,
-            wind: setup.wind_text,
+    finite(
+        PowerCurve {
+            rows,
+            context: CurveContext {
+                vehicle: vehicle.name().to_string(),
+                battery: setup.battery.name().to_string(),
+                takeoff_mass_kg: setup.mass_kg,
+                wind: setup.wind_text,
+            },
         },
-    })
+        "power curve",
+        || {
+            format!(
+                "vehicle {} with {:?}, step {step_mps} m/s",
+                vehicle.name(),
+                options
+            )
+        },
+    )
 }
 
 /// The vehicle at its take-off mass, its pack and the query of one set of options.

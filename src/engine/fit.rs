@@ -11,6 +11,7 @@ use aloft_power::fit::{DragFit, FitParameter, ForceSample, PowerFit};
 use aloft_power::{fit_drag, fit_power_model, FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
+use super::finite::finite;
 use super::logs::FlightLogs;
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -152,18 +153,22 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             source,
         })?;
     }
-    Ok(FitAnswer {
-        logs,
-        power,
-        drag,
-        output: request
-            .output
-            .as_ref()
-            .map(|p| p.display().to_string())
-            .unwrap_or_default(),
-        vehicle_toml,
-        notes,
-    })
+    finite(
+        FitAnswer {
+            logs,
+            power,
+            drag,
+            output: request
+                .output
+                .as_ref()
+                .map(|p| p.display().to_string())
+                .unwrap_or_default(),
+            vehicle_toml,
+            notes,
+        },
+        "fit",
+        || format!("logs {:?}", request.logs.logs),
+    )
 }
 
 /// Pack resistance of one log, when it has voltage and current.

@@ -12,6 +12,7 @@ use aloft_logs::{
 };
 use aloft_power::AoaModel;
 
+use super::finite::finite;
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions, AlignedFlight};
 
@@ -223,37 +224,41 @@ pub fn log_info(
         None => None,
         Some(max) => Some(lag_of(&file, &series, time.nominal_period_s, max)?),
     };
-    Ok(LogInfo {
-        format: reader.format(),
-        profile: match reader.format() {
-            LogFormat::Mcap => None,
-            LogFormat::Px4Csv => Some("px4".into()),
-            LogFormat::Csv => Some(profile.map_or("kaist".into(), |p| p.name())),
+    finite(
+        LogInfo {
+            format: reader.format(),
+            profile: match reader.format() {
+                LogFormat::Mcap => None,
+                LogFormat::Px4Csv => Some("px4".into()),
+                LogFormat::Csv => Some(profile.map_or("kaist".into(), |p| p.name())),
+            },
+            samples: stats.samples,
+            duration_s: stats.duration_s,
+            start_time_s: reader.start_time_s(),
+            channels: stats
+                .channels
+                .iter()
+                .map(|c| LogChannel {
+                    channel: c.channel,
+                    samples: c.samples,
+                    rate_hz: c.rate_hz(),
+                })
+                .collect(),
+            columns: reader.columns().map(|c| c.to_vec()),
+            topics: reader.topics().map(|t| t.iter().map(topic).collect()),
+            power_available: stats.energy_wh.is_some() || stats.mean_power_w.is_some(),
+            energy_wh: stats.energy_wh,
+            mean_power_w: stats.mean_power_w,
+            max_power_w: stats.max_power_w,
+            time: LogTime::from(&time),
+            dropped_values,
+            dropped,
+            lag,
+            file,
         },
-        samples: stats.samples,
-        duration_s: stats.duration_s,
-        start_time_s: reader.start_time_s(),
-        channels: stats
-            .channels
-            .iter()
-            .map(|c| LogChannel {
-                channel: c.channel,
-                samples: c.samples,
-                rate_hz: c.rate_hz(),
-            })
-            .collect(),
-        columns: reader.columns().map(|c| c.to_vec()),
-        topics: reader.topics().map(|t| t.iter().map(topic).collect()),
-        power_available: stats.energy_wh.is_some() || stats.mean_power_w.is_some(),
-        energy_wh: stats.energy_wh,
-        mean_power_w: stats.mean_power_w,
-        max_power_w: stats.max_power_w,
-        time: LogTime::from(&time),
-        dropped_values,
-        dropped,
-        lag,
-        file,
-    })
+        "log info",
+        || path.display().to_string(),
+    )
 }
 
 fn topic(t: &aloft_logs::TopicInfo) -> LogTopic {
@@ -381,20 +386,24 @@ pub fn convert_log(
     }
     let summary = w.finish()?;
     let time = reader.time_report();
-    Ok(ConvertSummary {
-        input: input.display().to_string(),
-        output: output.display().to_string(),
-        samples: n,
-        topics: summary
-            .messages
-            .iter()
-            .map(|(t, m)| TopicCount {
-                topic: t.clone(),
-                messages: *m,
-            })
-            .collect(),
-        time_notes: (!time.is_clean()).then_some((time.gap_count, time.non_monotonic_count)),
-    })
+    finite(
+        ConvertSummary {
+            input: input.display().to_string(),
+            output: output.display().to_string(),
+            samples: n,
+            topics: summary
+                .messages
+                .iter()
+                .map(|(t, m)| TopicCount {
+                    topic: t.clone(),
+                    messages: *m,
+                })
+                .collect(),
+            time_notes: (!time.is_clean()).then_some((time.gap_count, time.non_monotonic_count)),
+        },
+        "convert",
+        || input.display().to_string(),
+    )
 }
 
 /// The flight logs a fit or a validation reads, and how to align power with motion in them.

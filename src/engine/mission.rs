@@ -10,6 +10,7 @@ use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Wind,
 use aloft_power::AoaModel;
 
 use super::files::read_text_file;
+use super::finite::finite;
 use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use super::summary::{mission_summary, MissionSummary};
 use super::vehicles::Vehicle;
@@ -474,6 +475,9 @@ fn plan_in(
         battery.name(),
         payload,
     );
+    let summary = finite(summary, "mission", || {
+        format!("mission {} with {}", mission.origin, vehicle.name())
+    })?;
     let context = PlanContext {
         origin: mission.origin.clone(),
         description: mission.spec.description.clone(),

@@ -10,6 +10,7 @@ use aloft_logs::{Attitude, BatteryPoint, McapWriter, MissionSample, PathPoint, P
 use aloft_planner::trajectory::Shape;
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
+use super::finite::first_non_finite;
 use crate::error::Error;
 
 /// Points drawn per arc of the planned path, so the path shows the circle.
@@ -130,6 +131,15 @@ impl OutputSink {
 
 impl SampleSink for OutputSink {
     fn take(&mut self, s: &Sample) -> Result<(), PlannerError> {
+        if let Some((field, value)) = first_non_finite(s) {
+            let e = Error::NonFinite {
+                answer: "sample",
+                field,
+                value,
+                request: format!("the sample at t = {} s", s.time_s),
+            };
+            return Err(self.fail(e));
+        }
         if let Some((w, path)) = &mut self.csv {
             if let Err(e) = w.serialize(s) {
                 let e = Error::Csv {

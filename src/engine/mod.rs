@@ -42,6 +42,7 @@
 mod endurance;
 mod estimator;
 mod files;
+mod finite;
 mod fit;
 mod logs;
 mod mission;

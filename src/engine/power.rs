@@ -12,6 +12,7 @@ use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown,
 use aloft_power::{Term, Terms};
 
 use super::files::open_input_file;
+use super::finite::finite;
 use super::power_batch::power_csv;
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -130,22 +131,26 @@ pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer,
     } else {
         None
     };
-    Ok(PowerAnswer {
-        power,
-        electrical_gradient,
-        context: PowerContext {
-            vehicle: vehicle.name().to_string(),
-            efficiency: model.vehicle().efficiency(),
-            aoa: match aoa {
-                AoaInput::Paper => "paper eqs 3-4".to_string(),
-                AoaInput::Geometric { .. } => format!(
-                    "geometric, air from {:.1} deg off the nose",
-                    query.air_direction_deg.unwrap_or_default()
-                ),
+    finite(
+        PowerAnswer {
+            power,
+            electrical_gradient,
+            context: PowerContext {
+                vehicle: vehicle.name().to_string(),
+                efficiency: model.vehicle().efficiency(),
+                aoa: match aoa {
+                    AoaInput::Paper => "paper eqs 3-4".to_string(),
+                    AoaInput::Geometric { .. } => format!(
+                        "geometric, air from {:.1} deg off the nose",
+                        query.air_direction_deg.unwrap_or_default()
+                    ),
+                },
+                removed: query.without.iter().map(|t| t.name()).collect(),
             },
-            removed: query.without.iter().map(|t| t.name()).collect(),
         },
-    })
+        "power",
+        || format!("{query:?}"),
+    )
 }
 
 /// The angle of attack of a point query: the paper's unless a direction of the air-relative

@@ -12,6 +12,7 @@ use std::io::{Read, Write};
 use aloft_power::{AoaInput, FlightState, PowerBreakdown, PowerModel};
 
 use super::files::check_csv_header;
+use super::finite::first_non_finite;
 use crate::error::Error;
 
 /// The result columns, in order (the same keys as `aloft power --format json`).
@@ -102,6 +103,14 @@ pub fn power_csv<R: Read, W: Write>(
             row,
             source: e,
         })?;
+        if let Some((field, value)) = first_non_finite(&p) {
+            return Err(Error::NonFinite {
+                answer: "power",
+                field,
+                value,
+                request: format!("{origin}: row {row}"),
+            });
+        }
         write_row(&mut writer, &record, &p, &mut text).map_err(|e| csv_error(origin, row, e))?;
     }
     writer.flush().map_err(|e| Error::Io {

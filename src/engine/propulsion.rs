@@ -10,6 +10,7 @@ use aloft_propulsion::{
 };
 
 use super::files::read_text_file;
+use super::finite::finite;
 use super::vehicles::Vehicle;
 use crate::error::Error;
 
@@ -35,10 +36,11 @@ pub fn hover(vehicle: &Vehicle, request: HoverRequest) -> Result<HoverResult, Er
             format!("takeoff_mass_kg {kg}"),
         ),
     };
-    result.map_err(|source| Error::Hover {
-        request: what,
+    let hover = result.map_err(|source| Error::Hover {
+        request: what.clone(),
         source,
-    })
+    })?;
+    finite(hover, "hover", || what)
 }
 
 /// One point of a sweep over take-off mass: the hover, or why that mass cannot hover.
@@ -92,7 +94,9 @@ pub fn hover_sweep(
             },
         })
         .collect();
-    Ok(HoverSweep { points })
+    finite(HoverSweep { points }, "hover sweep", || {
+        format!("take-off mass {from_kg}..{to_kg} kg in steps of {step_kg} kg")
+    })
 }
 
 /// Built-in rotors: name and TOML text (identical to `fixtures/rotors/<name>.toml`).
@@ -160,7 +164,9 @@ pub fn rotor_response(request: &RotorRequest) -> Result<RotorAnswer, Error> {
     let base = request.rotor.as_deref().map(base_rotor).transpose()?;
     let spec = merged_spec(base.as_ref(), &request.overrides)?;
     let result = rotor_step_response(&spec).map_err(|source| Error::Rotor { source })?;
-    Ok(RotorAnswer { result, spec })
+    finite(RotorAnswer { result, spec }, "rotor", || {
+        format!("{request:?}")
+    })
 }
 
 /// A built-in rotor by name, else the rotor file at that path.

@@ -12,6 +12,7 @@ use aloft_logs::Log;
 use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint};
 use aloft_power::{AoaModel, ModelOptions};
 
+use super::finite::finite;
 use super::vehicles::Vehicle;
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
@@ -158,7 +159,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     };
     let error = measured_wh.map(|m| 100.0 * (predicted_wh - m) / m);
     let logged_wind = trajectory.points.iter().any(|p| p.wind_enu_mps.is_some());
-    Ok(ReplayAnswer {
+    let answer = ReplayAnswer {
         file: path,
         vehicle: vehicle.name().to_string(),
         mass_kg,
@@ -189,7 +190,8 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
             },
             notes,
         },
-    })
+    };
+    finite(answer, "replay", || request.log.display().to_string())
 }
 
 /// The aircraft at its replay mass: airframe + default pack + payload, or a `[power]`-only

@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use super::finite::finite;
 use super::logs::FlightLogs;
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -94,14 +95,15 @@ pub fn validate_logs(
         Vec::new()
     };
     let table_i = mean_table_i(&results);
-    Ok(ValidateAnswer {
-        report: ValidateReport {
-            vehicle: vehicle.name().to_string(),
-            flights: results,
-            table_i,
-        },
-        series,
-    })
+    let report = ValidateReport {
+        vehicle: vehicle.name().to_string(),
+        flights: results,
+        table_i,
+    };
+    let report = finite(report, "validate", || {
+        format!("logs {:?}", request.logs.logs)
+    })?;
+    Ok(ValidateAnswer { report, series })
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {

@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{positive, PlannerError};
+use aloft_power::four_term::MAX_AIRSPEED_MPS;
+
+use crate::error::{positive, within, PlannerError};
 
 /// The `[airframe]` table: mass without battery and payload, and the limits a mission must stay
 /// inside. Units are in the key names; unknown keys are rejected.
@@ -50,36 +52,86 @@ impl Airframe {
     /// Any value non-positive or non-finite, a tilt limit of 90 deg or more, a largest take-off
     /// mass below the airframe mass, a thrust limit below the weight at the largest take-off mass.
     pub fn new(spec: AirframeSpec) -> Result<Self, PlannerError> {
-        positive("airframe mass_kg", spec.mass_kg, "kg")?;
-        positive(
-            "airframe max_takeoff_mass_kg",
-            spec.max_takeoff_mass_kg,
-            "kg",
-        )?;
-        positive("airframe max_tilt_deg", spec.max_tilt_deg, "deg")?;
-        positive("airframe max_speed_mps", spec.max_speed_mps, "m/s")?;
-        positive(
-            "airframe max_climb_rate_mps",
-            spec.max_climb_rate_mps,
-            "m/s",
-        )?;
-        positive(
-            "airframe max_descent_rate_mps",
-            spec.max_descent_rate_mps,
-            "m/s",
-        )?;
-        positive(
-            "airframe acceleration_mps2",
-            spec.acceleration_mps2,
-            "m/s^2",
-        )?;
-        positive(
-            "airframe vertical_acceleration_mps2",
-            spec.vertical_acceleration_mps2,
-            "m/s^2",
-        )?;
-        positive("airframe yaw_rate_deg_s", spec.yaw_rate_deg_s, "deg/s")?;
-        positive("airframe rotor_height_m", spec.rotor_height_m, "m")?;
+        // Each value positive, finite and within a physical range (a value beyond it is a unit
+        // slip, not a multirotor; the speed limit is the power model's).
+        let checks: [(&'static str, f64, &'static str, f64, &'static str); 10] = [
+            (
+                "airframe mass_kg",
+                spec.mass_kg,
+                "kg",
+                1e4,
+                "at most 10000 kg",
+            ),
+            (
+                "airframe max_takeoff_mass_kg",
+                spec.max_takeoff_mass_kg,
+                "kg",
+                1e4,
+                "at most 10000 kg",
+            ),
+            (
+                "airframe max_tilt_deg",
+                spec.max_tilt_deg,
+                "deg",
+                90.0,
+                "below 90 deg",
+            ),
+            (
+                "airframe max_speed_mps",
+                spec.max_speed_mps,
+                "m/s",
+                MAX_AIRSPEED_MPS,
+                "at most 150 m/s",
+            ),
+            (
+                "airframe max_climb_rate_mps",
+                spec.max_climb_rate_mps,
+                "m/s",
+                100.0,
+                "at most 100 m/s",
+            ),
+            (
+                "airframe max_descent_rate_mps",
+                spec.max_descent_rate_mps,
+                "m/s",
+                100.0,
+                "at most 100 m/s",
+            ),
+            (
+                "airframe acceleration_mps2",
+                spec.acceleration_mps2,
+                "m/s^2",
+                100.0,
+                "at most 100 m/s^2",
+            ),
+            (
+                "airframe vertical_acceleration_mps2",
+                spec.vertical_acceleration_mps2,
+                "m/s^2",
+                100.0,
+                "at most 100 m/s^2",
+            ),
+            (
+                "airframe yaw_rate_deg_s",
+                spec.yaw_rate_deg_s,
+                "deg/s",
+                3600.0,
+                "at most 3600 deg/s",
+            ),
+            (
+                "airframe rotor_height_m",
+                spec.rotor_height_m,
+                "m",
+                100.0,
+                "at most 100 m",
+            ),
+        ];
+        for (name, value, unit, max, expected) in checks {
+            positive(name, value, unit)?;
+            if name != "airframe max_tilt_deg" {
+                within(name, value, (0.0, max), unit, expected)?;
+            }
+        }
         if spec.max_tilt_deg >= 90.0 {
             return Err(PlannerError::InvalidParameter {
                 name: "airframe max_tilt_deg",
@@ -98,6 +150,7 @@ impl Airframe {
         }
         if let Some(t) = spec.max_thrust_n {
             positive("airframe max_thrust_n", t, "N")?;
+            within("airframe max_thrust_n", t, (0.0, 1e7), "N", "at most 1e7 N")?;
         }
         Ok(Self {
             max_tilt_rad: spec.max_tilt_deg.to_radians(),

@@ -231,11 +231,13 @@ impl Pack {
                 key,
             })
         };
+        // Positive, finite and at most 1e7 in its unit (10,000 A h, 10 MW h): beyond that a value
+        // is a unit slip, not a pack.
         let pos = |key, v: f64, unit| {
-            if v.is_finite() && v > 0.0 {
+            if v.is_finite() && v > 0.0 && v <= 1e7 {
                 Ok(v)
             } else {
-                Err(bad(key, v, unit, "a positive finite number"))
+                Err(bad(key, v, unit, "a positive finite number up to 1e7"))
             }
         };
         if spec.cells_series == 0 {
@@ -255,12 +257,12 @@ impl Pack {
             ));
         }
         let r = need("internal_resistance_ohm", spec.internal_resistance_ohm)?;
-        if !(r.is_finite() && r >= 0.0) {
+        if !(r.is_finite() && (0.0..=1e3).contains(&r)) {
             return Err(bad(
                 "internal_resistance_ohm",
                 r,
                 "ohm",
-                "a finite resistance, not negative",
+                "a finite resistance from 0 to 1000 ohm",
             ));
         }
         let u = spec.usable_fraction;

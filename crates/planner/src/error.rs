@@ -138,6 +138,38 @@ pub enum PlannerError {
         /// What is expected.
         expected: &'static str,
     },
+    /// An orbit tighter than the vehicle can turn at that speed.
+    #[error("an orbit of radius {radius_m} m at {speed_mps} m/s needs more bank than the vehicle's {max_tilt_deg:.1} deg tilt limit: the radius must be at least {min_radius_m:.2} m at that speed")]
+    OrbitTooTight {
+        /// The radius asked for, m.
+        radius_m: f64,
+        /// The ground speed asked for, m/s.
+        speed_mps: f64,
+        /// The smallest radius at that speed, m.
+        min_radius_m: f64,
+        /// The vehicle's tilt limit, deg.
+        max_tilt_deg: f64,
+    },
+    /// A mission with more segments than the planner takes.
+    #[error("the mission has {segments} segments, more than the {limit} a mission may have: split it into several missions")]
+    TooManySegments {
+        /// Segments in the mission.
+        segments: usize,
+        /// The limit.
+        limit: usize,
+    },
+    /// A segment whose piece of trajectory would take longer than a flight can.
+    #[error("segment {index} ({kind}) would take {duration_s:e} s, more than the {max_s:e} s a segment may take: check its speed, rate and length")]
+    SegmentTooLong {
+        /// Segment number, from 1.
+        index: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Its duration, s.
+        duration_s: f64,
+        /// The limit, s.
+        max_s: f64,
+    },
     /// A flight that would take more steps than the limit (a tiny time step, a huge hold).
     #[error("the flight takes more than {limit} samples at a time step of {time_step_s} s (stopped at t = {flown_s:.0} s of flight): raise the time step (--time-step) to at least {suggested_time_step_s:.3e} s")]
     TooManySamples {
@@ -206,6 +238,26 @@ pub(crate) fn non_negative(
             value,
             unit,
             expected: "a finite number, not negative",
+        })
+    }
+}
+
+/// Check that `value` lies in `[min, max]` (a finite range), naming the range in the error.
+pub(crate) fn within(
+    name: &'static str,
+    value: f64,
+    (min, max): (f64, f64),
+    unit: &'static str,
+    expected: &'static str,
+) -> Result<f64, PlannerError> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(PlannerError::InvalidParameter {
+            name,
+            value,
+            unit,
+            expected,
         })
     }
 }

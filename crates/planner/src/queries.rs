@@ -234,8 +234,15 @@ pub fn stop_soc(battery: &Pack, reserve_fraction: f64) -> f64 {
 /// Mean electrical power on a circle of radius `radius_m` at ground speed `speed_mps` in the
 /// horizontal wind, W (72 points around the circle, centripetal acceleration included).
 ///
+/// The circle must be one the vehicle can turn: ground speed within its maximum, and the
+/// centripetal acceleration `v^2 / r` within what its tilt limit allows in still air,
+/// `g tan(tilt_max)` (the same limit a mission's orbit is held to), so the radius is at least
+/// `v^2 / (g tan(tilt_max))`.
+///
 /// # Errors
-/// A flight condition the model rejects.
+/// A radius or speed that is not positive and finite, a speed beyond the vehicle's maximum, a
+/// circle tighter than the tilt limit allows ([`PlannerError::OrbitTooTight`]), a flight
+/// condition the model rejects.
 pub fn orbit_power_w(
     p: &Powered<'_>,
     radius_m: f64,
@@ -244,8 +251,26 @@ pub fn orbit_power_w(
 ) -> Result<f64, PlannerError> {
     crate::error::positive("orbit radius_m", radius_m, "m")?;
     crate::error::positive("orbit ground_speed_mps", speed_mps, "m/s")?;
-    let n = 72;
+    let airframe = p.aircraft.airframe();
+    if speed_mps > airframe.max_speed_mps() {
+        return Err(PlannerError::InvalidParameter {
+            name: "orbit ground_speed_mps",
+            value: speed_mps,
+            unit: "m/s",
+            expected: "at most the vehicle's maximum speed",
+        });
+    }
     let ac = speed_mps * speed_mps / radius_m;
+    let max_ac = aloft_core::STANDARD_GRAVITY_MPS2 * airframe.max_tilt_rad().tan();
+    if ac > max_ac * (1.0 + 1e-9) {
+        return Err(PlannerError::OrbitTooTight {
+            radius_m,
+            speed_mps,
+            min_radius_m: speed_mps * speed_mps / max_ac,
+            max_tilt_deg: airframe.max_tilt_rad().to_degrees(),
+        });
+    }
+    let n = 72;
     let mut sum = 0.0;
     for k in 0..n {
         let phi = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;

@@ -53,13 +53,20 @@ impl WindGrid {
     /// Build from rows `[x_m, y_m, z_m, u_mps, v_mps, w_mps]` (east, north, up), in any order.
     ///
     /// # Errors
-    /// Non-finite values, fewer than two distinct values on an axis, or rows that do not fill
+    /// Values that are not finite or out of range (coordinates beyond 1e7 m, wind beyond
+    /// [`MAX_WIND_MPS`]), fewer than two distinct values on an axis, or rows that do not fill
     /// every node of the grid exactly once.
     pub fn from_rows(rows: &[[f64; 6]]) -> Result<Self, PlannerError> {
         for r in rows {
-            if let Some(&bad) = r.iter().find(|v| !v.is_finite()) {
+            // Coordinates within 10,000 km, wind components within the strongest wind.
+            let limit = |k: usize| if k < 3 { 1e7 } else { MAX_WIND_MPS };
+            let bad = r
+                .iter()
+                .enumerate()
+                .find(|(k, v)| v.is_nan() || v.abs() > limit(*k));
+            if let Some((_, &bad)) = bad {
                 return Err(PlannerError::InvalidWindGrid {
-                    reason: "a value is not a finite number",
+                    reason: "a value is not a finite number within range (coordinates 1e7 m, wind 100 m/s)",
                     found: bad,
                 });
             }
@@ -161,6 +168,16 @@ pub struct Gusts {
     components: [[(f64, f64, f64); GUST_COMPONENTS]; 2],
 }
 
+/// Strongest wind a query takes, m/s (above a category-5 hurricane's sustained winds; no
+/// multirotor flies in it, and a larger number is a mistake).
+pub const MAX_WIND_MPS: f64 = 100.0;
+
+/// Largest gust standard deviation, m/s.
+pub const MAX_GUST_STD_MPS: f64 = 50.0;
+
+/// Largest reference height of a wind profile, m.
+pub const MAX_REFERENCE_HEIGHT_M: f64 = 10_000.0;
+
 impl Gusts {
     /// Gusts with standard deviation `std_mps` per horizontal axis, reproducible from `seed`.
     ///
@@ -168,6 +185,8 @@ impl Gusts {
     /// A negative or non-finite standard deviation.
     pub fn new(std_mps: f64, seed: u64) -> Result<Self, PlannerError> {
         crate::error::non_negative("gust_std_mps", std_mps, "m/s")?;
+        let range = (0.0, MAX_GUST_STD_MPS);
+        crate::error::within("gust_std_mps", std_mps, range, "m/s", "at most 50 m/s")?;
         let mut state = seed;
         let mut next = || {
             // splitmix64: a small, well-mixed generator, enough for phases and frequencies.
@@ -276,6 +295,8 @@ impl Wind {
     /// roughness, a roughness not below the reference height, a negative exponent.
     pub fn profiled(speed_mps: f64, from_deg: f64, profile: Profile) -> Result<Self, PlannerError> {
         crate::error::non_negative("wind_speed_mps", speed_mps, "m/s")?;
+        let range = (0.0, MAX_WIND_MPS);
+        crate::error::within("wind_speed_mps", speed_mps, range, "m/s", "at most 100 m/s")?;
         if !from_deg.is_finite() {
             return Err(PlannerError::InvalidParameter {
                 name: "wind_from_deg",
@@ -291,13 +312,33 @@ impl Wind {
                 exponent,
             } => {
                 crate::error::positive("reference_height_m", reference_height_m, "m")?;
+                let range = (0.0, MAX_REFERENCE_HEIGHT_M);
+                let expected = "at most 10000 m";
+                crate::error::within(
+                    "reference_height_m",
+                    reference_height_m,
+                    range,
+                    "m",
+                    expected,
+                )?;
                 crate::error::non_negative("power_law_exponent", exponent, "")?;
+                let expected = "at most 1 (open country 0.14, cities 0.4)";
+                crate::error::within("power_law_exponent", exponent, (0.0, 1.0), "", expected)?;
             }
             Profile::Log {
                 reference_height_m,
                 roughness_m,
             } => {
                 crate::error::positive("reference_height_m", reference_height_m, "m")?;
+                let range = (0.0, MAX_REFERENCE_HEIGHT_M);
+                let expected = "at most 10000 m";
+                crate::error::within(
+                    "reference_height_m",
+                    reference_height_m,
+                    range,
+                    "m",
+                    expected,
+                )?;
                 crate::error::positive("roughness_m", roughness_m, "m")?;
                 if roughness_m >= reference_height_m {
                     return Err(PlannerError::InvalidParameter {

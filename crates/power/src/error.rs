@@ -217,6 +217,20 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64> {
     }
 }
 
+/// Check that `value` lies in `[min, max]` (NaN does not).
+pub(crate) fn within(name: &'static str, value: f64, min: f64, max: f64) -> Result<f64> {
+    if (min..=max).contains(&value) {
+        Ok(value)
+    } else {
+        Err(PowerError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
 /// Check that `value` is finite and not negative.
 pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64> {
     finite(name, value)?;

@@ -46,7 +46,7 @@ use serde::Serialize;
 
 use crate::angle_of_attack::{AoaModel, Inflow};
 use crate::climb::climb_power_w;
-use crate::error::{finite, non_negative, PowerError, Result};
+use crate::error::{finite, non_negative, within, PowerError, Result};
 use crate::induced::{induced_power_of_root_w, induced_velocity_mps};
 use crate::kernels::trig::{sin_cos, sin_cos_pair};
 use crate::profile::profile_power_w;
@@ -405,14 +405,21 @@ impl PowerModel {
     }
 }
 
+/// Largest airspeed the model takes, m/s: beyond the fastest multirotor flown (about 130 m/s), so
+/// a value above it is a mistake, not a flight (and would overflow the cubic drag of eq (6)).
+pub const MAX_AIRSPEED_MPS: f64 = 150.0;
+
+/// Largest vertical speed the model takes, up or down, m/s.
+pub const MAX_CLIMB_RATE_MPS: f64 = 100.0;
+
 /// Validate a resolved condition's thrust, airspeed and climb rate (the inflow is checked by the
 /// solver).
 #[inline(always)]
 pub(crate) fn check_condition(c: &FlightCondition) -> Result<()> {
     // One test on the hot path; the checks that name the value only when it fails.
     let valid = (0.0..f64::INFINITY).contains(&c.thrust_n)
-        & (0.0..f64::INFINITY).contains(&c.airspeed_mps)
-        & (c.climb_rate_mps.abs() < f64::INFINITY);
+        & (0.0..=MAX_AIRSPEED_MPS).contains(&c.airspeed_mps)
+        & (c.climb_rate_mps.abs() <= MAX_CLIMB_RATE_MPS);
     if valid {
         Ok(())
     } else {
@@ -429,11 +436,19 @@ fn condition_error(c: &FlightCondition) -> Result<()> {
     check_speeds(c.airspeed_mps, c.climb_rate_mps)
 }
 
-/// The airspeed (finite, not negative) and the climb rate (finite), naming the bad value.
+/// The airspeed (finite, not negative, at most [`MAX_AIRSPEED_MPS`]) and the climb rate (finite,
+/// at most [`MAX_CLIMB_RATE_MPS`] either way), naming the bad value.
 fn check_speeds(airspeed_mps: f64, climb_rate_mps: f64) -> Result<()> {
     finite("airspeed_mps", airspeed_mps)?;
     non_negative("airspeed_mps", airspeed_mps)?;
+    within("airspeed_mps", airspeed_mps, 0.0, MAX_AIRSPEED_MPS)?;
     finite("climb_rate_mps", climb_rate_mps)?;
+    within(
+        "climb_rate_mps",
+        climb_rate_mps,
+        -MAX_CLIMB_RATE_MPS,
+        MAX_CLIMB_RATE_MPS,
+    )?;
     Ok(())
 }
 
@@ -448,8 +463,8 @@ pub(crate) fn resolve_point(state: &FlightState) -> Result<(f64, Inflow, AoaMode
     // finite and not negative, the climb rate finite. The checks that name the value run only
     // when it fails.
     let valid = (tilt_cos > MIN_TILT_COSINE)
-        & (0.0..f64::INFINITY).contains(&v)
-        & (state.climb_rate_mps.abs() < f64::INFINITY);
+        & (0.0..=MAX_AIRSPEED_MPS).contains(&v)
+        & (state.climb_rate_mps.abs() <= MAX_CLIMB_RATE_MPS);
     if !valid {
         check_point(state)?;
     }

@@ -4,8 +4,40 @@ use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
 use serde::{Deserialize, Serialize};
 
 use crate::drag::CubicDrag;
-use crate::error::{finite, non_negative, positive, PowerError, Result};
+use crate::error::{finite, non_negative, positive, within, PowerError, Result};
 use crate::induced::hover_induced_velocity_mps;
+
+/// The physical ranges of a vehicle's parameters: a value outside them is a mistake (a unit slip,
+/// a typo), not a multirotor, and would overflow the model's arithmetic. Generous: the largest
+/// multirotors flown weigh a few hundred kilograms and carry rotors a few metres across.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParameterLimits {
+    /// Largest mass, kg.
+    pub mass_kg: f64,
+    /// Largest gravity, m/s^2.
+    pub gravity_mps2: f64,
+    /// Largest air density, kg/m^3.
+    pub air_density_kg_m3: f64,
+    /// Largest rotor radius, m.
+    pub rotor_radius_m: f64,
+    /// Most rotors.
+    pub rotor_count: f64,
+    /// Largest profile coefficient, either kappa (units of their keys).
+    pub kappa: f64,
+    /// Largest drag coefficient in magnitude, mu1, mu2, mu3 (units of their keys).
+    pub drag: f64,
+}
+
+/// The limits [`Vehicle::new`] applies.
+pub const PARAMETER_LIMITS: ParameterLimits = ParameterLimits {
+    mass_kg: 10_000.0,
+    gravity_mps2: 100.0,
+    air_density_kg_m3: 10.0,
+    rotor_radius_m: 20.0,
+    rotor_count: 64.0,
+    kappa: 100.0,
+    drag: 1_000.0,
+};
 
 /// Which rotor disk area the hover induced velocity of eq (10) divides the weight by.
 ///
@@ -90,15 +122,35 @@ impl Vehicle {
     /// efficiency above 1, zero rotors, negative `kappa1`/`kappa2`, and drag coefficients that
     /// give a negative drag force anywhere in 0-60 m/s.
     pub fn new(params: VehicleParams) -> Result<Self> {
-        positive("mass_kg", params.mass_kg)?;
-        positive("gravity_mps2", params.gravity_mps2)?;
-        positive("air_density_kg_m3", params.air_density_kg_m3)?;
-        positive("rotor_radius_m", params.rotor_radius_m)?;
+        let limits = &PARAMETER_LIMITS;
+        within(
+            "mass_kg",
+            positive("mass_kg", params.mass_kg)?,
+            0.0,
+            limits.mass_kg,
+        )?;
+        let g = positive("gravity_mps2", params.gravity_mps2)?;
+        within("gravity_mps2", g, 0.0, limits.gravity_mps2)?;
+        let rho = positive("air_density_kg_m3", params.air_density_kg_m3)?;
+        within("air_density_kg_m3", rho, 0.0, limits.air_density_kg_m3)?;
+        let r = positive("rotor_radius_m", params.rotor_radius_m)?;
+        within("rotor_radius_m", r, 0.0, limits.rotor_radius_m)?;
         if params.rotor_count == 0 {
             return Err(PowerError::NoRotor { rotor_count: 0 });
         }
-        non_negative("kappa1_w_per_n1_5", params.kappa1_w_per_n1_5)?;
-        non_negative("kappa2_w_s2_per_m2_n0_5", params.kappa2_w_s2_per_m2_n0_5)?;
+        let n = f64::from(params.rotor_count);
+        within("rotor_count", n, 1.0, limits.rotor_count)?;
+        let k1 = non_negative("kappa1_w_per_n1_5", params.kappa1_w_per_n1_5)?;
+        within("kappa1_w_per_n1_5", k1, 0.0, limits.kappa)?;
+        let k2 = non_negative("kappa2_w_s2_per_m2_n0_5", params.kappa2_w_s2_per_m2_n0_5)?;
+        within("kappa2_w_s2_per_m2_n0_5", k2, 0.0, limits.kappa)?;
+        for (name, mu) in [
+            ("mu1_n_s_per_m", params.mu1_n_s_per_m),
+            ("mu2_n_s2_per_m2", params.mu2_n_s2_per_m2),
+            ("mu3_n_s3_per_m3", params.mu3_n_s3_per_m3),
+        ] {
+            within(name, finite(name, mu)?, -limits.drag, limits.drag)?;
+        }
         positive("efficiency", params.efficiency)?;
         if params.efficiency > 1.0 {
             return Err(PowerError::OutOfRange {

@@ -10,13 +10,13 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum PropulsionError {
     /// A motor velocity constant that is zero, negative or not finite.
-    #[error("motor Kv must be a positive finite number, got {kv_rpm_per_v} rpm/V")]
+    #[error("motor Kv must be a positive finite number up to 1e5 rpm/V, got {kv_rpm_per_v} rpm/V")]
     InvalidKv {
         /// The rejected value, rpm/V.
         kv_rpm_per_v: f64,
     },
     /// A mass that is zero, negative or not finite.
-    #[error("{name} must be a positive finite mass, got {mass_kg} kg")]
+    #[error("{name} must be a positive finite mass up to 10000 kg, got {mass_kg} kg")]
     InvalidMass {
         /// Which mass (e.g. `empty_mass_kg`).
         name: &'static str,
@@ -24,7 +24,7 @@ pub enum PropulsionError {
         mass_kg: f64,
     },
     /// A voltage that is zero, negative or not finite.
-    #[error("{name} must be a positive finite voltage, got {voltage_v} V")]
+    #[error("{name} must be a positive finite voltage up to 10000 V, got {voltage_v} V")]
     InvalidVoltage {
         /// Which voltage.
         name: &'static str,
@@ -32,7 +32,9 @@ pub enum PropulsionError {
         voltage_v: f64,
     },
     /// A resistance that is negative or not finite.
-    #[error("{name} must be a non-negative finite resistance, got {resistance_ohm} ohm")]
+    #[error(
+        "{name} must be a non-negative finite resistance up to 1000 ohm, got {resistance_ohm} ohm"
+    )]
     InvalidResistance {
         /// Which resistance.
         name: &'static str,
@@ -151,6 +153,23 @@ pub enum PropulsionError {
     },
 }
 
+/// Largest magnitude of any parameter a constructor takes, in its own unit: far beyond any
+/// propulsion system (a rotor of a kilometre, a million amperes), small enough that no product of
+/// the model's formulas overflows. A value above it is a mistake (a unit slip), not a motor.
+pub const MAX_PARAMETER: f64 = 1e6;
+
+/// Largest mass, kg.
+pub const MAX_MASS_KG: f64 = 1e4;
+
+/// Largest voltage, V.
+pub const MAX_VOLTAGE_V: f64 = 1e4;
+
+/// Largest resistance, ohm.
+pub const MAX_RESISTANCE_OHM: f64 = 1e3;
+
+/// Largest velocity constant, rpm/V.
+pub const MAX_KV_RPM_PER_V: f64 = 1e5;
+
 /// `value` when `ok`, else [`PropulsionError::InvalidParameter`] saying what was `expected`.
 fn parameter(
     name: &'static str,
@@ -177,7 +196,14 @@ pub(crate) fn finite(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
-    parameter(name, value, unit, value.is_finite(), "a finite number")
+    let ok = value.is_finite() && value.abs() <= MAX_PARAMETER;
+    parameter(
+        name,
+        value,
+        unit,
+        ok,
+        "a finite number of at most 1e6 in magnitude",
+    )
 }
 
 /// Check that `value` is finite and strictly positive.
@@ -186,8 +212,8 @@ pub(crate) fn positive(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
-    let ok = value.is_finite() && value > 0.0;
-    parameter(name, value, unit, ok, "a positive finite number")
+    let ok = value.is_finite() && value > 0.0 && value <= MAX_PARAMETER;
+    parameter(name, value, unit, ok, "a positive finite number up to 1e6")
 }
 
 /// Check that `value` is finite and not negative.
@@ -196,13 +222,20 @@ pub(crate) fn non_negative(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
-    let ok = value.is_finite() && value >= 0.0;
-    parameter(name, value, unit, ok, "a non-negative finite number")
+    let ok = value.is_finite() && value >= 0.0 && value <= MAX_PARAMETER;
+    parameter(
+        name,
+        value,
+        unit,
+        ok,
+        "a non-negative finite number up to 1e6",
+    )
 }
 
 /// Check a rated current limit: positive, infinity for none.
 pub(crate) fn current_limit(name: &'static str, current_a: f64) -> Result<f64, PropulsionError> {
-    let ok = !(current_a.is_nan() || current_a <= 0.0);
+    let ok = !(current_a.is_nan() || current_a <= 0.0)
+        && (current_a.is_infinite() || current_a <= MAX_PARAMETER);
     parameter(
         name,
         current_a,
@@ -239,7 +272,7 @@ pub(crate) fn fraction(
 
 /// Check a mass.
 pub(crate) fn mass(name: &'static str, mass_kg: f64) -> Result<f64, PropulsionError> {
-    if mass_kg.is_finite() && mass_kg > 0.0 {
+    if mass_kg.is_finite() && mass_kg > 0.0 && mass_kg <= MAX_MASS_KG {
         Ok(mass_kg)
     } else {
         Err(PropulsionError::InvalidMass { name, mass_kg })
@@ -248,7 +281,7 @@ pub(crate) fn mass(name: &'static str, mass_kg: f64) -> Result<f64, PropulsionEr
 
 /// Check a voltage.
 pub(crate) fn voltage(name: &'static str, voltage_v: f64) -> Result<f64, PropulsionError> {
-    if voltage_v.is_finite() && voltage_v > 0.0 {
+    if voltage_v.is_finite() && voltage_v > 0.0 && voltage_v <= MAX_VOLTAGE_V {
         Ok(voltage_v)
     } else {
         Err(PropulsionError::InvalidVoltage { name, voltage_v })
@@ -257,7 +290,7 @@ pub(crate) fn voltage(name: &'static str, voltage_v: f64) -> Result<f64, Propuls
 
 /// Check a resistance (zero allowed).
 pub(crate) fn resistance(name: &'static str, resistance_ohm: f64) -> Result<f64, PropulsionError> {
-    if resistance_ohm.is_finite() && resistance_ohm >= 0.0 {
+    if resistance_ohm.is_finite() && resistance_ohm >= 0.0 && resistance_ohm <= MAX_RESISTANCE_OHM {
         Ok(resistance_ohm)
     } else {
         Err(PropulsionError::InvalidResistance {
@@ -269,7 +302,7 @@ pub(crate) fn resistance(name: &'static str, resistance_ohm: f64) -> Result<f64,
 
 /// Check a Kv.
 pub(crate) fn kv(kv_rpm_per_v: f64) -> Result<f64, PropulsionError> {
-    if kv_rpm_per_v.is_finite() && kv_rpm_per_v > 0.0 {
+    if kv_rpm_per_v.is_finite() && kv_rpm_per_v > 0.0 && kv_rpm_per_v <= MAX_KV_RPM_PER_V {
         Ok(kv_rpm_per_v)
     } else {
         Err(PropulsionError::InvalidKv { kv_rpm_per_v })

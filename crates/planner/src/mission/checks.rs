@@ -5,6 +5,14 @@ use super::HomeSpec;
 use crate::error::PlannerError;
 use crate::geodesy::LocalFrame;
 
+/// Largest magnitude of a mission's values in their units (a coordinate of 10,000 km, a hold of
+/// 115 days): beyond it a value is a mistake, and the arithmetic of the flight would overflow.
+pub const MAX_MISSION_VALUE: f64 = 1e7;
+
+/// Longest a segment's piece of trajectory may take, s (31.7 years): a slower speed or longer
+/// path than that is a mistake (a speed of 1e-320 m/s), and its steps could not be counted.
+pub const MAX_PIECE_S: f64 = 1e9;
+
 /// The segment a check is about: its place in the mission (from 0) and its kind as written.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Seg {
@@ -50,8 +58,10 @@ impl Seg {
         value: f64,
         unit: &'static str,
     ) -> Result<f64, PlannerError> {
-        if value.is_finite() && value > 0.0 {
+        if value.is_finite() && value > 0.0 && value <= MAX_MISSION_VALUE {
             Ok(value)
+        } else if value.is_finite() && value > MAX_MISSION_VALUE {
+            Err(self.invalid(name, value, unit, "at most 1e7 (a mistake beyond it)"))
         } else if name.contains("altitude") {
             Err(self.invalid(
                 name,
@@ -61,6 +71,21 @@ impl Seg {
             ))
         } else {
             Err(self.invalid(name, value, unit, "must be positive and finite"))
+        }
+    }
+
+    /// A piece of this segment that takes `duration_s` can be flown: finite and at most
+    /// [`MAX_PIECE_S`].
+    pub(super) fn duration(self, duration_s: f64) -> Result<(), PlannerError> {
+        if duration_s.is_finite() && duration_s <= MAX_PIECE_S {
+            Ok(())
+        } else {
+            Err(PlannerError::SegmentTooLong {
+                index: self.index + 1,
+                kind: self.kind,
+                duration_s,
+                max_s: MAX_PIECE_S,
+            })
         }
     }
 
@@ -93,11 +118,11 @@ impl Seg {
         payload_kg: Option<f64>,
     ) -> Result<Option<f64>, PlannerError> {
         match payload_kg {
-            Some(v) if !(v.is_finite() && v >= 0.0) => Err(self.invalid(
+            Some(v) if !(v.is_finite() && v >= 0.0 && v <= MAX_MISSION_VALUE) => Err(self.invalid(
                 "payload_after_kg",
                 v,
                 "kg",
-                "must be finite and not negative",
+                "must be finite, not negative and at most 1e7",
             )),
             other => Ok(other),
         }
@@ -112,12 +137,12 @@ impl Seg {
 pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError> {
     let home_m = [home.east_m.unwrap_or(0.0), home.north_m.unwrap_or(0.0), 0.0];
     for (v, name) in [(home_m[0], "home east_m"), (home_m[1], "home north_m")] {
-        if !v.is_finite() {
+        if !(v.is_finite() && v.abs() <= MAX_MISSION_VALUE) {
             return Err(PlannerError::InvalidParameter {
                 name,
                 value: v,
                 unit: "m",
-                expected: "a finite coordinate",
+                expected: "a finite coordinate of at most 1e7 m in magnitude",
             });
         }
     }
@@ -145,12 +170,20 @@ impl Points {
                 home.longitude_deg,
             ) {
                 (None, None, Some(la), Some(lo)) => {
-                    if !(la.is_finite() && la.abs() < 90.0 && lo.is_finite()) {
+                    if !(la.is_finite() && la.abs() < 90.0) {
                         return Err(PlannerError::InvalidParameter {
                             name: "home latitude_deg",
                             value: la,
                             unit: "deg",
-                            expected: "a latitude within (-90, 90) and a finite longitude",
+                            expected: "a latitude within (-90, 90)",
+                        });
+                    }
+                    if !(lo.is_finite() && lo.abs() <= 180.0) {
+                        return Err(PlannerError::InvalidParameter {
+                            name: "home longitude_deg",
+                            value: lo,
+                            unit: "deg",
+                            expected: "a longitude within [-180, 180]",
                         });
                     }
                     Some(LocalFrame::new(la, lo))
@@ -178,8 +211,8 @@ impl Points {
         match given {
             [Some(e), Some(n), None, None] => {
                 for (v, name) in [(e, names[0]), (n, names[1])] {
-                    if !v.is_finite() {
-                        return Err(seg.invalid(name, v, "m", "must be finite"));
+                    if !(v.is_finite() && v.abs() <= MAX_MISSION_VALUE) {
+                        return Err(seg.invalid(name, v, "m", "must be finite, at most 1e7 m"));
                     }
                 }
                 Ok([e, n])
@@ -191,8 +224,8 @@ impl Points {
                 if !(la.is_finite() && la.abs() < 90.0) {
                     return Err(seg.invalid(names[2], la, "deg", "must be within (-90, 90)"));
                 }
-                if !lo.is_finite() {
-                    return Err(seg.invalid(names[3], lo, "deg", "must be finite"));
+                if !(lo.is_finite() && lo.abs() <= 180.0) {
+                    return Err(seg.invalid(names[3], lo, "deg", "must be within [-180, 180]"));
                 }
                 Ok(frame.to_local_m(la, lo))
             }

@@ -31,6 +31,12 @@ impl MissionSpec {
         if self.segments.is_empty() {
             return Err(PlannerError::EmptyMission);
         }
+        if self.segments.len() > MAX_SEGMENTS {
+            return Err(PlannerError::TooManySegments {
+                segments: self.segments.len(),
+                limit: MAX_SEGMENTS,
+            });
+        }
         let points = Points::for_home(&self.home)?;
         let home_m = home_position_m(&self.home)?;
         let start_payload_kg = payload_kg.unwrap_or(self.payload_kg);
@@ -43,6 +49,10 @@ impl MissionSpec {
         compiler.finish(&self.name)
     }
 }
+
+/// Most segments a mission may have: a survey of thousands of waypoints is well below it, and the
+/// compiled mission's memory (a few kilobytes a segment with its report) stays bounded.
+pub const MAX_SEGMENTS: usize = 50_000;
 
 /// Keys of a leg's waypoint, in the order [`Points::resolve`] takes them.
 const WAYPOINT_KEYS: [&str; 4] = ["east_m", "north_m", "latitude_deg", "longitude_deg"];
@@ -212,7 +222,7 @@ impl<'a> Compiler<'a> {
             self.airframe.max_climb_rate_mps(),
             "m/s",
         )?;
-        self.vertical_to(altitude_m, climb_rate_mps);
+        self.vertical_to(altitude_m, climb_rate_mps)?;
         self.airborne = true;
         Ok(())
     }
@@ -279,7 +289,7 @@ impl<'a> Compiler<'a> {
             OrbitDirection::Clockwise => -1.0,
         };
         let tangent = [-sign * phi0_rad.sin(), sign * phi0_rad.cos()];
-        self.yaw_to(tangent);
+        self.yaw_to(tangent)?;
         self.fly_arc(
             Shape::Arc {
                 centre_m,
@@ -310,7 +320,7 @@ impl<'a> Compiler<'a> {
             Shape::Hold { pos_m: self.pos_m },
             Profile::hold(duration_s),
             self.heading,
-        );
+        )?;
         self.change_payload(payload_after_kg)
     }
 
@@ -334,7 +344,7 @@ impl<'a> Compiler<'a> {
                 "a descent must end below the present height",
             ));
         }
-        self.vertical_to(altitude_m, rate_mps);
+        self.vertical_to(altitude_m, rate_mps)?;
         Ok(())
     }
 
@@ -353,7 +363,7 @@ impl<'a> Compiler<'a> {
             self.airframe.max_descent_rate_mps(),
             "m/s",
         )?;
-        self.vertical_to(0.0, rate_mps);
+        self.vertical_to(0.0, rate_mps)?;
         self.airborne = false;
         self.change_payload(payload_after_kg)
     }
@@ -413,7 +423,13 @@ impl<'a> Compiler<'a> {
     }
 
     /// Add a piece of the present segment, unless it takes no time.
-    fn push(&mut self, shape: Shape, profile: Profile, forward: [f64; 2]) {
+    fn push(
+        &mut self,
+        shape: Shape,
+        profile: Profile,
+        forward: [f64; 2],
+    ) -> Result<(), PlannerError> {
+        self.seg.duration(profile.duration_s)?;
         if profile.duration_s > 0.0 {
             self.pieces.push(Piece {
                 shape,
@@ -423,20 +439,22 @@ impl<'a> Compiler<'a> {
                 forward,
             });
         }
+        Ok(())
     }
 
     /// Yaw in place, hovering at the airframe's yaw rate, until the nose points along `to` (a
     /// unit east-north vector). Turns under 1e-6 rad take no piece.
-    fn yaw_to(&mut self, to: [f64; 2]) {
+    fn yaw_to(&mut self, to: [f64; 2]) -> Result<(), PlannerError> {
         let turn = turn_rad(self.heading, to);
         if turn > 1e-6 {
             self.push(
                 Shape::Hold { pos_m: self.pos_m },
                 Profile::hold(turn / self.airframe.yaw_rate_radps()),
                 self.heading,
-            );
+            )?;
         }
         self.heading = to;
+        Ok(())
     }
 
     /// A straight path from here to `to_m` with a horizontal ground speed, from rest to rest;
@@ -450,7 +468,7 @@ impl<'a> Compiler<'a> {
             return Ok(());
         }
         let (path_speed, path_acc) = if h > 1e-9 {
-            self.yaw_to([d[0] / h, d[1] / h]);
+            self.yaw_to([d[0] / h, d[1] / h])?;
             self.sloped_speed_and_acceleration(d, h, len, ground_speed_mps)?
         } else {
             // Vertical leg: the ground speed does not apply; use the rate limit.
@@ -468,7 +486,7 @@ impl<'a> Compiler<'a> {
             },
             Profile::rest_to_rest(len, path_speed, path_acc),
             self.heading,
-        );
+        )?;
         self.pos_m = to_m;
         Ok(())
     }
@@ -504,7 +522,7 @@ impl<'a> Compiler<'a> {
     }
 
     /// A vertical path from here to height `to_z_m` at `rate_mps`, from rest to rest.
-    fn vertical_to(&mut self, to_z_m: f64, rate_mps: f64) {
+    fn vertical_to(&mut self, to_z_m: f64, rate_mps: f64) -> Result<(), PlannerError> {
         let pos = self.pos_m;
         let len = (to_z_m - pos[2]).abs();
         if len > 0.0 {
@@ -515,9 +533,10 @@ impl<'a> Compiler<'a> {
                 },
                 Profile::rest_to_rest(len, rate_mps, self.airframe.vertical_acceleration_mps2()),
                 self.heading,
-            );
+            )?;
         }
         self.pos_m[2] = to_z_m;
+        Ok(())
     }
 
     /// Length of an orbit's arc, m: `laps` whole circles, or what a trapezoid speed profile

@@ -90,6 +90,8 @@ mod checks;
 mod compile;
 mod spec;
 
+pub use checks::{MAX_MISSION_VALUE, MAX_PIECE_S};
+pub use compile::MAX_SEGMENTS;
 pub use spec::{HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec};
 
 use crate::trajectory::Piece;
