@@ -40,7 +40,7 @@ pub enum Error {
     },
     /// An answer that would carry a number that is not finite (an overflow the input checks did
     /// not foresee): refused rather than printed as `null` or `inf`.
-    #[error("{answer}: {field} would be {value}, not a finite number, for {request}")]
+    #[error("{answer}: {field} would be {}, not a finite number, for {request}", aloft_core::Num::of(.value))]
     NonFinite {
         /// Which answer.
         answer: &'static str,
@@ -192,7 +192,7 @@ pub enum Error {
         source: Box<aloft_planner::PlannerError>,
     },
     /// A number outside its valid range in an option or a measured sample.
-    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
     InvalidInput {
         /// Option or field name, with its unit suffix.
         name: &'static str,

@@ -6,6 +6,7 @@ use std::fs::File;
 use std::io::{BufReader, BufWriter};
 use std::path::Path;
 
+use aloft_core::Num;
 use serde::Serialize;
 
 use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown, PowerModel};
@@ -116,7 +117,10 @@ pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer,
     let invalid = |source| Error::FlightState {
         state: format!(
             "airspeed_mps {}, roll_deg {}, pitch_deg {}, climb_rate_mps {}",
-            query.airspeed_mps, query.roll_deg, query.pitch_deg, query.climb_rate_mps
+            Num(query.airspeed_mps),
+            Num(query.roll_deg),
+            Num(query.pitch_deg),
+            Num(query.climb_rate_mps)
         ),
         source,
     };

@@ -31,3 +31,34 @@ pub const ISA_SEA_LEVEL_DENSITY_KG_M3: f64 = 1.225;
 
 /// Seconds per hour: joules to watt-hours, ampere-seconds to ampere-hours.
 pub const SECONDS_PER_HOUR: f64 = 3600.0;
+
+/// A number as an error message shows it: as written for ordinary magnitudes, in scientific
+/// notation when it is huge or tiny (`1e308`, not 309 digits), `NaN` and `inf` as such.
+///
+/// ```
+/// use aloft_core::Num;
+/// assert_eq!(Num(150.0).to_string(), "150");
+/// assert_eq!(Num(1e308).to_string(), "1e308");
+/// assert_eq!(Num(1e-320).to_string(), "1e-320");
+/// assert_eq!(Num(-0.25).to_string(), "-0.25");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl Num {
+    /// The display of `*value` (for error attributes that hold a reference to the field).
+    pub fn of(value: &f64) -> Self {
+        Self(*value)
+    }
+}
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if self.0.is_finite() && a != 0.0 && !(1e-4..1e15).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}

@@ -14,7 +14,7 @@ pub enum PlannerError {
     #[error(transparent)]
     Propulsion(#[from] aloft_propulsion::PropulsionError),
     /// A parameter outside its valid range.
-    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
     InvalidParameter {
         /// Parameter name (with its unit suffix).
         name: &'static str,
@@ -35,7 +35,7 @@ pub enum PlannerError {
     #[error("the mission has no segments: add at least a take-off and a landing")]
     EmptyMission,
     /// A mission segment that is invalid in itself.
-    #[error("segment {index} ({kind}): {name} = {value} {unit} is invalid: {expected}")]
+    #[error("segment {index} ({kind}): {name} = {} {unit} is invalid: {expected}", aloft_core::Num::of(.value))]
     InvalidSegment {
         /// Segment number, from 1.
         index: usize,
@@ -125,7 +125,7 @@ pub enum PlannerError {
         found: f64,
     },
     /// A battery description that is inconsistent.
-    #[error("battery '{name}': {key} = {value} {unit} is invalid: {expected}")]
+    #[error("battery '{name}': {key} = {} {unit} is invalid: {expected}", aloft_core::Num::of(.value))]
     InvalidBattery {
         /// Pack name.
         name: String,

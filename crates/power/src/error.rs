@@ -9,7 +9,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum PowerError {
     /// A parameter that must be a finite number is NaN or infinite.
-    #[error("{name} must be a finite number, got {value}")]
+    #[error("{name} must be a finite number, got {}", aloft_core::Num::of(.value))]
     NotFinite {
         /// Parameter name with its unit suffix, e.g. `airspeed_mps`.
         name: &'static str,
@@ -17,7 +17,7 @@ pub enum PowerError {
         value: f64,
     },
     /// A parameter that must be strictly positive is zero or negative.
-    #[error("{name} must be greater than zero, got {value}")]
+    #[error("{name} must be greater than zero, got {}", aloft_core::Num::of(.value))]
     NotPositive {
         /// Parameter name with its unit suffix.
         name: &'static str,
@@ -25,7 +25,7 @@ pub enum PowerError {
         value: f64,
     },
     /// A parameter that must not be negative is negative.
-    #[error("{name} must not be negative, got {value}")]
+    #[error("{name} must not be negative, got {}", aloft_core::Num::of(.value))]
     Negative {
         /// Parameter name with its unit suffix.
         name: &'static str,
@@ -33,7 +33,7 @@ pub enum PowerError {
         value: f64,
     },
     /// A parameter lies outside the range in which the model is defined or physical.
-    #[error("{name} = {value} is outside the accepted range {min} to {max}")]
+    #[error("{name} = {} is outside the accepted range {min} to {max}", aloft_core::Num::of(.value))]
     OutOfRange {
         /// Parameter name with its unit suffix.
         name: &'static str,

@@ -10,13 +10,13 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum PropulsionError {
     /// A motor velocity constant that is zero, negative or not finite.
-    #[error("motor Kv must be a positive finite number up to 1e5 rpm/V, got {kv_rpm_per_v} rpm/V")]
+    #[error("motor Kv must be a positive finite number up to 1e5 rpm/V, got {} rpm/V", aloft_core::Num::of(.kv_rpm_per_v))]
     InvalidKv {
         /// The rejected value, rpm/V.
         kv_rpm_per_v: f64,
     },
     /// A mass that is zero, negative or not finite.
-    #[error("{name} must be a positive finite mass up to 10000 kg, got {mass_kg} kg")]
+    #[error("{name} must be a positive finite mass up to 10000 kg, got {} kg", aloft_core::Num::of(.mass_kg))]
     InvalidMass {
         /// Which mass (e.g. `empty_mass_kg`).
         name: &'static str,
@@ -24,7 +24,7 @@ pub enum PropulsionError {
         mass_kg: f64,
     },
     /// A voltage that is zero, negative or not finite.
-    #[error("{name} must be a positive finite voltage up to 10000 V, got {voltage_v} V")]
+    #[error("{name} must be a positive finite voltage up to 10000 V, got {} V", aloft_core::Num::of(.voltage_v))]
     InvalidVoltage {
         /// Which voltage.
         name: &'static str,
@@ -33,7 +33,7 @@ pub enum PropulsionError {
     },
     /// A resistance that is negative or not finite.
     #[error(
-        "{name} must be a non-negative finite resistance up to 1000 ohm, got {resistance_ohm} ohm"
+        "{name} must be a non-negative finite resistance up to 1000 ohm, got {} ohm", aloft_core::Num::of(.resistance_ohm)
     )]
     InvalidResistance {
         /// Which resistance.
@@ -42,7 +42,7 @@ pub enum PropulsionError {
         resistance_ohm: f64,
     },
     /// Any other parameter outside its valid range.
-    #[error("{name} = {value} {unit} is invalid: expected {expected}")]
+    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
     InvalidParameter {
         /// Parameter name, with its unit suffix.
         name: &'static str,
