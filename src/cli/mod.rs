@@ -116,14 +116,14 @@ fn usage_error(e: clap::Error) -> ExitCode {
             ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
         }
         _ => {
-            eprintln!("aloft: error: {}", one_line(&e.render().to_string()));
+            eprintln!("aloft: error: {}", usage_line(&e.render().to_string()));
             ExitCode::from(2)
         }
     }
 }
 
 /// Clap's message without its usage hints, on one line: the first paragraph, lines joined.
-fn one_line(rendered: &str) -> String {
+fn usage_line(rendered: &str) -> String {
     let first = rendered.split("\n\n").next().unwrap_or(rendered);
     let text = first.strip_prefix("error: ").unwrap_or(first);
     text.split('\n')
@@ -138,7 +138,7 @@ fn one_line(rendered: &str) -> String {
 fn message(e: &anyhow::Error) -> String {
     let mut text = String::new();
     for cause in e.chain() {
-        let c = cause.to_string();
+        let c = aloft::engine::one_line(&cause.to_string());
         if text.is_empty() {
             text = c;
         } else if !text.contains(&c) {

@@ -88,6 +88,9 @@ pub use validate::{
 };
 pub use vehicles::{list_vehicles, Vehicle, VehicleEntry};
 
+/// A parser's message on one line (the CLI prints every error on one line).
+pub use aloft_core::one_line;
+
 /// The vehicle every command uses when none is named.
 pub use crate::vehicle::DEFAULT_VEHICLE;
 pub use wind::{describe_wind_spec, GustSpec};

@@ -62,3 +62,27 @@ impl std::fmt::Display for Num {
         }
     }
 }
+
+/// A parser's message on one line: TOML errors come with a snippet of the file (a line number
+/// gutter, the line, a caret under the spot) between their first line and the explanation; the
+/// snippet is dropped and the rest joined with `: `, so a message names the line, the column and
+/// the problem in one line (`TOML parse error at line 3, column 11: invalid type: string "a",
+/// expected f64`).
+///
+/// ```
+/// let text = "TOML parse error at line 2, column 8\n  |\n2 | kind = 1\n  |        ^\ninvalid type";
+/// assert_eq!(aloft_core::one_line(text), "TOML parse error at line 2, column 8: invalid type");
+/// ```
+pub fn one_line(message: &str) -> String {
+    let snippet = |l: &str| {
+        let t = l.trim_start();
+        let gutter = t.trim_start_matches(|c: char| c.is_ascii_digit());
+        gutter.trim_start().starts_with('|')
+    };
+    message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !snippet(l))
+        .collect::<Vec<_>>()
+        .join(": ")
+}

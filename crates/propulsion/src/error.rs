@@ -222,7 +222,7 @@ pub(crate) fn non_negative(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
-    let ok = value.is_finite() && value >= 0.0 && value <= MAX_PARAMETER;
+    let ok = (0.0..=MAX_PARAMETER).contains(&value);
     parameter(
         name,
         value,
@@ -290,7 +290,7 @@ pub(crate) fn voltage(name: &'static str, voltage_v: f64) -> Result<f64, Propuls
 
 /// Check a resistance (zero allowed).
 pub(crate) fn resistance(name: &'static str, resistance_ohm: f64) -> Result<f64, PropulsionError> {
-    if resistance_ohm.is_finite() && resistance_ohm >= 0.0 && resistance_ohm <= MAX_RESISTANCE_OHM {
+    if (0.0..=MAX_RESISTANCE_OHM).contains(&resistance_ohm) {
         Ok(resistance_ohm)
     } else {
         Err(PropulsionError::InvalidResistance {

@@ -118,7 +118,7 @@ impl Seg {
         payload_kg: Option<f64>,
     ) -> Result<Option<f64>, PlannerError> {
         match payload_kg {
-            Some(v) if !(v.is_finite() && v >= 0.0 && v <= MAX_MISSION_VALUE) => Err(self.invalid(
+            Some(v) if !(0.0..=MAX_MISSION_VALUE).contains(&v) => Err(self.invalid(
                 "payload_after_kg",
                 v,
                 "kg",

@@ -257,7 +257,7 @@ impl MissionSpec {
     /// names the line and the key.
     pub fn from_toml_str(text: &str) -> Result<Self, PlannerError> {
         toml::from_str(text).map_err(|e| PlannerError::MissionFormat {
-            message: e.to_string().trim_end().to_string(),
+            message: aloft_core::one_line(&e.to_string()),
         })
     }
 }
