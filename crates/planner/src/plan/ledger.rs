@@ -162,21 +162,19 @@ impl<'p> Ledger<'p> {
         self.book_piece(tally, piece.duration_s(), piece.profile.length_m, soc);
     }
 
-    /// The pack cannot deliver the step at `tm` s into `piece` (`why`): the flight ends before
-    /// it, with the pack at `soc`. The piece's energy is not booked into its segment.
+    /// The pack cannot deliver the step that starts `start_s` s into `piece` (`why`): the flight
+    /// ends before it, with the pack at `soc`; the piece's steps flown until then are booked
+    /// (their energy, peak and time) like those of a piece cut short by [`Ledger::stop_after`].
     pub(super) fn stop_before(
         &mut self,
         tally: PieceTally,
         piece: &Piece,
-        tm: f64,
+        start_s: f64,
         soc: f64,
         why: Shortfall,
     ) {
         self.shortfall = Some(why);
-        let a = &mut self.segments[tally.segment];
-        a.duration_s += tm;
-        a.distance_m += piece.profile.at(tm).0;
-        self.soc = soc;
+        self.book_piece(tally, start_s, piece.profile.at(start_s).0, soc);
     }
 
     /// The pack fails (`why`) in the step that ends `end_s` s into `piece`, leaving it at `soc`:

@@ -391,7 +391,8 @@ impl<'p, 'a> PackPass<'p, 'a> {
                     position_m: pos,
                     power_w: p,
                 };
-                self.ledger.stop_before(tally, run.piece, tm, soc, why);
+                let start_s = tm - 0.5 * run.h;
+                self.ledger.stop_before(tally, run.piece, start_s, soc, why);
                 return Ok(ControlFlow::Break(()));
             };
             self.ledger.book(&mut tally, p, run.h, &draw);
@@ -555,5 +556,74 @@ mod tests {
             assert!(s.soc < soc_before);
             soc_before = s.soc;
         }
+    }
+
+    #[test]
+    fn a_pack_that_cannot_deliver_books_the_energy_flown_before_it_stops() {
+        // Regression: a flight stopped by the pack's current limit lost the energy of the piece it
+        // was flying (neither its segment nor the mission total booked it).
+        let (aircraft, _) = m100();
+        let mut spec = crate::test_support::tb48d();
+        // A slow climb and the hover draw about 12 A; the fast leg draws more, part-way along it.
+        spec.max_current_a = Some(13.5);
+        let battery = Pack::new(&spec).unwrap();
+        let fast_leg = r#"
+            [[segment]]
+            kind = "take-off"
+            altitude_m = 20.0
+            climb_rate_mps = 0.5
+            [[segment]]
+            kind = "hover"
+            duration_s = 10.0
+            [[segment]]
+            kind = "leg"
+            east_m = 1500.0
+            north_m = 0.0
+            ground_speed_mps = 16.0
+            [[segment]]
+            kind = "landing"
+            rate_mps = 1.0
+        "#;
+        let mission = MissionSpec::from_toml_str(fast_leg)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
+        let opts = PlanOptions {
+            record_samples: true,
+            ..PlanOptions::default()
+        };
+        let r = plan(&aircraft, &battery, &mission, &Wind::calm(), &opts).unwrap();
+        let Some(Shortfall::PackLimit {
+            time_s, segment, ..
+        }) = r.shortfall
+        else {
+            panic!(
+                "expected the pack's current limit to stop the flight: {:?}",
+                r.shortfall
+            );
+        };
+        let last = r.segments.last().unwrap();
+        assert_eq!(last.index, segment);
+        // The segment's energy and time are those of its samples flown (midpoint rule: each
+        // sample stands for its step; the steps of one piece are equal).
+        let flown: Vec<&Sample> = r.samples.iter().filter(|s| s.segment == segment).collect();
+        assert!(!flown.is_empty());
+        assert!(last.energy_wh > 0.0, "{last:?}");
+        let mean_w = flown.iter().map(|s| s.power_w).sum::<f64>() / flown.len() as f64;
+        // 2 %: the segment's mean weights each piece by its time, the samples' by their count.
+        assert!(
+            (last.mean_power_w / mean_w - 1.0).abs() < 0.02,
+            "{} vs {mean_w}",
+            last.mean_power_w
+        );
+        // The mission's energy is the sum of its segments' (no piece left out), and the flight
+        // ended before the failing step.
+        let sum: f64 = r.segments.iter().map(|s| s.energy_wh).sum();
+        assert!(
+            (r.energy_wh - sum).abs() < 1e-9 * sum,
+            "{} vs {sum}",
+            r.energy_wh
+        );
+        assert!(r.duration_s <= time_s && r.duration_s > time_s - opts.time_step_s);
     }
 }
