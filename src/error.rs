@@ -140,6 +140,16 @@ pub enum Error {
         /// File.
         origin: String,
     },
+    /// A log whose time stamps span far longer than its samples could cover.
+    #[error("{origin}: the time stamps span {span_s:.3e} s for {samples} samples: a time stamp is off (see `aloft log info`)")]
+    SparseTime {
+        /// File.
+        origin: String,
+        /// The span of the time stamps, s.
+        span_s: f64,
+        /// Samples of the longer channel.
+        samples: usize,
+    },
     /// Time runs backwards in a log that must be aligned.
     #[error("{origin}: time is not monotonic; alignment needs an ordered time base (see `aloft log info`)")]
     NotMonotonic {

@@ -150,7 +150,18 @@ pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, 
             let dt = 0.1;
             let start = pt[0].max(mt[0]);
             let end = pt[pt.len() - 1].min(mt[mt.len() - 1]);
-            let n = ((end - start) / dt).floor() as usize;
+            let n = ((end - start) / dt).floor().max(0.0);
+            // The grid covers the overlap of the channels; one whose span is far longer than
+            // the samples could fill (a time stamp off by years) is refused before it is built.
+            let limit = 10.0 * (pt.len() + mt.len()) as f64 + 1e5;
+            if n > limit {
+                return Err(Error::SparseTime {
+                    origin: source,
+                    span_s: end - start,
+                    samples: pt.len().max(mt.len()),
+                });
+            }
+            let n = n as usize;
             let grid: Vec<f64> = (0..n).map(|i| start + i as f64 * dt).collect();
             let p: Vec<f64> = grid
                 .iter()

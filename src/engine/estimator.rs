@@ -6,6 +6,10 @@ use aloft_power::FlightState;
 use super::vehicles::Vehicle;
 use crate::error::Error;
 
+/// Largest power a sample may carry, W (a gigawatt: beyond any multirotor; a larger number is a
+/// unit slip, and the energy sums would overflow).
+const MAX_POWER_W: f64 = 1e9;
+
 /// In-flight re-estimate of the overall efficiency `eta` from measured electrical power.
 ///
 /// Each sample pairs a time with the model's predicted electrical power at a reference efficiency
@@ -71,21 +75,22 @@ impl InFlightEstimator {
     /// [`Error::InvalidInput`] for a non-finite or non-increasing time, or a non-finite or negative
     /// power; the sample is then ignored.
     pub fn push(&mut self, time_s: f64, predicted_w: f64, measured_w: f64) -> Result<(), Error> {
-        if !time_s.is_finite() || self.measured_j.last().is_some_and(|(t, _)| time_s <= t) {
+        let in_range = time_s.is_finite() && time_s.abs() <= 1e9;
+        if !in_range || self.measured_j.last().is_some_and(|(t, _)| time_s <= t) {
             return Err(Error::InvalidInput {
                 name: "time_s",
                 value: time_s,
                 unit: "s",
-                expected: "a finite time after the previous sample's",
+                expected: "a finite time (within 1e9 s) after the previous sample's",
             });
         }
         for (name, value) in [("predicted_w", predicted_w), ("measured_w", measured_w)] {
-            if !(value.is_finite() && value >= 0.0) {
+            if !(0.0..=MAX_POWER_W).contains(&value) {
                 return Err(Error::InvalidInput {
                     name,
                     value,
                     unit: "W",
-                    expected: "a finite power, not negative",
+                    expected: "a finite power, not negative, at most 1e9 W",
                 });
             }
         }
