@@ -1,12 +1,28 @@
 //! Streaming MCAP reader: decodes the supported topics of a file into [`Sample`]s, one per message.
 //!
 //! # Memory
-//! The file is read through `mcap`'s sans-I/O [`LinearReader`] from any `std::io::Read`, in
-//! requests of the size the reader asks for: memory is bounded by the largest record or
-//! (decompressed) chunk, typically a few MB, whatever the file size. This is preferred over
-//! memory-mapping because it also works on pipes, and a file truncated or replaced while it is
-//! being read gives an I/O error instead of a `SIGBUS`. A record whose length field exceeds
-//! [`RECORD_LIMIT`] (a corrupt length) is refused before anything is allocated for it.
+//! The file is read through `mcap`'s sans-I/O [`LinearReader`] from any `std::io::Read`: memory
+//! is bounded by the largest record or chunk, typically a few MB, whatever the file size. This
+//! is preferred over memory-mapping because it also works on pipes, and a file truncated or
+//! replaced while it is being read gives an I/O error instead of a `SIGBUS`.
+//!
+//! # Corrupt lengths
+//! Every length read out of the file is checked before anything is allocated for it, so a
+//! flipped byte is an error, never a multi-gigabyte allocation:
+//! - Records of the file: no record may claim more than the file holds ([`RECORD_LIMIT`] at most,
+//!   the reader's `record_length_limit`), nor more than remains after it: a request for more
+//!   bytes than remain is the same error as a truncated file ([`LogError::Mcap`], at the
+//!   record's byte offset). Input is handed to the reader in pieces of at most [`FILL_BYTES`],
+//!   so its buffer only grows with bytes actually read.
+//! - Chunks are taken whole ([`LinearReaderOptions::emit_chunks`]), their header is checked
+//!   ([`crate::mcap_records::chunk`]: the records must fit in the chunk; a declared
+//!   uncompressed size over [`MAX_CHUNK_RATIO`] times the compressed size or over
+//!   [`RECORD_LIMIT`] is refused), and their records are read by a reader of their own whose
+//!   record limit is the chunk's uncompressed size: a record inside a chunk cannot claim (and
+//!   make the decompressor reserve) more than its chunk holds.
+//! - Schema, Channel and Message records are read by [`crate::mcap_records`], which checks every
+//!   string, byte array and map length against the record and allocates nothing; other records
+//!   are skipped unparsed.
 //!
 //! # Topic selection
 //! Without named topics, each model channel (position, velocity, attitude, battery, ...) is taken
@@ -24,16 +40,31 @@ use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use mcap::records::MessageHeader;
+use mcap::records::{op, MessageHeader};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use serde::Serialize;
 
 use crate::error::{LogError, Result};
+use crate::mcap_records::{self, record_name, ChannelView, McapPlace, McapProblem};
 use crate::ros::{decode_cdr, decode_json, Decoded, MessageKind, RosDecodeOptions, SUPPORTED};
 use crate::sample::{Channel, Sample, TimeChecker, TimeReport};
 
-/// Largest record (or chunk) accepted, bytes.
+/// Largest record (or chunk, compressed or not) accepted, bytes; smaller for a smaller file.
 pub const RECORD_LIMIT: usize = 256 << 20;
+
+/// Largest accepted ratio of a chunk's declared uncompressed size to its compressed size
+/// (flight data compress 3 to 20 times; 1000 leaves room for runs of zeros).
+pub const MAX_CHUNK_RATIO: u64 = 1000;
+
+/// A compressed chunk may always declare this many bytes uncompressed, whatever its ratio (a
+/// tiny chunk of empty messages can compress more than [`MAX_CHUNK_RATIO`] times).
+const MIN_CHUNK_LIMIT: u64 = 64 << 10;
+
+/// Largest piece of input handed to the reader at once, bytes.
+pub const FILL_BYTES: usize = 256 << 10;
+
+/// Opcode and length before every record, bytes.
+const RECORD_PREFIX: u64 = 1 + 8;
 
 /// Which clock gives [`Sample::time_s`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -115,8 +146,92 @@ struct ChanState {
 pub struct McapSamples<R: Read> {
     input: R,
     reader: LinearReader,
+    /// The chunk whose records are being read.
+    chunk: Option<ChunkRecords>,
+    /// Size of the input when known: no record may claim more than remains of it.
+    input_len: Option<u64>,
+    /// Bytes of input handed to `reader`.
+    fed: u64,
+    /// Byte offset of the next record of the file.
+    offset: u64,
     records: RecordDecoder,
     done: bool,
+}
+
+/// The records of one chunk, read by a [`LinearReader`] of their own that holds the chunk's
+/// header and compressed records, and whose record length limit is what the chunk holds.
+struct ChunkRecords {
+    reader: LinearReader,
+    /// Byte offset of the chunk in the file.
+    at: u64,
+    /// Byte offset of the next record in the chunk's records.
+    offset: u64,
+}
+
+impl ChunkRecords {
+    /// Check the chunk record at byte `at` (its body) and set up the reading of its records.
+    fn new(body: &[u8], at: u64) -> std::result::Result<Self, McapProblem> {
+        let chunk = mcap_records::chunk(body)?;
+        let compressed = chunk.records.len() as u64;
+        let holds = if chunk.compression.is_empty() {
+            compressed
+        } else {
+            let limit = (RECORD_LIMIT as u64).min(
+                compressed
+                    .saturating_mul(MAX_CHUNK_RATIO)
+                    .max(MIN_CHUNK_LIMIT),
+            );
+            if chunk.uncompressed_size > limit {
+                return Err(McapProblem::ChunkSize {
+                    uncompressed: chunk.uncompressed_size,
+                    compressed,
+                    max_ratio: MAX_CHUNK_RATIO,
+                    limit: RECORD_LIMIT as u64,
+                });
+            }
+            chunk.uncompressed_size
+        };
+        // The header's own length is checked against the limit too: never below it.
+        let limit = holds.max(MIN_CHUNK_LIMIT) as usize;
+        let mut reader = LinearReader::new_with_options(
+            LinearReaderOptions::default()
+                .with_skip_start_magic(true)
+                .with_skip_end_magic(true)
+                .with_record_length_limit(limit),
+        );
+        // The chunk without what follows its records: a record cannot run into padding.
+        let body = &body[..chunk.records_end];
+        let len = RECORD_PREFIX as usize + body.len();
+        let buf = reader.insert(len);
+        buf[0] = op::CHUNK;
+        buf[1..9].copy_from_slice(&(body.len() as u64).to_le_bytes());
+        buf[9..len].copy_from_slice(body);
+        reader.notify_read(len);
+        Ok(Self {
+            reader,
+            at,
+            offset: 0,
+        })
+    }
+
+    fn place(&self) -> McapPlace {
+        McapPlace::Chunk {
+            chunk: self.at,
+            offset: self.offset,
+        }
+    }
+}
+
+/// What one step of the reader gave. (It lives on the stack for one step; boxing the sample would
+/// allocate once per message.)
+#[allow(clippy::large_enum_variant)]
+enum Step {
+    /// A record decoded into a sample.
+    Sample(Sample),
+    /// Nothing yet.
+    More,
+    /// The end of the file.
+    End,
 }
 
 /// The sans-I/O half of [`McapSamples`]: what the records seen so far say (schemas, channels,
@@ -136,13 +251,15 @@ struct RecordDecoder {
 
 impl McapSamples<std::io::BufReader<File>> {
     /// Open a file.
+    ///
+    /// A FIFO, device or directory is refused before it is opened.
     pub fn open(path: &Path, options: McapOptions) -> Result<Self> {
-        let f = File::open(path).map_err(LogError::reading(path))?;
-        Ok(Self::from_reader(
-            std::io::BufReader::with_capacity(1 << 16, f),
-            path,
-            options,
-        ))
+        let f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
+        let len = f.metadata().map_err(LogError::reading(path))?.len();
+        Ok(
+            Self::from_reader(std::io::BufReader::with_capacity(1 << 16, f), path, options)
+                .with_input_len(len),
+        )
     }
 }
 
@@ -186,12 +303,13 @@ fn mask(s: &mut Sample, keep: &[bool; 9]) {
 impl<R: Read> McapSamples<R> {
     /// Read from any reader; `path` names the source in errors.
     pub fn from_reader(input: R, path: &Path, options: McapOptions) -> Self {
-        let reader = LinearReader::new_with_options(
-            LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT),
-        );
         Self {
             input,
-            reader,
+            reader: file_reader(RECORD_LIMIT),
+            chunk: None,
+            input_len: None,
+            fed: 0,
+            offset: mcap::MAGIC.len() as u64,
             records: RecordDecoder {
                 path: path.to_path_buf(),
                 options,
@@ -206,6 +324,15 @@ impl<R: Read> McapSamples<R> {
             },
             done: false,
         }
+    }
+
+    /// Declare the size of the input, bytes (before reading): no record may then claim more
+    /// than the input holds, nor more than remains of it after the record's offset.
+    /// [`Self::open`] does this with the file's size.
+    pub fn with_input_len(mut self, len: u64) -> Self {
+        self.input_len = Some(len);
+        self.reader = file_reader(RECORD_LIMIT.min(usize::try_from(len).unwrap_or(usize::MAX)));
+        self
     }
 
     /// The topics seen so far (all of them once the stream is exhausted), in order of appearance.
@@ -246,28 +373,95 @@ impl<R: Read> McapSamples<R> {
     /// The next sample: feed the reader until a record decodes into one, or the file ends.
     fn step(&mut self) -> Result<Option<Sample>> {
         loop {
-            let event = match self.reader.next_event() {
-                None => {
+            let step = if self.chunk.is_some() {
+                self.chunk_step()?
+            } else {
+                self.file_step()?
+            };
+            match step {
+                Step::Sample(s) => return Ok(Some(s)),
+                Step::More => {}
+                Step::End => {
                     self.done = true;
                     self.records.finish_checks()?;
                     return Ok(None);
-                }
-                Some(event) => event.map_err(|e| self.records.mcap_error(e))?,
-            };
-            match event {
-                LinearReadEvent::ReadRequest(n) => self.fill(n)?,
-                LinearReadEvent::Record { opcode, data } => {
-                    if let Some(s) = self.records.on_record(opcode, data)? {
-                        return Ok(Some(s));
-                    }
                 }
             }
         }
     }
 
-    /// Hand the reader up to `n` bytes of input (0 at the end of the input).
-    fn fill(&mut self, n: usize) -> Result<()> {
-        let buf = self.reader.insert(n);
+    /// One event of the file's reader: a read, a record, or a chunk to read next.
+    fn file_step(&mut self) -> Result<Step> {
+        let place = McapPlace::File {
+            offset: self.offset,
+        };
+        let event = match self.reader.next_event() {
+            None => return Ok(Step::End),
+            Some(event) => event.map_err(|e| self.records.mcap_error(place, e))?,
+        };
+        match event {
+            LinearReadEvent::ReadRequest(n) => {
+                self.fill(n, place)?;
+                Ok(Step::More)
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                self.offset += RECORD_PREFIX + data.len() as u64;
+                if opcode == op::CHUNK {
+                    let chunk =
+                        ChunkRecords::new(data, self.offset - RECORD_PREFIX - data.len() as u64)
+                            .map_err(|e| self.records.corrupt(opcode, place, e))?;
+                    self.chunk = Some(chunk);
+                    return Ok(Step::More);
+                }
+                Ok(self
+                    .records
+                    .on_record(opcode, data, place)?
+                    .map_or(Step::More, Step::Sample))
+            }
+        }
+    }
+
+    /// One event of the current chunk's reader: a record, or the end of the chunk.
+    fn chunk_step(&mut self) -> Result<Step> {
+        let Some(chunk) = self.chunk.as_mut() else {
+            return Ok(Step::More);
+        };
+        let place = chunk.place();
+        let event = match chunk.reader.next_event() {
+            None => {
+                self.chunk = None;
+                return Ok(Step::More);
+            }
+            Some(event) => event.map_err(|e| self.records.mcap_error(place, e))?,
+        };
+        match event {
+            // The whole chunk was handed over: a request for more is its end.
+            LinearReadEvent::ReadRequest(_) => {
+                chunk.reader.notify_read(0);
+                Ok(Step::More)
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                chunk.offset += RECORD_PREFIX + data.len() as u64;
+                Ok(self
+                    .records
+                    .on_record(opcode, data, place)?
+                    .map_or(Step::More, Step::Sample))
+            }
+        }
+    }
+
+    /// Hand the reader up to `n` bytes of input (0 at the end of the input), the reader being
+    /// at the record at `place`. A request for more than remains of an input of known size is
+    /// refused at once: the record runs past the end of the file.
+    fn fill(&mut self, n: usize, place: McapPlace) -> Result<()> {
+        if let Some(len) = self.input_len {
+            if n as u64 > len.saturating_sub(self.fed) {
+                return Err(self
+                    .records
+                    .mcap_error(place, mcap::McapError::UnexpectedEof));
+            }
+        }
+        let buf = self.reader.insert(n.min(FILL_BYTES));
         let got = loop {
             match self.input.read(buf) {
                 Ok(k) => break k,
@@ -276,51 +470,79 @@ impl<R: Read> McapSamples<R> {
             }
         };
         self.reader.notify_read(got);
+        self.fed += got as u64;
         Ok(())
     }
 }
 
+/// The reader of the file's records: chunks are taken whole, no record may exceed `limit`.
+fn file_reader(limit: usize) -> LinearReader {
+    LinearReader::new_with_options(
+        LinearReaderOptions::default()
+            .with_emit_chunks(true)
+            .with_record_length_limit(limit),
+    )
+}
+
 impl RecordDecoder {
-    /// [`LogError::Mcap`] after the messages read so far.
-    fn mcap_error(&self, cause: mcap::McapError) -> LogError {
+    /// [`LogError::Mcap`] at `place`, after the messages read so far.
+    fn mcap_error(&self, place: McapPlace, cause: mcap::McapError) -> LogError {
         LogError::Mcap {
             path: self.path.clone(),
+            place,
             messages: self.messages,
             cause,
         }
     }
 
+    /// [`LogError::McapCorrupt`]: the record `opcode` at `place` is invalid.
+    fn corrupt(&self, opcode: u8, place: McapPlace, problem: McapProblem) -> LogError {
+        LogError::McapCorrupt {
+            path: self.path.clone(),
+            record: record_name(opcode),
+            place,
+            messages: self.messages,
+            problem,
+        }
+    }
+
     /// One record: schemas and new channels are remembered; a message on a decoded topic is a
-    /// sample.
-    fn on_record(&mut self, opcode: u8, data: &[u8]) -> Result<Option<Sample>> {
-        match mcap::parse_record(opcode, data).map_err(|e| self.mcap_error(e))? {
-            mcap::records::Record::Schema { header, .. } => {
+    /// sample. Records aloft does not use are not parsed.
+    fn on_record(&mut self, opcode: u8, data: &[u8], place: McapPlace) -> Result<Option<Sample>> {
+        let corrupt = |d: &Self, e| d.corrupt(opcode, place, e);
+        match opcode {
+            op::SCHEMA => {
+                let s = mcap_records::schema(data).map_err(|e| corrupt(self, e))?;
                 self.schemas
-                    .insert(header.id, (header.name, header.encoding));
+                    .insert(s.id, (s.name.to_string(), s.encoding.to_string()));
             }
-            mcap::records::Record::Channel(ch) if !self.channels.contains_key(&ch.id) => {
-                self.add_channel(ch)?;
+            op::CHANNEL => {
+                let ch = mcap_records::channel(data).map_err(|e| corrupt(self, e))?;
+                if !self.channels.contains_key(&ch.id) {
+                    self.add_channel(&ch)?;
+                }
             }
-            mcap::records::Record::Message { header, data } => {
-                return self.on_message(&header, &data);
+            op::MESSAGE => {
+                let m = mcap_records::message(data).map_err(|e| corrupt(self, e))?;
+                return self.on_message(&m.header, m.data, place);
             }
             _ => {}
         }
         Ok(None)
     }
 
-    fn add_channel(&mut self, ch: mcap::records::Channel) -> Result<()> {
+    fn add_channel(&mut self, ch: &ChannelView<'_>) -> Result<()> {
         let (schema, schema_encoding) =
             self.schemas.get(&ch.schema_id).cloned().unwrap_or_default();
-        let decoder = decoder_for(&schema, &schema_encoding, &ch.message_encoding);
+        let decoder = decoder_for(&schema, &schema_encoding, ch.message_encoding);
         let info = self.topics.len();
         let named = self.options.topics.iter().position(|t| *t == ch.topic);
         if !self.options.topics.is_empty() && named.is_some() && decoder.is_none() {
             return Err(LogError::UnsupportedTopic {
                 path: self.path.clone(),
-                topic: ch.topic.clone(),
+                topic: ch.topic.to_string(),
                 schema: schema.clone(),
-                encoding: ch.message_encoding.clone(),
+                encoding: ch.message_encoding.to_string(),
                 supported: SUPPORTED,
             });
         }
@@ -335,10 +557,10 @@ impl RecordDecoder {
             }
         }
         self.topics.push(TopicInfo {
-            topic: ch.topic.clone(),
+            topic: ch.topic.to_string(),
             schema,
             schema_encoding,
-            message_encoding: ch.message_encoding.clone(),
+            message_encoding: ch.message_encoding.to_string(),
             messages: 0,
             decoded: 0,
             log_time_range_ns: None,
@@ -361,11 +583,17 @@ impl RecordDecoder {
 
     /// A message: counted on its topic, and decoded into a sample when the topic feeds a
     /// channel.
-    fn on_message(&mut self, header: &MessageHeader, data: &[u8]) -> Result<Option<Sample>> {
+    fn on_message(
+        &mut self,
+        header: &MessageHeader,
+        data: &[u8],
+        place: McapPlace,
+    ) -> Result<Option<Sample>> {
         self.messages += 1;
         let Some(&st) = self.channels.get(&header.channel_id) else {
             return Err(LogError::Mcap {
                 path: self.path.clone(),
+                place,
                 messages: self.messages - 1,
                 cause: mcap::McapError::UnknownChannel(header.sequence, header.channel_id),
             });
