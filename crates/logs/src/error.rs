@@ -120,12 +120,12 @@ pub enum LogError {
     },
     /// A CSV line longer than aloft reads (a file that is not a table of rows, or has no line
     /// breaks): refused so that memory does not grow with it.
-    #[error("{path}: a line after line {after_line} is longer than {limit_bytes} bytes; this is not a CSV log aloft can read")]
+    #[error("{path}: line {line} is longer than {limit_bytes} bytes; this is not a CSV log aloft can read")]
     LineTooLong {
         /// The file.
         path: PathBuf,
-        /// The last line read completely (0: the header is too long).
-        after_line: u64,
+        /// The 1-based line (the header is line 1).
+        line: u64,
         /// The longest line accepted, bytes.
         limit_bytes: usize,
     },

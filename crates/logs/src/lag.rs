@@ -178,9 +178,13 @@ fn parabola_peak_offset(cs: &[f64], best: usize) -> Option<f64> {
     (den < 0.0).then(|| (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5))
 }
 
+/// Most points [`resample_uniform`] makes (8 bytes each, 128 MiB).
+pub const MAX_RESAMPLED_POINTS: usize = 1 << 24;
+
 /// Linear interpolation of `(times_s, values)` onto a uniform grid of step `dt_s` from the first
 /// time to the last. Samples whose time does not increase are skipped (they are reported by the
-/// log's [`crate::TimeReport`]). Returns the grid's start time and the values.
+/// log's [`crate::TimeReport`]). Returns the grid's start time and the values; a grid of more
+/// than [`MAX_RESAMPLED_POINTS`] is an error.
 pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f64, Vec<f64>)> {
     check_step(dt_s)?;
     let pts: Vec<(f64, f64)> = {
@@ -201,7 +205,16 @@ pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f
     }
     let t0 = pts[0].0;
     let t1 = pts[pts.len() - 1].0;
-    let n = ((t1 - t0) / dt_s).floor() as usize + 1;
+    let steps = ((t1 - t0) / dt_s).floor();
+    // The grid's size comes from the log's time stamps: bound it before allocating.
+    if !(steps < MAX_RESAMPLED_POINTS as f64) {
+        return Err(LogError::InvalidArgument {
+            name: "resampled points",
+            value: steps + 1.0,
+            reason: "more than 2^24 points: the log's time span is too long for the step",
+        });
+    }
+    let n = steps as usize + 1;
     let mut out = Vec::with_capacity(n);
     let mut j = 0;
     for i in 0..n {
@@ -229,6 +242,27 @@ mod tests {
                 (0.37 * t).sin() + 0.5 * (1.13 * t).sin() + 0.3 * (0.071 * t * t).cos()
             })
             .collect()
+    }
+
+    /// The grid's size comes from the log's time stamps: a span of 300 years at 0.1 s (a
+    /// corrupt stamp) is refused instead of allocating 10^11 points.
+    #[test]
+    fn a_time_span_too_long_for_the_step_is_refused_before_allocating() {
+        for t1 in [1e10, f64::MAX, (MAX_RESAMPLED_POINTS as f64) * 0.1] {
+            let e = resample_uniform(&[0.0, t1], &[1.0, 2.0], 0.1).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    LogError::InvalidArgument {
+                        name: "resampled points",
+                        ..
+                    }
+                ),
+                "{t1}: {e}"
+            );
+        }
+        let (_, v) = resample_uniform(&[0.0, 1.0], &[1.0, 2.0], 0.1).unwrap();
+        assert_eq!(v.len(), 11);
     }
 
     #[test]
