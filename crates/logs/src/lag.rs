@@ -206,8 +206,9 @@ pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f
     let t0 = pts[0].0;
     let t1 = pts[pts.len() - 1].0;
     let steps = ((t1 - t0) / dt_s).floor();
-    // The grid's size comes from the log's time stamps: bound it before allocating.
-    if !(steps < MAX_RESAMPLED_POINTS as f64) {
+    // The grid's size comes from the log's time stamps (finite, so `steps` is not NaN):
+    // bound it before allocating.
+    if steps >= MAX_RESAMPLED_POINTS as f64 {
         return Err(LogError::InvalidArgument {
             name: "resampled points",
             value: steps + 1.0,
