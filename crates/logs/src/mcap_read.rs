@@ -9,11 +9,13 @@
 //! # Corrupt lengths
 //! Every length read out of the file is checked before anything is allocated for it, so a
 //! flipped byte is an error, never a multi-gigabyte allocation:
-//! - Records of the file: no record may claim more than the file holds ([`RECORD_LIMIT`] at most,
-//!   the reader's `record_length_limit`), nor more than remains after it: a request for more
-//!   bytes than remain is the same error as a truncated file ([`LogError::Mcap`], at the
-//!   record's byte offset). Input is handed to the reader in pieces of at most [`FILL_BYTES`],
-//!   so its buffer only grows with bytes actually read.
+//! - Records of the file: no record may claim more than remains of the file (when its size is
+//!   known, [`McapSamples::with_input_len`]): the reader's request for more bytes than remain is
+//!   refused before anything is read or allocated for it, as the same error as a truncated file
+//!   ([`LogError::Mcap`], at the record's byte offset). No record may claim more than
+//!   [`RECORD_LIMIT`] (the reader's `record_length_limit`; [`LogError::McapCorrupt`]). Input is
+//!   handed to the reader in pieces of at most [`FILL_BYTES`], so its buffer only grows with
+//!   bytes actually read, whatever a length claims.
 //! - Chunks are taken whole ([`LinearReaderOptions::emit_chunks`]), their header is checked
 //!   ([`crate::mcap_records::chunk`]: the records must fit in the chunk; a declared
 //!   uncompressed size over [`MAX_CHUNK_RATIO`] times the compressed size or over
@@ -49,7 +51,7 @@ use crate::mcap_records::{self, record_name, ChannelView, McapPlace, McapProblem
 use crate::ros::{decode_cdr, decode_json, Decoded, MessageKind, RosDecodeOptions, SUPPORTED};
 use crate::sample::{Channel, Sample, TimeChecker, TimeReport};
 
-/// Largest record (or chunk, compressed or not) accepted, bytes; smaller for a smaller file.
+/// Largest record (or chunk, compressed or not) accepted, bytes.
 pub const RECORD_LIMIT: usize = 256 << 20;
 
 /// Largest accepted ratio of a chunk's declared uncompressed size to its compressed size
@@ -162,6 +164,8 @@ pub struct McapSamples<R: Read> {
 /// header and compressed records, and whose record length limit is what the chunk holds.
 struct ChunkRecords {
     reader: LinearReader,
+    /// The reader's record length limit, bytes.
+    limit: usize,
     /// Byte offset of the chunk in the file.
     at: u64,
     /// Byte offset of the next record in the chunk's records.
@@ -209,6 +213,7 @@ impl ChunkRecords {
         reader.notify_read(len);
         Ok(Self {
             reader,
+            limit,
             at,
             offset: 0,
         })
@@ -305,7 +310,7 @@ impl<R: Read> McapSamples<R> {
     pub fn from_reader(input: R, path: &Path, options: McapOptions) -> Self {
         Self {
             input,
-            reader: file_reader(RECORD_LIMIT),
+            reader: file_reader(),
             chunk: None,
             input_len: None,
             fed: 0,
@@ -331,7 +336,6 @@ impl<R: Read> McapSamples<R> {
     /// [`Self::open`] does this with the file's size.
     pub fn with_input_len(mut self, len: u64) -> Self {
         self.input_len = Some(len);
-        self.reader = file_reader(RECORD_LIMIT.min(usize::try_from(len).unwrap_or(usize::MAX)));
         self
     }
 
@@ -397,7 +401,7 @@ impl<R: Read> McapSamples<R> {
         };
         let event = match self.reader.next_event() {
             None => return Ok(Step::End),
-            Some(event) => event.map_err(|e| self.records.mcap_error(place, e))?,
+            Some(event) => event.map_err(|e| self.records.reader_error(place, e, RECORD_LIMIT))?,
         };
         match event {
             LinearReadEvent::ReadRequest(n) => {
@@ -426,13 +430,13 @@ impl<R: Read> McapSamples<R> {
         let Some(chunk) = self.chunk.as_mut() else {
             return Ok(Step::More);
         };
-        let place = chunk.place();
+        let (place, limit) = (chunk.place(), chunk.limit);
         let event = match chunk.reader.next_event() {
             None => {
                 self.chunk = None;
                 return Ok(Step::More);
             }
-            Some(event) => event.map_err(|e| self.records.mcap_error(place, e))?,
+            Some(event) => event.map_err(|e| self.records.reader_error(place, e, limit))?,
         };
         match event {
             // The whole chunk was handed over: a request for more is its end.
@@ -475,12 +479,13 @@ impl<R: Read> McapSamples<R> {
     }
 }
 
-/// The reader of the file's records: chunks are taken whole, no record may exceed `limit`.
-fn file_reader(limit: usize) -> LinearReader {
+/// The reader of the file's records: chunks are taken whole, no record may exceed
+/// [`RECORD_LIMIT`].
+fn file_reader() -> LinearReader {
     LinearReader::new_with_options(
         LinearReaderOptions::default()
             .with_emit_chunks(true)
-            .with_record_length_limit(limit),
+            .with_record_length_limit(RECORD_LIMIT),
     )
 }
 
@@ -492,6 +497,22 @@ impl RecordDecoder {
             place,
             messages: self.messages,
             cause,
+        }
+    }
+
+    /// The error of a reader whose record length limit is `limit`: a record over the limit is
+    /// [`LogError::McapCorrupt`], anything else [`LogError::Mcap`].
+    fn reader_error(&self, place: McapPlace, cause: mcap::McapError, limit: usize) -> LogError {
+        match cause {
+            mcap::McapError::RecordTooLarge { opcode, len } => self.corrupt(
+                opcode,
+                place,
+                McapProblem::RecordTooLong {
+                    claimed: len,
+                    limit: limit as u64,
+                },
+            ),
+            cause => self.mcap_error(place, cause),
         }
     }
 

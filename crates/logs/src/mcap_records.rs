@@ -34,6 +34,14 @@ pub enum McapProblem {
         /// map's entry), bytes.
         available: u64,
     },
+    /// A record whose length is more than the chunk it is in holds, or than any record may have.
+    #[error("its length, {claimed} bytes, is more than the {limit} bytes a record can have there")]
+    RecordTooLong {
+        /// The length the record claims, bytes.
+        claimed: u64,
+        /// The most it can have, bytes.
+        limit: u64,
+    },
     /// The record ends inside a fixed-size field.
     #[error("it ends inside its {field} ({needed} bytes needed, {available} left)")]
     Truncated {
@@ -51,7 +59,7 @@ pub enum McapProblem {
         field: &'static str,
     },
     /// A chunk whose declared uncompressed size is implausible for its compressed size.
-    #[error("it declares {uncompressed} bytes of records from {compressed} compressed bytes; more than {max_ratio} times the compressed size (or {limit} bytes in all) is taken as a corrupt size")]
+    #[error("its uncompressed size, {uncompressed} bytes, is more than {max_ratio} times its {compressed} compressed bytes or more than {limit} bytes: a corrupt size")]
     ChunkSize {
         /// The declared uncompressed size, bytes.
         uncompressed: u64,
