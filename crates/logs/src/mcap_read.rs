@@ -1,30 +1,32 @@
 //! Streaming MCAP reader: decodes the supported topics of a file into [`Sample`]s, one per message.
 //!
 //! # Memory
-//! The file is read through `mcap`'s sans-I/O [`LinearReader`] from any `std::io::Read`: memory
-//! is bounded by the largest record or chunk, typically a few MB, whatever the file size. This
-//! is preferred over memory-mapping because it also works on pipes, and a file truncated or
-//! replaced while it is being read gives an I/O error instead of a `SIGBUS`.
+//! The file is read front to back from any `std::io::Read` (pipes too; a file truncated or
+//! replaced while it is read gives an error, not the `SIGBUS` of a memory map). Only the records
+//! aloft decodes are held in memory, one at a time: Schema, Channel and Message records of the
+//! file, and one record of a chunk at a time (its compressed records are streamed through
+//! `mcap`'s sans-I/O [`LinearReader`], which decompresses them). Any other record (attachments,
+//! metadata, indexes, the summary) is skipped without being kept. Memory is bounded by the
+//! largest decoded record, typically a few kB, whatever the file size.
 //!
 //! # Corrupt lengths
 //! Every length read out of the file is checked before anything is allocated for it, so a
 //! flipped byte is an error, never a multi-gigabyte allocation:
-//! - Records of the file: no record may claim more than remains of the file (when its size is
-//!   known, [`McapSamples::with_input_len`]): the reader's request for more bytes than remain is
-//!   refused before anything is read or allocated for it, as the same error as a truncated file
-//!   ([`LogError::Mcap`], at the record's byte offset). No record may claim more than
-//!   [`RECORD_LIMIT`] (the reader's `record_length_limit`; [`LogError::McapCorrupt`]). Input is
-//!   handed to the reader in pieces of at most [`FILL_BYTES`], so its buffer only grows with
-//!   bytes actually read, whatever a length claims.
-//! - Chunks are taken whole ([`LinearReaderOptions::emit_chunks`]), their header is checked
-//!   ([`crate::mcap_records::chunk`]: the records must fit in the chunk; a declared
-//!   uncompressed size over [`MAX_CHUNK_RATIO`] times the compressed size or over
-//!   [`RECORD_LIMIT`] is refused), and their records are read by a reader of their own whose
-//!   record limit is the chunk's uncompressed size: a record inside a chunk cannot claim (and
-//!   make the decompressor reserve) more than its chunk holds.
-//! - Schema, Channel and Message records are read by [`crate::mcap_records`], which checks every
-//!   string, byte array and map length against the record and allocates nothing; other records
-//!   are skipped unparsed.
+//! - Records of the file: none may claim more than remains of the file (when its size is known,
+//!   [`McapSamples::with_input_len`]; [`McapSamples::open`] knows it): that is refused before
+//!   anything is read, as the same error as a truncated file ([`LogError::Mcap`], at the
+//!   record's byte offset). A record that is kept may not claim more than [`RECORD_LIMIT`]
+//!   ([`LogError::McapCorrupt`]), and its buffer grows with the bytes actually read.
+//! - Chunks: the header is read first and checked ([`crate::mcap_records::chunk_header_len`],
+//!   [`crate::mcap_records::chunk_header`]: the compression string and the records must fit in
+//!   the record; an uncompressed size over [`MAX_CHUNK_RATIO`] times the compressed size or
+//!   over [`RECORD_LIMIT`] is refused). The records are then read by a [`LinearReader`] of
+//!   their own whose record length limit is what the chunk holds, handed the compressed bytes
+//!   in pieces of at most [`FILL_BYTES`]: a record inside a chunk cannot claim (and make the
+//!   decompressor reserve) more than its chunk holds, nor run past it.
+//! - Schema, Channel and Message records are parsed by [`crate::mcap_records`], which checks
+//!   every string, byte array and map length against the record and allocates nothing; other
+//!   records are not parsed at all.
 //!
 //! # Topic selection
 //! Without named topics, each model channel (position, velocity, attitude, battery, ...) is taken
@@ -64,6 +66,9 @@ const MIN_CHUNK_LIMIT: u64 = 64 << 10;
 
 /// Largest piece of input handed to the reader at once, bytes.
 pub const FILL_BYTES: usize = 256 << 10;
+
+/// A Footer record's body: summary start, summary offset start, summary CRC, bytes.
+const FOOTER_LEN: u64 = 8 + 8 + 4;
 
 /// Opcode and length before every record, bytes.
 const RECORD_PREFIX: u64 = 1 + 8;
@@ -147,73 +152,94 @@ struct ChanState {
 /// Samples of one MCAP file, decoded message by message.
 pub struct McapSamples<R: Read> {
     input: R,
-    reader: LinearReader,
-    /// The chunk whose records are being read.
-    chunk: Option<ChunkRecords>,
     /// Size of the input when known: no record may claim more than remains of it.
     input_len: Option<u64>,
-    /// Bytes of input handed to `reader`.
-    fed: u64,
-    /// Byte offset of the next record of the file.
+    /// Bytes of the input read so far (the offset of what comes next).
     offset: u64,
+    /// Where the reading is in the file's layout.
+    at: At,
+    /// The body of the record being decoded (reused).
+    body: Vec<u8>,
+    /// The chunk whose records are being read.
+    chunk: Option<ChunkRecords>,
     records: RecordDecoder,
     done: bool,
 }
 
-/// The records of one chunk, read by a [`LinearReader`] of their own that holds the chunk's
-/// header and compressed records, and whose record length limit is what the chunk holds.
+/// Where the reading is in the file's layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum At {
+    /// Before the start magic.
+    Start,
+    /// Before a record of the file.
+    Record,
+    /// In the records of a chunk (`self.chunk`), which `padding` bytes follow.
+    Chunk { padding: u64 },
+    /// After the footer: the end magic.
+    EndMagic,
+    /// After the end magic.
+    End,
+}
+
+/// The records of one chunk, read by a [`LinearReader`] of their own: it is handed the chunk's
+/// header, then the compressed records as it asks for them, and its record length limit is what
+/// the chunk holds.
 struct ChunkRecords {
     reader: LinearReader,
     /// The reader's record length limit, bytes.
     limit: usize,
-    /// Byte offset of the chunk in the file.
+    /// Compressed bytes of the chunk not yet handed to the reader.
+    compressed_left: u64,
+    /// Byte offset of the chunk record in the file.
     at: u64,
     /// Byte offset of the next record in the chunk's records.
     offset: u64,
 }
 
 impl ChunkRecords {
-    /// Check the chunk record at byte `at` (its body) and set up the reading of its records.
-    fn new(body: &[u8], at: u64) -> std::result::Result<Self, McapProblem> {
-        let chunk = mcap_records::chunk(body)?;
-        let compressed = chunk.records.len() as u64;
-        let holds = if chunk.compression.is_empty() {
-            compressed
-        } else {
-            let limit = (RECORD_LIMIT as u64).min(
+    /// Check the chunk at byte `at`, whose header is `head`, and set up the reading of its
+    /// records.
+    fn new(head: &[u8], record_len: u64, at: u64) -> std::result::Result<Self, McapProblem> {
+        let header = mcap_records::chunk_header(head, record_len)?;
+        let compressed = header.compressed_size;
+        if !header.compression.is_empty() {
+            let most = (RECORD_LIMIT as u64).min(
                 compressed
                     .saturating_mul(MAX_CHUNK_RATIO)
                     .max(MIN_CHUNK_LIMIT),
             );
-            if chunk.uncompressed_size > limit {
+            if header.uncompressed_size > most {
                 return Err(McapProblem::ChunkSize {
-                    uncompressed: chunk.uncompressed_size,
+                    uncompressed: header.uncompressed_size,
                     compressed,
                     max_ratio: MAX_CHUNK_RATIO,
                     limit: RECORD_LIMIT as u64,
                 });
             }
-            chunk.uncompressed_size
-        };
-        // The header's own length is checked against the limit too: never below it.
-        let limit = holds.max(MIN_CHUNK_LIMIT) as usize;
+        }
+        // No record inside can be longer than the chunk's records, compressed or not (the
+        // header's own length is checked against the limit too: never below it).
+        let limit = header
+            .uncompressed_size
+            .max(compressed)
+            .max(MIN_CHUNK_LIMIT) as usize;
         let mut reader = LinearReader::new_with_options(
             LinearReaderOptions::default()
                 .with_skip_start_magic(true)
                 .with_skip_end_magic(true)
                 .with_record_length_limit(limit),
         );
-        // The chunk without what follows its records: a record cannot run into padding.
-        let body = &body[..chunk.records_end];
-        let len = RECORD_PREFIX as usize + body.len();
+        // The chunk record without what follows its records: a record cannot run into padding.
+        let len = RECORD_PREFIX as usize + head.len();
         let buf = reader.insert(len);
         buf[0] = op::CHUNK;
-        buf[1..9].copy_from_slice(&(body.len() as u64).to_le_bytes());
-        buf[9..len].copy_from_slice(body);
+        buf[1..9].copy_from_slice(&(head.len() as u64 + compressed).to_le_bytes());
+        buf[9..len].copy_from_slice(head);
         reader.notify_read(len);
         Ok(Self {
             reader,
             limit,
+            compressed_left: compressed,
             at,
             offset: 0,
         })
@@ -310,11 +336,11 @@ impl<R: Read> McapSamples<R> {
     pub fn from_reader(input: R, path: &Path, options: McapOptions) -> Self {
         Self {
             input,
-            reader: file_reader(),
-            chunk: None,
             input_len: None,
-            fed: 0,
-            offset: mcap::MAGIC.len() as u64,
+            offset: 0,
+            at: At::Start,
+            body: Vec::new(),
+            chunk: None,
             records: RecordDecoder {
                 path: path.to_path_buf(),
                 options,
@@ -374,13 +400,15 @@ impl<R: Read> McapSamples<R> {
         v
     }
 
-    /// The next sample: feed the reader until a record decodes into one, or the file ends.
+    /// The next sample: read until a record decodes into one, or the file ends.
     fn step(&mut self) -> Result<Option<Sample>> {
         loop {
-            let step = if self.chunk.is_some() {
-                self.chunk_step()?
-            } else {
-                self.file_step()?
+            let step = match self.at {
+                At::Start => self.magic(At::Record)?,
+                At::Record => self.file_record()?,
+                At::Chunk { padding } => self.chunk_step(padding)?,
+                At::EndMagic => self.magic(At::End)?,
+                At::End => Step::End,
             };
             match step {
                 Step::Sample(s) => return Ok(Some(s)),
@@ -394,54 +422,127 @@ impl<R: Read> McapSamples<R> {
         }
     }
 
-    /// One event of the file's reader: a read, a record, or a chunk to read next.
-    fn file_step(&mut self) -> Result<Step> {
-        let place = McapPlace::File {
-            offset: self.offset,
-        };
-        let event = match self.reader.next_event() {
-            None => return Ok(Step::End),
-            Some(event) => event.map_err(|e| self.records.reader_error(place, e, RECORD_LIMIT))?,
-        };
-        match event {
-            LinearReadEvent::ReadRequest(n) => {
-                self.fill(n, place)?;
-                Ok(Step::More)
-            }
-            LinearReadEvent::Record { opcode, data } => {
-                self.offset += RECORD_PREFIX + data.len() as u64;
-                if opcode == op::CHUNK {
-                    let chunk =
-                        ChunkRecords::new(data, self.offset - RECORD_PREFIX - data.len() as u64)
-                            .map_err(|e| self.records.corrupt(opcode, place, e))?;
-                    self.chunk = Some(chunk);
+    /// The magic at the start or end of the file; `next` is what follows it.
+    fn magic(&mut self, next: At) -> Result<Step> {
+        let place = self.file_place();
+        self.read_body(mcap::MAGIC.len() as u64, place)?;
+        if self.body != mcap::MAGIC {
+            return Err(self.records.mcap_error(place, mcap::McapError::BadMagic));
+        }
+        self.at = next;
+        Ok(Step::More)
+    }
+
+    /// The next record of the file: Schema, Channel and Message records are read and decoded,
+    /// a chunk's records are read next, the footer leads to the end magic, and any other record
+    /// is skipped unread.
+    fn file_record(&mut self) -> Result<Step> {
+        let place = self.file_place();
+        self.read_body(RECORD_PREFIX, place)?;
+        let opcode = self.body[0];
+        let mut len = [0u8; 8];
+        len.copy_from_slice(&self.body[1..9]);
+        let len = u64::from_le_bytes(len);
+        self.check_remaining(len, place)?;
+        match opcode {
+            op::SCHEMA | op::CHANNEL | op::MESSAGE | op::FOOTER => {
+                if len > RECORD_LIMIT as u64 {
+                    let problem = McapProblem::RecordTooLong {
+                        claimed: len,
+                        limit: RECORD_LIMIT as u64,
+                    };
+                    return Err(self.records.corrupt(opcode, place, problem));
+                }
+                if opcode == op::FOOTER && len < FOOTER_LEN {
+                    let problem = McapProblem::Truncated {
+                        field: "footer",
+                        needed: FOOTER_LEN,
+                        available: len,
+                    };
+                    return Err(self.records.corrupt(opcode, place, problem));
+                }
+                self.read_body(len, place)?;
+                if opcode == op::FOOTER {
+                    self.at = At::EndMagic;
                     return Ok(Step::More);
                 }
-                Ok(self
-                    .records
-                    .on_record(opcode, data, place)?
-                    .map_or(Step::More, Step::Sample))
+                let body = std::mem::take(&mut self.body);
+                let sample = self.records.on_record(opcode, &body, place);
+                self.body = body;
+                Ok(sample?.map_or(Step::More, Step::Sample))
+            }
+            op::CHUNK => {
+                self.start_chunk(len, place)?;
+                Ok(Step::More)
+            }
+            _ => {
+                self.skip(len, place)?;
+                Ok(Step::More)
             }
         }
     }
 
-    /// One event of the current chunk's reader: a record, or the end of the chunk.
-    fn chunk_step(&mut self) -> Result<Step> {
+    /// Read and check the header of the chunk at `place`, whose record is `len` bytes long, and
+    /// set up the reading of its records.
+    fn start_chunk(&mut self, len: u64, place: McapPlace) -> Result<()> {
+        let McapPlace::File { offset: at } = place else {
+            return Ok(());
+        };
+        let corrupt = |me: &Self, problem| me.records.corrupt(op::CHUNK, place, problem);
+        let fixed_len = mcap_records::CHUNK_HEADER_FIXED;
+        let head_len = {
+            let mut fixed = [0u8; mcap_records::CHUNK_HEADER_FIXED];
+            if len >= fixed_len as u64 {
+                self.read_body(fixed_len as u64, place)?;
+                fixed.copy_from_slice(&self.body);
+            }
+            mcap_records::chunk_header_len(&fixed, len).map_err(|p| corrupt(self, p))?
+        };
+        let mut head = std::mem::take(&mut self.body);
+        let read = self.read_body((head_len - fixed_len) as u64, place);
+        head.extend_from_slice(&self.body);
+        read?;
+        let chunk = ChunkRecords::new(&head, len, at);
+        self.body = head;
+        let chunk = chunk.map_err(|p| corrupt(self, p))?;
+        self.at = At::Chunk {
+            padding: len - head_len as u64 - chunk.compressed_left,
+        };
+        self.chunk = Some(chunk);
+        Ok(())
+    }
+
+    /// One event of the current chunk's reader: a record, a read of compressed records, or the
+    /// end of the chunk (then its `padding` is skipped).
+    fn chunk_step(&mut self, padding: u64) -> Result<Step> {
         let Some(chunk) = self.chunk.as_mut() else {
+            self.at = At::Record;
             return Ok(Step::More);
         };
         let (place, limit) = (chunk.place(), chunk.limit);
         let event = match chunk.reader.next_event() {
             None => {
+                let at = McapPlace::File { offset: chunk.at };
                 self.chunk = None;
+                self.skip(padding, at)?;
+                self.at = At::Record;
                 return Ok(Step::More);
             }
             Some(event) => event.map_err(|e| self.records.reader_error(place, e, limit))?,
         };
         match event {
-            // The whole chunk was handed over: a request for more is its end.
-            LinearReadEvent::ReadRequest(_) => {
-                chunk.reader.notify_read(0);
+            LinearReadEvent::ReadRequest(n) => {
+                let at = McapPlace::File { offset: chunk.at };
+                let want = (n.min(FILL_BYTES) as u64).min(chunk.compressed_left) as usize;
+                let buf = chunk.reader.insert(want);
+                let got = read_some(&mut self.input, buf)
+                    .map_err(LogError::reading(&self.records.path))?;
+                chunk.reader.notify_read(got);
+                chunk.compressed_left -= got as u64;
+                self.offset += got as u64;
+                if got == 0 && want > 0 {
+                    return Err(self.records.mcap_error(at, mcap::McapError::UnexpectedEof));
+                }
                 Ok(Step::More)
             }
             LinearReadEvent::Record { opcode, data } => {
@@ -454,39 +555,65 @@ impl<R: Read> McapSamples<R> {
         }
     }
 
-    /// Hand the reader up to `n` bytes of input (0 at the end of the input), the reader being
-    /// at the record at `place`. A request for more than remains of an input of known size is
-    /// refused at once: the record runs past the end of the file.
-    fn fill(&mut self, n: usize, place: McapPlace) -> Result<()> {
-        if let Some(len) = self.input_len {
-            if n as u64 > len.saturating_sub(self.fed) {
-                return Err(self
-                    .records
-                    .mcap_error(place, mcap::McapError::UnexpectedEof));
-            }
+    /// The place of the next record of the file.
+    fn file_place(&self) -> McapPlace {
+        McapPlace::File {
+            offset: self.offset,
         }
-        let buf = self.reader.insert(n.min(FILL_BYTES));
-        let got = loop {
-            match self.input.read(buf) {
-                Ok(k) => break k,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(cause) => return Err(LogError::reading(&self.records.path)(cause)),
-            }
-        };
-        self.reader.notify_read(got);
-        self.fed += got as u64;
+    }
+
+    /// A record at `place` may not claim more than remains of an input of known size: that is
+    /// the error of a truncated file, given before anything is read or allocated.
+    fn check_remaining(&self, len: u64, place: McapPlace) -> Result<()> {
+        match self.input_len {
+            Some(total) if len > total.saturating_sub(self.offset) => Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof)),
+            _ => Ok(()),
+        }
+    }
+
+    /// Read the next `n` bytes into `self.body`, for the record at `place`. The buffer grows
+    /// with the bytes actually read, whatever `n` claims.
+    fn read_body(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.check_remaining(n, place)?;
+        self.body.clear();
+        let got = (&mut self.input)
+            .take(n)
+            .read_to_end(&mut self.body)
+            .map_err(LogError::reading(&self.records.path))?;
+        self.offset += got as u64;
+        if (got as u64) < n {
+            return Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof));
+        }
+        Ok(())
+    }
+
+    /// Skip the next `n` bytes (a record aloft does not use), without keeping them.
+    fn skip(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.check_remaining(n, place)?;
+        let got = std::io::copy(&mut (&mut self.input).take(n), &mut std::io::sink())
+            .map_err(LogError::reading(&self.records.path))?;
+        self.offset += got;
+        if got < n {
+            return Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof));
+        }
         Ok(())
     }
 }
 
-/// The reader of the file's records: chunks are taken whole, no record may exceed
-/// [`RECORD_LIMIT`].
-fn file_reader() -> LinearReader {
-    LinearReader::new_with_options(
-        LinearReaderOptions::default()
-            .with_emit_chunks(true)
-            .with_record_length_limit(RECORD_LIMIT),
-    )
+/// One `read` into `buf`, retried when interrupted.
+fn read_some(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    loop {
+        match input.read(buf) {
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            r => return r,
+        }
+    }
 }
 
 impl RecordDecoder {

@@ -128,17 +128,70 @@ pub struct MessageView<'a> {
     pub data: &'a [u8],
 }
 
-/// A Chunk record's header and its compressed records.
+/// A Chunk record's header (what precedes its compressed records).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ChunkView<'a> {
+pub struct ChunkHeaderView<'a> {
     /// Size of the records once decompressed, bytes.
     pub uncompressed_size: u64,
     /// Compression (`""` for none, `zstd`, `lz4`).
     pub compression: &'a str,
-    /// The (compressed) records.
-    pub records: &'a [u8],
-    /// Bytes of the body up to the end of the records (what follows is padding).
-    pub records_end: usize,
+    /// Size of the (compressed) records that follow the header, bytes.
+    pub compressed_size: u64,
+}
+
+/// Bytes of a Chunk header up to and including its compression's length: start and end times,
+/// uncompressed size and CRC, then the `u32` length of the compression string.
+pub const CHUNK_HEADER_FIXED: usize = 8 + 8 + 8 + 4 + 4;
+
+/// The length of a Chunk header from its first [`CHUNK_HEADER_FIXED`] bytes, checked against
+/// the length of its record (`record_len`, the body's bytes).
+pub fn chunk_header_len(
+    fixed: &[u8; CHUNK_HEADER_FIXED],
+    record_len: u64,
+) -> Result<usize, McapProblem> {
+    let min = (CHUNK_HEADER_FIXED + 8) as u64;
+    if record_len < min {
+        return Err(McapProblem::Truncated {
+            field: "chunk header",
+            needed: min,
+            available: record_len,
+        });
+    }
+    let claimed = u32::from_le_bytes([fixed[28], fixed[29], fixed[30], fixed[31]]);
+    if u64::from(claimed) > record_len - min {
+        return Err(McapProblem::FieldTooLong {
+            field: "compression",
+            claimed: u64::from(claimed),
+            available: record_len - min,
+        });
+    }
+    Ok(min as usize + claimed as usize)
+}
+
+/// A Chunk header (its [`chunk_header_len`] bytes), its records checked against the length of
+/// its record (`record_len`): they must fit after the header. Bytes after them (padding) are
+/// allowed, as by `mcap`.
+pub fn chunk_header(head: &[u8], record_len: u64) -> Result<ChunkHeaderView<'_>, McapProblem> {
+    let mut f = Fields::new(head);
+    f.u64("message start time")?;
+    f.u64("message end time")?;
+    let uncompressed_size = f.u64("uncompressed size")?;
+    f.u32("uncompressed CRC")?;
+    let compression = f.string("compression")?;
+    let compressed_size = f.u64("compressed size")?;
+    let available = record_len.saturating_sub(f.pos as u64);
+    if compressed_size > available {
+        return Err(McapProblem::FieldTooLong {
+            field: "records",
+            claimed: compressed_size,
+            available,
+        });
+    }
+    Ok(ChunkHeaderView {
+        uncompressed_size,
+        compression,
+        compressed_size,
+    })
 }
 
 /// Where in an MCAP file a record is.
@@ -289,33 +342,6 @@ pub fn message(body: &[u8]) -> Result<MessageView<'_>, McapProblem> {
     })
 }
 
-/// A Chunk record's body: its header, and its records checked against the bytes that remain.
-/// Bytes after the records (padding) are ignored, as by `mcap`.
-pub fn chunk(body: &[u8]) -> Result<ChunkView<'_>, McapProblem> {
-    let mut f = Fields::new(body);
-    f.u64("message start time")?;
-    f.u64("message end time")?;
-    let uncompressed_size = f.u64("uncompressed size")?;
-    f.u32("uncompressed CRC")?;
-    let compression = f.string("compression")?;
-    let compressed_size = f.u64("compressed size")?;
-    let available = f.left() as u64;
-    if compressed_size > available {
-        return Err(McapProblem::FieldTooLong {
-            field: "records",
-            claimed: compressed_size,
-            available,
-        });
-    }
-    let records = f.bytes(compressed_size as usize, "records")?;
-    Ok(ChunkView {
-        uncompressed_size,
-        compression,
-        records,
-        records_end: f.pos,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -429,29 +455,39 @@ mod tests {
 
     #[test]
     fn chunk_records_must_fit_in_the_chunk() {
-        let mut body = Vec::new();
-        body.extend(0u64.to_le_bytes());
-        body.extend(0u64.to_le_bytes());
-        body.extend(4u64.to_le_bytes());
-        body.extend(0u32.to_le_bytes());
-        body.extend(string(""));
-        body.extend(4u64.to_le_bytes());
-        body.extend(b"abcd");
-        let c = chunk(&body).unwrap();
+        let mut head = Vec::new();
+        head.extend(0u64.to_le_bytes());
+        head.extend(0u64.to_le_bytes());
+        head.extend(4u64.to_le_bytes());
+        head.extend(0u32.to_le_bytes());
+        head.extend(string("zstd"));
+        head.extend(4u64.to_le_bytes());
+        let fixed: [u8; CHUNK_HEADER_FIXED] = head[..CHUNK_HEADER_FIXED].try_into().unwrap();
+        let record_len = head.len() as u64 + 4;
+        assert_eq!(chunk_header_len(&fixed, record_len).unwrap(), head.len());
+        let c = chunk_header(&head, record_len).unwrap();
         assert_eq!(
-            (c.uncompressed_size, c.compression, c.records),
-            (4, "", &b"abcd"[..])
+            (c.uncompressed_size, c.compression, c.compressed_size),
+            (4, "zstd", 4)
         );
-        let n = body.len();
-        body[n - 12..n - 4].copy_from_slice(&u64::MAX.to_le_bytes());
+        // The records, then the compression string, claiming more than the record holds.
         assert!(matches!(
-            chunk(&body),
+            chunk_header(&head, record_len - 1),
             Err(McapProblem::FieldTooLong {
                 field: "records",
-                claimed: u64::MAX,
-                available: 4,
+                claimed: 4,
+                available: 3,
+            })
+        ));
+        let mut fixed = fixed;
+        fixed[28..32].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(matches!(
+            chunk_header_len(&fixed, record_len),
+            Err(McapProblem::FieldTooLong {
+                field: "compression",
                 ..
             })
         ));
+        assert!(chunk_header_len(&fixed, 39).is_err());
     }
 }

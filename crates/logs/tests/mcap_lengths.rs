@@ -613,3 +613,42 @@ fn truncated_files_are_errors_within_the_bound() {
         }
     }
 }
+
+/// Records aloft does not use are skipped, not held: an 8 MiB attachment (and a chunk whose
+/// length claims more than its records, the rest skipped as padding) costs no memory.
+#[test]
+fn records_aloft_does_not_use_are_skipped_without_being_held() {
+    let plain = ros2_mcap(false);
+    let mut w = mcap::WriteOptions::new()
+        .use_chunks(false)
+        .create(Cursor::new(Vec::new()))
+        .unwrap();
+    w.attach(&mcap::Attachment {
+        log_time: 0,
+        create_time: 0,
+        name: "calibration.bin".into(),
+        media_type: "application/octet-stream".into(),
+        data: std::borrow::Cow::Owned(vec![7u8; 8 << 20]),
+    })
+    .unwrap();
+    w.finish().unwrap();
+    let attachment_file = w.into_inner().into_inner();
+    // The attachment record spliced in after the plain file's header.
+    let attachment = file_records(&attachment_file)
+        .into_iter()
+        .find(|r| r.op == mcap::records::op::ATTACHMENT)
+        .unwrap();
+    let header = file_records(&plain)[0];
+    let mut b = plain[..header.body + header.len].to_vec();
+    b.extend_from_slice(&attachment_file[attachment.at..attachment.body + attachment.len]);
+    b.extend_from_slice(&plain[header.body + header.len..]);
+    let r = read(&b);
+    assert_eq!(r.result.unwrap().len(), 66);
+    assert!(
+        r.peak_bytes < 1 << 20 && r.largest_bytes < 1 << 20,
+        "peak {} largest {} for a file of {} bytes",
+        r.peak_bytes,
+        r.largest_bytes,
+        b.len()
+    );
+}
