@@ -70,6 +70,9 @@ pub const FILL_BYTES: usize = 256 << 10;
 /// A Footer record's body: summary start, summary offset start, summary CRC, bytes.
 const FOOTER_LEN: u64 = 8 + 8 + 4;
 
+/// A Message record's header: channel id, sequence, log time, publish time, bytes.
+const MESSAGE_HEADER_LEN: u64 = 2 + 4 + 8 + 8;
+
 /// Opcode and length before every record, bytes.
 const RECORD_PREFIX: u64 = 1 + 8;
 
@@ -445,6 +448,7 @@ impl<R: Read> McapSamples<R> {
         let len = u64::from_le_bytes(len);
         self.check_remaining(len, place)?;
         match opcode {
+            op::MESSAGE if len >= MESSAGE_HEADER_LEN => self.file_message(len, place),
             op::SCHEMA | op::CHANNEL | op::MESSAGE | op::FOOTER => {
                 if len > RECORD_LIMIT as u64 {
                     let problem = McapProblem::RecordTooLong {
@@ -482,6 +486,32 @@ impl<R: Read> McapSamples<R> {
         }
     }
 
+    /// A Message record of the file, `len` bytes long: its header is read, and its data only if
+    /// its topic is decoded (otherwise it is counted and skipped).
+    fn file_message(&mut self, len: u64, place: McapPlace) -> Result<Step> {
+        self.read_body(MESSAGE_HEADER_LEN, place)?;
+        let header = mcap_records::message(&self.body)
+            .map_err(|p| self.records.corrupt(op::MESSAGE, place, p))?
+            .header;
+        if !self.records.decodes(header.channel_id) {
+            let counted = self.records.on_message(&header, &[], place);
+            self.skip(len - MESSAGE_HEADER_LEN, place)?;
+            return counted.map(|s| s.map_or(Step::More, Step::Sample));
+        }
+        if len > RECORD_LIMIT as u64 {
+            let problem = McapProblem::RecordTooLong {
+                claimed: len,
+                limit: RECORD_LIMIT as u64,
+            };
+            return Err(self.records.corrupt(op::MESSAGE, place, problem));
+        }
+        self.read_more(len - MESSAGE_HEADER_LEN, place)?;
+        let body = std::mem::take(&mut self.body);
+        let sample = self.records.on_record(op::MESSAGE, &body, place);
+        self.body = body;
+        Ok(sample?.map_or(Step::More, Step::Sample))
+    }
+
     /// Read and check the header of the chunk at `place`, whose record is `len` bytes long, and
     /// set up the reading of its records.
     fn start_chunk(&mut self, len: u64, place: McapPlace) -> Result<()> {
@@ -492,19 +522,15 @@ impl<R: Read> McapSamples<R> {
         let fixed_len = mcap_records::CHUNK_HEADER_FIXED;
         let head_len = {
             let mut fixed = [0u8; mcap_records::CHUNK_HEADER_FIXED];
+            self.body.clear();
             if len >= fixed_len as u64 {
                 self.read_body(fixed_len as u64, place)?;
                 fixed.copy_from_slice(&self.body);
             }
             mcap_records::chunk_header_len(&fixed, len).map_err(|p| corrupt(self, p))?
         };
-        let mut head = std::mem::take(&mut self.body);
-        let read = self.read_body((head_len - fixed_len) as u64, place);
-        head.extend_from_slice(&self.body);
-        read?;
-        let chunk = ChunkRecords::new(&head, len, at);
-        self.body = head;
-        let chunk = chunk.map_err(|p| corrupt(self, p))?;
+        self.read_more((head_len - fixed_len) as u64, place)?;
+        let chunk = ChunkRecords::new(&self.body, len, at).map_err(|p| corrupt(self, p))?;
         self.at = At::Chunk {
             padding: len - head_len as u64 - chunk.compressed_left,
         };
@@ -576,8 +602,13 @@ impl<R: Read> McapSamples<R> {
     /// Read the next `n` bytes into `self.body`, for the record at `place`. The buffer grows
     /// with the bytes actually read, whatever `n` claims.
     fn read_body(&mut self, n: u64, place: McapPlace) -> Result<()> {
-        self.check_remaining(n, place)?;
         self.body.clear();
+        self.read_more(n, place)
+    }
+
+    /// Read the next `n` bytes onto the end of `self.body`, as [`Self::read_body`].
+    fn read_more(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.check_remaining(n, place)?;
         let got = (&mut self.input)
             .take(n)
             .read_to_end(&mut self.body)
@@ -652,6 +683,12 @@ impl RecordDecoder {
             messages: self.messages,
             problem,
         }
+    }
+
+    /// Whether messages on channel `id` are decoded (an unknown channel is, so that its first
+    /// message is the error).
+    fn decodes(&self, id: u16) -> bool {
+        self.channels.get(&id).is_none_or(|c| c.decoder.is_some())
     }
 
     /// One record: schemas and new channels are remembered; a message on a decoded topic is a

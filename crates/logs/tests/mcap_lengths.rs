@@ -614,14 +614,28 @@ fn truncated_files_are_errors_within_the_bound() {
     }
 }
 
-/// Records aloft does not use are skipped, not held: an 8 MiB attachment (and a chunk whose
-/// length claims more than its records, the rest skipped as padding) costs no memory.
+/// Records aloft does not use are skipped, not held: an 8 MiB attachment and an 8 MiB message on
+/// a topic it does not decode cost no memory (the message is counted on its topic).
 #[test]
 fn records_aloft_does_not_use_are_skipped_without_being_held() {
     let plain = ros2_mcap(false);
     let mut w = mcap::WriteOptions::new()
         .use_chunks(false)
         .create(Cursor::new(Vec::new()))
+        .unwrap();
+    let si = w
+        .add_schema_with_id(50, "sensor_msgs/msg/Image", "ros2msg", b"")
+        .unwrap();
+    let ci = w
+        .add_channel_with_id(50, si, "/camera", "cdr", &BTreeMap::new())
+        .unwrap();
+    let image = mcap::records::MessageHeader {
+        channel_id: ci,
+        sequence: 0,
+        log_time: 1_700_000_000_000_000_000,
+        publish_time: 0,
+    };
+    w.write_to_known_channel(&image, &vec![9u8; 8 << 20])
         .unwrap();
     w.attach(&mcap::Attachment {
         log_time: 0,
@@ -633,17 +647,41 @@ fn records_aloft_does_not_use_are_skipped_without_being_held() {
     .unwrap();
     w.finish().unwrap();
     let attachment_file = w.into_inner().into_inner();
-    // The attachment record spliced in after the plain file's header.
-    let attachment = file_records(&attachment_file)
-        .into_iter()
-        .find(|r| r.op == mcap::records::op::ATTACHMENT)
-        .unwrap();
+    // The camera's schema, channel and message and the attachment spliced in after the plain
+    // file's header (the records before the data end).
     let header = file_records(&plain)[0];
     let mut b = plain[..header.body + header.len].to_vec();
-    b.extend_from_slice(&attachment_file[attachment.at..attachment.body + attachment.len]);
+    for r in file_records(&attachment_file) {
+        if r.op == mcap::records::op::DATA_END {
+            break;
+        }
+        if r.op != mcap::records::op::HEADER {
+            b.extend_from_slice(&attachment_file[r.at..r.body + r.len]);
+        }
+    }
     b.extend_from_slice(&plain[header.body + header.len..]);
-    let r = read(&b);
-    assert_eq!(r.result.unwrap().len(), 66);
+    let mut reader = McapSamples::from_reader(
+        Cursor::new(&b[..]),
+        Path::new("skip.mcap"),
+        McapOptions::default(),
+    )
+    .with_input_len(b.len() as u64);
+    let before = LIVE.with(Cell::get);
+    PEAK.with(|p| p.set(before));
+    LARGEST.with(|l| l.set(0));
+    let n = reader.by_ref().map(|s| s.unwrap()).count();
+    let r = Read {
+        result: Ok(Vec::new()),
+        peak_bytes: (PEAK.with(Cell::get) - before).max(0) as usize,
+        largest_bytes: LARGEST.with(Cell::get),
+    };
+    assert_eq!(n, 66);
+    let camera = reader
+        .topics()
+        .iter()
+        .find(|t| t.topic == "/camera")
+        .unwrap();
+    assert_eq!((camera.messages, camera.decoded), (1, 0));
     assert!(
         r.peak_bytes < 1 << 20 && r.largest_bytes < 1 << 20,
         "peak {} largest {} for a file of {} bytes",
