@@ -46,6 +46,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{LogError, Result};
 
+/// Largest column-map file read, bytes (a map is a few hundred bytes).
+pub const MAX_MAP_BYTES: u64 = 1 << 20;
+
 /// Unit of a time column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum TimeUnit {
@@ -467,7 +470,8 @@ impl ColumnMap {
 
     /// Read and parse a TOML map file.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(LogError::reading(path))?;
+        let text =
+            aloft_core::read_regular_text(path, MAX_MAP_BYTES).map_err(LogError::reading(path))?;
         Self::from_toml_str(&text, path)
     }
 

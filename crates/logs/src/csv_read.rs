@@ -1,11 +1,14 @@
 //! Streaming CSV reader: one row in, one [`Sample`] out, through a [`ColumnMap`].
 //!
 //! Memory is bounded by one row: the reader holds a single `csv::ByteRecord` and parses only the
-//! mapped columns. Empty fields and `nan`/`inf` in a mapped column leave that channel `None` for the
+//! mapped columns, and a line longer than [`MAX_LINE_BYTES`] is refused
+//! ([`LogError::LineTooLong`]) before the record grows with it. A header that names a column
+//! twice is refused ([`LogError::DuplicateColumn`]): which of the two a map means is ambiguous. Empty fields and `nan`/`inf` in a mapped column leave that channel `None` for the
 //! row (PX4 writes `nan` for unknown values); text that is not a number is an error naming the row
 //! and column. Values outside physical ranges are reported as [`LogError::Implausible`], which is
 //! how a wrong unit in a map shows up.
 
+use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -22,6 +25,48 @@ use crate::sample::{Attitude, DroppedValue, GeoOrigin, Sample, TimeChecker, Time
 
 /// Longest accepted step between consecutive time stamps, s: a longer step means a wrong time unit.
 const MAX_STEP_S: f64 = 86_400.0;
+
+/// Longest CSV line accepted, bytes (a flight log's rows are a few hundred bytes; a header of
+/// thousands of columns fits too).
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// The marker of the I/O error [`LineLimit`] returns, recognised in [`csv_error`].
+#[derive(Debug)]
+struct LineTooLong;
+
+impl std::fmt::Display for LineTooLong {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "a line is longer than {MAX_LINE_BYTES} bytes")
+    }
+}
+
+impl std::error::Error for LineTooLong {}
+
+/// A reader that fails once more than `limit` bytes pass without a line break (`\n` or `\r`),
+/// so a file without line breaks cannot make the CSV record grow with it. A line may exceed the
+/// limit by at most one read before it is caught.
+struct LineLimit<R> {
+    inner: R,
+    since_break: usize,
+    limit: usize,
+}
+
+impl<R: Read> Read for LineLimit<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        match buf[..n].iter().rposition(|&b| b == b'\n' || b == b'\r') {
+            Some(p) => self.since_break = n - p - 1,
+            None => self.since_break += n,
+        }
+        if self.since_break > self.limit {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                LineTooLong,
+            ));
+        }
+        Ok(n)
+    }
+}
 
 /// The range a channel's value must lie in, after conversion to SI; a value outside it is
 /// [`LogError::Implausible`] (usually a wrong unit in the column map).
@@ -144,7 +189,7 @@ struct Compiled {
 /// Samples of one CSV file, read row by row.
 pub struct CsvSamples<R: Read> {
     path: PathBuf,
-    reader: csv::Reader<R>,
+    reader: csv::Reader<LineLimit<R>>,
     record: csv::ByteRecord,
     map: std::sync::Arc<Compiled>,
     checker: TimeChecker,
@@ -160,9 +205,11 @@ pub struct CsvSamples<R: Read> {
 }
 
 impl CsvSamples<BufReader<File>> {
-    /// Open a CSV file with a column map. Fails when a mapped column is missing from the header.
+    /// Open a CSV file with a column map. Fails when a mapped column is missing from the header,
+    /// or the path is not a regular file (a FIFO, device or directory is refused before it is
+    /// opened).
     pub fn open(path: &Path, map: &ColumnMap) -> Result<Self> {
-        let file = File::open(path).map_err(LogError::reading(path))?;
+        let file = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
         Self::from_reader(BufReader::with_capacity(1 << 16, file), path, map)
     }
 }
@@ -186,10 +233,14 @@ impl<R: Read> CsvSamples<R> {
             .delimiter(delimiter)
             .has_headers(true)
             .flexible(false)
-            .from_reader(reader);
+            .from_reader(LineLimit {
+                inner: reader,
+                since_break: 0,
+                limit: MAX_LINE_BYTES,
+            });
         let header = reader
             .byte_headers()
-            .map_err(|e| csv_error(path, &e))?
+            .map_err(|e| csv_error(path, &e, 0))?
             .clone();
         let columns: Vec<String> = header
             .iter()
@@ -201,6 +252,7 @@ impl<R: Read> CsvSamples<R> {
                 what: "no header line".into(),
             });
         }
+        check_unique(&columns, path)?;
         let compiled = compile(map, &columns, path)?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -567,9 +619,33 @@ fn trim(b: &[u8]) -> &[u8] {
     &b[start..end]
 }
 
-fn csv_error(path: &Path, e: &csv::Error) -> LogError {
+/// Every column name once: a name that appears twice is [`LogError::DuplicateColumn`].
+fn check_unique(columns: &[String], path: &Path) -> Result<()> {
+    let mut seen: HashMap<&str, usize> = HashMap::with_capacity(columns.len());
+    for (i, c) in columns.iter().enumerate() {
+        if let Some(first) = seen.insert(c.as_str(), i) {
+            return Err(LogError::DuplicateColumn {
+                path: path.to_path_buf(),
+                column: c.clone(),
+                first: first + 1,
+                second: i + 1,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The [`LogError`] of a CSV error, `last_line` being the last line read completely.
+fn csv_error(path: &Path, e: &csv::Error, last_line: u64) -> LogError {
     let row = e.position().map_or(0, |p| p.line());
     match e.kind() {
+        csv::ErrorKind::Io(io) if io.get_ref().is_some_and(|c| c.is::<LineTooLong>()) => {
+            LogError::LineTooLong {
+                path: path.to_path_buf(),
+                line: last_line + 1,
+                limit_bytes: MAX_LINE_BYTES,
+            }
+        }
         csv::ErrorKind::Io(io) => LogError::Io {
             path: path.to_path_buf(),
             cause: std::io::Error::new(io.kind(), io.to_string()),
@@ -761,7 +837,7 @@ impl<R: Read> Iterator for CsvSamples<R> {
             }
             Err(e) => {
                 self.done = true;
-                Some(Err(csv_error(&self.path, &e)))
+                Some(Err(csv_error(&self.path, &e, self.row)))
             }
         }
     }
@@ -940,6 +1016,69 @@ mod tests {
         let s = read("timestamp,voltage_v,current_a\n1,12.0,nan\n", &map).unwrap();
         assert_eq!(s[0].voltage_v, Some(12.0));
         assert_eq!(s[0].current_a, None);
+    }
+
+    #[test]
+    fn duplicated_column_names_are_refused_naming_column_and_file() {
+        let row = "1000000,0.634769,2.223,89.0,0.1,-0.2,0.5,1.0,2.0,-0.5,0,0,0,0,0,0,12150,48.0,25.0,12000";
+        // A mapped column twice (which one is the voltage?), an unmapped one twice, a name
+        // that differs only by spaces, and two empty names.
+        for (header, column, first, second) in [
+            (KAIST_HEADER.replace(",cur,", ",vol,"), "vol", 18, 19),
+            (KAIST_HEADER.replace("act_vy", "act_vx"), "act_vx", 14, 15),
+            (KAIST_HEADER.replace(",cur,", ", vol ,"), "vol", 18, 19),
+            (KAIST_HEADER.replace(",act_vx,act_vy,", ",,,"), "", 14, 15),
+        ] {
+            let e = read(&format!("{header}{row}\n"), &ColumnMap::kaist()).unwrap_err();
+            match &e {
+                LogError::DuplicateColumn {
+                    column: c,
+                    first: f,
+                    second: s,
+                    ..
+                } => assert_eq!((c.as_str(), *f, *s), (column, first, second), "{e}"),
+                e => panic!("{header}: {e}"),
+            }
+            let msg = e.to_string();
+            assert!(
+                msg.contains("t.csv") && msg.contains(&format!("'{column}'")),
+                "{msg}"
+            );
+        }
+        // Through a user map too.
+        let map = ColumnMap::new("m", "t", crate::column_map::TimeUnit::S);
+        let e = read("t,v,t\n0,1,2\n", &map).unwrap_err();
+        assert!(matches!(e, LogError::DuplicateColumn { .. }), "{e}");
+    }
+
+    /// An endless line (a device, a file with no line breaks) is refused after about
+    /// `MAX_LINE_BYTES`, whether it is the header or a row.
+    #[test]
+    fn a_line_without_breaks_is_refused_before_it_grows() {
+        use std::io::Read as _;
+        let map = ColumnMap::new("m", "t", crate::column_map::TimeUnit::S);
+        let endless = std::io::repeat(b'7');
+        match CsvSamples::from_reader(endless, Path::new("z.csv"), &map) {
+            Err(LogError::LineTooLong { line: 1, path, .. }) => {
+                assert_eq!(path, Path::new("z.csv"))
+            }
+            Err(e) => panic!("{e}"),
+            Ok(_) => panic!("an endless header was read"),
+        }
+        let text = b"t,v\n0,1\n".chain(std::io::repeat(b'8'));
+        let r = CsvSamples::from_reader(text, Path::new("z.csv"), &map).unwrap();
+        let e = r.collect::<Result<Vec<_>>>().unwrap_err();
+        assert!(matches!(e, LogError::LineTooLong { line: 3, .. }), "{e}");
+        assert!(e.to_string().contains("z.csv"), "{e}");
+        // Line breaks of any kind (\n, \r\n, \r) keep long files readable.
+        for eol in ["\n", "\r\n", "\r"] {
+            let mut text = format!("t,v{eol}");
+            let rows = 2 * MAX_LINE_BYTES / 8;
+            for i in 0..rows {
+                text.push_str(&format!("{i},1{eol}"));
+            }
+            assert_eq!(read(&text, &map).unwrap().len(), rows, "{eol:?}");
+        }
     }
 
     #[test]

@@ -4,6 +4,8 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+use crate::mcap_records::{McapPlace, McapProblem};
+
 /// Errors of `aloft-logs`. Each carries the offending file and, where known, row, column, channel
 /// or topic and value, so a user can find the problem without a debugger.
 #[derive(Debug, Error)]
@@ -104,6 +106,29 @@ pub enum LogError {
         /// The built-in names, comma-separated.
         known: String,
     },
+    /// A CSV header that names the same column twice: which one a map means is ambiguous.
+    #[error("{path}: column '{column}' appears twice in the header (columns {first} and {second}); rename one of them")]
+    DuplicateColumn {
+        /// The file.
+        path: PathBuf,
+        /// The column name.
+        column: String,
+        /// 1-based position of its first occurrence.
+        first: usize,
+        /// 1-based position of the second.
+        second: usize,
+    },
+    /// A CSV line longer than aloft reads (a file that is not a table of rows, or has no line
+    /// breaks): refused so that memory does not grow with it.
+    #[error("{path}: line {line} is longer than {limit_bytes} bytes; this is not a CSV log aloft can read")]
+    LineTooLong {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line (the header is line 1).
+        line: u64,
+        /// The longest line accepted, bytes.
+        limit_bytes: usize,
+    },
     /// A PX4 per-topic table needed for the join is missing.
     #[error("PX4 log {prefix}: topic table {expected} is missing")]
     Px4TopicMissing {
@@ -120,15 +145,32 @@ pub enum LogError {
         /// Why.
         reason: String,
     },
-    /// The MCAP container is truncated or corrupt.
-    #[error("{path}: corrupt or truncated MCAP after {messages} messages: {cause}")]
+    /// The MCAP container is truncated or corrupt (as found by the `mcap` crate's reader).
+    #[error("{path}: corrupt or truncated MCAP at {place}, after {messages} messages: {cause}")]
     Mcap {
         /// The file.
         path: PathBuf,
+        /// Where the record being read starts.
+        place: McapPlace,
         /// Messages read successfully before the error.
         messages: u64,
         /// The `mcap` crate's error.
         cause: mcap::McapError,
+    },
+    /// An MCAP record or chunk whose lengths contradict its size (a corrupt file), refused before
+    /// anything is allocated for it.
+    #[error("{path}: corrupt MCAP: the {record} record at {place} (after {messages} messages) is invalid: {problem}")]
+    McapCorrupt {
+        /// The file.
+        path: PathBuf,
+        /// The record type (`Channel`, `Chunk`, ...).
+        record: &'static str,
+        /// Where the record starts.
+        place: McapPlace,
+        /// Messages read successfully before the error.
+        messages: u64,
+        /// What is wrong.
+        problem: McapProblem,
     },
     /// A ROS 2 CDR message that does not decode as its declared type.
     #[error("{path}: topic {topic}, message {index} ({schema}): {cause}")]

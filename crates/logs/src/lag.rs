@@ -178,43 +178,78 @@ fn parabola_peak_offset(cs: &[f64], best: usize) -> Option<f64> {
     (den < 0.0).then(|| (0.5 * (y0 - y2) / den).clamp(-0.5, 0.5))
 }
 
+/// Most points [`resample_uniform`] makes (8 bytes each, 128 MiB).
+pub const MAX_RESAMPLED_POINTS: usize = 1 << 24;
+
 /// Linear interpolation of `(times_s, values)` onto a uniform grid of step `dt_s` from the first
 /// time to the last. Samples whose time does not increase are skipped (they are reported by the
-/// log's [`crate::TimeReport`]). Returns the grid's start time and the values.
+/// log's [`crate::TimeReport`]). Returns the grid's start time and the values; a grid of more
+/// than [`MAX_RESAMPLED_POINTS`] is an error.
 pub fn resample_uniform(times_s: &[f64], values: &[f64], dt_s: f64) -> Result<(f64, Vec<f64>)> {
     check_step(dt_s)?;
-    let pts: Vec<(f64, f64)> = {
-        let mut v: Vec<(f64, f64)> = Vec::with_capacity(times_s.len());
-        for (t, y) in times_s.iter().zip(values) {
-            if v.last().is_none_or(|(tl, _)| t > tl) && t.is_finite() && y.is_finite() {
-                v.push((*t, *y));
-            }
-        }
-        v
+    // The kept samples are walked twice (their count and span, then the grid) rather than
+    // copied: memory is the grid alone.
+    let (count, first, last) = increasing(times_s, values)
+        .fold((0usize, None, None), |(n, f, _), p| {
+            (n + 1, f.or(Some(p.0)), Some(p.0))
+        });
+    let (Some(t0), Some(t1)) = (first, last) else {
+        return Err(too_few(count));
     };
-    if pts.len() < 2 {
+    if count < 2 {
+        return Err(too_few(count));
+    }
+    let steps = ((t1 - t0) / dt_s).floor();
+    // The grid's size comes from the log's time stamps (finite, so `steps` is not NaN):
+    // bound it before allocating.
+    if steps >= MAX_RESAMPLED_POINTS as f64 {
         return Err(LogError::InvalidArgument {
-            name: "samples",
-            value: pts.len() as f64,
-            reason: "at least two samples with increasing time are needed",
+            name: "resampled points",
+            value: steps + 1.0,
+            reason: "more than 2^24 points: the log's time span is too long for the step",
         });
     }
-    let t0 = pts[0].0;
-    let t1 = pts[pts.len() - 1].0;
-    let n = ((t1 - t0) / dt_s).floor() as usize + 1;
+    let n = steps as usize + 1;
     let mut out = Vec::with_capacity(n);
-    let mut j = 0;
+    let mut kept = increasing(times_s, values);
+    let (Some(mut a), Some(mut b)) = (kept.next(), kept.next()) else {
+        return Err(too_few(count));
+    };
+    // The index of `b` among the kept samples: `b` moves on while it is not the last one.
+    let mut jb = 1;
     for i in 0..n {
         let t = t0 + i as f64 * dt_s;
-        while j + 2 < pts.len() && pts[j + 1].0 < t {
-            j += 1;
+        while jb + 1 < count && b.0 < t {
+            let Some(next) = kept.next() else { break };
+            (a, b) = (b, next);
+            jb += 1;
         }
-        let (ta, ya) = pts[j];
-        let (tb, yb) = pts[j + 1];
+        let (ta, ya) = a;
+        let (tb, yb) = b;
         let w = ((t - ta) / (tb - ta)).clamp(0.0, 1.0);
         out.push(ya + (yb - ya) * w);
     }
     Ok((t0, out))
+}
+
+/// The samples with finite values whose time is above every time kept before.
+fn increasing<'a>(times_s: &'a [f64], values: &'a [f64]) -> impl Iterator<Item = (f64, f64)> + 'a {
+    let mut last: Option<f64> = None;
+    times_s.iter().zip(values).filter_map(move |(&t, &y)| {
+        let keep = last.is_none_or(|tl| t > tl) && t.is_finite() && y.is_finite();
+        keep.then(|| {
+            last = Some(t);
+            (t, y)
+        })
+    })
+}
+
+fn too_few(count: usize) -> LogError {
+    LogError::InvalidArgument {
+        name: "samples",
+        value: count as f64,
+        reason: "at least two samples with increasing time are needed",
+    }
 }
 
 #[cfg(test)]
@@ -229,6 +264,73 @@ mod tests {
                 (0.37 * t).sin() + 0.5 * (1.13 * t).sin() + 0.3 * (0.071 * t * t).cos()
             })
             .collect()
+    }
+
+    /// The copy-based version `resample_uniform` had before it walked the samples in place.
+    fn resample_reference(times_s: &[f64], values: &[f64], dt_s: f64) -> Vec<f64> {
+        let mut pts: Vec<(f64, f64)> = Vec::new();
+        for (t, y) in times_s.iter().zip(values) {
+            if pts.last().is_none_or(|(tl, _)| t > tl) && t.is_finite() && y.is_finite() {
+                pts.push((*t, *y));
+            }
+        }
+        let (t0, t1) = (pts[0].0, pts[pts.len() - 1].0);
+        let n = ((t1 - t0) / dt_s).floor() as usize + 1;
+        let mut j = 0;
+        (0..n)
+            .map(|i| {
+                let t = t0 + i as f64 * dt_s;
+                while j + 2 < pts.len() && pts[j + 1].0 < t {
+                    j += 1;
+                }
+                let ((ta, ya), (tb, yb)) = (pts[j], pts[j + 1]);
+                ya + (yb - ya) * ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+            })
+            .collect()
+    }
+
+    /// Bit for bit the reference, with repeated, backwards, NaN and infinite samples.
+    #[test]
+    fn resample_matches_the_copying_reference_bit_for_bit() {
+        let mut times: Vec<f64> = (0..500)
+            .map(|i| i as f64 * 0.037 + (i % 7) as f64 * 1e-3)
+            .collect();
+        let mut values: Vec<f64> = (0..500).map(|i| (i as f64 * 0.3).sin()).collect();
+        times[10] = times[9];
+        times[20] = times[15];
+        times[30] = f64::NAN;
+        values[40] = f64::NAN;
+        values[50] = f64::INFINITY;
+        for dt in [0.01, 0.1, 0.037, 1.0] {
+            let (_, v) = resample_uniform(&times, &values, dt).unwrap();
+            let r = resample_reference(&times, &values, dt);
+            assert_eq!(v.len(), r.len());
+            assert!(
+                v.iter().zip(&r).all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{dt}"
+            );
+        }
+    }
+
+    /// The grid's size comes from the log's time stamps: a span of 300 years at 0.1 s (a
+    /// corrupt stamp) is refused instead of allocating 10^11 points.
+    #[test]
+    fn a_time_span_too_long_for_the_step_is_refused_before_allocating() {
+        for t1 in [1e10, f64::MAX, (MAX_RESAMPLED_POINTS as f64) * 0.1] {
+            let e = resample_uniform(&[0.0, t1], &[1.0, 2.0], 0.1).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    LogError::InvalidArgument {
+                        name: "resampled points",
+                        ..
+                    }
+                ),
+                "{t1}: {e}"
+            );
+        }
+        let (_, v) = resample_uniform(&[0.0, 1.0], &[1.0, 2.0], 0.1).unwrap();
+        assert_eq!(v.len(), 11);
     }
 
     #[test]

@@ -39,6 +39,7 @@ pub mod frame;
 pub mod info;
 pub mod lag;
 pub mod mcap_read;
+pub mod mcap_records;
 pub mod mcap_write;
 pub mod open;
 pub mod px4;

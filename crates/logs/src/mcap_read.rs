@@ -1,12 +1,32 @@
 //! Streaming MCAP reader: decodes the supported topics of a file into [`Sample`]s, one per message.
 //!
 //! # Memory
-//! The file is read through `mcap`'s sans-I/O [`LinearReader`] from any `std::io::Read`, in
-//! requests of the size the reader asks for: memory is bounded by the largest record or
-//! (decompressed) chunk, typically a few MB, whatever the file size. This is preferred over
-//! memory-mapping because it also works on pipes, and a file truncated or replaced while it is
-//! being read gives an I/O error instead of a `SIGBUS`. A record whose length field exceeds
-//! [`RECORD_LIMIT`] (a corrupt length) is refused before anything is allocated for it.
+//! The file is read front to back from any `std::io::Read` (pipes too; a file truncated or
+//! replaced while it is read gives an error, not the `SIGBUS` of a memory map). Only the records
+//! aloft decodes are held in memory, one at a time: Schema, Channel and Message records of the
+//! file, and one record of a chunk at a time (its compressed records are streamed through
+//! `mcap`'s sans-I/O [`LinearReader`], which decompresses them). Any other record (attachments,
+//! metadata, indexes, the summary) is skipped without being kept. Memory is bounded by the
+//! largest decoded record, typically a few kB, whatever the file size.
+//!
+//! # Corrupt lengths
+//! Every length read out of the file is checked before anything is allocated for it, so a
+//! flipped byte is an error, never a multi-gigabyte allocation:
+//! - Records of the file: none may claim more than remains of the file (when its size is known,
+//!   [`McapSamples::with_input_len`]; [`McapSamples::open`] knows it): that is refused before
+//!   anything is read, as the same error as a truncated file ([`LogError::Mcap`], at the
+//!   record's byte offset). A record that is kept may not claim more than [`RECORD_LIMIT`]
+//!   ([`LogError::McapCorrupt`]), and its buffer grows with the bytes actually read.
+//! - Chunks: the header is read first and checked ([`crate::mcap_records::chunk_header_len`],
+//!   [`crate::mcap_records::chunk_header`]: the compression string and the records must fit in
+//!   the record; an uncompressed size over [`MAX_CHUNK_RATIO`] times the compressed size or
+//!   over [`RECORD_LIMIT`] is refused). The records are then read by a [`LinearReader`] of
+//!   their own whose record length limit is what the chunk holds, handed the compressed bytes
+//!   in pieces of at most [`FILL_BYTES`]: a record inside a chunk cannot claim (and make the
+//!   decompressor reserve) more than its chunk holds, nor run past it.
+//! - Schema, Channel and Message records are parsed by [`crate::mcap_records`], which checks
+//!   every string, byte array and map length against the record and allocates nothing; other
+//!   records are not parsed at all.
 //!
 //! # Topic selection
 //! Without named topics, each model channel (position, velocity, attitude, battery, ...) is taken
@@ -24,16 +44,37 @@ use std::fs::File;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use mcap::records::MessageHeader;
+use mcap::records::{op, MessageHeader};
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use serde::Serialize;
 
 use crate::error::{LogError, Result};
+use crate::mcap_records::{self, record_name, ChannelView, McapPlace, McapProblem};
 use crate::ros::{decode_cdr, decode_json, Decoded, MessageKind, RosDecodeOptions, SUPPORTED};
 use crate::sample::{Channel, Sample, TimeChecker, TimeReport};
 
-/// Largest record (or chunk) accepted, bytes.
+/// Largest record (or chunk, compressed or not) accepted, bytes.
 pub const RECORD_LIMIT: usize = 256 << 20;
+
+/// Largest accepted ratio of a chunk's declared uncompressed size to its compressed size
+/// (flight data compress 3 to 20 times; 1000 leaves room for runs of zeros).
+pub const MAX_CHUNK_RATIO: u64 = 1000;
+
+/// A compressed chunk may always declare this many bytes uncompressed, whatever its ratio (a
+/// tiny chunk of empty messages can compress more than [`MAX_CHUNK_RATIO`] times).
+const MIN_CHUNK_LIMIT: u64 = 64 << 10;
+
+/// Largest piece of input handed to the reader at once, bytes.
+pub const FILL_BYTES: usize = 256 << 10;
+
+/// A Footer record's body: summary start, summary offset start, summary CRC, bytes.
+const FOOTER_LEN: u64 = 8 + 8 + 4;
+
+/// A Message record's header: channel id, sequence, log time, publish time, bytes.
+const MESSAGE_HEADER_LEN: u64 = 2 + 4 + 8 + 8;
+
+/// Opcode and length before every record, bytes.
+const RECORD_PREFIX: u64 = 1 + 8;
 
 /// Which clock gives [`Sample::time_s`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -114,9 +155,117 @@ struct ChanState {
 /// Samples of one MCAP file, decoded message by message.
 pub struct McapSamples<R: Read> {
     input: R,
-    reader: LinearReader,
+    /// Size of the input when known: no record may claim more than remains of it.
+    input_len: Option<u64>,
+    /// Bytes of the input read so far (the offset of what comes next).
+    offset: u64,
+    /// Where the reading is in the file's layout.
+    at: At,
+    /// The body of the record being decoded (reused).
+    body: Vec<u8>,
+    /// The chunk whose records are being read.
+    chunk: Option<ChunkRecords>,
     records: RecordDecoder,
     done: bool,
+}
+
+/// Where the reading is in the file's layout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum At {
+    /// Before the start magic.
+    Start,
+    /// Before a record of the file.
+    Record,
+    /// In the records of a chunk (`self.chunk`), which `padding` bytes follow.
+    Chunk { padding: u64 },
+    /// After the footer: the end magic.
+    EndMagic,
+    /// After the end magic.
+    End,
+}
+
+/// The records of one chunk, read by a [`LinearReader`] of their own: it is handed the chunk's
+/// header, then the compressed records as it asks for them, and its record length limit is what
+/// the chunk holds.
+struct ChunkRecords {
+    reader: LinearReader,
+    /// The reader's record length limit, bytes.
+    limit: usize,
+    /// Compressed bytes of the chunk not yet handed to the reader.
+    compressed_left: u64,
+    /// Byte offset of the chunk record in the file.
+    at: u64,
+    /// Byte offset of the next record in the chunk's records.
+    offset: u64,
+}
+
+impl ChunkRecords {
+    /// Check the chunk at byte `at`, whose header is `head`, and set up the reading of its
+    /// records.
+    fn new(head: &[u8], record_len: u64, at: u64) -> std::result::Result<Self, McapProblem> {
+        let header = mcap_records::chunk_header(head, record_len)?;
+        let compressed = header.compressed_size;
+        if !header.compression.is_empty() {
+            let most = (RECORD_LIMIT as u64).min(
+                compressed
+                    .saturating_mul(MAX_CHUNK_RATIO)
+                    .max(MIN_CHUNK_LIMIT),
+            );
+            if header.uncompressed_size > most {
+                return Err(McapProblem::ChunkSize {
+                    uncompressed: header.uncompressed_size,
+                    compressed,
+                    max_ratio: MAX_CHUNK_RATIO,
+                    limit: RECORD_LIMIT as u64,
+                });
+            }
+        }
+        // No record inside can be longer than the chunk's records, compressed or not (the
+        // header's own length is checked against the limit too: never below it).
+        let limit = header
+            .uncompressed_size
+            .max(compressed)
+            .max(MIN_CHUNK_LIMIT) as usize;
+        let mut reader = LinearReader::new_with_options(
+            LinearReaderOptions::default()
+                .with_skip_start_magic(true)
+                .with_skip_end_magic(true)
+                .with_record_length_limit(limit),
+        );
+        // The chunk record without what follows its records: a record cannot run into padding.
+        let len = RECORD_PREFIX as usize + head.len();
+        let buf = reader.insert(len);
+        buf[0] = op::CHUNK;
+        buf[1..9].copy_from_slice(&(head.len() as u64 + compressed).to_le_bytes());
+        buf[9..len].copy_from_slice(head);
+        reader.notify_read(len);
+        Ok(Self {
+            reader,
+            limit,
+            compressed_left: compressed,
+            at,
+            offset: 0,
+        })
+    }
+
+    fn place(&self) -> McapPlace {
+        McapPlace::Chunk {
+            chunk: self.at,
+            offset: self.offset,
+        }
+    }
+}
+
+/// What one step of the reader gave. (It lives on the stack for one step; boxing the sample would
+/// allocate once per message.)
+#[allow(clippy::large_enum_variant)]
+enum Step {
+    /// A record decoded into a sample.
+    Sample(Sample),
+    /// Nothing yet.
+    More,
+    /// The end of the file.
+    End,
 }
 
 /// The sans-I/O half of [`McapSamples`]: what the records seen so far say (schemas, channels,
@@ -136,13 +285,15 @@ struct RecordDecoder {
 
 impl McapSamples<std::io::BufReader<File>> {
     /// Open a file.
+    ///
+    /// A FIFO, device or directory is refused before it is opened.
     pub fn open(path: &Path, options: McapOptions) -> Result<Self> {
-        let f = File::open(path).map_err(LogError::reading(path))?;
-        Ok(Self::from_reader(
-            std::io::BufReader::with_capacity(1 << 16, f),
-            path,
-            options,
-        ))
+        let f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
+        let len = f.metadata().map_err(LogError::reading(path))?.len();
+        Ok(
+            Self::from_reader(std::io::BufReader::with_capacity(1 << 16, f), path, options)
+                .with_input_len(len),
+        )
     }
 }
 
@@ -186,12 +337,13 @@ fn mask(s: &mut Sample, keep: &[bool; 9]) {
 impl<R: Read> McapSamples<R> {
     /// Read from any reader; `path` names the source in errors.
     pub fn from_reader(input: R, path: &Path, options: McapOptions) -> Self {
-        let reader = LinearReader::new_with_options(
-            LinearReaderOptions::default().with_record_length_limit(RECORD_LIMIT),
-        );
         Self {
             input,
-            reader,
+            input_len: None,
+            offset: 0,
+            at: At::Start,
+            body: Vec::new(),
+            chunk: None,
             records: RecordDecoder {
                 path: path.to_path_buf(),
                 options,
@@ -206,6 +358,14 @@ impl<R: Read> McapSamples<R> {
             },
             done: false,
         }
+    }
+
+    /// Declare the size of the input, bytes (before reading): no record may then claim more
+    /// than the input holds, nor more than remains of it after the record's offset.
+    /// [`Self::open`] does this with the file's size.
+    pub fn with_input_len(mut self, len: u64) -> Self {
+        self.input_len = Some(len);
+        self
     }
 
     /// The topics seen so far (all of them once the stream is exhausted), in order of appearance.
@@ -243,84 +403,331 @@ impl<R: Read> McapSamples<R> {
         v
     }
 
-    /// The next sample: feed the reader until a record decodes into one, or the file ends.
+    /// The next sample: read until a record decodes into one, or the file ends.
     fn step(&mut self) -> Result<Option<Sample>> {
         loop {
-            let event = match self.reader.next_event() {
-                None => {
+            let step = match self.at {
+                At::Start => self.magic(At::Record)?,
+                At::Record => self.file_record()?,
+                At::Chunk { padding } => self.chunk_step(padding)?,
+                At::EndMagic => self.magic(At::End)?,
+                At::End => Step::End,
+            };
+            match step {
+                Step::Sample(s) => return Ok(Some(s)),
+                Step::More => {}
+                Step::End => {
                     self.done = true;
                     self.records.finish_checks()?;
                     return Ok(None);
-                }
-                Some(event) => event.map_err(|e| self.records.mcap_error(e))?,
-            };
-            match event {
-                LinearReadEvent::ReadRequest(n) => self.fill(n)?,
-                LinearReadEvent::Record { opcode, data } => {
-                    if let Some(s) = self.records.on_record(opcode, data)? {
-                        return Ok(Some(s));
-                    }
                 }
             }
         }
     }
 
-    /// Hand the reader up to `n` bytes of input (0 at the end of the input).
-    fn fill(&mut self, n: usize) -> Result<()> {
-        let buf = self.reader.insert(n);
-        let got = loop {
-            match self.input.read(buf) {
-                Ok(k) => break k,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
-                Err(cause) => return Err(LogError::reading(&self.records.path)(cause)),
+    /// The magic at the start or end of the file; `next` is what follows it.
+    fn magic(&mut self, next: At) -> Result<Step> {
+        let place = self.file_place();
+        self.read_body(mcap::MAGIC.len() as u64, place)?;
+        if self.body != mcap::MAGIC {
+            return Err(self.records.mcap_error(place, mcap::McapError::BadMagic));
+        }
+        self.at = next;
+        Ok(Step::More)
+    }
+
+    /// The next record of the file: Schema, Channel and Message records are read and decoded,
+    /// a chunk's records are read next, the footer leads to the end magic, and any other record
+    /// is skipped unread.
+    fn file_record(&mut self) -> Result<Step> {
+        let place = self.file_place();
+        self.read_body(RECORD_PREFIX, place)?;
+        let opcode = self.body[0];
+        let mut len = [0u8; 8];
+        len.copy_from_slice(&self.body[1..9]);
+        let len = u64::from_le_bytes(len);
+        self.check_remaining(len, place)?;
+        match opcode {
+            op::MESSAGE if len >= MESSAGE_HEADER_LEN => self.file_message(len, place),
+            op::SCHEMA | op::CHANNEL | op::MESSAGE | op::FOOTER => {
+                if len > RECORD_LIMIT as u64 {
+                    let problem = McapProblem::RecordTooLong {
+                        claimed: len,
+                        limit: RECORD_LIMIT as u64,
+                    };
+                    return Err(self.records.corrupt(opcode, place, problem));
+                }
+                if opcode == op::FOOTER && len < FOOTER_LEN {
+                    let problem = McapProblem::Truncated {
+                        field: "footer",
+                        needed: FOOTER_LEN,
+                        available: len,
+                    };
+                    return Err(self.records.corrupt(opcode, place, problem));
+                }
+                self.read_body(len, place)?;
+                if opcode == op::FOOTER {
+                    self.at = At::EndMagic;
+                    return Ok(Step::More);
+                }
+                let body = std::mem::take(&mut self.body);
+                let sample = self.records.on_record(opcode, &body, place);
+                self.body = body;
+                Ok(sample?.map_or(Step::More, Step::Sample))
             }
+            op::CHUNK => {
+                self.start_chunk(len, place)?;
+                Ok(Step::More)
+            }
+            _ => {
+                self.skip(len, place)?;
+                Ok(Step::More)
+            }
+        }
+    }
+
+    /// A Message record of the file, `len` bytes long: its header is read, and its data only if
+    /// its topic is decoded (otherwise it is counted and skipped).
+    fn file_message(&mut self, len: u64, place: McapPlace) -> Result<Step> {
+        self.read_body(MESSAGE_HEADER_LEN, place)?;
+        let header = mcap_records::message(&self.body)
+            .map_err(|p| self.records.corrupt(op::MESSAGE, place, p))?
+            .header;
+        if !self.records.decodes(header.channel_id) {
+            let counted = self.records.on_message(&header, &[], place);
+            self.skip(len - MESSAGE_HEADER_LEN, place)?;
+            return counted.map(|s| s.map_or(Step::More, Step::Sample));
+        }
+        if len > RECORD_LIMIT as u64 {
+            let problem = McapProblem::RecordTooLong {
+                claimed: len,
+                limit: RECORD_LIMIT as u64,
+            };
+            return Err(self.records.corrupt(op::MESSAGE, place, problem));
+        }
+        self.read_more(len - MESSAGE_HEADER_LEN, place)?;
+        let body = std::mem::take(&mut self.body);
+        let sample = self.records.on_record(op::MESSAGE, &body, place);
+        self.body = body;
+        Ok(sample?.map_or(Step::More, Step::Sample))
+    }
+
+    /// Read and check the header of the chunk at `place`, whose record is `len` bytes long, and
+    /// set up the reading of its records.
+    fn start_chunk(&mut self, len: u64, place: McapPlace) -> Result<()> {
+        let McapPlace::File { offset: at } = place else {
+            return Ok(());
         };
-        self.reader.notify_read(got);
+        let corrupt = |me: &Self, problem| me.records.corrupt(op::CHUNK, place, problem);
+        let fixed_len = mcap_records::CHUNK_HEADER_FIXED;
+        let head_len = {
+            let mut fixed = [0u8; mcap_records::CHUNK_HEADER_FIXED];
+            self.body.clear();
+            if len >= fixed_len as u64 {
+                self.read_body(fixed_len as u64, place)?;
+                fixed.copy_from_slice(&self.body);
+            }
+            mcap_records::chunk_header_len(&fixed, len).map_err(|p| corrupt(self, p))?
+        };
+        self.read_more((head_len - fixed_len) as u64, place)?;
+        let chunk = ChunkRecords::new(&self.body, len, at).map_err(|p| corrupt(self, p))?;
+        self.at = At::Chunk {
+            padding: len - head_len as u64 - chunk.compressed_left,
+        };
+        self.chunk = Some(chunk);
+        Ok(())
+    }
+
+    /// One event of the current chunk's reader: a record, a read of compressed records, or the
+    /// end of the chunk (then its `padding` is skipped).
+    fn chunk_step(&mut self, padding: u64) -> Result<Step> {
+        let Some(chunk) = self.chunk.as_mut() else {
+            self.at = At::Record;
+            return Ok(Step::More);
+        };
+        let (place, limit) = (chunk.place(), chunk.limit);
+        let event = match chunk.reader.next_event() {
+            None => {
+                let at = McapPlace::File { offset: chunk.at };
+                self.chunk = None;
+                self.skip(padding, at)?;
+                self.at = At::Record;
+                return Ok(Step::More);
+            }
+            Some(event) => event.map_err(|e| self.records.reader_error(place, e, limit))?,
+        };
+        match event {
+            LinearReadEvent::ReadRequest(n) => {
+                let at = McapPlace::File { offset: chunk.at };
+                let want = (n.min(FILL_BYTES) as u64).min(chunk.compressed_left) as usize;
+                let buf = chunk.reader.insert(want);
+                let got = read_some(&mut self.input, buf)
+                    .map_err(LogError::reading(&self.records.path))?;
+                chunk.reader.notify_read(got);
+                chunk.compressed_left -= got as u64;
+                self.offset += got as u64;
+                if got == 0 && want > 0 {
+                    return Err(self.records.mcap_error(at, mcap::McapError::UnexpectedEof));
+                }
+                Ok(Step::More)
+            }
+            LinearReadEvent::Record { opcode, data } => {
+                chunk.offset += RECORD_PREFIX + data.len() as u64;
+                Ok(self
+                    .records
+                    .on_record(opcode, data, place)?
+                    .map_or(Step::More, Step::Sample))
+            }
+        }
+    }
+
+    /// The place of the next record of the file.
+    fn file_place(&self) -> McapPlace {
+        McapPlace::File {
+            offset: self.offset,
+        }
+    }
+
+    /// A record at `place` may not claim more than remains of an input of known size: that is
+    /// the error of a truncated file, given before anything is read or allocated.
+    fn check_remaining(&self, len: u64, place: McapPlace) -> Result<()> {
+        match self.input_len {
+            Some(total) if len > total.saturating_sub(self.offset) => Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof)),
+            _ => Ok(()),
+        }
+    }
+
+    /// Read the next `n` bytes into `self.body`, for the record at `place`. The buffer grows
+    /// with the bytes actually read, whatever `n` claims.
+    fn read_body(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.body.clear();
+        self.read_more(n, place)
+    }
+
+    /// Read the next `n` bytes onto the end of `self.body`, as [`Self::read_body`].
+    fn read_more(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.check_remaining(n, place)?;
+        let got = (&mut self.input)
+            .take(n)
+            .read_to_end(&mut self.body)
+            .map_err(LogError::reading(&self.records.path))?;
+        self.offset += got as u64;
+        if (got as u64) < n {
+            return Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof));
+        }
+        Ok(())
+    }
+
+    /// Skip the next `n` bytes (a record aloft does not use), without keeping them.
+    fn skip(&mut self, n: u64, place: McapPlace) -> Result<()> {
+        self.check_remaining(n, place)?;
+        let got = std::io::copy(&mut (&mut self.input).take(n), &mut std::io::sink())
+            .map_err(LogError::reading(&self.records.path))?;
+        self.offset += got;
+        if got < n {
+            return Err(self
+                .records
+                .mcap_error(place, mcap::McapError::UnexpectedEof));
+        }
         Ok(())
     }
 }
 
+/// One `read` into `buf`, retried when interrupted.
+fn read_some(input: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
+    loop {
+        match input.read(buf) {
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            r => return r,
+        }
+    }
+}
+
 impl RecordDecoder {
-    /// [`LogError::Mcap`] after the messages read so far.
-    fn mcap_error(&self, cause: mcap::McapError) -> LogError {
+    /// [`LogError::Mcap`] at `place`, after the messages read so far.
+    fn mcap_error(&self, place: McapPlace, cause: mcap::McapError) -> LogError {
         LogError::Mcap {
             path: self.path.clone(),
+            place,
             messages: self.messages,
             cause,
         }
     }
 
+    /// The error of a reader whose record length limit is `limit`: a record over the limit is
+    /// [`LogError::McapCorrupt`], anything else [`LogError::Mcap`].
+    fn reader_error(&self, place: McapPlace, cause: mcap::McapError, limit: usize) -> LogError {
+        match cause {
+            mcap::McapError::RecordTooLarge { opcode, len } => self.corrupt(
+                opcode,
+                place,
+                McapProblem::RecordTooLong {
+                    claimed: len,
+                    limit: limit as u64,
+                },
+            ),
+            cause => self.mcap_error(place, cause),
+        }
+    }
+
+    /// [`LogError::McapCorrupt`]: the record `opcode` at `place` is invalid.
+    fn corrupt(&self, opcode: u8, place: McapPlace, problem: McapProblem) -> LogError {
+        LogError::McapCorrupt {
+            path: self.path.clone(),
+            record: record_name(opcode),
+            place,
+            messages: self.messages,
+            problem,
+        }
+    }
+
+    /// Whether messages on channel `id` are decoded (an unknown channel is, so that its first
+    /// message is the error).
+    fn decodes(&self, id: u16) -> bool {
+        self.channels.get(&id).is_none_or(|c| c.decoder.is_some())
+    }
+
     /// One record: schemas and new channels are remembered; a message on a decoded topic is a
-    /// sample.
-    fn on_record(&mut self, opcode: u8, data: &[u8]) -> Result<Option<Sample>> {
-        match mcap::parse_record(opcode, data).map_err(|e| self.mcap_error(e))? {
-            mcap::records::Record::Schema { header, .. } => {
+    /// sample. Records aloft does not use are not parsed.
+    fn on_record(&mut self, opcode: u8, data: &[u8], place: McapPlace) -> Result<Option<Sample>> {
+        let corrupt = |d: &Self, e| d.corrupt(opcode, place, e);
+        match opcode {
+            op::SCHEMA => {
+                let s = mcap_records::schema(data).map_err(|e| corrupt(self, e))?;
                 self.schemas
-                    .insert(header.id, (header.name, header.encoding));
+                    .insert(s.id, (s.name.to_string(), s.encoding.to_string()));
             }
-            mcap::records::Record::Channel(ch) if !self.channels.contains_key(&ch.id) => {
-                self.add_channel(ch)?;
+            op::CHANNEL => {
+                let ch = mcap_records::channel(data).map_err(|e| corrupt(self, e))?;
+                if !self.channels.contains_key(&ch.id) {
+                    self.add_channel(&ch)?;
+                }
             }
-            mcap::records::Record::Message { header, data } => {
-                return self.on_message(&header, &data);
+            op::MESSAGE => {
+                let m = mcap_records::message(data).map_err(|e| corrupt(self, e))?;
+                return self.on_message(&m.header, m.data, place);
             }
             _ => {}
         }
         Ok(None)
     }
 
-    fn add_channel(&mut self, ch: mcap::records::Channel) -> Result<()> {
+    fn add_channel(&mut self, ch: &ChannelView<'_>) -> Result<()> {
         let (schema, schema_encoding) =
             self.schemas.get(&ch.schema_id).cloned().unwrap_or_default();
-        let decoder = decoder_for(&schema, &schema_encoding, &ch.message_encoding);
+        let decoder = decoder_for(&schema, &schema_encoding, ch.message_encoding);
         let info = self.topics.len();
         let named = self.options.topics.iter().position(|t| *t == ch.topic);
         if !self.options.topics.is_empty() && named.is_some() && decoder.is_none() {
             return Err(LogError::UnsupportedTopic {
                 path: self.path.clone(),
-                topic: ch.topic.clone(),
+                topic: ch.topic.to_string(),
                 schema: schema.clone(),
-                encoding: ch.message_encoding.clone(),
+                encoding: ch.message_encoding.to_string(),
                 supported: SUPPORTED,
             });
         }
@@ -335,10 +742,10 @@ impl RecordDecoder {
             }
         }
         self.topics.push(TopicInfo {
-            topic: ch.topic.clone(),
+            topic: ch.topic.to_string(),
             schema,
             schema_encoding,
-            message_encoding: ch.message_encoding.clone(),
+            message_encoding: ch.message_encoding.to_string(),
             messages: 0,
             decoded: 0,
             log_time_range_ns: None,
@@ -361,11 +768,17 @@ impl RecordDecoder {
 
     /// A message: counted on its topic, and decoded into a sample when the topic feeds a
     /// channel.
-    fn on_message(&mut self, header: &MessageHeader, data: &[u8]) -> Result<Option<Sample>> {
+    fn on_message(
+        &mut self,
+        header: &MessageHeader,
+        data: &[u8],
+        place: McapPlace,
+    ) -> Result<Option<Sample>> {
         self.messages += 1;
         let Some(&st) = self.channels.get(&header.channel_id) else {
             return Err(LogError::Mcap {
                 path: self.path.clone(),
+                place,
                 messages: self.messages - 1,
                 cause: mcap::McapError::UnknownChannel(header.sequence, header.channel_id),
             });

@@ -91,14 +91,14 @@ fn is_mcap(path: &Path) -> Result<bool> {
     if !path.is_file() {
         return Ok(false);
     }
-    let mut f = File::open(path).map_err(LogError::reading(path))?;
+    let mut f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
     let mut head = [0u8; 8];
     let n = f.read(&mut head).map_err(LogError::reading(path))?;
     Ok(n == 8 && head == MCAP_MAGIC)
 }
 
 fn first_line(path: &Path) -> Result<String> {
-    let f = File::open(path).map_err(LogError::reading(path))?;
+    let f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
     let mut line = String::new();
     // A header longer than 64 KiB is not a layout we know; read at most that much.
     BufReader::new(f.take(1 << 16))
@@ -107,9 +107,20 @@ fn first_line(path: &Path) -> Result<String> {
     Ok(line.trim_end().to_string())
 }
 
+/// A log path that exists must be a regular file: a FIFO, device or directory is refused before
+/// it is opened (opening a FIFO blocks until a writer comes). A PX4 prefix need not exist.
+fn refuse_non_regular(path: &Path) -> Result<()> {
+    if std::fs::metadata(path).is_ok() {
+        aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
+    }
+    Ok(())
+}
+
 /// Open a log. MCAP is recognised by extension or magic; a CSV uses `profile`, or without one is
-/// recognised as KAIST by its header or as PX4 by its table name.
+/// recognised as KAIST by its header or as PX4 by its table name. A path that is not a regular
+/// file (a FIFO, device or directory) is refused before it is opened.
 pub fn open_log(path: &Path, profile: Option<&Profile>, mcap: &McapOptions) -> Result<LogReader> {
+    refuse_non_regular(path)?;
     if is_mcap(path)? {
         return Ok(LogReader::Mcap(Box::new(McapSamples::open(
             path,
@@ -248,4 +259,84 @@ impl Iterator for LogReader {
 /// Open and read a whole log.
 pub fn read_log(path: &Path, profile: Option<&Profile>, mcap: &McapOptions) -> Result<Log> {
     open_log(path, profile, mcap)?.read_all(&path.display().to_string())
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+    use std::sync::mpsc;
+    use std::time::Duration;
+
+    /// `open_log(path)`, which must answer within 10 s (opening a FIFO blocks for ever).
+    fn open_at_once(path: PathBuf) -> Result<LogReader> {
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let r = open_log(&path, None, &McapOptions::default());
+            let _ = tx.send(r);
+        });
+        rx.recv_timeout(Duration::from_secs(10))
+            .expect("open_log did not return: it blocked on the path")
+    }
+
+    fn mkfifo(path: &Path) -> bool {
+        std::process::Command::new("mkfifo")
+            .arg(path)
+            .status()
+            .is_ok_and(|s| s.success())
+    }
+
+    #[test]
+    fn fifos_directories_and_devices_are_refused_before_they_are_opened() {
+        let dir = std::env::temp_dir().join(format!("aloft-logs-open-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut cases = vec![(dir.clone(), "directory")];
+        // A FIFO under each name a log can have: MCAP, CSV, a PX4 table.
+        for name in ["log.mcap", "log.csv", "flight_vehicle_local_position_0.csv"] {
+            let p = dir.join(name);
+            if mkfifo(&p) {
+                cases.push((p, "FIFO"));
+            }
+        }
+        if Path::new("/dev/zero").exists() {
+            cases.push((PathBuf::from("/dev/zero"), "device"));
+        }
+        assert!(cases.len() > 1, "no FIFO could be made");
+        for (path, kind) in cases {
+            let e = open_at_once(path.clone())
+                .err()
+                .unwrap_or_else(|| panic!("{} was opened", path.display()));
+            let msg = e.to_string();
+            assert!(
+                msg.contains(&path.display().to_string()) && msg.contains(kind),
+                "{msg}"
+            );
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A PX4 log whose other tables are regular, one of them a FIFO: refused, not blocked on.
+    #[test]
+    fn a_fifo_among_px4_tables_is_refused() {
+        let dir = std::env::temp_dir().join(format!("aloft-logs-px4fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let prefix = dir.join("flight");
+        std::fs::write(
+            table(&prefix, PX4_TOPICS[0]),
+            "timestamp,x,y,z,vx,vy,vz,ax,ay,az\n1,0,0,0,0,0,0,0,0,0\n",
+        )
+        .unwrap();
+        std::fs::write(
+            table(&prefix, PX4_TOPICS[2]),
+            "timestamp,q[0],q[1],q[2],q[3]\n1,1,0,0,0\n",
+        )
+        .unwrap();
+        if mkfifo(&table(&prefix, PX4_TOPICS[1])) {
+            let e = open_at_once(table(&prefix, PX4_TOPICS[0]))
+                .err()
+                .expect("a FIFO table was opened");
+            assert!(e.to_string().contains("FIFO"), "{e}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

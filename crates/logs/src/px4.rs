@@ -303,6 +303,51 @@ mod tests {
         assert!(px4_prefix(Path::new("/nonexistent/flight.csv")).is_none());
     }
 
+    /// Write the three tables of a small PX4 log under a fresh directory; `battery_header`
+    /// replaces the battery table's header.
+    fn write_log(name: &str, battery_header: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("aloft-px4-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let prefix = dir.join("flight");
+        let mut pos = String::from("timestamp,x,y,z,vx,vy,vz,ax,ay,az\n");
+        let mut bat = format!("{battery_header}\n");
+        let mut att = String::from("timestamp,q[0],q[1],q[2],q[3]\n");
+        for i in 0..5u64 {
+            let t = 1_000_000 + i * 100_000;
+            pos.push_str(&format!("{t},0,0,-1,0,0,0,0,0,0\n"));
+            bat.push_str(&format!("{t},16.0,12.0,16.0\n"));
+            att.push_str(&format!("{t},1,0,0,0\n"));
+        }
+        std::fs::write(table(&prefix, PX4_TOPICS[0]), pos).unwrap();
+        std::fs::write(table(&prefix, PX4_TOPICS[1]), bat).unwrap();
+        std::fs::write(table(&prefix, PX4_TOPICS[2]), att).unwrap();
+        prefix
+    }
+
+    #[test]
+    fn a_table_with_a_duplicated_column_is_refused_naming_the_table() {
+        let ok = write_log("ok", "timestamp,voltage_v,current_a,voltage_filtered_v");
+        let n = Px4Samples::open(&ok, Px4Options::default())
+            .unwrap()
+            .collect::<Result<Vec<_>>>()
+            .unwrap();
+        assert_eq!(n.len(), 5);
+        assert_eq!(n[2].voltage_v, Some(16.0));
+        let bad = write_log("dup", "timestamp,voltage_v,current_a,voltage_v");
+        let e = Px4Samples::open(&bad, Px4Options::default())
+            .err()
+            .expect("a duplicated column must be refused");
+        let msg = e.to_string();
+        assert!(matches!(e, LogError::DuplicateColumn { .. }), "{msg}");
+        assert!(
+            msg.contains("flight_battery_status_0.csv") && msg.contains("'voltage_v'"),
+            "{msg}"
+        );
+        for p in [ok, bad] {
+            std::fs::remove_dir_all(p.parent().unwrap()).unwrap();
+        }
+    }
+
     #[test]
     fn yaw_interpolates_across_pi() {
         let a = Sample {
