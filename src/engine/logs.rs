@@ -128,6 +128,10 @@ pub struct LagInfo {
     pub correlation_at_zero: f64,
     /// True when the best lag is at the edge of the search window.
     pub at_window_edge: bool,
+    /// Log time up to which the samples were used, s, when the log was longer than the search
+    /// keeps (about 2 million samples of each series); absent when the whole log was used.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub used_until_s: Option<f64>,
 }
 
 /// What a log holds: the JSON of `aloft log info --format json`.
@@ -178,6 +182,10 @@ pub struct LogInfo {
     pub lag: Option<LagInfo>,
 }
 
+/// Most samples of each series the lag search keeps (58 hours at 10 Hz): memory stays bounded
+/// whatever the log's length; a longer log's lag is estimated from its first part (and says so).
+const LAG_SAMPLES: usize = 1 << 21;
+
 /// Power and ground-speed series kept for the lag search.
 #[derive(Default)]
 struct LagSeries {
@@ -185,6 +193,26 @@ struct LagSeries {
     power_w: Vec<f64>,
     speed_t: Vec<f64>,
     speed_mps: Vec<f64>,
+    /// Time of the first sample left out when a series was full.
+    full_at_s: Option<f64>,
+}
+
+impl LagSeries {
+    fn push(&mut self, s: &aloft_logs::Sample) {
+        let full = self.power_t.len() >= LAG_SAMPLES || self.speed_t.len() >= LAG_SAMPLES;
+        if full {
+            self.full_at_s.get_or_insert(s.time_s);
+            return;
+        }
+        if let Some(w) = s.electrical_power_w() {
+            self.power_t.push(s.time_s);
+            self.power_w.push(w);
+        }
+        if let Some(u) = s.vel_enu_mps {
+            self.speed_t.push(s.time_s);
+            self.speed_mps.push(u[0].hypot(u[1]));
+        }
+    }
 }
 
 /// Summarise the log at `path`: duration, rates, channels or topics, energy used, the regularity
@@ -205,14 +233,7 @@ pub fn log_info(
         let s = s?;
         acc.push(&s);
         if lag_window_s.is_some() {
-            if let Some(w) = s.electrical_power_w() {
-                series.power_t.push(s.time_s);
-                series.power_w.push(w);
-            }
-            if let Some(u) = s.vel_enu_mps {
-                series.speed_t.push(s.time_s);
-                series.speed_mps.push(u[0].hypot(u[1]));
-            }
+            series.push(&s);
         }
     }
     let stats = acc.finish();
@@ -316,6 +337,7 @@ fn lag_of(
         correlation: e.correlation,
         correlation_at_zero: e.correlation_at_zero,
         at_window_edge: e.at_window_edge,
+        used_until_s: s.full_at_s,
     })
 }
 
