@@ -108,82 +108,150 @@ fn motion(s: &Sample) -> Option<(FlightState, f64)> {
         .then_some((state, tilt_cos.clamp(-1.0, 1.0).acos()))
 }
 
-/// Pair power with motion in `log` (see the module docs).
+/// Pair power with motion in `log` (see the module docs): the power series, the motion series,
+/// the lag between them (given or estimated), each motion sample paired with the power at its
+/// time plus the lag, and the idle samples dropped.
 pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, Error> {
     let source = log.source.clone();
-    let (pt, pw): (Vec<f64>, Vec<f64>) = log
+    let power = power_series(log)?;
+    let (motion, mut skipped) = motion_series(log)?;
+    let (lag_s, lag_correlation) = match options.lag_s {
+        Some(l) => (l, None),
+        None => {
+            let est = estimate_lag(log, &power, &motion, options.max_lag_s)?;
+            (est.lag_s, Some(est.correlation))
+        }
+    };
+    let (times_s, samples, unpaired) = pair_with_power(&power, &motion, lag_s);
+    skipped += unpaired;
+    let (times_s, samples, idle) = drop_idle(times_s, samples, options.idle_power_fraction);
+    Ok(AlignedFlight {
+        source,
+        lag_s,
+        lag_correlation,
+        idle,
+        times_s,
+        samples,
+        skipped,
+    })
+}
+
+/// Electrical power against time, where both are finite: (times, watts), at least two samples,
+/// in time order.
+struct PowerSeries {
+    times_s: Vec<f64>,
+    power_w: Vec<f64>,
+}
+
+/// Flight states against time, with the tilt of each (for the lag estimate).
+struct MotionSeries {
+    times_s: Vec<f64>,
+    states: Vec<FlightState>,
+    tilt_rad: Vec<f64>,
+}
+
+/// The log's electrical power series.
+fn power_series(log: &Log) -> Result<PowerSeries, Error> {
+    let (times_s, power_w): (Vec<f64>, Vec<f64>) = log
         .samples
         .iter()
         .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
         .filter(|(t, p)| t.is_finite() && p.is_finite())
         .unzip();
-    if pt.len() < 2 {
-        return Err(Error::NoPower { origin: source });
+    if times_s.len() < 2 {
+        return Err(Error::NoPower {
+            origin: log.source.clone(),
+        });
     }
-    if pt.windows(2).any(|w| w[1] < w[0]) {
-        return Err(Error::NotMonotonic { origin: source });
+    if times_s.windows(2).any(|w| w[1] < w[0]) {
+        return Err(Error::NotMonotonic {
+            origin: log.source.clone(),
+        });
     }
-    let mut mt = Vec::new();
-    let mut states = Vec::new();
-    let mut tilt = Vec::new();
+    Ok(PowerSeries { times_s, power_w })
+}
+
+/// The log's flight states, and how many samples gave none.
+fn motion_series(log: &Log) -> Result<(MotionSeries, usize), Error> {
+    let mut m = MotionSeries {
+        times_s: Vec::new(),
+        states: Vec::new(),
+        tilt_rad: Vec::new(),
+    };
     let mut skipped = 0;
     for s in &log.samples {
         match motion(s) {
-            Some((state, tl)) if s.time_s.is_finite() => {
-                mt.push(s.time_s);
-                states.push(state);
-                tilt.push(tl);
+            Some((state, tilt)) if s.time_s.is_finite() => {
+                m.times_s.push(s.time_s);
+                m.states.push(state);
+                m.tilt_rad.push(tilt);
             }
             _ => skipped += 1,
         }
     }
-    if mt.len() < 2 {
-        return Err(Error::NoMotion { origin: source });
+    if m.times_s.len() < 2 {
+        return Err(Error::NoMotion {
+            origin: log.source.clone(),
+        });
     }
-    if mt.windows(2).any(|w| w[1] < w[0]) {
-        return Err(Error::NotMonotonic { origin: source });
+    if m.times_s.windows(2).any(|w| w[1] < w[0]) {
+        return Err(Error::NotMonotonic {
+            origin: log.source.clone(),
+        });
     }
-    let (lag_s, lag_correlation) = match options.lag_s {
-        Some(l) => (l, None),
-        None => {
-            // Common 0.1 s grid over the overlap of the two channels.
-            let dt = 0.1;
-            let start = pt[0].max(mt[0]);
-            let end = pt[pt.len() - 1].min(mt[mt.len() - 1]);
-            let n = ((end - start) / dt).floor().max(0.0);
-            // The grid covers the overlap of the channels; one whose span is far longer than
-            // the samples could fill (a time stamp off by years) is refused before it is built.
-            let limit = 10.0 * (pt.len() + mt.len()) as f64 + 1e5;
-            if n > limit {
-                return Err(Error::SparseTime {
-                    origin: source,
-                    span_s: end - start,
-                    samples: pt.len().max(mt.len()),
-                });
-            }
-            let n = n as usize;
-            let grid: Vec<f64> = (0..n).map(|i| start + i as f64 * dt).collect();
-            let p: Vec<f64> = grid
-                .iter()
-                .filter_map(|&t| interpolate(&pt, &pw, t))
-                .collect();
-            let m: Vec<f64> = grid
-                .iter()
-                .filter_map(|&t| interpolate(&mt, &tilt, t))
-                .collect();
-            let est = aloft_logs::estimate_lag_s(&p, &m, dt, options.max_lag_s).map_err(|e| {
-                Error::Log {
-                    origin: source.clone(),
-                    source: Box::new(e),
-                }
-            })?;
-            (est.lag_s, Some(est.correlation))
-        }
-    };
-    let mut times_s = Vec::with_capacity(mt.len());
-    let mut samples = Vec::with_capacity(mt.len());
-    for (&t, state) in mt.iter().zip(&states) {
-        match interpolate(&pt, &pw, t + lag_s) {
+    Ok((m, skipped))
+}
+
+/// The lag of power behind motion, from the cross-correlation of power and tilt on a common
+/// 0.1 s grid over the overlap of the two channels.
+fn estimate_lag(
+    log: &Log,
+    power: &PowerSeries,
+    motion: &MotionSeries,
+    max_lag_s: f64,
+) -> Result<aloft_logs::LagEstimate, Error> {
+    let (pt, mt) = (&power.times_s, &motion.times_s);
+    let dt = 0.1;
+    let start = pt[0].max(mt[0]);
+    let end = pt[pt.len() - 1].min(mt[mt.len() - 1]);
+    let n = ((end - start) / dt).floor().max(0.0);
+    // The grid covers the overlap of the channels; one whose span is far longer than the
+    // samples could fill (a time stamp off by years) is refused before it is built.
+    let limit = 10.0 * (pt.len() + mt.len()) as f64 + 1e5;
+    if n > limit {
+        return Err(Error::SparseTime {
+            origin: log.source.clone(),
+            span_s: end - start,
+            samples: pt.len().max(mt.len()),
+        });
+    }
+    let grid: Vec<f64> = (0..n as usize).map(|i| start + i as f64 * dt).collect();
+    let p: Vec<f64> = grid
+        .iter()
+        .filter_map(|&t| interpolate(pt, &power.power_w, t))
+        .collect();
+    let m: Vec<f64> = grid
+        .iter()
+        .filter_map(|&t| interpolate(mt, &motion.tilt_rad, t))
+        .collect();
+    aloft_logs::estimate_lag_s(&p, &m, dt, max_lag_s).map_err(|e| Error::Log {
+        origin: log.source.clone(),
+        source: Box::new(e),
+    })
+}
+
+/// Each flight state with the power at its time plus the lag, where that power is positive;
+/// and how many states had none.
+fn pair_with_power(
+    power: &PowerSeries,
+    motion: &MotionSeries,
+    lag_s: f64,
+) -> (Vec<f64>, Vec<FitSample>, usize) {
+    let mut times_s = Vec::with_capacity(motion.times_s.len());
+    let mut samples = Vec::with_capacity(motion.times_s.len());
+    let mut unpaired = 0;
+    for (&t, state) in motion.times_s.iter().zip(&motion.states) {
+        match interpolate(&power.times_s, &power.power_w, t + lag_s) {
             Some(p) if p > 0.0 => {
                 times_s.push(t);
                 samples.push(FitSample {
@@ -191,28 +259,29 @@ pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, 
                     measured_power_w: p,
                 });
             }
-            _ => skipped += 1,
+            _ => unpaired += 1,
         }
     }
+    (times_s, samples, unpaired)
+}
+
+/// The samples at or above `idle_power_fraction` of the median power, and how many were below.
+fn drop_idle(
+    times_s: Vec<f64>,
+    samples: Vec<FitSample>,
+    idle_power_fraction: f64,
+) -> (Vec<f64>, Vec<FitSample>, usize) {
     let mut sorted: Vec<f64> = samples.iter().map(|s| s.measured_power_w).collect();
     sorted.sort_by(f64::total_cmp);
-    let threshold =
-        options.idle_power_fraction * sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let threshold = idle_power_fraction * sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
     let before = samples.len();
     let (times_s, samples): (Vec<f64>, Vec<FitSample>) = times_s
         .into_iter()
         .zip(samples)
         .filter(|(_, s)| s.measured_power_w >= threshold)
         .unzip();
-    Ok(AlignedFlight {
-        source,
-        lag_s,
-        lag_correlation,
-        idle: before - samples.len(),
-        times_s,
-        samples,
-        skipped,
-    })
+    let idle = before - samples.len();
+    (times_s, samples, idle)
 }
 
 /// Force-balance samples of a log for [`aloft_power::fit_drag`]: air velocity (ground velocity

@@ -45,6 +45,87 @@ pub struct Airframe {
     yaw_rate_radps: f64,
 }
 
+/// Each value of the table with its unit and upper bound: positive, finite and within a
+/// physical range (a value beyond it is a unit slip, not a multirotor; the speed limit is the
+/// power model's).
+type RangeCheck = (&'static str, f64, &'static str, f64, &'static str);
+
+/// The range checks of [`Airframe::new`], one per value of the table.
+fn range_checks(spec: &AirframeSpec) -> [RangeCheck; 10] {
+    [
+        (
+            "airframe mass_kg",
+            spec.mass_kg,
+            "kg",
+            1e4,
+            "at most 10000 kg",
+        ),
+        (
+            "airframe max_takeoff_mass_kg",
+            spec.max_takeoff_mass_kg,
+            "kg",
+            1e4,
+            "at most 10000 kg",
+        ),
+        (
+            "airframe max_tilt_deg",
+            spec.max_tilt_deg,
+            "deg",
+            90.0,
+            "below 90 deg",
+        ),
+        (
+            "airframe max_speed_mps",
+            spec.max_speed_mps,
+            "m/s",
+            MAX_AIRSPEED_MPS,
+            "at most 150 m/s",
+        ),
+        (
+            "airframe max_climb_rate_mps",
+            spec.max_climb_rate_mps,
+            "m/s",
+            100.0,
+            "at most 100 m/s",
+        ),
+        (
+            "airframe max_descent_rate_mps",
+            spec.max_descent_rate_mps,
+            "m/s",
+            100.0,
+            "at most 100 m/s",
+        ),
+        (
+            "airframe acceleration_mps2",
+            spec.acceleration_mps2,
+            "m/s^2",
+            100.0,
+            "at most 100 m/s^2",
+        ),
+        (
+            "airframe vertical_acceleration_mps2",
+            spec.vertical_acceleration_mps2,
+            "m/s^2",
+            100.0,
+            "at most 100 m/s^2",
+        ),
+        (
+            "airframe yaw_rate_deg_s",
+            spec.yaw_rate_deg_s,
+            "deg/s",
+            3600.0,
+            "at most 3600 deg/s",
+        ),
+        (
+            "airframe rotor_height_m",
+            spec.rotor_height_m,
+            "m",
+            100.0,
+            "at most 100 m",
+        ),
+    ]
+}
+
 impl Airframe {
     /// Validate the table.
     ///
@@ -52,80 +133,7 @@ impl Airframe {
     /// Any value non-positive or non-finite, a tilt limit of 90 deg or more, a largest take-off
     /// mass below the airframe mass, a thrust limit below the weight at the largest take-off mass.
     pub fn new(spec: AirframeSpec) -> Result<Self, PlannerError> {
-        // Each value positive, finite and within a physical range (a value beyond it is a unit
-        // slip, not a multirotor; the speed limit is the power model's).
-        let checks: [(&'static str, f64, &'static str, f64, &'static str); 10] = [
-            (
-                "airframe mass_kg",
-                spec.mass_kg,
-                "kg",
-                1e4,
-                "at most 10000 kg",
-            ),
-            (
-                "airframe max_takeoff_mass_kg",
-                spec.max_takeoff_mass_kg,
-                "kg",
-                1e4,
-                "at most 10000 kg",
-            ),
-            (
-                "airframe max_tilt_deg",
-                spec.max_tilt_deg,
-                "deg",
-                90.0,
-                "below 90 deg",
-            ),
-            (
-                "airframe max_speed_mps",
-                spec.max_speed_mps,
-                "m/s",
-                MAX_AIRSPEED_MPS,
-                "at most 150 m/s",
-            ),
-            (
-                "airframe max_climb_rate_mps",
-                spec.max_climb_rate_mps,
-                "m/s",
-                100.0,
-                "at most 100 m/s",
-            ),
-            (
-                "airframe max_descent_rate_mps",
-                spec.max_descent_rate_mps,
-                "m/s",
-                100.0,
-                "at most 100 m/s",
-            ),
-            (
-                "airframe acceleration_mps2",
-                spec.acceleration_mps2,
-                "m/s^2",
-                100.0,
-                "at most 100 m/s^2",
-            ),
-            (
-                "airframe vertical_acceleration_mps2",
-                spec.vertical_acceleration_mps2,
-                "m/s^2",
-                100.0,
-                "at most 100 m/s^2",
-            ),
-            (
-                "airframe yaw_rate_deg_s",
-                spec.yaw_rate_deg_s,
-                "deg/s",
-                3600.0,
-                "at most 3600 deg/s",
-            ),
-            (
-                "airframe rotor_height_m",
-                spec.rotor_height_m,
-                "m",
-                100.0,
-                "at most 100 m",
-            ),
-        ];
+        let checks = range_checks(&spec);
         for (name, value, unit, max, expected) in checks {
             positive(name, value, unit)?;
             if name != "airframe max_tilt_deg" {
