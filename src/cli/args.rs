@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::Args;
 
-use aloft::engine::{AoaModel, GustSpec, WindProfileKind, WindSpec};
+use aloft::engine::{AoaModel, CornerMode, GustSpec, WindProfileKind, WindSpec};
 
 /// Every numeric flag: a finite number (`nan`, `inf` and overflowing text like `1e999` are
 /// refused here with the flag's name; the engine checks each value's physical range and unit).
@@ -30,6 +30,20 @@ pub fn aoa_parser() -> impl TypedValueParser<Value = AoaModel> {
     .map(|s| match s.as_str() {
         "paper" => AoaModel::Paper,
         _ => AoaModel::Geometric,
+    })
+}
+
+/// `--corners pass|stop`, parsed into the engine's [`CornerMode`].
+pub fn corners_parser() -> impl TypedValueParser<Value = CornerMode> {
+    PossibleValuesParser::new([
+        PossibleValue::new("pass").help(
+            "Through waypoints without a hold at the speed the turn allows (as autopilots fly)",
+        ),
+        PossibleValue::new("stop").help("Stop at every waypoint, yaw, go on"),
+    ])
+    .map(|s| match s.as_str() {
+        "stop" => CornerMode::Stop,
+        _ => CornerMode::Pass,
     })
 }
 

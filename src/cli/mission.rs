@@ -10,18 +10,19 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 
 use aloft::engine::{
-    plan_mission_with, AoaModel, Mission, MissionOptions, MissionOutputs, MissionReport, Plan,
-    Sample, Vehicle,
+    plan_mission_with, AoaModel, CornerMode, Mission, MissionOptions, MissionOutputs,
+    MissionReport, Plan, Sample, Vehicle,
 };
 
-use super::args::{aoa_parser, MissionWindArgs};
+use super::args::{aoa_parser, corners_parser, MissionWindArgs};
 use super::output::{self, Row};
 use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
 
 #[derive(Debug, Args)]
 pub struct MissionArgs {
-    /// Mission file, TOML or JSON (see fixtures/missions/example.toml). Without it, the built-in
-    /// demonstration: a survey with four lines and an orbit in a 6 m/s breeze.
+    /// Mission file: an aloft mission in TOML or JSON (see fixtures/missions/example.toml),
+    /// recognised from its content. Without it, the built-in demonstration: a survey with four
+    /// lines and an orbit in a 6 m/s breeze.
     pub mission: Option<PathBuf>,
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
@@ -43,6 +44,17 @@ pub struct MissionArgs {
     /// Sampling step, s (default: the mission's, else 0.1).
     #[arg(value_parser = super::args::finite(), long, value_name = "S")]
     pub time_step: Option<f64>,
+    /// Planning speed, m/s: the ground speed of legs without one of their own (overrides the
+    /// vehicle's cruise_speed_mps and the file's, e.g. a .plan's hoverSpeed).
+    #[arg(value_parser = super::args::finite(), long, value_name = "M/S")]
+    pub speed: Option<f64>,
+    /// Lowest height of a return to launch, m (overrides the vehicle's rtl_altitude_m and the
+    /// mission's): a return below it climbs first.
+    #[arg(value_parser = super::args::finite(), long, value_name = "M")]
+    pub rtl_altitude_m: Option<f64>,
+    /// How waypoints without a hold are flown (default: the mission's, else pass).
+    #[arg(long, value_parser = corners_parser(), value_name = "MODE")]
+    pub corners: Option<CornerMode>,
     /// Angle-of-attack model of the power model.
     #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
     pub aoa: AoaModel,
@@ -116,6 +128,9 @@ impl MissionArgs {
             aoa: self.aoa,
             ground_effect: !self.no_ground_effect,
             record_samples: false,
+            speed_mps: self.speed,
+            rtl_altitude_m: self.rtl_altitude_m,
+            corners: self.corners,
         }
     }
 
@@ -177,6 +192,7 @@ fn write_table(out: &mut impl Write, plan: &Plan) -> Result<()> {
     writeln!(out)?;
     write_segments(out, plan.report())?;
     writeln!(out)?;
+    write_sorties(out, plan.summary())?;
     let c = plan.context();
     writeln!(
         out,
@@ -217,8 +233,23 @@ fn header(plan: &Plan) -> Result<String> {
         r.takeoff_mass_kg
     )?;
     writeln!(head, "Wind: {}", c.wind)?;
+    if let Some(v) = &s.planning_speed {
+        writeln!(
+            head,
+            "Planning speed: {} m/s ({}), for the legs without a speed of their own",
+            v.speed_mps,
+            match v.source.as_str() {
+                "option" => "--speed",
+                "vehicle" => "the vehicle's cruise_speed_mps",
+                _ => "the mission file's",
+            }
+        )?;
+    }
     for n in &c.notes {
         writeln!(head, "Note: {n}")?;
+    }
+    for w in &s.warnings {
+        writeln!(head, "Warning: {w}")?;
     }
     writeln!(head)?;
     match &r.shortfall {
@@ -246,7 +277,56 @@ fn header(plan: &Plan) -> Result<String> {
             p.position_m[2]
         )?,
     }
+    if let Some(l) = &s.loiter {
+        let item = l.item.map_or(String::new(), |i| format!(" (item {i})"));
+        writeln!(
+            head,
+            "Loiter until the reserve{item}: {}{} of hovering from t = {:.0} s (segment {}), then home to land with the reserve.",
+            if l.at_least { "at least " } else { "" },
+            mmss(l.duration_s),
+            l.start_s,
+            l.segment
+        )?;
+    }
     Ok(head)
+}
+
+/// Batteries and sorties, when the route takes more than one pack or cannot be split.
+fn write_sorties(out: &mut impl Write, s: &aloft::engine::MissionSummary) -> Result<()> {
+    if s.sorties.is_empty() {
+        if s.batteries_required.is_none() && !s.feasible {
+            writeln!(out, "Batteries required: unknown (see the warning above).")?;
+            writeln!(out)?;
+        }
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "Batteries required: {}, one per sortie (each from home and back with the reserve, a fresh pack at home)",
+        s.sorties.len()
+    )?;
+    writeln!(
+        out,
+        "  {:>2}  {:>11} {:>8} {:>9} {:>11}",
+        "#", "items", "time", "energy", "battery end"
+    )?;
+    for (k, x) in s.sorties.iter().enumerate() {
+        let items = match (x.first_item, x.last_item) {
+            (Some(a), Some(b)) => format!("{a}-{b}"),
+            _ => format!("seg {}-{}", x.first_segment, x.last_segment),
+        };
+        writeln!(
+            out,
+            "  {:>2}  {:>11} {:>8} {:>6.1} Wh {:>9.1} %",
+            k + 1,
+            items,
+            mmss(x.duration_s),
+            x.energy_wh,
+            x.end_soc * 100.0
+        )?;
+    }
+    writeln!(out)?;
+    Ok(())
 }
 
 fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
@@ -281,17 +361,32 @@ fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
     ]
 }
 
+/// The segments; with the operator's item numbers when the mission came from a planner file.
 fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
+    let items = r.segments.iter().any(|s| s.item.is_some());
     writeln!(out, "Segments")?;
     writeln!(
         out,
-        "  {:>2}  {:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>11}",
-        "#", "kind", "time", "distance", "energy", "mean power", "peak power", "battery end"
+        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>11}",
+        "#",
+        if items { "item " } else { "" },
+        "kind",
+        "time",
+        "distance",
+        "energy",
+        "mean power",
+        "peak power",
+        "battery end"
     )?;
     for s in &r.segments {
+        let item = match (items, s.item) {
+            (false, _) => String::new(),
+            (true, Some(i)) => format!("{i:>4} "),
+            (true, None) => "     ".to_string(),
+        };
         writeln!(
             out,
-            "  {:>2}  {:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.0} W {:>9.1} %",
+            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.0} W {:>9.1} %",
             s.index,
             s.kind,
             mmss(s.duration_s),

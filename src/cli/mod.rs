@@ -51,7 +51,7 @@ enum Command {
     /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
     Validate(validate::ValidateArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
-    Mission(mission::MissionArgs),
+    Mission(Box<mission::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
     Endurance(endurance::EnduranceArgs),
 }
@@ -91,7 +91,7 @@ pub fn main() -> ExitCode {
         Command::Convert(args) => convert::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Validate(args) => validate::run(args),
-        Command::Mission(args) => mission::run(args),
+        Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
     };
     match result {

@@ -6,12 +6,18 @@ use std::path::{Path, PathBuf};
 use aloft_core::Trapezoid;
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Wind, WindSpec};
+use aloft_planner::{
+    CornerMode, MissionReport, MissionSpec, Pack, PlanOptions, Sample, Wind, WindSpec,
+};
 use aloft_power::AoaModel;
 
 use super::files::read_text_file;
 use super::finite::finite;
+use super::flight::Flight;
+use super::flown::flown_spec;
+use super::loiter::resolve_loiter;
 use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
+use super::sorties::{split, Sorties};
 use super::summary::{mission_summary, MissionSummary};
 use super::vehicles::Vehicle;
 use super::wind::{mission_wind, GustSpec};
@@ -172,6 +178,15 @@ pub struct MissionOptions {
     pub ground_effect: bool,
     /// Keep every sample in the [`Plan`] (needed by [`Plan::remaining`]; default false).
     pub record_samples: bool,
+    /// Planning speed, m/s: the ground speed of the legs, orbits and returns that give none
+    /// (overrides the vehicle's `cruise_speed_mps` and the mission's default, e.g. a `.plan`'s
+    /// `hoverSpeed`).
+    pub speed_mps: Option<f64>,
+    /// Lowest height of a return to home, m (overrides the vehicle's and the mission's).
+    pub rtl_altitude_m: Option<f64>,
+    /// Corners: `pass` (through waypoints without a hold, as autopilots fly) or `stop`
+    /// (overrides the mission's; default pass).
+    pub corners: Option<CornerMode>,
 }
 
 impl Default for MissionOptions {
@@ -188,6 +203,9 @@ impl Default for MissionOptions {
             aoa: AoaModel::Geometric,
             ground_effect: true,
             record_samples: false,
+            speed_mps: None,
+            rtl_altitude_m: None,
+            corners: None,
         }
     }
 }
@@ -420,8 +438,9 @@ pub fn plan_mission_in(
     plan_in(vehicle, mission, options, wind, &MissionOutputs::default())
 }
 
-/// The steps of a plan: the pack, the compiled mission, the planner's options, the flight (into
-/// the outputs), the summary.
+/// The steps of a plan: the pack and the flight's fixed parts, the spec flown (the options
+/// applied), a loiter until the reserve resolved, the compiled mission, the flight (into the
+/// outputs), the sorties when one pack is not enough, the summary.
 fn plan_in(
     vehicle: &Vehicle,
     mission: &Mission,
@@ -429,52 +448,52 @@ fn plan_in(
     (wind, wind_text): (&Wind, String),
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
-    let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
     let in_mission = |e| Error::Mission {
         origin: mission.origin.clone(),
         vehicle: vehicle.name().to_string(),
         source: Box::new(e),
     };
-    let compiled = mission
-        .spec
-        .compile(aircraft.airframe(), battery.mass_kg(), options.payload_kg)
+    check_options(options)?;
+    let flight = Flight {
+        aircraft: vehicle.aircraft()?,
+        pack: &battery,
+        wind,
+        options: planner_options(options, &mission.spec)?,
+    };
+    let (spec, planning_speed) = flown_spec(mission, vehicle, options);
+    let (spec, loiter) =
+        match resolve_loiter(&flight, &spec, options.payload_kg).map_err(in_mission)? {
+            Some((flown, loiter)) => (flown, Some(loiter)),
+            None => (spec, None),
+        };
+    let compiled = flight
+        .compile(&spec, options.payload_kg)
         .map_err(in_mission)?;
-    let plan_options = planner_options(options, &mission.spec)?;
-    let (report, plot_samples) = if outputs.any() {
-        let keep_all = plan_options.record_samples;
-        let mut sink = OutputSink::create(outputs, path_points(&compiled), keep_all)?;
-        match aloft_planner::plan_into(
-            aircraft,
-            &battery,
-            &compiled,
-            wind,
-            &plan_options,
-            &mut sink,
-        ) {
-            Ok(mut report) => {
-                let (plot, all) = sink.finish()?;
-                report.samples = all;
-                (report, plot)
-            }
-            Err(e) => {
-                sink.discard();
-                return Err(sink.take_failure().unwrap_or_else(|| in_mission(e)));
-            }
-        }
+    let (report, plot_samples) = fly_into_outputs(&flight, &compiled, outputs, in_mission)?;
+    let sorties = if report.feasible || compiled.ends_in_air() {
+        Sorties::one(report.feasible)
     } else {
-        let report = aloft_planner::plan(aircraft, &battery, &compiled, wind, &plan_options)
-            .map_err(in_mission)?;
-        (report, Vec::new())
+        let mut flat = spec.clone();
+        flat.payload_kg = compiled.payloads_kg().first().copied().unwrap_or(0.0);
+        split(&flight, &flat, &compiled)
     };
     let payload = compiled.payloads_kg().first().copied().unwrap_or(0.0);
-    let summary = mission_summary(
+    let mut summary = mission_summary(
         &report,
         mission.display_name(),
         vehicle.name(),
         battery.name(),
         payload,
     );
+    summary.planning_speed = planning_speed;
+    summary.loiter = loiter;
+    summary.batteries_required = sorties.batteries_required;
+    summary.sorties = sorties.sorties;
+    summary.warnings = compiled.warnings().to_vec();
+    summary
+        .warnings
+        .extend(sorties.note.map(|n| format!("not split into sorties: {n}")));
     let summary = finite(summary, "mission", || {
         format!("mission {} with {}", mission.origin, vehicle.name())
     })?;
@@ -494,6 +513,54 @@ fn plan_in(
         compiled,
         plot_samples,
     })
+}
+
+/// Fly the compiled mission, writing the files of `outputs` (removed again after a failed run)
+/// and keeping a chart's samples; without outputs, the planner's report alone (with every sample
+/// when the options ask).
+fn fly_into_outputs(
+    flight: &Flight<'_>,
+    compiled: &aloft_planner::Mission,
+    outputs: &MissionOutputs,
+    in_mission: impl Fn(aloft_planner::PlannerError) -> Error,
+) -> Result<(MissionReport, Vec<Sample>), Error> {
+    if !outputs.any() {
+        let report = flight.fly(compiled).map_err(in_mission)?;
+        return Ok((report, Vec::new()));
+    }
+    let keep_all = flight.options.record_samples;
+    let mut sink = OutputSink::create(outputs, path_points(compiled), keep_all)?;
+    match flight.fly_into(compiled, &mut sink) {
+        Ok(mut report) => {
+            let (plot, all) = sink.finish()?;
+            report.samples = all;
+            Ok((report, plot))
+        }
+        Err(e) => {
+            sink.discard();
+            Err(sink.take_failure().unwrap_or_else(|| in_mission(e)))
+        }
+    }
+}
+
+/// The options' own values, before anything is flown: a planning speed and an RTL altitude are
+/// positive and finite.
+fn check_options(options: &MissionOptions) -> Result<(), Error> {
+    let positive = |name: &'static str, value: Option<f64>, unit: &'static str| match value {
+        Some(v)
+            if !(v.is_finite() && v > 0.0 && v <= aloft_planner::mission::MAX_MISSION_VALUE) =>
+        {
+            Err(Error::InvalidInput {
+                name,
+                value: v,
+                unit,
+                expected: "positive and finite, at most 1e7",
+            })
+        }
+        _ => Ok(()),
+    };
+    positive("speed_mps", options.speed_mps, "m/s")?;
+    positive("rtl_altitude_m", options.rtl_altitude_m, "m")
 }
 
 /// The planner's options: the request's, else the mission file's, else the defaults (reserve

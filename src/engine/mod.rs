@@ -44,13 +44,17 @@ mod estimator;
 mod files;
 mod finite;
 mod fit;
+mod flight;
+mod flown;
 mod logs;
+mod loiter;
 mod mission;
 mod mission_outputs;
 mod power;
 mod power_batch;
 mod propulsion;
 mod replay;
+mod sorties;
 mod summary;
 mod validate;
 mod vehicles;
@@ -63,10 +67,12 @@ pub use endurance::{
 pub use estimator::InFlightEstimator;
 pub use files::read_text_file;
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
+pub use flown::PlanningSpeed;
 pub use logs::{
     convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
     LogReadOptions, LogTime, LogTopic, TopicCount,
 };
+pub use loiter::LoiterSummary;
 pub use mission::{
     plan_mission, plan_mission_in, plan_mission_with, Mission, MissionOptions, PackDescription,
     Plan, PlanContext, Remaining, DEMO_MISSION, DEMO_ORIGIN,
@@ -82,6 +88,7 @@ pub use propulsion::{
     RotorRequest, SweepPoint, BUILTIN_ROTORS,
 };
 pub use replay::{replay_log, ReplayAcceleration, ReplayAnswer, ReplayContext, ReplayRequest};
+pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
 pub use validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,
@@ -99,8 +106,8 @@ pub use wind::{describe_wind_spec, GustSpec};
 /// command line among them) need no model crate.
 pub use aloft_logs::{sample::Gap, sample::NonMonotonic, Channel, DroppedValue, LogFormat};
 pub use aloft_planner::{
-    EnduranceReport, MissionReport, PointOfNoReturn, Sample, SegmentReport, Shortfall, SweepRow,
-    Wind, WindProfileKind, WindSpec,
+    CornerMode, EnduranceReport, MissionReport, PointOfNoReturn, Sample, SegmentReport, Shortfall,
+    SweepRow, Wind, WindProfileKind, WindSpec,
 };
 pub use aloft_power::fit::{DragFit, FitParameter, PowerFit};
 pub use aloft_power::{AoaModel, FlightState, PowerBreakdown, Term, Terms};

@@ -5,6 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::MissionReport;
 
+use super::flown::PlanningSpeed;
+use super::loiter::LoiterSummary;
+use super::sorties::SortieSummary;
 use crate::error::Error;
 
 /// One segment of a [`MissionSummary`] (keys as `aloft mission --format json`).
@@ -14,6 +17,9 @@ pub struct SegmentSummary {
     pub index: usize,
     /// Segment kind (`take-off`, `leg`, `orbit`, ...).
     pub kind: String,
+    /// The operator's mission item number, when the mission came from a planner file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub item: Option<u32>,
     /// Duration, s.
     pub duration_s: f64,
     /// Distance flown, m.
@@ -91,6 +97,23 @@ pub struct MissionSummary {
     /// Where it lies (absent when there is none).
     #[serde(flatten, skip_serializing_if = "Option::is_none")]
     pub point_of_no_return: Option<PointOfNoReturnSummary>,
+    /// The planning speed (the ground speed of legs that give none) and where it came from;
+    /// absent when the mission gives a speed on every leg.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub planning_speed: Option<PlanningSpeed>,
+    /// The loiter of a route that ends in a loiter until the reserve.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loiter: Option<LoiterSummary>,
+    /// Packs the route takes (1 when one suffices); absent when it cannot be told (a mission
+    /// that ends in the air and falls short, a route that cannot be split: see `warnings`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub batteries_required: Option<u32>,
+    /// The sorties, when the route takes more than one pack.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sorties: Vec<SortieSummary>,
+    /// What the reader should know: speeds clamped to the vehicle's, why a route was not split.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Per segment.
     pub segments: Vec<SegmentSummary>,
 }
@@ -150,12 +173,18 @@ pub fn mission_summary(
             point_of_no_return_up_m: p.position_m[2],
             point_of_no_return_segment: p.segment,
         }),
+        planning_speed: None,
+        loiter: None,
+        batteries_required: report.feasible.then_some(1),
+        sorties: Vec::new(),
+        warnings: Vec::new(),
         segments: report
             .segments
             .iter()
             .map(|s| SegmentSummary {
                 index: s.index,
                 kind: s.kind.to_string(),
+                item: s.item,
                 duration_s: s.duration_s,
                 distance_m: s.distance_m,
                 energy_wh: s.energy_wh,

@@ -149,6 +149,11 @@ impl Vehicle {
         self.file.battery(name)
     }
 
+    /// The vehicle's defaults for missions: its cruise speed and RTL altitude.
+    pub(crate) fn flight_defaults(&self) -> super::flown::FlightDefaults {
+        super::flown::FlightDefaults::default()
+    }
+
     /// The aircraft the planner flies, or the error that says which table is missing.
     pub(crate) fn aircraft(&self) -> Result<&Aircraft, Error> {
         match &self.aircraft {

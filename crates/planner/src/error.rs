@@ -35,12 +35,14 @@ pub enum PlannerError {
     #[error("the mission has no segments: add at least a take-off and a landing")]
     EmptyMission,
     /// A mission segment that is invalid in itself.
-    #[error("segment {index} ({kind}): {name} = {} {unit} is invalid: {expected}", aloft_core::Num::of(.value))]
+    #[error("segment {index} ({kind}{}): {name} = {} {unit} is invalid: {expected}", ItemNote(*.item), aloft_core::Num::of(.value))]
     InvalidSegment {
         /// Segment number, from 1.
         index: usize,
         /// Segment kind (`leg`, `orbit`, ...).
         kind: &'static str,
+        /// The operator's item number, when the segment came from a planner file.
+        item: Option<u32>,
         /// The offending key.
         name: &'static str,
         /// Its value.
@@ -51,12 +53,14 @@ pub enum PlannerError {
         expected: &'static str,
     },
     /// A segment asks for something the vehicle cannot do (speed, climb rate, turn load).
-    #[error("segment {index} ({kind}): {name} = {value:.3} {unit} is beyond the vehicle's limit of {limit:.3} {unit}")]
+    #[error("segment {index} ({kind}{}): {name} = {value:.3} {unit} is beyond the vehicle's limit of {limit:.3} {unit}", ItemNote(*.item))]
     Unreachable {
         /// Segment number, from 1.
         index: usize,
         /// Segment kind.
         kind: &'static str,
+        /// The operator's item number, when the segment came from a planner file.
+        item: Option<u32>,
         /// What is beyond the limit.
         name: &'static str,
         /// The value asked for.
@@ -67,12 +71,14 @@ pub enum PlannerError {
         unit: &'static str,
     },
     /// Segments in an order that cannot be flown (a leg before take-off, a take-off in the air).
-    #[error("segment {index} ({kind}) cannot be flown here: {reason}")]
+    #[error("segment {index} ({kind}{}) cannot be flown here: {reason}", ItemNote(*.item))]
     SegmentOrder {
         /// Segment number, from 1.
         index: usize,
         /// Segment kind.
         kind: &'static str,
+        /// The operator's item number, when the segment came from a planner file.
+        item: Option<u32>,
         /// Why.
         reason: &'static str,
     },
@@ -159,12 +165,14 @@ pub enum PlannerError {
         limit: usize,
     },
     /// A segment whose piece of trajectory would take longer than a flight can.
-    #[error("segment {index} ({kind}) would take {duration_s:e} s, more than the {max_s:e} s a segment may take: check its speed, rate and length")]
+    #[error("segment {index} ({kind}{}) would take {duration_s:e} s, more than the {max_s:e} s a segment may take: check its speed, rate and length", ItemNote(*.item))]
     SegmentTooLong {
         /// Segment number, from 1.
         index: usize,
         /// Segment kind.
         kind: &'static str,
+        /// The operator's item number, when the segment came from a planner file.
+        item: Option<u32>,
         /// Its duration, s.
         duration_s: f64,
         /// The limit, s.
@@ -259,5 +267,17 @@ pub(crate) fn within(
             unit,
             expected,
         })
+    }
+}
+
+/// `, item 7` after a segment's kind when it came from a planner file, else nothing.
+pub(crate) struct ItemNote(pub(crate) Option<u32>);
+
+impl std::fmt::Display for ItemNote {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            Some(i) => write!(f, ", item {i}"),
+            None => Ok(()),
+        }
     }
 }

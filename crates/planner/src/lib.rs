@@ -138,7 +138,8 @@ pub use aloft_power::AoaModel;
 pub use battery::{BatterySpec, Pack, PackDraw};
 pub use error::PlannerError;
 pub use mission::{
-    HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
+    CornerMode, HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind,
+    WindSpec,
 };
 pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{

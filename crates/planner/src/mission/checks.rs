@@ -20,9 +20,20 @@ pub(super) struct Seg {
     pub(super) index: usize,
     /// Kind as written in the file (`leg`, `orbit`, ...).
     pub(super) kind: &'static str,
+    /// The operator's item number, when the segment came from a planner file.
+    pub(super) item: Option<u32>,
 }
 
 impl Seg {
+    /// The segment in words: `item 7 (leg)` for a segment from a planner file, else
+    /// `segment 3 (leg)`.
+    pub(super) fn name(self) -> String {
+        match self.item {
+            Some(i) => format!("item {i} ({})", self.kind),
+            None => format!("segment {} ({})", self.index + 1, self.kind),
+        }
+    }
+
     /// A value of this segment is invalid in itself.
     pub(super) fn invalid(
         self,
@@ -34,6 +45,7 @@ impl Seg {
         PlannerError::InvalidSegment {
             index: self.index + 1,
             kind: self.kind,
+            item: self.item,
             name,
             value,
             unit,
@@ -46,6 +58,7 @@ impl Seg {
         PlannerError::SegmentOrder {
             index: self.index + 1,
             kind: self.kind,
+            item: self.item,
             reason,
         }
     }
@@ -83,6 +96,7 @@ impl Seg {
             Err(PlannerError::SegmentTooLong {
                 index: self.index + 1,
                 kind: self.kind,
+                item: self.item,
                 duration_s,
                 max_s: MAX_PIECE_S,
             })
@@ -102,6 +116,7 @@ impl Seg {
             Err(PlannerError::Unreachable {
                 index: self.index + 1,
                 kind: self.kind,
+                item: self.item,
                 name,
                 value,
                 limit,

@@ -43,6 +43,10 @@ impl MissionSpec {
         crate::error::non_negative("payload_kg", start_payload_kg, "kg")?;
         let mut compiler =
             Compiler::new(airframe, battery_mass_kg, points, home_m, start_payload_kg)?;
+        compiler.rtl_altitude_m = self.rtl_altitude_m;
+        compiler.allow_end_in_air = self.allow_end_in_air;
+        compiler.default_speed_mps = self.default_speed_mps;
+        compiler.clamp_speeds = self.clamp_speeds;
         for (index, segment) in self.segments.iter().enumerate() {
             compiler.segment(index, segment)?;
         }
@@ -91,7 +95,25 @@ struct Compiler<'a> {
     kinds: Vec<&'static str>,
     /// The payload of each mass phase so far, kg (a phase ends where a segment changes it).
     payloads_kg: Vec<f64>,
+    /// The operator's item number of each segment so far.
+    items: Vec<Option<u32>>,
+    /// Lowest height of a return to home, m.
+    rtl_altitude_m: Option<f64>,
+    /// The route ended in a loiter until the reserve.
+    loiter_until_reserve: bool,
+    /// A mission may end in the air.
+    allow_end_in_air: bool,
+    /// Ground speed of segments that give none, m/s.
+    default_speed_mps: Option<f64>,
+    /// Speeds beyond the vehicle's are flown at its maximum (with a warning).
+    clamp_speeds: bool,
+    /// What the compiler adjusted, for the reader.
+    warnings: Vec<String>,
 }
+
+/// Vertical rate of a return's climb or descent to its height, m/s (or the airframe's limit if
+/// lower): a gentle autopilot rate.
+const RTL_VERTICAL_RATE_MPS: f64 = 2.5;
 
 impl<'a> Compiler<'a> {
     /// A vehicle on the ground at home, nose north, with the take-off payload (checked against
@@ -112,6 +134,7 @@ impl<'a> Compiler<'a> {
             seg: Seg {
                 index: 0,
                 kind: "mission",
+                item: None,
             },
             pos_m: home_m,
             heading: [0.0, 1.0],
@@ -119,6 +142,13 @@ impl<'a> Compiler<'a> {
             pieces: Vec::new(),
             kinds: Vec::new(),
             payloads_kg: vec![start_payload_kg],
+            items: Vec::new(),
+            rtl_altitude_m: None,
+            loiter_until_reserve: false,
+            allow_end_in_air: false,
+            default_speed_mps: None,
+            clamp_speeds: false,
+            warnings: Vec::new(),
         };
         compiler.check_take_off_mass(start_payload_kg)?;
         Ok(compiler)
@@ -129,12 +159,20 @@ impl<'a> Compiler<'a> {
         self.seg = Seg {
             index,
             kind: spec.kind(),
+            item: spec.item(),
         };
         self.kinds.push(spec.kind());
+        self.items.push(spec.item());
+        if self.loiter_until_reserve {
+            return Err(self
+                .seg
+                .out_of_order("a loiter until the reserve ends the route: nothing can follow it"));
+        }
         match *spec {
             SegmentSpec::TakeOff {
                 altitude_m,
                 climb_rate_mps,
+                item: _,
             } => self.take_off(altitude_m, climb_rate_mps),
             SegmentSpec::Leg {
                 east_m,
@@ -144,13 +182,19 @@ impl<'a> Compiler<'a> {
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
+                acceptance_radius_m: _,
+                item: _,
             } => self.leg(
                 [east_m, north_m, latitude_deg, longitude_deg],
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
             ),
-            SegmentSpec::Return { ground_speed_mps } => self.return_home(ground_speed_mps),
+            SegmentSpec::Return {
+                ground_speed_mps,
+                altitude_m,
+                item: _,
+            } => self.return_home(ground_speed_mps, altitude_m),
             SegmentSpec::Orbit {
                 centre_east_m,
                 centre_north_m,
@@ -162,6 +206,7 @@ impl<'a> Compiler<'a> {
                 direction,
                 laps,
                 duration_s,
+                item: _,
             } => self.orbit(
                 [
                     centre_east_m,
@@ -178,21 +223,25 @@ impl<'a> Compiler<'a> {
             SegmentSpec::Hover {
                 duration_s,
                 payload_after_kg,
+                item: _,
             } => self.hover(duration_s, payload_after_kg),
             SegmentSpec::Descent {
                 altitude_m,
                 rate_mps,
+                item: _,
             } => self.descent(altitude_m, rate_mps),
             SegmentSpec::Landing {
                 rate_mps,
                 payload_after_kg,
+                item: _,
             } => self.landing(rate_mps, payload_after_kg),
+            SegmentSpec::LoiterUntilReserve { item: _ } => self.loiter_until_reserve(),
         }
     }
 
     /// The compiled mission, once the vehicle is back on the ground.
     fn finish(self, name: &str) -> Result<Mission, PlannerError> {
-        if self.airborne {
+        if self.airborne && !(self.allow_end_in_air || self.loiter_until_reserve) {
             return Err(self
                 .seg
                 .out_of_order("the mission ends in the air: add a landing"));
@@ -203,6 +252,10 @@ impl<'a> Compiler<'a> {
             pieces: self.pieces,
             kinds: self.kinds,
             payloads_kg: self.payloads_kg,
+            items: self.items,
+            ends_in_air: self.airborne,
+            loiter_until_reserve: self.loiter_until_reserve,
+            warnings: self.warnings,
         })
     }
 
@@ -232,7 +285,7 @@ impl<'a> Compiler<'a> {
         &mut self,
         waypoint: [Option<f64>; 4],
         altitude_m: Option<f64>,
-        ground_speed_mps: f64,
+        ground_speed_mps: Option<f64>,
         payload_after_kg: Option<f64>,
     ) -> Result<(), PlannerError> {
         let seg = self.seg;
@@ -240,20 +293,49 @@ impl<'a> Compiler<'a> {
         let [east_m, north_m] = self.points.resolve(seg, waypoint, WAYPOINT_KEYS)?;
         let up_m = altitude_m.unwrap_or(self.pos_m[2]);
         seg.positive("altitude_m", up_m, "m")?;
-        seg.positive("ground_speed_mps", ground_speed_mps, "m/s")?;
-        self.within_max_speed(ground_speed_mps)?;
+        let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
         self.straight_to([east_m, north_m, up_m], ground_speed_mps)?;
         self.change_payload(payload_after_kg)
     }
 
     /// `return`: yaw, then straight back over home at the present height.
-    fn return_home(&mut self, ground_speed_mps: f64) -> Result<(), PlannerError> {
+    fn return_home(
+        &mut self,
+        ground_speed_mps: Option<f64>,
+        altitude_m: Option<f64>,
+    ) -> Result<(), PlannerError> {
+        let seg = self.seg;
         self.need_air()?;
-        self.seg
-            .positive("ground_speed_mps", ground_speed_mps, "m/s")?;
-        self.within_max_speed(ground_speed_mps)?;
-        let to_m = [self.home_m[0], self.home_m[1], self.pos_m[2]];
+        let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
+        // The height of the return: the segment's, else at least the mission's RTL altitude.
+        let up_m = match (altitude_m, self.rtl_altitude_m) {
+            (Some(a), _) => seg.positive("altitude_m", a, "m")?,
+            (None, Some(rtl)) => self.pos_m[2].max(seg.positive("rtl_altitude_m", rtl, "m")?),
+            (None, None) => self.pos_m[2],
+        };
+        if up_m > self.pos_m[2] {
+            let rate = self
+                .airframe
+                .max_climb_rate_mps()
+                .min(RTL_VERTICAL_RATE_MPS);
+            self.vertical_to(up_m, rate)?;
+        } else if up_m < self.pos_m[2] {
+            let rate = self
+                .airframe
+                .max_descent_rate_mps()
+                .min(RTL_VERTICAL_RATE_MPS);
+            self.vertical_to(up_m, rate)?;
+        }
+        let to_m = [self.home_m[0], self.home_m[1], up_m];
         self.straight_to(to_m, ground_speed_mps)
+    }
+
+    /// `loiter-until-reserve`: the route ends here, in the air; the vehicle hovers until the pack
+    /// must fly home (the planner reports how long).
+    fn loiter_until_reserve(&mut self) -> Result<(), PlannerError> {
+        self.need_air()?;
+        self.loiter_until_reserve = true;
+        Ok(())
     }
 
     /// `orbit`: a straight transit to the nearest point of the circle, a yaw to its tangent, then
@@ -263,7 +345,7 @@ impl<'a> Compiler<'a> {
         centre: [Option<f64>; 4],
         altitude_m: Option<f64>,
         radius_m: f64,
-        ground_speed_mps: f64,
+        ground_speed_mps: Option<f64>,
         direction: OrbitDirection,
         laps_or_duration_s: (Option<f64>, Option<f64>),
     ) -> Result<(), PlannerError> {
@@ -271,10 +353,9 @@ impl<'a> Compiler<'a> {
         self.need_air()?;
         let centre_m = self.points.resolve(seg, centre, CENTRE_KEYS)?;
         seg.positive("radius_m", radius_m, "m")?;
-        seg.positive("ground_speed_mps", ground_speed_mps, "m/s")?;
+        let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
         let up_m = altitude_m.unwrap_or(self.pos_m[2]);
         seg.positive("altitude_m", up_m, "m")?;
-        self.within_max_speed(ground_speed_mps)?;
         // Centripetal load in still air: v^2 / r <= g tan(tilt_max).
         seg.within(
             "centripetal acceleration v^2/r",
@@ -382,13 +463,24 @@ impl<'a> Compiler<'a> {
     }
 
     /// A commanded ground speed is within the airframe's maximum speed.
-    fn within_max_speed(&self, ground_speed_mps: f64) -> Result<(), PlannerError> {
-        self.seg.within(
-            "ground_speed_mps",
-            ground_speed_mps,
-            self.airframe.max_speed_mps(),
-            "m/s",
-        )
+    /// The ground speed of this segment: its own, else the mission's default; positive and
+    /// within the vehicle's maximum (or, for a planner file, flown at the maximum with a warning).
+    fn ground_speed(&mut self, ground_speed_mps: Option<f64>) -> Result<f64, PlannerError> {
+        let seg = self.seg;
+        let v = ground_speed_mps.or(self.default_speed_mps).ok_or(
+            seg.out_of_order("give ground_speed_mps, or a default_speed_mps for the mission"),
+        )?;
+        seg.positive("ground_speed_mps", v, "m/s")?;
+        let max = self.airframe.max_speed_mps();
+        if self.clamp_speeds && v > max {
+            self.warnings.push(format!(
+                "{}: ground speed {v} m/s is beyond the vehicle's {max} m/s: flown at {max} m/s",
+                seg.name()
+            ));
+            return Ok(max);
+        }
+        seg.within("ground_speed_mps", v, max, "m/s")?;
+        Ok(v)
     }
 
     /// The payload changes after this segment when `payload_after_kg` is given: a new mass phase,
@@ -408,6 +500,7 @@ impl<'a> Compiler<'a> {
             return Err(PlannerError::Unreachable {
                 index: 0,
                 kind: "mission",
+                item: None,
                 name: "take-off mass (airframe + battery + payload)",
                 value: m,
                 limit: self.airframe.max_takeoff_mass_kg(),

@@ -92,7 +92,9 @@ mod spec;
 
 pub use checks::{MAX_MISSION_VALUE, MAX_PIECE_S};
 pub use compile::MAX_SEGMENTS;
-pub use spec::{HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec};
+pub use spec::{
+    CornerMode, HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
+};
 
 use crate::trajectory::Piece;
 
@@ -110,9 +112,34 @@ pub struct Mission {
     kinds: Vec<&'static str>,
     /// The payload of each mass phase, kg: the take-off payload, then one per change.
     payloads_kg: Vec<f64>,
+    /// The operator's item number of each segment (from a planner file).
+    items: Vec<Option<u32>>,
+    /// The route ends in the air (a planner file without landing, or a loiter until the reserve).
+    ends_in_air: bool,
+    /// The route ends in a loiter until the reserve.
+    loiter_until_reserve: bool,
+    /// What the compiler adjusted (a speed beyond the vehicle's flown at its maximum).
+    warnings: Vec<String>,
 }
 
 impl Mission {
+    /// The operator's item number of each segment (from a planner file), in order.
+    pub fn segment_items(&self) -> &[Option<u32>] {
+        &self.items
+    }
+    /// What the compiler adjusted, for the reader (a speed beyond the vehicle's flown at its
+    /// maximum).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+    /// Whether the route ends in the air (no landing): its reserve is judged where it ends.
+    pub fn ends_in_air(&self) -> bool {
+        self.ends_in_air
+    }
+    /// Whether the route ends in a loiter until the reserve.
+    pub fn ends_in_loiter_until_reserve(&self) -> bool {
+        self.loiter_until_reserve
+    }
     /// Name.
     pub fn name(&self) -> &str {
         &self.name
@@ -199,6 +226,7 @@ mod tests {
                 SegmentSpec::TakeOff {
                     altitude_m: 20.0,
                     climb_rate_mps: 2.0,
+                    item: None,
                 },
                 SegmentSpec::Leg {
                     east_m: None,
@@ -206,8 +234,10 @@ mod tests {
                     latitude_deg: Some(47.379),
                     longitude_deg: Some(8.545),
                     altitude_m: None,
-                    ground_speed_mps: 8.0,
+                    ground_speed_mps: Some(8.0),
                     payload_after_kg: Some(0.0),
+                    acceptance_radius_m: None,
+                    item: None,
                 },
                 SegmentSpec::Orbit {
                     centre_east_m: Some(100.0),
@@ -216,17 +246,21 @@ mod tests {
                     centre_longitude_deg: None,
                     altitude_m: None,
                     radius_m: 25.0,
-                    ground_speed_mps: 4.0,
+                    ground_speed_mps: Some(4.0),
                     direction: OrbitDirection::Clockwise,
                     laps: Some(1.5),
                     duration_s: None,
+                    item: None,
                 },
                 SegmentSpec::Return {
-                    ground_speed_mps: 8.0,
+                    ground_speed_mps: Some(8.0),
+                    altitude_m: None,
+                    item: None,
                 },
                 SegmentSpec::Landing {
                     rate_mps: 1.0,
                     payload_after_kg: None,
+                    item: None,
                 },
             ],
             ..MissionSpec::default()

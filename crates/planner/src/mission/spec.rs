@@ -51,6 +51,9 @@ pub enum SegmentSpec {
         altitude_m: f64,
         /// Climb rate, m/s.
         climb_rate_mps: f64,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
     /// Straight leg to a waypoint.
     Leg {
@@ -69,11 +72,19 @@ pub enum SegmentSpec {
         /// Waypoint height, m (default: the present one).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         altitude_m: Option<f64>,
-        /// Horizontal ground speed, m/s.
-        ground_speed_mps: f64,
+        /// Horizontal ground speed, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ground_speed_mps: Option<f64>,
         /// Payload after the waypoint, kg (a pick-up or delivery).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
+        /// Acceptance radius of the waypoint, m: how far from it a pass-through corner may start
+        /// (default: the airframe's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        acceptance_radius_m: Option<f64>,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
     /// Circles about a centre.
     Orbit {
@@ -94,8 +105,9 @@ pub enum SegmentSpec {
         altitude_m: Option<f64>,
         /// Radius, m.
         radius_m: f64,
-        /// Ground speed on the circle, m/s.
-        ground_speed_mps: f64,
+        /// Ground speed on the circle, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ground_speed_mps: Option<f64>,
         /// Direction seen from above.
         direction: OrbitDirection,
         /// Number of laps (give this or `duration_s`).
@@ -104,6 +116,9 @@ pub enum SegmentSpec {
         /// Time on the circle, s.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         duration_s: Option<f64>,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
     /// Hover in place.
     Hover {
@@ -112,11 +127,23 @@ pub enum SegmentSpec {
         /// Payload after the hover, kg (a winch delivery).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
-    /// Straight back over home at the present height.
+    /// Straight back over home at the present height (or at `altitude_m`, reached first), as an
+    /// autopilot's return-to-launch; a landing follows.
     Return {
-        /// Horizontal ground speed, m/s.
-        ground_speed_mps: f64,
+        /// Horizontal ground speed, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ground_speed_mps: Option<f64>,
+        /// Height to return at, m (default: the present height, or the mission's
+        /// `rtl_altitude_m` when that is higher).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        altitude_m: Option<f64>,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
     /// Vertical descent to a lower height.
     Descent {
@@ -124,6 +151,9 @@ pub enum SegmentSpec {
         altitude_m: f64,
         /// Descent rate, m/s.
         rate_mps: f64,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
     /// Vertical descent to the ground.
     Landing {
@@ -132,6 +162,17 @@ pub enum SegmentSpec {
         /// Payload after landing, kg.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
+    },
+    /// Hover here until the pack must fly home with the reserve: an open-ended loiter (an
+    /// autopilot's "loiter unlimited"), which ends the route. The report says how long the
+    /// vehicle can stay.
+    LoiterUntilReserve {
+        /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        item: Option<u32>,
     },
 }
 
@@ -146,6 +187,21 @@ impl SegmentSpec {
             SegmentSpec::Return { .. } => "return",
             SegmentSpec::Descent { .. } => "descent",
             SegmentSpec::Landing { .. } => "landing",
+            SegmentSpec::LoiterUntilReserve { .. } => "loiter-until-reserve",
+        }
+    }
+
+    /// The operator's mission item number, when the segment came from a planner file.
+    pub fn item(&self) -> Option<u32> {
+        match *self {
+            SegmentSpec::TakeOff { item, .. }
+            | SegmentSpec::Leg { item, .. }
+            | SegmentSpec::Orbit { item, .. }
+            | SegmentSpec::Hover { item, .. }
+            | SegmentSpec::Return { item, .. }
+            | SegmentSpec::Descent { item, .. }
+            | SegmentSpec::Landing { item, .. }
+            | SegmentSpec::LoiterUntilReserve { item } => item,
         }
     }
 }
@@ -244,9 +300,42 @@ pub struct MissionSpec {
     /// Wind (optional; the command line overrides it).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wind: Option<WindSpec>,
+    /// Ground speed of the legs, orbits and returns that give none, m/s (a planner file's
+    /// planning speed; the command line or the vehicle may set it instead).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub default_speed_mps: Option<f64>,
+    /// Fly a speed beyond the vehicle's maximum at the maximum, with a warning, instead of
+    /// refusing the mission (planner files, written for another vehicle; default false).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub clamp_speeds: bool,
+    /// How the vehicle flies through a waypoint without a hold: `pass` (the default: through a
+    /// corner at a speed its turn allows, as autopilots do) or `stop` (stop, turn, go on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub corners: Option<CornerMode>,
+    /// Lowest height of a return to home, m: a `return` below it climbs to it first (an
+    /// autopilot's RTL altitude; default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtl_altitude_m: Option<f64>,
+    /// Accept a mission that ends in the air (a planner file without a landing or a return): its
+    /// reserve is judged where it ends (default false: a mission lands).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub allow_end_in_air: bool,
     /// Segments, in order.
     #[serde(default, rename = "segment")]
     pub segments: Vec<SegmentSpec>,
+}
+
+/// How the vehicle flies through a waypoint that has no hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CornerMode {
+    /// Through a corner at the speed the turn allows: the turn angle, the lateral acceleration
+    /// limit and the acceptance radius (as PX4's multicopter trajectory and ArduPilot's S-curve
+    /// navigation fly waypoints).
+    #[default]
+    Pass,
+    /// Stop at the waypoint, yaw to the next leg, go on (the planner's mode before corners).
+    Stop,
 }
 
 impl MissionSpec {

@@ -42,6 +42,7 @@ pub(super) struct PieceTally {
 /// The accumulators of a run, per segment and per mission.
 pub(super) struct Ledger<'p> {
     kinds: &'p [&'static str],
+    items: &'p [Option<u32>],
     segments: Vec<SegmentTotals>,
     /// State of charge where the flight ended (the start until then).
     soc: f64,
@@ -71,6 +72,7 @@ impl<'p> Ledger<'p> {
         let kinds = mission.segment_kinds();
         Ledger {
             kinds,
+            items: mission.segment_items(),
             segments: vec![SegmentTotals::default(); kinds.len()],
             soc: options.start_soc,
             energy_j: 0.0,
@@ -255,6 +257,7 @@ impl<'p> Ledger<'p> {
             .map(|(i, a)| SegmentReport {
                 index: i + 1,
                 kind: self.kinds[i],
+                item: self.items.get(i).copied().flatten(),
                 duration_s: a.duration_s,
                 distance_m: a.distance_m,
                 energy_wh: a.energy_j / 3600.0,

@@ -165,6 +165,9 @@ pub struct SegmentReport {
     pub index: usize,
     /// Kind (`take-off`, `leg`, `orbit`, `hover`, `return`, `descent`, `landing`).
     pub kind: &'static str,
+    /// The operator's mission item number, when the mission came from a planner file.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub item: Option<u32>,
     /// Duration flown, s.
     pub duration_s: f64,
     /// Path length flown, m.

@@ -1,0 +1,118 @@
+//! One planning run's fixed parts (aircraft, pack, wind, planner options) and the flight of a
+//! mission spec with them: the main plan flies through it, and so do the searches that re-plan
+//! parts of a route (the loiter until the reserve, the sorties).
+
+use aloft_planner::{
+    Aircraft, Mission as Compiled, MissionReport, MissionSpec, NoSamples, Pack, PlanOptions,
+    PlannerError, SampleSink, SegmentSpec, Wind,
+};
+
+/// Descent rate of the landing after a return home that aloft adds (a loiter's, a sortie's), m/s
+/// (or the airframe's limit if lower): an autopilot's gentle landing.
+const LANDING_RATE_MPS: f64 = 1.0;
+
+/// What every flight of one request shares.
+pub(super) struct Flight<'a> {
+    /// The aircraft flown.
+    pub(super) aircraft: &'a Aircraft,
+    /// The pack.
+    pub(super) pack: &'a Pack,
+    /// The wind.
+    pub(super) wind: &'a Wind,
+    /// The planner's options.
+    pub(super) options: PlanOptions,
+}
+
+impl Flight<'_> {
+    /// Compile `spec` (its take-off payload overridden by `payload_kg` when given).
+    ///
+    /// # Errors
+    /// As [`MissionSpec::compile`].
+    pub(super) fn compile(
+        &self,
+        spec: &MissionSpec,
+        payload_kg: Option<f64>,
+    ) -> Result<Compiled, PlannerError> {
+        spec.compile(self.aircraft.airframe(), self.pack.mass_kg(), payload_kg)
+    }
+
+    /// Fly a compiled mission, handing each sample to `sink`.
+    ///
+    /// # Errors
+    /// As [`aloft_planner::plan_into`].
+    pub(super) fn fly_into(
+        &self,
+        compiled: &Compiled,
+        sink: &mut dyn SampleSink,
+    ) -> Result<MissionReport, PlannerError> {
+        aloft_planner::plan_into(
+            self.aircraft,
+            self.pack,
+            compiled,
+            self.wind,
+            &self.options,
+            sink,
+        )
+    }
+
+    /// Fly a compiled mission, keeping the samples when the options ask.
+    ///
+    /// # Errors
+    /// As [`aloft_planner::plan`].
+    pub(super) fn fly(&self, compiled: &Compiled) -> Result<MissionReport, PlannerError> {
+        aloft_planner::plan(self.aircraft, self.pack, compiled, self.wind, &self.options)
+    }
+
+    /// Compile and fly `spec` (take-off payload `payload_kg` when given) for its report alone:
+    /// a trial of a search.
+    ///
+    /// # Errors
+    /// As [`Flight::compile`] and [`Flight::fly_into`].
+    pub(super) fn trial(
+        &self,
+        spec: &MissionSpec,
+        payload_kg: Option<f64>,
+    ) -> Result<MissionReport, PlannerError> {
+        let compiled = self.compile(spec, payload_kg)?;
+        self.fly_into(&compiled, &mut NoSamples)
+    }
+
+    /// The way home aloft adds to a route it cuts short (a loiter's end, a sortie's): a return
+    /// at the mission's planning speed (else the first speed the route gives, so that a mission
+    /// with a speed on every leg returns at it) and a landing at 1 m/s (or the airframe's limit).
+    pub(super) fn way_home(&self, spec: &MissionSpec) -> [SegmentSpec; 2] {
+        let ground_speed_mps = match spec.default_speed_mps {
+            Some(_) => None,
+            None => first_speed(&spec.segments),
+        };
+        let rate_mps = LANDING_RATE_MPS.min(self.aircraft.airframe().max_descent_rate_mps());
+        [
+            SegmentSpec::Return {
+                ground_speed_mps,
+                altitude_m: None,
+                item: None,
+            },
+            SegmentSpec::Landing {
+                rate_mps,
+                payload_after_kg: None,
+                item: None,
+            },
+        ]
+    }
+}
+
+/// The first ground speed the segments give.
+pub(super) fn first_speed(segments: &[SegmentSpec]) -> Option<f64> {
+    segments.iter().find_map(|s| match *s {
+        SegmentSpec::Leg {
+            ground_speed_mps, ..
+        }
+        | SegmentSpec::Orbit {
+            ground_speed_mps, ..
+        }
+        | SegmentSpec::Return {
+            ground_speed_mps, ..
+        } => ground_speed_mps,
+        _ => None,
+    })
+}
