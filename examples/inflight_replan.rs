@@ -30,6 +30,8 @@ pub struct Outcome {
     pub true_landing_soc: f64,
     /// Number of re-plans.
     pub replans: usize,
+    /// Flight time of the true flight, s.
+    pub duration_s: f64,
 }
 
 /// Deterministic noise in [-1, 1] (a 64-bit LCG: the example needs no random crate).
@@ -141,6 +143,7 @@ pub fn run(
         replanned_landing_soc: at_check.ok_or("the check time is after the landing")?,
         true_landing_soc,
         replans,
+        duration_s: duration,
     })
 }
 

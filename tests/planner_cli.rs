@@ -279,3 +279,36 @@ fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `--corners`: the demo's survey flown through its corners (the default) is shorter than with
+/// stop-and-turn, over the same route (the distance flown differs only by the arcs' cuts); the
+/// command line's answer is the engine's, byte for byte; an unknown mode is refused.
+#[test]
+fn corners_pass_through_by_default_and_stop_on_request() {
+    use aloft::engine::{plan_mission, CornerMode, Mission, MissionOptions, Vehicle};
+    let json = |args: &[&str]| -> serde_json::Value {
+        let (code, out, err) = aloft(args);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let pass = json(&["mission", "--format", "json"]);
+    let stop = json(&["mission", "--format", "json", "--corners", "stop"]);
+    let t = |v: &serde_json::Value| v["duration_s"].as_f64().unwrap();
+    let d = |v: &serde_json::Value| v["distance_m"].as_f64().unwrap();
+    // The demo has eight turns of 90 deg between its legs: each saves a few seconds.
+    assert!(t(&stop) - t(&pass) > 8.0, "{} {}", t(&stop), t(&pass));
+    // Each 2 m cut is replaced by a quarter circle of 2 m radius: 4 - pi m shorter a corner.
+    assert!(d(&stop) > d(&pass) && d(&stop) - d(&pass) < 8.0 * (4.0 - std::f64::consts::PI) + 1.0);
+    // The engine gives the same answer.
+    let m100 = Vehicle::builtin("dji-m100").unwrap();
+    let options = MissionOptions {
+        corners: Some(CornerMode::Stop),
+        ..MissionOptions::default()
+    };
+    let engine = plan_mission(&m100, &Mission::demo(), &options).unwrap();
+    let engine: serde_json::Value = serde_json::from_str(&engine.to_json().unwrap()).unwrap();
+    assert_eq!(engine, stop);
+    let (code, out, err) = aloft(&["mission", "--corners", "round"]);
+    assert_eq!(code, 2, "{out}");
+    assert!(err.contains("--corners") && err.lines().count() == 1, "{err}");
+}

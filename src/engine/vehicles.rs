@@ -151,7 +151,11 @@ impl Vehicle {
 
     /// The vehicle's defaults for missions: its cruise speed and RTL altitude.
     pub(crate) fn flight_defaults(&self) -> super::flown::FlightDefaults {
-        super::flown::FlightDefaults::default()
+        let airframe = self.file.airframe.as_ref();
+        super::flown::FlightDefaults {
+            cruise_speed_mps: airframe.and_then(|a| a.cruise_speed_mps),
+            rtl_altitude_m: airframe.and_then(|a| a.rtl_altitude_m),
+        }
     }
 
     /// The aircraft the planner flies, or the error that says which table is missing.

@@ -35,6 +35,18 @@ pub struct AirframeSpec {
     pub yaw_rate_deg_s: f64,
     /// Height of the rotor plane above the ground when landed, m (ground effect).
     pub rotor_height_m: f64,
+    /// Acceptance radius of a waypoint, m: how far before it a pass-through corner may start
+    /// (default 2 m, the PX4 and ArduPilot defaults; a mission leg may give its own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceptance_radius_m: Option<f64>,
+    /// Planning speed of the autopilot, m/s: the ground speed of mission legs that give none
+    /// (default: the mission file's; `--speed` overrides both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cruise_speed_mps: Option<f64>,
+    /// Return-to-launch height of the autopilot, m: a return below it climbs to it first
+    /// (default: the mission's, else none; `--rtl-altitude-m` overrides both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtl_altitude_m: Option<f64>,
 }
 
 /// A validated airframe, angles in radians.
@@ -49,6 +61,35 @@ pub struct Airframe {
 /// physical range (a value beyond it is a unit slip, not a multirotor; the speed limit is the
 /// power model's).
 type RangeCheck = (&'static str, f64, &'static str, f64, &'static str);
+
+/// The range checks of the optional values of the table, when given.
+fn optional_checks(
+    spec: &AirframeSpec,
+) -> [(&'static str, Option<f64>, &'static str, f64, &'static str); 3] {
+    [
+        (
+            "airframe acceptance_radius_m",
+            spec.acceptance_radius_m,
+            "m",
+            1e3,
+            "at most 1000 m",
+        ),
+        (
+            "airframe cruise_speed_mps",
+            spec.cruise_speed_mps,
+            "m/s",
+            MAX_AIRSPEED_MPS,
+            "at most 150 m/s",
+        ),
+        (
+            "airframe rtl_altitude_m",
+            spec.rtl_altitude_m,
+            "m",
+            1e4,
+            "at most 10000 m",
+        ),
+    ]
+}
 
 /// The range checks of [`Airframe::new`], one per value of the table.
 fn range_checks(spec: &AirframeSpec) -> [RangeCheck; 10] {
@@ -156,6 +197,12 @@ impl Airframe {
                 expected: "at least the airframe mass",
             });
         }
+        for (name, value, unit, max, expected) in optional_checks(&spec) {
+            if let Some(v) = value {
+                positive(name, v, unit)?;
+                within(name, v, (0.0, max), unit, expected)?;
+            }
+        }
         if let Some(t) = spec.max_thrust_n {
             positive("airframe max_thrust_n", t, "N")?;
             within("airframe max_thrust_n", t, (0.0, 1e7), "N", "at most 1e7 N")?;
@@ -216,5 +263,11 @@ impl Airframe {
     /// Rotor height above the ground when landed, m.
     pub fn rotor_height_m(&self) -> f64 {
         self.spec.rotor_height_m
+    }
+    /// Acceptance radius of a waypoint, m (the table's, else 2 m).
+    pub fn acceptance_radius_m(&self) -> f64 {
+        self.spec
+            .acceptance_radius_m
+            .unwrap_or(crate::mission::DEFAULT_ACCEPTANCE_RADIUS_M)
     }
 }

@@ -77,6 +77,9 @@
 //!     max_speed_mps: 17.0, max_climb_rate_mps: 5.0, max_descent_rate_mps: 4.0,
 //!     acceleration_mps2: 2.0, vertical_acceleration_mps2: 1.5, yaw_rate_deg_s: 60.0,
 //!     rotor_height_m: 0.3,
+//!     acceptance_radius_m: None,
+//!     cruise_speed_mps: None,
+//!     rtl_altitude_m: None,
 //! })?;
 //! let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
 //!     mass_kg: 3.29, gravity_mps2: 9.8066, air_density_kg_m3: 1.225, rotor_count: 4,

@@ -93,6 +93,9 @@ pub fn power_only_aircraft(
         vertical_acceleration_mps2: 100.0,
         yaw_rate_deg_s: 1000.0,
         rotor_height_m: vehicle.params().rotor_radius_m,
+        acceptance_radius_m: None,
+        cruise_speed_mps: None,
+        rtl_altitude_m: None,
     })?;
     Ok(Aircraft::four_term(airframe, vehicle, options))
 }

@@ -18,6 +18,9 @@ pub(crate) fn m100_airframe() -> Airframe {
         vertical_acceleration_mps2: 1.5,
         yaw_rate_deg_s: 60.0,
         rotor_height_m: 0.3,
+        acceptance_radius_m: None,
+        cruise_speed_mps: None,
+        rtl_altitude_m: None,
     })
     .unwrap()
 }

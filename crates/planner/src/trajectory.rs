@@ -1,18 +1,20 @@
 //! Trajectory pieces and their closed-form kinematics: position, ground velocity and acceleration
 //! at any time, in east-north-up (ENU) metres.
 //!
-//! A mission compiles into pieces, each flown from rest to rest along its path with a trapezoidal
-//! speed profile (constant acceleration `a` up to the cruise speed `v`, cruise, constant
-//! deceleration), or triangular when the path is too short to reach `v`:
+//! A mission compiles into pieces, each flown along its path with a trapezoidal speed profile
+//! (constant acceleration `a` from the start speed up to the cruise speed `v`, cruise, constant
+//! deceleration to the end speed), or triangular when the path is too short to reach `v`. Most
+//! pieces run from rest to rest; the straight lines and arcs of a pass-through corner
+//! (`mission/corners.rs`) start or end at the corner's speed:
 //!
 //! - [`Shape::Line`]: a straight path (legs, take-off, descent, landing);
 //! - [`Shape::Arc`]: a circle at constant height (orbits); the acceleration adds the centripetal
 //!   `v^2 / r` towards the centre to the tangential `dv/dt`;
 //! - [`Shape::Hold`]: a fixed point for a time (hover, and the yaw turn at a waypoint).
 //!
-//! Stopping at every waypoint is the planner's choice (a multirotor's "stop and turn" waypoint
-//! mode): it makes every speed change cost time and the thrust of the acceleration, and keeps the
-//! path exactly the mission's polyline.
+//! With `corners = "stop"` the vehicle stops at every waypoint (a multirotor's "stop and turn"
+//! waypoint mode) and the path is exactly the mission's polyline; by default it passes through
+//! waypoints without a hold on a circular arc (see `mission/corners.rs`).
 
 /// Path geometry of one piece.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,19 +47,26 @@ pub enum Shape {
     },
 }
 
-/// Trapezoidal speed profile along a path of length `length_m`, from rest to rest.
+/// Trapezoidal speed profile along a path of length `length_m`: from `start_mps` up to the
+/// peak, cruise, down to `end_mps` (both zero for a piece flown from rest to rest).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Profile {
     /// Path length, m.
     pub length_m: f64,
+    /// Speed at the start, m/s.
+    pub start_mps: f64,
     /// Peak speed reached, m/s.
     pub peak_mps: f64,
+    /// Speed at the end, m/s.
+    pub end_mps: f64,
     /// Acceleration magnitude, m/s^2.
     pub accel_mps2: f64,
     /// End of the acceleration phase, s.
     pub t_accel_end_s: f64,
     /// End of the cruise phase, s.
     pub t_cruise_end_s: f64,
+    /// Length of the deceleration phase, s.
+    pub t_decel_s: f64,
     /// Total duration, s.
     pub duration_s: f64,
 }
@@ -79,11 +88,50 @@ impl Profile {
         };
         Self {
             length_m,
+            start_mps: 0.0,
             peak_mps: peak,
+            end_mps: 0.0,
             accel_mps2,
             t_accel_end_s: t1,
             t_cruise_end_s: t2,
+            t_decel_s: t1,
             duration_s: t2 + t1,
+        }
+    }
+
+    /// Profile over `length_m` from `start_mps` to `end_mps` with cruise speed `speed_mps` and
+    /// acceleration `accel_mps2`: the peak is the cruise speed, or (a triangle) the speed
+    /// `sqrt((2 a L + v0^2 + v1^2) / 2)` where the path is too short to reach it. The caller
+    /// keeps the end speeds reachable: `|v1^2 - v0^2| <= 2 a L` and both at most the cruise
+    /// speed (within rounding; the profile clamps).
+    pub fn between(
+        length_m: f64,
+        (start_mps, speed_mps, end_mps): (f64, f64, f64),
+        accel_mps2: f64,
+    ) -> Self {
+        if start_mps <= 0.0 && end_mps <= 0.0 {
+            return Self::rest_to_rest(length_m, speed_mps, accel_mps2);
+        }
+        if length_m <= 0.0 {
+            return Self::hold(0.0);
+        }
+        let a = accel_mps2;
+        let (v0, v1) = (start_mps.min(speed_mps), end_mps.min(speed_mps));
+        let triangle = ((2.0 * a * length_m + v0 * v0 + v1 * v1) / 2.0).sqrt();
+        let peak = speed_mps.min(triangle).max(v0).max(v1);
+        let (t1, t3) = ((peak - v0) / a, (peak - v1) / a);
+        let s_ramps = 0.5 * (v0 + peak) * t1 + 0.5 * (peak + v1) * t3;
+        let cruise_s = ((length_m - s_ramps) / peak).max(0.0);
+        Self {
+            length_m,
+            start_mps: v0,
+            peak_mps: peak,
+            end_mps: v1,
+            accel_mps2: a,
+            t_accel_end_s: t1,
+            t_cruise_end_s: t1 + cruise_s,
+            t_decel_s: t3,
+            duration_s: t1 + cruise_s + t3,
         }
     }
 
@@ -91,30 +139,37 @@ impl Profile {
     pub fn hold(duration_s: f64) -> Self {
         Self {
             length_m: 0.0,
+            start_mps: 0.0,
             peak_mps: 0.0,
+            end_mps: 0.0,
             accel_mps2: 0.0,
             t_accel_end_s: 0.0,
             t_cruise_end_s: duration_s,
+            t_decel_s: 0.0,
             duration_s,
         }
     }
 
     /// Path length `s`, speed `v` and tangential acceleration at time `t_s` in `[0, duration]`.
+    ///
+    /// With a start and end at rest (`v0 = v1 = 0`) every expression reduces to the rest-to-rest
+    /// one bit for bit (`0 t + x = x`, `0 + x = x`).
     #[inline]
     pub fn at(&self, t_s: f64) -> (f64, f64, f64) {
         let a = self.accel_mps2;
+        let v0 = self.start_mps;
         if t_s < self.t_accel_end_s {
-            (0.5 * a * t_s * t_s, a * t_s, a)
+            (v0 * t_s + 0.5 * a * t_s * t_s, v0 + a * t_s, a)
         } else if t_s < self.t_cruise_end_s {
-            let s1 = 0.5 * self.peak_mps * self.t_accel_end_s;
+            let s1 = 0.5 * (v0 + self.peak_mps) * self.t_accel_end_s;
             (
                 s1 + self.peak_mps * (t_s - self.t_accel_end_s),
                 self.peak_mps,
                 0.0,
             )
         } else {
-            let tau = (t_s - self.t_cruise_end_s).min(self.t_accel_end_s);
-            let s2 = self.length_m - 0.5 * self.peak_mps * self.t_accel_end_s;
+            let tau = (t_s - self.t_cruise_end_s).min(self.t_decel_s);
+            let s2 = self.length_m - 0.5 * (self.peak_mps + self.end_mps) * self.t_decel_s;
             (
                 s2 + self.peak_mps * tau - 0.5 * a * tau * tau,
                 self.peak_mps - a * tau,

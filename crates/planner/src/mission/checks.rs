@@ -165,9 +165,15 @@ pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError>
 }
 
 /// Resolves points given in either local metres or latitude/longitude.
+///
+/// A point in latitude/longitude is placed from the last such point (the home at first) in the
+/// local frame of that point, so each leg's length and direction are those of its own tangent
+/// plane: a survey hundreds of kilometres from its home point keeps its legs' lengths, which one
+/// flat frame at home would stretch (by about 2 % east-west 300 km north of home at 25 deg).
 pub(super) struct Points {
-    /// The local frame about a home given in latitude/longitude; none for a home in metres.
-    frame: Option<LocalFrame>,
+    /// The last point given in latitude/longitude (the home at first): its latitude, longitude
+    /// and local metres; none for a home in metres.
+    last: Option<(f64, f64, [f64; 2])>,
 }
 
 impl Points {
@@ -201,7 +207,7 @@ impl Points {
                             expected: "a longitude within [-180, 180]",
                         });
                     }
-                    Some(LocalFrame::new(la, lo))
+                    Some((la, lo))
                 }
                 (_, _, None, None) => None,
                 _ => return Err(PlannerError::InvalidParameter {
@@ -212,13 +218,15 @@ impl Points {
                         "home as east_m/north_m or as latitude_deg/longitude_deg, not both or half",
                 }),
             };
-        Ok(Self { frame })
+        Ok(Self {
+            last: frame.map(|(la, lo)| (la, lo, [0.0, 0.0])),
+        })
     }
 
     /// The local east/north metres of a point given as `[east, north, latitude, longitude]`
     /// (exactly one pair), with the keys of those four in `names` for the errors.
     pub(super) fn resolve(
-        &self,
+        &mut self,
         seg: Seg,
         given: [Option<f64>; 4],
         names: [&'static str; 4],
@@ -233,7 +241,7 @@ impl Points {
                 Ok([e, n])
             }
             [None, None, Some(la), Some(lo)] => {
-                let frame = self.frame.ok_or(seg.out_of_order(
+                self.last.ok_or(seg.out_of_order(
                     "a point in latitude/longitude needs the home point in latitude/longitude",
                 ))?;
                 if !(la.is_finite() && la.abs() < 90.0) {
@@ -242,11 +250,23 @@ impl Points {
                 if !(lo.is_finite() && lo.abs() <= 180.0) {
                     return Err(seg.invalid(names[3], lo, "deg", "must be within [-180, 180]"));
                 }
-                Ok(frame.to_local_m(la, lo))
+                Ok(self.chained(la, lo))
             }
             _ => Err(seg.out_of_order(
                 "give the point as east_m and north_m, or as latitude_deg and longitude_deg (exactly one pair)",
             )),
         }
+    }
+
+    /// Local metres of a valid latitude/longitude: the last such point's, plus the offset in
+    /// that point's tangent plane; it becomes the last point.
+    fn chained(&mut self, la: f64, lo: f64) -> [f64; 2] {
+        let Some((la0, lo0, at_m)) = self.last else {
+            return [0.0, 0.0];
+        };
+        let d = LocalFrame::new(la0, lo0).to_local_m(la, lo);
+        let here = [at_m[0] + d[0], at_m[1] + d[1]];
+        self.last = Some((la, lo, here));
+        here
     }
 }

@@ -9,7 +9,8 @@
 use aloft_core::STANDARD_GRAVITY_MPS2;
 
 use super::checks::{home_position_m, Points, Seg};
-use super::{Mission, MissionSpec, OrbitDirection, SegmentSpec};
+use super::corners::{pass_through, turn_rad, Role};
+use super::{CornerMode, Mission, MissionSpec, OrbitDirection, SegmentSpec};
 use crate::airframe::Airframe;
 use crate::error::PlannerError;
 use crate::trajectory::{Piece, Profile, Shape};
@@ -47,6 +48,7 @@ impl MissionSpec {
         compiler.allow_end_in_air = self.allow_end_in_air;
         compiler.default_speed_mps = self.default_speed_mps;
         compiler.clamp_speeds = self.clamp_speeds;
+        compiler.corners = self.corners.unwrap_or_default();
         for (index, segment) in self.segments.iter().enumerate() {
             compiler.segment(index, segment)?;
         }
@@ -91,6 +93,13 @@ struct Compiler<'a> {
     airborne: bool,
     /// The pieces so far.
     pieces: Vec<Piece>,
+    /// What each piece is to the corner pass.
+    roles: Vec<Role>,
+    /// How waypoints without a hold are flown.
+    corners: CornerMode,
+    /// The acceptance radius of the present leg's waypoint, m (the leg's own, when it gives
+    /// one).
+    acceptance_m: Option<f64>,
     /// The kind of each segment so far.
     kinds: Vec<&'static str>,
     /// The payload of each mass phase so far, kg (a phase ends where a segment changes it).
@@ -140,6 +149,9 @@ impl<'a> Compiler<'a> {
             heading: [0.0, 1.0],
             airborne: false,
             pieces: Vec::new(),
+            roles: Vec::new(),
+            corners: CornerMode::default(),
+            acceptance_m: None,
             kinds: Vec::new(),
             payloads_kg: vec![start_payload_kg],
             items: Vec::new(),
@@ -182,9 +194,10 @@ impl<'a> Compiler<'a> {
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
-                acceptance_radius_m: _,
+                acceptance_radius_m,
                 item: _,
-            } => self.leg(
+            } => self.leg_to(
+                acceptance_radius_m,
                 [east_m, north_m, latitude_deg, longitude_deg],
                 altitude_m,
                 ground_speed_mps,
@@ -249,7 +262,10 @@ impl<'a> Compiler<'a> {
         Ok(Mission {
             name: name.to_string(),
             home_m: self.home_m,
-            pieces: self.pieces,
+            pieces: match self.corners {
+                CornerMode::Pass => pass_through(self.pieces, &self.roles, self.airframe),
+                CornerMode::Stop => self.pieces,
+            },
             kinds: self.kinds,
             payloads_kg: self.payloads_kg,
             items: self.items,
@@ -278,6 +294,25 @@ impl<'a> Compiler<'a> {
         self.vertical_to(altitude_m, climb_rate_mps)?;
         self.airborne = true;
         Ok(())
+    }
+
+    /// `leg` with the waypoint's acceptance radius (for a pass-through corner).
+    fn leg_to(
+        &mut self,
+        acceptance_radius_m: Option<f64>,
+        waypoint: [Option<f64>; 4],
+        altitude_m: Option<f64>,
+        ground_speed_mps: Option<f64>,
+        payload_after_kg: Option<f64>,
+    ) -> Result<(), PlannerError> {
+        if let Some(r) = acceptance_radius_m {
+            self.seg.positive("acceptance_radius_m", r, "m")?;
+            self.seg.within("acceptance_radius_m", r, 1e3, "m")?;
+        }
+        self.acceptance_m = acceptance_radius_m;
+        let flown = self.leg(waypoint, altitude_m, ground_speed_mps, payload_after_kg);
+        self.acceptance_m = None;
+        flown
     }
 
     /// `leg`: yaw, then straight to a waypoint at a horizontal ground speed.
@@ -401,6 +436,7 @@ impl<'a> Compiler<'a> {
             Shape::Hold { pos_m: self.pos_m },
             Profile::hold(duration_s),
             self.heading,
+            Role::Other,
         )?;
         self.change_payload(payload_after_kg)
     }
@@ -515,12 +551,14 @@ impl<'a> Compiler<'a> {
         self.payloads_kg.len() - 1
     }
 
-    /// Add a piece of the present segment, unless it takes no time.
+    /// Add a piece of the present segment, unless it takes no time; it plays `role` in the
+    /// corner pass.
     fn push(
         &mut self,
         shape: Shape,
         profile: Profile,
         forward: [f64; 2],
+        role: Role,
     ) -> Result<(), PlannerError> {
         self.seg.duration(profile.duration_s)?;
         if profile.duration_s > 0.0 {
@@ -531,6 +569,7 @@ impl<'a> Compiler<'a> {
                 mass_phase: self.mass_phase(),
                 forward,
             });
+            self.roles.push(role);
         }
         Ok(())
     }
@@ -544,6 +583,7 @@ impl<'a> Compiler<'a> {
                 Shape::Hold { pos_m: self.pos_m },
                 Profile::hold(turn / self.airframe.yaw_rate_radps()),
                 self.heading,
+                Role::Yaw,
             )?;
         }
         self.heading = to;
@@ -572,6 +612,17 @@ impl<'a> Compiler<'a> {
             };
             (v, self.airframe.vertical_acceleration_mps2())
         };
+        // A level leg or return may be flown through a corner at either end.
+        let role = match self.seg.kind {
+            "leg" | "return" if h > 1e-9 && d[2].abs() < 1e-9 => Role::Level {
+                cruise_mps: path_speed,
+                accel_mps2: path_acc,
+                acceptance_m: self
+                    .acceptance_m
+                    .unwrap_or(self.airframe.acceptance_radius_m()),
+            },
+            _ => Role::Other,
+        };
         self.push(
             Shape::Line {
                 start_m: pos,
@@ -579,6 +630,7 @@ impl<'a> Compiler<'a> {
             },
             Profile::rest_to_rest(len, path_speed, path_acc),
             self.heading,
+            role,
         )?;
         self.pos_m = to_m;
         Ok(())
@@ -626,6 +678,7 @@ impl<'a> Compiler<'a> {
                 },
                 Profile::rest_to_rest(len, rate_mps, self.airframe.vertical_acceleration_mps2()),
                 self.heading,
+                Role::Other,
             )?;
         }
         self.pos_m[2] = to_z_m;
@@ -700,12 +753,6 @@ impl<'a> Compiler<'a> {
         self.pos_m = arc.end_m();
         self.heading = arc.at(arc.duration_s()).forward;
         self.pieces.push(arc);
+        self.roles.push(Role::Other);
     }
-}
-
-/// Heading change (absolute, rad) from `from` to `to` (unit east-north vectors).
-fn turn_rad(from: [f64; 2], to: [f64; 2]) -> f64 {
-    let cross = from[0] * to[1] - from[1] * to[0];
-    let dot = from[0] * to[0] + from[1] * to[1];
-    cross.atan2(dot).abs()
 }

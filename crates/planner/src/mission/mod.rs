@@ -88,10 +88,12 @@
 
 mod checks;
 mod compile;
+mod corners;
 mod spec;
 
 pub use checks::{MAX_MISSION_VALUE, MAX_PIECE_S};
 pub use compile::MAX_SEGMENTS;
+pub use corners::{DEFAULT_ACCEPTANCE_RADIUS_M, MIN_CORNER_SPEED_MPS};
 pub use spec::{
     CornerMode, HomeSpec, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind, WindSpec,
 };
@@ -274,6 +276,56 @@ mod tests {
         assert_eq!(
             mission.segment_kinds(),
             ["take-off", "leg", "orbit", "return", "landing"]
+        );
+    }
+    /// Legs far from home keep their length: each leg is placed in its own tangent plane, not
+    /// in one flat frame at home (which stretches an east-west leg 300 km north of home at
+    /// 25 deg by about 2 %). The length is checked against the haversine distance on a sphere
+    /// of the WGS-84 radius of curvature there, written out here (sphere against ellipsoid:
+    /// agreement to 1e-4 over 1 km).
+    #[test]
+    fn a_leg_far_from_home_has_its_own_length() {
+        let text = r#"
+            [home]
+            latitude_deg = 25.0
+            longitude_deg = 120.0
+            [[segment]]
+            kind = "take-off"
+            altitude_m = 50.0
+            climb_rate_mps = 5.0
+            [[segment]]
+            kind = "leg"
+            latitude_deg = 27.7
+            longitude_deg = 120.0
+            ground_speed_mps = 15.0
+            [[segment]]
+            kind = "leg"
+            latitude_deg = 27.7
+            longitude_deg = 120.01
+            ground_speed_mps = 15.0
+            [[segment]]
+            kind = "landing"
+            rate_mps = 2.0
+        "#;
+        let mut spec = MissionSpec::from_toml_str(text).unwrap();
+        spec.corners = Some(CornerMode::Stop);
+        let mission = spec.compile(&m100_airframe(), 0.68, None).unwrap();
+        let legs: Vec<f64> = mission
+            .pieces()
+            .iter()
+            .filter(|p| matches!(p.shape, crate::trajectory::Shape::Line { dir, .. } if dir[2].abs() < 1e-9))
+            .map(|p| p.profile.length_m)
+            .collect();
+        let lat = 27.7f64.to_radians();
+        // Prime-vertical radius of curvature at 27.7 deg (WGS-84).
+        let n = 6_378_137.0 / (1.0 - 6.694_379_990_14e-3 * lat.sin().powi(2)).sqrt();
+        let dlon = 0.01f64.to_radians();
+        let haversine = 2.0 * n * (lat.cos() * (dlon / 2.0).sin()).asin();
+        assert_eq!(legs.len(), 2);
+        assert!(
+            (legs[1] / haversine - 1.0).abs() < 1e-4,
+            "{} against {haversine}",
+            legs[1]
         );
     }
 }
