@@ -310,5 +310,8 @@ fn corners_pass_through_by_default_and_stop_on_request() {
     assert_eq!(engine, stop);
     let (code, out, err) = aloft(&["mission", "--corners", "round"]);
     assert_eq!(code, 2, "{out}");
-    assert!(err.contains("--corners") && err.lines().count() == 1, "{err}");
+    assert!(
+        err.contains("--corners") && err.lines().count() == 1,
+        "{err}"
+    );
 }

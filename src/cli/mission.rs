@@ -268,10 +268,14 @@ fn header(plan: &Plan) -> Result<String> {
         )?,
         Some(p) => writeln!(
             head,
-            "Point of no return: {} into the flight (t = {:.0} s), segment {}, at {:.0} m east, {:.0} m north, {:.0} m up.\n  After it, a straight return home at best-range speed would no longer land with the reserve.",
+            "Point of no return: {} into the flight (t = {:.0} s), segment {}{}, at {:.0} m east, {:.0} m north, {:.0} m up.\n  After it, a straight return home at best-range speed would no longer land with the reserve.",
             mmss(p.time_s),
             p.time_s,
             p.segment,
+            s.point_of_no_return
+                .as_ref()
+                .and_then(|x| x.point_of_no_return_item)
+                .map_or(String::new(), |i| format!(" (item {i})")),
             p.position_m[0],
             p.position_m[1],
             p.position_m[2]

@@ -45,6 +45,9 @@ pub struct PointOfNoReturnSummary {
     pub point_of_no_return_up_m: f64,
     /// Segment it lies in, from 1.
     pub point_of_no_return_segment: usize,
+    /// The operator's mission item of that segment, when the mission came from a planner file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_of_no_return_item: Option<u32>,
 }
 
 /// The summary of a planned mission: its JSON is exactly that of `aloft mission --format json`
@@ -172,6 +175,11 @@ pub fn mission_summary(
             point_of_no_return_north_m: p.position_m[1],
             point_of_no_return_up_m: p.position_m[2],
             point_of_no_return_segment: p.segment,
+            point_of_no_return_item: p
+                .segment
+                .checked_sub(1)
+                .and_then(|i| report.segments.get(i))
+                .and_then(|s| s.item),
         }),
         planning_speed: None,
         loiter: None,
