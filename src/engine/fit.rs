@@ -7,8 +7,11 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
-use aloft_power::fit::{DragFit, FitParameter, ForceSample, PowerFit};
-use aloft_power::{fit_drag, fit_power_model, FitOptions, FitSample};
+use aloft_power::fit::{
+    fit_drag_bounded, fit_power_model_bounded, DragFit, FitParameter, ForceSample, KeptParameter,
+    PowerFit,
+};
+use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
 use super::finite::finite;
@@ -100,6 +103,13 @@ pub struct FitAnswer {
     /// Drag from the force balance, when fitted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drag: Option<DragFit>,
+    /// The constants fitted: the power fit's lumped constants and the force balance's drag
+    /// coefficients.
+    pub fitted_parameters: Vec<String>,
+    /// The constants kept at the template's value or at a bound, with the reason: what the logs
+    /// cannot identify, or what a free fit would have made unphysical (an efficiency above 1,
+    /// negative drag).
+    pub kept_parameters: Vec<KeptParameter>,
     /// Where the vehicle file was written (empty when it was not).
     pub output: String,
     /// The fitted vehicle file (TOML with the statistics in a comment header; not in the JSON).
@@ -137,14 +147,29 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         });
     }
     let mut notes = Vec::new();
-    let drag = drag_fit(request, &forces, &mut notes, &mut vehicle)?;
+    let mut kept = Vec::new();
+    let (drag, drag_fitted) = drag_fit(request, &forces, &mut notes, &mut kept, &mut vehicle)?;
     let mut options = FitOptions::known_geometry();
     options.free = request.free.clone();
     if let Some(p) = &request.progress {
         let p = p.clone();
         options.progress = Some(Arc::new(move |i, cost| p(i, cost)));
     }
-    let power = fit_power_model(&vehicle, &samples, &options)?;
+    let bounded = fit_power_model_bounded(&vehicle, &samples, &options)?;
+    let power = bounded.fit;
+    kept.extend(bounded.kept);
+    let mut fitted_parameters: Vec<String> = power
+        .parameters
+        .iter()
+        .map(|p| p.name.to_string())
+        .collect();
+    fitted_parameters.extend(drag_fitted.iter().map(|n| n.to_string()));
+    notes.extend(kept.iter().map(|k| {
+        format!(
+            "{} kept at {:.6e} {}: {}",
+            k.name, k.value, k.unit, k.reason
+        )
+    }));
     let vehicle_toml =
         fitted_vehicle_toml(template.file(), &power, drag.as_ref(), &logs, &vehicle)?;
     if let Some(path) = &request.output {
@@ -158,6 +183,8 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             logs,
             power,
             drag,
+            fitted_parameters,
+            kept_parameters: kept,
             output: request
                 .output
                 .as_ref()
@@ -184,33 +211,46 @@ fn pack_fit(log: &aloft_logs::Log) -> Option<PackResistanceFit> {
     fit_pack_resistance(&t, &i, &v).ok()
 }
 
-/// Drag from the force balance, unless asked not to or asked of power; the fitted drag replaces
-/// the vehicle's.
+/// Drag from the force balance, unless asked not to or asked of power, kept physical and
+/// limited to what the logs identify (`aloft_power::fit::bounded`); the fitted drag replaces
+/// the vehicle's. The coefficients fitted, and the kept ones in `kept`.
 fn drag_fit(
     request: &FitRequest,
     forces: &[ForceSample],
     notes: &mut Vec<String>,
+    kept: &mut Vec<KeptParameter>,
     vehicle: &mut aloft_power::Vehicle,
-) -> Result<Option<DragFit>, Error> {
+) -> Result<(Option<DragFit>, Vec<&'static str>), Error> {
     let drag_in_free = request
         .free
         .iter()
         .any(|p| matches!(p, FitParameter::Mu1 | FitParameter::Mu2 | FitParameter::Mu3));
     if request.no_drag || drag_in_free {
-        return Ok(None);
+        return Ok((None, Vec::new()));
     }
     if forces.is_empty() {
         notes.push(
             "the logs carry no acceleration: drag (mu1..mu3) kept from the template".to_string(),
         );
-        return Ok(None);
+        return Ok((None, Vec::new()));
     }
-    let d = fit_drag(vehicle.mass_kg(), vehicle.gravity_mps2(), forces, 1.0, 5.0)
-        .map_err(|source| Error::Drag { source })?;
+    let (mu1, mu2, mu3) = vehicle.drag().coefficients();
+    let bounded = fit_drag_bounded(
+        [mu1, mu2, mu3],
+        vehicle.mass_kg(),
+        vehicle.gravity_mps2(),
+        forces,
+        1.0,
+        5.0,
+    );
+    kept.extend(bounded.kept);
+    let Some(d) = bounded.fit else {
+        return Ok((None, bounded.fitted));
+    };
     let mut p = vehicle.params().clone();
     [p.mu1_n_s_per_m, p.mu2_n_s2_per_m2, p.mu3_n_s3_per_m3] = d.mu_n;
     *vehicle = aloft_power::Vehicle::new(p)?;
-    Ok(Some(d))
+    Ok((Some(d), bounded.fitted))
 }
 
 /// The fitted vehicle file: the template with its `[power]` table replaced and the statistics in

@@ -109,7 +109,7 @@ pub use aloft_planner::{
     CornerMode, EnduranceReport, MissionReport, PointOfNoReturn, Sample, SegmentReport, Shortfall,
     SweepRow, Wind, WindProfileKind, WindSpec,
 };
-pub use aloft_power::fit::{DragFit, FitParameter, PowerFit};
+pub use aloft_power::fit::{DragFit, FitParameter, KeptParameter, PowerFit};
 pub use aloft_power::{AoaModel, FlightState, PowerBreakdown, Term, Terms};
 pub use aloft_propulsion::fit::battery::PackResistanceFit;
 pub use aloft_propulsion::{EscProtocol, HoverResult, RotorSpec, RotorTransientResult};

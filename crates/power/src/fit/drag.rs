@@ -49,14 +49,16 @@ pub struct DragFit {
     pub outliers_rejected: usize,
 }
 
-/// Fit `mu1..mu3` (for `mass_kg`) to the force balance of `samples`.
-pub fn fit_drag(
-    mass_kg: f64,
+/// Fewest samples above the airspeed threshold a drag fit takes.
+pub(crate) const MIN_FORWARD_ROWS: usize = 30;
+
+/// Airspeed and drag per unit mass of each sample faster than `min_airspeed_mps` whose thrust
+/// axis is within 84 deg of the vertical.
+pub(crate) fn force_rows(
     gravity_mps2: f64,
     samples: &[ForceSample],
     min_airspeed_mps: f64,
-    outlier_sigma: f64,
-) -> Result<DragFit, FitError> {
+) -> Vec<(f64, f64)> {
     let mut rows = Vec::with_capacity(samples.len());
     for s in samples {
         let v = s.vel_air_enu_mps;
@@ -76,7 +78,19 @@ pub fn fit_drag(
             rows.push((speed, d_per_m));
         }
     }
-    if rows.len() < 30 {
+    rows
+}
+
+/// Fit `mu1..mu3` (for `mass_kg`) to the force balance of `samples`.
+pub fn fit_drag(
+    mass_kg: f64,
+    gravity_mps2: f64,
+    samples: &[ForceSample],
+    min_airspeed_mps: f64,
+    outlier_sigma: f64,
+) -> Result<DragFit, FitError> {
+    let rows = force_rows(gravity_mps2, samples, min_airspeed_mps);
+    if rows.len() < MIN_FORWARD_ROWS {
         return Err(FitError::NoForwardFlight {
             parameter: "mu1_n_s_per_m",
             above: rows.len(),

@@ -3,11 +3,17 @@
 //! - [`power`]: the lumped constants of the four-term model from measured electrical power
 //!   (Gauss-Newton, analytic Jacobian, outlier rejection, standard errors, identifiability checks);
 //! - [`drag`]: the cubic drag of eq (6) per unit mass from the force balance (attitude,
-//!   acceleration and air velocity), as the power seed fits its drag (Fig. 3).
+//!   acceleration and air velocity), as the power seed fits its drag (Fig. 3);
+//! - [`bounded`]: both fits kept physical (efficiency at most 1, drag never negative) and
+//!   limited to what the data identifies, saying which constants were fitted and which kept.
 
+pub mod bounded;
 pub mod drag;
 pub mod power;
 
+pub use bounded::{
+    fit_drag_bounded, fit_power_model_bounded, BoundedDragFit, BoundedPowerFit, KeptParameter,
+};
 pub use drag::{fit_drag, DragFit, ForceSample};
 pub use power::{
     fit_power_model, FitOptions, FitParameter, FitSample, FittedParameter, PowerFit, ProgressFn,
