@@ -301,7 +301,9 @@ impl<'a> Flight<'a> {
         let target = self.target(item)?;
         self.climb_if_landed(item, target)?;
         let acceptance = item.params[1];
-        self.fly_to(item, target, (acceptance > 0.0).then_some(acceptance))?;
+        // Always a leg, of no length for a repeated point: every waypoint has its line in the
+        // answer.
+        self.fly_to_always(item, target, (acceptance > 0.0).then_some(acceptance))?;
         self.hover(item, item.params[0])
     }
 
@@ -547,3 +549,6 @@ impl<'a> Flight<'a> {
 }
 
 mod steps;
+
+#[cfg(test)]
+mod tests;

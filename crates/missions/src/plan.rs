@@ -295,3 +295,195 @@ fn complex_item(
 
 mod item;
 use item::{bad_key, missing, object, short, simple_item};
+
+#[cfg(test)]
+mod tests {
+    use aloft_planner::SegmentSpec;
+    use serde_json::json;
+
+    use super::*;
+
+    fn item(command: u32, params: serde_json::Value) -> Value {
+        json!({"type": "SimpleItem", "command": command, "frame": 3, "params": params, "autoContinue": true})
+    }
+
+    fn plan(mission: Value) -> String {
+        json!({"fileType": "Plan", "version": 1, "mission": mission}).to_string()
+    }
+
+    fn mission(items: Vec<Value>) -> Value {
+        json!({
+            "version": 2, "firmwareType": 12, "vehicleType": 2, "hoverSpeed": 6,
+            "plannedHomePosition": [47.0, 8.0, 400.0], "items": items,
+        })
+    }
+
+    fn takeoff() -> Value {
+        item(22, json!([0, 0, 0, null, 47.0, 8.0, 30]))
+    }
+
+    fn err(text: &str) -> String {
+        read_plan(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn the_file_type_and_versions_are_checked_naming_the_key() {
+        let fence = json!({"fileType": "GeoFence", "mission": {}}).to_string();
+        assert_eq!(
+            err(&fence),
+            "key fileType is \"GeoFence\", not \"Plan\": not a QGroundControl mission plan"
+        );
+        assert_eq!(
+            err(&json!({"mission": {}}).to_string()),
+            "file: missing key \"fileType\""
+        );
+        let mut m = mission(vec![takeoff()]);
+        m["version"] = 1.into();
+        assert!(err(&plan(m)).starts_with("file: key mission.version is 1: expected 2"));
+        let mut m = mission(vec![takeoff()]);
+        m.as_object_mut().unwrap().remove("plannedHomePosition");
+        assert_eq!(
+            err(&plan(m)),
+            "file: missing key \"mission.plannedHomePosition\""
+        );
+        let mut m = mission(vec![takeoff()]);
+        m["plannedHomePosition"] = json!([95.0, 8.0, 0.0]);
+        assert!(err(&plan(m)).contains("key mission.plannedHomePosition is [95.0,8.0,0.0]"));
+        let e = err("{\"fileType\": \"Plan\", \"mission\": ");
+        assert!(e.starts_with("not valid JSON at line 1, column"), "{e}");
+    }
+
+    #[test]
+    fn missing_and_mistyped_item_keys_name_the_item_and_the_key() {
+        let mut bare = takeoff();
+        for k in ["type", "frame", "autoContinue"] {
+            bare.as_object_mut().unwrap().remove(k);
+        }
+        let e = err(&plan(mission(vec![takeoff(), bare])));
+        assert_eq!(
+            e,
+            "item 2 (command 22 NAV_TAKEOFF): missing keys \"type\", \"frame\", \"autoContinue\""
+        );
+        let six = item(16, json!([0, 0, 0, 0, 47.0, 8.0]));
+        let e = err(&plan(mission(vec![takeoff(), six])));
+        assert!(
+            e.starts_with("item 2 (command 16 NAV_WAYPOINT): key params is 6 values: expected 7"),
+            "{e}"
+        );
+        let text = item(16, json!([0, "x", 0, 0, 47.0, 8.0, 30]));
+        let e = err(&plan(mission(vec![takeoff(), text])));
+        assert!(
+            e.starts_with("item 2 (command 16 NAV_WAYPOINT): key params[1] is \"x\""),
+            "{e}"
+        );
+        let mut frame = takeoff();
+        frame["frame"] = json!("relative");
+        let e = err(&plan(mission(vec![frame])));
+        assert!(
+            e.starts_with("item 1 (command 22 NAV_TAKEOFF): key frame is \"relative\""),
+            "{e}"
+        );
+        let huge = item(16, json!([0, 0, 0, 0, 1e300, 8.0, 30]));
+        let e = err(&plan(mission(vec![takeoff(), huge])));
+        assert!(
+            e.starts_with("item 2 (command 16 NAV_WAYPOINT): param5 (latitude) = 1e300"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn null_params_are_not_set_and_the_altitude_key_is_never_read() {
+        let mut wp = item(16, json!([null, null, null, null, 47.001, 8.0, 30]));
+        wp["Altitude"] = 99.into();
+        let i = read_plan(&plan(mission(vec![takeoff(), wp]))).unwrap();
+        match &i.spec.segments[1] {
+            SegmentSpec::Leg {
+                altitude_m,
+                acceptance_radius_m,
+                ..
+            } => {
+                assert_eq!((*altitude_m, *acceptance_radius_m), (Some(30.0), None));
+            }
+            s => panic!("{s:?}"),
+        }
+        assert_eq!(i.spec.segments.len(), 2, "no hold from a null p1");
+        assert_eq!(i.spec.default_speed_mps, Some(6.0));
+        assert_eq!(i.spec.home.altitude_amsl_m, Some(400.0));
+    }
+
+    #[test]
+    fn old_item_layouts_are_converted_as_qgroundcontrol_does() {
+        // V1: param1..param4 and a coordinate; V2: four params and a coordinate.
+        let v1 = json!({"type": "missionItem", "command": 16, "frame": 3, "autoContinue": true,
+            "param1": 5, "param2": 0, "param3": 0, "param4": 0, "coordinate": [47.001, 8.0, 30]});
+        let v2 = json!({"type": "SimpleItem", "command": 16, "frame": 3, "autoContinue": true,
+            "params": [0, 0, 0, 0], "coordinate": [47.002, 8.0, 35]});
+        let i = read_plan(&plan(mission(vec![takeoff(), v1, v2]))).unwrap();
+        let kinds: Vec<&str> = i.spec.segments.iter().map(SegmentSpec::kind).collect();
+        assert_eq!(kinds, ["take-off", "leg", "hover", "leg"]);
+        assert_eq!(i.spec.segments[2].item(), Some(2));
+        assert_eq!(i.spec.segments[3].item(), Some(3));
+    }
+
+    #[test]
+    fn surveys_are_flattened_in_sequence_and_path_less_items_refused() {
+        let inner = vec![
+            item(16, json!([0, 0, 0, null, 47.001, 8.0, 30])),
+            item(206, json!([25, 0, 1, 0, 0, 0, 0])),
+            item(16, json!([0, 0, 0, null, 47.002, 8.0, 30])),
+        ];
+        let survey = json!({"type": "ComplexItem", "complexItemType": "survey", "version": 5,
+            "TransectStyleComplexItem": {"Items": inner}});
+        let rtl = item(20, json!([0, 0, 0, 0, 0, 0, 0]));
+        let i = read_plan(&plan(mission(vec![takeoff(), survey, rtl]))).unwrap();
+        let items: Vec<Option<u32>> = i.spec.segments.iter().map(SegmentSpec::item).collect();
+        assert_eq!(items, [1, 2, 4, 5, 5, 5].map(Some));
+        assert_eq!((i.counted.total, i.counted.free), (5, 1));
+        for (kind, what) in [
+            ("StructureScan", "stores no flight path"),
+            ("fwLandingPattern", "landing pattern"),
+            ("vtolLandingPattern", "landing pattern"),
+            ("somethingNew", "unknown complex item"),
+        ] {
+            let c = json!({"type": "ComplexItem", "complexItemType": kind});
+            let e = err(&plan(mission(vec![takeoff(), c])));
+            assert!(
+                e.starts_with(&format!("item 2: ComplexItem {kind} is refused")),
+                "{e}"
+            );
+            assert!(e.contains(what), "{e}");
+        }
+        let old = json!({"type": "ComplexItem", "complexItemType": "survey", "version": 3});
+        let e = err(&plan(mission(vec![takeoff(), old])));
+        assert_eq!(e, "item 2: missing key \"TransectStyleComplexItem.Items\"");
+    }
+
+    #[test]
+    fn vtol_vehicles_are_refused_and_a_fixed_wing_planner_vehicle_is_a_warning() {
+        let mut m = mission(vec![takeoff()]);
+        m["vehicleType"] = 21.into();
+        assert!(err(&plan(m))
+            .starts_with("file: key mission.vehicleType 21 (a VTOL, MAV_TYPE 19-25) is refused"));
+        let mut m = mission(vec![takeoff()]);
+        m["vehicleType"] = 1.into();
+        let i = read_plan(&plan(m)).unwrap();
+        assert!(i.warnings.iter().any(|w| w.contains("vehicleType 1")));
+    }
+
+    #[test]
+    fn arbitrary_bytes_never_panic() {
+        assert_eq!(
+            crate::import_bytes(b"QGC WPL 110\n\xff").unwrap_err(),
+            ImportError::NotText { offset: 12 }
+        );
+        for t in [
+            "{}",
+            "[]",
+            "{\"fileType\": 3}",
+            "{\"fileType\":\"Plan\",\"mission\":[]}",
+            "QGC WPL 110",
+        ] {
+            let _ = crate::import(t);
+        }
+    }
+}

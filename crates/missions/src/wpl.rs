@@ -194,3 +194,62 @@ fn check_sequence(rows: &[RawItem], first: u32, notes: &mut Notes) {
         );
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HOME: &str = "0\t1\t0\t16\t0\t0\t0\t0\t-35.0\t149.0\t100.0\t1";
+    const TAKEOFF: &str = "1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1";
+
+    fn err(text: &str) -> String {
+        read_waypoints(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn the_header_fields_and_numbers_are_checked_naming_the_line_and_column() {
+        assert_eq!(
+            err("QGC WPL 120\n"),
+            "line 1: header is \"QGC WPL 120\", expected \"QGC WPL 110\""
+        );
+        let short = format!("QGC WPL 110\n{HOME}\n1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\n");
+        assert!(err(&short).starts_with("line 3: 11 tab-separated fields, expected 12"));
+        let word = format!("QGC WPL 110\n{HOME}\n1\t0\t3\t22\t0\t0\t0\t0\tnorth\t0\t20\t1\n");
+        assert_eq!(err(&word), "line 3: field LAT is \"north\", not a number");
+        let nan = format!("QGC WPL 110\n{HOME}\n1\t0\t3\t22\t0\t0\t0\t0\t0\t0\tNaN\t1\n");
+        assert_eq!(err(&nan), "line 3: field ALT is \"NaN\", not a number");
+        let inf = format!("QGC WPL 110\n{HOME}\n1\t0\t3\t22\tinf\t0\t0\t0\t0\t0\t20\t1\n");
+        assert_eq!(err(&inf), "line 3: field P1 is \"inf\", not a number");
+        let index = format!("QGC WPL 110\n{HOME}\n-1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1\n");
+        assert_eq!(err(&index), "line 3: field INDEX is \"-1\", not a number");
+    }
+
+    #[test]
+    fn crlf_trailing_blanks_and_blank_lines_are_tolerated() {
+        let t = format!("QGC WPL 110\r\n{HOME}  \r\n\r\n{TAKEOFF}\t\r\n");
+        let i = read_waypoints(&t).unwrap();
+        assert_eq!(i.spec.segments.len(), 1);
+        assert_eq!(i.spec.home.altitude_amsl_m, Some(100.0));
+        assert_eq!(i.spec.default_speed_mps, Some(ARDUPILOT_WPNAV_SPEED_MPS));
+    }
+
+    #[test]
+    fn a_file_without_a_home_row_keeps_row_0_and_refuses_amsl_heights() {
+        let t = "QGC WPL 110\n0\t0\t3\t22\t0\t0\t0\t0\t-35.0\t149.0\t10\t1\n";
+        let i = read_waypoints(t).unwrap();
+        assert_eq!(i.spec.segments[0].item(), Some(0));
+        assert!(i.warnings[0].starts_with("row 0: no home row"));
+        let amsl = format!("{t}1\t0\t0\t16\t0\t0\t0\t0\t-35.001\t149.0\t110\t1\n");
+        assert!(err(&amsl).starts_with("row 1: no home position: an altitude above mean sea level"));
+        let nowhere = "QGC WPL 110\n0\t0\t2\t178\t1\t5\t0\t0\t0\t0\t0\t1\n";
+        assert!(err(nowhere).starts_with("file: no home position"));
+    }
+
+    #[test]
+    fn rows_out_of_sequence_are_numbered_by_their_index_with_a_warning() {
+        let t = format!("QGC WPL 110\n{HOME}\n7\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1\n");
+        let i = read_waypoints(&t).unwrap();
+        assert_eq!(i.spec.segments[0].item(), Some(7));
+        assert!(i.warnings[0].starts_with("row 7: INDEX 7 where 1 was expected"));
+    }
+}
