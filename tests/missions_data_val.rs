@@ -419,8 +419,7 @@ fn data_val_ardupilot_do_change_speed_waypoints() {
 fn speeds_beyond_the_tilt_limit_are_still_refused_by_the_stock_m100() {
     let m = load("ardupilot_DO_CHANGE_SPEED_mission.txt");
     let e = plan_mission(&m100(), &m, &MissionOptions::default())
-        .err()
-        .expect("the tilt check refuses 17 m/s");
+        .expect_err("the tilt check refuses 17 m/s");
     assert!(e.to_string().contains("tilt"), "{e}");
 }
 

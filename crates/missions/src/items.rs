@@ -225,6 +225,11 @@ fn has_position(command: u32) -> bool {
     )
 }
 
+/// A parameter that holds a code (an enum value written as a float): the whole number, else none.
+fn code(x: f64) -> Option<i64> {
+    (x.is_finite() && x.fract() == 0.0 && x.abs() < 1e15).then_some(x as i64)
+}
+
 /// Where an item sends the vehicle: a point (none: here) and a height above home (none: the
 /// present height).
 #[derive(Debug, Clone, Copy)]
@@ -462,7 +467,7 @@ impl<'a> Flight<'a> {
     /// NAV_DELAY (93), CONDITION_DELAY (112): a hover of p1 s in the air.
     fn delay(&mut self, item: &RawItem) -> Result<(), ImportError> {
         let seconds = item.params[0];
-        if !(seconds >= 0.0) {
+        if seconds.is_nan() || seconds < 0.0 {
             self.notes.add(
                 item.at,
                 "delay without a duration (p1 < 0: until a time of day): not flown",
@@ -479,35 +484,38 @@ impl<'a> Flight<'a> {
     /// DO_CHANGE_SPEED (178): the ground speed of the following legs.
     fn change_speed(&mut self, item: &RawItem) {
         let [kind, speed, ..] = item.params;
-        let kind = if kind.is_nan() { 1.0 } else { kind };
-        if kind == 2.0 || kind == 3.0 {
+        // Not set: a ground speed.
+        let kind = if kind.is_nan() { Some(1) } else { code(kind) };
+        if matches!(kind, Some(2 | 3)) {
             self.notes.add(
                 item.at,
                 "DO_CHANGE_SPEED of the climb or descent speed (p1 2 or 3): not modelled",
             );
             return;
         }
-        if kind == 0.0 {
+        if kind == Some(0) {
             self.notes.add(
                 item.at,
                 "DO_CHANGE_SPEED of the airspeed (p1 0) flown as ground speed, as multirotor autopilots do",
             );
         }
-        if speed == -2.0 {
-            self.speed_mps = None;
-        } else if speed > 0.0 {
+        if speed > 0.0 {
             self.speed_mps = Some(speed);
-        } else if speed != -1.0 {
-            self.notes.add(
+            return;
+        }
+        match code(speed) {
+            Some(-2) => self.speed_mps = None,
+            Some(-1) => {}
+            _ => self.notes.add(
                 item.at,
                 "DO_CHANGE_SPEED without a speed (p2 not positive, -1 or -2): no change",
-            );
+            ),
         }
     }
 
     /// DO_GRIPPER (211): p2 0 releases the payload after the last segment flown.
     fn gripper(&mut self, item: &RawItem) -> Result<(), ImportError> {
-        if item.params[1] != 0.0 {
+        if code(item.params[1]) != Some(0) {
             self.notes.add(
                 item.at,
                 "DO_GRIPPER grab: the mass picked up is unknown, not added",

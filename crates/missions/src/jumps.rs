@@ -94,11 +94,13 @@ fn resolve(
     let found = whole
         .then(|| match by {
             JumpsBy::DoJumpId => find_jump_id(item, items, target as i64, notes),
-            JumpsBy::RowIndex if target == 0.0 => {
+            JumpsBy::RowIndex if target.abs() < 0.5 => {
                 notes.add(item.at, "DO_JUMP to row 0 (home) jumps to the first item");
                 (!items.is_empty()).then_some(0)
             }
-            JumpsBy::RowIndex => items.iter().position(|x| f64::from(x.number) == target),
+            JumpsBy::RowIndex => items
+                .iter()
+                .position(|x| i64::from(x.number) == target as i64),
         })
         .flatten();
     match found {

@@ -131,7 +131,7 @@ impl Walk {
 
     fn segment(&mut self, k: usize, s: &SegmentSpec) {
         match s {
-            SegmentSpec::TakeOff { altitude_m, .. } => self.to_height(Some(*altitude_m)),
+            SegmentSpec::TakeOff { altitude_m, .. } => self.climb_or_descend_to(Some(*altitude_m)),
             SegmentSpec::Leg {
                 east_m,
                 north_m,
@@ -140,8 +140,8 @@ impl Walk {
                 altitude_m,
                 ..
             } => {
-                self.to_point(point([*east_m, *north_m, *latitude_deg, *longitude_deg]));
-                self.to_height(*altitude_m);
+                self.move_to(point([*east_m, *north_m, *latitude_deg, *longitude_deg]));
+                self.climb_or_descend_to(*altitude_m);
             }
             SegmentSpec::Orbit { .. } => self.orbit(k, s),
             SegmentSpec::Hover { duration_s, .. } => {
@@ -151,11 +151,11 @@ impl Walk {
             }
             SegmentSpec::Return { altitude_m, .. } => {
                 let up = altitude_m.or_else(|| self.rtl_altitude_m.map(|r| r.max(self.height_m)));
-                self.to_height(up);
-                self.to_point(Some(self.home));
+                self.climb_or_descend_to(up);
+                self.move_to(Some(self.home));
             }
-            SegmentSpec::Descent { altitude_m, .. } => self.to_height(Some(*altitude_m)),
-            SegmentSpec::Landing { .. } => self.to_height(Some(0.0)),
+            SegmentSpec::Descent { altitude_m, .. } => self.climb_or_descend_to(Some(*altitude_m)),
+            SegmentSpec::Landing { .. } => self.climb_or_descend_to(Some(0.0)),
             SegmentSpec::LoiterUntilReserve { .. } => {}
         }
     }
@@ -183,8 +183,8 @@ impl Walk {
             *centre_latitude_deg,
             *centre_longitude_deg,
         ];
-        self.to_point(point(centre));
-        self.to_height(*altitude_m);
+        self.move_to(point(centre));
+        self.climb_or_descend_to(*altitude_m);
         let circle_m = std::f64::consts::TAU * radius_m.abs();
         let speed = ground_speed_mps.or(self.default_speed_mps);
         let arc_m = match (laps, duration_s, speed) {
@@ -204,7 +204,7 @@ impl Walk {
     }
 
     /// Horizontally to `to` (none: stay).
-    fn to_point(&mut self, to: Option<Pos>) {
+    fn move_to(&mut self, to: Option<Pos>) {
         let Some(to) = to else { return };
         if let Some(d) = self.distance_m(self.here, to) {
             self.horizontal_m += d;
@@ -213,7 +213,7 @@ impl Walk {
     }
 
     /// Vertically to `height_m` (none or not finite: stay).
-    fn to_height(&mut self, height_m: Option<f64>) {
+    fn climb_or_descend_to(&mut self, height_m: Option<f64>) {
         let Some(h) = height_m.filter(|h| h.is_finite()) else {
             return;
         };

@@ -16,6 +16,9 @@ use crate::ItemCounts;
 const POSITION_FRAMES: &str =
     "0 or 5 (AMSL), 3 or 6 (relative to home), 10 or 11 (terrain, flown as relative)";
 
+/// Heights closer than this are the same, m (a micrometre: the same value as written).
+const SAME_HEIGHT_M: f64 = 1e-6;
+
 impl Flight<'_> {
     /// The point and height `item` sends the vehicle to.
     pub(super) fn target(&mut self, item: &RawItem) -> Result<Target, ImportError> {
@@ -147,7 +150,9 @@ impl Flight<'_> {
         acceptance_m: Option<f64>,
     ) -> Result<(), ImportError> {
         let moves = target.point.is_some_and(|p| p != self.here)
-            || target.height_m.is_some_and(|h| h != self.height_m);
+            || target
+                .height_m
+                .is_some_and(|h| (h - self.height_m).abs() > SAME_HEIGHT_M);
         if moves || acceptance_m.is_some() {
             self.fly_to_always(item, target, acceptance_m)?;
         }

@@ -17,24 +17,7 @@ pub(super) fn simple_item(
     let at = Place::Item(number);
     let command = obj.get("command").and_then(Value::as_u64);
     let command = command.and_then(|c| u32::try_from(c).ok());
-    let mut absent: Vec<&str> = SIMPLE_KEYS
-        .iter()
-        .copied()
-        .filter(|k| !obj.contains_key(*k))
-        .collect();
-    let v1 = !obj.contains_key("params");
-    if v1 {
-        absent.extend(
-            ["param1", "param2", "param3", "param4"]
-                .into_iter()
-                .filter(|k| !obj.contains_key(*k)),
-        );
-        if absent.len() > 4 {
-            // Neither layout: name the current one.
-            absent.retain(|k| !k.starts_with("param"));
-            absent.push("params");
-        }
-    }
+    let absent = absent_keys(obj);
     if !absent.is_empty() {
         return Err(missing(at, command, &absent));
     }
@@ -100,6 +83,26 @@ pub(super) fn simple_item(
         params,
         jump_id,
     })
+}
+
+/// The keys a SimpleItem lacks: [`SIMPLE_KEYS`], and `params` (or the V1 layout's
+/// `param1`..`param4`).
+fn absent_keys(obj: &Map<String, Value>) -> Vec<&'static str> {
+    let mut absent: Vec<&str> = SIMPLE_KEYS
+        .iter()
+        .copied()
+        .filter(|k| !obj.contains_key(*k))
+        .collect();
+    if !obj.contains_key("params") {
+        let v1 = ["param1", "param2", "param3", "param4"];
+        if v1.iter().any(|k| obj.contains_key(*k)) {
+            absent.extend(v1.into_iter().filter(|k| !obj.contains_key(*k)));
+        } else {
+            // Neither layout: name the current one.
+            absent.push("params");
+        }
+    }
+    absent
 }
 
 /// The seven parameters: `params` (7 values, or 4 with a V2 `coordinate`), or the V1 keys
