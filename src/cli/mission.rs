@@ -308,7 +308,7 @@ fn route_line(r: &RouteFigures) -> String {
     );
     if let Some(n) = &r.items {
         line += &format!(
-            "; {} items: {} flown, {} commands, {} free (camera, gimbal, mode), {} unknown, {} never reached",
+            "; {} items: {} flown, {} speed/jump/gripper, {} free (camera, gimbal, mode), {} unknown, {} never reached",
             n.total, n.flown, n.commands, n.free, n.unknown, n.unreachable
         );
     }

@@ -184,3 +184,67 @@ fn assemble(
         counted: translation.counts,
     }
 }
+
+#[cfg(test)]
+mod proptests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// A command from those with meaning and a few without.
+    fn command() -> impl Strategy<Value = u32> {
+        prop::sample::select(vec![
+            16, 17, 18, 19, 20, 21, 22, 31, 82, 93, 112, 177, 178, 211, 530, 206, 84, 9999,
+        ])
+    }
+
+    /// A parameter: ordinary, zero, or extreme.
+    fn value() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            -200.0..200.0f64,
+            Just(0.0),
+            Just(-1.0),
+            Just(-2.0),
+            Just(1e300),
+            Just(-1e-300),
+        ]
+    }
+
+    proptest! {
+        /// Any `.waypoints` rows: an answer or an error, never a panic; the figures of an
+        /// answer are finite and not negative.
+        #[test]
+        fn waypoints_of_any_values_never_panic_and_give_finite_figures(
+            rows in prop::collection::vec(
+                (0u32..12, prop::sample::select(vec![0u32, 2, 3, 5, 6, 10, 1]), command(),
+                 prop::array::uniform7(value())),
+                0..12,
+            )
+        ) {
+            let mut t = String::from("QGC WPL 110\n0\t1\t0\t16\t0\t0\t0\t0\t47.0\t8.0\t400\t1\n");
+            for (k, (index, frame, cmd, p)) in rows.iter().enumerate() {
+                let index = if k % 3 == 0 { *index } else { k as u32 + 1 };
+                t += &format!(
+                    "{index}\t0\t{frame}\t{cmd}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t1\n",
+                    p[0], p[1], p[2], p[3], p[4], p[5], p[6]
+                );
+            }
+            if let Ok(i) = import(&t) {
+                let r = &i.route;
+                for v in [r.horizontal_m, r.climb_m, r.descent_m, r.hold_s] {
+                    prop_assert!(v.is_finite() && v >= 0.0, "{r:?}");
+                }
+                prop_assert!(!i.spec.segments.is_empty());
+            }
+        }
+
+        /// Any bytes: never a panic.
+        #[test]
+        fn any_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..400)) {
+            let _ = import_bytes(&bytes);
+            let mut plan = b"{\"fileType\":\"Plan\",\"mission\":".to_vec();
+            plan.extend(&bytes);
+            let _ = import_bytes(&plan);
+        }
+    }
+}

@@ -1,6 +1,7 @@
 //! Warnings gathered while a file is read, one line per message with every place it applies to
 //! (`items 3-5, 9: terrain-relative altitude (frame 10) flown as relative to home`), so that a
-//! survey of hundreds of items gives a few readable lines.
+//! survey of hundreds of items gives a few readable lines; a note about the whole file has no
+//! place.
 
 use crate::error::Place;
 
@@ -28,7 +29,13 @@ impl Notes {
     pub(crate) fn finish(self) -> Vec<String> {
         self.entries
             .into_iter()
-            .map(|(message, places)| format!("{}: {message}", places_text(&places)))
+            .map(|(message, places)| {
+                if places.iter().all(|p| *p == Place::File) {
+                    message
+                } else {
+                    format!("{}: {message}", places_text(&places))
+                }
+            })
             .collect()
     }
 }
@@ -94,7 +101,7 @@ mod tests {
         n.add(Place::File, "whole");
         assert_eq!(
             n.finish(),
-            ["items 3-5, 9: terrain", "row 2: other", "file: whole"]
+            ["items 3-5, 9: terrain", "row 2: other", "whole"]
         );
     }
 }
