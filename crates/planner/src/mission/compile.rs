@@ -665,9 +665,10 @@ impl<'a> Compiler<'a> {
 
     /// Speed and acceleration along a path `d` (m) with horizontal length `h` and length `len`
     /// flown at a horizontal ground speed: the vertical rate that implies must be within the
-    /// climb or descent limit, and neither acceleration limit is exceeded.
+    /// climb or descent limit (for a mission that clamps its speeds, a planner file, the ground
+    /// speed is lowered until it is, with a warning), and neither acceleration limit is exceeded.
     fn sloped_speed_and_acceleration(
-        &self,
+        &mut self,
         d: [f64; 3],
         h: f64,
         len: f64,
@@ -684,7 +685,17 @@ impl<'a> Compiler<'a> {
                 "descent rate of the leg",
             )
         };
-        self.seg.within(name, vz, vlim, "m/s")?;
+        let ground_speed_mps = if self.clamp_speeds && vz > vlim {
+            let slower = vlim * h / d[2].abs();
+            self.warnings.push(format!(
+                "{}: the {name} at {ground_speed_mps} m/s over the ground would be {vz:.2} m/s, beyond the vehicle's {vlim} m/s: flown at {slower:.2} m/s over the ground",
+                self.seg.name()
+            ));
+            slower
+        } else {
+            self.seg.within(name, vz, vlim, "m/s")?;
+            ground_speed_mps
+        };
         let acc = if d[2].abs() > 1e-9 {
             (a_h * len / h).min(a_v * len / d[2].abs())
         } else {
