@@ -31,12 +31,16 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod binary;
+pub mod bytes;
 pub mod cdr;
 pub mod column_map;
 pub mod csv_read;
+pub mod dataflash;
 pub mod error;
 pub mod frame;
 pub mod info;
+pub mod join;
 pub mod lag;
 pub mod mcap_read;
 pub mod mcap_records;
@@ -45,7 +49,11 @@ pub mod open;
 pub mod px4;
 pub mod ros;
 pub mod sample;
+pub mod ulog;
 
+pub use binary::{
+    read_dataflash, read_ulog, BinaryLog, BinaryOptions, BinarySamples, BinarySummary,
+};
 pub use column_map::ColumnMap;
 pub use csv_read::CsvSamples;
 pub use error::{LogError, Result};
