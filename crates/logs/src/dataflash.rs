@@ -333,10 +333,13 @@ impl Framer {
             let Some(rec) = w.peek(len) else {
                 let name = self.format(t).map_or(String::new(), |f| f.name.clone());
                 s.warn(format!(
-                    "truncated DataFlash: the {name} record at byte {at} needs {len} bytes, {} remain",
+                    "truncated or corrupt DataFlash: the {name} record at byte {at} needs {len} bytes, {} remain",
                     w.remaining()
                 ));
-                return None;
+                if !self.resync(w, s, at) {
+                    return None;
+                }
+                continue;
             };
             payload.clear();
             payload.extend_from_slice(&rec[3..]);

@@ -224,6 +224,8 @@ pub struct UlogDecoder {
     in_air_s: f64,
     stamped_zero: u64,
     unknown_ids: u64,
+    /// Message ids of subscriptions without a usable format (their records are skipped).
+    ignored: std::collections::HashSet<u16>,
 }
 
 /// The size of format `name`, bytes (`None`: unknown type, too deep, or over 64 KiB).
@@ -258,6 +260,7 @@ impl UlogDecoder {
             in_air_s: 0.0,
             stamped_zero: 0,
             unknown_ids: 0,
+            ignored: std::collections::HashSet::new(),
         }
     }
 
@@ -415,14 +418,22 @@ impl UlogDecoder {
         if !KNOWN_TYPES.contains(&t) {
             return Some(Err(format!("unknown record type 0x{t:02x} (size {size})")));
         }
+        if t == b'D' {
+            let h = w.peek_max(5);
+            let id = le::u16(h, 3).unwrap_or(u16::MAX);
+            if self.plausible(h).is_none() && !self.ignored.contains(&id) {
+                return Some(Err(format!(
+                    "data record of {size} bytes for msg_id {id} contradicts its subscription"
+                )));
+            }
+        }
         let Some(rec) = w.peek(size + 3) else {
-            s.warn(format!(
-                "truncated ULog: the '{}' record at byte {at} needs {} bytes, {} remain",
+            return Some(Err(format!(
+                "truncated or corrupt: the '{}' record needs {} bytes, {} remain",
                 t as char,
                 size + 3,
                 w.remaining()
-            ));
-            return None;
+            )));
         };
         let r = self.handle(t, &rec[3..], s);
         w.consume(size + 3);
@@ -506,11 +517,15 @@ impl UlogDecoder {
         }
         match self.subscription(name, multi_id) {
             Some(sub) => {
+                self.ignored.remove(&id);
                 self.subs.insert(id, sub);
             }
-            None => s.warn(format!(
+            None => {
+                self.ignored.insert(id);
+                s.warn(format!(
                 "ULog topic '{name}' (msg_id {id}) has no valid format: its records are skipped"
-            )),
+            ))
+            }
         }
         Ok(())
     }
