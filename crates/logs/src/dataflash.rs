@@ -241,6 +241,7 @@ fn role(name: &str) -> Role {
 /// corruption (see the module docs).
 pub struct Framer {
     formats: Vec<Option<Format>>,
+    roles: Vec<Role>,
     mults: Vec<(u8, f64)>,
 }
 
@@ -250,6 +251,7 @@ impl Default for Framer {
         formats[FMT_TYPE as usize] = Some(fmt_of_fmt());
         Self {
             formats,
+            roles: vec![Role::Other; 256],
             mults: Vec::new(),
         }
     }
@@ -355,6 +357,7 @@ impl Framer {
         match Format::parse(p) {
             Some(f) if f.type_id != FMT_TYPE => {
                 let t = f.type_id as usize;
+                self.roles[t] = role(&f.name);
                 self.formats[t] = Some(f);
             }
             Some(_) => {}
@@ -448,14 +451,17 @@ impl DataflashDecoder {
 
     /// The event of the record just framed, if the join keeps it.
     fn event(&mut self, t: u8, s: &mut BinarySummary) -> Option<Event> {
-        let f = self.framer.format(t)?.clone();
-        let p = std::mem::take(&mut self.payload);
-        let r = role(&f.name);
-        if r != Role::Other {
-            s.count(&f.name);
+        let r = self.framer.roles[t as usize];
+        if r == Role::Other {
+            return None;
         }
+        // Taken out of the table while it is used (put back below), so nothing is cloned.
+        let f = self.framer.formats[t as usize].take()?;
+        let p = std::mem::take(&mut self.payload);
+        s.count(&f.name);
         let e = self.by_role(r, &f, &p, s);
         self.payload = p;
+        self.framer.formats[t as usize] = Some(f);
         e
     }
 
