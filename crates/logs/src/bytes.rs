@@ -159,7 +159,8 @@ mod tests {
         let data: Vec<u8> = (0..200_000u32).map(|i| (i % 251) as u8).collect();
         let mut w = ByteWindow::new(&data[..]);
         assert_eq!(w.peek(3).unwrap(), &[0, 1, 2]);
-        w.consume(100_000);
+        w.consume(3);
+        assert!(w.skip_to(100_000));
         assert_eq!(w.offset(), 100_000);
         assert_eq!(w.peek(1).unwrap()[0], (100_000 % 251) as u8);
         assert!(w.skip_to(199_999));
