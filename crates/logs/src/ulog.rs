@@ -551,7 +551,11 @@ impl UlogDecoder {
                 sub.full
             ));
         }
-        let Some(topic) = sub.topic else {
+        // Instance 0 of every topic but the battery (whose instance is chosen).
+        let Some(topic) = sub
+            .topic
+            .filter(|t| *t == Topic::Battery || sub.multi_id == 0)
+        else {
             return Ok(None);
         };
         let ts = sub.timestamp.and_then(|l| l.prim.read(payload, l.offset));
