@@ -78,8 +78,12 @@ struct Judged {
 /// RMS sideslip of a log: `atan2(rms v_right, rms v_forward)` over samples faster than 1 m/s.
 fn sideslip_deg(path: &str) -> f64 {
     let profile = aloft_logs::Profile::resolve("kaist").unwrap();
-    let log = aloft_logs::read_log(std::path::Path::new(path), Some(&profile), &Default::default())
-        .unwrap();
+    let log = aloft_logs::read_log(
+        std::path::Path::new(path),
+        Some(&profile),
+        &Default::default(),
+    )
+    .unwrap();
     let (mut f2, mut r2) = (0.0, 0.0);
     for s in &log.samples {
         let (Some(v), Some(a)) = (s.vel_enu_mps, s.attitude) else {
@@ -104,10 +108,8 @@ fn judge_day(held_out: &'static str) -> Vec<Judged> {
         "{}/fixtures/vehicles/kaist-template.toml",
         env!("CARGO_MANIFEST_DIR")
     );
-    let vehicle = std::env::temp_dir().join(format!(
-        "aloft-lodo-{}-{held_out}.toml",
-        std::process::id()
-    ));
+    let vehicle =
+        std::env::temp_dir().join(format!("aloft-lodo-{}-{held_out}.toml", std::process::id()));
     let vehicle = vehicle.display().to_string();
     let mut fit = words(&["fit", "--profile", "kaist", "--log"]);
     for d in DAYS.iter().filter(|d| **d != held_out) {

@@ -13,6 +13,10 @@
 //! | `v_air` | velocity of the vehicle relative to the air, `v_ground - wind` | m/s |
 //! | `f_D` | cubic drag of power seed eq (6) | N |
 //!
+//! With body-axis drag (`aloft_power::drag`, "Deviation") the horizontal drag is split along the
+//! heading and its right, `k_x v_f f + k_y v_r r`, so the heading matters: missions head along
+//! the track, replays along the logged yaw.
+//!
 //! The attitude follows from the thrust axis `t = T / |T|` with the heading along the track:
 //! with `f`, `r` the forward and right horizontal unit vectors, `sin(roll) = t.r`,
 //! `tan(pitch) = -t.f / t.up` (Z-Y-X Euler angles of a forward-right-down body, as in
@@ -115,10 +119,24 @@ impl Powered<'_> {
         let speed = (vx * vx + vy * vy + vz * vz).sqrt();
         // f_D(v) / v = mu1 + mu2 v + mu3 v^2 (eq 6 divided by v): no division on the hot path,
         // and 0 N of drag at zero airspeed since f_D(0) = 0 multiplies v_air = 0.
-        let (mu1, mu2, mu3) = self.aircraft.drag().coefficients();
+        let drag = self.aircraft.drag();
+        let (mu1, mu2, mu3) = drag.coefficients();
         let k = mu1 + speed * (mu2 + speed * mu3);
-        let tx = m * acc_mps2[0] + k * vx;
-        let ty = m * acc_mps2[1] + k * vy;
+        let (tx, ty) = match drag.body_axes() {
+            None => (m * acc_mps2[0] + k * vx, m * acc_mps2[1] + k * vy),
+            // Body-axis drag: the air velocity split along the heading `f` and its right
+            // `r = (f_n, -f_e)`, each with its own coefficient (aloft_power::drag).
+            Some(_) => {
+                let [kx, ky, _] = drag.axis_coefficients(speed);
+                let [fe, fn_] = forward;
+                let v_f = vx * fe + vy * fn_;
+                let v_r = vx * fn_ - vy * fe;
+                (
+                    m * acc_mps2[0] + kx * v_f * fe + ky * v_r * fn_,
+                    m * acc_mps2[1] + kx * v_f * fn_ - ky * v_r * fe,
+                )
+            }
+        };
         let tz = m * acc_mps2[2] + self.weight_n + k * vz;
         let thrust = (tx * tx + ty * ty + tz * tz).sqrt();
         let inv = 1.0 / thrust;
