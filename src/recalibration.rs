@@ -120,15 +120,21 @@ mod tests {
 
     #[test]
     fn independent_noise_counts_every_sample_and_a_slow_drift_few() {
-        // A deterministic sequence with no serial correlation to speak of.
+        // A deterministic pseudo-random sequence (xorshift64) with no serial correlation.
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
         let white: Vec<f64> = (0..1000)
-            .map(|i| ((i as f64 * 12.9898).sin() * 43758.5453).fract() - 0.5)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                (x >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            })
             .collect();
         let n_white = effective_sample_size(&white);
         assert!(n_white > 500.0, "{n_white}");
         // A sine of period 200 samples: strongly correlated over tens of samples.
         let slow: Vec<f64> = (0..1000)
-            .map(|i| (i as f64 / 200.0 * 6.283).sin())
+            .map(|i| (i as f64 / 200.0 * std::f64::consts::TAU).sin())
             .collect();
         let n_slow = effective_sample_size(&slow);
         assert!(n_slow < 30.0, "{n_slow}");

@@ -387,6 +387,28 @@ pub(crate) mod tests {
         assert!(err.contains("mass_lb"), "{err}");
     }
 
+    #[test]
+    fn body_axis_drag_needs_both_keys_and_old_files_write_no_new_keys() {
+        let mut p = m100_params();
+        p.mu2_x_n_s2_per_m2 = Some(0.01);
+        let e = Vehicle::new(p.clone()).unwrap_err();
+        assert!(matches!(e, PowerError::LoneBodyAxisDrag { .. }), "{e}");
+        p.mu2_y_n_s2_per_m2 = Some(-1.0);
+        // Negative drag sideways at low speed: refused as the scalar law would be.
+        assert!(Vehicle::new(p.clone()).is_err());
+        p.mu2_y_n_s2_per_m2 = Some(0.02);
+        let v = Vehicle::new(p).unwrap();
+        assert_eq!(v.drag().body_axes(), Some([0.01, 0.02]));
+        let mut q = m100_params();
+        q.efficiency_relative_sd = Some(-0.1);
+        assert!(Vehicle::new(q).is_err());
+        let json = serde_json::to_string(&m100_params()).unwrap();
+        assert!(
+            !json.contains("mu2_x") && !json.contains("efficiency_relative_sd"),
+            "{json}"
+        );
+    }
+
     // The crate does not depend on toml; serde's own test format is enough to show the attribute works.
     fn toml_like_parse(text: &str) -> String {
         let mut map = serde_json::Map::new();
