@@ -8,6 +8,10 @@ use crate::airframe::Airframe;
 use crate::error::{positive, PlannerError};
 
 /// Where the electrical power of a flight condition comes from.
+// The four-term variant holds the vehicle inline (about 250 bytes with the optional body-axis
+// drag and efficiency spread): it is the common case, built once per aircraft, and boxing it
+// would put an indirection on the trim's hot path for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum PowerSource {
     /// The four-term model (power seed eqs 3-14) of a vehicle; its mass is replaced by the
@@ -144,6 +148,8 @@ impl Aircraft {
 }
 
 /// The evaluator behind [`Powered`].
+// Inline for the same reason as `PowerSource`: the model is read on every trim.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub(crate) enum Engine<'a> {
     FourTerm(PowerModel),
