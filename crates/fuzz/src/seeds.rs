@@ -12,7 +12,7 @@ use aloft::engine::{
 };
 use aloft_logs::cdr::CdrWriter;
 
-use crate::targets::{scratch, MAP_SEPARATOR};
+use crate::targets::{scratch, MAP_SEPARATOR, TABLE_SEPARATOR};
 
 /// The repository's root (fixtures are read from it).
 pub fn repo_root() -> PathBuf {
@@ -102,6 +102,59 @@ pub fn column_map() -> Vec<Vec<u8>> {
         }
     }
     out
+}
+
+/// PX4 tables as `ulog2csv` writes them (local position at 10 Hz, battery at 5 Hz, attitude at
+/// 20 Hz, a 2 s climb and turn), joined by [`TABLE_SEPARATOR`]; and the same with a missing
+/// battery current and a `nan` row.
+pub fn px4_csv() -> Vec<Vec<u8>> {
+    let mut position = String::from("timestamp,x,y,z,vx,vy,vz,ax,ay,az\n");
+    for k in 0..20 {
+        let t = f64::from(k) * 0.1;
+        position += &format!(
+            "{},{:.3},{:.3},{:.3},2.0,1.0,-0.5,0.1,0,0\n",
+            1_000_000 + k * 100_000,
+            2.0 * t,
+            t,
+            -0.5 * t
+        );
+    }
+    let mut battery = String::from("timestamp,voltage_v,current_a,remaining\n");
+    for k in 0..10 {
+        battery += &format!(
+            "{},{:.2},{:.1},0.9\n",
+            1_000_000 + k * 200_000,
+            16.4 - 0.01 * f64::from(k),
+            12.0 + 0.1 * f64::from(k)
+        );
+    }
+    let mut attitude = String::from("timestamp,q[0],q[1],q[2],q[3]\n");
+    for k in 0..40 {
+        let yaw = 0.01 * f64::from(k);
+        attitude += &format!(
+            "{},{:.6},0,0,{:.6}\n",
+            1_000_000 + k * 50_000,
+            (yaw / 2.0).cos(),
+            (yaw / 2.0).sin()
+        );
+    }
+    let join = |tables: [&str; 3]| -> Vec<u8> {
+        let mut out = Vec::new();
+        for (k, t) in tables.iter().enumerate() {
+            if k > 0 {
+                out.extend_from_slice(TABLE_SEPARATOR);
+            }
+            out.extend_from_slice(t.as_bytes());
+        }
+        out
+    };
+    let gappy_battery = battery
+        .replacen(",12.3,", ",nan,", 1)
+        .replacen(",16.36,", ",,", 1);
+    vec![
+        join([&position, &battery, &attitude]),
+        join([&position, &gappy_battery, &attitude]),
+    ]
 }
 
 /// `fixtures/logs/*.mcap`; the CSV logs converted by `aloft convert` (zstd chunks, JSON
@@ -265,6 +318,7 @@ mod tests {
         assert_eq!(missions_json().len(), 2 * missions_toml().len());
         assert!(log_csv().len() >= 5);
         assert!(column_map().len() >= 4);
+        assert_eq!(px4_csv().len(), 2);
         // truncated.mcap, two converted logs and their two re-encodings, ROS 2, mission.
         assert_eq!(mcap().len(), 1 + 2 * 3 + 1 + 1);
         crate::targets::remove_scratch();

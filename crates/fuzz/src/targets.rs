@@ -83,6 +83,14 @@ pub const TARGETS: &[Target] = &[
         run: column_map,
     },
     Target {
+        name: "px4-csv",
+        about: "log_info of PX4 ulog2csv tables (local position, battery, attitude; input: the \
+                three tables between separator lines), recognised by their names",
+        format: Format::Text,
+        seeds: seeds::px4_csv,
+        run: px4_csv,
+    },
+    Target {
         name: "mcap",
         about: "log_info of an MCAP log (options varied by input), a lag search on every 4th",
         format: Format::Mcap,
@@ -98,6 +106,13 @@ pub fn target(name: &str) -> Option<&'static Target> {
 
 /// The line between the column map and the CSV log in an input of the `column-map` target.
 pub const MAP_SEPARATOR: &[u8] = b"\n#--- csv ---\n";
+
+/// The lag search window of `log info --lag` on every 4th log input, s (the seeds are 0.5 to 2 s
+/// long, and a search needs a log of twice its window).
+pub const LAG_WINDOW_S: f64 = 0.2;
+
+/// The line between the tables of an input of the `px4-csv` target.
+pub const TABLE_SEPARATOR: &[u8] = b"\n#--- table ---\n";
 
 /// Most steps one fuzzed flight is planned with: a longer mission is planned with a coarser time
 /// step (duration / this), so that one input stays fast.
@@ -285,7 +300,7 @@ fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, lag: Option<f64>
 fn log_csv(data: &[u8]) -> Outcome {
     let path = write_scratch("log.csv", data);
     let h = fnv1a(data);
-    let lag = (h % 4 == 0).then_some(5.0);
+    let lag = (h % 4 == 0).then_some(LAG_WINDOW_S);
     let mut options = LogReadOptions::default();
     let mut o = Outcome::default();
     let first = log_info(&path, &options, lag);
@@ -348,9 +363,40 @@ fn column_map(data: &[u8]) -> Outcome {
         profile: Some(map_path.display().to_string()),
         ..LogReadOptions::default()
     };
-    let lag = (fnv1a(data) % 4 == 0).then_some(5.0);
+    let lag = (fnv1a(data) % 4 == 0).then_some(LAG_WINDOW_S);
     let mut o = Outcome::default();
     o.accepted = info(&mut o, &csv_path, &options, lag);
+    o
+}
+
+/// The parts of `data` between `separator`s.
+fn split<'a>(data: &'a [u8], separator: &[u8]) -> Vec<&'a [u8]> {
+    let mut parts = Vec::new();
+    let mut rest = data;
+    while let Some(k) = rest.windows(separator.len()).position(|w| w == separator) {
+        parts.push(&rest[..k]);
+        rest = &rest[k + separator.len()..];
+    }
+    parts.push(rest);
+    parts
+}
+
+fn px4_csv(data: &[u8]) -> Outcome {
+    let parts = split(data, TABLE_SEPARATOR);
+    let mut first = PathBuf::new();
+    for (k, topic) in aloft_logs::px4::PX4_TOPICS.iter().enumerate() {
+        // A table the input does not have (its separator was mutated away) is empty.
+        let path = write_scratch(
+            &format!("flight_{topic}_0.csv"),
+            parts.get(k).copied().unwrap_or_default(),
+        );
+        if k == 0 {
+            first = path;
+        }
+    }
+    let lag = (fnv1a(data) % 4 == 0).then_some(LAG_WINDOW_S);
+    let mut o = Outcome::default();
+    o.accepted = info(&mut o, &first, &LogReadOptions::default(), lag);
     o
 }
 
@@ -367,7 +413,7 @@ fn mcap(data: &[u8]) -> Outcome {
         },
         ..LogReadOptions::default()
     };
-    let lag = (h % 4 == 0).then_some(5.0);
+    let lag = (h % 4 == 0).then_some(LAG_WINDOW_S);
     let mut o = Outcome::default();
     o.accepted = info(&mut o, &path, &options, lag);
     o
