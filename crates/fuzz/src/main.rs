@@ -40,7 +40,8 @@ struct Args {
     /// Where findings are written (default: fixtures/fuzz of the repository).
     #[arg(long)]
     findings: Option<PathBuf>,
-    /// Where notes (answers the engine refused as not finite) are written (default: not written).
+    /// Where notes (answers the engine refused as not finite) and each target's slowest input
+    /// (`<target>/slowest.input`) are written (default: not written).
     #[arg(long)]
     notes: Option<PathBuf>,
     /// Seconds between progress lines on stderr (0: none).
@@ -149,6 +150,12 @@ fn main() -> ExitCode {
             s.slowest_s,
             args.seed
         );
+        if let Some(dir) = &args.notes {
+            // The slowest input, for a look at what takes long.
+            let d = dir.join(s.target);
+            let _ = std::fs::create_dir_all(&d)
+                .and_then(|()| std::fs::write(d.join("slowest.input"), &s.slowest));
+        }
         if args.verbose {
             for (line, n) in &s.top_refusals {
                 eprintln!("aloft-fuzz: {}: {n} x {line}", s.target);

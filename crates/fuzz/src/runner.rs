@@ -317,6 +317,8 @@ pub struct RunStats {
     pub notes: Vec<Finding>,
     /// Slowest input, s.
     pub slowest_s: f64,
+    /// The slowest input.
+    pub slowest: Vec<u8>,
     /// The most frequent refusals (message without numbers and quotes) and their counts.
     pub top_refusals: Vec<(String, u64)>,
 }
@@ -471,6 +473,7 @@ pub fn fuzz(session: &Session, target: &Target, run: &Run) -> RunStats {
         note_inputs: 0,
         notes: Vec::new(),
         slowest_s: 0.0,
+        slowest: Vec::new(),
         top_refusals: Vec::new(),
     };
     let mut last_progress = Instant::now();
@@ -486,7 +489,10 @@ pub fn fuzz(session: &Session, target: &Target, run: &Run) -> RunStats {
         k += 1;
         let report = session.run(target, &input);
         stats.inputs += 1;
-        stats.slowest_s = stats.slowest_s.max(report.elapsed.as_secs_f64());
+        if report.elapsed.as_secs_f64() > stats.slowest_s {
+            stats.slowest_s = report.elapsed.as_secs_f64();
+            stats.slowest = input.clone();
+        }
         match report.outcome.as_ref() {
             Some(o) if o.accepted => stats.accepted += 1,
             Some(o) => {
