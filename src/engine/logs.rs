@@ -429,9 +429,10 @@ fn lag_of(
     let dt = nominal_period_s.unwrap_or(0.1);
     let (t0p, pu) = resample_uniform(&s.power_t, &s.power_w, dt)?;
     let (t0v, vu) = resample_uniform(&s.speed_t, &s.speed_mps, dt)?;
-    // Align both grids on their common span.
-    let off_p = ((t0v - t0p) / dt).round().max(0.0) as usize;
-    let off_v = ((t0p - t0v) / dt).round().max(0.0) as usize;
+    // Align both grids on their common span (none when one series ends before the other
+    // starts: the offsets are then clamped to the grids and no sample is left to correlate).
+    let off_p = (((t0v - t0p) / dt).round().max(0.0) as usize).min(pu.len());
+    let off_v = (((t0p - t0v) / dt).round().max(0.0) as usize).min(vu.len());
     let n = pu
         .len()
         .saturating_sub(off_p)
@@ -604,5 +605,35 @@ impl FlightLogs {
             out.push((flight, log));
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regression (found by aloft-fuzz on an MCAP log): power and velocity series that do not
+    /// overlap in time (the power ends before the velocity starts) made the grid offset exceed
+    /// the power grid, and `log info --lag` panicked slicing it. It is now an error.
+    #[test]
+    fn a_lag_search_on_series_that_do_not_overlap_is_an_error() {
+        let s = LagSeries {
+            power_t: (0..5).map(f64::from).collect(),
+            power_w: vec![100.0; 5],
+            speed_t: (40..50).map(f64::from).collect(),
+            speed_mps: vec![3.0; 10],
+            full_at_s: None,
+        };
+        let e = lag_of("log.mcap", &s, Some(1.0), 5.0).unwrap_err();
+        assert!(e.to_string().contains("lag"), "{e}");
+        // And the other way round.
+        let s = LagSeries {
+            power_t: s.speed_t.clone(),
+            power_w: vec![100.0; 10],
+            speed_t: (0..5).map(f64::from).collect(),
+            speed_mps: vec![3.0; 5],
+            full_at_s: None,
+        };
+        assert!(lag_of("log.mcap", &s, Some(1.0), 5.0).is_err());
     }
 }

@@ -69,9 +69,15 @@ impl std::fmt::Display for Num {
 /// the problem in one line (`TOML parse error at line 3, column 11: invalid type: string "a",
 /// expected f64`).
 ///
+/// Control characters left inside the line (a carriage return, a vertical tab or a form feed
+/// that a message quotes from its input: a column name, a key, a topic) are written as escapes
+/// (`\r`, `\u{b}`), as are the Unicode line and paragraph separators, so that the message stays
+/// one line on a terminal and for any reader that splits lines; a tab is kept.
+///
 /// ```
 /// let text = "TOML parse error at line 2, column 8\n  |\n2 | kind = 1\n  |        ^\ninvalid type";
 /// assert_eq!(aloft_core::one_line(text), "TOML parse error at line 2, column 8: invalid type");
+/// assert_eq!(aloft_core::one_line("column 'a\rb\u{b}c'"), "column 'a\\rb\\u{b}c'");
 /// ```
 pub fn one_line(message: &str) -> String {
     let snippet = |l: &str| {
@@ -79,10 +85,44 @@ pub fn one_line(message: &str) -> String {
         let gutter = t.trim_start_matches(|c: char| c.is_ascii_digit());
         gutter.trim_start().starts_with('|')
     };
-    message
+    let joined = message
         .lines()
         .map(str::trim)
         .filter(|l| !l.is_empty() && !snippet(l))
         .collect::<Vec<_>>()
-        .join(": ")
+        .join(": ");
+    let escaped = |c: char| (c.is_control() && c != '\t') || matches!(c, '\u{2028}' | '\u{2029}');
+    if !joined.chars().any(escaped) {
+        return joined;
+    }
+    let mut out = String::with_capacity(joined.len() + 8);
+    for c in joined.chars() {
+        if escaped(c) {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod one_line_tests {
+    use super::one_line;
+
+    /// Regression (found by aloft-fuzz): a carriage return, vertical tab or form feed quoted
+    /// from the input (a CSV header, an unknown TOML or JSON key, an MCAP topic) was printed as
+    /// is, so the one-line error of the CLI broke into several lines on a terminal.
+    #[test]
+    fn quoted_control_characters_do_not_break_the_line() {
+        let m = one_line("missing column (found: a\u{b}b,c\rd)\nunknown field `pro\u{c}ile`");
+        assert_eq!(
+            m,
+            "missing column (found: a\\u{b}b,c\\rd): unknown field `pro\\u{c}ile`"
+        );
+        assert!(!m.chars().any(char::is_control));
+        assert_eq!(one_line("x\u{2028}y\u{85}z\0"), "x\\u{2028}y\\u{85}z\\u{0}");
+        // Tabs and ordinary text are kept.
+        assert_eq!(one_line("a\tb: c"), "a\tb: c");
+    }
 }

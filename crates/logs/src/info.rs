@@ -19,10 +19,13 @@ pub struct ChannelStats {
 }
 
 impl ChannelStats {
-    /// Mean rate, Hz (`None` below two samples or with no time span).
+    /// Mean rate, Hz (`None` below two samples, with no time span, or with a span so short that
+    /// the rate is not a finite number: a subnormal one, 1e-311 s).
     pub fn rate_hz(&self) -> Option<f64> {
         let span = self.last_s - self.first_s;
-        (self.samples > 1 && span > 0.0).then(|| (self.samples - 1) as f64 / span)
+        (self.samples > 1 && span > 0.0)
+            .then(|| (self.samples - 1) as f64 / span)
+            .filter(|r| r.is_finite())
     }
 }
 
@@ -143,6 +146,22 @@ impl InfoAccumulator {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Regression (found by aloft-fuzz): two rows 2.2e-308 ms apart (a span of 2.2e-311 s) gave a
+    /// rate of inf Hz, and `aloft log info` refused the log as a non-finite answer. The rate is
+    /// left out instead.
+    #[test]
+    fn a_subnormal_time_span_has_no_rate() {
+        let c = ChannelStats {
+            channel: Channel::Voltage,
+            samples: 2,
+            first_s: 0.0,
+            last_s: 1e-311,
+        };
+        assert_eq!(c.rate_hz(), None);
+        let c = ChannelStats { last_s: 0.5, ..c };
+        assert_eq!(c.rate_hz(), Some(2.0));
+    }
 
     #[test]
     fn energy_of_constant_power() {

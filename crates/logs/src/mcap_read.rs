@@ -221,11 +221,15 @@ impl ChunkRecords {
             }
         }
         // No record inside can be longer than the chunk's records, compressed or not (the
-        // header's own length is checked against the limit too: never below it).
+        // header's own length is checked against the limit too: never below it), nor than
+        // RECORD_LIMIT: an uncompressed chunk's declared size is not checked above, and a
+        // corrupt one (u64::MAX) must not lift the limit, or a record length near u64::MAX
+        // overflows in the `mcap` reader (a panic, found by aloft-fuzz).
         let limit = header
             .uncompressed_size
             .max(compressed)
-            .max(MIN_CHUNK_LIMIT) as usize;
+            .max(MIN_CHUNK_LIMIT)
+            .min(RECORD_LIMIT as u64) as usize;
         let mut reader = LinearReader::new_with_options(
             LinearReaderOptions::default()
                 .with_skip_start_magic(true)

@@ -396,13 +396,23 @@ pub fn decode_json(
     Ok(Decoded { stamp_s, sample })
 }
 
-/// `aloft.BatteryState` (SI field names, current positive while discharging, optional power) or
-/// `sensor_msgs/BatteryState` field names with the ROS sign.
+/// The fields of `aloft.BatteryState`, each optional: aloft's writer leaves out what the log did
+/// not have (a row with current but no voltage).
+const ALOFT_BATTERY_KEYS: [&str; 4] = ["voltage_v", "current_a", "power_w", "charge_ah"];
+
+/// `aloft.BatteryState` (SI field names, every one optional, current positive while
+/// discharging) or `sensor_msgs/BatteryState` field names with the ROS sign.
 fn json_battery_state(v: &Value, opts: RosDecodeOptions) -> Result<Sample, String> {
-    if v.get("voltage_v").is_none() {
+    if !ALOFT_BATTERY_KEYS.iter().any(|k| v.get(k).is_some()) {
         return json_battery_fields(v, ["voltage", "current", "charge"], opts, true);
     }
-    let mut s = json_battery_fields(v, ["voltage_v", "current_a", "charge_ah"], opts, false)?;
+    let mut s = battery(
+        optional_num(v, "voltage_v")?,
+        optional_num(v, "current_a")?,
+        optional_num(v, "charge_ah")?,
+        opts,
+        false,
+    );
     s.power_w = finite(optional_num(v, "power_w")?);
     Ok(s)
 }
@@ -627,6 +637,32 @@ mod tests {
         .unwrap_err();
         assert!(e.contains("current"), "{e}");
         assert!(decode_json(MessageKind::BatteryState, b"{", RosDecodeOptions::default()).is_err());
+    }
+
+    /// Regression (found by aloft-fuzz): `aloft convert` of a log row with current but no
+    /// voltage (a `nan` in the voltage column) wrote an `aloft.BatteryState` without `voltage_v`,
+    /// which this decoder refused ("missing field 'voltage'"): aloft could not read the MCAP it
+    /// wrote. Every field of aloft's battery message is optional.
+    #[test]
+    fn aloft_battery_messages_may_leave_out_any_field() {
+        let opts = RosDecodeOptions::default();
+        let d = decode_json(
+            MessageKind::BatteryState,
+            br#"{"time_s":0.7,"current_a":25.0}"#,
+            opts,
+        )
+        .unwrap();
+        assert_eq!((d.sample.voltage_v, d.sample.current_a), (None, Some(25.0)));
+        let d = decode_json(
+            MessageKind::BatteryState,
+            br#"{"time_s":0.7,"voltage_v":47.9,"charge_ah":11.9}"#,
+            opts,
+        )
+        .unwrap();
+        assert_eq!((d.sample.voltage_v, d.sample.current_a), (Some(47.9), None));
+        assert_eq!(d.sample.charge_ah, Some(11.9));
+        let d = decode_json(MessageKind::BatteryState, br#"{"power_w":100.5}"#, opts).unwrap();
+        assert_eq!(d.sample.power_w, Some(100.5));
     }
 
     #[test]

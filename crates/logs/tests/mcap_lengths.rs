@@ -588,6 +588,33 @@ fn record_lengths_inside_chunks_beyond_the_chunk_are_errors() {
     assert!(seen > 20, "{seen}");
 }
 
+/// Regression (found by aloft-fuzz): an uncompressed chunk declaring an uncompressed size of
+/// u64::MAX lifted the record length limit of its reader to usize::MAX, and a record inside it
+/// claiming u64::MAX - 1 bytes overflowed in the `mcap` reader (a panic, in debug and release).
+#[test]
+fn an_uncompressed_chunk_of_declared_size_u64_max_does_not_lift_the_record_limit() {
+    let base = ros2_mcap(true);
+    let chunk = file_records(&base)
+        .into_iter()
+        .find(|r| r.op == mcap::records::op::CHUNK)
+        .unwrap();
+    let (uncompressed, _, compressed, start) = chunk_fields(&base, &chunk);
+    let end = start + u64_at(&base, compressed) as usize;
+    let inner = records_in(&base, start, end);
+    assert!(inner.len() > 2);
+    for r in &inner {
+        for claimed in [u64::MAX, u64::MAX - 1, u64::MAX - 8, 1 << 63] {
+            let mut c = base.clone();
+            put_u64(&mut c, uncompressed, u64::MAX);
+            put_u64(&mut c, r.at + 1, claimed);
+            expect_error(
+                &c,
+                &format!("record {:#04x} at {} claims {claimed}", r.op, r.at),
+            );
+        }
+    }
+}
+
 #[test]
 fn every_flipped_byte_is_an_error_or_a_read_within_the_bound() {
     // Every third byte (length fields are 4 or 8 bytes wide, so each is hit), to keep the test

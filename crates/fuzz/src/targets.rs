@@ -1,0 +1,420 @@
+//! The table of fuzz targets: one entry per parser, each calling the engine as the command line
+//! does and computing the answer the command line would print.
+//!
+//! A new parser (a QGroundControl `.plan` reader, PX4 ULog, ArduPilot DataFlash) joins by one more
+//! [`Target`] in [`TARGETS`]: a name, its format, a function that gives its seeds and a function
+//! that runs one input and returns the [`Outcome`].
+
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use aloft::engine::{
+    convert_log, endurance, hover, log_info, plan_mission, power_csv, power_model, power_point,
+    EnduranceOptions, HoverRequest, LogReadOptions, Mission, MissionOptions, PowerQuery, Vehicle,
+};
+use aloft::power::{ModelOptions, PowerModel};
+use aloft_planner::Aircraft;
+
+use crate::check::{Outcome, Problem};
+use crate::mutate::Format;
+use crate::rng::fnv1a;
+use crate::seeds;
+
+/// One parser under fuzzing.
+#[derive(Debug, Clone, Copy)]
+pub struct Target {
+    /// Name on the command line and directory of its findings (`fixtures/fuzz/<name>/`).
+    pub name: &'static str,
+    /// What it runs, in words.
+    pub about: &'static str,
+    /// The kind of bytes it reads (which structure-aware mutations apply).
+    pub format: Format,
+    /// Its seeds: fixtures of the repository and inputs made by aloft itself.
+    pub seeds: fn() -> Vec<Vec<u8>>,
+    /// Run one input.
+    pub run: fn(&[u8]) -> Outcome,
+}
+
+/// Every target.
+pub const TARGETS: &[Target] = &[
+    Target {
+        name: "vehicle-toml",
+        about: "Vehicle::from_toml, then power_point at hover and in forward flight, hover \
+                (propulsion), endurance on every 8th input",
+        format: Format::Text,
+        seeds: seeds::vehicles,
+        run: vehicle_toml,
+    },
+    Target {
+        name: "mission-toml",
+        about: "Mission::from_toml, then compile and plan_mission with dji-m100",
+        format: Format::Text,
+        seeds: seeds::missions_toml,
+        run: mission_toml,
+    },
+    Target {
+        name: "mission-json",
+        about: "Mission::from_json, then compile and plan_mission with dji-m100",
+        format: Format::Text,
+        seeds: seeds::missions_json,
+        run: mission_json,
+    },
+    Target {
+        name: "power-csv",
+        about: "power_csv with the dji-m100 power model (aloft power --states)",
+        format: Format::Text,
+        seeds: seeds::power_csv,
+        run: power_csv_target,
+    },
+    Target {
+        name: "log-csv",
+        about: "log_info of a CSV log (layout recognised, else the kaist profile), a lag search \
+                on every 4th input, convert_log and log_info of the MCAP on every 8th",
+        format: Format::Text,
+        seeds: seeds::log_csv,
+        run: log_csv,
+    },
+    Target {
+        name: "column-map",
+        about: "log_info of a CSV log through a column-map TOML (input: map, separator line, CSV)",
+        format: Format::Text,
+        seeds: seeds::column_map,
+        run: column_map,
+    },
+    Target {
+        name: "px4-csv",
+        about: "log_info of PX4 ulog2csv tables (local position, battery, attitude; input: the \
+                three tables between separator lines), recognised by their names",
+        format: Format::Text,
+        seeds: seeds::px4_csv,
+        run: px4_csv,
+    },
+    Target {
+        name: "mcap",
+        about: "log_info of an MCAP log (options varied by input), a lag search on every 4th",
+        format: Format::Mcap,
+        seeds: seeds::mcap,
+        run: mcap,
+    },
+];
+
+/// A target by name.
+pub fn target(name: &str) -> Option<&'static Target> {
+    TARGETS.iter().find(|t| t.name == name)
+}
+
+/// The line between the column map and the CSV log in an input of the `column-map` target.
+pub const MAP_SEPARATOR: &[u8] = b"\n#--- csv ---\n";
+
+/// The lag search window of `log info --lag` on every 4th log input, s (the seeds are 0.5 to 2 s
+/// long, and a search needs a log of twice its window).
+pub const LAG_WINDOW_S: f64 = 0.2;
+
+/// The line between the tables of an input of the `px4-csv` target.
+pub const TABLE_SEPARATOR: &[u8] = b"\n#--- table ---\n";
+
+/// Most steps one fuzzed flight is planned with: a longer mission is planned with a coarser time
+/// step (duration / this), so that one input stays fast.
+pub const MAX_PLAN_STEPS: f64 = 2_000.0;
+
+thread_local! {
+    static SCRATCH: RefCell<Option<PathBuf>> = const { RefCell::new(None) };
+}
+
+/// A file in this thread's scratch directory (on tmpfs, `/dev/shm`, when there is one): the
+/// engine's log readers take paths, so an input is written there and read back.
+pub fn scratch(name: &str) -> PathBuf {
+    SCRATCH.with(|s| {
+        let mut s = s.borrow_mut();
+        let dir = s.get_or_insert_with(|| {
+            static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            let base = if Path::new("/dev/shm").is_dir() {
+                PathBuf::from("/dev/shm")
+            } else {
+                std::env::temp_dir()
+            };
+            let dir = base.join(format!("aloft-fuzz-{}-{n}", std::process::id()));
+            let _ = std::fs::create_dir_all(&dir);
+            dir
+        });
+        dir.join(name)
+    })
+}
+
+/// Remove this thread's scratch directory.
+pub fn remove_scratch() {
+    SCRATCH.with(|s| {
+        if let Some(dir) = s.borrow_mut().take() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    });
+}
+
+fn write_scratch(name: &str, data: &[u8]) -> PathBuf {
+    let path = scratch(name);
+    // A failed write shows up as the engine's read error, which is checked like any other.
+    let _ = std::fs::write(&path, data);
+    path
+}
+
+/// The vehicle missions and power batches are run with.
+fn m100() -> &'static Vehicle {
+    static V: OnceLock<Vehicle> = OnceLock::new();
+    V.get_or_init(|| Vehicle::builtin("dji-m100").expect("dji-m100 is built in"))
+}
+
+fn accepted() -> Outcome {
+    Outcome {
+        accepted: true,
+        ..Outcome::default()
+    }
+}
+
+fn vehicle_toml(data: &[u8]) -> Outcome {
+    let text = String::from_utf8_lossy(data);
+    let v = match Vehicle::from_toml(&text, "fuzz-vehicle.toml") {
+        Ok(v) => v,
+        Err(e) => return Outcome::refused("vehicle", &e),
+    };
+    let mut o = accepted();
+    o.step("power at hover", &power_point(&v, &PowerQuery::default()));
+    let forward = PowerQuery {
+        airspeed_mps: 12.0,
+        pitch_deg: -10.0,
+        climb_rate_mps: 1.0,
+        gradient: true,
+        ..PowerQuery::default()
+    };
+    o.step("power in forward flight", &power_point(&v, &forward));
+    o.step("hover", &hover(&v, HoverRequest::Payload(0.0)));
+    if fnv1a(data) % 8 == 0 {
+        o.step("endurance", &endurance(&v, &EnduranceOptions::default()));
+    }
+    o
+}
+
+fn mission_toml(data: &[u8]) -> Outcome {
+    let text = String::from_utf8_lossy(data);
+    mission(Mission::from_toml(&text, "fuzz-mission.toml"))
+}
+
+fn mission_json(data: &[u8]) -> Outcome {
+    let text = String::from_utf8_lossy(data);
+    mission(Mission::from_json(&text, "fuzz-mission.json"))
+}
+
+/// A parsed mission: compiled for dji-m100, planned (with a coarser step when it would take
+/// more than [`MAX_PLAN_STEPS`]), and, when it plans, its JSON read back to the same mission.
+fn mission(parsed: Result<Mission, aloft::Error>) -> Outcome {
+    let m = match parsed {
+        Ok(m) => m,
+        Err(e) => return Outcome::refused("mission", &e),
+    };
+    let mut o = accepted();
+    let v = m100();
+    let mut options = MissionOptions::default();
+    if let Some(duration_s) = compiled_duration_s(&m) {
+        let step_s = m.spec().time_step_s.unwrap_or(0.1);
+        if step_s > 0.0 && step_s.is_finite() && duration_s / step_s > MAX_PLAN_STEPS {
+            options.time_step_s = Some((duration_s / MAX_PLAN_STEPS).max(1.0));
+        }
+    }
+    // A mission that does not compile is refused by the engine at the same step (cheaply).
+    match plan_mission(v, &m, &options) {
+        Ok(plan) => {
+            o.json("mission", plan.summary());
+            round_trip(&m, &mut o);
+        }
+        Err(e) => o.refuse("plan", &e),
+    }
+    o
+}
+
+/// The duration of the mission compiled for dji-m100 and its default pack, if it compiles.
+fn compiled_duration_s(m: &Mission) -> Option<f64> {
+    static AIRCRAFT: OnceLock<Option<(Aircraft, f64)>> = OnceLock::new();
+    let (aircraft, pack_kg) = AIRCRAFT
+        .get_or_init(|| {
+            let v = m100();
+            let (a, _) = v.file().aircraft(ModelOptions::default()).ok()?;
+            Some((a, v.battery(None).ok()?.mass_kg()))
+        })
+        .as_ref()?;
+    let c = m.spec().compile(aircraft.airframe(), *pack_kg, None).ok()?;
+    Some(c.duration_s())
+}
+
+/// A mission that plans survives its JSON (what a ground station sends back) unchanged.
+fn round_trip(m: &Mission, o: &mut Outcome) {
+    let back = m.to_json().and_then(|j| Mission::from_json(&j, m.origin()));
+    match back {
+        Ok(b) if &b == m => {}
+        Ok(_) => o.broken.push(Problem {
+            check: "json-round-trip",
+            detail: "the mission read back from its JSON differs".into(),
+        }),
+        Err(e) => o.broken.push(Problem {
+            check: "json-round-trip",
+            detail: format!(
+                "its JSON does not read back: {}",
+                crate::check::cli_line(&e)
+            ),
+        }),
+    }
+}
+
+fn power_csv_target(data: &[u8]) -> Outcome {
+    static MODEL: OnceLock<PowerModel> = OnceLock::new();
+    let model = MODEL.get_or_init(|| power_model(m100(), &[], None).expect("dji-m100 has a model"));
+    let mut out = Vec::new();
+    match power_csv(model, data, &mut out, "fuzz-states.csv") {
+        Ok(_) => {
+            let mut o = accepted();
+            o.answers.push(crate::check::Answer::Csv {
+                what: "power csv",
+                text: String::from_utf8_lossy(&out).into_owned(),
+                computed: aloft::engine::POWER_KEYS.len(),
+            });
+            o
+        }
+        Err(e) => Outcome::refused("power csv", &e),
+    }
+}
+
+/// `log_info` of `path` (and the lag search when `lag`), as `aloft log info`.
+fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, lag: Option<f64>) -> bool {
+    match log_info(path, options, lag) {
+        Ok(i) => {
+            o.json("log info", &i);
+            true
+        }
+        Err(e) => {
+            o.refuse("log info", &e);
+            false
+        }
+    }
+}
+
+fn log_csv(data: &[u8]) -> Outcome {
+    let path = write_scratch("log.csv", data);
+    let h = fnv1a(data);
+    let lag = (h % 4 == 0).then_some(LAG_WINDOW_S);
+    let mut options = LogReadOptions::default();
+    let mut o = Outcome::default();
+    let first = log_info(&path, &options, lag);
+    let unrecognised = matches!(&first, Err(e) if e.to_string().contains("layout not recognised"));
+    if unrecognised {
+        options.profile = Some("kaist".into());
+        o.accepted = info(&mut o, &path, &options, lag);
+    } else {
+        o.step("log info", &first);
+        o.accepted = first.is_ok();
+    }
+    if o.accepted && h % 8 == 1 {
+        convert_and_read_back(&mut o, &path, &options);
+    }
+    o
+}
+
+/// `aloft convert` of an accepted log, and `log info` of the MCAP it wrote: aloft reads what it
+/// writes, with the same number of samples.
+fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions) {
+    let out = scratch("converted.mcap");
+    match convert_log(path, options, &out) {
+        Ok(c) => {
+            o.json("convert", &c);
+            let source = log_info(path, options, None).map(|i| i.duration_s);
+            match (log_info(&out, &LogReadOptions::default(), None), source) {
+                (Ok(i), Ok(d)) if (i.duration_s - d).abs() <= 1e-6 * d.abs().max(1.0) => {
+                    o.json("log info of the MCAP", &i);
+                }
+                (Ok(i), Ok(d)) => o.broken.push(Problem {
+                    check: "mcap-round-trip",
+                    detail: format!("{d} s converted, {} s read back", i.duration_s),
+                }),
+                (Err(e), _) => o.broken.push(Problem {
+                    check: "mcap-round-trip",
+                    detail: format!(
+                        "aloft cannot read the MCAP it wrote: {}",
+                        crate::check::cli_line(&e)
+                    ),
+                }),
+                (_, Err(e)) => o.refuse("log info", &e),
+            }
+        }
+        // An empty log is refused by convert; anything else is checked as a refusal.
+        Err(e) => o.refuse("convert", &e),
+    }
+}
+
+fn column_map(data: &[u8]) -> Outcome {
+    let (map, csv) = match data
+        .windows(MAP_SEPARATOR.len())
+        .position(|w| w == MAP_SEPARATOR)
+    {
+        Some(k) => (&data[..k], &data[k + MAP_SEPARATOR.len()..]),
+        None => (data, seeds::CUSTOM_CSV),
+    };
+    let map_path = write_scratch("map.toml", map);
+    let csv_path = write_scratch("mapped.csv", csv);
+    let options = LogReadOptions {
+        profile: Some(map_path.display().to_string()),
+        ..LogReadOptions::default()
+    };
+    let lag = (fnv1a(data) % 4 == 0).then_some(LAG_WINDOW_S);
+    let mut o = Outcome::default();
+    o.accepted = info(&mut o, &csv_path, &options, lag);
+    o
+}
+
+/// The parts of `data` between `separator`s.
+fn split<'a>(data: &'a [u8], separator: &[u8]) -> Vec<&'a [u8]> {
+    let mut parts = Vec::new();
+    let mut rest = data;
+    while let Some(k) = rest.windows(separator.len()).position(|w| w == separator) {
+        parts.push(&rest[..k]);
+        rest = &rest[k + separator.len()..];
+    }
+    parts.push(rest);
+    parts
+}
+
+fn px4_csv(data: &[u8]) -> Outcome {
+    let parts = split(data, TABLE_SEPARATOR);
+    let mut first = PathBuf::new();
+    for (k, topic) in aloft_logs::px4::PX4_TOPICS.iter().enumerate() {
+        // A table the input does not have (its separator was mutated away) is empty.
+        let path = write_scratch(
+            &format!("flight_{topic}_0.csv"),
+            parts.get(k).copied().unwrap_or_default(),
+        );
+        if k == 0 {
+            first = path;
+        }
+    }
+    let lag = (fnv1a(data) % 4 == 0).then_some(LAG_WINDOW_S);
+    let mut o = Outcome::default();
+    o.accepted = info(&mut o, &first, &LogReadOptions::default(), lag);
+    o
+}
+
+fn mcap(data: &[u8]) -> Outcome {
+    let path = write_scratch("log.mcap", data);
+    let h = fnv1a(data);
+    let options = LogReadOptions {
+        header_time: h & 2 != 0,
+        battery_current_positive: h & 4 != 0,
+        topics: if h % 16 == 3 {
+            vec!["/battery".into(), "/vehicle/pose".into()]
+        } else {
+            Vec::new()
+        },
+        ..LogReadOptions::default()
+    };
+    let lag = (h % 4 == 0).then_some(LAG_WINDOW_S);
+    let mut o = Outcome::default();
+    o.accepted = info(&mut o, &path, &options, lag);
+    o
+}
