@@ -250,7 +250,8 @@ fn compiled_duration_s(m: &Mission) -> Option<f64> {
 fn round_trip(m: &Mission, o: &mut Outcome) {
     let back = m.to_json().and_then(|j| Mission::from_json(&j, m.origin()));
     match back {
-        Ok(b) if &b == m => {}
+        // The spec, not the whole mission: the route's source format says which text it was.
+        Ok(b) if b.spec() == m.spec() => {}
         Ok(_) => o.broken.push(Problem {
             check: "json-round-trip",
             detail: "the mission read back from its JSON differs".into(),
