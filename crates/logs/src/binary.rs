@@ -91,6 +91,24 @@ impl BinarySummary {
         }
     }
 
+    /// A decoder resynchronised: the bytes from `from` to `at` were skipped (`what`: "ULog
+    /// record", "DataFlash data").
+    pub(crate) fn resynchronised(&mut self, what: &str, from: u64, at: u64) {
+        let skipped = at - from;
+        self.bytes_skipped += skipped;
+        self.warn(format!(
+            "corrupt {what} at byte {from}: skipped {skipped} bytes to the next valid record at byte {at}"
+        ));
+    }
+
+    /// A decoder found no valid record in the `skipped` bytes from `from` to the end.
+    pub(crate) fn lost_to_end(&mut self, what: &str, from: u64, skipped: u64) {
+        self.bytes_skipped += skipped;
+        self.warn(format!(
+            "corrupt {what} at byte {from}: no valid record in the {skipped} bytes after it"
+        ));
+    }
+
     /// Energy of the battery records, W h, when there are at least two valid ones.
     pub fn energy_wh(&self) -> Option<f64> {
         (self.battery.valid > 1).then(|| self.battery.energy_j / aloft_core::SECONDS_PER_HOUR)

@@ -281,22 +281,17 @@ impl Framer {
             if let Some(len) = self.plausible(h) {
                 let next = w.peek_max(len + 3);
                 if next.len() == len || self.plausible(&next[len.min(next.len())..]).is_some() {
-                    let skipped = w.offset() - from;
-                    s.bytes_skipped += skipped;
-                    s.warn(format!(
-                        "corrupt DataFlash data at byte {from}: skipped {skipped} bytes to the next record at byte {}",
-                        w.offset()
-                    ));
+                    s.resynchronised("DataFlash data", from, w.offset());
                     return true;
                 }
             }
             w.consume(1);
         }
-        let skipped = w.offset() + w.remaining() as u64 - from;
-        s.bytes_skipped += skipped;
-        s.warn(format!(
-            "corrupt DataFlash data at byte {from}: no valid record in the {skipped} bytes after it"
-        ));
+        s.lost_to_end(
+            "DataFlash data",
+            from,
+            w.offset() + w.remaining() as u64 - from,
+        );
         false
     }
 

@@ -355,22 +355,17 @@ impl UlogDecoder {
                 if next.len() == len
                     || (next.len() >= len + 3 && self.plausible(&next[len..]).is_some())
                 {
-                    let skipped = w.offset() - from;
-                    s.bytes_skipped += skipped;
-                    s.warn(format!(
-                        "corrupt ULog record at byte {from}: skipped {skipped} bytes to the next valid record at byte {}",
-                        w.offset()
-                    ));
+                    s.resynchronised("ULog record", from, w.offset());
                     return true;
                 }
             }
             w.consume(1);
         }
-        let skipped = w.offset() + w.remaining() as u64 - from;
-        s.bytes_skipped += skipped;
-        s.warn(format!(
-            "corrupt ULog record at byte {from}: no valid record in the {skipped} bytes after it"
-        ));
+        s.lost_to_end(
+            "ULog record",
+            from,
+            w.offset() + w.remaining() as u64 - from,
+        );
         false
     }
 
