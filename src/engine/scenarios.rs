@@ -1010,7 +1010,10 @@ mod tests {
         assert_eq!(o.payload_kg, Some(0.5));
         let s = s.unwrap();
         assert_eq!((s.samples, s.payload_sd_kg, s.seed), (10, 0.1, 1));
-        assert_eq!(s.power_sd_percent, DEFAULT_POWER_SD_PERCENT);
+        assert_eq!(
+            s.power_sd_percent.to_bits(),
+            DEFAULT_POWER_SD_PERCENT.to_bits()
+        );
         assert!(options_from_json(r#"{"scenarios": {"sample": 10}}"#).is_err());
         assert!(options_from_json(r#"{"bogus": 1}"#).is_err());
         assert_eq!(options_from_json("{}").unwrap().1, None);
