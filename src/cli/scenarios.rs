@@ -179,6 +179,12 @@ fn verdict(plan: &Plan, u: &Uncertainty) -> String {
         u.samples,
         spreads_text(u)
     );
+    if let Some(why) = &u.cannot_fly_reason {
+        text.push_str(&format!(
+            "  {} of them cannot be flown at all; the first: {why}.\n",
+            u.cannot_fly_scenarios
+        ));
+    }
     match u.point_of_no_return_s.p5 {
         Some(t) if t <= 0.0 => text.push_str(&format!(
             "Point of no return with 95 % confidence: at take-off: in more than 5 % of the scenarios the vehicle cannot fly the route ({:.1} % do not complete it) or cannot turn back from its start.\n",

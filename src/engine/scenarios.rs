@@ -266,6 +266,12 @@ pub struct Uncertainty {
     /// Scenarios flown to the end of the route (feasible or short of the reserve): those the
     /// percentiles of energy, state of charge and duration are over.
     pub completed_scenarios: u32,
+    /// Scenarios the vehicle cannot fly (beyond its tilt, thrust or take-off mass limit, or its
+    /// propulsion chain's range): infeasible, and not flown to the end.
+    pub cannot_fly_scenarios: u32,
+    /// Why, in the first such scenario (by index).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cannot_fly_reason: Option<String>,
     /// The spreads drawn with.
     pub spreads: Spreads,
     /// Electrical energy, Wh (absent when no scenario completes the route).
@@ -572,18 +578,23 @@ struct Record {
     /// Point of no return, s: infinity when there is none, 0 when it cannot be flown.
     pnr_s: f64,
     segment_end_soc: Vec<f64>,
+    /// Why the vehicle cannot fly it, when it cannot.
+    cannot_fly: Option<String>,
 }
 
 impl Record {
-    const CANNOT_FLY: Record = Record {
-        feasible: false,
-        completed: false,
-        energy_wh: 0.0,
-        end_soc: 0.0,
-        duration_s: 0.0,
-        pnr_s: 0.0,
-        segment_end_soc: Vec::new(),
-    };
+    fn cannot_fly(e: &PlannerError) -> Self {
+        Record {
+            feasible: false,
+            completed: false,
+            energy_wh: 0.0,
+            end_soc: 0.0,
+            duration_s: 0.0,
+            pnr_s: 0.0,
+            segment_end_soc: Vec::new(),
+            cannot_fly: Some(e.to_string()),
+        }
+    }
 
     fn of(r: &MissionReport, keep_segments: bool) -> Self {
         Self {
@@ -598,6 +609,7 @@ impl Record {
             } else {
                 Vec::new()
             },
+            cannot_fly: None,
         }
     }
 }
@@ -681,7 +693,7 @@ impl<'a> MissionScenarios<'a> {
             });
         match report {
             Ok(r) => Ok(Record::of(&r, keep_segments)),
-            Err(e) if cannot_fly(&e) => Ok(Record::CANNOT_FLY),
+            Err(e) if cannot_fly(&e) => Ok(Record::cannot_fly(&e)),
             Err(e) => Err(mission_error(self.origin, self.vehicle, e)),
         }
     }
@@ -779,6 +791,11 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
         p_feasible: feasible as f64 / n as f64,
         feasible_scenarios: u32::try_from(feasible).unwrap_or(u32::MAX),
         completed_scenarios: u32::try_from(completed.len()).unwrap_or(u32::MAX),
+        cannot_fly_scenarios: u32::try_from(
+            records.iter().filter(|r| r.cannot_fly.is_some()).count(),
+        )
+        .unwrap_or(u32::MAX),
+        cannot_fly_reason: records.iter().find_map(|r| r.cannot_fly.clone()),
         spreads: sc.spreads(),
         energy_wh: of(|r| r.energy_wh),
         end_soc: of(|r| r.end_soc),
