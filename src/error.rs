@@ -191,6 +191,15 @@ pub enum Error {
         /// The parser's message (line, column and key).
         message: String,
     },
+    /// A planner file (QGroundControl `.plan`, `.waypoints`) that cannot be read or holds what
+    /// aloft does not fly; the message names the item (or row, or line) and the command or key.
+    #[error("invalid mission {origin}: {source}")]
+    MissionImport {
+        /// Where the text came from.
+        origin: String,
+        /// The importer's error.
+        source: aloft_missions::ImportError,
+    },
     /// A mission that cannot be compiled or flown by this vehicle.
     #[error("mission {origin} with {vehicle}: {source}")]
     Mission {

@@ -333,8 +333,17 @@ pub struct AblationRow {
 pub struct Calibration {
     /// Length of the calibration window, s.
     pub calibrate_s: f64,
-    /// The efficiency re-estimated from that window.
+    /// The efficiency applied after the window: the window's estimate shrunk toward the
+    /// fitted efficiency by the uncertainty of each ([`crate::recalibration`]).
     pub efficiency: f64,
+    /// The efficiency from the window alone (measured over predicted energy).
+    pub window_efficiency: f64,
+    /// Weight of the window's estimate (0: the fitted efficiency kept, 1: the window's taken
+    /// alone, as without a prior spread in the vehicle file).
+    pub window_weight: f64,
+    /// Relative standard error of the window's estimate (effective sample size of the
+    /// residuals' autocorrelation).
+    pub window_relative_sd: f64,
     /// Measured energy after the window, Wh.
     pub measured_energy_wh: f64,
     /// Predicted energy after the window, Wh.
@@ -527,8 +536,13 @@ fn calibrate(
     }
     // Electrical power is aero power / eta: rescaling by the ratio of energies over the
     // window is the least-biased re-estimate of eta from that window.
-    let scale = trapezoid_wh(&t[..split], &measured[..split])
+    let window_ratio = trapezoid_wh(&t[..split], &measured[..split])
         / trapezoid_wh(&t[..split], &predicted[..split]);
+    // Shrunk toward the fitted model by the uncertainty of each (crate::recalibration).
+    let prior = model.vehicle().params().efficiency_relative_sd;
+    let shrunk =
+        crate::recalibration::shrink(window_ratio, &measured[..split], &predicted[..split], prior);
+    let scale = shrunk.ratio;
     let efficiency = model.vehicle().efficiency() / scale;
     let rest_pred: Vec<f64> = predicted[split..].iter().map(|p| p * scale).collect();
     let rest_meas = &measured[split..];
@@ -538,6 +552,9 @@ fn calibrate(
     Ok(Calibration {
         calibrate_s: window,
         efficiency,
+        window_efficiency: model.vehicle().efficiency() / window_ratio,
+        window_weight: shrunk.window_weight,
+        window_relative_sd: shrunk.window_relative_sd,
         measured_energy_wh,
         predicted_energy_wh,
         energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),

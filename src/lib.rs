@@ -25,6 +25,7 @@
 pub mod engine;
 pub mod error;
 pub mod identify;
+pub mod recalibration;
 pub mod vehicle;
 
 pub use aloft_power as power;

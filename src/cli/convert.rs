@@ -13,7 +13,8 @@ use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
-    /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), or an MCAP file.
+    /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), an MCAP file, a
+    /// PX4 ULog (.ulg) or an ArduPilot DataFlash log (.bin).
     log: PathBuf,
     #[command(flatten)]
     read: ReadOptions,

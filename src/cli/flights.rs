@@ -12,7 +12,7 @@ use super::args::aoa_parser;
 /// The flight logs and how to align them.
 #[derive(Debug, Args)]
 pub struct FlightLogArgs {
-    /// Flight logs (CSV or MCAP).
+    /// Flight logs (CSV, MCAP, PX4 ULog or ArduPilot DataFlash).
     #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
     pub log: Vec<PathBuf>,
     /// Log layout: kaist, px4 or a column-map TOML (default: detected).
@@ -28,6 +28,9 @@ pub struct FlightLogArgs {
     /// Search window of the lag estimate, s.
     #[arg(value_parser = super::args::finite(), long, default_value_t = 10.0, value_name = "S")]
     pub max_lag: f64,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub battery_instance: u8,
 }
 
 impl FlightLogArgs {
@@ -39,6 +42,7 @@ impl FlightLogArgs {
             aoa: self.aoa,
             lag_s: self.lag,
             max_lag_s: self.max_lag,
+            battery_instance: self.battery_instance,
         }
     }
 }

@@ -41,6 +41,9 @@ pub struct ReadOptions {
     /// definition says negative; some drivers publish the opposite).
     #[arg(long)]
     pub battery_current_positive: bool,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub battery_instance: u8,
 }
 
 impl ReadOptions {
@@ -51,13 +54,15 @@ impl ReadOptions {
             topics: self.topics.clone(),
             header_time: self.header_time,
             battery_current_positive: self.battery_current_positive,
+            battery_instance: self.battery_instance,
         }
     }
 }
 
 #[derive(Debug, Args)]
 struct InfoArgs {
-    /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), or an MCAP file.
+    /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), an MCAP file, a
+    /// PX4 ULog (.ulg) or an ArduPilot DataFlash log (.bin).
     file: PathBuf,
     #[command(flatten)]
     read: ReadOptions,
@@ -89,7 +94,11 @@ fn info(args: InfoArgs) -> Result<Outcome> {
 fn write_table(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     output::write_table(out, &title(j), &summary_rows(j))?;
     write_contents(out, j)?;
-    write_time_notes(out, j)
+    write_time_notes(out, j)?;
+    for w in &j.warnings {
+        writeln!(out, "warning: {w}")?;
+    }
+    Ok(())
 }
 
 fn title(j: &LogInfo) -> String {
@@ -97,6 +106,8 @@ fn title(j: &LogInfo) -> String {
         LogFormat::Csv => "CSV",
         LogFormat::Px4Csv => "PX4 CSV tables",
         LogFormat::Mcap => "MCAP",
+        LogFormat::Px4Ulog => "PX4 ULog",
+        LogFormat::ArduPilotDataflash => "ArduPilot DataFlash",
     };
     match &j.profile {
         Some(p) => format!("{} ({fmt}, profile {p})", j.file),

@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 
 use aloft::engine::{
     plan_mission_with, AoaModel, CornerMode, Mission, MissionOptions, MissionOutputs,
-    MissionReport, Plan, Sample, Vehicle,
+    MissionReport, Plan, RouteFigures, Sample, SourceFormat, Vehicle,
 };
 
 use super::args::{aoa_parser, corners_parser, MissionWindArgs};
@@ -20,9 +20,10 @@ use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
 
 #[derive(Debug, Args)]
 pub struct MissionArgs {
-    /// Mission file: an aloft mission in TOML or JSON (see fixtures/missions/example.toml),
-    /// recognised from its content. Without it, the built-in demonstration: a survey with four
-    /// lines and an orbit in a 6 m/s breeze.
+    /// Mission file: an aloft mission in TOML or JSON (see fixtures/missions/example.toml), a
+    /// QGroundControl .plan or a Mission Planner .waypoints file (QGC WPL 110), recognised from
+    /// its content. Without it, the built-in demonstration: a survey with four lines and an
+    /// orbit in a 6 m/s breeze.
     pub mission: Option<PathBuf>,
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
@@ -265,10 +266,11 @@ pub(super) fn header(plan: &Plan) -> Result<String> {
             }
         )?;
     }
+    writeln!(head, "{}", route_line(&s.route))?;
     for n in &c.notes {
         writeln!(head, "Note: {n}")?;
     }
-    for w in &s.warnings {
+    for w in s.route.warnings.iter().chain(&s.warnings) {
         writeln!(head, "Warning: {w}")?;
     }
     writeln!(head)?;
@@ -313,6 +315,28 @@ pub(super) fn header(plan: &Plan) -> Result<String> {
         )?;
     }
     Ok(head)
+}
+
+/// The planned route in one line: the file's format, its path, climb, descent and holds, and
+/// the items of a planner file.
+fn route_line(r: &RouteFigures) -> String {
+    let format = match r.source_format {
+        SourceFormat::QgcPlan => "QGroundControl plan",
+        SourceFormat::QgcWpl => "QGC WPL 110 waypoints",
+        SourceFormat::AloftJson => "aloft JSON",
+        _ => "aloft TOML",
+    };
+    let mut line = format!(
+        "Route ({format}): {:.0} m horizontal, {:.0} m climb, {:.0} m descent, {:.0} s of holds",
+        r.horizontal_m, r.climb_m, r.descent_m, r.hold_s
+    );
+    if let Some(n) = &r.items {
+        line += &format!(
+            "; {} items: {} flown, {} speed/jump/gripper, {} free (camera, gimbal, mode), {} unknown, {} never reached",
+            n.total, n.flown, n.commands, n.free, n.unknown, n.unreachable
+        );
+    }
+    line
 }
 
 /// Batteries and sorties, when the route takes more than one pack or cannot be split.

@@ -45,7 +45,8 @@ enum Command {
     Vehicles(vehicles::VehiclesArgs),
     /// Summarise a flight log: duration, rates, channels, energy used, time-base gaps.
     Log(log::LogArgs),
-    /// Convert a flight log (CSV or MCAP) to MCAP that Foxglove displays.
+    /// Convert a flight log (CSV, MCAP, PX4 ULog, ArduPilot DataFlash) to MCAP that Foxglove
+    /// displays.
     Convert(convert::ConvertArgs),
     /// Fit the power model of a vehicle to flight logs (lag alignment, Gauss-Newton, drag from the force balance).
     Fit(fit::FitArgs),

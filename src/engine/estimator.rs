@@ -36,6 +36,8 @@ pub struct InFlightEstimator {
     predicted_j: Trapezoid,
     measured_j: Trapezoid,
     samples: usize,
+    predicted_w: Vec<f64>,
+    measured_w: Vec<f64>,
 }
 
 impl InFlightEstimator {
@@ -57,6 +59,8 @@ impl InFlightEstimator {
             predicted_j: Trapezoid::new(),
             measured_j: Trapezoid::new(),
             samples: 0,
+            predicted_w: Vec::new(),
+            measured_w: Vec::new(),
         })
     }
 
@@ -97,6 +101,8 @@ impl InFlightEstimator {
         self.predicted_j.push(time_s, predicted_w);
         self.measured_j.push(time_s, measured_w);
         self.samples += 1;
+        self.predicted_w.push(predicted_w);
+        self.measured_w.push(measured_w);
         Ok(())
     }
 
@@ -156,6 +162,29 @@ impl InFlightEstimator {
     }
 }
 
+impl InFlightEstimator {
+    /// The re-estimated efficiency shrunk toward the reference efficiency by the uncertainty of
+    /// each ([`crate::recalibration`]): `prior_relative_sd` is the vehicle file's
+    /// `efficiency_relative_sd` (`None`: the estimate of [`Self::efficiency`] alone). `None`
+    /// until two samples with energy have been added.
+    ///
+    /// # Errors
+    /// As [`Self::efficiency`].
+    pub fn shrunk_efficiency(&self, prior_relative_sd: Option<f64>) -> Result<Option<f64>, Error> {
+        let Some(eta) = self.efficiency()? else {
+            return Ok(None);
+        };
+        let ratio = self.reference_efficiency / eta;
+        let shrunk = crate::recalibration::shrink(
+            ratio,
+            &self.measured_w,
+            &self.predicted_w,
+            prior_relative_sd,
+        );
+        Ok(Some(self.reference_efficiency / shrunk.ratio))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,6 +205,12 @@ mod tests {
         let eta = est.efficiency().unwrap().unwrap();
         // Exact up to rounding: both energies use the same trapezoid.
         assert!((eta - eta0 / 1.1).abs() < 1e-12, "{eta} vs {}", eta0 / 1.1);
+        // Without a prior spread the shrunk estimate is the window's; with noise-free data the
+        // window is certain and outweighs even a tight prior.
+        let alone = est.shrunk_efficiency(None).unwrap().unwrap();
+        assert!((alone - eta).abs() < 1e-12, "{alone} vs {eta}");
+        let sure = est.shrunk_efficiency(Some(1e-3)).unwrap().unwrap();
+        assert!((sure - eta).abs() < 1e-12, "{sure} vs {eta}");
         let recal = v.with_efficiency(eta).unwrap();
         assert!((recal.efficiency().unwrap() - eta).abs() < 1e-15);
     }

@@ -8,8 +8,8 @@ use std::sync::Arc;
 use serde::Serialize;
 
 use aloft_power::fit::{
-    fit_drag_bounded, fit_power_model_bounded, DragFit, FitParameter, ForceSample, KeptParameter,
-    PowerFit,
+    fit_body_axis_drag, fit_drag_bounded, fit_power_model_bounded, BodyAxisDragFit,
+    BodyAxisRefusal, DragFit, FitParameter, ForceSample, KeptParameter, PowerFit,
 };
 use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
@@ -103,6 +103,15 @@ pub struct FitAnswer {
     /// Drag from the force balance, when fitted.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub drag: Option<DragFit>,
+    /// Body-axis quadratic drag (`mu2_x`, `mu2_y`) from the force balance, when the logs
+    /// separate the two axes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drag_body_axes: Option<BodyAxisDragFit>,
+    /// Relative standard deviation of the efficiency between the fitted logs (each log's
+    /// measured energy against the fitted model's), when there are two logs or more: written to
+    /// the vehicle file as `efficiency_relative_sd`, the prior of in-flight re-calibration.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub efficiency_relative_sd: Option<f64>,
     /// The constants fitted: the power fit's lumped constants and the force balance's drag
     /// coefficients.
     pub fitted_parameters: Vec<String>,
@@ -148,7 +157,12 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     }
     let mut notes = Vec::new();
     let mut kept = Vec::new();
-    let (drag, drag_fitted) = drag_fit(request, &forces, &mut notes, &mut kept, &mut vehicle)?;
+    let (drag, mut drag_fitted) = drag_fit(request, &forces, &mut notes, &mut kept, &mut vehicle)?;
+    let drag_body_axes = if drag.is_some() {
+        body_axis_fit(&forces, &mut kept, &mut drag_fitted, &mut vehicle)?
+    } else {
+        None
+    };
     let mut options = FitOptions::known_geometry();
     options.free = request.free.clone();
     if let Some(p) = &request.progress {
@@ -156,8 +170,10 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         options.progress = Some(Arc::new(move |i, cost| p(i, cost)));
     }
     let bounded = fit_power_model_bounded(&vehicle, &samples, &options)?;
-    let power = bounded.fit;
+    let mut power = bounded.fit;
     kept.extend(bounded.kept);
+    let efficiency_relative_sd = efficiency_spread(&power, &flights)?;
+    power.vehicle.efficiency_relative_sd = efficiency_relative_sd;
     let mut fitted_parameters: Vec<String> = power
         .parameters
         .iter()
@@ -183,6 +199,8 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             logs,
             power,
             drag,
+            drag_body_axes,
+            efficiency_relative_sd,
             fitted_parameters,
             kept_parameters: kept,
             output: request
@@ -251,6 +269,125 @@ fn drag_fit(
     [p.mu1_n_s_per_m, p.mu2_n_s2_per_m2, p.mu3_n_s3_per_m3] = d.mu_n;
     *vehicle = aloft_power::Vehicle::new(p)?;
     Ok((Some(d), bounded.fitted))
+}
+
+/// Relative change of the efficiency from one day to another that a fit cannot see in its own
+/// logs: air density is not logged and enters the induced power as `rho^(-1/2)` (power seed
+/// eq 10, `vh = sqrt(m g / (2 rho A))`); a 10 K change in air temperature between days at one
+/// site (3.5 % in density) moves it by 1.7 %. Pack temperature and payload, also unlogged, add
+/// to it; this is the floor.
+pub const UNSEEN_DAY_RELATIVE_SD: f64 = 0.5 * 10.0 / 288.15;
+
+/// Body-axis drag from the force balance with the vehicle's (fitted) `mu1`, `mu3`: written to
+/// the vehicle when the logs separate the two axes, else the vehicle's own keys (the template's,
+/// or none: the scalar law) are kept and said.
+fn body_axis_fit(
+    forces: &[ForceSample],
+    kept: &mut Vec<KeptParameter>,
+    fitted: &mut Vec<&'static str>,
+    vehicle: &mut aloft_power::Vehicle,
+) -> Result<Option<BodyAxisDragFit>, Error> {
+    let (mu1, mu2, mu3) = vehicle.drag().coefficients();
+    let mut p = vehicle.params().clone();
+    let answer = fit_body_axis_drag(
+        [mu1, mu2, mu3],
+        vehicle.mass_kg(),
+        vehicle.gravity_mps2(),
+        forces,
+        1.0,
+        5.0,
+    );
+    let fit = match answer {
+        Ok(fit) => fit,
+        Err(refusal) => {
+            let reason = match refusal {
+                BodyAxisRefusal::TooFewSamples { rows } => format!(
+                    "too little flight along the body axes to tell them apart ({} samples forward, {} sideways faster than 1 m/s; {} each needed)",
+                    rows[0], rows[1], aloft_power::fit::body_drag::MIN_AXIS_ROWS
+                ),
+                BodyAxisRefusal::NotSeparated { fit } => format!(
+                    "the forward and sideways coefficients ({:.4} +/- {:.4}, {:.4} +/- {:.4} N s^2/m^2) do not differ by twice their uncertainty: the scalar law of eq (6)",
+                    fit.mu2_n[0], fit.std_error[0], fit.mu2_n[1], fit.std_error[1]
+                ),
+            };
+            // A template's body-axis keys that the new mu1, mu3 make unphysical are dropped.
+            if aloft_power::Vehicle::new(p.clone()).is_err() {
+                p.mu2_x_n_s2_per_m2 = None;
+                p.mu2_y_n_s2_per_m2 = None;
+                *vehicle = aloft_power::Vehicle::new(p.clone())?;
+            }
+            for (name, value) in [
+                ("mu2_x_n_s2_per_m2", p.mu2_x_n_s2_per_m2),
+                ("mu2_y_n_s2_per_m2", p.mu2_y_n_s2_per_m2),
+            ] {
+                kept.push(KeptParameter {
+                    name,
+                    value: value.unwrap_or(mu2),
+                    unit: "N s^2/m^2",
+                    reason: reason.clone(),
+                });
+            }
+            return Ok(None);
+        }
+    };
+    p.mu2_x_n_s2_per_m2 = Some(fit.mu2_n[0]);
+    p.mu2_y_n_s2_per_m2 = Some(fit.mu2_n[1]);
+    match aloft_power::Vehicle::new(p) {
+        Ok(v) => {
+            *vehicle = v;
+            fitted.extend(["mu2_x_n_s2_per_m2", "mu2_y_n_s2_per_m2"]);
+            Ok(Some(fit))
+        }
+        Err(e) => {
+            for (name, value) in [
+                ("mu2_x_n_s2_per_m2", fit.mu2_n[0]),
+                ("mu2_y_n_s2_per_m2", fit.mu2_n[1]),
+            ] {
+                kept.push(KeptParameter {
+                    name,
+                    value,
+                    unit: "N s^2/m^2",
+                    reason: format!(
+                        "not physical with the fitted mu1, mu3 ({e}): the scalar law of eq (6)"
+                    ),
+                });
+            }
+            Ok(None)
+        }
+    }
+}
+
+/// Relative uncertainty of the fitted efficiency for a flight on a day the fit has not seen.
+///
+/// Two parts, added in quadrature: the spread between the fitted logs of the efficiency each
+/// implies against the fitted model (`eta_i = eta E_predicted,i / E_measured,i`, as
+/// `sd(ln eta_i)`), and [`UNSEEN_DAY_RELATIVE_SD`], the day-to-day change that logs of one or two
+/// days cannot show. `None` with fewer than two logs.
+fn efficiency_spread(
+    power: &PowerFit,
+    flights: &[(crate::identify::AlignedFlight, aloft_logs::Log)],
+) -> Result<Option<f64>, Error> {
+    if flights.len() < 2 {
+        return Ok(None);
+    }
+    let model = aloft_power::PowerModel::new(aloft_power::Vehicle::new(power.vehicle.clone())?);
+    let mut logs = Vec::with_capacity(flights.len());
+    for (f, _) in flights {
+        let predicted = crate::identify::predict(&model, f)?;
+        let measured: Vec<f64> = f.samples.iter().map(|s| s.measured_power_w).collect();
+        let ratio = aloft_core::trapezoid(&f.times_s, &predicted)
+            / aloft_core::trapezoid(&f.times_s, &measured);
+        if ratio.is_finite() && ratio > 0.0 {
+            logs.push(ratio.ln());
+        }
+    }
+    if logs.len() < 2 {
+        return Ok(None);
+    }
+    let n = logs.len() as f64;
+    let mean = logs.iter().sum::<f64>() / n;
+    let var = logs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    Ok(Some(var.sqrt().hypot(UNSEEN_DAY_RELATIVE_SD).min(1.0)))
 }
 
 /// The fitted vehicle file: the template with its `[power]` table replaced and the statistics in

@@ -33,7 +33,15 @@ impl Flight<'_> {
         spec: &MissionSpec,
         payload_kg: Option<f64>,
     ) -> Result<Compiled, PlannerError> {
-        spec.compile(self.aircraft.airframe(), self.pack.mass_kg(), payload_kg)
+        let airframe = self.aircraft.airframe();
+        // Speeds of a planner file are clamped to what the vehicle can hold within its tilt
+        // limit at take-off (with the payload and the pack), in still air.
+        let clamp_to_mps = spec.clamp_speeds.then(|| {
+            let payload = payload_kg.unwrap_or(spec.payload_kg).max(0.0);
+            let mass = airframe.mass_kg() + self.pack.mass_kg() + payload;
+            self.aircraft.tilt_limited_speed_mps(mass)
+        });
+        spec.compile_clamped(airframe, self.pack.mass_kg(), payload_kg, clamp_to_mps)
     }
 
     /// Fly a compiled mission, handing each sample to `sink`.

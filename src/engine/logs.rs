@@ -7,8 +7,9 @@ use serde::Serialize;
 
 use aloft_logs::sample::{Gap, NonMonotonic};
 use aloft_logs::{
-    estimate_lag_s, open_log, resample_uniform, Channel, DroppedValue, InfoAccumulator, LogFormat,
-    LogReader, McapOptions, McapTime, McapWriter, Profile, TimeReport,
+    estimate_lag_s, open_log_with, resample_uniform, BinaryOptions, BinarySummary, Channel,
+    DroppedValue, InfoAccumulator, LogError, LogFormat, LogReader, McapOptions, McapTime,
+    McapWriter, OpenOptions, Profile, TimeReport,
 };
 use aloft_power::AoaModel;
 
@@ -28,6 +29,8 @@ pub struct LogReadOptions {
     pub header_time: bool,
     /// MCAP: `sensor_msgs/BatteryState` current positive while discharging.
     pub battery_current_positive: bool,
+    /// ULog and DataFlash: the battery instance to read (0: the first).
+    pub battery_instance: u8,
 }
 
 impl LogReadOptions {
@@ -47,10 +50,20 @@ impl LogReadOptions {
         o
     }
 
+    fn open_options(&self) -> OpenOptions {
+        OpenOptions {
+            mcap: self.mcap(),
+            binary: BinaryOptions {
+                battery_instance: self.battery_instance,
+                ..BinaryOptions::default()
+            },
+        }
+    }
+
     /// Open `path` as a stream of samples.
     fn open(&self, path: &Path) -> Result<(LogReader, Option<Profile>), Error> {
         let profile = self.profile()?;
-        let reader = open_log(path, profile.as_ref(), &self.mcap())?;
+        let reader = open_log_with(path, profile.as_ref(), &self.open_options())?;
         Ok((reader, profile))
     }
 }
@@ -134,6 +147,64 @@ pub struct LagInfo {
     pub used_until_s: Option<f64>,
 }
 
+/// What a PX4 ULog or ArduPilot DataFlash log holds besides its samples.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BinaryLogInfo {
+    /// Records decoded, by topic or record type (the kinds aloft reads).
+    pub records: std::collections::BTreeMap<String, u64>,
+    /// The battery instance read.
+    pub battery_instance: u8,
+    /// Battery instances with records.
+    pub battery_instances: Vec<u8>,
+    /// Battery records of the instance read.
+    pub battery_records: u64,
+    /// Of them, used for the energy.
+    pub battery_valid: u64,
+    /// Left out: current unknown (PX4 `current_a` < 0).
+    pub battery_unknown_current: u64,
+    /// Left out: voltage not positive (no sensor).
+    pub battery_no_voltage: u64,
+    /// Time from the first to the last valid battery record, s.
+    pub battery_span_s: f64,
+    /// Battery cells (parameters).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery_cells: Option<u32>,
+    /// Battery capacity (parameters), A h.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery_capacity_ah: Option<f64>,
+    /// Mean air density (PX4 `vehicle_air_data`), kg/m^3.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_density_kg_m3: Option<f64>,
+    /// Time not landed (PX4 `vehicle_land_detected`), s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub in_air_s: Option<f64>,
+    /// Bytes skipped over corrupt data.
+    pub bytes_skipped: u64,
+    /// Bytes read.
+    pub bytes: u64,
+}
+
+impl BinaryLogInfo {
+    fn of(s: &BinarySummary, battery_instance: u8) -> Self {
+        Self {
+            records: s.records.clone(),
+            battery_instance,
+            battery_instances: s.battery_instances.clone(),
+            battery_records: s.battery.records,
+            battery_valid: s.battery.valid,
+            battery_unknown_current: s.battery.unknown_current,
+            battery_no_voltage: s.battery.no_voltage,
+            battery_span_s: s.battery.span_s(),
+            battery_cells: s.battery_cells,
+            battery_capacity_ah: s.battery_capacity_ah,
+            air_density_kg_m3: s.air_density_kg_m3,
+            in_air_s: s.in_air_s,
+            bytes_skipped: s.bytes_skipped,
+            bytes: s.bytes,
+        }
+    }
+}
+
 /// What a log holds: the JSON of `aloft log info --format json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogInfo {
@@ -180,6 +251,41 @@ pub struct LogInfo {
     /// With a lag search: the lag of power behind ground speed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lag: Option<LagInfo>,
+    /// ULog and DataFlash: records, battery records, parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log: Option<BinaryLogInfo>,
+    /// What went wrong or was left out while reading (corrupt or truncated data with its byte
+    /// offset, records left out, no battery data).
+    pub warnings: Vec<String>,
+}
+
+/// Energy, power availability, warnings and the binary details of a log just read: a ULog or
+/// DataFlash log's battery records decide (the trapezoid over the records themselves); any other
+/// log's joined samples.
+fn power_facts(
+    reader: &LogReader,
+    stats: &aloft_logs::LogStats,
+    battery_instance: u8,
+) -> (Option<f64>, bool, Vec<String>, Option<BinaryLogInfo>) {
+    match reader.binary_summary() {
+        Some(b) => (
+            b.energy_wh(),
+            b.power_available(),
+            b.warnings.clone(),
+            Some(BinaryLogInfo::of(b, battery_instance)),
+        ),
+        None => {
+            let available = stats.energy_wh.is_some() || stats.mean_power_w.is_some();
+            let warnings = if available {
+                Vec::new()
+            } else {
+                vec![
+                    "the log has no battery data: no voltage and current (or power) channel".into(),
+                ]
+            };
+            (stats.energy_wh, available, warnings, None)
+        }
+    }
 }
 
 /// Most samples of each series the lag search keeps (58 hours at 10 Hz): memory stays bounded
@@ -241,6 +347,8 @@ pub fn log_info(
     let (dropped_values, mut dropped) = reader.dropped();
     dropped.truncate(10);
     let file = path.display().to_string();
+    let (energy_wh, power_available, warnings, log) =
+        power_facts(&reader, &stats, options.battery_instance);
     let lag = match lag_window_s {
         None => None,
         Some(max) => Some(lag_of(&file, &series, time.nominal_period_s, max)?),
@@ -249,7 +357,7 @@ pub fn log_info(
         LogInfo {
             format: reader.format(),
             profile: match reader.format() {
-                LogFormat::Mcap => None,
+                LogFormat::Mcap | LogFormat::Px4Ulog | LogFormat::ArduPilotDataflash => None,
                 LogFormat::Px4Csv => Some("px4".into()),
                 LogFormat::Csv => Some(profile.map_or("kaist".into(), |p| p.name())),
             },
@@ -267,8 +375,8 @@ pub fn log_info(
                 .collect(),
             columns: reader.columns().map(|c| c.to_vec()),
             topics: reader.topics().map(|t| t.iter().map(topic).collect()),
-            power_available: stats.energy_wh.is_some() || stats.mean_power_w.is_some(),
-            energy_wh: stats.energy_wh,
+            power_available,
+            energy_wh,
             mean_power_w: stats.mean_power_w,
             max_power_w: stats.max_power_w,
             time: LogTime::from(&time),
@@ -276,6 +384,8 @@ pub fn log_info(
             dropped,
             lag,
             file,
+            log,
+            warnings,
         },
         "log info",
         || path.display().to_string(),
@@ -441,6 +551,8 @@ pub struct FlightLogs {
     pub lag_s: Option<f64>,
     /// Search window of the lag estimate, s.
     pub max_lag_s: f64,
+    /// ULog and DataFlash: the battery instance to read.
+    pub battery_instance: u8,
 }
 
 impl Default for FlightLogs {
@@ -451,6 +563,7 @@ impl Default for FlightLogs {
             aoa: AoaModel::Geometric,
             lag_s: None,
             max_lag_s: 10.0,
+            battery_instance: 0,
         }
     }
 }
@@ -464,9 +577,24 @@ impl FlightLogs {
             lag_s: self.lag_s,
             ..AlignOptions::default()
         };
+        let open = OpenOptions {
+            binary: BinaryOptions {
+                battery_instance: self.battery_instance,
+                ..BinaryOptions::default()
+            },
+            ..OpenOptions::default()
+        };
         let mut out = Vec::new();
         for path in &self.logs {
-            let log = aloft_logs::read_log(path, profile.as_ref(), &Default::default())?;
+            let mut reader = open_log_with(path, profile.as_ref(), &open)?;
+            let log = reader.read_rest(&path.display().to_string())?;
+            if let Some(reason) = reader.binary_summary().and_then(|b| b.no_power_reason()) {
+                return Err(LogError::NoBatteryData {
+                    source_name: path.display().to_string(),
+                    reason,
+                }
+                .into());
+            }
             let mut flight = align_flight(&log, &align)?;
             if self.aoa == AoaModel::Paper {
                 for s in &mut flight.samples {

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use aloft_core::Trapezoid;
+use aloft_missions::{route_figures, RouteFigures, SourceFormat};
 use serde::{Deserialize, Serialize};
 
 use aloft_planner::{
@@ -30,20 +31,22 @@ pub const DEMO_MISSION: &str = include_str!("../../fixtures/missions/demo-survey
 /// Origin the CLI gives the built-in demonstration mission (its name when the file has none).
 pub const DEMO_ORIGIN: &str = "built-in demo";
 
-/// A mission to plan: the parsed mission file and where it came from.
+/// A mission to plan: the parsed mission file, where it came from, and its route figures (the
+/// file's own geometry, with what the reader of a planner file noticed).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mission {
     spec: MissionSpec,
     origin: String,
+    route: RouteFigures,
 }
 
 impl Mission {
-    /// The mission file at `path` (TOML, or JSON when its first non-blank character is `{`), or
-    /// the built-in demonstration mission when `path` is `None`.
+    /// The mission file at `path` in any of the four formats, recognised from its content (see
+    /// [`Mission::from_text`]), or the built-in demonstration mission when `path` is `None`.
     ///
     /// # Errors
-    /// [`Error::Io`] when the file cannot be read, [`Error::MissionFormat`] when it does not
-    /// parse.
+    /// [`Error::Io`] when the file cannot be read, [`Error::MissionFormat`] or
+    /// [`Error::MissionImport`] when it does not parse.
     pub fn load(path: Option<&Path>) -> Result<Self, Error> {
         match path {
             None => Ok(Self::demo()),
@@ -57,16 +60,18 @@ impl Mission {
     /// The built-in demonstration mission ([`DEMO_MISSION`]).
     pub fn demo() -> Self {
         // Parsed once per call; the text is compiled in and checked by a unit test.
-        match MissionSpec::from_toml_str(DEMO_MISSION) {
-            Ok(spec) => Self {
-                spec,
-                origin: DEMO_ORIGIN.to_string(),
-            },
-            // Unreachable for the committed fixture; an empty mission fails cleanly at planning.
-            Err(_) => Self {
-                spec: MissionSpec::default(),
-                origin: DEMO_ORIGIN.to_string(),
-            },
+        // Unreachable failure for the committed fixture; an empty mission fails cleanly at
+        // planning.
+        let spec = MissionSpec::from_toml_str(DEMO_MISSION).unwrap_or_default();
+        Self::of_spec(spec, DEMO_ORIGIN, SourceFormat::AloftToml)
+    }
+
+    /// An aloft mission spec from `format`, with its route figures.
+    fn of_spec(spec: MissionSpec, origin: &str, format: SourceFormat) -> Self {
+        Self {
+            route: route_figures(&spec, format, Vec::new()),
+            spec,
+            origin: origin.to_string(),
         }
     }
 
@@ -83,10 +88,7 @@ impl Mission {
                 other => other.to_string(),
             },
         })?;
-        Ok(Self {
-            spec,
-            origin: origin.to_string(),
-        })
+        Ok(Self::of_spec(spec, origin, SourceFormat::AloftToml))
     }
 
     /// A mission from JSON text: the mission file's structure, e.g.
@@ -99,21 +101,38 @@ impl Mission {
             origin: origin.to_string(),
             message: e.to_string(),
         })?;
-        Ok(Self {
-            spec,
+        Ok(Self::of_spec(spec, origin, SourceFormat::AloftJson))
+    }
+
+    /// A mission from a planner file: a QGroundControl `.plan` or a `QGC WPL 110` `.waypoints`
+    /// (see the `aloft-missions` crate for what each MAVLink command flies). Every segment
+    /// carries the operator's item number; the route figures carry the reader's warnings.
+    ///
+    /// # Errors
+    /// [`Error::MissionImport`] naming the item (or row, or line) and the command or key.
+    pub fn from_planner_file(text: &str, origin: &str) -> Result<Self, Error> {
+        let imported = aloft_missions::import(text).map_err(|source| Error::MissionImport {
             origin: origin.to_string(),
+            source,
+        })?;
+        Ok(Self {
+            spec: imported.spec,
+            origin: origin.to_string(),
+            route: imported.route,
         })
     }
 
-    /// JSON when the first non-blank character is `{`, TOML otherwise.
+    /// Any of the four formats, recognised from the content (not the file name): a
+    /// QGroundControl `.plan` (JSON with a `fileType` key), a `.waypoints` file (`QGC WPL`),
+    /// an aloft mission in JSON (another JSON object) or in TOML (anything else).
     ///
     /// # Errors
-    /// As [`Mission::from_json`] or [`Mission::from_toml`].
+    /// As [`Mission::from_planner_file`], [`Mission::from_json`] or [`Mission::from_toml`].
     pub fn from_text(text: &str, origin: &str) -> Result<Self, Error> {
-        if text.trim_start().starts_with('{') {
-            Self::from_json(text, origin)
-        } else {
-            Self::from_toml(text, origin)
+        match aloft_missions::detect(text) {
+            SourceFormat::QgcPlan | SourceFormat::QgcWpl => Self::from_planner_file(text, origin),
+            SourceFormat::AloftJson => Self::from_json(text, origin),
+            SourceFormat::AloftToml => Self::from_toml(text, origin),
         }
     }
 
@@ -137,6 +156,11 @@ impl Mission {
     /// Where it came from.
     pub fn origin(&self) -> &str {
         &self.origin
+    }
+
+    /// The route figures: the file's own geometry, its format and the reader's warnings.
+    pub fn route(&self) -> &RouteFigures {
+        &self.route
     }
 
     /// The name the summary reports: the file's `name`, else the origin.
@@ -486,6 +510,7 @@ fn plan_in(
         battery.name(),
         payload,
     );
+    summary.route = mission.route.clone();
     summary.planning_speed = planning_speed;
     summary.loiter = loiter;
     summary.batteries_required = sorties.batteries_required;
@@ -609,10 +634,14 @@ mod tests {
         let v = Vehicle::builtin("dji-m100").unwrap();
         let demo = Mission::demo();
         let again = Mission::from_text(&demo.to_json().unwrap(), DEMO_ORIGIN).unwrap();
-        assert_eq!(demo, again);
+        assert_eq!(demo.spec(), again.spec());
+        assert_eq!(again.route().source_format, SourceFormat::AloftJson);
         let a = plan_mission(&v, &demo, &MissionOptions::default()).unwrap();
         let b = plan_mission(&v, &again, &MissionOptions::default()).unwrap();
-        assert_eq!(a.to_json().unwrap(), b.to_json().unwrap());
+        // The same answer but for the format the route was read from.
+        let mut read_back = b.summary().clone();
+        read_back.route.source_format = SourceFormat::AloftToml;
+        assert_eq!(a.summary(), &read_back);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 //! | concern | requests | answer | file |
 //! |---|---|---|---|
 //! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`] | [`Vehicle`], [`list_vehicles`] | `vehicles.rs` |
-//! | missions | [`Mission::load`] + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
+//! | missions | [`Mission::load`] (aloft TOML or JSON, QGroundControl `.plan`, `.waypoints`, recognised from the content) + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`] with the [`RouteFigures`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
 //! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
 //! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`] | [`EnduranceSummary`], [`PowerCurve`] | `endurance.rs` |
 //! | power | [`PowerQuery`] → [`power_point`]; [`power_csv`] | [`PowerAnswer`] | `power.rs`, `power_batch.rs` |
@@ -63,6 +63,9 @@ mod validate;
 mod vehicles;
 mod wind;
 
+/// The route figures of a mission and the formats a mission file may be in (from the
+/// `aloft-missions` importers), for the CLI and embedding programs.
+pub use aloft_missions::{ItemCounts, RouteFigures, SourceFormat};
 pub use endurance::{
     endurance, power_curve, CurveContext, EnduranceContext, EnduranceOptions, EnduranceSummary,
     PowerCurve,

@@ -270,6 +270,7 @@ fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajecto
             pos_enu_m: s.pos_enu_m.unwrap_or([0.0; 3]),
             height_above_ground_m: None,
             wind_enu_mps: s.wind_enu_mps,
+            yaw_rad: s.attitude.map(|a| a.yaw_rad),
         })
         .collect();
     Ok(Trajectory { times, points })

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use aloft_missions::RouteFigures;
 use aloft_planner::MissionReport;
 
 use super::flown::PlanningSpeed;
@@ -117,6 +118,9 @@ pub struct MissionSummary {
     /// What the reader should know: speeds clamped to the vehicle's, why a route was not split.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// The planned route as the file describes it (format, horizontal path, climb, descent,
+    /// holds, the items of a planner file and what its reader noticed).
+    pub route: RouteFigures,
     /// Per segment.
     pub segments: Vec<SegmentSummary>,
 }
@@ -186,6 +190,7 @@ pub fn mission_summary(
         batteries_required: report.feasible.then_some(1),
         sorties: Vec::new(),
         warnings: Vec::new(),
+        route: RouteFigures::default(),
         segments: report
             .segments
             .iter()

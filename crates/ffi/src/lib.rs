@@ -199,6 +199,7 @@ impl From<Error> for Failure {
             }
             Error::VehicleFormat { .. }
             | Error::MissionFormat { .. }
+            | Error::MissionImport { .. }
             | Error::OptionsFormat { .. } => AloftStatus::Parse,
             Error::Mission { .. } | Error::TooHeavy { .. } => AloftStatus::Mission,
             _ => AloftStatus::InvalidInput,

@@ -230,6 +230,15 @@ pub enum LogError {
         /// What the log does hold.
         found: String,
     },
+    /// A ULog or DataFlash log without battery data for the flight (no battery topic, a battery
+    /// topic declared and never written, no valid record, or records covering a small part).
+    #[error("{source_name}: {reason}")]
+    NoBatteryData {
+        /// The file.
+        source_name: String,
+        /// Why, in words (starts with "the log has no battery data").
+        reason: String,
+    },
     /// Motion was asked for but the log has no velocity, position or attitude channel.
     #[error("{source_name}: no {channel} data in the log (channels found: {found})")]
     NoChannel {

@@ -11,6 +11,10 @@
 //! - MCAP ([`mcap_read`]): JSON and ROS 2 CDR messages of `sensor_msgs/BatteryState`,
 //!   `geometry_msgs/PoseStamped`, `geometry_msgs/TwistStamped`, `nav_msgs/Odometry`,
 //!   `sensor_msgs/Imu`, streamed with bounded memory.
+//! - PX4 ULog ([`ulog`]) and ArduPilot DataFlash ([`dataflash`]), decoded here from bytes
+//!   (sans-I/O: [`read_ulog`], [`read_dataflash`] take any reader, a `&[u8]` too), their topics
+//!   joined onto the motion topic ([`join`]) with bounded memory; a corrupt or truncated log gives
+//!   its valid prefix and warnings with byte offsets ([`BinarySummary`]).
 //!
 //! Output: [`mcap_write`] writes JSON-encoded MCAP with JSON Schemas that Foxglove displays, for
 //! converted logs and for missions ([`write_mission_mcap`] takes plain slices).
@@ -31,12 +35,16 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod binary;
+pub mod bytes;
 pub mod cdr;
 pub mod column_map;
 pub mod csv_read;
+pub mod dataflash;
 pub mod error;
 pub mod frame;
 pub mod info;
+pub mod join;
 pub mod lag;
 pub mod mcap_read;
 pub mod mcap_records;
@@ -45,7 +53,11 @@ pub mod open;
 pub mod px4;
 pub mod ros;
 pub mod sample;
+pub mod ulog;
 
+pub use binary::{
+    read_dataflash, read_ulog, BinaryLog, BinaryOptions, BinarySamples, BinarySummary,
+};
 pub use column_map::ColumnMap;
 pub use csv_read::CsvSamples;
 pub use error::{LogError, Result};
@@ -56,7 +68,9 @@ pub use mcap_write::{
     write_log_mcap, write_mission_mcap, BatteryPoint, McapWriter, MissionSample, PathPoint,
     PowerTerms, WriteSummary,
 };
-pub use open::{open_log, read_log, LogFormat, LogReader, Profile, BUILTIN_PROFILES};
+pub use open::{
+    open_log, open_log_with, read_log, LogFormat, LogReader, OpenOptions, Profile, BUILTIN_PROFILES,
+};
 pub use px4::{Px4Options, Px4Samples};
 pub use sample::{
     Attitude, Channel, DroppedValue, GeoOrigin, Log, Sample, TimeChecker, TimeReport,

@@ -6,12 +6,15 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::binary::{BinaryOptions, BinarySamples, BinarySummary};
 use crate::column_map::ColumnMap;
 use crate::csv_read::CsvSamples;
+use crate::dataflash::{dataflash_samples, is_dataflash, DataflashDecoder};
 use crate::error::{LogError, Result};
 use crate::mcap_read::{McapOptions, McapSamples, TopicInfo};
 use crate::px4::{px4_prefix, table, Px4Options, Px4Samples, PX4_TOPICS};
 use crate::sample::{DroppedValue, GeoOrigin, Log, Sample, TimeReport};
+use crate::ulog::{is_ulog, ulog_samples, UlogDecoder};
 
 /// Built-in CSV profiles.
 pub const BUILTIN_PROFILES: [&str; 2] = ["kaist", "px4"];
@@ -67,6 +70,11 @@ pub enum LogFormat {
     Px4Csv,
     /// MCAP.
     Mcap,
+    /// PX4 ULog (`.ulg`).
+    Px4Ulog,
+    /// ArduPilot DataFlash (`.bin`).
+    #[serde(rename = "ardupilot_dataflash")]
+    ArduPilotDataflash,
 }
 
 /// A reader of any supported log, yielding [`Sample`]s.
@@ -77,6 +85,51 @@ pub enum LogReader {
     Px4(Box<Px4Samples>),
     /// MCAP.
     Mcap(Box<McapSamples<BufReader<File>>>),
+    /// PX4 ULog.
+    Ulog(Box<BinarySamples<BufReader<File>, UlogDecoder>>),
+    /// ArduPilot DataFlash.
+    Dataflash(Box<BinarySamples<BufReader<File>, DataflashDecoder>>),
+}
+
+/// How to open a log of any format.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct OpenOptions {
+    /// MCAP options.
+    pub mcap: McapOptions,
+    /// ULog and DataFlash options.
+    pub binary: BinaryOptions,
+}
+
+/// The container recognised from the first bytes of `path` (`None`: not a binary log).
+fn binary_format(path: &Path) -> Result<Option<LogFormat>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let mut f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
+    let mut head = [0u8; 8];
+    let mut n = 0;
+    while n < head.len() {
+        match f.read(&mut head[n..]).map_err(LogError::reading(path))? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(if is_ulog(&head[..n]) {
+        Some(LogFormat::Px4Ulog)
+    } else if is_dataflash(&head[..n]) {
+        Some(LogFormat::ArduPilotDataflash)
+    } else {
+        None
+    })
+}
+
+fn open_binary(path: &Path, format: LogFormat, o: &BinaryOptions) -> Result<LogReader> {
+    let f = aloft_core::open_regular_file(path).map_err(LogError::reading(path))?;
+    let r = BufReader::with_capacity(1 << 16, f);
+    Ok(match format {
+        LogFormat::Px4Ulog => LogReader::Ulog(Box::new(ulog_samples(r, o, path)?)),
+        _ => LogReader::Dataflash(Box::new(dataflash_samples(r, o, path)?)),
+    })
 }
 
 const MCAP_MAGIC: &[u8] = b"\x89MCAP0\r\n";
@@ -120,7 +173,21 @@ fn refuse_non_regular(path: &Path) -> Result<()> {
 /// recognised as KAIST by its header or as PX4 by its table name. A path that is not a regular
 /// file (a FIFO, device or directory) is refused before it is opened.
 pub fn open_log(path: &Path, profile: Option<&Profile>, mcap: &McapOptions) -> Result<LogReader> {
+    let o = OpenOptions {
+        mcap: mcap.clone(),
+        ..OpenOptions::default()
+    };
+    open_log_with(path, profile, &o)
+}
+
+/// [`open_log`] with the options of every format. PX4 ULog (magic `55 4C 6F 67 01 12 35`) and
+/// ArduPilot DataFlash (`A3 95 80`) are recognised by their first bytes, whatever the profile.
+pub fn open_log_with(path: &Path, profile: Option<&Profile>, o: &OpenOptions) -> Result<LogReader> {
     refuse_non_regular(path)?;
+    if let Some(format) = binary_format(path)? {
+        return open_binary(path, format, &o.binary);
+    }
+    let mcap = &o.mcap;
     if is_mcap(path)? {
         return Ok(LogReader::Mcap(Box::new(McapSamples::open(
             path,
@@ -161,6 +228,8 @@ impl LogReader {
             LogReader::Csv(_) => LogFormat::Csv,
             LogReader::Px4(_) => LogFormat::Px4Csv,
             LogReader::Mcap(_) => LogFormat::Mcap,
+            LogReader::Ulog(_) => LogFormat::Px4Ulog,
+            LogReader::Dataflash(_) => LogFormat::ArduPilotDataflash,
         }
     }
 
@@ -170,6 +239,8 @@ impl LogReader {
             LogReader::Csv(r) => r.start_time_s(),
             LogReader::Px4(r) => r.start_time_s(),
             LogReader::Mcap(r) => r.start_time_s(),
+            LogReader::Ulog(r) => r.start_time_s(),
+            LogReader::Dataflash(r) => r.start_time_s(),
         }
     }
 
@@ -179,6 +250,8 @@ impl LogReader {
             LogReader::Csv(r) => r.time_report(),
             LogReader::Px4(r) => r.time_report(),
             LogReader::Mcap(r) => r.time_report(),
+            LogReader::Ulog(r) => r.time_report(),
+            LogReader::Dataflash(r) => r.time_report(),
         }
     }
 
@@ -186,6 +259,7 @@ impl LogReader {
     pub fn origin(&self) -> Option<GeoOrigin> {
         match self {
             LogReader::Csv(r) => r.origin(),
+            LogReader::Dataflash(r) => r.origin(),
             _ => None,
         }
     }
@@ -214,6 +288,16 @@ impl LogReader {
         }
     }
 
+    /// What a ULog or DataFlash log holds besides its samples: battery records, energy,
+    /// warnings (complete once every sample has been read).
+    pub fn binary_summary(&self) -> Option<&BinarySummary> {
+        match self {
+            LogReader::Ulog(r) => Some(r.summary()),
+            LogReader::Dataflash(r) => Some(r.summary()),
+            _ => None,
+        }
+    }
+
     /// Values dropped as isolated contradictions so far (CSV sources).
     pub fn dropped(&self) -> (u64, Vec<DroppedValue>) {
         match self {
@@ -227,6 +311,12 @@ impl LogReader {
 
     /// Read every sample into memory (for small logs).
     pub fn read_all(mut self, source: &str) -> Result<Log> {
+        self.read_rest(source)
+    }
+
+    /// Read every remaining sample into memory, keeping the reader (for what it learnt on the
+    /// way, e.g. [`Self::binary_summary`]).
+    pub fn read_rest(&mut self, source: &str) -> Result<Log> {
         let mut samples = Vec::new();
         for s in self.by_ref() {
             samples.push(s?);
@@ -252,6 +342,8 @@ impl Iterator for LogReader {
             LogReader::Csv(r) => r.next(),
             LogReader::Px4(r) => r.next(),
             LogReader::Mcap(r) => r.next(),
+            LogReader::Ulog(r) => r.next(),
+            LogReader::Dataflash(r) => r.next(),
         }
     }
 }

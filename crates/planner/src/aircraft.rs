@@ -8,6 +8,10 @@ use crate::airframe::Airframe;
 use crate::error::{positive, PlannerError};
 
 /// Where the electrical power of a flight condition comes from.
+// The four-term variant holds the vehicle inline (about 250 bytes with the optional body-axis
+// drag and efficiency spread): it is the common case, built once per aircraft, and boxing it
+// would put an indirection on the trim's hot path for nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum PowerSource {
     /// The four-term model (power seed eqs 3-14) of a vehicle; its mass is replaced by the
@@ -127,6 +131,31 @@ impl Aircraft {
         self.gravity_mps2
     }
 
+    /// The highest level ground speed, in still air and at `mass_kg`, that the aircraft can reach
+    /// and hold within its tilt limit while accelerating at its airframe's horizontal
+    /// acceleration: the largest `v` (at most the airframe's maximum speed) for which
+    /// `m a + f_D(u) <= m g tan(tilt_max - 0.25 deg)` at every `u <= v` (the thrust tilt of
+    /// level flight, `tan(tilt) = (m a + f_D) / (m g)`, with a quarter degree of margin for the
+    /// midpoint sampling). Planner files written for other vehicles are clamped to it.
+    pub fn tilt_limited_speed_mps(&self, mass_kg: f64) -> f64 {
+        let af = &self.airframe;
+        let tan_max = (af.max_tilt_rad() - 0.25f64.to_radians()).max(0.0).tan();
+        let budget_n = mass_kg * (self.gravity_mps2 * tan_max - af.acceleration_mps2());
+        let step = 0.01;
+        let n = (af.max_speed_mps() / step).ceil() as usize;
+        let mut highest_drag_n: f64 = 0.0;
+        let mut reachable = 0.0;
+        for k in 1..=n {
+            let u = (k as f64 * step).min(af.max_speed_mps());
+            highest_drag_n = highest_drag_n.max(self.drag.force_n(u));
+            if highest_drag_n > budget_n {
+                break;
+            }
+            reachable = u;
+        }
+        reachable
+    }
+
     /// The power evaluator at a total mass.
     ///
     /// # Errors
@@ -150,6 +179,8 @@ impl Aircraft {
 }
 
 /// The evaluator behind [`Powered`].
+// Inline for the same reason as `PowerSource`: the model is read on every trim.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone)]
 pub(crate) enum Engine<'a> {
     FourTerm(PowerModel),

@@ -86,6 +86,7 @@
 //!     rotor_radius_m: 0.172, disk_area: aloft_power::DiskArea::OneRotor,
 //!     mu1_n_s_per_m: 0.1816, mu2_n_s2_per_m2: -0.02326, mu3_n_s3_per_m3: 0.004045,
 //!     kappa1_w_per_n1_5: 0.275, kappa2_w_s2_per_m2_n0_5: 0.0, efficiency: 0.9703,
+//!     mu2_x_n_s2_per_m2: None, mu2_y_n_s2_per_m2: None, efficiency_relative_sd: None,
 //! })?;
 //! let aircraft = Aircraft::four_term(airframe, vehicle, Default::default());
 //! let battery = Pack::new(&BatterySpec {

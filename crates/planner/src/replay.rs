@@ -10,9 +10,10 @@
 //! Energy is the trapezoidal integral of the power over the points' times,
 //! `E = sum (P_i + P_{i+1}) / 2 (t_{i+1} - t_i)`, so irregular log rates are handled.
 //!
-//! Heading: along the horizontal ground velocity when it exceeds [`HEADING_MIN_SPEED_MPS`], else
-//! the previous heading (north at the start). Only the paper's angle-of-attack model uses it; the
-//! geometric one is independent of heading.
+//! Heading: the logged yaw where the point has one ([`ReplayPoint::yaw_rad`]); else along the
+//! horizontal ground velocity when it exceeds [`HEADING_MIN_SPEED_MPS`], else the previous heading
+//! (north at the start). Only the paper's angle-of-attack model and body-axis drag use it; the
+//! geometric angle of attack with the scalar drag of eq (6) is independent of heading.
 //!
 //! Ground effect (survey eq 35) applies where a point gives its height above the ground; a log
 //! that does not know the ground (heights relative to an origin in flight) gives none.
@@ -50,6 +51,11 @@ pub struct ReplayPoint {
     /// Measured wind (velocity of the air), ENU m/s, when the log has it: used instead of the
     /// wind model at this point.
     pub wind_enu_mps: Option<[f64; 3]>,
+    /// Logged heading (yaw, clockwise from north), rad, when the log has the attitude: the
+    /// heading of the trim at this point (body-axis drag and the paper's angle of attack use it).
+    /// `None`: the heading follows the track.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub yaw_rad: Option<f64>,
 }
 
 /// The predicted energy of a trajectory.
@@ -212,7 +218,10 @@ pub fn replay(
             })?;
             let v = p.vel_enu_mps;
             let vh = v[0].hypot(v[1]);
-            if vh > HEADING_MIN_SPEED_MPS {
+            if let Some(yaw) = p.yaw_rad.filter(|y| y.is_finite()) {
+                let (e, n) = yaw.sin_cos();
+                heading = [e, n];
+            } else if vh > HEADING_MIN_SPEED_MPS {
                 heading = [v[0] / vh, v[1] / vh];
             }
             acc[j] = p.acc_enu_mps2;
@@ -310,6 +319,7 @@ mod tests {
                 pos_enu_m: [s.east_m, s.north_m, s.up_m],
                 height_above_ground_m: None,
                 wind_enu_mps: None,
+                yaw_rad: None,
             })
             .collect();
         let pw = aircraft
@@ -361,6 +371,7 @@ mod tests {
             pos_enu_m: [0.0; 3],
             height_above_ground_m: None,
             wind_enu_mps: None,
+            yaw_rad: None,
         };
         assert!(replay(&pw, &[p], &Wind::calm()).is_err());
         assert!(replay(&pw, &[p, p], &Wind::calm()).is_err());

@@ -40,6 +40,9 @@ pub(crate) fn m100_aircraft() -> Aircraft {
         kappa1_w_per_n1_5: 0.275,
         kappa2_w_s2_per_m2_n0_5: 0.0,
         efficiency: 0.9703,
+        mu2_x_n_s2_per_m2: None,
+        mu2_y_n_s2_per_m2: None,
+        efficiency_relative_sd: None,
     })
     .unwrap();
     Aircraft::four_term(m100_airframe(), vehicle, Default::default())

@@ -13,6 +13,10 @@
 //! | `v_air` | velocity of the vehicle relative to the air, `v_ground - wind` | m/s |
 //! | `f_D` | cubic drag of power seed eq (6) | N |
 //!
+//! With body-axis drag (`aloft_power::drag`, "Deviation") the horizontal drag is split along the
+//! heading and its right, `k_x v_f f + k_y v_r r`, so the heading matters: missions head along
+//! the track, replays along the logged yaw.
+//!
 //! The attitude follows from the thrust axis `t = T / |T|` with the heading along the track:
 //! with `f`, `r` the forward and right horizontal unit vectors, `sin(roll) = t.r`,
 //! `tan(pitch) = -t.f / t.up` (Z-Y-X Euler angles of a forward-right-down body, as in
@@ -115,10 +119,24 @@ impl Powered<'_> {
         let speed = (vx * vx + vy * vy + vz * vz).sqrt();
         // f_D(v) / v = mu1 + mu2 v + mu3 v^2 (eq 6 divided by v): no division on the hot path,
         // and 0 N of drag at zero airspeed since f_D(0) = 0 multiplies v_air = 0.
-        let (mu1, mu2, mu3) = self.aircraft.drag().coefficients();
+        let drag = self.aircraft.drag();
+        let (mu1, mu2, mu3) = drag.coefficients();
         let k = mu1 + speed * (mu2 + speed * mu3);
-        let tx = m * acc_mps2[0] + k * vx;
-        let ty = m * acc_mps2[1] + k * vy;
+        let (tx, ty) = match drag.body_axes() {
+            None => (m * acc_mps2[0] + k * vx, m * acc_mps2[1] + k * vy),
+            // Body-axis drag: the air velocity split along the heading `f` and its right
+            // `r = (f_n, -f_e)`, each with its own coefficient (aloft_power::drag).
+            Some(_) => {
+                let [kx, ky, _] = drag.axis_coefficients(speed);
+                let [fe, fn_] = forward;
+                let v_f = vx * fe + vy * fn_;
+                let v_r = vx * fn_ - vy * fe;
+                (
+                    m * acc_mps2[0] + kx * v_f * fe + ky * v_r * fn_,
+                    m * acc_mps2[1] + kx * v_f * fn_ - ky * v_r * fe,
+                )
+            }
+        };
         let tz = m * acc_mps2[2] + self.weight_n + k * vz;
         let thrust = (tx * tx + ty * ty + tz * tz).sqrt();
         let inv = 1.0 / thrust;
@@ -328,5 +346,77 @@ impl Powered<'_> {
                 1.0,
             )?
             .electrical_w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::aircraft::Aircraft;
+    use crate::test_support::{m100_aircraft, m100_airframe};
+    use aloft_power::AoaModel;
+
+    /// The M100 with body-axis drag `[mu2_x, mu2_y]`.
+    fn with_axes(mu2: [f64; 2]) -> Aircraft {
+        // test_support's M100 with the two keys added.
+        let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
+            mass_kg: 3.29,
+            gravity_mps2: 9.8066,
+            air_density_kg_m3: 1.225,
+            rotor_count: 4,
+            rotor_radius_m: 0.172,
+            disk_area: aloft_power::DiskArea::OneRotor,
+            mu1_n_s_per_m: 0.1816,
+            mu2_n_s2_per_m2: -0.02326,
+            mu3_n_s3_per_m3: 0.004045,
+            kappa1_w_per_n1_5: 0.275,
+            kappa2_w_s2_per_m2_n0_5: 0.0,
+            efficiency: 0.9703,
+            mu2_x_n_s2_per_m2: Some(mu2[0]),
+            mu2_y_n_s2_per_m2: Some(mu2[1]),
+            efficiency_relative_sd: None,
+        })
+        .unwrap();
+        Aircraft::four_term(m100_airframe(), vehicle, Default::default())
+    }
+
+    #[test]
+    fn equal_body_axes_trim_as_the_scalar_law() {
+        let scalar = m100_aircraft();
+        let mu2 = scalar.drag().coefficients().1;
+        let axes = with_axes([mu2, mu2]);
+        let (a, b) = (
+            scalar.at_mass(3.29, AoaModel::Geometric).unwrap(),
+            axes.at_mass(3.29, AoaModel::Geometric).unwrap(),
+        );
+        for (vel, fwd) in [
+            ([6.0, 2.0, 0.5], [0.6, 0.8]),
+            ([-3.0, 7.0, 0.0], [1.0, 0.0]),
+        ] {
+            let ta = a.trim([0.3, -0.2, 0.0], vel, fwd, 1.0).unwrap();
+            let tb = b.trim([0.3, -0.2, 0.0], vel, fwd, 1.0).unwrap();
+            // The same force, split along two axes and summed: equal to rounding.
+            assert!((ta.thrust_n - tb.thrust_n).abs() < 1e-9, "{ta:?} {tb:?}");
+            assert!((ta.electrical_w - tb.electrical_w).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn a_larger_side_area_costs_power_only_flying_sideways() {
+        let mu2 = m100_aircraft().drag().coefficients().1;
+        let axes = with_axes([mu2, mu2 + 0.05]);
+        let scalar = m100_aircraft();
+        let (s, b) = (
+            scalar.at_mass(3.29, AoaModel::Geometric).unwrap(),
+            axes.at_mass(3.29, AoaModel::Geometric).unwrap(),
+        );
+        // Flying north at 10 m/s: nose first (forward north), then sideways (forward east).
+        let forward = b.level_power_w([0.0, 10.0], [0.0, 1.0]).unwrap();
+        let sideways = b.level_power_w([0.0, 10.0], [1.0, 0.0]).unwrap();
+        let reference = s.level_power_w([0.0, 10.0], [0.0, 1.0]).unwrap();
+        assert!(
+            (forward - reference).abs() < 1e-6,
+            "{forward} vs {reference}"
+        );
+        assert!(sideways > forward + 1.0, "{sideways} vs {forward}");
     }
 }

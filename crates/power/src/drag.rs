@@ -11,6 +11,19 @@
 //!
 //! The paper fits the cubic to drag estimated from level flights of its M100 up to about 10 m/s
 //! (Fig. 3); outside the fitted range the cubic is an extrapolation.
+//!
+//! # Deviation: body-axis drag (optional)
+//! Eq (6) assumes the drag is co-linear with the freestream ("we assume that f_D is always
+//! co-linear with v_inf"). A multirotor's frontal area differs between its body axes (arms,
+//! battery and payload are not round), so with [`CubicDrag::with_body_axes`] the quadratic
+//! (area) coefficient differs by horizontal body axis `b` (forward `x`, right `y`):
+//!
+//! `D_b = (mu1 + mu2_b |v| + mu3 |v|^2) v_b`, `b = x, y`; vertically `D_z = f_D(|v|) v_z / |v|`,
+//!
+//! which is eq (6) again when `mu2_x = mu2_y = mu2`. `mu1` (rotor drag, proportional to speed)
+//! and `mu3` stay common to both axes: the quadratic term is the one that scales with a frontal
+//! area, `mu2_b = rho C_D A_b / 2`. The drag vector then points along the freestream only when
+//! flying along an axis. Without the body-axis keys the law is the scalar eq (6), bit for bit.
 
 use crate::error::{finite, PowerError, Result};
 
@@ -23,6 +36,7 @@ pub struct CubicDrag {
     mu1: f64,
     mu2: f64,
     mu3: f64,
+    body_mu2: Option<[f64; 2]>,
 }
 
 impl CubicDrag {
@@ -36,6 +50,7 @@ impl CubicDrag {
             mu1: mu1_n_s_per_m,
             mu2: mu2_n_s2_per_m2,
             mu3: mu3_n_s3_per_m3,
+            body_mu2: None,
         };
         // f_D(v) = v q(v) with q(v) = mu1 + mu2 v + mu3 v^2; f_D < 0 for some v > 0 iff q < 0 there.
         // q is a parabola: its minimum over [0, vmax] is at an end or at the vertex.
@@ -76,6 +91,53 @@ impl CubicDrag {
     pub fn parasitic_power_derivative(&self, airspeed_mps: f64) -> f64 {
         let v = airspeed_mps;
         v * (2.0 * self.mu1 + v * (3.0 * self.mu2 + v * 4.0 * self.mu3))
+    }
+
+    /// The same law with body-axis quadratic coefficients `mu2_x` (forward) and `mu2_y` (right),
+    /// N s^2/m^2 (see the module docs), each axis checked as [`Self::new`] checks the scalar law.
+    pub fn with_body_axes(self, mu2_x_n_s2_per_m2: f64, mu2_y_n_s2_per_m2: f64) -> Result<Self> {
+        for (name, mu2) in [
+            ("mu2_x_n_s2_per_m2", mu2_x_n_s2_per_m2),
+            ("mu2_y_n_s2_per_m2", mu2_y_n_s2_per_m2),
+        ] {
+            finite(name, mu2)?;
+            Self::new(self.mu1, mu2, self.mu3)?;
+        }
+        Ok(Self {
+            body_mu2: Some([mu2_x_n_s2_per_m2, mu2_y_n_s2_per_m2]),
+            ..self
+        })
+    }
+
+    /// The body-axis quadratic coefficients `[mu2_x, mu2_y]`, N s^2/m^2, when the law has them.
+    pub fn body_axes(&self) -> Option<[f64; 2]> {
+        self.body_mu2
+    }
+
+    /// Drag force over air velocity per axis, `[k_x, k_y, k_z]` with `D = k_x v_x e_x + k_y v_y
+    /// e_y + k_z v_z e_z` in the body-heading frame (forward, right, up), N s/m: the scalar law's
+    /// `f_D(v) / v` on every axis without body-axis coefficients.
+    #[inline]
+    pub fn axis_coefficients(&self, speed_mps: f64) -> [f64; 3] {
+        let v = speed_mps;
+        let k = self.mu1 + v * (self.mu2 + v * self.mu3);
+        match self.body_mu2 {
+            None => [k, k, k],
+            Some([mx, my]) => [
+                self.mu1 + v * (mx + v * self.mu3),
+                self.mu1 + v * (my + v * self.mu3),
+                k,
+            ],
+        }
+    }
+
+    /// Parasitic power `D . v`, W, of a horizontal air velocity `forward_mps` along the body's
+    /// forward axis and `right_mps` along its right axis: eq (11) for the scalar law.
+    #[inline]
+    pub fn parasitic_power_body_w(&self, forward_mps: f64, right_mps: f64) -> f64 {
+        let speed = forward_mps.hypot(right_mps);
+        let [kx, ky, _] = self.axis_coefficients(speed);
+        kx * forward_mps * forward_mps + ky * right_mps * right_mps
     }
 
     /// The coefficients `(mu1, mu2, mu3)`.

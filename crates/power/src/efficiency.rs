@@ -84,6 +84,9 @@ mod tests {
             kappa1_w_per_n1_5: 0.0,
             kappa2_w_s2_per_m2_n0_5: 0.0,
             efficiency: 1.0,
+            mu2_x_n_s2_per_m2: None,
+            mu2_y_n_s2_per_m2: None,
+            efficiency_relative_sd: None,
         })
         .unwrap()
     }

@@ -60,6 +60,14 @@ pub enum PowerError {
         /// The drag force there, N.
         drag_n: f64,
     },
+    /// One body-axis drag key without the other (`mu2_x_n_s2_per_m2`, `mu2_y_n_s2_per_m2`).
+    #[error("{given} is given without {missing}: body-axis drag needs both keys, or neither")]
+    LoneBodyAxisDrag {
+        /// The key given.
+        given: &'static str,
+        /// The key missing.
+        missing: &'static str,
+    },
     /// Roll and pitch tilt the thrust axis 90 degrees or more from vertical: the vehicle cannot hold altitude.
     #[error(
         "tilt of {tilt_deg:.2} deg (roll {roll_deg:.2} deg, pitch {pitch_deg:.2} deg) is 90 deg or more: thrust cannot balance weight"

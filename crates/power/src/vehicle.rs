@@ -89,6 +89,20 @@ pub struct VehicleParams {
     pub kappa2_w_s2_per_m2_n0_5: f64,
     /// Overall efficiency `eta` of eq (14): aerodynamic over electrical power, 0 < eta <= 1.
     pub efficiency: f64,
+    /// Body-axis drag (optional, both or neither): the quadratic coefficient `mu2` of eq (6)
+    /// along the body's forward axis, N s^2/m^2. With [`Self::mu2_y_n_s2_per_m2`] the drag
+    /// force is `D_b = (mu1 + mu2_b v + mu3 v^2) v_b` per horizontal body axis `b`, the frontal
+    /// area differing by axis; see [`crate::drag`]. Absent: the scalar law of eq (6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mu2_x_n_s2_per_m2: Option<f64>,
+    /// Body-axis drag: the quadratic coefficient `mu2` along the body's right axis, N s^2/m^2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mu2_y_n_s2_per_m2: Option<f64>,
+    /// Relative standard deviation of the efficiency between flights (optional, a fraction:
+    /// 0.02 is 2 %), written by `aloft fit` from the spread of the fitted flights: the prior
+    /// uncertainty an in-flight re-calibration weighs its estimate against.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub efficiency_relative_sd: Option<f64>,
 }
 
 /// Standard gravity (aloft-core's), the default when a vehicle file does not give one, m/s^2.
@@ -167,6 +181,15 @@ impl Vehicle {
             params.mu2_n_s2_per_m2,
             params.mu3_n_s3_per_m3,
         )?;
+        let drag = body_axis_drag(&params, drag)?;
+        if let Some(sd) = params.efficiency_relative_sd {
+            within(
+                "efficiency_relative_sd",
+                non_negative("efficiency_relative_sd", sd)?,
+                0.0,
+                1.0,
+            )?;
+        }
         let weight_n = params.mass_kg * params.gravity_mps2;
         let one_disk_m2 = std::f64::consts::PI * params.rotor_radius_m * params.rotor_radius_m;
         let disk_area_m2 = match params.disk_area {
@@ -295,6 +318,38 @@ impl Vehicle {
     }
 }
 
+/// The scalar law `drag` with the body-axis coefficients of `params`, when given (both or
+/// neither).
+fn body_axis_drag(params: &VehicleParams, drag: CubicDrag) -> Result<CubicDrag> {
+    let limit = PARAMETER_LIMITS.drag;
+    match (params.mu2_x_n_s2_per_m2, params.mu2_y_n_s2_per_m2) {
+        (None, None) => Ok(drag),
+        (Some(x), Some(y)) => {
+            within(
+                "mu2_x_n_s2_per_m2",
+                finite("mu2_x_n_s2_per_m2", x)?,
+                -limit,
+                limit,
+            )?;
+            within(
+                "mu2_y_n_s2_per_m2",
+                finite("mu2_y_n_s2_per_m2", y)?,
+                -limit,
+                limit,
+            )?;
+            drag.with_body_axes(x, y)
+        }
+        (Some(_), None) => Err(PowerError::LoneBodyAxisDrag {
+            given: "mu2_x_n_s2_per_m2",
+            missing: "mu2_y_n_s2_per_m2",
+        }),
+        (None, Some(_)) => Err(PowerError::LoneBodyAxisDrag {
+            given: "mu2_y_n_s2_per_m2",
+            missing: "mu2_x_n_s2_per_m2",
+        }),
+    }
+}
+
 #[cfg(test)]
 // Exact comparisons here check values that are exact by construction (zeros of removed terms and
 // of zero airspeed, bit-identical results of the same arithmetic).
@@ -317,6 +372,9 @@ pub(crate) mod tests {
             kappa1_w_per_n1_5: 0.275,
             kappa2_w_s2_per_m2_n0_5: 0.0,
             efficiency: 0.8,
+            mu2_x_n_s2_per_m2: None,
+            mu2_y_n_s2_per_m2: None,
+            efficiency_relative_sd: None,
         }
     }
 
@@ -401,6 +459,28 @@ pub(crate) mod tests {
         }
         assert!(v.with_power_scale(0.0).is_err());
         assert!(v.with_power_scale(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn body_axis_drag_needs_both_keys_and_old_files_write_no_new_keys() {
+        let mut p = m100_params();
+        p.mu2_x_n_s2_per_m2 = Some(0.01);
+        let e = Vehicle::new(p.clone()).unwrap_err();
+        assert!(matches!(e, PowerError::LoneBodyAxisDrag { .. }), "{e}");
+        p.mu2_y_n_s2_per_m2 = Some(-1.0);
+        // Negative drag sideways at low speed: refused as the scalar law would be.
+        assert!(Vehicle::new(p.clone()).is_err());
+        p.mu2_y_n_s2_per_m2 = Some(0.02);
+        let v = Vehicle::new(p).unwrap();
+        assert_eq!(v.drag().body_axes(), Some([0.01, 0.02]));
+        let mut q = m100_params();
+        q.efficiency_relative_sd = Some(-0.1);
+        assert!(Vehicle::new(q).is_err());
+        let json = serde_json::to_string(&m100_params()).unwrap();
+        assert!(
+            !json.contains("mu2_x") && !json.contains("efficiency_relative_sd"),
+            "{json}"
+        );
     }
 
     // The crate does not depend on toml; serde's own test format is enough to show the attribute works.

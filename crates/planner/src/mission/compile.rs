@@ -29,6 +29,23 @@ impl MissionSpec {
         battery_mass_kg: f64,
         payload_kg: Option<f64>,
     ) -> Result<Mission, PlannerError> {
+        self.compile_clamped(airframe, battery_mass_kg, payload_kg, None)
+    }
+
+    /// [`MissionSpec::compile`], with the speeds of a mission that clamps them
+    /// ([`MissionSpec::clamp_speeds`]: a planner file written for another vehicle) clamped to
+    /// `clamp_to_mps` where that is below the airframe's maximum speed (the speed the vehicle
+    /// can hold within its tilt limit: [`crate::Aircraft::tilt_limited_speed_mps`]).
+    ///
+    /// # Errors
+    /// As [`MissionSpec::compile`].
+    pub fn compile_clamped(
+        &self,
+        airframe: &Airframe,
+        battery_mass_kg: f64,
+        payload_kg: Option<f64>,
+        clamp_to_mps: Option<f64>,
+    ) -> Result<Mission, PlannerError> {
         if self.segments.is_empty() {
             return Err(PlannerError::EmptyMission);
         }
@@ -48,6 +65,7 @@ impl MissionSpec {
         compiler.allow_end_in_air = self.allow_end_in_air;
         compiler.default_speed_mps = self.default_speed_mps;
         compiler.clamp_speeds = self.clamp_speeds;
+        compiler.clamp_to_mps = clamp_to_mps;
         compiler.corners = self.corners.unwrap_or_default();
         for (index, segment) in self.segments.iter().enumerate() {
             compiler.segment(index, segment)?;
@@ -116,6 +134,8 @@ struct Compiler<'a> {
     default_speed_mps: Option<f64>,
     /// Speeds beyond the vehicle's are flown at its maximum (with a warning).
     clamp_speeds: bool,
+    /// The speed clamped speeds are flown at when below the airframe's maximum, m/s.
+    clamp_to_mps: Option<f64>,
     /// What the compiler adjusted, for the reader.
     warnings: Vec<String>,
 }
@@ -160,6 +180,7 @@ impl<'a> Compiler<'a> {
             allow_end_in_air: false,
             default_speed_mps: None,
             clamp_speeds: false,
+            clamp_to_mps: None,
             warnings: Vec::new(),
         };
         compiler.check_take_off_mass(start_payload_kg)?;
@@ -508,12 +529,18 @@ impl<'a> Compiler<'a> {
         )?;
         seg.positive("ground_speed_mps", v, "m/s")?;
         let max = self.airframe.max_speed_mps();
-        if self.clamp_speeds && v > max {
+        let clamp = self.clamp_to_mps.map_or(max, |c| c.min(max));
+        if self.clamp_speeds && v > clamp {
+            let why = if clamp < max {
+                format!("beyond the {clamp:.2} m/s the vehicle can reach within its tilt limit")
+            } else {
+                format!("beyond the vehicle's {max} m/s")
+            };
             self.warnings.push(format!(
-                "{}: ground speed {v} m/s is beyond the vehicle's {max} m/s: flown at {max} m/s",
+                "{}: ground speed {v} m/s is {why}: flown at {clamp:.2} m/s",
                 seg.name()
             ));
-            return Ok(max);
+            return Ok(clamp);
         }
         seg.within("ground_speed_mps", v, max, "m/s")?;
         Ok(v)
@@ -638,9 +665,10 @@ impl<'a> Compiler<'a> {
 
     /// Speed and acceleration along a path `d` (m) with horizontal length `h` and length `len`
     /// flown at a horizontal ground speed: the vertical rate that implies must be within the
-    /// climb or descent limit, and neither acceleration limit is exceeded.
+    /// climb or descent limit (for a mission that clamps its speeds, a planner file, the ground
+    /// speed is lowered until it is, with a warning), and neither acceleration limit is exceeded.
     fn sloped_speed_and_acceleration(
-        &self,
+        &mut self,
         d: [f64; 3],
         h: f64,
         len: f64,
@@ -657,7 +685,17 @@ impl<'a> Compiler<'a> {
                 "descent rate of the leg",
             )
         };
-        self.seg.within(name, vz, vlim, "m/s")?;
+        let ground_speed_mps = if self.clamp_speeds && vz > vlim {
+            let slower = vlim * h / d[2].abs();
+            self.warnings.push(format!(
+                "{}: the {name} at {ground_speed_mps} m/s over the ground would be {vz:.2} m/s, beyond the vehicle's {vlim} m/s: flown at {slower:.2} m/s over the ground",
+                self.seg.name()
+            ));
+            slower
+        } else {
+            self.seg.within(name, vz, vlim, "m/s")?;
+            ground_speed_mps
+        };
         let acc = if d[2].abs() > 1e-9 {
             (a_h * len / h).min(a_v * len / d[2].abs())
         } else {

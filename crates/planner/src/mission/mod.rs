@@ -328,4 +328,42 @@ mod tests {
             legs[1]
         );
     }
+    /// A leg steeper than the climb limit allows at its ground speed: refused in an aloft
+    /// mission, flown slower (the vertical rate at the limit) with a warning in a planner file.
+    #[test]
+    fn a_steep_leg_of_a_planner_file_is_flown_slower() {
+        let text = r#"
+            [[segment]]
+            kind = "take-off"
+            altitude_m = 10.0
+            climb_rate_mps = 2.0
+            [[segment]]
+            kind = "leg"
+            east_m = 20.0
+            north_m = 0.0
+            altitude_m = 40.0
+            ground_speed_mps = 10.0
+            [[segment]]
+            kind = "landing"
+            rate_mps = 1.0
+        "#;
+        let mut spec = MissionSpec::from_toml_str(text).unwrap();
+        let e = spec.compile(&m100_airframe(), 0.68, None).unwrap_err();
+        assert!(e.to_string().contains("climb rate of the leg"), "{e}");
+        spec.clamp_speeds = true;
+        let m = spec.compile(&m100_airframe(), 0.68, None).unwrap();
+        // 30 m up over 20 m at the M100's 5 m/s climb limit: 20/30 x 5 = 3.33 m/s over the ground.
+        assert!(
+            m.warnings()[0].contains("flown at 3.33 m/s"),
+            "{:?}",
+            m.warnings()
+        );
+        let leg = m
+            .pieces()
+            .iter()
+            .find(|p| p.segment == 1 && p.profile.length_m > 0.0)
+            .unwrap();
+        let vz = leg.profile.peak_mps * 30.0 / (20.0f64.hypot(30.0));
+        assert!((vz - 5.0).abs() < 1e-9, "{vz}");
+    }
 }

@@ -441,6 +441,9 @@ mod tests {
             kappa1_w_per_n1_5: 0.1,
             kappa2_w_s2_per_m2_n0_5: 0.0,
             efficiency,
+            mu2_x_n_s2_per_m2: None,
+            mu2_y_n_s2_per_m2: None,
+            efficiency_relative_sd: None,
         })
         .unwrap()
     }

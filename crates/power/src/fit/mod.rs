@@ -4,13 +4,17 @@
 //!   (Gauss-Newton, analytic Jacobian, outlier rejection, standard errors, identifiability checks);
 //! - [`drag`]: the cubic drag of eq (6) per unit mass from the force balance (attitude,
 //!   acceleration and air velocity), as the power seed fits its drag (Fig. 3);
+//! - [`body_drag`]: the quadratic drag coefficient per body axis (forward, right) from the same
+//!   force balance, kept only where the data separates the two;
 //! - [`bounded`]: both fits kept physical (efficiency at most 1, drag never negative) and
 //!   limited to what the data identifies, saying which constants were fitted and which kept.
 
+pub mod body_drag;
 pub mod bounded;
 pub mod drag;
 pub mod power;
 
+pub use body_drag::{fit_body_axis_drag, BodyAxisDragFit, BodyAxisRefusal};
 pub use bounded::{
     fit_drag_bounded, fit_power_model_bounded, BoundedDragFit, BoundedPowerFit, KeptParameter,
 };

@@ -1,0 +1,743 @@
+//! ArduPilot DataFlash (`.bin`), decoded here (sans-I/O, over a [`ByteWindow`]).
+//!
+//! # Format
+//! Every record is `A3 95`, a type byte, then the payload its `FMT` record declares. `FMT`
+//! (type 128, 89 bytes) defines every type: name, length, format characters, column names. The
+//! characters: `b B h H i I q Q` integers, `f d` floats, `n N Z` strings of 4, 16, 64 bytes, `a`
+//! 32 int16, `M` flight mode (u8), and the scaled ones `c C e E` (x 0.01) and `L` (x 1e-7,
+//! degrees). `MULT` and `FMTU` records (newer logs) give per-column multipliers, applied here to
+//! unscaled integer columns.
+//!
+//! # What is read
+//! - `ATT` is the time base (attitude). Its angles are degrees when the column is `f`/`d` or a
+//!   scaled `c`/`C`, centidegrees when an unscaled integer (old logs) unless `FMTU` says otherwise.
+//! - `POS` (or, without `POS`, a `GPS` with a 3D fix): position, ENU from the first fix.
+//! - `GPS` with a 3D fix: ground velocity from `Spd`, `GCrs`, `VZ` (down).
+//! - `BAT` of the chosen instance (`Instance` or `Inst`), else old `CURR`: `Volt`, `Curr`. Old
+//!   `CURR` integers have no multiplier in the file: their scale (centi-units in the logs seen)
+//!   is chosen so the first non-zero voltage is 3.3-4.4 V per cell for some 1-14 cells. A
+//!   record counts when `Volt` > 0 (a battery that reads 0 V has no sensor).
+//! - `PARM` (`BATT_CAPACITY`), `CTUN`, `MODE`, `CMD`: counted (and decoded by [`DataflashRecords`]).
+//!
+//! # Time
+//! `TimeUS` (microseconds since boot) or, in old logs, `TimeMS` (milliseconds since boot). `GPS`
+//! `TimeMS` is GPS time of week, never boot time: a GPS record without `TimeUS` takes its boot
+//! time from `T` (ms), or is not joined.
+//!
+//! # Robustness
+//! A record that does not start with `A3 95`, or whose type has no `FMT`, starts a scan for the
+//! next `A3 95` of a declared type followed by another record header (or the end); the bytes
+//! skipped are counted and reported with their offset. A truncated last record is a warning.
+
+use std::io::Read;
+use std::path::Path;
+
+use crate::binary::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
+use crate::bytes::ByteWindow;
+use crate::csv_read::wrap_pi;
+use crate::error::{LogError, Result};
+use crate::frame::geodetic_to_enu;
+use crate::join::{Event, Stream};
+use crate::sample::{Attitude, GeoOrigin, Sample};
+
+/// The first bytes of a DataFlash log: a record header and the type of `FMT`.
+pub const DATAFLASH_MAGIC: [u8; 3] = [0xA3, 0x95, 0x80];
+
+/// Type id of `FMT`.
+const FMT_TYPE: u8 = 0x80;
+/// Length of an `FMT` record, header included.
+const FMT_LEN: usize = 89;
+
+/// Size and scale of a format character (`None`: unknown character).
+fn char_size(c: u8) -> Option<usize> {
+    Some(match c {
+        b'b' | b'B' | b'M' => 1,
+        b'h' | b'H' | b'c' | b'C' => 2,
+        b'i' | b'I' | b'e' | b'E' | b'L' | b'f' | b'n' => 4,
+        b'd' | b'q' | b'Q' => 8,
+        b'N' => 16,
+        b'Z' | b'a' => 64,
+        _ => return None,
+    })
+}
+
+/// Whether a character is an integer without a scale of its own (a multiplier may apply).
+fn unscaled_int(c: u8) -> bool {
+    matches!(
+        c,
+        b'b' | b'B' | b'h' | b'H' | b'i' | b'I' | b'q' | b'Q' | b'M'
+    )
+}
+
+/// A numeric value of character `c` at the start of `b`, scaled by the character.
+fn number(c: u8, b: &[u8]) -> Option<f64> {
+    fn a<const N: usize>(b: &[u8]) -> Option<[u8; N]> {
+        b.get(..N)?.try_into().ok()
+    }
+    Some(match c {
+        b'b' => i8::from_le_bytes(a(b)?) as f64,
+        b'B' | b'M' => *b.first()? as f64,
+        b'h' => i16::from_le_bytes(a(b)?) as f64,
+        b'H' => u16::from_le_bytes(a(b)?) as f64,
+        b'c' => i16::from_le_bytes(a(b)?) as f64 * 0.01,
+        b'C' => u16::from_le_bytes(a(b)?) as f64 * 0.01,
+        b'i' => i32::from_le_bytes(a(b)?) as f64,
+        b'I' => u32::from_le_bytes(a(b)?) as f64,
+        b'e' => i32::from_le_bytes(a(b)?) as f64 * 0.01,
+        b'E' => u32::from_le_bytes(a(b)?) as f64 * 0.01,
+        b'L' => i32::from_le_bytes(a(b)?) as f64 * 1e-7,
+        b'f' => f32::from_le_bytes(a(b)?) as f64,
+        b'd' => f64::from_le_bytes(a(b)?),
+        b'q' => i64::from_le_bytes(a(b)?) as f64,
+        b'Q' => u64::from_le_bytes(a(b)?) as f64,
+        _ => return None,
+    })
+}
+
+/// The text of a NUL-padded string column.
+fn text(b: &[u8]) -> String {
+    let end = b.iter().position(|c| *c == 0).unwrap_or(b.len());
+    String::from_utf8_lossy(&b[..end]).into_owned()
+}
+
+/// One column of a record type.
+#[derive(Debug, Clone)]
+pub struct Column {
+    /// Its name.
+    pub name: String,
+    /// Its format character.
+    pub format: u8,
+    /// Offset in the payload (after the 3-byte header).
+    pub offset: usize,
+    /// Multiplier from `FMTU`/`MULT` (unscaled integer columns only).
+    pub mult: Option<f64>,
+}
+
+/// A record type declared by `FMT`.
+#[derive(Debug, Clone)]
+pub struct Format {
+    /// Type id.
+    pub type_id: u8,
+    /// Name (`BAT`, `ATT`, ...).
+    pub name: String,
+    /// Length with the header, bytes.
+    pub length: usize,
+    /// Columns.
+    pub columns: Vec<Column>,
+}
+
+impl Format {
+    fn col(&self, name: &str) -> Option<&Column> {
+        self.columns.iter().find(|c| c.name == name)
+    }
+
+    /// The numeric value of column `name` in `payload` (character scale and multiplier applied).
+    pub fn num(&self, payload: &[u8], name: &str) -> Option<f64> {
+        let c = self.col(name)?;
+        let v = number(c.format, payload.get(c.offset..)?)?;
+        Some(v * c.mult.unwrap_or(1.0))
+    }
+
+    /// The value of column `name` scaled by its character only (time stamps).
+    pub fn raw(&self, payload: &[u8], name: &str) -> Option<f64> {
+        let c = self.col(name)?;
+        number(c.format, payload.get(c.offset..)?)
+    }
+
+    /// The text of string column `name`.
+    pub fn text(&self, payload: &[u8], name: &str) -> Option<String> {
+        let c = self.col(name)?;
+        let n = char_size(c.format)?;
+        Some(text(payload.get(c.offset..c.offset + n)?))
+    }
+
+    /// Parse an `FMT` payload; `None` when it is not a usable definition.
+    fn parse(p: &[u8]) -> Option<Self> {
+        let type_id = *p.first()?;
+        let length = *p.get(1)? as usize;
+        let name = text(p.get(2..6)?);
+        let chars: Vec<u8> = p
+            .get(6..22)?
+            .iter()
+            .copied()
+            .take_while(|c| *c != 0)
+            .collect();
+        let names = text(p.get(22..86)?);
+        let names: Vec<&str> = if names.is_empty() {
+            Vec::new()
+        } else {
+            names.split(',').collect()
+        };
+        if name.is_empty() || length < 3 || (type_id == FMT_TYPE && length != FMT_LEN) {
+            return None;
+        }
+        let mut offset = 0;
+        let mut columns = Vec::with_capacity(chars.len());
+        for (i, c) in chars.iter().enumerate() {
+            let size = char_size(*c)?;
+            columns.push(Column {
+                name: names
+                    .get(i)
+                    .map_or_else(|| format!("col{i}"), |n| n.to_string()),
+                format: *c,
+                offset,
+                mult: None,
+            });
+            offset += size;
+        }
+        (offset <= length - 3).then_some(Format {
+            type_id,
+            name,
+            length,
+            columns,
+        })
+    }
+}
+
+/// The `FMT` of `FMT`, which every log starts from.
+fn fmt_of_fmt() -> Format {
+    let mut p = vec![FMT_TYPE, FMT_LEN as u8];
+    p.extend_from_slice(b"FMT\0");
+    let mut f = [0u8; 16];
+    f[..5].copy_from_slice(b"BBnNZ");
+    p.extend_from_slice(&f);
+    let mut c = [0u8; 64];
+    c[..30].copy_from_slice(b"Type,Length,Name,Format,Column");
+    p.extend_from_slice(&c);
+    Format::parse(&p).expect("the FMT of FMT is valid")
+}
+
+/// The records the join reads, by role.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    Att,
+    Pos,
+    Gps,
+    Bat,
+    Curr,
+    Parm,
+    Fmtu,
+    Mult,
+    Counted,
+    Other,
+}
+
+fn role(name: &str) -> Role {
+    match name {
+        "ATT" => Role::Att,
+        "POS" => Role::Pos,
+        "GPS" => Role::Gps,
+        "BAT" => Role::Bat,
+        "CURR" => Role::Curr,
+        "PARM" => Role::Parm,
+        "FMTU" => Role::Fmtu,
+        "MULT" => Role::Mult,
+        "CTUN" | "MODE" | "CMD" | "UNIT" => Role::Counted,
+        _ => Role::Other,
+    }
+}
+
+/// The record framing and `FMT` table of a DataFlash log: yields raw records, skipping
+/// corruption (see the module docs).
+pub struct Framer {
+    formats: Vec<Option<Format>>,
+    roles: Vec<Role>,
+    mults: Vec<(u8, f64)>,
+}
+
+impl Default for Framer {
+    fn default() -> Self {
+        let mut formats = vec![None; 256];
+        formats[FMT_TYPE as usize] = Some(fmt_of_fmt());
+        Self {
+            formats,
+            roles: vec![Role::Other; 256],
+            mults: Vec::new(),
+        }
+    }
+}
+
+impl Framer {
+    /// The format of type `t`.
+    pub fn format(&self, t: u8) -> Option<&Format> {
+        self.formats[t as usize].as_ref()
+    }
+
+    /// Length of a valid record starting at `h` (header bytes), if its type is declared.
+    fn plausible(&self, h: &[u8]) -> Option<usize> {
+        (h.len() >= 3 && h[0] == 0xA3 && h[1] == 0x95)
+            .then(|| self.format(h[2]).map(|f| f.length))
+            .flatten()
+    }
+
+    /// Skip to the next record header of a declared type followed by another (or the end).
+    fn resync<R: Read>(&self, w: &mut ByteWindow<R>, s: &mut BinarySummary, from: u64) -> bool {
+        w.consume(1);
+        loop {
+            let h = w.peek_max(3);
+            if h.len() < 3 {
+                break;
+            }
+            if let Some(len) = self.plausible(h) {
+                let next = w.peek_max(len + 3);
+                if next.len() == len || self.plausible(&next[len.min(next.len())..]).is_some() {
+                    let skipped = w.offset() - from;
+                    s.bytes_skipped += skipped;
+                    s.warn(format!(
+                        "corrupt DataFlash data at byte {from}: skipped {skipped} bytes to the next record at byte {}",
+                        w.offset()
+                    ));
+                    return true;
+                }
+            }
+            w.consume(1);
+        }
+        let skipped = w.offset() + w.remaining() as u64 - from;
+        s.bytes_skipped += skipped;
+        s.warn(format!(
+            "corrupt DataFlash data at byte {from}: no valid record in the {skipped} bytes after it"
+        ));
+        false
+    }
+
+    /// The next record: its offset, type and payload (copied into `payload`). `None` at the end.
+    pub fn next_record<R: Read>(
+        &mut self,
+        w: &mut ByteWindow<R>,
+        s: &mut BinarySummary,
+        payload: &mut Vec<u8>,
+    ) -> Option<(u64, u8)> {
+        loop {
+            let at = w.offset();
+            let h = w.peek_max(3);
+            if h.len() < 3 {
+                if !h.is_empty() {
+                    s.warn(format!(
+                        "truncated DataFlash: {} bytes at byte {at} are not a whole record header",
+                        h.len()
+                    ));
+                }
+                return None;
+            }
+            let Some(len) = self.plausible(h) else {
+                let what = if h[0] == 0xA3 && h[1] == 0x95 {
+                    format!("record type {} has no FMT", h[2])
+                } else {
+                    format!("bytes {:02x} {:02x} are not a record header", h[0], h[1])
+                };
+                s.warn(format!("DataFlash record at byte {at}: {what}"));
+                if !self.resync(w, s, at) {
+                    return None;
+                }
+                continue;
+            };
+            let t = h[2];
+            let Some(rec) = w.peek(len) else {
+                let name = self.format(t).map_or(String::new(), |f| f.name.clone());
+                s.warn(format!(
+                    "truncated or corrupt DataFlash: the {name} record at byte {at} needs {len} bytes, {} remain",
+                    w.remaining()
+                ));
+                if !self.resync(w, s, at) {
+                    return None;
+                }
+                continue;
+            };
+            payload.clear();
+            payload.extend_from_slice(&rec[3..]);
+            w.consume(len);
+            if t == FMT_TYPE {
+                self.define(payload, s, at);
+            }
+            return Some((at, t));
+        }
+    }
+
+    fn define(&mut self, p: &[u8], s: &mut BinarySummary, at: u64) {
+        match Format::parse(p) {
+            Some(f) if f.type_id != FMT_TYPE => {
+                let t = f.type_id as usize;
+                self.roles[t] = role(&f.name);
+                self.formats[t] = Some(f);
+            }
+            Some(_) => {}
+            None => s.warn(format!(
+                "DataFlash FMT at byte {at} is not a valid definition; ignored"
+            )),
+        }
+    }
+
+    /// `MULT`: a multiplier id and its value.
+    fn mult(&mut self, f: &Format, p: &[u8]) {
+        if let (Some(id), Some(m)) = (f.num(p, "Id"), f.num(p, "Mult")) {
+            self.mults.retain(|(i, _)| *i != id as u8);
+            self.mults.push((id as u8, m));
+        }
+    }
+
+    /// `FMTU`: multipliers of one type's columns (unscaled integers only; `-` and `?` mean none).
+    fn fmtu(&mut self, f: &Format, p: &[u8]) {
+        let (Some(t), Some(ids)) = (f.num(p, "FmtType"), f.text(p, "MultIds")) else {
+            return;
+        };
+        let mults = self.mults.clone();
+        let Some(target) = self.formats[(t as usize).min(255)].as_mut() else {
+            return;
+        };
+        for (c, id) in target.columns.iter_mut().zip(ids.bytes()) {
+            if unscaled_int(c.format) && id != b'-' && id != b'?' {
+                c.mult = mults
+                    .iter()
+                    .find(|(i, _)| *i == id)
+                    .map(|(_, m)| *m)
+                    .filter(|m| m.is_finite() && *m != 0.0);
+            }
+        }
+    }
+}
+
+/// The state of the DataFlash decoder.
+pub struct DataflashDecoder {
+    options: BinaryOptions,
+    framer: Framer,
+    payload: Vec<u8>,
+    origin: Option<GeoOrigin>,
+    has_bat: bool,
+    has_pos: bool,
+    curr_scale: Option<f64>,
+    untimed: u64,
+}
+
+/// Boot time of a record, s: `TimeUS`, else `TimeMS` (not for GPS), else GPS `T` (ms).
+fn boot_time_s(f: &Format, p: &[u8]) -> Option<f64> {
+    if let Some(us) = f.raw(p, "TimeUS") {
+        return Some(us * 1e-6);
+    }
+    if f.name.starts_with("GPS") {
+        return f.raw(p, "T").map(|ms| ms * 1e-3);
+    }
+    f.raw(p, "TimeMS").map(|ms| ms * 1e-3)
+}
+
+/// The scale of old integer `CURR` voltages: the first of centi, milli and whole units that puts
+/// `raw` at 3.3-4.4 V per cell for some 1-14 cells (centi when none does).
+fn curr_scale(raw: f64) -> f64 {
+    let fits = |v: f64| (1..=14).any(|n| (3.3..=4.4).contains(&(v / n as f64)));
+    [0.01, 0.001, 1.0]
+        .into_iter()
+        .find(|k| fits(raw * k))
+        .unwrap_or(0.01)
+}
+
+impl DataflashDecoder {
+    /// A decoder that has read nothing.
+    pub fn new(options: BinaryOptions) -> Self {
+        Self {
+            options,
+            framer: Framer::default(),
+            payload: Vec::new(),
+            origin: None,
+            has_bat: false,
+            has_pos: false,
+            curr_scale: None,
+            untimed: 0,
+        }
+    }
+
+    /// The origin of the ENU positions (the first fix).
+    pub fn origin(&self) -> Option<GeoOrigin> {
+        self.origin
+    }
+
+    /// The event of the record just framed, if the join keeps it.
+    fn event(&mut self, t: u8, s: &mut BinarySummary) -> Option<Event> {
+        let r = self.framer.roles[t as usize];
+        if r == Role::Other {
+            return None;
+        }
+        // Taken out of the table while it is used (put back below), so nothing is cloned.
+        let f = self.framer.formats[t as usize].take()?;
+        let p = std::mem::take(&mut self.payload);
+        s.count(&f.name);
+        let e = self.by_role(r, &f, &p, s);
+        self.payload = p;
+        self.framer.formats[t as usize] = Some(f);
+        e
+    }
+
+    fn by_role(&mut self, r: Role, f: &Format, p: &[u8], s: &mut BinarySummary) -> Option<Event> {
+        match r {
+            Role::Fmtu => self.framer.fmtu(f, p),
+            Role::Mult => self.framer.mult(f, p),
+            Role::Parm => {
+                let name = f.text(p, "Name")?;
+                let v = f.num(p, "Value")?;
+                if name == "BATT_CAPACITY" && v > 0.0 {
+                    s.battery_capacity_ah = Some(v / 1000.0);
+                }
+            }
+            Role::Att | Role::Pos | Role::Gps | Role::Bat | Role::Curr => {
+                let Some(time_s) = boot_time_s(f, p) else {
+                    self.untimed += 1;
+                    return None;
+                };
+                let (stream, sample) = match r {
+                    Role::Att => (Stream::Base, self.attitude(f, p)?),
+                    Role::Pos => (Stream::Position, self.position(f, p)?),
+                    Role::Gps => return self.gps(f, p, time_s),
+                    _ => (Stream::Battery, self.battery(r, f, p, time_s, s)?),
+                };
+                return Some(Event {
+                    time_s,
+                    stream,
+                    sample,
+                });
+            }
+            Role::Counted | Role::Other => {}
+        }
+        None
+    }
+
+    fn attitude(&self, f: &Format, p: &[u8]) -> Option<Sample> {
+        let deg = |name: &str| -> Option<f64> {
+            let c = f.col(name)?;
+            let v = f.num(p, name)?;
+            // Unscaled integers without a multiplier are centidegrees (old logs).
+            Some(if unscaled_int(c.format) && c.mult.is_none() {
+                v * 0.01
+            } else {
+                v
+            })
+        };
+        let (r, pi, y) = (deg("Roll")?, deg("Pitch")?, deg("Yaw")?);
+        [r, pi, y].iter().all(|x| x.is_finite()).then_some(())?;
+        Some(Sample {
+            attitude: Some(Attitude {
+                roll_rad: r.to_radians(),
+                pitch_rad: pi.to_radians(),
+                yaw_rad: wrap_pi(y.to_radians()),
+            }),
+            ..Sample::default()
+        })
+    }
+
+    fn enu(&mut self, lat: f64, lon: f64, alt: f64) -> Option<[f64; 3]> {
+        if !(lat.is_finite() && lon.is_finite() && alt.is_finite()) || (lat == 0.0 && lon == 0.0) {
+            return None;
+        }
+        let o = *self.origin.get_or_insert(GeoOrigin {
+            lat_rad: lat.to_radians(),
+            lon_rad: lon.to_radians(),
+            alt_m: alt,
+        });
+        Some(geodetic_to_enu(&o, lat.to_radians(), lon.to_radians(), alt))
+    }
+
+    fn position(&mut self, f: &Format, p: &[u8]) -> Option<Sample> {
+        let pos = self.enu(f.num(p, "Lat")?, f.num(p, "Lng")?, f.num(p, "Alt")?)?;
+        Some(Sample {
+            pos_enu_m: Some(pos),
+            ..Sample::default()
+        })
+    }
+
+    /// A GPS record with a 3D fix: velocity, and position when the log has no POS.
+    fn gps(&mut self, f: &Format, p: &[u8], time_s: f64) -> Option<Event> {
+        if f.num(p, "Status")? < 3.0 {
+            return None;
+        }
+        let (spd, crs) = (f.num(p, "Spd")?, f.num(p, "GCrs")?.to_radians());
+        let vz = f.num(p, "VZ").unwrap_or(0.0);
+        let vel = [spd * crs.sin(), spd * crs.cos(), -vz];
+        if self.has_pos {
+            return vel.iter().all(|x| x.is_finite()).then_some(Event {
+                time_s,
+                stream: Stream::Velocity,
+                sample: Sample {
+                    vel_enu_mps: Some(vel),
+                    ..Sample::default()
+                },
+            });
+        }
+        let pos = self.enu(f.num(p, "Lat")?, f.num(p, "Lng")?, f.num(p, "Alt")?);
+        // Without POS, GPS feeds position too (through the velocity stream's record).
+        Some(Event {
+            time_s,
+            stream: Stream::Velocity,
+            sample: Sample {
+                vel_enu_mps: vel.iter().all(|x| x.is_finite()).then_some(vel),
+                pos_enu_m: pos,
+                ..Sample::default()
+            },
+        })
+    }
+
+    fn battery(
+        &mut self,
+        r: Role,
+        f: &Format,
+        p: &[u8],
+        t: f64,
+        s: &mut BinarySummary,
+    ) -> Option<Sample> {
+        if r == Role::Curr && self.has_bat {
+            return None;
+        }
+        let inst = f
+            .num(p, "Instance")
+            .or_else(|| f.num(p, "Inst"))
+            .unwrap_or(0.0) as u8;
+        if !s.battery_instances.contains(&inst) {
+            s.battery_instances.push(inst);
+        }
+        if inst != self.options.battery_instance {
+            return None;
+        }
+        let (mut v, mut i) = (f.num(p, "Volt")?, f.num(p, "Curr")?);
+        if r == Role::Curr && f.col("Volt").is_some_and(|c| unscaled_int(c.format)) {
+            if self.curr_scale.is_none() && v > 0.0 {
+                let k = curr_scale(v);
+                self.curr_scale = Some(k);
+                s.warn(format!(
+                    "CURR Volt and Curr are integers without a unit in the file: read as x{k} (first voltage {:.2} V)",
+                    v * k
+                ));
+            }
+            let k = self.curr_scale.unwrap_or(0.01);
+            v *= k;
+            i *= k;
+        }
+        s.battery.records += 1;
+        if !(v.is_finite() && v > 0.0 && i.is_finite()) {
+            s.battery.no_voltage += 1;
+            return None;
+        }
+        s.battery.push(t, v, i);
+        Some(Sample {
+            voltage_v: Some(v),
+            current_a: Some(i),
+            ..Sample::default()
+        })
+    }
+
+    fn declare(&mut self, s: &mut BinarySummary) {
+        let names =
+            |n: &str| (0..=255u8).any(|t| self.framer.format(t).is_some_and(|f| f.name == n));
+        self.has_bat = names("BAT");
+        self.has_pos = names("POS");
+        s.battery_declared = self.has_bat || names("CURR");
+    }
+}
+
+impl Decoder for DataflashDecoder {
+    fn next_event<R: Read>(
+        &mut self,
+        w: &mut ByteWindow<R>,
+        s: &mut BinarySummary,
+    ) -> Option<Event> {
+        loop {
+            let Some((_, t)) = self.framer.next_record(w, s, &mut self.payload) else {
+                if self.untimed > 0 {
+                    s.warn(format!(
+                        "{} records without a boot time stamp were not joined",
+                        self.untimed
+                    ));
+                }
+                return None;
+            };
+            if t == FMT_TYPE {
+                self.declare(s);
+                continue;
+            }
+            if let Some(e) = self.event(t, s) {
+                return Some(e);
+            }
+        }
+    }
+
+    fn origin(&self) -> Option<GeoOrigin> {
+        self.origin
+    }
+}
+
+/// Whether `head` (the first bytes of a file) is a DataFlash log.
+pub fn is_dataflash(head: &[u8]) -> bool {
+    head.starts_with(&DATAFLASH_MAGIC)
+}
+
+/// Joined samples of the DataFlash log read from `reader`; `path` names it in errors.
+///
+/// # Errors
+/// [`LogError::UnsupportedFormat`] when the input does not start with `A3 95 80`.
+pub fn dataflash_samples<R: Read>(
+    reader: R,
+    options: &BinaryOptions,
+    path: &Path,
+) -> Result<BinarySamples<R, DataflashDecoder>> {
+    let mut it = BinarySamples::with_decoder(reader, DataflashDecoder::new(*options), options);
+    if !is_dataflash(it.window.peek_max(3)) {
+        return Err(LogError::UnsupportedFormat {
+            path: path.to_path_buf(),
+            reason: "not a DataFlash log: it does not start with the FMT record (A3 95 80)".into(),
+        });
+    }
+    Ok(it)
+}
+
+/// Every record of a DataFlash log with its numeric columns (for inspection and cross-checks).
+pub struct DataflashRecords<R> {
+    window: ByteWindow<R>,
+    framer: Framer,
+    payload: Vec<u8>,
+    /// Warnings and bytes skipped.
+    pub summary: BinarySummary,
+}
+
+/// One decoded record.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// Offset of its header, bytes.
+    pub offset: u64,
+    /// Type name.
+    pub name: String,
+    /// Numeric columns (scaled), by name; string columns are left out.
+    pub values: Vec<(String, f64)>,
+}
+
+impl<R: Read> DataflashRecords<R> {
+    /// Records of `reader`.
+    pub fn new(reader: R) -> Self {
+        Self {
+            window: ByteWindow::new(reader),
+            framer: Framer::default(),
+            payload: Vec::new(),
+            summary: BinarySummary::default(),
+        }
+    }
+}
+
+impl<R: Read> Iterator for DataflashRecords<R> {
+    type Item = Record;
+
+    fn next(&mut self) -> Option<Record> {
+        let (offset, t) =
+            self.framer
+                .next_record(&mut self.window, &mut self.summary, &mut self.payload)?;
+        let f = self.framer.format(t)?.clone();
+        match role(&f.name) {
+            Role::Fmtu => self.framer.fmtu(&f, &self.payload),
+            Role::Mult => self.framer.mult(&f, &self.payload),
+            _ => {}
+        }
+        let values = f
+            .columns
+            .iter()
+            .filter_map(|c| Some((c.name.clone(), f.num(&self.payload, &c.name)?)))
+            .collect();
+        Some(Record {
+            offset,
+            name: f.name.clone(),
+            values,
+        })
+    }
+}
