@@ -137,5 +137,39 @@ fn bench_queries(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_mission, bench_queries);
+/// `planner/monte_carlo/demo_1000` (issue 17): 1000 scenarios of the built-in demo mission
+/// (payload, capacity and model error drawn, so that every scenario flies the whole route) on
+/// every core, in under 2 s on the 2-core machine. `demo_1000_one_thread` shows what the second
+/// core gives.
+fn bench_monte_carlo(c: &mut Criterion) {
+    use aloft::engine::{plan_scenarios, Mission, MissionOptions, ScenarioOptions, Vehicle};
+    let v = Vehicle::builtin("dji-m100").unwrap();
+    let m = Mission::demo();
+    let o = MissionOptions::default();
+    let sc = ScenarioOptions {
+        samples: 1000,
+        payload_sd_kg: 0.1,
+        capacity_sd_percent: 5.0,
+        ..ScenarioOptions::default()
+    };
+    let mut g = c.benchmark_group("planner/monte_carlo");
+    g.sample_size(10);
+    g.bench_function("demo_1000", |b| {
+        b.iter(|| {
+            plan_scenarios(black_box(&v), black_box(&m), black_box(&o), black_box(&sc)).unwrap()
+        })
+    });
+    let one = ScenarioOptions {
+        threads: 1,
+        ..sc.clone()
+    };
+    g.bench_function("demo_1000_one_thread", |b| {
+        b.iter(|| {
+            plan_scenarios(black_box(&v), black_box(&m), black_box(&o), black_box(&one)).unwrap()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_mission, bench_queries, bench_monte_carlo);
 criterion_main!(benches);

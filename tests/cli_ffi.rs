@@ -119,6 +119,24 @@ fn mission_answers_are_the_same_bytes() {
             Some(example.as_str()),
             r#"{"battery": "TB48D"}"#.into(),
         ),
+        // Monte-Carlo scenarios (issue 17): the C ABI's `scenarios` object is `--samples` and the
+        // spreads; both add the same `uncertainty`.
+        (
+            vec![
+                "--samples", "40", "--seed", "7", "--wind-speed-sd", "1", "--wind-from-sd", "10",
+                "--payload-sd-kg", "0.1", "--capacity-sd-percent", "4", "--time-step", "0.5",
+            ],
+            None,
+            r#"{"time_step_s": 0.5, "scenarios": {"samples": 40, "seed": 7, "wind_speed_sd_mps": 1, "wind_from_sd_deg": 10, "payload_sd_kg": 0.1, "capacity_sd_percent": 4}}"#.into(),
+        ),
+        (
+            vec![
+                "--samples", "12", "--power-sd-percent", "0", "--wind-speed", "3", "--wind-from",
+                "90", "--gust-std", "1", "--time-step", "0.5",
+            ],
+            None,
+            r#"{"time_step_s": 0.5, "wind": {"speed_mps": 3, "from_deg": 90}, "gusts": {"std_mps": 1, "seed": 1}, "scenarios": {"samples": 12, "power_sd_percent": 0, "threads": 1}}"#.into(),
+        ),
     ];
     for (flags, mission, options) in cases {
         let mut args = vec!["mission", "--format", "json"];

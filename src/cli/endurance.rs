@@ -8,8 +8,8 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 
 use aloft::engine::{
-    endurance, power_curve, AoaModel, EnduranceOptions, EnduranceSummary, PowerCurve, SweepRow,
-    Vehicle,
+    endurance, endurance_scenarios, power_curve, AoaModel, EnduranceOptions, EnduranceSummary,
+    EnduranceWithUncertainty, PowerCurve, SweepRow, Vehicle,
 };
 
 use super::args::{aoa_parser, SteadyWindArgs};
@@ -59,6 +59,9 @@ pub struct EnduranceArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
+    /// Monte-Carlo scenarios (--samples N and the spreads; no gusts).
+    #[command(flatten)]
+    scenarios: super::scenarios::ScenarioArgs,
 }
 
 impl EnduranceArgs {
@@ -82,6 +85,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if let Some(step) = args.sweep_speed {
+        args.scenarios.refuse_with("--sweep-speed")?;
         let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
             plot_sweep(p, &curve.context.vehicle, &curve.rows)
@@ -98,9 +102,26 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
         bail!("aloft endurance writes table or json (csv with --sweep-speed)");
     }
     let summary = endurance(&vehicle, &options)?;
-    match args.format {
-        Format::Json => output::write_json(&mut out, &summary)?,
-        Format::Csv | Format::Table => write_table(&mut out, &summary, args.reserve_percent)?,
+    let uncertainty = match args.scenarios.options(false) {
+        Some(sc) => Some(endurance_scenarios(&vehicle, &options, &sc)?),
+        None => None,
+    };
+    match (args.format, &uncertainty) {
+        (Format::Json, None) => output::write_json(&mut out, &summary)?,
+        (Format::Json, Some(u)) => output::write_json(
+            &mut out,
+            &EnduranceWithUncertainty {
+                summary: &summary,
+                uncertainty: u,
+            },
+        )?,
+        (Format::Csv | Format::Table, _) => {
+            write_table(&mut out, &summary, args.reserve_percent)?;
+            if let Some(u) = &uncertainty {
+                writeln!(out)?;
+                super::scenarios::write_endurance_lines(&mut out, u)?;
+            }
+        }
     }
     Ok(Outcome::Ok)
 }

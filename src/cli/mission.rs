@@ -103,6 +103,9 @@ pub struct MissionArgs {
     /// Window of the velocity difference for --acceleration velocity, s.
     #[arg(value_parser = super::args::finite(), long, default_value_t = 1.0, value_name = "S")]
     pub acceleration_window: f64,
+    /// Monte-Carlo scenarios (--samples N and the spreads).
+    #[command(flatten)]
+    pub scenarios: super::scenarios::ScenarioArgs,
 }
 
 /// Where the replay takes the acceleration from.
@@ -147,6 +150,7 @@ impl MissionArgs {
 
 pub fn run(args: MissionArgs) -> Result<Outcome> {
     if args.replay.is_some() {
+        args.scenarios.refuse_with("--replay")?;
         return super::replay::run(&args);
     }
     if args.format == Format::Csv {
@@ -155,6 +159,17 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     let vehicle = Vehicle::load(&args.vehicle)?;
     let mission = Mission::load(args.mission.as_deref())?;
     let plan = plan_mission_with(&vehicle, &mission, &args.options(), &args.outputs())?;
+    if let Some(sc) = args.scenarios.options(args.plot.is_some()) {
+        let run = super::scenarios::MissionRun {
+            vehicle: &vehicle,
+            mission: &mission,
+            options: &args.options(),
+            plan: &plan,
+            plot: args.plot.as_deref(),
+            format: args.format,
+        };
+        return super::scenarios::run_mission(&run, &sc);
+    }
     if let Some(path) = &args.plot {
         let name = mission.spec().name.as_str();
         plot(
@@ -194,6 +209,11 @@ fn write_table(out: &mut impl Write, plan: &Plan) -> Result<()> {
     write_segments(out, plan.report())?;
     writeln!(out)?;
     write_sorties(out, plan.summary())?;
+    write_model_line(out, plan)
+}
+
+/// The model the plan was computed with, in one line.
+pub(super) fn write_model_line(out: &mut impl Write, plan: &Plan) -> Result<()> {
     let c = plan.context();
     writeln!(
         out,
@@ -213,7 +233,7 @@ fn write_table(out: &mut impl Write, plan: &Plan) -> Result<()> {
 }
 
 /// Mission, vehicle, pack and wind; the verdict and the point of no return.
-fn header(plan: &Plan) -> Result<String> {
+pub(super) fn header(plan: &Plan) -> Result<String> {
     let (s, c, r) = (plan.summary(), plan.context(), plan.report());
     let mut head = String::new();
     let desc = if c.description.is_empty() {
@@ -320,7 +340,7 @@ fn route_line(r: &RouteFigures) -> String {
 }
 
 /// Batteries and sorties, when the route takes more than one pack or cannot be split.
-fn write_sorties(out: &mut impl Write, s: &aloft::engine::MissionSummary) -> Result<()> {
+pub(super) fn write_sorties(out: &mut impl Write, s: &aloft::engine::MissionSummary) -> Result<()> {
     if s.sorties.is_empty() {
         if s.batteries_required.is_none() && !s.feasible {
             writeln!(out, "Batteries required: unknown (see the warning above).")?;
@@ -357,7 +377,7 @@ fn write_sorties(out: &mut impl Write, s: &aloft::engine::MissionSummary) -> Res
     Ok(())
 }
 
-fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
+pub(super) fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
     let mean_w = if r.duration_s > 0.0 {
         r.energy_wh * 3600.0 / r.duration_s
     } else {

@@ -15,6 +15,7 @@ mod power;
 mod propulsion;
 mod replay;
 mod rotor;
+mod scenarios;
 mod validate;
 mod vehicles;
 

@@ -4,7 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{EnduranceQuery, EnduranceReport, Pack, Powered, SweepRow, Wind, WindSpec};
+use aloft_planner::{
+    Aircraft, EnduranceQuery, EnduranceReport, Pack, Powered, SweepRow, Wind, WindSpec,
+};
 use aloft_power::AoaModel;
 
 use super::finite::finite;
@@ -199,10 +201,38 @@ struct Setup<'a> {
     wind_text: String,
 }
 
+/// The queries' report for `aircraft` and `battery` in place of the vehicle's own (a scenario's,
+/// scaled by its draws), with the options' payload and wind.
+///
+/// # Errors
+/// As [`endurance`].
+pub(super) fn endurance_report(
+    vehicle: &Vehicle,
+    aircraft: &Aircraft,
+    battery: &Pack,
+    options: &EnduranceOptions,
+) -> Result<EnduranceReport, Error> {
+    let setup = Setup::with(vehicle, aircraft, battery.clone(), options)?;
+    Ok(aloft_planner::endurance(
+        &setup.powered,
+        &setup.battery,
+        &setup.query,
+    )?)
+}
+
 impl<'a> Setup<'a> {
     fn new(vehicle: &'a Vehicle, options: &EnduranceOptions) -> Result<Self, Error> {
         let aircraft = vehicle.aircraft()?;
         let battery = vehicle.battery(options.battery.as_deref())?;
+        Self::with(vehicle, aircraft, battery, options)
+    }
+
+    fn with(
+        vehicle: &Vehicle,
+        aircraft: &'a Aircraft,
+        battery: Pack,
+        options: &EnduranceOptions,
+    ) -> Result<Self, Error> {
         let mass_kg = takeoff_mass_kg(vehicle, &battery, options.payload_kg)?;
         let powered = aircraft.at_mass(mass_kg, options.aoa)?;
         let (wind, wind_text) = steady_wind(options.wind.as_ref())?;

@@ -570,7 +570,7 @@ fn fly_into_outputs(
 
 /// The options' own values, before anything is flown: a planning speed and an RTL altitude are
 /// positive and finite.
-fn check_options(options: &MissionOptions) -> Result<(), Error> {
+pub(super) fn check_options(options: &MissionOptions) -> Result<(), Error> {
     let positive = |name: &'static str, value: Option<f64>, unit: &'static str| match value {
         Some(v)
             if !(v.is_finite() && v > 0.0 && v <= aloft_planner::mission::MAX_MISSION_VALUE) =>
@@ -590,7 +590,10 @@ fn check_options(options: &MissionOptions) -> Result<(), Error> {
 
 /// The planner's options: the request's, else the mission file's, else the defaults (reserve
 /// 20 %, time step 0.1 s).
-fn planner_options(options: &MissionOptions, spec: &MissionSpec) -> Result<PlanOptions, Error> {
+pub(super) fn planner_options(
+    options: &MissionOptions,
+    spec: &MissionSpec,
+) -> Result<PlanOptions, Error> {
     let reserve_percent = options
         .reserve_percent
         .or(spec.reserve_percent)

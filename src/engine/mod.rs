@@ -17,6 +17,7 @@
 //! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
 //! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `fit.rs`, `validate.rs` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `estimator.rs` |
+//! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
 //!
 //! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
 //! else the options' wind, else the mission file's, else still air; gusts on top), the reserve
@@ -54,6 +55,8 @@ mod power;
 mod power_batch;
 mod propulsion;
 mod replay;
+mod scenario_stats;
+mod scenarios;
 mod sorties;
 mod summary;
 mod validate;
@@ -91,6 +94,12 @@ pub use propulsion::{
     RotorRequest, SweepPoint, BUILTIN_ROTORS,
 };
 pub use replay::{replay_log, ReplayAcceleration, ReplayAnswer, ReplayContext, ReplayRequest};
+pub use scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
+pub use scenarios::{
+    endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
+    EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
+    Uncertainty, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
+};
 pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
 pub use validate::{
@@ -130,5 +139,7 @@ const _: () = {
     send_sync::<InFlightEstimator>();
     send_sync::<PowerQuery>();
     send_sync::<PowerAnswer>();
+    send_sync::<ScenarioOptions>();
+    send_sync::<Uncertainty>();
     send_sync::<crate::Error>();
 };

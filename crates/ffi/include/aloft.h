@@ -128,6 +128,11 @@ AloftStatus aloft_mission_plan(const struct AloftVehicle *vehicle,
 // and write the summary JSON (exactly `aloft mission --format json` without its final newline)
 // to `*out_json`, released with `aloft_string_free`.
 //
+// The options JSON may hold a `scenarios` object (`{"scenarios": {"samples": 1000,
+// "payload_sd_kg": 0.1}}`, keys of `aloft::engine::ScenarioOptions`): the JSON then carries
+// the `uncertainty` of that many Monte-Carlo scenarios, exactly as `aloft mission --samples N
+// --format json`.
+//
 // # Safety
 // As `aloft_mission_plan`, with `out_json` NULL or a writable pointer.
 AloftStatus aloft_mission_json(const struct AloftVehicle *vehicle,

@@ -49,8 +49,8 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::{LazyLock, Mutex, MutexGuard};
 
 use aloft::engine::{
-    endurance, plan_mission, power_point, EnduranceOptions, FlightState, Mission, MissionOptions,
-    Plan, PowerQuery, Vehicle,
+    endurance, options_from_json, plan_mission, plan_scenarios, power_point, EnduranceOptions,
+    FlightState, Mission, MissionOptions, MissionWithUncertainty, Plan, PowerQuery, Vehicle,
 };
 use aloft::Error;
 
@@ -602,6 +602,11 @@ pub unsafe extern "C" fn aloft_mission_plan(
 /// and write the summary JSON (exactly `aloft mission --format json` without its final newline)
 /// to `*out_json`, released with `aloft_string_free`.
 ///
+/// The options JSON may hold a `scenarios` object (`{"scenarios": {"samples": 1000,
+/// "payload_sd_kg": 0.1}}`, keys of `aloft::engine::ScenarioOptions`): the JSON then carries
+/// the `uncertainty` of that many Monte-Carlo scenarios, exactly as `aloft mission --samples N
+/// --format json`.
+///
 /// # Safety
 /// As `aloft_mission_plan`, with `out_json` NULL or a writable pointer.
 #[no_mangle]
@@ -616,9 +621,19 @@ pub unsafe extern "C" fn aloft_mission_json(
         let out = unsafe { out_ptr(out_json, "out_json")? };
         let v = unsafe { self::vehicle(vehicle, "vehicle")? };
         let mission = parse_mission(unsafe { optional_text(mission, "mission")? })?;
-        let options =
-            parse_mission_options(unsafe { optional_text(options_json, "options_json")? })?;
-        let json = plan_mission(v, &mission, &options)?.to_json()?;
+        let (options, scenarios) = match unsafe { optional_text(options_json, "options_json")? } {
+            None => (MissionOptions::default(), None),
+            Some(t) => options_from_json(t)?,
+        };
+        let plan = plan_mission(v, &mission, &options)?;
+        let json = match scenarios {
+            None => plan.to_json()?,
+            Some(sc) => MissionWithUncertainty {
+                summary: plan.summary(),
+                uncertainty: &plan_scenarios(v, &mission, &options, &sc)?,
+            }
+            .to_json()?,
+        };
         give_string(json, out)
     })
 }

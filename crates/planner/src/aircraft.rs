@@ -37,6 +37,9 @@ pub struct Aircraft {
     rotor_radius_m: f64,
     rotor_count: u32,
     gravity_mps2: f64,
+    /// Scale of the propulsion chain's electrical power (a model error; 1 unless set by
+    /// [`Aircraft::with_power_scale`]). The four-term model carries its scale in its vehicle.
+    chain_power_scale: f64,
 }
 
 impl Aircraft {
@@ -48,6 +51,7 @@ impl Aircraft {
             rotor_radius_m: vehicle.params().rotor_radius_m,
             rotor_count: vehicle.params().rotor_count,
             gravity_mps2: vehicle.gravity_mps2(),
+            chain_power_scale: 1.0,
             airframe,
             source: PowerSource::FourTerm { vehicle, options },
         }
@@ -70,9 +74,36 @@ impl Aircraft {
             rotor_radius_m,
             rotor_count: system.rotor_count(),
             gravity_mps2: system.gravity_mps2(),
+            chain_power_scale: 1.0,
             airframe,
             source: PowerSource::Chain(Box::new(system)),
         })
+    }
+
+    /// The same aircraft with its electrical power scaled by `scale` (a model error drawn by a
+    /// Monte-Carlo scenario), in every flight condition and query.
+    ///
+    /// For the four-term model it is [`Vehicle::with_power_scale`] (exactly the efficiency
+    /// `eta / s` for every term); for the propulsion chain, the supply power of the rotors and
+    /// the climb power are summed and then scaled, as a pack would see a chain whose losses are
+    /// off by that factor. With `scale = 1` every power is the unscaled aircraft's bit for bit.
+    ///
+    /// # Errors
+    /// A scale that is not positive and finite, or above 100.
+    pub fn with_power_scale(&self, scale: f64) -> Result<Self, PlannerError> {
+        positive("power_scale", scale, "")?;
+        crate::error::within("power_scale", scale, (0.0, 100.0), "", "at most 100")?;
+        let mut a = self.clone();
+        match &mut a.source {
+            PowerSource::FourTerm { vehicle, .. } => *vehicle = vehicle.with_power_scale(scale)?,
+            PowerSource::Chain(_) => a.chain_power_scale = scale,
+        }
+        Ok(a)
+    }
+
+    /// The scale of the propulsion chain's electrical power (1 unless set).
+    pub(crate) fn chain_power_scale(&self) -> f64 {
+        self.chain_power_scale
     }
 
     /// The airframe.

@@ -209,6 +209,32 @@ impl Pack {
 }
 
 impl Pack {
+    /// The same pack with its capacity (and rated energy) multiplied by `factor`: a pack's health,
+    /// or a Monte-Carlo scenario's draw of it. Mass, voltages and resistance are kept. With
+    /// `factor = 1` the pack is this one bit for bit.
+    ///
+    /// # Errors
+    /// A factor that is not positive and finite, or a capacity beyond 1e7 mA h.
+    pub fn with_capacity_factor(&self, factor: f64) -> Result<Self, PlannerError> {
+        let capacity_ah = self.capacity_ah * factor;
+        if !(factor.is_finite() && factor > 0.0 && capacity_ah * 1000.0 <= 1e7) {
+            return Err(PlannerError::InvalidBattery {
+                name: self.name.clone(),
+                key: "capacity factor",
+                value: factor,
+                unit: "",
+                expected: "a positive finite factor, the capacity at most 1e7 mA h",
+            });
+        }
+        Ok(Self {
+            capacity_ah,
+            energy_wh: self.energy_wh * factor,
+            ..self.clone()
+        })
+    }
+}
+
+impl Pack {
     /// The pack a mission flies with, from its description: validated, with its open-circuit table.
     ///
     /// # Errors
@@ -342,6 +368,19 @@ mod tests {
         }
         // mean rest voltage 3.858 V per cell: 6 x 3.858 x 4.5 = 104.2 W h
         assert!((b.rest_energy_wh(1.0, 0.0) - 6.0 * 3.85825 * 4.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_capacity_factor_scales_the_charge_and_one_is_the_pack_itself() {
+        let b = Pack::new(&tb47d()).unwrap();
+        assert_eq!(b.with_capacity_factor(1.0).unwrap(), b);
+        let h = b.with_capacity_factor(0.8).unwrap();
+        // 4.5 A h x 0.8 and 99.9 Wh x 0.8, one rounding each.
+        assert!((h.capacity_ah() - 3.6).abs() < 1e-12);
+        assert!((h.rated_energy_wh() - 79.92).abs() < 1e-12);
+        assert!((h.rest_energy_wh(1.0, 0.0) / b.rest_energy_wh(1.0, 0.0) - 0.8).abs() < 1e-12);
+        assert!(b.with_capacity_factor(0.0).is_err());
+        assert!(b.with_capacity_factor(f64::NAN).is_err());
     }
 
     #[test]

@@ -199,7 +199,8 @@ impl Powered<'_> {
                 } else {
                     0.0
                 };
-                (supply + climb).max(0.0)
+                // The model-error scale (1 unless a scenario draws one: then bit for bit).
+                (supply + climb).max(0.0) * self.aircraft.chain_power_scale()
             }
         })
     }

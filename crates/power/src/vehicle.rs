@@ -127,6 +127,8 @@ pub struct Vehicle {
     hover_induced_mps: f64,
     inv_hover_induced: f64,
     inv_efficiency: f64,
+    /// Scale of the electrical power (model error), 1 unless set by [`Vehicle::with_power_scale`].
+    power_scale: f64,
 }
 
 impl Vehicle {
@@ -206,23 +208,55 @@ impl Vehicle {
             hover_induced_mps,
             inv_hover_induced: 1.0 / hover_induced_mps,
             inv_efficiency,
+            power_scale: 1.0,
         })
     }
 
-    /// The same vehicle with another take-off mass (payload change), validated.
+    /// The same vehicle with another take-off mass (payload change), validated; its power scale
+    /// is kept.
     pub fn with_mass(&self, mass_kg: f64) -> Result<Self> {
         Self::new(VehicleParams {
             mass_kg,
             ..self.params.clone()
-        })
+        })?
+        .with_power_scale(self.power_scale)
     }
 
-    /// The same vehicle with another efficiency (a re-calibration), validated.
+    /// The same vehicle with another efficiency (a re-calibration), validated; its power scale
+    /// is kept.
     pub fn with_efficiency(&self, efficiency: f64) -> Result<Self> {
         Self::new(VehicleParams {
             efficiency,
             ..self.params.clone()
+        })?
+        .with_power_scale(self.power_scale)
+    }
+
+    /// The same vehicle with its electrical power scaled by `scale` (a model error drawn by a
+    /// Monte-Carlo scenario): `P_hat = s P_req / eta`.
+    ///
+    /// Every term of eq (7) (induced, parasitic, profile, climb, and the planner's acceleration
+    /// work) is summed into `P_req` before the one division by `eta` of eq (14), so a scale `s`
+    /// is exactly the efficiency `eta / s` for every term, and for the electrical power of every
+    /// flight condition. It is kept apart from `eta` so that `eta / s` may exceed 1 (a vehicle
+    /// that draws less than its model says) and so that [`Self::efficiency`] stays the vehicle
+    /// file's. Implemented as the factor `s` on the cached `1 / eta`: with `s = 1` every power is
+    /// the unscaled vehicle's bit for bit.
+    ///
+    /// # Errors
+    /// A scale that is not positive and finite, or above 100.
+    pub fn with_power_scale(&self, scale: f64) -> Result<Self> {
+        within("power_scale", positive("power_scale", scale)?, 0.0, 100.0)?;
+        Ok(Self {
+            inv_efficiency: (1.0 / self.params.efficiency) * scale,
+            power_scale: scale,
+            ..self.clone()
         })
+    }
+
+    /// The scale of the electrical power (1 unless set by [`Self::with_power_scale`]).
+    pub fn power_scale(&self) -> f64 {
+        self.power_scale
     }
 
     /// The parameters this vehicle was built from.
@@ -257,7 +291,8 @@ impl Vehicle {
     pub fn inverse_hover_induced_velocity(&self) -> f64 {
         self.inv_hover_induced
     }
-    /// `1 / eta` (cached for the hot path).
+    /// `s / eta` with the power scale `s` (1 unless set by [`Self::with_power_scale`]; cached for
+    /// the hot path).
     pub fn inverse_efficiency(&self) -> f64 {
         self.inv_efficiency
     }
@@ -385,6 +420,45 @@ pub(crate) mod tests {
         let text = "mass_kg = 1.0\nrotor_count = 4\nrotor_radius_m = 0.1\ndisk_area = \"one-rotor\"\nmu1_n_s_per_m = 0.1\nmu2_n_s2_per_m2 = 0.0\nmu3_n_s3_per_m3 = 0.0\nkappa1_w_per_n1_5 = 0.1\nefficiency = 0.7\nmass_lb = 3.0\n";
         let err = toml_like_parse(text);
         assert!(err.contains("mass_lb"), "{err}");
+    }
+
+    #[test]
+    fn a_power_scale_is_the_efficiency_eta_over_s_for_every_term() {
+        use crate::{FlightState, PowerModel};
+        let v = Vehicle::new(m100_params()).unwrap();
+        // A scale of 1 is the vehicle itself, bit for bit (and survives a change of mass).
+        assert_eq!(v.with_power_scale(1.0).unwrap(), Vehicle { ..v.clone() });
+        assert_eq!(
+            v.with_mass(4.0).unwrap().inverse_efficiency().to_bits(),
+            v.with_power_scale(1.0)
+                .unwrap()
+                .with_mass(4.0)
+                .unwrap()
+                .inverse_efficiency()
+                .to_bits()
+        );
+        let states = [
+            FlightState::new(0.0, 0.0, 0.0, 0.0),
+            FlightState::new(8.0, 0.05, -0.15, 0.0),
+            FlightState::new(4.0, 0.0, -0.05, 2.0),
+            FlightState::new(12.0, -0.1, -0.25, -1.5),
+        ];
+        for s in [0.9, 1.03, 1.25] {
+            let scaled = PowerModel::new(v.with_power_scale(s).unwrap().with_mass(3.5).unwrap());
+            let by_eta =
+                PowerModel::new(v.with_mass(3.5).unwrap().with_efficiency(0.8 / s).unwrap());
+            for st in &states {
+                let a = scaled.evaluate(st).unwrap();
+                let b = by_eta.evaluate(st).unwrap();
+                // s / eta against 1 / (eta / s): two roundings apart, a few ulp.
+                assert!(
+                    (a.electrical_w / b.electrical_w - 1.0).abs() < 1e-15,
+                    "{s} {st:?}"
+                );
+            }
+        }
+        assert!(v.with_power_scale(0.0).is_err());
+        assert!(v.with_power_scale(f64::NAN).is_err());
     }
 
     #[test]

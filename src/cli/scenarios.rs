@@ -1,0 +1,499 @@
+//! `--samples N`: Monte-Carlo scenarios of `aloft mission` and `aloft endurance` (the engine's
+//! `plan_scenarios` and `endurance_scenarios`), rendered as a line, bands in the tables, the JSON
+//! `uncertainty` object and, for a mission, a state-of-charge fan in the chart.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use clap::builder::TypedValueParser;
+use clap::Args;
+
+use aloft::engine::{
+    plan_scenarios, EnduranceUncertainty, Mission, MissionOptions, MissionWithUncertainty,
+    Percentiles, Plan, Sample, ScenarioOptions, Uncertainty, Vehicle, DEFAULT_POWER_SD_PERCENT,
+    MAX_SCENARIOS,
+};
+
+use super::mission::mmss;
+use super::output::{self, Row};
+use super::{Format, Outcome};
+
+/// A spread: a finite number from 0 to `max` (the flag is named in the message).
+fn spread(max: f64) -> impl TypedValueParser<Value = f64> {
+    super::args::finite().try_map(move |v: f64| {
+        if (0.0..=max).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("a standard deviation from 0 to {max}"))
+        }
+    })
+}
+
+/// Monte-Carlo scenarios: how many, from what seed, and the spread (one standard deviation) of
+/// each source drawn.
+#[derive(Debug, Args)]
+pub struct ScenarioArgs {
+    /// Draw and fly this many scenarios (1 to 100000): p_feasible and percentiles of energy,
+    /// battery, time and point of no return (README, "How sure is the answer").
+    #[arg(long, value_name = "N",
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SCENARIOS)))]
+    pub samples: Option<u32>,
+    /// Seed of the scenarios' draws (the same seed gives the same answer).
+    #[arg(long, requires = "samples", default_value_t = 1)]
+    pub seed: u64,
+    /// Spread of the wind speed, m/s (normal, clipped at 0).
+    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
+        value_name = "M/S", allow_negative_numbers = true)]
+    pub wind_speed_sd: f64,
+    /// Spread of the wind direction, degrees (normal).
+    #[arg(long, requires = "samples", value_parser = spread(180.0), default_value_t = 0.0,
+        value_name = "DEG", allow_negative_numbers = true)]
+    pub wind_from_sd: f64,
+    /// Spread of the take-off payload, kg (normal, clipped at 0).
+    #[arg(long, requires = "samples", value_parser = spread(1000.0), default_value_t = 0.0,
+        value_name = "KG", allow_negative_numbers = true)]
+    pub payload_sd_kg: f64,
+    /// Spread of the pack's capacity (health), percent of its rating (normal).
+    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
+        value_name = "PERCENT", allow_negative_numbers = true)]
+    pub capacity_sd_percent: f64,
+    /// Spread of the model's electrical power, percent (normal; default 3, aloft's own
+    /// whole-flight energy errors).
+    #[arg(long, requires = "samples", value_parser = spread(50.0),
+        default_value_t = DEFAULT_POWER_SD_PERCENT, value_name = "PERCENT",
+        allow_negative_numbers = true)]
+    pub power_sd_percent: f64,
+    /// Threads for the scenarios (0: one per core); the answer does not depend on it.
+    #[arg(long, requires = "samples", default_value_t = 0, value_name = "N",
+        value_parser = clap::value_parser!(u16).range(0..=1024))]
+    pub threads: u16,
+}
+
+impl ScenarioArgs {
+    /// The engine's scenario options, when `--samples` was given (`fan`: follow the state of
+    /// charge for a chart).
+    pub fn options(&self, fan: bool) -> Option<ScenarioOptions> {
+        Some(ScenarioOptions {
+            samples: self.samples?,
+            seed: self.seed,
+            wind_speed_sd_mps: self.wind_speed_sd,
+            wind_from_sd_deg: self.wind_from_sd,
+            payload_sd_kg: self.payload_sd_kg,
+            capacity_sd_percent: self.capacity_sd_percent,
+            power_sd_percent: self.power_sd_percent,
+            threads: usize::from(self.threads),
+            soc_fan: fan,
+        })
+    }
+
+    /// Refuse `--samples` with an option it does not apply to.
+    pub fn refuse_with(&self, other: &str) -> Result<()> {
+        if self.samples.is_some() {
+            bail!("--samples draws scenarios of a planned answer; it cannot be used with {other}");
+        }
+        Ok(())
+    }
+}
+
+/// What a mission's scenarios are drawn around and rendered with.
+pub struct MissionRun<'a> {
+    pub vehicle: &'a Vehicle,
+    pub mission: &'a Mission,
+    pub options: &'a MissionOptions,
+    pub plan: &'a Plan,
+    pub plot: Option<&'a Path>,
+    pub format: Format,
+}
+
+/// Draw the scenarios of a planned mission and print the plan with its uncertainty. The exit
+/// code is the plan's (1 when the plan itself is infeasible).
+pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome> {
+    let u = plan_scenarios(run.vehicle, run.mission, run.options, sc)?;
+    let plan = run.plan;
+    if let Some(path) = run.plot {
+        let name = run.mission.spec().name.as_str();
+        plot(path, name, plan, &u).with_context(|| format!("cannot draw {}", path.display()))?;
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    match run.format {
+        Format::Json => output::write_json(
+            &mut out,
+            &MissionWithUncertainty {
+                summary: plan.summary(),
+                uncertainty: &u,
+            },
+        )?,
+        Format::Table | Format::Csv => write_mission_table(&mut out, plan, &u)?,
+    }
+    Ok(if plan.report().feasible {
+        Outcome::Ok
+    } else {
+        Outcome::Failed
+    })
+}
+
+/// The mission's table with the scenarios' line, bands and segment columns.
+fn write_mission_table(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<()> {
+    out.write_all(super::mission::header(plan)?.as_bytes())?;
+    out.write_all(verdict(plan, u).as_bytes())?;
+    writeln!(out)?;
+    output::write_table(out, "Summary", &super::mission::summary_rows(plan.report()))?;
+    writeln!(out)?;
+    output::write_table(
+        out,
+        &format!(
+            "Uncertainty (5th percentile / median / 95th; energy, battery and time over the {} of {} scenarios that flew the whole route)",
+            u.completed_scenarios, u.samples
+        ),
+        &band_rows(u),
+    )?;
+    writeln!(out)?;
+    write_segments(out, plan, u)?;
+    writeln!(out)?;
+    super::mission::write_sorties(out, plan.summary())?;
+    super::mission::write_model_line(out, plan)
+}
+
+/// The drawn spreads in words.
+fn spreads_text(u: &Uncertainty) -> String {
+    let s = &u.spreads;
+    format!(
+        "seed {}; wind speed sd {} m/s, wind direction sd {} deg, payload sd {} kg, capacity sd {} %, power sd {} %",
+        u.seed,
+        s.wind_speed_sd_mps,
+        s.wind_from_sd_deg,
+        s.payload_sd_kg,
+        s.capacity_sd_percent,
+        s.power_sd_percent
+    )
+}
+
+/// The scenarios in two sentences: how often the reserve holds, and the point of no return with
+/// 95 % confidence.
+fn verdict(plan: &Plan, u: &Uncertainty) -> String {
+    let mut text = format!(
+        "Scenarios: lands with the reserve in {:.1} % of {} scenarios ({}).\n",
+        u.p_feasible * 100.0,
+        u.samples,
+        spreads_text(u)
+    );
+    if let Some(why) = &u.cannot_fly_reason {
+        text.push_str(&format!(
+            "  {} of them cannot be flown at all; the first: {why}.\n",
+            u.cannot_fly_scenarios
+        ));
+    }
+    match u.point_of_no_return_s.p5 {
+        Some(t) if t <= 0.0 => text.push_str(&format!(
+            "Point of no return with 95 % confidence: at take-off: in more than 5 % of the scenarios the vehicle cannot fly the route ({:.1} % do not complete it) or cannot turn back from its start.\n",
+            (1.0 - u.completed_scenarios as f64 / u.samples as f64) * 100.0
+        )),
+        Some(t) => {
+            let (segment, item) = segment_at(plan, t);
+            let item = item.map_or(String::new(), |i| format!(" (item {i})"));
+            text.push_str(&format!(
+                "Point of no return with 95 % confidence: {} into the flight (t = {t:.0} s), segment {segment}{item}: 95 % of the scenarios can still turn back until then.\n",
+                mmss(t)
+            ));
+        }
+        None => text.push_str(&format!(
+            "Point of no return with 95 % confidence: none; {:.1} % of the scenarios could fly straight home from every point of the route.\n",
+            (1.0 - u.p_point_of_no_return) * 100.0
+        )),
+    }
+    text
+}
+
+/// The segment (and operator's item) the plan flies at time `t_s`.
+fn segment_at(plan: &Plan, t_s: f64) -> (usize, Option<u32>) {
+    let mut end = 0.0;
+    let segments = &plan.report().segments;
+    for s in segments {
+        end += s.duration_s;
+        if t_s <= end {
+            return (s.index, s.item);
+        }
+    }
+    segments.last().map_or((1, None), |s| (s.index, s.item))
+}
+
+fn band_rows(u: &Uncertainty) -> Vec<Row<'static>> {
+    let three = |p: Option<Percentiles>, f: &dyn Fn(f64) -> String| {
+        p.map_or("-".to_string(), |p| {
+            format!("{} / {} / {}", f(p.p5), f(p.p50), f(p.p95))
+        })
+    };
+    let t = u.point_of_no_return_s;
+    let pnr = |v: Option<f64>| v.map_or("none".to_string(), mmss);
+    vec![
+        Row::new(
+            "energy used",
+            three(u.energy_wh, &|x| format!("{x:.1}")),
+            "Wh",
+        ),
+        Row::new(
+            "battery at the end",
+            three(u.end_soc, &|x| format!("{:.1}", x * 100.0)),
+            "%",
+        ),
+        Row::new("flight time", three(u.duration_s, &mmss), "min:s"),
+        Row::new(
+            "point of no return",
+            format!("{} / {} / {}", pnr(t.p5), pnr(t.p50), pnr(t.p95)),
+            "min:s",
+        ),
+    ]
+}
+
+/// The segments with the 5th and 95th percentiles of the battery at each segment's end.
+fn write_segments(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<()> {
+    let r = plan.report();
+    let items = r.segments.iter().any(|s| s.item.is_some());
+    writeln!(out, "Segments")?;
+    writeln!(
+        out,
+        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>9} {:>9}",
+        "#",
+        if items { "item " } else { "" },
+        "kind",
+        "time",
+        "distance",
+        "energy",
+        "mean power",
+        "battery end",
+        "p5 end",
+        "p95 end"
+    )?;
+    for s in &r.segments {
+        let item = match (items, s.item) {
+            (false, _) => String::new(),
+            (true, Some(i)) => format!("{i:>4} "),
+            (true, None) => "     ".to_string(),
+        };
+        let band = u.segments.iter().find(|b| b.index == s.index);
+        let pct = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{:.1} %", x * 100.0));
+        writeln!(
+            out,
+            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.1} % {:>9} {:>9}",
+            s.index,
+            s.kind,
+            mmss(s.duration_s),
+            s.distance_m,
+            s.energy_wh,
+            s.mean_power_w,
+            s.end_soc * 100.0,
+            pct(band.map(|b| b.end_soc.p5)),
+            pct(band.map(|b| b.end_soc.p95)),
+        )?;
+    }
+    Ok(())
+}
+
+type Area<'a> =
+    plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
+
+/// The state-of-charge fan over time (the plan's own line in it) and the ground track with the
+/// plan's point of no return and the one that holds with 95 % confidence.
+fn plot(path: &Path, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
+    use plotters::prelude::*;
+    let samples = plan.plot_samples();
+    if samples.is_empty() {
+        bail!("no samples to plot");
+    }
+    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(400);
+    plot_fan(&top, name, plan, u)?;
+    plot_track(&bottom, plan, u, samples)?;
+    root.present()?;
+    Ok(())
+}
+
+fn plot_fan(area: &Area<'_>, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
+    use plotters::prelude::*;
+    let s = plan.plot_samples();
+    let fan = u.soc_fan.as_ref();
+    let t_fan = fan.and_then(|f| f.time_s.last().copied()).unwrap_or(0.0);
+    let t_max = s[s.len() - 1].time_s.max(t_fan).max(1.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!("{name}: state of charge over {} scenarios", u.samples),
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..t_max, 0.0..100.0)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("state of charge (%)")
+        .draw()?;
+    if let Some(f) = fan {
+        let upper = f.time_s.iter().zip(&f.p95).map(|(&t, &v)| (t, v * 100.0));
+        let lower = f
+            .time_s
+            .iter()
+            .zip(&f.p5)
+            .rev()
+            .map(|(&t, &v)| (t, v * 100.0));
+        let band = BLUE.mix(0.2);
+        chart
+            .draw_series([Polygon::new(
+                upper.chain(lower).collect::<Vec<_>>(),
+                band.filled(),
+            )])?
+            .label("5th-95th percentile")
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], band.filled()));
+        chart
+            .draw_series(LineSeries::new(
+                f.time_s.iter().zip(&f.p50).map(|(&t, &v)| (t, v * 100.0)),
+                BLUE.mix(0.6).stroke_width(1),
+            ))?
+            .label("median")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.mix(0.6)));
+    }
+    chart
+        .draw_series(LineSeries::new(
+            s.iter().map(|x| (x.time_s, x.soc * 100.0)),
+            BLUE.stroke_width(2),
+        ))?
+        .label("plan")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    let r = plan.report();
+    let floor = (r.empty_soc + r.required_reserve_soc) * 100.0;
+    chart
+        .draw_series(LineSeries::new(
+            [(0.0, floor), (t_max, floor)],
+            RED.mix(0.6),
+        ))?
+        .label("reserve floor")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.mix(0.6)));
+    if let Some(t) = u.point_of_no_return_s.p5 {
+        chart
+            .draw_series(LineSeries::new(
+                [(t, 0.0), (t, 100.0)],
+                BLACK.stroke_width(2),
+            ))?
+            .label("point of no return, 95 % confidence")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerLeft)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// The plan's sample nearest to time `t_s`.
+fn sample_at(s: &[Sample], t_s: f64) -> Option<&Sample> {
+    let k = s.partition_point(|x| x.time_s < t_s);
+    s.get(k.min(s.len().saturating_sub(1)))
+}
+
+fn plot_track(area: &Area<'_>, plan: &Plan, u: &Uncertainty, s: &[Sample]) -> Result<()> {
+    use plotters::prelude::*;
+    let home = plan.home_m();
+    let (mut e0, mut e1, mut n0, mut n1) = (home[0], home[0], home[1], home[1]);
+    for x in s {
+        e0 = e0.min(x.east_m);
+        e1 = e1.max(x.east_m);
+        n0 = n0.min(x.north_m);
+        n1 = n1.max(x.north_m);
+    }
+    let span = (e1 - e0).max(n1 - n0).max(10.0) * 1.1;
+    let (ec, nc) = (0.5 * (e0 + e1), 0.5 * (n0 + n1));
+    let mut track = ChartBuilder::on(area)
+        .caption("ground track (east, north in m)", ("sans-serif", 18))
+        .margin(15)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (ec - span * 0.7)..(ec + span * 0.7),
+            (nc - span * 0.5)..(nc + span * 0.5),
+        )?;
+    track
+        .configure_mesh()
+        .x_desc("east (m)")
+        .y_desc("north (m)")
+        .draw()?;
+    track
+        .draw_series(LineSeries::new(
+            s.iter().map(|x| (x.east_m, x.north_m)),
+            &RED,
+        ))?
+        .label("track")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    track
+        .draw_series([Circle::new((home[0], home[1]), 6, GREEN.filled())])?
+        .label("home")
+        .legend(|(x, y)| Circle::new((x + 10, y), 5, GREEN.filled()));
+    if let Some(p) = plan.report().point_of_no_return {
+        track
+            .draw_series([Cross::new(
+                (p.position_m[0], p.position_m[1]),
+                8,
+                BLACK.stroke_width(2),
+            )])?
+            .label("point of no return (plan)")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    }
+    if let Some(x) = u.point_of_no_return_s.p5.and_then(|t| sample_at(s, t)) {
+        let style = MAGENTA.stroke_width(3);
+        track
+            .draw_series([TriangleMarker::new((x.east_m, x.north_m), 9, style)])?
+            .label("point of no return, 95 % confidence")
+            .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, style));
+    }
+    track
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// The endurance table's lines for the scenarios.
+pub fn write_endurance_lines(out: &mut impl Write, u: &EnduranceUncertainty) -> Result<()> {
+    let s = &u.spreads;
+    writeln!(
+        out,
+        "Scenarios: {} (seed {}; wind speed sd {} m/s, wind direction sd {} deg, payload sd {} kg, capacity sd {} %, power sd {} %); the vehicle can fly {:.1} % of them.",
+        u.samples,
+        u.seed,
+        s.wind_speed_sd_mps,
+        s.wind_from_sd_deg,
+        s.payload_sd_kg,
+        s.capacity_sd_percent,
+        s.power_sd_percent,
+        u.p_feasible * 100.0
+    )?;
+    let three = |p: Option<Percentiles>, f: &dyn Fn(f64) -> String| {
+        p.map_or("-".to_string(), |p| {
+            format!("{} / {} / {}", f(p.p5), f(p.p50), f(p.p95))
+        })
+    };
+    let min = |t: f64| format!("{:.1}", t / 60.0);
+    let mut rows = vec![
+        Row::new("hover endurance", three(u.hover_endurance_s, &min), "min"),
+        Row::new("best endurance", three(u.max_endurance_s, &min), "min"),
+        Row::new(
+            "best range",
+            three(u.max_range_m, &|m| format!("{:.2}", m / 1000.0)),
+            "km",
+        ),
+    ];
+    if u.orbit_endurance_s.is_some() {
+        rows.push(Row::new(
+            "orbit endurance",
+            three(u.orbit_endurance_s, &min),
+            "min",
+        ));
+    }
+    output::write_table(out, "Uncertainty (5th percentile / median / 95th)", &rows)?;
+    Ok(())
+}
