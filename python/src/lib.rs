@@ -340,11 +340,7 @@ impl States<'_> {
 }
 
 /// The power model over arrays: one array per key of `POWER_KEYS`.
-fn power_arrays(
-    vehicle: &str,
-    base: &PowerQuery,
-    s: &States<'_>,
-) -> Result<Vec<Vec<f64>>, PyErr> {
+fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<Vec<f64>>, PyErr> {
     let n = s.airspeed.len();
     if let Some((name, i, x)) = s.first_non_finite() {
         return Err(aloft_error(format!(
@@ -354,10 +350,16 @@ fn power_arrays(
     let v = Vehicle::load(vehicle).map_err(engine_error)?;
     // The configuration (a [power] table, the angle-of-attack choice) checked by the engine's
     // point query, so its refusals are the CLI's words.
-    let first = if n > 0 { s.query(0, base) } else { base.clone() };
+    let first = if n > 0 {
+        s.query(0, base)
+    } else {
+        base.clone()
+    };
     power_point(&v, &first).map_err(engine_error)?;
     let model = power_model(&v, &base.without, base.profile_cutoff_mps).map_err(engine_error)?;
-    let mut columns: Vec<Vec<f64>> = (0..POWER_KEYS.len()).map(|_| Vec::with_capacity(n)).collect();
+    let mut columns: Vec<Vec<f64>> = (0..POWER_KEYS.len())
+        .map(|_| Vec::with_capacity(n))
+        .collect();
     let mut states = Vec::with_capacity(BLOCK);
     let mut out = vec![PowerBreakdown::default(); BLOCK];
     for start in (0..n).step_by(BLOCK) {
@@ -366,7 +368,9 @@ fn power_arrays(
         states.extend((start..end).map(|i| s.state(i)));
         let out = &mut out[..end - start];
         let failed = model.evaluate_batch(&states, out).is_err()
-            || out.iter().any(|p| power_values(p).iter().any(|x| !x.is_finite()));
+            || out
+                .iter()
+                .any(|p| power_values(p).iter().any(|x| !x.is_finite()));
         if failed {
             return Err(first_failure(&v, base, s, start..end));
         }

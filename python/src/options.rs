@@ -198,8 +198,14 @@ fn steady_wind(k: &mut Kwargs<'_>) -> PyResult<Option<WindSpec>> {
     let reference = k.f64_or("wind_reference_height", 10.0)?;
     let exponent = k.f64_or("wind_exponent", 1.0 / 7.0)?;
     let roughness = k.f64_or("wind_roughness", 0.03)?;
-    k.needs(("wind_speed", speed.is_some()), ("wind_from", from.is_some()))?;
-    k.needs(("wind_from", from.is_some()), ("wind_speed", speed.is_some()))?;
+    k.needs(
+        ("wind_speed", speed.is_some()),
+        ("wind_from", from.is_some()),
+    )?;
+    k.needs(
+        ("wind_from", from.is_some()),
+        ("wind_speed", speed.is_some()),
+    )?;
     k.needs(
         ("wind_profile", profile.is_some()),
         ("wind_speed", speed.is_some()),
