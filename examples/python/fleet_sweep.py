@@ -36,7 +36,7 @@ MISSIONS: List[Optional[str]] = [None, str(REPO / "fixtures" / "missions" / "exa
 if (DATA / "missions" / "neilvaltec_test.plan").exists():
     MISSIONS.append(str(DATA / "missions" / "neilvaltec_test.plan"))
 PAYLOADS_KG = [0.0, 0.25, 0.5, 0.75, 1.0]
-WIND_SPEEDS_MPS = [0.0, 3.0, 6.0, 9.0, 12.0]
+WIND_SPEEDS_MPS = [0.0, 2.0, 4.0, 6.0, 8.0]
 WINDS_FROM_DEG = [0.0, 90.0, 180.0, 270.0]
 
 #: The columns of the answer kept per case.
@@ -146,13 +146,14 @@ def main(argv: Optional[Sequence[str]] = None) -> pd.DataFrame:
         table, t = local_sweep(all_cases, args.workers)
         print(f"sweep on a LocalCluster of {args.workers} worker(s): {t:.2f} s")
     summary = (
-        table.assign(mission=table["mission"].fillna("(refused)"))
+        table.assign(mission=table["path"].map(lambda p: Path(p).name if p.startswith("/") else p),
+                     refused=table["error"] != "", feasible=table["feasible"].fillna(False))
         .groupby(["mission", "payload_kg"])
-        .agg(cases=("energy_wh", "size"), feasible=("feasible", "sum"),
+        .agg(cases=("refused", "size"), refused=("refused", "sum"), feasible=("feasible", "sum"),
              energy_wh_min=("energy_wh", "min"), energy_wh_max=("energy_wh", "max"))
     )
-    with pd.option_context("display.width", 120, "display.max_rows", 40):
-        print(summary.round(2))
+    with pd.option_context("display.width", 120, "display.max_rows", 40, "display.max_columns", 10):
+        print(summary.round(1))
     refused = table[table["error"] != ""]
     if len(refused):
         print(f"{len(refused)} case(s) refused, e.g.: {refused['error'].iloc[0]}")
