@@ -235,6 +235,9 @@ pub fn vehicle(k: &mut Kwargs<'_>) -> PyResult<String> {
 }
 
 /// The options of `aloft mission` (`MissionArgs::options` of the CLI).
+// `..MissionOptions::default()` keeps this compiling when the engine adds options (Monte-Carlo
+// sampling is on its way); until then it has nothing to fill.
+#[allow(clippy::needless_update)]
 pub fn mission(k: &mut Kwargs<'_>) -> PyResult<MissionOptions> {
     let wind = steady_wind(k)?;
     let wind_field = k.path("wind_field")?;
