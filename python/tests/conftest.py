@@ -15,19 +15,17 @@ DATA = Path(os.environ.get("ALOFT_DATA_DIR", REPO.parent / "shared" / "data"))
 
 
 def _binary() -> Path:
-    """`$ALOFT_BIN`, else the workspace's release build (built here when missing).
+    """`$ALOFT_BIN`, else the workspace's debug build (built here when missing).
 
-    Release, as the wheel: `aloft fit` decides which drag terms to keep from values that differ
-    in the last bits between debug and release builds of the engine, so a debug CLI can disagree
-    with the (release) Python package there; missions, endurance and power agree in both.
+    The binary must be built from the same tree as the package: a CLI from another checkout
+    can differ (e.g. in which drag terms `aloft fit` keeps).
     """
     if os.environ.get("ALOFT_BIN"):
         return Path(os.environ["ALOFT_BIN"])
     target = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
-    binary = target / "release" / "aloft"
+    binary = target / "debug" / "aloft"
     if not binary.exists():
-        subprocess.run(["cargo", "build", "--release", "--locked", "--bin", "aloft"], cwd=REPO,
-                       check=True)
+        subprocess.run(["cargo", "build", "--locked", "--bin", "aloft"], cwd=REPO, check=True)
     return binary
 
 
