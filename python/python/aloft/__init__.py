@@ -1,0 +1,223 @@
+"""aloft from Python: the energy and feasibility of multirotor flights.
+
+The same engine as the ``aloft`` command line and its C ABI: for the same request every function
+here answers what ``aloft <command> --format json`` prints, with the same keys and the same
+numbers bit for bit (the engine's JSON parsed with :mod:`json`).
+
+Keyword arguments are the CLI's flags in snake_case (``--payload-kg`` is ``payload_kg=``,
+``--no-ground-effect`` is ``no_ground_effect=True``); ``None`` means "flag not given". An unknown
+keyword raises :class:`AloftError` naming it. Every refusal raises :class:`AloftError` (a
+``ValueError``) whose message is the line ``aloft`` prints after ``aloft: error:``.
+
+The functions are plain module-level functions taking and returning plain values, so they
+pickle by reference: ``client.submit(aloft.mission, path, payload_kg=0.5)`` runs on any Dask
+worker that has aloft installed (see ``examples/python/fleet_sweep.py``).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._native import AloftError
+
+__all__ = [
+    "AloftError",
+    "DEFAULT_VEHICLE",
+    "DEMO_MISSION",
+    "POWER_KEYS",
+    "__version__",
+    "endurance",
+    "fit",
+    "log_info",
+    "mission",
+    "power",
+    "timeseries",
+    "validate",
+]
+
+__version__: str = _native.version()
+
+#: The result keys of :func:`power`, in order (``aloft power``'s CSV/JSON keys).
+POWER_KEYS: List[str] = list(_native.POWER_KEYS)
+#: The built-in demonstration mission (TOML), flown when a mission's ``path`` is ``None``.
+DEMO_MISSION: str = _native.DEMO_MISSION
+#: The vehicle every function uses when none is named.
+DEFAULT_VEHICLE: str = _native.DEFAULT_VEHICLE
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _path(p: Optional[PathLike]) -> Optional[str]:
+    return None if p is None else os.fspath(p)
+
+
+def mission(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
+    """Fly a mission file (or, with ``path=None``, the built-in demo): ``aloft mission --format json``.
+
+    Args:
+        path: An aloft mission (TOML or JSON), a QGroundControl ``.plan`` or a ``.waypoints``
+            file, recognised from its content; ``None`` for the built-in demonstration survey.
+        **options: The flags of ``aloft mission`` in snake_case: ``vehicle`` (built-in name or
+            vehicle TOML path, default ``"dji-m100"``), ``battery``, ``payload_kg``,
+            ``wind_speed`` and ``wind_from`` (m/s and degrees the wind blows FROM; give both),
+            ``wind_profile`` (``"uniform"``, ``"power-law"``, ``"log"``),
+            ``wind_reference_height``, ``wind_exponent``, ``wind_roughness``, ``wind_field``
+            (CSV path), ``gust_std``, ``gust_seed``, ``reserve_percent``, ``start_percent``,
+            ``time_step``, ``speed``, ``rtl_altitude_m``, ``corners`` (``"pass"``, ``"stop"``),
+            ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``.
+
+    Returns:
+        The CLI's JSON answer as a dict: ``feasible``, ``energy_wh``, ``duration_s``,
+        ``segments``, ``point_of_no_return``... An infeasible mission is an answer
+        (``feasible`` is False; the CLI exits 1), not an error.
+
+    Raises:
+        AloftError: What ``aloft mission`` refuses with exit code 2 (unknown vehicle, a mission
+            the vehicle cannot fly, a bad option), with its message.
+    """
+    return json.loads(_native.mission_json(_path(path), options))
+
+
+def timeseries(path: Optional[PathLike] = None, **options: Any) -> Any:
+    """Every sample of a mission: the table ``aloft mission --timeseries`` writes.
+
+    Takes the arguments of :func:`mission`. Returns a ``pandas.DataFrame`` when pandas is
+    installed, else a dict of numpy arrays, with the CSV's columns in its order (``time_s``,
+    ``segment`` (int64), ``east_m``, ... ``power_w``, ``soc``, the power terms; a term the
+    model does not have is NaN where the CSV cell is empty).
+    """
+    columns = dict(_native.timeseries_columns(_path(path), options))
+    try:
+        import pandas as pd
+    except ImportError:
+        return columns
+    return pd.DataFrame(columns)
+
+
+def endurance(**options: Any) -> Dict[str, Any]:
+    """Hover and orbit endurance, best-endurance and best-range speeds: ``aloft endurance --format json``.
+
+    Args:
+        **options: ``vehicle``, ``battery``, ``payload_kg`` (default 0), ``wind_speed``,
+            ``wind_from``, ``wind_profile``, ``wind_reference_height``, ``wind_exponent``,
+            ``wind_roughness``, ``course`` (deg, default 0), ``reserve_percent`` (default 0),
+            ``orbit_radius`` and ``orbit_speed`` (together), ``aoa``; ``sweep_speed`` (m/s) for
+            the power curve instead (``aloft endurance --sweep-speed S --format json``).
+
+    Returns:
+        The CLI's JSON answer as a dict.
+    """
+    return json.loads(_native.endurance_json(options))
+
+
+def log_info(path: PathLike, **options: Any) -> Dict[str, Any]:
+    """Summarise a flight log: ``aloft log info PATH --format json``.
+
+    Args:
+        path: A CSV file (or PX4 CSV tables' prefix), MCAP, PX4 ULog or ArduPilot DataFlash log.
+        **options: ``profile`` (``"kaist"``, ``"px4"`` or a column-map TOML), ``topics`` (MCAP),
+            ``header_time``, ``battery_current_positive``, ``battery_instance``, ``lag``
+            (search window of the power lag estimate, s).
+    """
+    return json.loads(_native.log_info_json(os.fspath(path), options))
+
+
+def fit(
+    logs: Union[PathLike, Sequence[PathLike]], vehicle_template: str, **options: Any
+) -> Dict[str, Any]:
+    """Fit the power model of a vehicle to flight logs: ``aloft fit --format json``.
+
+    Args:
+        logs: One log or a list of logs (``--log``).
+        vehicle_template: The vehicle to start from, built-in name or TOML path.
+        **options: ``free`` (list or comma-separated text, default ``["k"]``), ``no_drag``,
+            ``output`` (write the fitted vehicle TOML there; the CLI requires it, here it is
+            optional), ``profile``, ``aoa``, ``lag``, ``max_lag`` (default 10),
+            ``battery_instance``.
+    """
+    return json.loads(_native.fit_json(_paths(logs), vehicle_template, options))
+
+
+def validate(
+    logs: Union[PathLike, Sequence[PathLike]], vehicle: str, **options: Any
+) -> Dict[str, Any]:
+    """Validate a vehicle's power model against flight logs: ``aloft validate --format json``.
+
+    Args:
+        logs: One log or a list of logs.
+        vehicle: Built-in name or TOML path of a vehicle with a ``[power]`` table.
+        **options: ``calibrate_first`` (s), ``profile``, ``aoa``, ``lag``, ``max_lag``,
+            ``battery_instance``.
+    """
+    return json.loads(_native.validate_json(_paths(logs), vehicle, options))
+
+
+def _paths(logs: Union[PathLike, Sequence[PathLike]]) -> List[str]:
+    if isinstance(logs, (str, os.PathLike)):
+        return [os.fspath(logs)]
+    return [os.fspath(p) for p in logs]
+
+
+def power(
+    airspeed: Any,
+    roll: Any,
+    pitch: Any,
+    climb_rate: Any = 0.0,
+    vehicle: str = DEFAULT_VEHICLE,
+    *,
+    without: Optional[Union[str, Sequence[str]]] = None,
+    profile_cutoff: Optional[float] = None,
+    aoa: Optional[str] = None,
+    air_direction_deg: Any = None,
+) -> Dict[str, np.ndarray]:
+    """The four-term power model over arrays of flight states: ``aloft power`` vectorised.
+
+    The inputs broadcast against each other (numpy rules); each output has the broadcast shape.
+    The work is done in compiled code with the GIL released (the power crate's batch kernels,
+    identical bit for bit to ``aloft power`` for each state).
+
+    Args:
+        airspeed: Airspeed, m/s (``--airspeed``).
+        roll: Roll, degrees, positive right side down (``--roll``).
+        pitch: Pitch, degrees, positive nose up (``--pitch``; forward flight is negative).
+        climb_rate: Vertical speed, m/s, positive up (``--climb-rate``).
+        vehicle: Built-in name or vehicle TOML path.
+        without: Terms removed (``"induced"``, ``"parasitic"``, ``"profile"``, ``"climb"``).
+        profile_cutoff: Drop the profile term above this airspeed, m/s.
+        aoa: ``"paper"`` (default) or ``"geometric"`` (needs ``air_direction_deg``).
+        air_direction_deg: Direction of the air-relative velocity from the nose, degrees
+            (array or scalar); selects the geometric angle of attack.
+
+    Returns:
+        A dict of float64 arrays keyed by :data:`POWER_KEYS`: ``thrust_n``,
+        ``induced_velocity_mps``, ``hover_induced_velocity_mps``, ``induced_w``,
+        ``parasitic_w``, ``profile_w``, ``acceleration_w``, ``climb_w``, ``aero_w``,
+        ``electrical_w``.
+
+    Raises:
+        AloftError: A state the model refuses (the CLI's message, with the element's flat
+            index), a non-finite input, a vehicle without a ``[power]`` table.
+    """
+    inputs = [airspeed, roll, pitch, climb_rate]
+    if air_direction_deg is not None:
+        inputs.append(air_direction_deg)
+    arrays = [np.asarray(x, dtype=np.float64) for x in inputs]
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    except ValueError as e:
+        raise AloftError(f"aloft.power: the inputs do not broadcast together: {e}") from None
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1) for a in arrays]
+    options = {
+        "vehicle": vehicle,
+        "without": without,
+        "profile_cutoff": profile_cutoff,
+        "aoa": aoa,
+    }
+    direction = flat[4] if air_direction_deg is not None else None
+    out = _native.power(flat[0], flat[1], flat[2], flat[3], direction, options)
+    return {k: out[k].reshape(shape) for k in POWER_KEYS}

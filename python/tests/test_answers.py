@@ -1,0 +1,136 @@
+"""The Python answers equal the CLI's JSON for the same request, key for key, bit for bit."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import aloft
+
+MISSION_CASES = [
+    # (path relative to the repo or None, Python options, CLI flags)
+    (None, {}, []),
+    (None, {"payload_kg": 0.5, "wind_speed": 6.0, "wind_from": 270.0},
+     ["--payload-kg", "0.5", "--wind-speed", "6", "--wind-from", "270"]),
+    ("fixtures/missions/demo-survey.toml",
+     {"reserve_percent": 30, "corners": "stop", "speed": 6.5, "time_step": 0.2, "rtl_altitude_m": 40},
+     ["--reserve-percent", "30", "--corners", "stop", "--speed", "6.5", "--time-step", "0.2",
+      "--rtl-altitude-m", "40"]),
+    ("fixtures/missions/example.toml",
+     {"battery": None, "aoa": "paper", "no_ground_effect": True, "start_percent": 90,
+      "wind_speed": 4, "wind_from": 45, "wind_profile": "power-law", "gust_std": 0.5, "gust_seed": 7},
+     ["--aoa", "paper", "--no-ground-effect", "--start-percent", "90",
+      "--wind-speed", "4", "--wind-from", "45", "--wind-profile", "power-law", "--gust-std", "0.5",
+      "--gust-seed", "7"]),
+]
+
+
+@pytest.mark.parametrize("path, options, flags", MISSION_CASES)
+def test_mission_equals_cli(cli, repo, path, options, flags):
+    args = ["mission"] + ([repo / path] if path else []) + flags
+    rc, out, err = cli.run(*map(str, args), "--format", "json")
+    assert rc in (0, 1), err
+    got = aloft.mission(None if path is None else repo / path, **options)
+    assert got == json.loads(out)
+
+
+def test_planner_file_and_infeasible_mission_equal_cli(cli, data):
+    plan = data / "missions" / "neilvaltec_test.plan"
+    # A reserve the flight cannot keep: the CLI exits 1, Python answers feasible=False.
+    expected = cli.json("mission", str(plan), "--reserve-percent", "95", code=1)
+    got = aloft.mission(plan, reserve_percent=95)
+    assert got == expected
+    assert got["feasible"] is False
+
+
+@pytest.mark.parametrize("options, flags", [
+    ({}, []),
+    ({"payload_kg": 0.4, "wind_speed": 7, "wind_from": 90, "course": 45, "reserve_percent": 20},
+     ["--payload-kg", "0.4", "--wind-speed", "7", "--wind-from", "90", "--course", "45",
+      "--reserve-percent", "20"]),
+    ({"orbit_radius": 50, "orbit_speed": 8, "aoa": "paper"},
+     ["--orbit-radius", "50", "--orbit-speed", "8", "--aoa", "paper"]),
+    ({"sweep_speed": 2.0, "vehicle": "fixtures/vehicles/dji-m100.toml"},
+     ["--sweep-speed", "2", "--vehicle", "fixtures/vehicles/dji-m100.toml"]),
+])
+def test_endurance_equals_cli(cli, repo, monkeypatch, options, flags):
+    monkeypatch.chdir(repo)
+    assert aloft.endurance(**options) == cli.json("endurance", *flags)
+
+
+STATES = [
+    (0.0, 0.0, 0.0, 0.0),
+    (5.0, 0.0, -5.0, 0.0),
+    (12.5, 3.0, -14.0, 1.5),
+    (7.25, -2.5, -9.75, -1.0),
+    (15.0, 10.0, -20.0, 2.0),
+]
+
+
+def test_power_equals_cli_per_state(cli):
+    a, r, p, c = (np.array(x) for x in zip(*STATES))
+    got = aloft.power(a, r, p, c, vehicle="dji-m100")
+    for i, (va, vr, vp, vc) in enumerate(STATES):
+        expected = cli.json("power", "--airspeed", repr(va), "--roll", repr(vr), "--pitch", repr(vp),
+                            "--climb-rate", repr(vc))
+        assert set(expected) == set(aloft.POWER_KEYS)
+        for k in aloft.POWER_KEYS:
+            assert got[k][i] == expected[k], (k, i)  # bit for bit, no tolerance
+
+
+def test_power_options_equal_cli(cli):
+    got = aloft.power([9.0], [1.0], [-11.0], [0.5], vehicle="dji-m100",
+                      without=["profile", "climb"], air_direction_deg=[20.0])
+    expected = cli.json("power", "--vehicle", "dji-m100", "--airspeed", "9", "--roll", "1",
+                        "--pitch", "-11", "--climb-rate", "0.5", "--without", "profile,climb",
+                        "--air-direction-deg", "20")
+    assert {k: float(got[k][0]) for k in aloft.POWER_KEYS} == {k: expected[k] for k in aloft.POWER_KEYS}
+    got = aloft.power(14.0, 0.0, -16.0, profile_cutoff=10.0)
+    expected = cli.json("power", "--airspeed", "14", "--pitch", "-16", "--profile-cutoff", "10")
+    assert {k: float(got[k]) for k in aloft.POWER_KEYS} == {k: expected[k] for k in aloft.POWER_KEYS}
+
+
+def test_timeseries_equals_cli_csv(cli, tmp_path):
+    csv = tmp_path / "ts.csv"
+    rc, _, err = cli.run("mission", "--payload-kg", "0.3", "--timeseries", str(csv))
+    assert rc == 0, err
+    expected = pd.read_csv(csv, float_precision="round_trip")
+    got = aloft.timeseries(payload_kg=0.3)
+    assert isinstance(got, pd.DataFrame)
+    assert list(got.columns) == list(expected.columns)
+    assert len(got) == len(expected) > 100
+    for col in expected.columns:
+        e, g = expected[col].to_numpy(), got[col].to_numpy()
+        assert np.array_equal(g, e, equal_nan=g.dtype.kind == "f"), col
+    assert got["segment"].dtype == np.int64
+
+
+def test_log_info_equals_cli(cli, repo, data):
+    log = repo / "fixtures" / "logs" / "kaist_small.csv"
+    assert aloft.log_info(log) == cli.json("log", "info", str(log))
+    log = sorted((data / "kaist_energy_drone").glob("2018-08-03*.csv"))[0]
+    assert aloft.log_info(str(log), profile="kaist", lag=5.0) == cli.json(
+        "log", "info", str(log), "--profile", "kaist", "--lag", "5")
+
+
+def test_fit_and_validate_equal_cli(cli, repo, data, tmp_path):
+    kaist = data / "kaist_energy_drone"
+    train = sorted(kaist.glob("2018-08-03*.csv"))[0]
+    test = sorted(kaist.glob("2018-08-06*.csv"))[0]
+    template = repo / "fixtures" / "vehicles" / "kaist-template.toml"
+    cli_toml, py_toml = tmp_path / "cli.toml", tmp_path / "py.toml"
+    expected = cli.json("fit", "--log", str(train), "--profile", "kaist", "--vehicle-template",
+                        str(template), "-o", str(cli_toml))
+    got = aloft.fit(train, str(template), profile="kaist", output=py_toml)
+    assert (got.pop("output"), expected.pop("output")) == (str(py_toml), str(cli_toml))
+    assert got == expected
+    assert py_toml.read_text() == cli_toml.read_text()
+    expected = cli.json("validate", "--log", str(test), "--profile", "kaist", "--vehicle",
+                        str(cli_toml), "--calibrate-first", "120")
+    got = aloft.validate([test], str(py_toml), profile="kaist", calibrate_first=120)
+    assert got == expected
+    assert math.isfinite(got["flights"][0]["energy_error_percent"])
