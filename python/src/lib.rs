@@ -27,9 +27,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use aloft::engine::{
-    endurance, fit_logs, fit_parameter, log_info, plan_mission, power_curve, power_model,
-    power_point, power_values, validate_logs, FitRequest, Mission, PowerQuery, Term,
-    ValidateRequest, Vehicle, POWER_KEYS,
+    endurance, fit_logs, fit_parameter, log_info, plan_mission, plan_scenarios, power_curve,
+    power_model, power_point, power_values, validate_logs, FitRequest, Mission,
+    MissionWithUncertainty, PowerQuery, Term, ValidateRequest, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -87,11 +87,21 @@ fn mission_json(
     let mut k = Kwargs::new("mission", options)?;
     let vehicle = options::vehicle(&mut k)?;
     let opts = options::mission(&mut k)?;
+    let scenarios = options::scenarios(&mut k)?;
     k.finish()?;
     py.detach(|| {
         let v = Vehicle::load(&vehicle)?;
         let m = Mission::load(path.as_deref())?;
-        plan_mission(&v, &m, &opts)?.to_json()
+        let plan = plan_mission(&v, &m, &opts)?;
+        match scenarios {
+            None => plan.to_json(),
+            // As `aloft mission --samples N --format json`: the answer with its uncertainty.
+            Some(sc) => MissionWithUncertainty {
+                summary: plan.summary(),
+                uncertainty: &plan_scenarios(&v, &m, &opts, &sc)?,
+            }
+            .to_json(),
+        }
     })
     .map_err(engine_error)
 }

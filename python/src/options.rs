@@ -16,7 +16,7 @@ use pyo3::types::PyDict;
 
 use aloft::engine::{
     AoaModel, CornerMode, EnduranceOptions, FlightLogs, GustSpec, LogReadOptions, MissionOptions,
-    WindProfileKind, WindSpec,
+    ScenarioOptions, WindProfileKind, WindSpec,
 };
 
 use crate::aloft_error;
@@ -238,6 +238,44 @@ pub fn vehicle(k: &mut Kwargs<'_>) -> PyResult<String> {
 // `..MissionOptions::default()` keeps this compiling when the engine adds options (Monte-Carlo
 // sampling is on its way); until then it has nothing to fill.
 #[allow(clippy::needless_update)]
+/// The Monte-Carlo options (`samples`, `seed`, `wind_speed_sd`, `wind_from_sd`,
+/// `payload_sd_kg`, `capacity_sd_percent`, `power_sd_percent`, `threads`), as the CLI's
+/// `--samples N` and its spreads: none without `samples`, and the spreads need it. The engine
+/// checks the ranges (its messages name the option).
+pub fn scenarios(k: &mut Kwargs<'_>) -> PyResult<Option<ScenarioOptions>> {
+    let samples = k.int("samples", u64::from(u32::MAX))?;
+    let defaults = ScenarioOptions::default();
+    let seed = k.int("seed", u64::MAX)?;
+    let spreads = [
+        k.f64("wind_speed_sd")?,
+        k.f64("wind_from_sd")?,
+        k.f64("payload_sd_kg")?,
+        k.f64("capacity_sd_percent")?,
+        k.f64("power_sd_percent")?,
+    ];
+    let threads = k.int("threads", 1024)?;
+    let Some(samples) = samples else {
+        if seed.is_some() || threads.is_some() || spreads.iter().any(Option::is_some) {
+            return Err(aloft_error(
+                "the scenario options (seed, spreads, threads) of aloft.mission need 'samples'",
+            ));
+        }
+        return Ok(None);
+    };
+    let [wind_speed, wind_from, payload, capacity, power] = spreads;
+    Ok(Some(ScenarioOptions {
+        samples: samples as u32,
+        seed: seed.unwrap_or(defaults.seed),
+        wind_speed_sd_mps: wind_speed.unwrap_or(defaults.wind_speed_sd_mps),
+        wind_from_sd_deg: wind_from.unwrap_or(defaults.wind_from_sd_deg),
+        payload_sd_kg: payload.unwrap_or(defaults.payload_sd_kg),
+        capacity_sd_percent: capacity.unwrap_or(defaults.capacity_sd_percent),
+        power_sd_percent: power.unwrap_or(defaults.power_sd_percent),
+        threads: threads.map_or(defaults.threads, |t| t as usize),
+        soc_fan: false,
+    }))
+}
+
 pub fn mission(k: &mut Kwargs<'_>) -> PyResult<MissionOptions> {
     let wind = steady_wind(k)?;
     let wind_field = k.path("wind_field")?;
@@ -266,7 +304,6 @@ pub fn mission(k: &mut Kwargs<'_>) -> PyResult<MissionOptions> {
         speed_mps: k.f64("speed")?,
         rtl_altitude_m: k.f64("rtl_altitude_m")?,
         corners: k.word::<CornerMode>("corners", "'pass', 'stop'")?,
-        ..MissionOptions::default()
     })
 }
 

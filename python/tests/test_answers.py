@@ -134,3 +134,14 @@ def test_fit_and_validate_equal_cli(cli, repo, data, tmp_path):
     got = aloft.validate([test], str(py_toml), profile="kaist", calibrate_first=120)
     assert got == expected
     assert math.isfinite(got["flights"][0]["energy_error_percent"])
+
+
+def test_monte_carlo_mission_equals_cli(cli):
+    """`samples` and the spreads, as `aloft mission --samples N ...`: the same uncertainty."""
+    flags = ["--samples", "64", "--seed", "3", "--payload-sd-kg", "0.2", "--wind-speed-sd", "1",
+             "--threads", "1"]
+    rc, out, err = cli.run("mission", *flags, "--format", "json")
+    assert rc in (0, 1), err
+    got = aloft.mission(samples=64, seed=3, payload_sd_kg=0.2, wind_speed_sd=1.0, threads=1)
+    assert got == json.loads(out)
+    assert got["uncertainty"]["samples"] == 64

@@ -53,9 +53,12 @@ def test_non_finite_inputs_refused():
 
 
 def test_unknown_option_named():
-    # The hook for options the engine does not know yet (e.g. Monte-Carlo `samples`).
-    with pytest.raises(aloft.AloftError, match="unknown option 'samples' for aloft.mission"):
-        aloft.mission(samples=100)
+    # An option no flag of `aloft mission` has.
+    with pytest.raises(aloft.AloftError, match="unknown option 'sample' for aloft.mission"):
+        aloft.mission(sample=100)
+    # Scenario spreads without `samples`, as `--seed` without `--samples`.
+    with pytest.raises(aloft.AloftError, match="need 'samples'"):
+        aloft.mission(payload_sd_kg=0.2)
     with pytest.raises(aloft.AloftError, match="unknown option 'wind' for aloft.endurance"):
         aloft.endurance(wind=5)
 

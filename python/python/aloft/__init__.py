@@ -69,11 +69,15 @@ def mission(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
             ``wind_reference_height``, ``wind_exponent``, ``wind_roughness``, ``wind_field``
             (CSV path), ``gust_std``, ``gust_seed``, ``reserve_percent``, ``start_percent``,
             ``time_step``, ``speed``, ``rtl_altitude_m``, ``corners`` (``"pass"``, ``"stop"``),
-            ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``.
+            ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``; and the Monte-Carlo
+            options of ``--samples N``: ``samples``, ``seed``, ``wind_speed_sd``,
+            ``wind_from_sd``, ``payload_sd_kg``, ``capacity_sd_percent``, ``power_sd_percent``,
+            ``threads`` (the spreads need ``samples``).
 
     Returns:
         The CLI's JSON answer as a dict: ``feasible``, ``energy_wh``, ``duration_s``,
-        ``segments``, ``point_of_no_return``... An infeasible mission is an answer
+        ``segments``, ``point_of_no_return``... (with ``samples``, also ``uncertainty``:
+        ``p_feasible`` and percentiles). An infeasible mission is an answer
         (``feasible`` is False; the CLI exits 1), not an error.
 
     Raises:

@@ -42,6 +42,14 @@ def mission(
     corners: Optional[Literal["pass", "stop"]] = None,
     aoa: Optional[Aoa] = None,
     no_ground_effect: bool = False,
+    samples: Optional[int] = None,
+    seed: Optional[int] = None,
+    wind_speed_sd: Optional[float] = None,
+    wind_from_sd: Optional[float] = None,
+    payload_sd_kg: Optional[float] = None,
+    capacity_sd_percent: Optional[float] = None,
+    power_sd_percent: Optional[float] = None,
+    threads: Optional[int] = None,
     **options: Any,
 ) -> Dict[str, Any]: ...
 def timeseries(
