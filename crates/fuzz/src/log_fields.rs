@@ -146,7 +146,7 @@ mod tests {
             [(16, 2), (19, 1), (20, 2), (36, 2), (39, 2), (41, 8)]
         );
         assert_eq!(f.floats, [49, 53]);
-        assert_eq!(f32::from_le_bytes(d[53..57].try_into().unwrap()), 10.0);
+        assert_eq!(d[53..57], 10.0f32.to_le_bytes());
     }
 
     #[test]
@@ -157,6 +157,6 @@ mod tests {
         assert_eq!(f.ints, [(2, 1), (3, 1), (4, 1), (91, 1), (92, 8)]);
         assert_eq!(f.floats, [100, 104]);
         assert_eq!(f.format_chars, [9, 10, 11]);
-        assert_eq!(f32::from_le_bytes(d[104..108].try_into().unwrap()), 5.0);
+        assert_eq!(d[104..108], 5.0f32.to_le_bytes());
     }
 }
