@@ -474,8 +474,8 @@ impl DataflashDecoder {
             Role::Parm => {
                 let name = f.text(p, "Name")?;
                 let v = f.num(p, "Value")?;
-                if name == "BATT_CAPACITY" && v > 0.0 {
-                    s.battery_capacity_ah = Some(v / 1000.0);
+                if name == "BATT_CAPACITY" {
+                    s.battery_capacity_ah = crate::binary::capacity_ah(v).or(s.battery_capacity_ah);
                 }
             }
             Role::Att | Role::Pos | Role::Gps | Role::Bat | Role::Curr => {
@@ -792,5 +792,34 @@ mod tests {
             "{:?}",
             s.warnings
         );
+    }
+
+    /// Fuzz finding `fixtures/fuzz/dataflash/f70328e305c524bd.bin`: a `BATT_CAPACITY` of
+    /// infinity was read as an infinite capacity, which `log info` refused as not finite.
+    #[test]
+    fn a_battery_capacity_that_is_not_plausible_is_not_read() {
+        for (mah, ah) in [
+            (f32::INFINITY, None),
+            (f32::NAN, None),
+            (-1.0, None),
+            (5000.0, Some(5.0)),
+        ] {
+            let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+            b.extend(dataflash_fmt(
+                3,
+                3 + 8 + 16 + 4,
+                "PARM",
+                "QNf",
+                "TimeUS,Name,Value",
+            ));
+            b.extend([0xA3, 0x95, 3]);
+            b.extend(1_000_000u64.to_le_bytes());
+            let mut name = b"BATT_CAPACITY".to_vec();
+            name.resize(16, 0);
+            b.extend(name);
+            b.extend(mah.to_le_bytes());
+            let r = read_dataflash(&b[..], &BinaryOptions::default()).unwrap();
+            assert_eq!(r.summary.battery_capacity_ah, ah, "{mah} mA h");
+        }
     }
 }
