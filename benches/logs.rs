@@ -14,6 +14,7 @@ use std::path::Path;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 
 use aloft_logs::cdr::CdrWriter;
+use aloft_logs::synth;
 use aloft_logs::{
     read_dataflash, read_ulog, BinaryOptions, ColumnMap, CsvSamples, McapOptions, McapSamples,
 };
@@ -160,152 +161,10 @@ fn mcap_read(c: &mut Criterion) {
     g.finish();
 }
 
-fn ulog_record(out: &mut Vec<u8>, t: u8, payload: &[u8]) {
-    out.extend_from_slice(&(payload.len() as u16).to_le_bytes());
-    out.push(t);
-    out.extend_from_slice(payload);
-}
-
-fn ulog_data(out: &mut Vec<u8>, id: u16, t_us: u64, floats: &[f32]) {
-    let mut d = id.to_le_bytes().to_vec();
-    d.extend_from_slice(&t_us.to_le_bytes());
-    for f in floats {
-        d.extend_from_slice(&f.to_le_bytes());
-    }
-    ulog_record(out, b'D', &d);
-}
-
-/// A ULog of `seconds` of flight: sensor_combined 200 Hz (skipped), vehicle_attitude 50 Hz,
-/// vehicle_local_position 10 Hz, battery_status 5 Hz.
-fn ulog_bytes(seconds: u64) -> Vec<u8> {
-    let mut b = vec![0x55, 0x4C, 0x6F, 0x67, 0x01, 0x12, 0x35, 1];
-    b.extend_from_slice(&0u64.to_le_bytes());
-    ulog_record(&mut b, b'B', &[0u8; 40]);
-    let formats: [(&str, u16, usize); 4] = [
-        ("sensor_combined", 1, 12),
-        ("vehicle_attitude", 2, 4),
-        ("vehicle_local_position", 3, 9),
-        ("battery_status", 4, 2),
-    ];
-    let fields = |n: usize, names: &[&str]| -> String {
-        (0..n)
-            .map(|i| {
-                format!(
-                    "float {};",
-                    names.get(i).map_or(format!("f{i}"), |s| s.to_string())
-                )
-            })
-            .collect()
-    };
-    for (name, _, n) in formats {
-        let names: Vec<&str> = match name {
-            "vehicle_attitude" => vec![],
-            "vehicle_local_position" => vec!["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"],
-            "battery_status" => vec!["voltage_v", "current_a"],
-            _ => vec![],
-        };
-        let body = if name == "vehicle_attitude" {
-            "float[4] q;".to_string()
-        } else {
-            fields(n, &names)
-        };
-        ulog_record(
-            &mut b,
-            b'F',
-            format!("{name}:uint64_t timestamp;{body}").as_bytes(),
-        );
-    }
-    for (name, id, _) in formats {
-        let mut a = vec![0u8];
-        a.extend_from_slice(&id.to_le_bytes());
-        a.extend_from_slice(name.as_bytes());
-        ulog_record(&mut b, b'A', &a);
-    }
-    for k in 0..seconds * 200 {
-        let t = 1_000_000 + k * 5_000;
-        let x = (k as f32 * 0.001).sin();
-        ulog_data(&mut b, 1, t, &[x; 12]);
-        if k % 4 == 0 {
-            ulog_data(&mut b, 2, t, &[1.0, 0.01 * x, 0.02, 0.0]);
-        }
-        if k % 20 == 0 {
-            ulog_data(
-                &mut b,
-                3,
-                t,
-                &[x, 2.0 * x, -10.0, 1.0, 2.0, 0.1, 0.0, 0.0, 0.0],
-            );
-        }
-        if k % 40 == 0 {
-            ulog_data(&mut b, 4, t, &[16.0 - x, 20.0 + x]);
-        }
-    }
-    b
-}
-
-fn df_fmt(out: &mut Vec<u8>, t: u8, len: u8, name: &str, format: &str, cols: &str) {
-    out.extend_from_slice(&[0xA3, 0x95, 0x80, t, len]);
-    for (s, n) in [(name, 4), (format, 16), (cols, 64)] {
-        let mut v = s.as_bytes().to_vec();
-        v.resize(n, 0);
-        out.extend_from_slice(&v);
-    }
-}
-
-fn df_record(out: &mut Vec<u8>, t: u8, t_us: u64, floats: &[f32]) {
-    out.extend_from_slice(&[0xA3, 0x95, t]);
-    out.extend_from_slice(&t_us.to_le_bytes());
-    for f in floats {
-        out.extend_from_slice(&f.to_le_bytes());
-    }
-}
-
-/// A DataFlash log of `seconds`: IMU 400 Hz (skipped), ATT 25 Hz, BAT 10 Hz.
-fn dataflash_bytes(seconds: u64) -> Vec<u8> {
-    let mut b = Vec::new();
-    df_fmt(
-        &mut b,
-        0x80,
-        89,
-        "FMT",
-        "BBnNZ",
-        "Type,Length,Name,Format,Columns",
-    );
-    df_fmt(
-        &mut b,
-        1,
-        3 + 8 + 24,
-        "IMU",
-        "Qffffff",
-        "TimeUS,GyrX,GyrY,GyrZ,AccX,AccY,AccZ",
-    );
-    df_fmt(
-        &mut b,
-        2,
-        3 + 8 + 12,
-        "ATT",
-        "Qfff",
-        "TimeUS,Roll,Pitch,Yaw",
-    );
-    df_fmt(&mut b, 3, 3 + 8 + 8, "BAT", "Qff", "TimeUS,Volt,Curr");
-    for k in 0..seconds * 400 {
-        let t = 1_000_000 + k * 2_500;
-        let x = (k as f32 * 0.001).sin();
-        df_record(&mut b, 1, t, &[x; 6]);
-        if k % 16 == 0 {
-            df_record(&mut b, 2, t, &[x, -x, 90.0 + x]);
-        }
-        if k % 40 == 0 {
-            df_record(&mut b, 3, t, &[12.0 - x, 10.0 + x]);
-        }
-    }
-    b
-}
-
 fn binary_read(c: &mut Criterion) {
     let mut g = c.benchmark_group("logs/read");
     g.sample_size(10);
-    let ulog = ulog_bytes(3_000);
+    let ulog = synth::ulog_flight(3_000);
     g.throughput(Throughput::Bytes(ulog.len() as u64));
     g.bench_function("ulog", |b| {
         b.iter(|| {
@@ -313,7 +172,7 @@ fn binary_read(c: &mut Criterion) {
             black_box(r.summary.energy_wh())
         })
     });
-    let df = dataflash_bytes(3_000);
+    let df = synth::dataflash_flight(3_000);
     g.throughput(Throughput::Bytes(df.len() as u64));
     g.bench_function("dataflash", |b| {
         b.iter(|| {

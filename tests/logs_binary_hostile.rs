@@ -2,96 +2,17 @@
 //! length fields at their extremes. Nothing may panic, allocate beyond the input, or lose the
 //! valid prefix; every problem is a warning with its byte offset.
 
+use aloft_logs::synth::{self, dataflash_fmt as fmt, ulog_record};
 use aloft_logs::{read_dataflash, read_ulog, BinaryLog, BinaryOptions};
-
-/// A ULog record: size, type, payload.
-fn ulog_record(t: u8, payload: &[u8]) -> Vec<u8> {
-    let mut r = (payload.len() as u16).to_le_bytes().to_vec();
-    r.push(t);
-    r.extend_from_slice(payload);
-    r
-}
 
 /// A small ULog: 50 local positions at 10 Hz and 50 battery records of 16 V, 10 A (160 W).
 fn ulog_bytes() -> Vec<u8> {
-    let mut b = vec![0x55, 0x4C, 0x6F, 0x67, 0x01, 0x12, 0x35, 1];
-    b.extend_from_slice(&0u64.to_le_bytes());
-    b.extend(ulog_record(b'B', &[0u8; 40]));
-    b.extend(ulog_record(
-        b'F',
-        b"battery_status:uint64_t timestamp;float voltage_v;float current_a;uint8_t[4] _padding0;",
-    ));
-    b.extend(ulog_record(
-        b'F',
-        b"vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;",
-    ));
-    let mut p = vec![11u8];
-    p.extend_from_slice(b"int32_t BAT1_N_CELLS");
-    p.truncate(1 + 20);
-    p[0] = 20;
-    p.extend_from_slice(&4i32.to_le_bytes());
-    b.extend(ulog_record(b'P', &p));
-    let mut a = vec![0u8, 1, 0];
-    a.extend_from_slice(b"battery_status");
-    b.extend(ulog_record(b'A', &a));
-    let mut a = vec![0u8, 2, 0];
-    a.extend_from_slice(b"vehicle_local_position");
-    b.extend(ulog_record(b'A', &a));
-    for i in 0..50u64 {
-        let t = 1_000_000 + i * 100_000;
-        let mut d = 2u16.to_le_bytes().to_vec();
-        d.extend_from_slice(&t.to_le_bytes());
-        for v in [1.0f32, 2.0, -3.0, 0.5, 0.0, 0.0] {
-            d.extend_from_slice(&v.to_le_bytes());
-        }
-        b.extend(ulog_record(b'D', &d));
-        let mut d = 1u16.to_le_bytes().to_vec();
-        d.extend_from_slice(&t.to_le_bytes());
-        d.extend_from_slice(&16.0f32.to_le_bytes());
-        d.extend_from_slice(&10.0f32.to_le_bytes());
-        b.extend(ulog_record(b'D', &d));
-    }
-    b
-}
-
-fn fmt(t: u8, len: u8, name: &str, format: &str, cols: &str) -> Vec<u8> {
-    let mut r = vec![0xA3, 0x95, 0x80, t, len];
-    let pad = |s: &str, n: usize| {
-        let mut v = s.as_bytes().to_vec();
-        v.resize(n, 0);
-        v
-    };
-    r.extend(pad(name, 4));
-    r.extend(pad(format, 16));
-    r.extend(pad(cols, 64));
-    r
+    synth::ulog_small()
 }
 
 /// A small DataFlash log: 50 ATT (degrees) and 50 BAT (12 V, 5 A) at 10 Hz.
 fn dataflash_bytes() -> Vec<u8> {
-    let mut b = fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
-    b.extend(fmt(1, 3 + 8 + 12, "ATT", "Qfff", "TimeUS,Roll,Pitch,Yaw"));
-    b.extend(fmt(
-        2,
-        3 + 8 + 1 + 8,
-        "BAT",
-        "QBff",
-        "TimeUS,Instance,Volt,Curr",
-    ));
-    for i in 0..50u64 {
-        let t = 1_000_000 + i * 100_000;
-        b.extend([0xA3, 0x95, 1]);
-        b.extend(t.to_le_bytes());
-        for v in [1.0f32, 2.0, 90.0] {
-            b.extend(v.to_le_bytes());
-        }
-        b.extend([0xA3, 0x95, 2]);
-        b.extend(t.to_le_bytes());
-        b.push(0);
-        b.extend(12.0f32.to_le_bytes());
-        b.extend(5.0f32.to_le_bytes());
-    }
-    b
+    synth::dataflash_small()
 }
 
 fn ulog(b: &[u8]) -> Option<BinaryLog> {

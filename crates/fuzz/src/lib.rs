@@ -21,7 +21,9 @@
 //! splices of two inputs, little-endian integers overwritten with extreme values; for text,
 //! numbers replaced by extreme values ([`EXTREME_NUMBERS`]), keys by other keys of the seeds, lines
 //! dropped, repeated or swapped, CSV columns repeated, `key = value` lines inserted; for MCAP,
-//! the record, string and chunk length fields overwritten. Inputs that end in a new kind of
+//! the record, string and chunk length fields overwritten; for ULog and DataFlash, record sizes,
+//! ids, `FMT` lengths and timestamps set to extreme values, the floats of data records to NaN,
+//! infinities and extremes, and format characters to other ones ([`log_fields`]). Inputs that end in a new kind of
 //! answer or message join the corpus (a coarse stand-in for coverage feedback). The generator is
 //! seeded ([`Rng`]), so a run is reproduced by its seed.
 
@@ -30,6 +32,7 @@
 
 pub mod alloc;
 pub mod check;
+pub mod log_fields;
 pub mod mutate;
 pub mod rng;
 pub mod runner;

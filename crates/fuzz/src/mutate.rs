@@ -1,7 +1,10 @@
 //! Mutations of an input: byte-level ones for every format, structure-aware ones for text (numbers
 //! replaced by extreme values, key names by other known keys, lines dropped or repeated, CSV
-//! columns repeated) and for MCAP (length fields overwritten with extreme values).
+//! columns repeated), for MCAP (length fields overwritten with extreme values) and for ULog and
+//! DataFlash (record sizes, ids, `FMT` lengths and timestamps set to extreme values, floats of
+//! data records to NaN, infinities and extremes, format characters to other ones).
 
+use crate::log_fields::{dataflash_fields, ulog_fields, LogFields, EXTREME_F32, FORMAT_CHARS};
 use crate::rng::Rng;
 
 /// What kind of bytes a target reads, which decides the structure-aware mutations.
@@ -11,6 +14,10 @@ pub enum Format {
     Text,
     /// MCAP: record and string length fields.
     Mcap,
+    /// PX4 ULog: record sizes, message ids, timestamps, floats, field types.
+    Ulog,
+    /// ArduPilot DataFlash: `FMT` lengths and formats, record types, timestamps, floats.
+    Dataflash,
 }
 
 /// Numbers that break parsers and models: zeros of both signs, subnormals, overflow to infinity,
@@ -236,7 +243,7 @@ impl Mutator {
     fn mutate_once(&self, rng: &mut Rng, data: &mut Vec<u8>, other: &[u8]) {
         let structured = match self.format {
             Format::Text => 9,
-            Format::Mcap => 3,
+            Format::Mcap | Format::Ulog | Format::Dataflash => 3,
         };
         let k = rng.below(7 + structured);
         match k {
@@ -257,6 +264,14 @@ impl Mutator {
                         let f = *rng.pick(&fields);
                         overwrite_int(rng, data, Some(f));
                     }
+                }
+                Format::Ulog => {
+                    let fields = ulog_fields(data);
+                    log_field_mutation(rng, data, &fields, k - 7);
+                }
+                Format::Dataflash => {
+                    let fields = dataflash_fields(data);
+                    log_field_mutation(rng, data, &fields, k - 7);
                 }
             },
         }
@@ -440,6 +455,29 @@ fn overwrite_int(rng: &mut Rng, data: &mut [u8], field: Option<(usize, usize)>) 
     now[..width].copy_from_slice(bytes);
     let v = extreme_value(rng, width, u64::from_le_bytes(now), len);
     bytes.copy_from_slice(&v.to_le_bytes()[..width]);
+}
+
+/// One mutation of a ULog or DataFlash field: `k` 0 an integer field to an extreme, 1 a float to
+/// an extreme, 2 a format character to another (each falls back to a random integer).
+fn log_field_mutation(rng: &mut Rng, data: &mut [u8], fields: &LogFields, k: usize) {
+    match k {
+        0 if !fields.ints.is_empty() => {
+            let f = *rng.pick(&fields.ints);
+            overwrite_int(rng, data, Some(f));
+        }
+        1 if !fields.floats.is_empty() => {
+            let at = *rng.pick(&fields.floats);
+            let v = *rng.pick(&EXTREME_F32);
+            if let Some(b) = data.get_mut(at..at + 4) {
+                b.copy_from_slice(&v.to_le_bytes());
+            }
+        }
+        2 if !fields.format_chars.is_empty() => {
+            let at = *rng.pick(&fields.format_chars);
+            data[at] = *rng.pick(FORMAT_CHARS);
+        }
+        _ => overwrite_int(rng, data, None),
+    }
 }
 
 fn replace_number(rng: &mut Rng, data: &mut Vec<u8>) {

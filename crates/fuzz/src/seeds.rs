@@ -1,6 +1,8 @@
 //! Seeds: the repository's fixtures, and inputs aloft makes itself (a mission as JSON, logs
 //! converted to MCAP, the same MCAP re-encoded without compression and without chunks, a ROS 2
-//! CDR file, a planned mission's MCAP).
+//! CDR file, a planned mission's MCAP), planner files and binary logs made in code, and, when the
+//! shared data folder is there at run time ([`data_dir`]), its mission files and the first
+//! [`DATA_LOG_HEAD`] bytes of its flight logs (read, never copied into the repository).
 
 use std::collections::BTreeMap;
 use std::io::Cursor;
@@ -11,6 +13,8 @@ use aloft::engine::{
     Vehicle, DEMO_MISSION,
 };
 use aloft_logs::cdr::CdrWriter;
+use aloft_logs::synth;
+use serde_json::{json, Value};
 
 use crate::targets::{scratch, MAP_SEPARATOR, TABLE_SEPARATOR};
 
@@ -307,6 +311,184 @@ fn mission_mcap() -> Vec<Vec<u8>> {
     }
 }
 
+/// The shared data folder: `ALOFT_DATA_DIR`, else `../shared/data` beside the workspace (as the
+/// `data_val` tests find it); `None` when it is not a directory.
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = match std::env::var_os("ALOFT_DATA_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => repo_root().join("../shared/data"),
+    };
+    dir.is_dir().then_some(dir)
+}
+
+/// The files of the shared data folder's `sub` whose names end in one of `suffixes` (any case),
+/// sorted, at most `limit` bytes of each.
+fn shared(sub: &str, suffixes: &[&str], limit: usize) -> Vec<Vec<u8>> {
+    let Some(dir) = data_dir() else {
+        return Vec::new();
+    };
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir.join(sub))
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    paths.retain(|p| {
+        let name = p.to_string_lossy().to_ascii_lowercase();
+        suffixes.iter().any(|s| name.ends_with(s))
+    });
+    paths.sort();
+    let head = |p: &PathBuf| -> Option<Vec<u8>> {
+        use std::io::Read;
+        let mut out = Vec::new();
+        let f = std::fs::File::open(p).ok()?;
+        f.take(limit as u64).read_to_end(&mut out).ok()?;
+        Some(out)
+    };
+    paths.iter().filter_map(head).collect()
+}
+
+/// How much of each shared flight log is a seed, bytes (a log's definitions and its first
+/// seconds; whole logs are megabytes).
+pub const DATA_LOG_HEAD: usize = 64 << 10;
+
+/// A QGroundControl SimpleItem.
+fn qgc_item(command: u32, frame: u32, jump_id: u32, params: Value) -> Value {
+    json!({"type": "SimpleItem", "command": command, "frame": frame, "doJumpId": jump_id,
+           "params": params, "autoContinue": true})
+}
+
+/// A `.plan` of `items` with its home at 47.3977 N, 8.5456 E, 488 m.
+fn qgc_plan(items: Vec<Value>) -> Vec<u8> {
+    let plan = json!({
+        "fileType": "Plan", "version": 1, "groundStation": "QGroundControl",
+        "geoFence": {"circles": [], "polygons": [], "version": 2},
+        "rallyPoints": {"points": [], "version": 2},
+        "mission": {"version": 2, "firmwareType": 12, "vehicleType": 2, "cruiseSpeed": 15,
+                    "hoverSpeed": 5, "plannedHomePosition": [47.3977, 8.5456, 488.0],
+                    "items": items},
+    });
+    serde_json::to_string_pretty(&plan)
+        .unwrap_or_default()
+        .into_bytes()
+}
+
+/// QGroundControl `.plan` files made in code: take-off (22), waypoints (16) with a hold, in the
+/// relative (3) and AMSL (0) frames, a speed change (178), a gripper (211), camera commands
+/// (530, 206), a delay (93), loiters (18 turns with a radius, 19 time, 31 to altitude), a jump
+/// back (177, `doJumpId` and a repeat), a survey ComplexItem, `null` params, then a return
+/// (20) or a landing (21); and the shared folder's `.plan` files.
+pub fn qgc_plan_files() -> Vec<Vec<u8>> {
+    let (lat, lon) = (47.3977, 8.5456);
+    let wp = |id, hold: f64, dn: f64, de: f64, alt: f64, frame| {
+        qgc_item(
+            16,
+            frame,
+            id,
+            json!([hold, 0, 0, null, lat + dn, lon + de, alt]),
+        )
+    };
+    let survey_inner = vec![
+        wp(100, 0.0, 0.0010, 0.0005, 30.0, 3),
+        qgc_item(206, 2, 101, json!([25, 0, 1, 0, 0, 0, 0])),
+        wp(102, 0.0, 0.0010, 0.0015, 30.0, 3),
+        wp(103, 0.0, 0.0005, 0.0015, 30.0, 3),
+        qgc_item(206, 2, 104, json!([0, 0, 1, 0, 0, 0, 0])),
+    ];
+    let survey = json!({"type": "ComplexItem", "complexItemType": "survey", "version": 5,
+        "TransectStyleComplexItem": {"Items": survey_inner, "CameraTriggerInTurnAround": true},
+        "angle": 0, "entryLocation": 0, "flyAlternateTransects": false,
+        "polygon": [[lat + 0.0005, lon + 0.0005], [lat + 0.0010, lon + 0.0005],
+                    [lat + 0.0010, lon + 0.0015], [lat + 0.0005, lon + 0.0015]]});
+    let full = vec![
+        qgc_item(22, 3, 1, json!([0, 0, 0, null, lat, lon, 30])),
+        wp(2, 5.0, 0.0003, 0.0, 30.0, 3),
+        qgc_item(178, 2, 3, json!([1, 8, -1, 0, 0, 0, 0])),
+        wp(4, 0.0, 0.0006, 0.0004, 528.0, 0),
+        qgc_item(
+            18,
+            3,
+            5,
+            json!([2, 0, 20, 0, lat + 0.0006, lon + 0.0008, 30]),
+        ),
+        qgc_item(
+            19,
+            3,
+            6,
+            json!([10, 0, 15, 0, lat + 0.0003, lon + 0.0008, 35]),
+        ),
+        qgc_item(211, 2, 7, json!([1, 0, 0, 0, 0, 0, 0])),
+        qgc_item(530, 2, 8, json!([0, 1, null, null, null, null, null])),
+        qgc_item(93, 2, 9, json!([3, -1, -1, -1, 0, 0, 0])),
+        qgc_item(31, 3, 10, json!([0, 15, 0, 0, lat, lon + 0.0004, 40])),
+        qgc_item(177, 2, 11, json!([2, 1, 0, 0, 0, 0, 0])),
+        survey,
+        qgc_item(20, 2, 13, json!([0, 0, 0, 0, 0, 0, 0])),
+    ];
+    let short = vec![
+        qgc_item(22, 3, 1, json!([0, 0, 0, null, lat, lon, 20])),
+        wp(2, 0.0, 0.0004, 0.0004, 20.0, 3),
+        qgc_item(
+            21,
+            3,
+            3,
+            json!([0, 0, 0, null, lat + 0.0004, lon + 0.0004, 0]),
+        ),
+    ];
+    let mut out = vec![qgc_plan(full), qgc_plan(short)];
+    out.extend(shared("missions", &[".plan"], usize::MAX));
+    out
+}
+
+/// One `QGC WPL 110` row: index, current, frame, command, four params, lat, lon, alt, continue.
+fn wpl_row(index: u32, frame: u32, command: u32, p: [f64; 4], pos: [f64; 3]) -> String {
+    let current = u32::from(index == 0);
+    format!(
+        "{index}\t{current}\t{frame}\t{command}\t{:.6}\t{:.6}\t{:.6}\t{:.6}\t{:.8}\t{:.8}\t{:.6}\t1\n",
+        p[0], p[1], p[2], p[3], pos[0], pos[1], pos[2]
+    )
+}
+
+/// Mission Planner `.waypoints` made in code: the home row (0, AMSL), a take-off, waypoints (one
+/// with a hold, one in the AMSL frame), a loiter, a jump back to row 2 repeated twice (the row
+/// index), a return; the same with CRLF line ends; and the shared folder's `.waypoints` and
+/// `.txt` files.
+pub fn qgc_wpl_files() -> Vec<Vec<u8>> {
+    let (lat, lon) = (-35.363262, 149.165237);
+    let zero = [0.0; 4];
+    let rows = [
+        wpl_row(0, 0, 16, zero, [lat, lon, 584.0]),
+        wpl_row(1, 3, 22, zero, [0.0, 0.0, 20.0]),
+        wpl_row(2, 3, 16, [3.0, 0.0, 0.0, 0.0], [lat + 0.0003, lon, 20.0]),
+        wpl_row(3, 0, 16, zero, [lat + 0.0003, lon + 0.0004, 610.0]),
+        wpl_row(4, 3, 18, [1.0, 0.0, 15.0, 0.0], [lat, lon + 0.0004, 25.0]),
+        wpl_row(5, 0, 177, [2.0, 2.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
+        wpl_row(6, 3, 20, zero, [0.0, 0.0, 0.0]),
+    ];
+    let text = format!("QGC WPL 110\n{}", rows.concat());
+    let crlf = text.replace('\n', "\r\n");
+    let mut out = vec![text.into_bytes(), crlf.into_bytes()];
+    out.extend(shared("missions", &[".waypoints", ".txt"], usize::MAX));
+    out
+}
+
+/// PX4 ULogs made in code ([`synth`]: a small one with a parameter, one second of a flight's
+/// topic mix), a ULog without its battery records, and the heads of the shared `.ulg` logs.
+pub fn ulog() -> Vec<Vec<u8>> {
+    let small = synth::ulog_small();
+    // The definitions and subscriptions only: 50 position (3 + 34 bytes) and 50 battery
+    // (3 + 18 bytes) data records cut off.
+    let definitions = small[..small.len() - 50 * ((3 + 34) + (3 + 18))].to_vec();
+    let mut out = vec![small, synth::ulog_flight(1), definitions];
+    out.extend(shared("flight_logs", &[".ulg"], DATA_LOG_HEAD));
+    out
+}
+
+/// ArduPilot DataFlash logs made in code ([`synth`]: a small one with a battery instance, one
+/// second of a flight's record mix) and the heads of the shared `.bin` logs.
+pub fn dataflash() -> Vec<Vec<u8>> {
+    let mut out = vec![synth::dataflash_small(), synth::dataflash_flight(1)];
+    out.extend(shared("flight_logs", &[".bin"], DATA_LOG_HEAD));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -322,5 +504,37 @@ mod tests {
         // truncated.mcap, two converted logs and their two re-encodings, ROS 2, mission.
         assert_eq!(mcap().len(), 1 + 2 * 3 + 1 + 1);
         crate::targets::remove_scratch();
+        // Made in code, and the shared files when the folder is there.
+        let shared = usize::from(data_dir().is_some());
+        assert!(qgc_plan_files().len() >= 2 + 6 * shared);
+        assert!(qgc_wpl_files().len() >= 2 + 6 * shared);
+        assert!(ulog().len() >= 3 + 3 * shared);
+        assert!(dataflash().len() >= 2 + 4 * shared);
+        assert!(ulog().iter().all(|s| s.len() <= DATA_LOG_HEAD));
+    }
+
+    /// The seeds made in code are read whole, so the fuzzing starts from the accepted path.
+    #[test]
+    fn the_planner_files_and_logs_made_in_code_are_accepted() {
+        for (i, text) in qgc_plan_files()[..2].iter().enumerate() {
+            let m = Mission::from_text(&String::from_utf8_lossy(text), "seed.plan");
+            assert!(m.is_ok(), "plan {i}: {:?}", m.err());
+        }
+        for (i, text) in qgc_wpl_files()[..2].iter().enumerate() {
+            let m = Mission::from_text(&String::from_utf8_lossy(text), "seed.waypoints");
+            assert!(m.is_ok(), "waypoints {i}: {:?}", m.err());
+        }
+        let o = aloft_logs::BinaryOptions::default();
+        for u in &ulog()[..2] {
+            assert!(aloft_logs::read_ulog(&u[..], &o)
+                .unwrap()
+                .summary
+                .warnings
+                .is_empty());
+        }
+        let defs = aloft_logs::read_ulog(&ulog()[2][..], &o).unwrap();
+        assert!(defs.log.samples.is_empty());
+        let w = &defs.summary.warnings;
+        assert!(w.iter().any(|w| w.contains("never written")), "{w:?}");
     }
 }

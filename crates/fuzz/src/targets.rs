@@ -1,9 +1,8 @@
 //! The table of fuzz targets: one entry per parser, each calling the engine as the command line
 //! does and computing the answer the command line would print.
 //!
-//! A new parser (a QGroundControl `.plan` reader, PX4 ULog, ArduPilot DataFlash) joins by one more
-//! [`Target`] in [`TARGETS`]: a name, its format, a function that gives its seeds and a function
-//! that runs one input and returns the [`Outcome`].
+//! A new parser joins by one more [`Target`] in [`TARGETS`]: a name, its format, a function that
+//! gives its seeds and a function that runs one input and returns the [`Outcome`].
 
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -96,6 +95,38 @@ pub const TARGETS: &[Target] = &[
         format: Format::Mcap,
         seeds: seeds::mcap,
         run: mcap,
+    },
+    Target {
+        name: "qgc-plan",
+        about: "Mission::from_text of a QGroundControl .plan (content detection), then compile \
+                and plan_mission with dji-m100",
+        format: Format::Text,
+        seeds: seeds::qgc_plan_files,
+        run: planner_file,
+    },
+    Target {
+        name: "qgc-wpl",
+        about: "Mission::from_text of a QGC WPL 110 .waypoints (content detection), then \
+                compile and plan_mission with dji-m100",
+        format: Format::Text,
+        seeds: seeds::qgc_wpl_files,
+        run: planner_file,
+    },
+    Target {
+        name: "ulog",
+        about: "aloft_logs::read_ulog of the bytes; log_info of them written to a file on \
+                every 8th input",
+        format: Format::Ulog,
+        seeds: seeds::ulog,
+        run: ulog,
+    },
+    Target {
+        name: "dataflash",
+        about: "aloft_logs::read_dataflash of the bytes; log_info of them written to a file on \
+                every 8th input",
+        format: Format::Dataflash,
+        seeds: seeds::dataflash,
+        run: dataflash,
     },
 ];
 
@@ -203,6 +234,12 @@ fn mission_toml(data: &[u8]) -> Outcome {
 fn mission_json(data: &[u8]) -> Outcome {
     let text = String::from_utf8_lossy(data);
     mission(Mission::from_json(&text, "fuzz-mission.json"))
+}
+
+/// A planner file (`.plan` or `.waypoints`), told by its content as `aloft mission` tells it.
+fn planner_file(data: &[u8]) -> Outcome {
+    let text = String::from_utf8_lossy(data);
+    mission(Mission::from_text(&text, "fuzz-planner-file"))
 }
 
 /// A parsed mission: compiled for dji-m100, planned (with a coarser step when it would take
@@ -418,4 +455,79 @@ fn mcap(data: &[u8]) -> Outcome {
     let mut o = Outcome::default();
     o.accepted = info(&mut o, &path, &options, lag);
     o
+}
+
+/// A binary log read from bytes: what the reader found, each optional figure only when present
+/// (so a `null` is a number that was not finite).
+fn binary_answer(o: &mut Outcome, what: &'static str, log: &aloft_logs::BinaryLog) {
+    let s = &log.summary;
+    let mut a = serde_json::Map::new();
+    a.insert("samples".into(), log.log.samples.len().into());
+    a.insert("bytes".into(), s.bytes.into());
+    a.insert("bytes_skipped".into(), s.bytes_skipped.into());
+    a.insert("warnings".into(), s.warnings.len().into());
+    a.insert("battery_valid".into(), s.battery.valid.into());
+    a.insert("battery_energy_j".into(), json_f64(s.battery.energy_j));
+    a.insert("base_span_s".into(), json_f64(s.base_span_s));
+    a.insert("start_time_s".into(), json_f64(log.log.start_time_s));
+    let optional = [
+        ("energy_wh", s.energy_wh()),
+        ("battery_capacity_ah", s.battery_capacity_ah),
+        ("air_density_kg_m3", s.air_density_kg_m3),
+        ("in_air_s", s.in_air_s),
+        ("battery_first_s", s.battery.first_s),
+        ("battery_last_s", s.battery.last_s),
+    ];
+    for (k, v) in optional {
+        if let Some(v) = v {
+            a.insert(k.into(), json_f64(v));
+        }
+    }
+    if let Some(last) = log.log.samples.last() {
+        a.insert("last_time_s".into(), json_f64(last.time_s));
+    }
+    o.json(what, &a);
+}
+
+/// A number as JSON: `null` when it is not finite (which the checks report).
+fn json_f64(v: f64) -> serde_json::Value {
+    serde_json::Number::from_f64(v).map_or(serde_json::Value::Null, serde_json::Value::Number)
+}
+
+/// A binary log: read from the bytes (the reader refuses only what is not such a log), and on
+/// every 8th input `log_info` of the bytes written to `file` (the engine's path, as `aloft log
+/// info` runs it).
+fn binary_log(
+    data: &[u8],
+    file: &str,
+    read: fn(&[u8]) -> aloft_logs::Result<aloft_logs::BinaryLog>,
+) -> Outcome {
+    let mut o = Outcome::default();
+    match read(data) {
+        Ok(log) => {
+            o.accepted = true;
+            binary_answer(&mut o, "binary log", &log);
+        }
+        Err(e) => {
+            let e = aloft::Error::from(e);
+            o.refuse("binary log", &e);
+        }
+    }
+    if fnv1a(data) % 8 == 0 {
+        let path = write_scratch(file, data);
+        info(&mut o, &path, &LogReadOptions::default(), None);
+    }
+    o
+}
+
+fn ulog(data: &[u8]) -> Outcome {
+    binary_log(data, "log.ulg", |d| {
+        aloft_logs::read_ulog(d, &aloft_logs::BinaryOptions::default())
+    })
+}
+
+fn dataflash(data: &[u8]) -> Outcome {
+    binary_log(data, "log.bin", |d| {
+        aloft_logs::read_dataflash(d, &aloft_logs::BinaryOptions::default())
+    })
 }

@@ -40,6 +40,16 @@ impl Default for BinaryOptions {
 /// does not count as power data.
 pub const MIN_BATTERY_COVERAGE: f64 = 0.5;
 
+/// Largest battery capacity a log's parameters may give, mA h (10,000 A h, the end of the CSV
+/// charge range): a larger or non-finite one is a corrupt parameter and is not read.
+pub const MAX_BATTERY_CAPACITY_MAH: f64 = 1e7;
+
+/// A capacity parameter in mA h as A h, when it is positive and at most
+/// [`MAX_BATTERY_CAPACITY_MAH`] (an infinite one made the answer of `log info` not finite).
+pub(crate) fn capacity_ah(mah: f64) -> Option<f64> {
+    (mah > 0.0 && mah <= MAX_BATTERY_CAPACITY_MAH).then_some(mah / 1000.0)
+}
+
 /// What a binary log holds besides its samples.
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct BinarySummary {

@@ -92,6 +92,16 @@ const CURRENT: Plausible = Plausible {
     unit: "A",
     expected: "-500 to 2000 A",
 };
+/// Electrical power: the products of the voltage and current ranges' ends (1000 V x 2000 A,
+/// 1000 V x -500 A). A logged power outside it is dropped and counted like a glitch (a `power`
+/// of 1e308 overflowed the energy and mean power of `log info`).
+const POWER: Plausible = Plausible {
+    channel: "power",
+    lo: -500_000.0,
+    hi: 2_000_000.0,
+    unit: "W",
+    expected: "-500 kW to 2 MW",
+};
 const CHARGE: Plausible = Plausible {
     channel: "charge",
     lo: -1000.0,
@@ -448,7 +458,8 @@ impl<R: Read> CsvSamples<R> {
         Ok(value)
     }
 
-    /// The logged power, when it agrees with V x I within 20 % (+5 W for noise at idle). On the
+    /// The logged power, when it lies in the plausible range ([`POWER`]; outside it, the value is
+    /// dropped and reported) and agrees with V x I within 20 % (+5 W for noise at idle). On the
     /// first row that has all three, a mismatch is a wrong unit or scale (e.g. KAIST's 10 x V x I
     /// without scale = 0.1) and an error; later, an isolated mismatch is a sensor glitch (the
     /// KAIST logs have 10 rows with a 16-bit overflowed power): the power value is dropped and
@@ -460,6 +471,10 @@ impl<R: Read> CsvSamples<R> {
         current_a: Option<f64>,
     ) -> Result<Option<f64>> {
         let power_w = self.field(col, self.name_of(col))?;
+        if let Some(p) = power_w.filter(|p| !(POWER.lo..=POWER.hi).contains(p)) {
+            self.record_dropped(POWER.channel, p);
+            return Ok(None);
+        }
         let (Some(p), Some(v), Some(i)) = (power_w, voltage_v, current_a) else {
             return Ok(power_w);
         };
@@ -965,6 +980,34 @@ mod tests {
             ),
             "{e}"
         );
+    }
+
+    /// Fuzz findings `fixtures/fuzz/log-csv/*.bin`: a power of 1e308 (with the voltage missing,
+    /// so no V x I check) overflowed the energy and mean power of `log info`.
+    #[test]
+    fn power_outside_its_plausible_range_is_dropped_and_counted() {
+        let row = |t: u32, v: &str, p: &str| {
+            format!("{t},0.634769,2.223,89.0,0.1,-0.2,0.5,1.0,2.0,-0.5,0,0,0,0,0,0,12150,{v},25.0,{p}\n")
+        };
+        let text = format!(
+            "{KAIST_HEADER}{}{}{}{}",
+            row(1_000_000, "", "1e308"),
+            row(1_100_000, "", "-1e308"),
+            row(1_200_000, "", "30000000"),
+            row(1_300_000, "", "12000")
+        );
+        let mut r =
+            CsvSamples::from_reader(text.as_bytes(), Path::new("g.csv"), &ColumnMap::kaist())
+                .unwrap();
+        let s: Vec<Sample> = r.by_ref().collect::<Result<_>>().unwrap();
+        assert_eq!(s.len(), 4);
+        assert!(s[..3].iter().all(|s| s.power_w.is_none()));
+        // KAIST's power column is 10 x W (scale 0.1).
+        assert_eq!(s[3].power_w, Some(1200.0));
+        let (n, d) = r.dropped();
+        assert_eq!(n, 3);
+        assert_eq!((d[0].row, d[0].channel), (2, "power"));
+        assert!(d[0].value > 1e300);
     }
 
     #[test]

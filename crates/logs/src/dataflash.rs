@@ -403,15 +403,17 @@ pub struct DataflashDecoder {
     untimed: u64,
 }
 
-/// Boot time of a record, s: `TimeUS`, else `TimeMS` (not for GPS), else GPS `T` (ms).
+/// Boot time of a record, s: `TimeUS`, else `TimeMS` (not for GPS), else GPS `T` (ms). A time
+/// that is not finite (a format declaring the time column as a float holding NaN) is no time.
 fn boot_time_s(f: &Format, p: &[u8]) -> Option<f64> {
-    if let Some(us) = f.raw(p, "TimeUS") {
-        return Some(us * 1e-6);
-    }
-    if f.name.starts_with("GPS") {
-        return f.raw(p, "T").map(|ms| ms * 1e-3);
-    }
-    f.raw(p, "TimeMS").map(|ms| ms * 1e-3)
+    let t = if let Some(us) = f.raw(p, "TimeUS") {
+        Some(us * 1e-6)
+    } else if f.name.starts_with("GPS") {
+        f.raw(p, "T").map(|ms| ms * 1e-3)
+    } else {
+        f.raw(p, "TimeMS").map(|ms| ms * 1e-3)
+    };
+    t.filter(|t| t.is_finite())
 }
 
 /// The scale of old integer `CURR` voltages: the first of centi, milli and whole units that puts
@@ -467,8 +469,8 @@ impl DataflashDecoder {
             Role::Parm => {
                 let name = f.text(p, "Name")?;
                 let v = f.num(p, "Value")?;
-                if name == "BATT_CAPACITY" && v > 0.0 {
-                    s.battery_capacity_ah = Some(v / 1000.0);
+                if name == "BATT_CAPACITY" {
+                    s.battery_capacity_ah = crate::binary::capacity_ah(v).or(s.battery_capacity_ah);
                 }
             }
             Role::Att | Role::Pos | Role::Gps | Role::Bat | Role::Curr => {
@@ -734,5 +736,85 @@ impl<R: Read> Iterator for DataflashRecords<R> {
             name: f.name.clone(),
             values,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::synth::{dataflash_fmt, dataflash_record};
+    use crate::{read_dataflash, BinaryOptions};
+
+    /// Fuzz finding `fixtures/fuzz/dataflash/07eadf3218906b21.bin`: an `FMT` declaring `TimeUS`
+    /// as a float let a NaN time into the base topic, and the span of the flight was NaN.
+    #[test]
+    fn a_time_that_is_not_finite_is_no_time() {
+        let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+        b.extend(dataflash_fmt(
+            1,
+            3 + 16,
+            "ATT",
+            "ffff",
+            "TimeUS,Roll,Pitch,Yaw",
+        ));
+        b.extend(dataflash_fmt(
+            2,
+            3 + 8 + 8,
+            "BAT",
+            "Qff",
+            "TimeUS,Volt,Curr",
+        ));
+        for (k, t_us) in [f32::NAN, 1e6, f32::INFINITY, 1.1e6, 1.2e6]
+            .into_iter()
+            .enumerate()
+        {
+            b.extend([0xA3, 0x95, 1]);
+            for v in [t_us, 1.0, 2.0, 90.0] {
+                b.extend(v.to_le_bytes());
+            }
+            b.extend(dataflash_record(
+                2,
+                1_000_000 + 100_000 * k as u64,
+                &[12.0, 5.0],
+            ));
+        }
+        let r = read_dataflash(&b[..], &BinaryOptions::default()).unwrap();
+        let s = &r.summary;
+        // 1.0 to 1.2 s; 1e-9 s covers the f32 microseconds' rounding.
+        assert!((s.base_span_s - 0.2).abs() < 1e-9, "{}", s.base_span_s);
+        assert!(r.log.samples.iter().all(|x| x.time_s.is_finite()));
+        assert!(
+            s.warnings.iter().any(|w| w.contains('2')),
+            "{:?}",
+            s.warnings
+        );
+    }
+
+    /// Fuzz finding `fixtures/fuzz/dataflash/f70328e305c524bd.bin`: a `BATT_CAPACITY` of
+    /// infinity was read as an infinite capacity, which `log info` refused as not finite.
+    #[test]
+    fn a_battery_capacity_that_is_not_plausible_is_not_read() {
+        for (mah, ah) in [
+            (f32::INFINITY, None),
+            (f32::NAN, None),
+            (-1.0, None),
+            (5000.0, Some(5.0)),
+        ] {
+            let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+            b.extend(dataflash_fmt(
+                3,
+                3 + 8 + 16 + 4,
+                "PARM",
+                "QNf",
+                "TimeUS,Name,Value",
+            ));
+            b.extend([0xA3, 0x95, 3]);
+            b.extend(1_000_000u64.to_le_bytes());
+            let mut name = b"BATT_CAPACITY".to_vec();
+            name.resize(16, 0);
+            b.extend(name);
+            b.extend(mah.to_le_bytes());
+            let r = read_dataflash(&b[..], &BinaryOptions::default()).unwrap();
+            assert_eq!(r.summary.battery_capacity_ah, ah, "{mah} mA h");
+        }
     }
 }

@@ -53,6 +53,8 @@ pub mod open;
 pub mod px4;
 pub mod ros;
 pub mod sample;
+#[doc(hidden)]
+pub mod synth;
 pub mod ulog;
 
 pub use binary::{

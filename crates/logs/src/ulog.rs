@@ -505,7 +505,9 @@ impl UlogDecoder {
             Some("BAT_N_CELLS") if v >= 1.0 && s.battery_cells.is_none() => {
                 s.battery_cells = Some(v as u32)
             }
-            Some("BAT1_CAPACITY") if v > 0.0 => s.battery_capacity_ah = Some(v / 1000.0),
+            Some("BAT1_CAPACITY") if crate::binary::capacity_ah(v).is_some() => {
+                s.battery_capacity_ah = crate::binary::capacity_ah(v);
+            }
             _ => {}
         }
         Ok(())

@@ -9,13 +9,22 @@ use crate::induced::hover_induced_velocity_mps;
 
 /// The physical ranges of a vehicle's parameters: a value outside them is a mistake (a unit slip,
 /// a typo), not a multirotor, and would overflow the model's arithmetic. Generous: the largest
-/// multirotors flown weigh a few hundred kilograms and carry rotors a few metres across.
+/// multirotors flown weigh a few hundred kilograms and carry rotors a few metres across; the
+/// smallest weigh about a gram. The lower bounds keep the model finite: a mass of 1e-320 kg, an
+/// efficiency of 1e-308 or a gravity of 1e-9 m/s^2 passed a positivity check and made the power
+/// infinite or NaN (fuzz findings, `fixtures/fuzz/vehicle-toml/`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParameterLimits {
+    /// Smallest mass, kg (a gram).
+    pub min_mass_kg: f64,
     /// Largest mass, kg.
     pub mass_kg: f64,
-    /// Largest gravity, m/s^2.
+    /// Smallest gravity, m/s^2 (Titan's is 1.35).
+    pub min_gravity_mps2: f64,
+    /// Largest gravity, m/s^2 (Jupiter's cloud tops, 24.8).
     pub gravity_mps2: f64,
+    /// Smallest overall efficiency (measured multirotors are 0.3 to 0.8).
+    pub min_efficiency: f64,
     /// Largest air density, kg/m^3.
     pub air_density_kg_m3: f64,
     /// Largest rotor radius, m.
@@ -30,8 +39,11 @@ pub struct ParameterLimits {
 
 /// The limits [`Vehicle::new`] applies.
 pub const PARAMETER_LIMITS: ParameterLimits = ParameterLimits {
+    min_mass_kg: 1e-3,
     mass_kg: 10_000.0,
-    gravity_mps2: 100.0,
+    min_gravity_mps2: 1.0,
+    gravity_mps2: 30.0,
+    min_efficiency: 0.01,
     air_density_kg_m3: 10.0,
     rotor_radius_m: 20.0,
     rotor_count: 64.0,
@@ -135,18 +147,24 @@ impl Vehicle {
     /// Validate the parameters and build the vehicle.
     ///
     /// Rejects NaN and infinities, non-positive mass, gravity, density, radius and efficiency,
-    /// efficiency above 1, zero rotors, negative `kappa1`/`kappa2`, and drag coefficients that
-    /// give a negative drag force anywhere in 0-60 m/s.
+    /// values outside [`PARAMETER_LIMITS`] (mass 1 g to 10 t, gravity 1 to 30 m/s^2, efficiency
+    /// 0.01 to 1), zero rotors, negative `kappa1`/`kappa2`, and drag coefficients that give a
+    /// negative drag force anywhere in 0-60 m/s.
     pub fn new(params: VehicleParams) -> Result<Self> {
         let limits = &PARAMETER_LIMITS;
         within(
             "mass_kg",
             positive("mass_kg", params.mass_kg)?,
-            0.0,
+            limits.min_mass_kg,
             limits.mass_kg,
         )?;
         let g = positive("gravity_mps2", params.gravity_mps2)?;
-        within("gravity_mps2", g, 0.0, limits.gravity_mps2)?;
+        within(
+            "gravity_mps2",
+            g,
+            limits.min_gravity_mps2,
+            limits.gravity_mps2,
+        )?;
         let rho = positive("air_density_kg_m3", params.air_density_kg_m3)?;
         within("air_density_kg_m3", rho, 0.0, limits.air_density_kg_m3)?;
         let r = positive("rotor_radius_m", params.rotor_radius_m)?;
@@ -168,14 +186,7 @@ impl Vehicle {
             within(name, finite(name, mu)?, -limits.drag, limits.drag)?;
         }
         positive("efficiency", params.efficiency)?;
-        if params.efficiency > 1.0 {
-            return Err(PowerError::OutOfRange {
-                name: "efficiency",
-                value: params.efficiency,
-                min: 0.0,
-                max: 1.0,
-            });
-        }
+        within("efficiency", params.efficiency, limits.min_efficiency, 1.0)?;
         let drag = CubicDrag::new(
             params.mu1_n_s_per_m,
             params.mu2_n_s2_per_m2,
@@ -399,6 +410,44 @@ pub(crate) mod tests {
             mutate(&mut p);
             let err = Vehicle::new(p).expect_err(name);
             assert!(err.to_string().contains(name), "{err} should name {name}");
+        }
+    }
+
+    /// Fuzz findings `fixtures/fuzz/vehicle-toml/*.bin`: each value passed validation and made
+    /// the power model infinite or NaN.
+    #[test]
+    fn tiny_mass_efficiency_and_gravity_are_refused_with_key_and_range() {
+        let cases: Vec<(Mutation, &str)> = vec![
+            (|p| p.mass_kg = 1e-320, "mass_kg"),
+            (|p| p.mass_kg = 1e-4, "mass_kg"),
+            (|p| p.efficiency = 1e-320, "efficiency"),
+            (|p| p.efficiency = 2.2250738585072014e-308, "efficiency"),
+            (|p| p.efficiency = 0.009, "efficiency"),
+            (|p| p.gravity_mps2 = 1e-9, "gravity_mps2"),
+            (|p| p.gravity_mps2 = 0.5, "gravity_mps2"),
+            (|p| p.gravity_mps2 = 31.0, "gravity_mps2"),
+        ];
+        for (mutate, name) in cases {
+            let mut p = m100_params();
+            mutate(&mut p);
+            let err = Vehicle::new(p).expect_err(name);
+            assert!(
+                matches!(err, PowerError::OutOfRange { .. }),
+                "{name}: {err:?}"
+            );
+            assert!(err.to_string().contains(name), "{err} should name {name}");
+        }
+        // The bounds themselves are vehicles, and their hover power is finite.
+        for mutate in [
+            (|p| p.mass_kg = 1e-3) as Mutation,
+            |p| p.efficiency = 0.01,
+            |p| p.gravity_mps2 = 1.0,
+            |p| p.gravity_mps2 = 30.0,
+        ] {
+            let mut p = m100_params();
+            mutate(&mut p);
+            let v = Vehicle::new(p).unwrap();
+            assert!(v.ideal_hover_power_w().is_finite());
         }
     }
 

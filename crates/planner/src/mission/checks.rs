@@ -13,6 +13,12 @@ pub const MAX_MISSION_VALUE: f64 = 1e7;
 /// path than that is a mistake (a speed of 1e-320 m/s), and its steps could not be counted.
 pub const MAX_PIECE_S: f64 = 1e9;
 
+/// The range of a home point's ground altitude above mean sea level, m: from below the shore
+/// of the Dead Sea (-430 m) to above the summit of Everest (8,849 m). The altitude is
+/// informational (heights are above home), but a value outside it is a mistake, and one that is
+/// not finite would be written back as `null`.
+pub const HOME_AMSL_RANGE_M: (f64, f64) = (-500.0, 10_000.0);
+
 /// The segment a check is about: its place in the mission (from 0) and its kind as written.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Seg {
@@ -145,10 +151,12 @@ impl Seg {
 }
 
 /// The home point in local metres: `east_m`/`north_m` when given (each defaults to 0), the origin
-/// when the home is in latitude/longitude; height 0.
+/// when the home is in latitude/longitude; height 0. The ground altitude, when given, is checked
+/// against [`HOME_AMSL_RANGE_M`].
 ///
 /// # Errors
-/// [`PlannerError::InvalidParameter`] for a coordinate that is not finite.
+/// [`PlannerError::InvalidParameter`] for a coordinate that is not finite, or a ground altitude
+/// that is not finite or outside [`HOME_AMSL_RANGE_M`].
 pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError> {
     let home_m = [home.east_m.unwrap_or(0.0), home.north_m.unwrap_or(0.0), 0.0];
     for (v, name) in [(home_m[0], "home east_m"), (home_m[1], "home north_m")] {
@@ -161,7 +169,17 @@ pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError>
             });
         }
     }
-    Ok(home_m)
+    let (lo, hi) = HOME_AMSL_RANGE_M;
+    match home.altitude_amsl_m {
+        // `contains` is false for NaN.
+        Some(v) if !(lo..=hi).contains(&v) => Err(PlannerError::InvalidParameter {
+            name: "home altitude_amsl_m",
+            value: v,
+            unit: "m",
+            expected: "a finite ground altitude from -500 to 10000 m above mean sea level",
+        }),
+        _ => Ok(home_m),
+    }
 }
 
 /// Resolves points given in either local metres or latitude/longitude.

@@ -91,7 +91,7 @@ mod compile;
 mod corners;
 mod spec;
 
-pub use checks::{MAX_MISSION_VALUE, MAX_PIECE_S};
+pub use checks::{HOME_AMSL_RANGE_M, MAX_MISSION_VALUE, MAX_PIECE_S};
 pub use compile::MAX_SEGMENTS;
 pub use corners::{DEFAULT_ACCEPTANCE_RADIUS_M, MIN_CORNER_SPEED_MPS};
 pub use spec::{
@@ -172,6 +172,38 @@ impl Mission {
 mod tests {
     use super::*;
     use crate::test_support::m100_airframe;
+
+    /// Fuzz finding `fixtures/fuzz/mission-toml/f421c065e260953e.bin`: a home altitude of NaN
+    /// or infinity was accepted, and the mission's JSON wrote it as `null`.
+    #[test]
+    fn home_altitude_amsl_not_finite_or_out_of_range_is_refused_by_name() {
+        for (amsl, ok) in [
+            ("nan", false),
+            ("inf", false),
+            ("-inf", false),
+            ("1e5", false),
+            ("-501.0", false),
+            ("-430.0", true),
+            ("488.0", true),
+            ("8849.0", true),
+        ] {
+            let text = format!(
+                "[home]\naltitude_amsl_m = {amsl}\n\
+                 [[segment]]\nkind = \"take-off\"\naltitude_m = 10.0\nclimb_rate_mps = 2.0\n\
+                 [[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n"
+            );
+            let spec = MissionSpec::from_toml_str(&text).unwrap();
+            match spec.compile(&m100_airframe(), 0.68, None) {
+                Ok(_) => assert!(ok, "{amsl} m accepted"),
+                Err(e) => {
+                    assert!(!ok, "{amsl} m refused: {e}");
+                    let msg = e.to_string();
+                    assert!(msg.contains("home altitude_amsl_m"), "{msg}");
+                    assert!(msg.contains(" m"), "{msg}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_default_spec_is_the_empty_file() {
