@@ -69,39 +69,11 @@ fn main() -> ExitCode {
         }
         return ExitCode::SUCCESS;
     }
-    let targets: Vec<&Target> = if args.target == "all" {
-        TARGETS.iter().collect()
-    } else {
-        match target(&args.target) {
-            Some(t) => vec![t],
-            None => {
-                eprintln!(
-                    "aloft-fuzz: error: unknown target '{}' (known: all, {})",
-                    args.target,
-                    TARGETS
-                        .iter()
-                        .map(|t| t.name)
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                );
-                return ExitCode::from(2);
-            }
-        }
+    let Some(targets) = selected(&args.target) else {
+        return ExitCode::from(2);
     };
     if let Some(dir) = &args.write_seeds {
-        for t in &targets {
-            let d = dir.join(t.name);
-            for (k, s) in (t.seeds)().iter().enumerate() {
-                let written = std::fs::create_dir_all(&d)
-                    .and_then(|()| std::fs::write(d.join(format!("{k}.bin")), s));
-                if let Err(e) = written {
-                    eprintln!("aloft-fuzz: error: cannot write to {}: {e}", d.display());
-                    return ExitCode::from(2);
-                }
-            }
-        }
-        aloft_fuzz::targets::remove_scratch();
-        return ExitCode::SUCCESS;
+        return write_seeds(&targets, dir);
     }
     if args.inputs == u64::MAX && args.seconds.is_none() && args.replay.is_empty() {
         eprintln!("aloft-fuzz: error: give --inputs or --seconds (or both)");
@@ -135,37 +107,79 @@ fn main() -> ExitCode {
     for t in targets {
         let s = fuzz(&session, t, &run);
         any |= !s.findings.is_empty();
-        println!(
-            "{},{},{:.1},{:.0},{},{},{},{},{},{},{:.3},{}",
-            s.target,
-            s.inputs,
-            s.seconds,
-            s.inputs as f64 / s.seconds.max(1e-9),
-            s.accepted,
-            s.corpus,
-            s.finding_inputs,
-            s.findings.len(),
-            s.note_inputs,
-            s.notes.len(),
-            s.slowest_s,
-            args.seed
-        );
-        if let Some(dir) = &args.notes {
-            // The slowest input, for a look at what takes long.
-            let d = dir.join(s.target);
-            let _ = std::fs::create_dir_all(&d)
-                .and_then(|()| std::fs::write(d.join("slowest.input"), &s.slowest));
-        }
-        if args.verbose {
-            for (line, n) in &s.top_refusals {
-                eprintln!("aloft-fuzz: {}: {n} x {line}", s.target);
-            }
-        }
+        report(&s, &args);
     }
     if any {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS
+    }
+}
+
+/// The targets `name` selects (`all`, or one by name); none, with the error printed, for an
+/// unknown name.
+fn selected(name: &str) -> Option<Vec<&'static Target>> {
+    if name == "all" {
+        return Some(TARGETS.iter().collect());
+    }
+    match target(name) {
+        Some(t) => Some(vec![t]),
+        None => {
+            let known: Vec<&str> = TARGETS.iter().map(|t| t.name).collect();
+            eprintln!(
+                "aloft-fuzz: error: unknown target '{name}' (known: all, {})",
+                known.join(", ")
+            );
+            None
+        }
+    }
+}
+
+/// Write each target's seeds to `dir/<target>/<k>.bin`.
+fn write_seeds(targets: &[&Target], dir: &std::path::Path) -> ExitCode {
+    for t in targets {
+        let d = dir.join(t.name);
+        for (k, s) in (t.seeds)().iter().enumerate() {
+            let written = std::fs::create_dir_all(&d)
+                .and_then(|()| std::fs::write(d.join(format!("{k}.bin")), s));
+            if let Err(e) = written {
+                eprintln!("aloft-fuzz: error: cannot write to {}: {e}", d.display());
+                return ExitCode::from(2);
+            }
+        }
+    }
+    aloft_fuzz::targets::remove_scratch();
+    ExitCode::SUCCESS
+}
+
+/// One target's CSV row on stdout; its slowest input beside the notes; with `--verbose` its
+/// most common refusals on stderr.
+fn report(s: &aloft_fuzz::runner::RunStats, args: &Args) {
+    println!(
+        "{},{},{:.1},{:.0},{},{},{},{},{},{},{:.3},{}",
+        s.target,
+        s.inputs,
+        s.seconds,
+        s.inputs as f64 / s.seconds.max(1e-9),
+        s.accepted,
+        s.corpus,
+        s.finding_inputs,
+        s.findings.len(),
+        s.note_inputs,
+        s.notes.len(),
+        s.slowest_s,
+        args.seed
+    );
+    if let Some(dir) = &args.notes {
+        // The slowest input, for a look at what takes long.
+        let d = dir.join(s.target);
+        let _ = std::fs::create_dir_all(&d)
+            .and_then(|()| std::fs::write(d.join("slowest.input"), &s.slowest));
+    }
+    if args.verbose {
+        for (line, n) in &s.top_refusals {
+            eprintln!("aloft-fuzz: {}: {n} x {line}", s.target);
+        }
     }
 }
 

@@ -460,22 +460,8 @@ pub fn fuzz(session: &Session, target: &Target, run: &Run) -> RunStats {
         seen: HashSet::new(),
     };
     let mut refusals: HashMap<String, u64> = HashMap::new();
-    let mut finding_keys: HashSet<String> = HashSet::new();
-    let mut note_keys: HashSet<String> = HashSet::new();
-    let mut stats = RunStats {
-        target: target.name,
-        inputs: 0,
-        accepted: 0,
-        seconds: 0.0,
-        corpus: 0,
-        finding_inputs: 0,
-        findings: Vec::new(),
-        note_inputs: 0,
-        notes: Vec::new(),
-        slowest_s: 0.0,
-        slowest: Vec::new(),
-        top_refusals: Vec::new(),
-    };
+    let mut kept = Kept::default();
+    let mut stats = RunStats::new(target.name);
     let mut last_progress = Instant::now();
     let mut k = 0usize;
     while stats.inputs < run.inputs && started.elapsed() < run.time {
@@ -504,36 +490,7 @@ pub fn fuzz(session: &Session, target: &Target, run: &Run) -> RunStats {
             None => {}
         }
         corpus.offer(&input, &report);
-        if !report.notes.is_empty() {
-            stats.note_inputs += 1;
-            let f = Finding {
-                target: target.name,
-                problems: report.notes.clone(),
-                input: input.clone(),
-            };
-            keep(
-                &mut stats.notes,
-                &mut note_keys,
-                f,
-                run.notes.as_deref(),
-                "NOTE",
-            );
-        }
-        if !report.problems.is_empty() {
-            stats.finding_inputs += 1;
-            let f = Finding {
-                target: target.name,
-                problems: report.problems,
-                input,
-            };
-            keep(
-                &mut stats.findings,
-                &mut finding_keys,
-                f,
-                run.findings.as_deref(),
-                "FINDING",
-            );
-        }
+        kept.book(&mut stats, run, input, report);
         if let Some(every) = run.progress {
             if last_progress.elapsed() >= every {
                 last_progress = Instant::now();
@@ -548,6 +505,69 @@ pub fn fuzz(session: &Session, target: &Target, run: &Run) -> RunStats {
     top.truncate(8);
     stats.top_refusals = top;
     stats
+}
+
+impl RunStats {
+    /// Nothing run yet.
+    fn new(target: &'static str) -> Self {
+        Self {
+            target,
+            inputs: 0,
+            accepted: 0,
+            seconds: 0.0,
+            corpus: 0,
+            finding_inputs: 0,
+            findings: Vec::new(),
+            note_inputs: 0,
+            notes: Vec::new(),
+            slowest_s: 0.0,
+            slowest: Vec::new(),
+            top_refusals: Vec::new(),
+        }
+    }
+}
+
+/// The kinds of findings and notes kept so far in a run (one input of each kind is kept).
+#[derive(Default)]
+struct Kept {
+    findings: HashSet<String>,
+    notes: HashSet<String>,
+}
+
+impl Kept {
+    /// Count an input's notes and findings and keep the first input of each new kind.
+    fn book(&mut self, stats: &mut RunStats, run: &Run, input: Vec<u8>, report: Report) {
+        if !report.notes.is_empty() {
+            stats.note_inputs += 1;
+            let f = Finding {
+                target: stats.target,
+                problems: report.notes,
+                input: input.clone(),
+            };
+            keep(
+                &mut stats.notes,
+                &mut self.notes,
+                f,
+                run.notes.as_deref(),
+                "NOTE",
+            );
+        }
+        if !report.problems.is_empty() {
+            stats.finding_inputs += 1;
+            let f = Finding {
+                target: stats.target,
+                problems: report.problems,
+                input,
+            };
+            keep(
+                &mut stats.findings,
+                &mut self.findings,
+                f,
+                run.findings.as_deref(),
+                "FINDING",
+            );
+        }
+    }
 }
 
 fn progress_line(stats: &RunStats, started: Instant, corpus: usize) -> String {
