@@ -464,12 +464,12 @@ fn plot(
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(400);
     plot_power(&top, name, report, samples)?;
-    plot_track(&bottom, report, samples, home)?;
+    plot_track(&bottom, report, samples, home, None)?;
     root.present()?;
     Ok(())
 }
 
-type Area<'a> =
+pub(super) type Area<'a> =
     plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
 
 fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample]) -> Result<()> {
@@ -514,7 +514,15 @@ fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample])
     Ok(())
 }
 
-fn plot_track(area: &Area<'_>, report: &MissionReport, s: &[Sample], home: [f64; 3]) -> Result<()> {
+/// The ground track (equal scales) with home and the point of no return; with `confident`, also
+/// the point of no return that holds with 95 % confidence over the scenarios (east, north).
+pub(super) fn plot_track(
+    area: &Area<'_>,
+    report: &MissionReport,
+    s: &[Sample],
+    home: [f64; 3],
+    confident: Option<(f64, f64)>,
+) -> Result<()> {
     use plotters::prelude::*;
     // Ground track, equal scales.
     let (mut e0, mut e1, mut n0, mut n1) = (home[0], home[0], home[1], home[1]);
@@ -558,8 +566,18 @@ fn plot_track(area: &Area<'_>, report: &MissionReport, s: &[Sample], home: [f64;
                 8,
                 BLACK.stroke_width(3),
             )])?
-            .label("point of no return")
+            .label(match confident {
+                Some(_) => "point of no return (plan)",
+                None => "point of no return",
+            })
             .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+    }
+    if let Some(at) = confident {
+        let style = MAGENTA.stroke_width(3);
+        track
+            .draw_series([TriangleMarker::new(at, 9, style)])?
+            .label("point of no return, 95 % confidence")
+            .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, style));
     }
     track
         .configure_series_labels()

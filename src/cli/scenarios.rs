@@ -291,8 +291,7 @@ fn write_segments(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<
     Ok(())
 }
 
-type Area<'a> =
-    plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
+use super::mission::Area;
 
 /// The state-of-charge fan over time (the plan's own line in it) and the ground track with the
 /// plan's point of no return and the one that holds with 95 % confidence.
@@ -396,65 +395,12 @@ fn sample_at(s: &[Sample], t_s: f64) -> Option<&Sample> {
 }
 
 fn plot_track(area: &Area<'_>, plan: &Plan, u: &Uncertainty, s: &[Sample]) -> Result<()> {
-    use plotters::prelude::*;
-    let home = plan.home_m();
-    let (mut e0, mut e1, mut n0, mut n1) = (home[0], home[0], home[1], home[1]);
-    for x in s {
-        e0 = e0.min(x.east_m);
-        e1 = e1.max(x.east_m);
-        n0 = n0.min(x.north_m);
-        n1 = n1.max(x.north_m);
-    }
-    let span = (e1 - e0).max(n1 - n0).max(10.0) * 1.1;
-    let (ec, nc) = (0.5 * (e0 + e1), 0.5 * (n0 + n1));
-    let mut track = ChartBuilder::on(area)
-        .caption("ground track (east, north in m)", ("sans-serif", 18))
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(
-            (ec - span * 0.7)..(ec + span * 0.7),
-            (nc - span * 0.5)..(nc + span * 0.5),
-        )?;
-    track
-        .configure_mesh()
-        .x_desc("east (m)")
-        .y_desc("north (m)")
-        .draw()?;
-    track
-        .draw_series(LineSeries::new(
-            s.iter().map(|x| (x.east_m, x.north_m)),
-            &RED,
-        ))?
-        .label("track")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    track
-        .draw_series([Circle::new((home[0], home[1]), 6, GREEN.filled())])?
-        .label("home")
-        .legend(|(x, y)| Circle::new((x + 10, y), 5, GREEN.filled()));
-    if let Some(p) = plan.report().point_of_no_return {
-        track
-            .draw_series([Cross::new(
-                (p.position_m[0], p.position_m[1]),
-                8,
-                BLACK.stroke_width(2),
-            )])?
-            .label("point of no return (plan)")
-            .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
-    }
-    if let Some(x) = u.point_of_no_return_s.p5.and_then(|t| sample_at(s, t)) {
-        let style = MAGENTA.stroke_width(3);
-        track
-            .draw_series([TriangleMarker::new((x.east_m, x.north_m), 9, style)])?
-            .label("point of no return, 95 % confidence")
-            .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, style));
-    }
-    track
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
+    let confident = u
+        .point_of_no_return_s
+        .p5
+        .and_then(|t| sample_at(s, t))
+        .map(|x| (x.east_m, x.north_m));
+    super::mission::plot_track(area, plan.report(), s, plan.home_m(), confident)
 }
 
 /// The endurance table's lines for the scenarios.
