@@ -222,6 +222,16 @@ pub enum Error {
         /// What a valid value looks like.
         expected: &'static str,
     },
+    /// A spec sheet (`aloft vehicles calibrate`) with a missing, malformed or impossible value.
+    #[error("spec sheet {origin}: {key}: {message}")]
+    SpecSheet {
+        /// The spec sheet's path or name.
+        origin: String,
+        /// The key at fault, as written in the file (e.g. `published_hover.minutes`).
+        key: String,
+        /// What is wrong, with the value and its unit.
+        message: String,
+    },
     /// An option document (JSON) that does not parse or has unknown keys.
     #[error("invalid {what}: {message}")]
     OptionsFormat {

@@ -49,6 +49,18 @@ pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
         toml: include_str!("../fixtures/vehicles/dji-m100.toml"),
     },
     BuiltinVehicle {
+        name: "dji-m600",
+        toml: include_str!("../fixtures/vehicles/dji-m600.toml"),
+    },
+    BuiltinVehicle {
+        name: "dji-inspire1",
+        toml: include_str!("../fixtures/vehicles/dji-inspire1.toml"),
+    },
+    BuiltinVehicle {
+        name: "dji-inspire1-pro",
+        toml: include_str!("../fixtures/vehicles/dji-inspire1-pro.toml"),
+    },
+    BuiltinVehicle {
         name: "aec-quadrotor",
         toml: include_str!("../fixtures/vehicles/aec-quadrotor.toml"),
     },
@@ -66,6 +78,9 @@ pub struct VehicleFile {
     /// One line about the vehicle and its source.
     #[serde(default)]
     pub description: String,
+    /// The published figures the vehicle was built from and where they were published.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<VehicleSource>,
     /// Four-term power model parameters.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub power: Option<aloft_power::VehicleParams>,
@@ -78,6 +93,18 @@ pub struct VehicleFile {
     /// Battery packs for missions (`[[battery]]` tables).
     #[serde(default, rename = "battery", skip_serializing_if = "Vec::is_empty")]
     pub batteries: Vec<aloft_planner::BatterySpec>,
+}
+
+/// Where a vehicle's numbers come from (`[source]`): shown by `aloft vehicles`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VehicleSource {
+    /// The published figures the vehicle was built from, in words with units.
+    pub figures: String,
+    /// The one figure the efficiency was calibrated on.
+    pub calibrated_on: String,
+    /// Where the figures were published.
+    pub published: String,
 }
 
 impl VehicleFile {
@@ -277,7 +304,7 @@ mod tests {
     #[test]
     fn m100_has_its_packs_and_airframe() {
         let f = VehicleFile::builtin("dji-m100").unwrap();
-        assert_eq!(f.battery_names(), ["TB47D", "TB48D"]);
+        assert_eq!(f.battery_names(), ["TB47D", "TB48D", "2xTB47D", "2xTB48D"]);
         let b = f.battery(None).unwrap();
         assert_eq!(b.name(), "TB47D");
         // DJI: 2355 g with the TB47D
@@ -318,6 +345,7 @@ mod tests {
         let bad = toml::to_string(&VehicleFile {
             name: "bad".into(),
             description: String::new(),
+            source: None,
             power: Some(p),
             propulsion: None,
             airframe: None,

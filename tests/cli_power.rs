@@ -292,7 +292,27 @@ fn vehicles_lists_the_builtins() {
         .iter()
         .map(|e| e["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["dji-m100", "aec-quadrotor"]);
+    assert_eq!(
+        names,
+        [
+            "dji-m100",
+            "dji-m600",
+            "dji-inspire1",
+            "dji-inspire1-pro",
+            "aec-quadrotor"
+        ]
+    );
+    // Each DJI vehicle says what it was calibrated on and where the figures were published.
+    for e in v.as_array().unwrap().iter().take(4) {
+        assert!(e["source"]["calibrated_on"]
+            .as_str()
+            .unwrap()
+            .contains("hover"));
+        assert!(e["source"]["published"].as_str().unwrap().contains("DJI"));
+        assert!(!e["batteries"].as_array().unwrap().is_empty());
+    }
+    let o = aloft(&["vehicles"]);
+    assert!(stdout(&o).contains("calibrated on: hover 35 min with 6x TB47S"));
 }
 
 #[test]

@@ -12,36 +12,35 @@ fn m100() -> aloft::power::Vehicle {
         .unwrap()
 }
 
-/// The vehicle file's efficiency is reproduced from DJI's published M100 hover time: the full
-/// model (eqs 7-14) at hover reproduces the measured power. Published: 13 min hovering with the
-/// TB47D (99.9 Wh) and a 1 kg payload, 1755 g + 600 g + 1 kg. The file rounds eta to 4 digits:
-/// tolerance 5e-5. The seed's own definition (ideal over measured hover power) gives 0.8577, lower
-/// by the profile share (see the fixture's comment).
+/// The vehicle file's efficiency is reproduced from the one DJI figure it is calibrated on: the full
+/// model (eqs 7-14) hovers 22 min with the TB47D (99.9 Wh) at 2355 g (1755 g + 600 g, no payload)
+/// through the planner's pack model. The file rounds eta to 4 digits: tolerance 5e-5. The seed's
+/// own definition (ideal over measured hover power, eq 14 without the profile term) gives 0.8577
+/// for DJI's 13 min with 1 kg, lower by the profile share (see the fixture's comment).
 #[test]
 fn paper_val_m100_efficiency_from_dji_hover_time() {
-    let hover = FlightState::new(0.0, 0.0, 0.0, 0.0);
-    let measured = mean_power_w(99.9, 13.0 * 60.0).unwrap();
-    let at = |mass: f64| PowerModel::new(m100().with_mass(mass).unwrap());
-    let eta = calibrate_efficiency(&at(1.755 + 0.600 + 1.0), &hover, measured).unwrap();
+    let file = VehicleFile::builtin("dji-m100").unwrap();
+    let c = aloft::engine::calibrate_hover(&file, Some("TB47D"), 2.355, 22.0).unwrap();
     assert!(
-        (eta - m100().efficiency()).abs() < 5e-5,
-        "eta {eta} vs file {}",
+        (c.efficiency - m100().efficiency()).abs() < 5e-5,
+        "eta {} vs file {}",
+        c.efficiency,
         m100().efficiency()
     );
+    let measured = mean_power_w(99.9, 13.0 * 60.0).unwrap();
     let paper = efficiency_from_hover(&m100().with_mass(3.355).unwrap(), measured).unwrap();
     assert!((paper - 0.8577).abs() < 5e-5, "{paper}");
-    // DJI's other published hover times give 0.937-0.996: the file's value sits inside that spread.
-    for (mass, wh, min) in [
-        (2.355, 99.9, 22.0),
-        (2.855, 99.9, 17.0),
-        (2.431, 129.96, 28.0),
-        (2.931, 129.96, 20.0),
-        (3.431, 129.96, 16.0),
-    ] {
-        let e =
-            calibrate_efficiency(&at(mass), &hover, mean_power_w(wh, min * 60.0).unwrap()).unwrap();
-        assert!((0.93..1.0).contains(&e), "{mass} kg: {e}");
-    }
+    // The same figure through the rated energy instead of the pack model
+    // (`calibrate_efficiency`, mean power 99.9 Wh / 22 min): within 3 % of the file's value (the
+    // pack model's open-circuit energy and resistive loss differ from the rated 99.9 Wh).
+    let hover = FlightState::new(0.0, 0.0, 0.0, 0.0);
+    let rated = calibrate_efficiency(
+        &PowerModel::new(m100().with_mass(2.355).unwrap()),
+        &hover,
+        mean_power_w(99.9, 22.0 * 60.0).unwrap(),
+    )
+    .unwrap();
+    assert!((rated / m100().efficiency() - 1.0).abs() < 0.03, "{rated}");
 }
 
 /// Eq (10) with the paper's constants (m = 3.29 kg, r = 0.172 m, one disk, rho = 1.225):

@@ -1,54 +1,182 @@
-//! `aloft vehicles`: list the built-in vehicles.
+//! `aloft vehicles`: list the built-in vehicles with their sources; `aloft vehicles calibrate`:
+//! a vehicle file from a spec sheet.
 
 use std::io::Write;
+use std::path::PathBuf;
 
-use aloft::engine::list_vehicles;
-use anyhow::Result;
-use clap::Args;
+use aloft::engine::{calibrate_spec_file, list_vehicles, SpecCalibration, VehicleEntry};
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand};
 
 use super::{output, Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct VehiclesArgs {
+    #[command(subcommand)]
+    action: Option<VehiclesAction>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
+#[derive(Debug, Subcommand)]
+enum VehiclesAction {
+    /// Make a vehicle file from a spec sheet: rotors, masses, battery and one published hover time
+    /// (the efficiency is calibrated on it; see the README's "A vehicle from its spec sheet").
+    Calibrate(CalibrateArgs),
+}
+
+#[derive(Debug, Args)]
+struct CalibrateArgs {
+    /// The spec sheet (TOML: name, rotors, rotor_diameter_m, frame_mass_kg, [battery],
+    /// [published_hover]).
+    spec: PathBuf,
+    /// Write the vehicle file here.
+    #[arg(short = 'o', long, value_name = "VEHICLE.toml")]
+    output: PathBuf,
+    /// Output format of the summary.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
 pub fn run(args: VehiclesArgs) -> Result<Outcome> {
+    match args.action {
+        Some(VehiclesAction::Calibrate(c)) => calibrate(c),
+        None => list(args.format),
+    }
+}
+
+fn list(format: Format) -> Result<Outcome> {
     let entries = list_vehicles()?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    match args.format {
+    match format {
         Format::Json => output::write_json(&mut out, &entries)?,
         Format::Csv => {
             let mut w = csv::Writer::from_writer(out);
-            w.write_record(["name", "mass_kg", "models", "description"])?;
+            w.write_record([
+                "name",
+                "mass_kg",
+                "models",
+                "batteries",
+                "description",
+                "calibrated_on",
+                "published",
+            ])?;
             for e in &entries {
                 let mass = e.mass_kg.map(|m| m.to_string()).unwrap_or_default();
-                w.write_record([e.name, &mass, &e.models.join(" "), &e.description])?;
+                let (cal, publ) = source_words(e);
+                w.write_record([
+                    e.name,
+                    &mass,
+                    &e.models.join(" "),
+                    &e.batteries.join(" "),
+                    &e.description,
+                    cal,
+                    publ,
+                ])?;
             }
             w.flush()?;
         }
-        Format::Table => {
-            let nw = entries.iter().map(|e| e.name.len()).max().unwrap_or(4);
-            writeln!(
-                out,
-                "{:<nw$}  {:>8}  {:<10}  description",
-                "name", "mass", "models"
-            )?;
-            for e in &entries {
-                let mass = e.mass_kg.map(|m| format!("{m:.3} kg")).unwrap_or_default();
-                writeln!(
-                    out,
-                    "{:<nw$}  {:>8}  {:<10}  {}",
-                    e.name,
-                    mass,
-                    e.models.join(","),
-                    e.description
-                )?;
-            }
-        }
+        Format::Table => list_table(&mut out, &entries)?,
     }
     Ok(Outcome::Ok)
+}
+
+/// What the efficiency was calibrated on and where it was published, or empty.
+fn source_words(e: &VehicleEntry) -> (&str, &str) {
+    e.source
+        .as_ref()
+        .map(|s| (s.calibrated_on.as_str(), s.published.as_str()))
+        .unwrap_or(("", ""))
+}
+
+fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
+    let nw = entries.iter().map(|e| e.name.len()).max().unwrap_or(4);
+    writeln!(
+        out,
+        "{:<nw$}  {:>8}  {:<10}  {:<28}  description",
+        "name", "mass", "models", "batteries"
+    )?;
+    for e in entries {
+        let mass = e.mass_kg.map(|m| format!("{m:.3} kg")).unwrap_or_default();
+        writeln!(
+            out,
+            "{:<nw$}  {:>8}  {:<10}  {:<28}  {}",
+            e.name,
+            mass,
+            e.models.join(","),
+            e.batteries.join(","),
+            e.description
+        )?;
+        if let Some(s) = &e.source {
+            writeln!(out, "{:<nw$}  figures: {}", "", s.figures)?;
+            writeln!(out, "{:<nw$}  calibrated on: {}", "", s.calibrated_on)?;
+            writeln!(out, "{:<nw$}  published: {}", "", s.published)?;
+        }
+    }
+    Ok(())
+}
+
+fn calibrate(args: CalibrateArgs) -> Result<Outcome> {
+    let c = calibrate_spec_file(&args.spec)?;
+    let text = c.to_toml()?;
+    std::fs::write(&args.output, text)
+        .with_context(|| format!("cannot write vehicle file {}", args.output.display()))?;
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &c)?,
+        Format::Csv => {
+            let mut w = csv::Writer::from_writer(out);
+            w.write_record([
+                "name",
+                "battery",
+                "takeoff_mass_kg",
+                "published_minutes",
+                "efficiency",
+                "hover_power_w",
+                "max_minutes_at_unit_efficiency",
+            ])?;
+            w.write_record([
+                c.name.clone(),
+                c.battery.clone(),
+                c.takeoff_mass_kg.to_string(),
+                c.published_minutes.to_string(),
+                c.calibration.efficiency.to_string(),
+                c.calibration.hover_power_w.to_string(),
+                c.calibration.max_minutes_at_unit_efficiency.to_string(),
+            ])?;
+            w.flush()?;
+        }
+        Format::Table => calibrate_table(&mut out, &c, &args.output)?,
+    }
+    Ok(Outcome::Ok)
+}
+
+fn calibrate_table(
+    out: &mut impl Write,
+    c: &SpecCalibration,
+    path: &std::path::Path,
+) -> Result<()> {
+    writeln!(
+        out,
+        "{}: efficiency {:.4}, so that it hovers {} min at {} kg with {} ({:.1} W)",
+        c.name,
+        c.calibration.efficiency,
+        c.published_minutes,
+        c.takeoff_mass_kg,
+        c.battery,
+        c.calibration.hover_power_w
+    )?;
+    writeln!(
+        out,
+        "  the pack could give at most {:.1} min at this mass with efficiency 1",
+        c.calibration.max_minutes_at_unit_efficiency
+    )?;
+    for d in &c.defaults {
+        writeln!(out, "  default: {d}")?;
+    }
+    writeln!(out, "wrote {}", path.display())?;
+    Ok(())
 }

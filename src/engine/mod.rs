@@ -40,6 +40,7 @@
 //! # Ok::<(), aloft::Error>(())
 //! ```
 
+mod calibrate;
 mod endurance;
 mod estimator;
 mod files;
@@ -66,6 +67,10 @@ mod wind;
 /// The route figures of a mission and the formats a mission file may be in (from the
 /// `aloft-missions` importers), for the CLI and embedding programs.
 pub use aloft_missions::{ItemCounts, RouteFigures, SourceFormat};
+pub use calibrate::{
+    calibrate_hover, calibrate_spec, calibrate_spec_file, HoverCalibration, PublishedHover,
+    SpecBattery, SpecCalibration, SpecDrag, SpecSheet,
+};
 pub use endurance::{
     endurance, power_curve, CurveContext, EnduranceContext, EnduranceOptions, EnduranceSummary,
     PowerCurve,

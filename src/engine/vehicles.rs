@@ -9,7 +9,7 @@ use aloft_power::{FlightState, ModelOptions, PowerBreakdown, PowerModel};
 
 use super::files::read_text_file;
 use crate::error::Error;
-use crate::vehicle::{builtin_names, VehicleFile, BUILTIN_VEHICLES};
+use crate::vehicle::{builtin_names, VehicleFile, VehicleSource, BUILTIN_VEHICLES};
 
 /// A loaded, validated vehicle: its file, the power model of its `[power]` table (when present)
 /// and the aircraft the planner flies (when it has an `[airframe]` and a model).
@@ -187,6 +187,11 @@ pub struct VehicleEntry {
     pub mass_kg: Option<f64>,
     /// Models it has tables for (`power`, `propulsion`).
     pub models: Vec<&'static str>,
+    /// Its battery options (`--battery`), the default first.
+    pub batteries: Vec<String>,
+    /// The published figures it was built from and where they were published.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub source: Option<VehicleSource>,
 }
 
 /// The built-in vehicles, the default first.
@@ -212,6 +217,8 @@ pub fn list_vehicles() -> Result<Vec<VehicleEntry>, Error> {
                     .as_ref()
                     .map(|p| p.mass_kg)
                     .or(f.propulsion.as_ref().map(|p| p.empty_mass_kg)),
+                batteries: f.battery_names().iter().map(|s| s.to_string()).collect(),
+                source: f.source.clone(),
                 description: f.description,
                 models,
             })
