@@ -311,10 +311,20 @@ fn converted_log_reads_back_equal() {
     let att: Vec<_> = back.samples.iter().filter_map(|s| s.attitude).collect();
     let vel: Vec<_> = back.samples.iter().filter_map(|s| s.vel_enu_mps).collect();
     let cur: Vec<_> = back.samples.iter().filter_map(|s| s.current_a).collect();
+    let acc: Vec<_> = back.samples.iter().filter_map(|s| s.acc_enu_mps2).collect();
+    let charge: Vec<_> = back.samples.iter().filter_map(|s| s.charge_ah).collect();
     assert_eq!(
         (pos.len(), att.len(), vel.len(), cur.len()),
         (20, 20, 20, 20)
     );
+    // Acceleration and remaining charge are converted too (the fuzz harness found them lost:
+    // fixtures/fuzz/log-csv/).
+    assert_eq!((acc.len(), charge.len()), (20, 20));
+    for (s, (a, c)) in log.samples.iter().zip(acc.iter().zip(&charge)) {
+        let x = s.acc_enu_mps2.unwrap();
+        assert!((0..3).all(|k| (x[k] - a[k]).abs() < TOL), "{x:?} {a:?}");
+        assert!((s.charge_ah.unwrap() - c).abs() < TOL);
+    }
     for (i, s) in log.samples.iter().enumerate() {
         let (p, q) = (s.pos_enu_m.unwrap(), pos[i]);
         assert!((0..3).all(|k| (p[k] - q[k]).abs() < TOL), "{p:?} {q:?}");

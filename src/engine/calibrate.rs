@@ -304,14 +304,14 @@ impl SpecCalibration {
         let mut head = format!(
             "# Made by `aloft vehicles calibrate` from the spec sheet of {}.\n\
              # efficiency: calibrated so the model hovers {} min at {} kg with {} (eta {:.6}).\n",
-            self.name,
+            comment_text(&self.name),
             self.published_minutes,
             self.takeoff_mass_kg,
-            self.battery,
+            comment_text(&self.battery),
             self.calibration.efficiency
         );
         for d in &self.defaults {
-            head.push_str(&format!("# default: {d}\n"));
+            head.push_str(&format!("# default: {}\n", comment_text(d)));
         }
         Ok(format!("{head}\n{body}"))
     }
@@ -386,6 +386,20 @@ fn max_minutes(file: &VehicleFile, mass_kg: f64) -> Option<f64> {
         .level_power_w([0.0, 0.0], [0.0, 1.0])
         .ok()?;
     Some(endurance_at_power_s(&pack, p, 1.0, pack.empty_soc()) / 60.0)
+}
+
+/// Text for a TOML comment: anything that would end the comment line (a control character or a
+/// line separator from a name in the spec) becomes a space.
+fn comment_text(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() || matches!(c, '\u{2028}' | '\u{2029}' | '\u{85}') {
+                ' '
+            } else {
+                c
+            }
+        })
+        .collect()
 }
 
 /// `x` to 9 decimals: figures written to a file without binary noise (22.2, not 22.200000000000003).

@@ -43,6 +43,11 @@ pub fn vehicles() -> Vec<Vec<u8>> {
     fixtures("vehicles", ".toml")
 }
 
+/// `fixtures/vehicles/specs/*.toml`: the spec sheets of the built-in DJI vehicles.
+pub fn spec_sheets() -> Vec<Vec<u8>> {
+    fixtures("vehicles/specs", ".toml")
+}
+
 /// `fixtures/missions/*.toml` and the built-in demo mission.
 pub fn missions_toml() -> Vec<Vec<u8>> {
     let mut s = fixtures("missions", ".toml");

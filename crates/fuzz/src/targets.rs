@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use aloft::engine::{
-    convert_log, endurance, hover, log_info, plan_mission, power_csv, power_model, power_point,
-    EnduranceOptions, HoverRequest, LogReadOptions, Mission, MissionOptions, PowerQuery, Vehicle,
+    calibrate_spec, convert_log, endurance, hover, log_info, plan_mission, power_csv, power_model,
+    power_point, EnduranceOptions, HoverRequest, LogReadOptions, Mission, MissionOptions,
+    PowerQuery, SpecSheet, Vehicle,
 };
 use aloft::power::{ModelOptions, PowerModel};
 use aloft_planner::Aircraft;
@@ -44,6 +45,14 @@ pub const TARGETS: &[Target] = &[
         format: Format::Text,
         seeds: seeds::vehicles,
         run: vehicle_toml,
+    },
+    Target {
+        name: "spec-sheet",
+        about: "SpecSheet::from_toml and calibrate_spec (aloft vehicles calibrate), the vehicle \
+                file it writes read back with Vehicle::from_toml, endurance on every 8th input",
+        format: Format::Text,
+        seeds: seeds::spec_sheets,
+        run: spec_sheet,
     },
     Target {
         name: "mission-toml",
@@ -222,6 +231,36 @@ fn vehicle_toml(data: &[u8]) -> Outcome {
     o.step("hover", &hover(&v, HoverRequest::Payload(0.0)));
     if fnv1a(data) % 8 == 0 {
         o.step("endurance", &endurance(&v, &EnduranceOptions::default()));
+    }
+    o
+}
+
+fn spec_sheet(data: &[u8]) -> Outcome {
+    let text = String::from_utf8_lossy(data);
+    let spec = match SpecSheet::from_toml(&text, "fuzz-spec.toml") {
+        Ok(s) => s,
+        Err(e) => return Outcome::refused("spec sheet", &e),
+    };
+    let c = match calibrate_spec(&spec, "fuzz-spec.toml") {
+        Ok(c) => c,
+        Err(e) => return Outcome::refused("spec sheet", &e),
+    };
+    let mut o = accepted();
+    o.json("calibration", &c);
+    // A vehicle file aloft wrote must read back: a refusal here is a broken round trip.
+    match c
+        .to_toml()
+        .and_then(|t| Vehicle::from_toml(&t, "fuzz-calibrated.toml"))
+    {
+        Ok(v) => {
+            if fnv1a(data) % 8 == 0 {
+                o.step("endurance", &endurance(&v, &EnduranceOptions::default()));
+            }
+        }
+        Err(e) => o.broken.push(Problem {
+            check: "round-trip",
+            detail: format!("the calibrated vehicle file does not read back: {e}"),
+        }),
     }
     o
 }

@@ -6,7 +6,7 @@
 //! | topic | schema | content |
 //! |---|---|---|
 //! | `/aloft/pose` | `foxglove.PoseInFrame` | position and attitude |
-//! | `/aloft/state` | `aloft.VehicleState` | ENU position, velocity, roll/pitch/yaw (rad and deg), ground speed |
+//! | `/aloft/state` | `aloft.VehicleState` | ENU position, velocity, acceleration, wind, roll/pitch/yaw (rad and deg), ground speed |
 //! | `/aloft/battery` | `aloft.BatteryState` | `voltage_v`, `current_a`, `power_w`, `charge_ah`, `state_of_charge`, `energy_used_wh` |
 //! | `/aloft/power` | `aloft.PowerTerms` | `induced_w`, `parasitic_w`, `profile_w`, `acceleration_w`, `climb_w`, `electrical_w` |
 //! | `/aloft/path` | `foxglove.PosesInFrame` | the planned path, once |
@@ -154,12 +154,13 @@ fn schema_for(name: &str) -> Value {
             "properties": {"timestamp": schema_time(), "frame_id": {"type": "string"}, "poses": {"type": "array", "items": schema_pose()}},
             "required": ["timestamp", "frame_id", "poses"]}),
         "aloft.VehicleState" => json!({
-            "title": "aloft.VehicleState", "description": "Vehicle state: ENU position (m) and velocity (m/s), aerospace Euler angles relative to NED",
+            "title": "aloft.VehicleState", "description": "Vehicle state: ENU position (m), velocity (m/s), acceleration (m/s^2) and wind (m/s), aerospace Euler angles relative to NED",
             "type": "object",
             "properties": {
                 "timestamp": schema_time(), "time_s": {"type": "number"},
                 "position_enu_m": schema_vec3(), "velocity_enu_mps": schema_vec3(),
                 "ground_speed_mps": {"type": "number"},
+                "acceleration_enu_mps2": schema_vec3(), "wind_enu_mps": schema_vec3(),
                 "roll_rad": {"type": "number"}, "pitch_rad": {"type": "number"}, "yaw_rad": {"type": "number"},
                 "roll_deg": {"type": "number"}, "pitch_deg": {"type": "number"}, "yaw_deg": {"type": "number"}},
             "required": ["timestamp", "time_s"]}),
@@ -313,24 +314,26 @@ impl<W: Write + Seek> McapWriter<W> {
             .map_err(|e| self.err(e))
     }
 
-    fn state(
-        &mut self,
-        index: usize,
-        time_s: f64,
-        pos: Option<[f64; 3]>,
-        vel: Option<[f64; 3]>,
-        att: Option<Attitude>,
-    ) -> Result<()> {
+    fn state(&mut self, index: usize, s: &StateFields) -> Result<()> {
+        let (time_s, pos, att) = (s.time_s, s.pos, s.att);
         let ns = self.time_ns(time_s, index)?;
         let mut m = Map::new();
         m.insert("time_s".into(), json!(time_s));
         if let Some(p) = pos {
             m.insert("position_enu_m".into(), xyz(check3("pos_enu_m", index, p)?));
         }
-        if let Some(v) = vel {
+        if let Some(v) = s.vel {
             let v = check3("vel_enu_mps", index, v)?;
             m.insert("velocity_enu_mps".into(), xyz(v));
             m.insert("ground_speed_mps".into(), json!(v[0].hypot(v[1])));
+        }
+        if let Some(a) = s.acc {
+            let a = check3("acc_enu_mps2", index, a)?;
+            m.insert("acceleration_enu_mps2".into(), xyz(a));
+        }
+        if let Some(w) = s.wind {
+            let w = check3("wind_enu_mps", index, w)?;
+            m.insert("wind_enu_mps".into(), xyz(w));
         }
         if let Some(a) = att {
             for (k, v) in [
@@ -357,13 +360,28 @@ impl<W: Write + Seek> McapWriter<W> {
         Ok(())
     }
 
-    /// Write one log sample: state and pose (when it has position), battery (when it has any
-    /// battery channel).
+    /// Write one log sample: state (when it has any motion, attitude or wind channel, or no
+    /// channel at all) and pose (when it has position), battery (when it has any battery
+    /// channel), so every channel and every time of the sample is in the file.
     pub fn write_sample(&mut self, index: usize, s: &Sample) -> Result<()> {
-        if s.pos_enu_m.is_some() || s.vel_enu_mps.is_some() || s.attitude.is_some() {
-            self.state(index, s.time_s, s.pos_enu_m, s.vel_enu_mps, s.attitude)?;
+        let state = StateFields {
+            time_s: s.time_s,
+            pos: s.pos_enu_m,
+            vel: s.vel_enu_mps,
+            acc: s.acc_enu_mps2,
+            att: s.attitude,
+            wind: s.wind_enu_mps,
+        };
+        let battery = s.voltage_v.is_some()
+            || s.current_a.is_some()
+            || s.power_w.is_some()
+            || s.charge_ah.is_some();
+        // A sample with no usable channel keeps its time (a state message with the time alone),
+        // so the file has the source's samples and span.
+        if state.any() || !battery {
+            self.state(index, &state)?;
         }
-        if s.voltage_v.is_some() || s.current_a.is_some() || s.power_w.is_some() {
+        if battery {
             let ns = self.time_ns(s.time_s, index)?;
             let mut m = Map::new();
             m.insert("time_s".into(), json!(s.time_s));
@@ -386,10 +404,14 @@ impl<W: Write + Seek> McapWriter<W> {
     pub fn write_mission_sample(&mut self, index: usize, s: &MissionSample) -> Result<()> {
         self.state(
             index,
-            s.time_s,
-            Some(s.pos_enu_m),
-            Some(s.vel_enu_mps),
-            Some(s.attitude),
+            &StateFields {
+                time_s: s.time_s,
+                pos: Some(s.pos_enu_m),
+                vel: Some(s.vel_enu_mps),
+                acc: None,
+                att: Some(s.attitude),
+                wind: None,
+            },
         )?;
         let ns = self.time_ns(s.time_s, index)?;
         let p = &s.power;
@@ -501,4 +523,24 @@ pub fn write_mission_mcap(
         w.write_mission_sample(i, s)?;
     }
     w.finish()
+}
+
+/// The fields of one `aloft.VehicleState` message (each optional but the time).
+struct StateFields {
+    time_s: f64,
+    pos: Option<[f64; 3]>,
+    vel: Option<[f64; 3]>,
+    acc: Option<[f64; 3]>,
+    att: Option<Attitude>,
+    wind: Option<[f64; 3]>,
+}
+
+impl StateFields {
+    fn any(&self) -> bool {
+        self.pos.is_some()
+            || self.vel.is_some()
+            || self.acc.is_some()
+            || self.att.is_some()
+            || self.wind.is_some()
+    }
 }

@@ -72,7 +72,13 @@ impl MessageKind {
             MessageKind::TwistStamped => &[Channel::Velocity],
             MessageKind::Odometry => &[Channel::Position, Channel::Velocity, Channel::Attitude],
             MessageKind::Imu => &[Channel::Attitude, Channel::Acceleration],
-            MessageKind::AloftState => &[Channel::Position, Channel::Velocity, Channel::Attitude],
+            MessageKind::AloftState => &[
+                Channel::Position,
+                Channel::Velocity,
+                Channel::Acceleration,
+                Channel::Attitude,
+                Channel::Wind,
+            ],
         }
     }
 }
@@ -466,6 +472,8 @@ fn json_aloft_state(v: &Value) -> Result<Sample, String> {
     Ok(Sample {
         pos_enu_m: optional_vec3(v, "position_enu_m")?,
         vel_enu_mps: optional_vec3(v, "velocity_enu_mps")?,
+        acc_enu_mps2: optional_vec3(v, "acceleration_enu_mps2")?,
+        wind_enu_mps: optional_vec3(v, "wind_enu_mps")?,
         attitude: optional_euler(v)?,
         ..Sample::default()
     })
