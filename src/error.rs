@@ -340,6 +340,26 @@ pub enum Error {
         /// The pack's name.
         battery: String,
     },
+    /// A payload sweep `START:STOP:STEP` (kg) that cannot be swept.
+    #[error("payload sweep {text}: {problem}")]
+    PayloadSweep {
+        /// The sweep as given.
+        text: String,
+        /// What is wrong with it.
+        problem: SweepProblem,
+    },
+    /// No payload of a sweep can be carried with any of the packs swept: every take-off mass
+    /// exceeds the airframe's limit.
+    #[error("every payload from {start_kg} kg exceeds the {max_takeoff_mass_kg:.3} kg maximum take-off mass with every pack swept (the most any of them leaves for payload is {max_payload_kg:.3} kg)")]
+    SweepTooHeavy {
+        /// The sweep's first payload, kg.
+        start_kg: f64,
+        /// The airframe's maximum take-off mass, kg.
+        max_takeoff_mass_kg: f64,
+        /// The largest payload any pack swept leaves room for, kg (negative when even the
+        /// airframe and pack alone exceed the limit).
+        max_payload_kg: f64,
+    },
     /// The vehicle has no table for the model that was asked for.
     #[error("vehicle '{vehicle}' has no [{table}] table, which {needed_for} needs")]
     MissingTable {
@@ -349,6 +369,59 @@ pub enum Error {
         table: &'static str,
         /// What needs it.
         needed_for: &'static str,
+    },
+}
+
+/// What is wrong with a payload sweep `START:STOP:STEP` ([`Error::PayloadSweep`]).
+#[derive(Debug, Clone, Error)]
+#[non_exhaustive]
+pub enum SweepProblem {
+    /// Not three fields separated by colons.
+    #[error("expected START:STOP:STEP in kg, three numbers such as 0:1:0.25")]
+    Format,
+    /// A field that is not a number.
+    #[error("{field} '{text}' is not a number")]
+    NotANumber {
+        /// `START`, `STOP` or `STEP`.
+        field: &'static str,
+        /// The text found.
+        text: String,
+    },
+    /// A field that is NaN or infinite.
+    #[error("{field} = {} kg is not a finite number", aloft_core::Num::of(.value_kg))]
+    NotFinite {
+        /// `START`, `STOP` or `STEP`.
+        field: &'static str,
+        /// The value, kg.
+        value_kg: f64,
+    },
+    /// A negative first payload.
+    #[error("START = {} kg is negative: a payload is 0 kg or more", aloft_core::Num::of(.start_kg))]
+    NegativeStart {
+        /// START, kg.
+        start_kg: f64,
+    },
+    /// The last payload below the first.
+    #[error("STOP = {} kg is below START = {} kg", aloft_core::Num::of(.stop_kg), aloft_core::Num::of(.start_kg))]
+    StopBelowStart {
+        /// START, kg.
+        start_kg: f64,
+        /// STOP, kg.
+        stop_kg: f64,
+    },
+    /// A step that is zero or negative.
+    #[error("STEP = {} kg is not positive", aloft_core::Num::of(.step_kg))]
+    StepNotPositive {
+        /// STEP, kg.
+        step_kg: f64,
+    },
+    /// More payloads than a sweep may have.
+    #[error("{} payloads, more than the {max} a sweep may have: take a larger STEP", aloft_core::Num::of(.points))]
+    TooManyPoints {
+        /// How many payloads the sweep would have.
+        points: f64,
+        /// The most a sweep may have.
+        max: usize,
     },
 }
 

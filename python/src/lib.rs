@@ -27,13 +27,13 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use aloft::engine::{
-    endurance, fit_logs, fit_parameter, log_info, plan_mission, plan_scenarios, power_curve,
-    power_model, power_point, power_values, validate_logs, FitRequest, Mission,
+    endurance, fit_logs, fit_parameter, log_info, payload_sweep, plan_mission, plan_scenarios,
+    power_curve, power_model, power_point, power_values, validate_logs, FitRequest, Mission,
     MissionWithUncertainty, PowerQuery, Term, ValidateRequest, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
-use options::Kwargs;
+use options::{EnduranceCurve, Kwargs};
 
 create_exception!(
     aloft,
@@ -197,7 +197,8 @@ impl Table {
     }
 }
 
-/// `aloft endurance --format json` (with `sweep_speed`: the power curve) as text.
+/// `aloft endurance --format json` as text (with `sweep_speed`: the power curve; with
+/// `payload_sweep`: endurance against payload per pack).
 #[pyfunction]
 #[pyo3(signature = (options=None))]
 fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<String> {
@@ -208,8 +209,9 @@ fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResu
     py.detach(|| {
         let v = Vehicle::load(&vehicle)?;
         match sweep {
-            Some(step) => json_of(&power_curve(&v, &opts, step)?),
-            None => endurance(&v, &opts)?.to_json(),
+            EnduranceCurve::Speed(step) => json_of(&power_curve(&v, &opts, step)?),
+            EnduranceCurve::Payload(s) => json_of(&payload_sweep(&v, &opts, &s)?),
+            EnduranceCurve::None => endurance(&v, &opts)?.to_json(),
         }
     })
     .map_err(engine_error)

@@ -16,7 +16,7 @@ use pyo3::types::PyDict;
 
 use aloft::engine::{
     AoaModel, CornerMode, EnduranceOptions, FlightLogs, GustSpec, LogReadOptions, MissionOptions,
-    ScenarioOptions, WindProfileKind, WindSpec,
+    PayloadSweep, ScenarioOptions, WindProfileKind, WindSpec,
 };
 
 use crate::aloft_error;
@@ -173,6 +173,43 @@ impl<'py> Kwargs<'py> {
         Ok(())
     }
 
+    /// Refuse `b` whenever `a` is given (clap's `conflicts_with`).
+    pub fn excludes(&self, a: (&str, bool), b: (&str, bool)) -> PyResult<()> {
+        if a.1 && b.1 {
+            return Err(aloft_error(format!(
+                "the option '{}' of aloft.{} cannot be used with '{}'",
+                a.0, self.function, b.0
+            )));
+        }
+        Ok(())
+    }
+
+    /// A payload sweep: the CLI's text `"START:STOP:STEP"` (kg) or a tuple or list of three
+    /// numbers, checked by the engine (the message says what is wrong).
+    pub fn payload_sweep(&mut self, key: &'static str) -> PyResult<Option<PayloadSweep>> {
+        let Some(v) = self.take(key) else {
+            return Ok(None);
+        };
+        let numbers = v.extract::<Vec<f64>>().ok();
+        let sweep = if let Ok(text) = v.extract::<String>() {
+            PayloadSweep::parse(&text)
+        } else if let Some([start, stop, step]) = numbers.as_deref() {
+            PayloadSweep::new(*start, *stop, *step)
+        } else {
+            return Err(self.invalid(
+                key,
+                &v,
+                "expected 'START:STOP:STEP' or (START, STOP, STEP) in kg",
+            ));
+        };
+        sweep.map(Some).map_err(|e| match e {
+            aloft::Error::PayloadSweep { problem, .. } => {
+                self.invalid(key, &v, &problem.to_string())
+            }
+            other => aloft_error(other.to_string()),
+        })
+    }
+
     /// Refuse a key that is left over: unknown here (or not yet known to this version).
     pub fn finish(self) -> PyResult<()> {
         if let Some(key) = self.values.keys().next() {
@@ -307,9 +344,20 @@ pub fn mission(k: &mut Kwargs<'_>) -> PyResult<MissionOptions> {
     })
 }
 
+/// What `aloft endurance` answers: the queries at one payload, the power curve
+/// (`--sweep-speed`), or endurance against payload (`--payload-sweep`).
+pub enum EnduranceCurve {
+    /// The endurance queries.
+    None,
+    /// The power curve in steps of this many m/s.
+    Speed(f64),
+    /// Endurance against payload.
+    Payload(PayloadSweep),
+}
+
 /// The options of `aloft endurance` (`EnduranceArgs::options` of the CLI) and its
-/// `--sweep-speed`.
-pub fn endurance(k: &mut Kwargs<'_>) -> PyResult<(EnduranceOptions, Option<f64>)> {
+/// `--sweep-speed` or `--payload-sweep` (which, as there, exclude each other and a payload).
+pub fn endurance(k: &mut Kwargs<'_>) -> PyResult<(EnduranceOptions, EnduranceCurve)> {
     let wind = steady_wind(k)?;
     let orbit_radius_m = k.f64("orbit_radius")?;
     let orbit_speed_mps = k.f64("orbit_speed")?;
@@ -321,9 +369,27 @@ pub fn endurance(k: &mut Kwargs<'_>) -> PyResult<(EnduranceOptions, Option<f64>)
         ("orbit_speed", orbit_speed_mps.is_some()),
         ("orbit_radius", orbit_radius_m.is_some()),
     )?;
+    let payload_kg = k.f64("payload_kg")?;
+    let sweep_speed = k.f64("sweep_speed")?;
+    let payload_sweep = k.payload_sweep("payload_sweep")?;
+    if payload_sweep.is_some() {
+        k.excludes(
+            ("payload_sweep", true),
+            ("sweep_speed", sweep_speed.is_some()),
+        )?;
+        k.excludes(
+            ("payload_sweep", true),
+            ("payload_kg", payload_kg.is_some()),
+        )?;
+    }
+    let curve = match (sweep_speed, payload_sweep) {
+        (_, Some(sweep)) => EnduranceCurve::Payload(sweep),
+        (Some(step), None) => EnduranceCurve::Speed(step),
+        (None, None) => EnduranceCurve::None,
+    };
     let options = EnduranceOptions {
         battery: k.string("battery")?,
-        payload_kg: k.f64_or("payload_kg", 0.0)?,
+        payload_kg: payload_kg.unwrap_or(0.0),
         wind,
         course_deg: k.f64_or("course", 0.0)?,
         reserve_percent: k.f64_or("reserve_percent", 0.0)?,
@@ -331,7 +397,7 @@ pub fn endurance(k: &mut Kwargs<'_>) -> PyResult<(EnduranceOptions, Option<f64>)
         orbit_speed_mps,
         aoa: k.aoa()?.unwrap_or(AoaModel::Geometric),
     };
-    Ok((options, k.f64("sweep_speed")?))
+    Ok((options, curve))
 }
 
 /// The read options of `aloft log info` (`ReadOptions::options` of the CLI).

@@ -1,15 +1,17 @@
 //! `aloft endurance`: hover endurance and power, best-endurance speed, best-range speed and range
-//! along a course in wind, orbit endurance, and the power curve (`--sweep-speed`).
+//! along a course in wind, orbit endurance, the power curve (`--sweep-speed`) and endurance
+//! against payload per pack (`--payload-sweep`, rendered in `payload_sweep.rs`).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::Args;
+use clap::builder::{StringValueParser, TypedValueParser};
+use clap::{ArgGroup, Args};
 
 use aloft::engine::{
-    endurance, endurance_scenarios, power_curve, AoaModel, EnduranceOptions, EnduranceSummary,
-    EnduranceWithUncertainty, PowerCurve, SweepRow, Vehicle,
+    endurance, endurance_scenarios, payload_sweep, power_curve, AoaModel, EnduranceOptions,
+    EnduranceSummary, EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
 use super::args::{aoa_parser, SteadyWindArgs};
@@ -17,6 +19,7 @@ use super::output::{self, Row};
 use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
 
 #[derive(Debug, Args)]
+#[command(group(ArgGroup::new("curve").args(["sweep_speed", "payload_sweep"])))]
 pub struct EnduranceArgs {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
@@ -53,8 +56,15 @@ pub struct EnduranceArgs {
     /// many m/s up to the vehicle's maximum speed.
     #[arg(value_parser = super::args::finite(), long, value_name = "STEP_M/S")]
     sweep_speed: Option<f64>,
-    /// With --sweep-speed: also draw the curve to this SVG.
-    #[arg(long, value_name = "SVG", requires = "sweep_speed")]
+    /// Endurance against payload instead, one curve per pack (every pack of the vehicle unless
+    /// --battery names one): hover endurance, best endurance and best range at payloads from
+    /// START to STOP kg in steps of STEP kg (e.g. 0:1:0.25; at most 1000 payloads). A pack's
+    /// curve stops at the maximum take-off mass.
+    #[arg(long, value_name = "START:STOP:STEP", value_parser = payload_sweep_parser(),
+        allow_hyphen_values = true, conflicts_with_all = ["payload_kg", "samples"])]
+    payload_sweep: Option<PayloadSweep>,
+    /// With --sweep-speed or --payload-sweep: also draw the curves to this SVG.
+    #[arg(long, value_name = "SVG", requires = "curve")]
     plot: Option<PathBuf>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
@@ -79,9 +89,22 @@ impl EnduranceArgs {
     }
 }
 
+/// `START:STOP:STEP`, parsed and checked by the engine (clap names the flag and the value).
+fn payload_sweep_parser() -> impl TypedValueParser<Value = PayloadSweep> {
+    StringValueParser::new().try_map(|text: String| {
+        PayloadSweep::parse(&text).map_err(|e| match e {
+            Error::PayloadSweep { problem, .. } => problem.to_string(),
+            other => other.to_string(),
+        })
+    })
+}
+
 pub fn run(args: EnduranceArgs) -> Result<Outcome> {
     let vehicle = Vehicle::load(&args.vehicle)?;
     let options = args.options();
+    if let Some(sweep) = &args.payload_sweep {
+        return run_payload_sweep(&args, &vehicle, &options, sweep);
+    }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if let Some(step) = args.sweep_speed {
@@ -99,7 +122,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
         return Ok(Outcome::Ok);
     }
     if args.format == Format::Csv {
-        bail!("aloft endurance writes table or json (csv with --sweep-speed)");
+        bail!("aloft endurance writes table or json (csv with --sweep-speed or --payload-sweep)");
     }
     let summary = endurance(&vehicle, &options)?;
     let uncertainty = match args.scenarios.options(false) {
@@ -122,6 +145,34 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
                 super::scenarios::write_endurance_lines(&mut out, u)?;
             }
         }
+    }
+    Ok(Outcome::Ok)
+}
+
+/// `--payload-sweep`: the engine's curve per pack, drawn when asked, then printed.
+fn run_payload_sweep(
+    args: &EnduranceArgs,
+    vehicle: &Vehicle,
+    options: &EnduranceOptions,
+    sweep: &PayloadSweep,
+) -> Result<Outcome> {
+    let curve = payload_sweep(vehicle, options, sweep).map_err(|e| match e {
+        // The one error that is the sweep's own: name the flag.
+        e @ Error::SweepTooHeavy { .. } => {
+            anyhow::Error::new(e).context(format!("--payload-sweep {sweep}"))
+        }
+        e => e.into(),
+    })?;
+    if let Some(p) = &args.plot {
+        super::payload_sweep::plot(p, &curve)
+            .with_context(|| format!("cannot draw {}", p.display()))?;
+    }
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &curve)?,
+        Format::Csv => super::payload_sweep::write_csv(out, &curve)?,
+        Format::Table => super::payload_sweep::write_table(&mut out, &curve)?,
     }
     Ok(Outcome::Ok)
 }

@@ -10,6 +10,7 @@ mod flights;
 mod log;
 mod mission;
 mod output;
+mod payload_sweep;
 mod plot;
 mod power;
 mod propulsion;

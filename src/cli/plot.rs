@@ -1,4 +1,5 @@
-//! The chart the subcommands share: two lines against one x axis, each on its own y axis.
+//! The charts the subcommands share: two lines against one x axis, each on its own y axis
+//! ([`dual_lines`]), and several labelled lines against one y axis ([`lines`]).
 
 use anyhow::Result;
 use plotters::chart::DualCoordChartContext;
@@ -67,6 +68,71 @@ pub fn legend<'a, 'b: 'a>(
     chart
         .configure_series_labels()
         .position(position)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+/// One labelled line of [`lines`].
+pub struct Series {
+    pub label: String,
+    pub color: RGBColor,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// The `k`-th colour of a chart with several lines of one kind (a colour-blind-safe set, then
+/// again from the first).
+pub fn color(k: usize) -> RGBColor {
+    const COLORS: [RGBColor; 6] = [
+        RGBColor(0, 114, 178),
+        RGBColor(213, 94, 0),
+        RGBColor(0, 158, 115),
+        RGBColor(204, 121, 167),
+        RGBColor(86, 180, 233),
+        RGBColor(230, 159, 0),
+    ];
+    COLORS[k % COLORS.len()]
+}
+
+/// Draw each series as a line with its points marked, against one y axis from 0 (`y_desc`) over
+/// `x` (its range and description), with a legend of the series' labels.
+pub fn lines(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    caption: String,
+    x: (std::ops::Range<f64>, &str),
+    y_desc: &str,
+    series: Vec<Series>,
+) -> Result<()> {
+    let (x_range, x_desc) = x;
+    let y_max = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(0.0, f64::max)
+        * 1.1
+        + 1e-9;
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(60)
+        .build_cartesian_2d(x_range, 0.0..y_max)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .draw()?;
+    for s in series {
+        let c = s.color;
+        chart
+            .draw_series(LineSeries::new(s.points.clone(), c.stroke_width(2)))?
+            .label(s.label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        chart.draw_series(s.points.into_iter().map(|p| Circle::new(p, 3, c.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;

@@ -11,7 +11,7 @@
 //! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`] | [`Vehicle`], [`list_vehicles`] | `vehicles.rs` |
 //! | missions | [`Mission::load`] (aloft TOML or JSON, QGroundControl `.plan`, `.waypoints`, recognised from the content) + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`] with the [`RouteFigures`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
 //! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
-//! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`] | [`EnduranceSummary`], [`PowerCurve`] | `endurance.rs` |
+//! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`]; + [`PayloadSweep`] → [`payload_sweep`] | [`EnduranceSummary`], [`PowerCurve`], [`PayloadCurve`] | `endurance.rs`, `payload_sweep.rs` |
 //! | power | [`PowerQuery`] → [`power_point`]; [`power_csv`] | [`PowerAnswer`] | `power.rs`, `power_batch.rs` |
 //! | propulsion | [`hover`], [`hover_sweep`], [`RotorRequest`] → [`rotor_response`] | [`HoverResult`], [`HoverSweep`], [`RotorAnswer`] | `propulsion.rs` |
 //! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
@@ -52,6 +52,7 @@ mod logs;
 mod loiter;
 mod mission;
 mod mission_outputs;
+mod payload_sweep;
 mod power;
 mod power_batch;
 mod propulsion;
@@ -89,6 +90,9 @@ pub use mission::{
     Plan, PlanContext, Remaining, DEMO_MISSION, DEMO_ORIGIN,
 };
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
+pub use payload_sweep::{
+    payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
+};
 pub use power::{
     power_csv_file, power_model, power_point, PowerAnswer, PowerContext, PowerGradientDeg,
     PowerQuery,
@@ -114,6 +118,10 @@ pub use vehicles::{list_vehicles, Vehicle, VehicleEntry};
 
 /// A parser's message on one line (the CLI prints every error on one line).
 pub use aloft_core::one_line;
+
+/// The error of every engine function, and what is wrong with a payload sweep (so callers match
+/// on them through this module alone).
+pub use crate::error::{Error, SweepProblem};
 
 /// The vehicle every command uses when none is named.
 pub use crate::vehicle::DEFAULT_VEHICLE;
@@ -141,6 +149,8 @@ const _: () = {
     send_sync::<MissionSummary>();
     send_sync::<EnduranceOptions>();
     send_sync::<EnduranceSummary>();
+    send_sync::<PayloadSweep>();
+    send_sync::<PayloadCurve>();
     send_sync::<InFlightEstimator>();
     send_sync::<PowerQuery>();
     send_sync::<PowerAnswer>();

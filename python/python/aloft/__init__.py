@@ -111,7 +111,11 @@ def endurance(**options: Any) -> Dict[str, Any]:
             ``wind_from``, ``wind_profile``, ``wind_reference_height``, ``wind_exponent``,
             ``wind_roughness``, ``course`` (deg, default 0), ``reserve_percent`` (default 0),
             ``orbit_radius`` and ``orbit_speed`` (together), ``aoa``; ``sweep_speed`` (m/s) for
-            the power curve instead (``aloft endurance --sweep-speed S --format json``).
+            the power curve instead (``aloft endurance --sweep-speed S --format json``), or
+            ``payload_sweep`` (``"START:STOP:STEP"`` in kg, or a tuple of the three numbers) for
+            endurance against payload, one curve per pack, instead
+            (``aloft endurance --payload-sweep START:STOP:STEP --format json``; not with
+            ``payload_kg`` or ``sweep_speed``).
 
     Returns:
         The CLI's JSON answer as a dict.

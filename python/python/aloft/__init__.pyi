@@ -1,7 +1,7 @@
 """Type stubs of aloft: keyword arguments are the CLI's flags in snake_case."""
 
 import os
-from typing import Any, Dict, List, Literal, Optional, Sequence, Union
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -94,6 +94,7 @@ def endurance(
     orbit_speed: Optional[float] = None,
     aoa: Optional[Aoa] = None,
     sweep_speed: Optional[float] = None,
+    payload_sweep: Optional[Union[str, Tuple[float, float, float], Sequence[float]]] = None,
 ) -> Dict[str, Any]: ...
 def log_info(
     path: PathLike,
