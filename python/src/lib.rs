@@ -27,9 +27,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use aloft::engine::{
-    endurance, fit_logs, fit_parameter, log_info, payload_sweep, plan_mission, plan_scenarios,
-    power_curve, power_model, power_point, power_values, validate_logs, FitRequest, Mission,
-    MissionWithUncertainty, PowerQuery, Term, ValidateRequest, Vehicle, POWER_KEYS,
+    calibrate_spec_file, endurance, fit_logs, fit_parameter, list_vehicles, log_info,
+    payload_sweep, plan_mission, plan_scenarios, power_curve, power_model, power_point,
+    power_values, validate_logs, FitRequest, Mission, MissionWithUncertainty, PowerQuery, Term,
+    ValidateRequest, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -213,6 +214,27 @@ fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResu
             EnduranceCurve::Payload(s) => json_of(&payload_sweep(&v, &opts, &s)?),
             EnduranceCurve::None => endurance(&v, &opts)?.to_json(),
         }
+    })
+    .map_err(engine_error)
+}
+
+/// `aloft vehicles --format json` as text: the built-in vehicles with their packs and sources.
+#[pyfunction]
+fn vehicles_json() -> PyResult<String> {
+    list_vehicles()
+        .and_then(|v| json_of(&v))
+        .map_err(engine_error)
+}
+
+/// `aloft vehicles calibrate SPEC -o OUTPUT --format json` as text: the vehicle file of a spec
+/// sheet, written to `output`.
+#[pyfunction]
+#[pyo3(signature = (spec, output))]
+fn calibrate_vehicle_json(py: Python<'_>, spec: PathBuf, output: PathBuf) -> PyResult<String> {
+    py.detach(|| {
+        let c = calibrate_spec_file(&spec)?;
+        c.write_vehicle_file(&output)?;
+        json_of(&c)
     })
     .map_err(engine_error)
 }
@@ -490,6 +512,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mission_json, m)?)?;
     m.add_function(wrap_pyfunction!(timeseries_columns, m)?)?;
     m.add_function(wrap_pyfunction!(endurance_json, m)?)?;
+    m.add_function(wrap_pyfunction!(vehicles_json, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate_vehicle_json, m)?)?;
     m.add_function(wrap_pyfunction!(log_info_json, m)?)?;
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(validate_json, m)?)?;

@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use aloft::engine::{calibrate_spec_file, list_vehicles, SpecCalibration, VehicleEntry};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
 
 use super::{output, Format, Outcome};
@@ -120,9 +120,7 @@ fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
 
 fn calibrate(args: CalibrateArgs) -> Result<Outcome> {
     let c = calibrate_spec_file(&args.spec)?;
-    let text = c.to_toml()?;
-    std::fs::write(&args.output, text)
-        .with_context(|| format!("cannot write vehicle file {}", args.output.display()))?;
+    c.write_vehicle_file(&args.output)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {

@@ -292,6 +292,17 @@ pub struct SpecCalibration {
 }
 
 impl SpecCalibration {
+    /// Write the vehicle file ([`Self::to_toml`]) to `path` (`aloft vehicles calibrate -o`).
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file when it cannot be written.
+    pub fn write_vehicle_file(&self, path: &std::path::Path) -> Result<(), Error> {
+        std::fs::write(path, self.to_toml()?).map_err(|source| Error::Io {
+            origin: format!("cannot write vehicle file {}", path.display()),
+            source,
+        })
+    }
+
     /// The vehicle file as TOML, headed by comments that say where each part came from.
     ///
     /// # Errors

@@ -27,6 +27,7 @@ from ._native import AloftError
 
 __all__ = [
     "AloftError",
+    "calibrate_vehicle",
     "DEFAULT_VEHICLE",
     "DEMO_MISSION",
     "POWER_KEYS",
@@ -38,6 +39,7 @@ __all__ = [
     "power",
     "timeseries",
     "validate",
+    "vehicles",
 ]
 
 __version__: str = _native.version()
@@ -121,6 +123,33 @@ def endurance(**options: Any) -> Dict[str, Any]:
         The CLI's JSON answer as a dict.
     """
     return json.loads(_native.endurance_json(options))
+
+
+def vehicles() -> List[Dict[str, Any]]:
+    """The built-in vehicles: ``aloft vehicles --format json``.
+
+    Returns:
+        One dict per vehicle: ``name``, ``description``, ``mass_kg``, ``models``, ``batteries``
+        (the pack names for ``battery=``, default first) and, for the DJI vehicles, ``source``
+        (``figures``, ``calibrated_on``, ``published``).
+    """
+    return json.loads(_native.vehicles_json())
+
+
+def calibrate_vehicle(spec: PathLike, output: PathLike) -> Dict[str, Any]:
+    """A vehicle file from a spec sheet: ``aloft vehicles calibrate SPEC -o OUTPUT --format json``.
+
+    Args:
+        spec: The spec sheet (TOML: ``name``, ``rotors``, ``rotor_diameter_m``,
+            ``frame_mass_kg``, ``[battery]``, ``[published_hover]``; see the README).
+        output: Where to write the vehicle file; every function accepts it as ``vehicle=``.
+
+    Returns:
+        The calibration: ``efficiency``, ``hover_power_w``, ``max_minutes_at_unit_efficiency``,
+        ``battery``, ``takeoff_mass_kg``, ``published_minutes``, ``defaults`` (the class defaults
+        used, in words).
+    """
+    return json.loads(_native.calibrate_vehicle_json(os.fspath(spec), os.fspath(output)))
 
 
 def log_info(path: PathLike, **options: Any) -> Dict[str, Any]:
