@@ -433,7 +433,7 @@ mod tests {
     #[test]
     fn every_pack_is_swept_default_first_and_the_named_pack_alone() {
         let v = m100();
-        let sweep = PayloadSweep::parse("0:0.5:0.25").unwrap();
+        let sweep = PayloadSweep::parse("0:0.3:0.15").unwrap();
         let all = payload_sweep(&v, &EnduranceOptions::default(), &sweep).unwrap();
         let names: Vec<&str> = all.batteries.iter().map(|b| b.name.as_str()).collect();
         assert_eq!(names, v.file().battery_names());
