@@ -337,7 +337,7 @@ impl SpecCalibration {
 /// efficiency up to 1).
 pub fn calibrate_spec(spec: &SpecSheet, origin: &str) -> Result<SpecCalibration, Error> {
     check_spec(spec, origin)?;
-    let (mut file, defaults) = spec_vehicle(spec);
+    let (mut file, defaults) = spec_vehicle(spec)?;
     let hover = &spec.published_hover;
     let calibration = calibrate_hover(&file, None, hover.takeoff_mass_kg, hover.minutes).map_err(
         |e| match e {
@@ -513,7 +513,13 @@ fn check_spec(spec: &SpecSheet, origin: &str) -> Result<(), Error> {
 }
 
 /// The vehicle file of a spec sheet before calibration (`eta = 1`), and the defaults used.
-fn spec_vehicle(spec: &SpecSheet) -> (VehicleFile, Vec<String>) {
+fn spec_vehicle(spec: &SpecSheet) -> Result<(VehicleFile, Vec<String>), Error> {
+    let m100 = VehicleFile::builtin("dji-m100")?;
+    let m100_envelope = m100.airframe.ok_or_else(|| Error::MissingTable {
+        vehicle: "dji-m100".to_string(),
+        table: "airframe",
+        needed_for: "the class defaults of a spec sheet",
+    })?;
     let mut defaults = Vec::new();
     let radius = spec.rotor_diameter_m / 2.0;
     let n = f64::from(spec.rotors);
@@ -587,21 +593,15 @@ fn spec_vehicle(spec: &SpecSheet) -> (VehicleFile, Vec<String>) {
         mu2_y_n_s2_per_m2: None,
         efficiency_relative_sd: None,
     };
+    // The M100's envelope (its published limits and assumed accelerations), with this
+    // vehicle's masses.
     let airframe = AirframeSpec {
         mass_kg: spec.frame_mass_kg,
         max_takeoff_mass_kg: max_takeoff,
         max_thrust_n: None,
-        max_tilt_deg: 35.0,
-        max_speed_mps: 17.0,
-        max_climb_rate_mps: 5.0,
-        max_descent_rate_mps: 4.0,
-        acceleration_mps2: 2.0,
-        vertical_acceleration_mps2: 1.5,
-        yaw_rate_deg_s: 60.0,
-        rotor_height_m: 0.30,
-        acceptance_radius_m: None,
         cruise_speed_mps: None,
         rtl_altitude_m: None,
+        ..m100_envelope
     };
     let source = VehicleSource {
         figures: format!(
@@ -640,5 +640,5 @@ fn spec_vehicle(spec: &SpecSheet) -> (VehicleFile, Vec<String>) {
         airframe: Some(airframe),
         batteries: vec![pack],
     };
-    (file, defaults)
+    Ok((file, defaults))
 }
