@@ -9,6 +9,7 @@
 //! | concern | requests | answer | file |
 //! |---|---|---|---|
 //! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`] | [`Vehicle`], [`list_vehicles`] | `vehicles.rs` |
+//! | calibrate | [`SpecSheet`] → [`calibrate_spec`]; a vehicle file → [`calibrate_hover`] | [`SpecCalibration`], [`HoverCalibration`] | `calibrate.rs` |
 //! | missions | [`Mission::load`] (aloft TOML or JSON, QGroundControl `.plan`, `.waypoints`, recognised from the content) + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`] with the [`RouteFigures`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
 //! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
 //! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`]; + [`PayloadSweep`] → [`payload_sweep`] | [`EnduranceSummary`], [`PowerCurve`], [`PayloadCurve`] | `endurance.rs`, `payload_sweep.rs` |
