@@ -120,6 +120,20 @@ pub enum Error {
         /// The channel, in words.
         channel: &'static str,
     },
+    /// Power and velocity that share too little time for a lag estimate.
+    #[error("{origin}: --lag needs power and velocity over a common span of at least 10 samples; power covers {power}, velocity {velocity} ({shared} samples of {step} shared)")]
+    NoCommonSpan {
+        /// File.
+        origin: String,
+        /// The power series' span, in words with units.
+        power: String,
+        /// The velocity series' span, in words with units.
+        velocity: String,
+        /// Samples the two share on the resampling grid.
+        shared: usize,
+        /// The grid's step, in words with its unit.
+        step: String,
+    },
     /// A log with no decodable samples.
     #[error("{origin}: the log holds no decodable samples")]
     EmptyLog {

@@ -437,6 +437,22 @@ fn lag_of(
         .len()
         .saturating_sub(off_p)
         .min(vu.len().saturating_sub(off_v));
+    if n < 10 {
+        // Say what is wrong: the series do not share enough time, not the search window.
+        let span = |t0: f64, len: usize| format!("{t0:.3} to {:.3} s", t0 + dt * len as f64);
+        return Err(Error::NoCommonSpan {
+            origin: file.to_string(),
+            power: span(t0p, pu.len()),
+            velocity: span(t0v, vu.len()),
+            shared: n,
+            step: format!(
+                "{} s",
+                format!("{dt:.6}")
+                    .trim_end_matches('0')
+                    .trim_end_matches('.')
+            ),
+        });
+    }
     let e = estimate_lag_s(&pu[off_p..off_p + n], &vu[off_v..off_v + n], dt, max_lag_s).map_err(
         |e| Error::Log {
             origin: "lag estimation".to_string(),
