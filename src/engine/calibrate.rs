@@ -514,16 +514,36 @@ fn check_spec(spec: &SpecSheet, origin: &str) -> Result<(), Error> {
 
 /// The vehicle file of a spec sheet before calibration (`eta = 1`), and the defaults used.
 fn spec_vehicle(spec: &SpecSheet) -> Result<(VehicleFile, Vec<String>), Error> {
-    let m100 = VehicleFile::builtin("dji-m100")?;
-    let m100_envelope = m100.airframe.ok_or_else(|| Error::MissingTable {
-        vehicle: "dji-m100".to_string(),
-        table: "airframe",
-        needed_for: "the class defaults of a spec sheet",
-    })?;
     let mut defaults = Vec::new();
+    let power = spec_power(spec, &mut defaults);
+    let airframe = spec_airframe(spec, &mut defaults)?;
+    defaults.push(format!(
+        "pack: {} mohm per cell, cut-off {CUTOFF_CELL_V} V per cell, generic LiPo open-circuit curve",
+        CELL_RESISTANCE_OHM * 1000.0
+    ));
+    let file = VehicleFile {
+        name: spec.name.clone(),
+        description: if spec.description.is_empty() {
+            format!(
+                "{} from its spec sheet (aloft vehicles calibrate)",
+                spec.name
+            )
+        } else {
+            spec.description.clone()
+        },
+        source: Some(spec_source(spec)),
+        power: Some(power),
+        propulsion: None,
+        airframe: Some(airframe),
+        batteries: vec![spec_pack(&spec.battery)],
+    };
+    Ok((file, defaults))
+}
+
+/// The four-term model of a spec sheet: its rotors, the class's profile share and drag.
+fn spec_power(spec: &SpecSheet, defaults: &mut Vec<String>) -> VehicleParams {
     let radius = spec.rotor_diameter_m / 2.0;
-    let n = f64::from(spec.rotors);
-    let all_disks = n * std::f64::consts::PI * radius * radius;
+    let all_disks = f64::from(spec.rotors) * std::f64::consts::PI * radius * radius;
     let seed_share = SEED_KAPPA1
         * (2.0 * SEA_LEVEL_DENSITY * std::f64::consts::PI * SEED_ROTOR_RADIUS_M.powi(2)).sqrt();
     let kappa1 = seed_share / (2.0 * SEA_LEVEL_DENSITY * all_disks).sqrt();
@@ -543,41 +563,8 @@ fn spec_vehicle(spec: &SpecSheet) -> Result<(VehicleFile, Vec<String>), Error> {
             mu3_n_s3_per_m3: round9(SEED_MU[2] * scale),
         }
     });
-    let hover = &spec.published_hover;
-    let max_takeoff = spec.max_takeoff_mass_kg.unwrap_or_else(|| {
-        defaults.push(format!(
-            "largest take-off mass: the published hover's {} kg (max_takeoff_mass_kg not given)",
-            hover.takeoff_mass_kg
-        ));
-        hover.takeoff_mass_kg
-    });
-    defaults.push(
-        "flight envelope: the M100's (35 deg tilt, 17 m/s, climb 5 m/s, descent 4 m/s, 2 m/s^2, rotors 0.30 m above the ground)"
-            .to_string(),
-    );
-    defaults.push(format!(
-        "pack: {} mohm per cell, cut-off {CUTOFF_CELL_V} V per cell, generic LiPo open-circuit curve",
-        CELL_RESISTANCE_OHM * 1000.0
-    ));
-    let b = &spec.battery;
-    let count = f64::from(b.count);
-    let pack = BatterySpec {
-        name: b
-            .name
-            .clone()
-            .unwrap_or_else(|| format!("{}x{}mAh", b.count, b.capacity_mah)),
-        default: true,
-        cells_series: b.cells,
-        capacity_mah: b.capacity_mah * count,
-        nominal_v: Some(round9(b.energy_wh / (b.capacity_mah / 1000.0))),
-        energy_wh: Some(round9(b.energy_wh * count)),
-        mass_kg: Some(round9(b.mass_kg * count + b.mount_mass_kg)),
-        internal_resistance_ohm: Some(CELL_RESISTANCE_OHM * f64::from(b.cells) / count),
-        cutoff_cell_v: Some(CUTOFF_CELL_V),
-        ..BatterySpec::default()
-    };
-    let power = VehicleParams {
-        mass_kg: hover.takeoff_mass_kg,
+    VehicleParams {
+        mass_kg: spec.published_hover.takeoff_mass_kg,
         gravity_mps2: aloft_core::STANDARD_GRAVITY_MPS2,
         air_density_kg_m3: SEA_LEVEL_DENSITY,
         rotor_count: spec.rotors,
@@ -592,18 +579,65 @@ fn spec_vehicle(spec: &SpecSheet) -> Result<(VehicleFile, Vec<String>), Error> {
         mu2_x_n_s2_per_m2: None,
         mu2_y_n_s2_per_m2: None,
         efficiency_relative_sd: None,
-    };
-    // The M100's envelope (its published limits and assumed accelerations), with this
-    // vehicle's masses.
-    let airframe = AirframeSpec {
+    }
+}
+
+/// The airframe of a spec sheet: its masses in the M100's envelope (its published limits and
+/// assumed accelerations).
+fn spec_airframe(spec: &SpecSheet, defaults: &mut Vec<String>) -> Result<AirframeSpec, Error> {
+    let m100_envelope =
+        VehicleFile::builtin("dji-m100")?
+            .airframe
+            .ok_or_else(|| Error::MissingTable {
+                vehicle: "dji-m100".to_string(),
+                table: "airframe",
+                needed_for: "the class defaults of a spec sheet",
+            })?;
+    let hover_kg = spec.published_hover.takeoff_mass_kg;
+    let max_takeoff = spec.max_takeoff_mass_kg.unwrap_or_else(|| {
+        defaults.push(format!(
+            "largest take-off mass: the published hover's {hover_kg} kg (max_takeoff_mass_kg not given)"
+        ));
+        hover_kg
+    });
+    defaults.push(
+        "flight envelope: the M100's (35 deg tilt, 17 m/s, climb 5 m/s, descent 4 m/s, 2 m/s^2, rotors 0.30 m above the ground)"
+            .to_string(),
+    );
+    Ok(AirframeSpec {
         mass_kg: spec.frame_mass_kg,
         max_takeoff_mass_kg: max_takeoff,
         max_thrust_n: None,
         cruise_speed_mps: None,
         rtl_altitude_m: None,
         ..m100_envelope
-    };
-    let source = VehicleSource {
+    })
+}
+
+/// The pack option of a spec sheet: `count` packs in parallel, the kit's mass included.
+fn spec_pack(b: &SpecBattery) -> BatterySpec {
+    let count = f64::from(b.count);
+    BatterySpec {
+        name: b
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("{}x{}mAh", b.count, b.capacity_mah)),
+        default: true,
+        cells_series: b.cells,
+        capacity_mah: b.capacity_mah * count,
+        nominal_v: Some(round9(b.energy_wh / (b.capacity_mah / 1000.0))),
+        energy_wh: Some(round9(b.energy_wh * count)),
+        mass_kg: Some(round9(b.mass_kg * count + b.mount_mass_kg)),
+        internal_resistance_ohm: Some(CELL_RESISTANCE_OHM * f64::from(b.cells) / count),
+        cutoff_cell_v: Some(CUTOFF_CELL_V),
+        ..BatterySpec::default()
+    }
+}
+
+/// The `[source]` of a spec-sheet vehicle: the sheet's figures and where they were published.
+fn spec_source(spec: &SpecSheet) -> VehicleSource {
+    let (b, hover) = (&spec.battery, &spec.published_hover);
+    VehicleSource {
         figures: format!(
             "{} rotors of {} m; frame {} kg; {} pack(s) of {}S, {} mAh, {} Wh, {} kg; hover {} min at {} kg",
             spec.rotors,
@@ -623,22 +657,5 @@ fn spec_vehicle(spec: &SpecSheet) -> Result<(VehicleFile, Vec<String>), Error> {
         } else {
             hover.source.clone()
         },
-    };
-    let file = VehicleFile {
-        name: spec.name.clone(),
-        description: if spec.description.is_empty() {
-            format!(
-                "{} from its spec sheet (aloft vehicles calibrate)",
-                spec.name
-            )
-        } else {
-            spec.description.clone()
-        },
-        source: Some(source),
-        power: Some(power),
-        propulsion: None,
-        airframe: Some(airframe),
-        batteries: vec![pack],
-    };
-    Ok((file, defaults))
+    }
 }
