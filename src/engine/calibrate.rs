@@ -27,7 +27,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::{endurance_at_power_s, AirframeSpec, AoaModel, BatterySpec};
+use aloft_planner::{endurance_at_power_s, AirframeSpec, AoaModel, BatterySpec, Pack};
 use aloft_power::{DiskArea, ModelOptions, VehicleParams};
 
 use crate::error::Error;
@@ -214,59 +214,82 @@ pub fn calibrate_hover(
     takeoff_mass_kg: f64,
     minutes: f64,
 ) -> Result<HoverCalibration, Error> {
-    let mut ideal = file.clone();
-    if let Some(p) = ideal.power.as_mut() {
-        p.efficiency = 1.0;
-    }
-    let (aircraft, _) = ideal.aircraft(ModelOptions::default())?;
-    let pack = ideal.battery(battery)?;
-    let powered = aircraft
-        .at_mass(takeoff_mass_kg, AoaModel::Geometric)
-        .map_err(|e| Error::Planner(Box::new(e)))?;
-    let p1 = powered
-        .level_power_w([0.0, 0.0], [0.0, 1.0])
-        .map_err(|e| Error::Planner(Box::new(e)))?;
-    let target_s = minutes * 60.0;
-    let hover_s = |p: f64| endurance_at_power_s(&pack, p, 1.0, pack.empty_soc());
-    let longest = hover_s(p1);
-    let bad = |expected: &'static str| Error::InvalidInput {
-        name: "published hover minutes",
-        value: minutes,
-        unit: "min",
-        expected,
-    };
-    if !(target_s > 0.0 && target_s.is_finite()) {
-        return Err(bad("a positive, finite time"));
-    }
-    if longest < target_s {
-        return Err(bad(
-            "a time the pack can supply at this mass with an efficiency of at most 1",
-        ));
-    }
-    if hover_s(p1 * 100.0) > target_s {
-        return Err(bad(
-            "a time the model reaches with an efficiency of at least 0.01",
-        ));
-    }
-    // Bisection on the power: hover time falls as power rises.
-    let (mut lo, mut hi) = (p1, p1 * 100.0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if hover_s(mid) > target_s {
-            lo = mid;
-        } else {
-            hi = mid;
+    IdealHover::of(file, battery, takeoff_mass_kg)?.calibrate(minutes)
+}
+
+/// The hover of a vehicle at one mass with `eta = 1`: its electrical power and the pack.
+struct IdealHover {
+    power_w: f64,
+    pack: Pack,
+}
+
+impl IdealHover {
+    fn of(file: &VehicleFile, battery: Option<&str>, takeoff_mass_kg: f64) -> Result<Self, Error> {
+        let mut ideal = file.clone();
+        if let Some(p) = ideal.power.as_mut() {
+            p.efficiency = 1.0;
         }
-        if hi - lo <= 1e-12 * hi {
-            break;
-        }
+        let (aircraft, _) = ideal.aircraft(ModelOptions::default())?;
+        let pack = ideal.battery(battery)?;
+        let power_w = aircraft
+            .at_mass(takeoff_mass_kg, AoaModel::Geometric)
+            .and_then(|p| p.level_power_w([0.0, 0.0], [0.0, 1.0]))
+            .map_err(|e| Error::Planner(Box::new(e)))?;
+        Ok(Self { power_w, pack })
     }
-    let p = 0.5 * (lo + hi);
-    Ok(HoverCalibration {
-        efficiency: p1 / p,
-        hover_power_w: p,
-        max_minutes_at_unit_efficiency: longest / 60.0,
-    })
+
+    /// Hover time on the pack at electrical power `power_w`, s.
+    fn hover_s(&self, power_w: f64) -> f64 {
+        endurance_at_power_s(&self.pack, power_w, 1.0, self.pack.empty_soc())
+    }
+
+    /// The longest hover the pack gives (`eta = 1`), min.
+    fn longest_minutes(&self) -> f64 {
+        self.hover_s(self.power_w) / 60.0
+    }
+
+    /// The efficiency that hovers `minutes`: bisection on the power (hover time falls as power
+    /// rises), `eta = P(eta = 1) / P`.
+    fn calibrate(&self, minutes: f64) -> Result<HoverCalibration, Error> {
+        let (p1, target_s) = (self.power_w, minutes * 60.0);
+        let bad = |expected: &'static str| Error::InvalidInput {
+            name: "published hover minutes",
+            value: minutes,
+            unit: "min",
+            expected,
+        };
+        if !(target_s > 0.0 && target_s.is_finite()) {
+            return Err(bad("a positive, finite time"));
+        }
+        if self.hover_s(p1) < target_s {
+            return Err(bad(
+                "a time the pack can supply at this mass with an efficiency of at most 1",
+            ));
+        }
+        if self.hover_s(p1 * 100.0) > target_s {
+            return Err(bad(
+                "a time the model reaches with an efficiency of at least 0.01",
+            ));
+        }
+        let (mut lo, mut hi) = (p1, p1 * 100.0);
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if self.hover_s(mid) > target_s {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            if hi - lo <= 1e-12 * hi {
+                break;
+            }
+        }
+        let p = 0.5 * (lo + hi);
+        Ok(HoverCalibration {
+            efficiency: p1 / p,
+            hover_power_w: p,
+            max_minutes_at_unit_efficiency: self.longest_minutes(),
+        })
+    }
 }
 
 /// A vehicle file made from a spec sheet ([`calibrate_spec`]), with what was calibrated and
@@ -339,21 +362,20 @@ pub fn calibrate_spec(spec: &SpecSheet, origin: &str) -> Result<SpecCalibration,
     check_spec(spec, origin)?;
     let (mut file, defaults) = spec_vehicle(spec)?;
     let hover = &spec.published_hover;
-    let calibration = calibrate_hover(&file, None, hover.takeoff_mass_kg, hover.minutes).map_err(
-        |e| match e {
-            Error::InvalidInput { expected, .. } => Error::SpecSheet {
-                origin: origin.to_string(),
-                key: "published_hover.minutes".to_string(),
-                message: format!(
-                    "{} min is not {expected} (at most {:.1} min with eta = 1 at {} kg)",
-                    hover.minutes,
-                    max_minutes(&file, hover.takeoff_mass_kg).unwrap_or(0.0),
-                    hover.takeoff_mass_kg
-                ),
-            },
-            other => other,
+    let ideal = IdealHover::of(&file, None, hover.takeoff_mass_kg)?;
+    let calibration = ideal.calibrate(hover.minutes).map_err(|e| match e {
+        Error::InvalidInput { expected, .. } => Error::SpecSheet {
+            origin: origin.to_string(),
+            key: "published_hover.minutes".to_string(),
+            message: format!(
+                "{} min is not {expected} (at most {:.1} min with eta = 1 at {} kg)",
+                hover.minutes,
+                ideal.longest_minutes(),
+                hover.takeoff_mass_kg
+            ),
         },
-    )?;
+        other => other,
+    })?;
     if let Some(p) = file.power.as_mut() {
         p.efficiency = (calibration.efficiency * 1e6).round() / 1e6;
     }
@@ -383,20 +405,6 @@ pub fn calibrate_spec_file(path: &std::path::Path) -> Result<SpecCalibration, Er
     let text = super::files::read_text_file(path, "spec sheet")?;
     let origin = path.display().to_string();
     calibrate_spec(&SpecSheet::from_toml(&text, &origin)?, &origin)
-}
-
-/// The hover time at `eta = 1` (for the message of an impossible figure).
-fn max_minutes(file: &VehicleFile, mass_kg: f64) -> Option<f64> {
-    let mut ideal = file.clone();
-    ideal.power.as_mut()?.efficiency = 1.0;
-    let (aircraft, _) = ideal.aircraft(ModelOptions::default()).ok()?;
-    let pack = ideal.battery(None).ok()?;
-    let p = aircraft
-        .at_mass(mass_kg, AoaModel::Geometric)
-        .ok()?
-        .level_power_w([0.0, 0.0], [0.0, 1.0])
-        .ok()?;
-    Some(endurance_at_power_s(&pack, p, 1.0, pack.empty_soc()) / 60.0)
 }
 
 /// Text for a TOML comment: anything that would end the comment line (a control character or a
