@@ -322,16 +322,7 @@ impl<'a> Flight<'a> {
             return self.fly_to(item, target, None);
         }
         let height_m = self.ground_height(item, target.height_m);
-        self.push(
-            item,
-            SegmentSpec::TakeOff {
-                altitude_m: height_m,
-                climb_rate_mps: self.source.autopilot.take_off_rate_mps(),
-                item: Some(item.number),
-            },
-        )?;
-        self.airborne = true;
-        self.height_m = height_m;
+        self.vertical_take_off(item, height_m)?;
         match (self.source.autopilot, target.point) {
             (Autopilot::Px4, Some(p)) if distance_m(self.here, p) > 0.1 => {
                 let to = Target {

@@ -129,6 +129,16 @@ impl Flight<'_> {
                 CommandName(item.command)
             ),
         );
+        self.vertical_take_off(item, height_m)
+    }
+
+    /// A vertical take-off to `height_m` at the autopilot's rate: the vehicle is then airborne
+    /// at that height.
+    pub(super) fn vertical_take_off(
+        &mut self,
+        item: &RawItem,
+        height_m: f64,
+    ) -> Result<(), ImportError> {
         self.push(
             item,
             SegmentSpec::TakeOff {
