@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 
 use aloft::engine::{
     plan_mission_with, AoaModel, CornerMode, Mission, MissionOptions, MissionOutputs,
-    MissionReport, Plan, RouteFigures, Sample, SourceFormat, Vehicle,
+    MissionReport, Plan, RouteFigures, Sample, Shortfall, SourceFormat, Vehicle,
 };
 
 use super::args::{aoa_parser, corners_parser, MissionWindArgs};
@@ -281,9 +281,19 @@ pub(super) fn header(plan: &Plan) -> Result<String> {
             r.reserve_soc * 100.0,
             r.required_reserve_soc * 100.0
         )?,
-        Some(why) => writeln!(head, "NOT FEASIBLE: {why}.")?,
+        Some(why) => writeln!(
+            head,
+            "NOT FEASIBLE: {}.",
+            s.reason.clone().unwrap_or_else(|| why.to_string())
+        )?,
     }
+    let ended_early = !matches!(r.shortfall, None | Some(Shortfall::Reserve { .. }));
     match r.point_of_no_return {
+        None if ended_early => writeln!(
+            head,
+            "Point of no return: none before the flight ends (t = {:.0} s): until then it could fly straight home and land with the reserve.",
+            r.duration_s
+        )?,
         None => writeln!(
             head,
             "Point of no return: none. From every point of the route it could fly straight home and land with the reserve."
@@ -412,10 +422,13 @@ pub(super) fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
 /// The segments; with the operator's item numbers when the mission came from a planner file.
 fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
     let items = r.segments.iter().any(|s| s.item.is_some());
+    // A column of the time lost at the edge of the envelope, when the wind or a limit slowed
+    // any segment.
+    let slowed = r.segments.iter().any(|s| s.edge.is_some());
     writeln!(out, "Segments")?;
     writeln!(
         out,
-        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>11}",
+        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>11}{}",
         "#",
         if items { "item " } else { "" },
         "kind",
@@ -424,7 +437,8 @@ fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
         "energy",
         "mean power",
         "peak power",
-        "battery end"
+        "battery end",
+        if slowed { "   time lost (limit)" } else { "" }
     )?;
     for s in &r.segments {
         let item = match (items, s.item) {
@@ -432,9 +446,13 @@ fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
             (true, Some(i)) => format!("{i:>4} "),
             (true, None) => "     ".to_string(),
         };
+        let lost = match s.edge {
+            Some(e) => format!("  {:>8.1} s ({})", s.time_lost_s, e.limit.name()),
+            _ => String::new(),
+        };
         writeln!(
             out,
-            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.0} W {:>9.1} %",
+            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.0} W {:>9.1} %{lost}",
             s.index,
             s.kind,
             mmss(s.duration_s),

@@ -8,7 +8,7 @@ use aloft_missions::{route_figures, RouteFigures, SourceFormat};
 use serde::{Deserialize, Serialize};
 
 use aloft_planner::{
-    CornerMode, MissionReport, MissionSpec, Pack, PlanOptions, Sample, Wind, WindSpec,
+    CornerMode, MissionReport, MissionSpec, Pack, PlanOptions, Sample, Shortfall, Wind, WindSpec,
 };
 use aloft_power::AoaModel;
 
@@ -19,7 +19,7 @@ use super::flown::flown_spec;
 use super::loiter::resolve_loiter;
 use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use super::sorties::{split, Sorties};
-use super::summary::{mission_summary, MissionSummary};
+use super::summary::{edge_warnings, mission_summary, MissionSummary};
 use super::vehicles::Vehicle;
 use super::wind::{mission_wind, GustSpec};
 use crate::error::Error;
@@ -495,7 +495,9 @@ fn plan_in(
         .compile(&spec, options.payload_kg)
         .map_err(in_mission)?;
     let (report, plot_samples) = fly_into_outputs(&flight, &compiled, outputs, in_mission)?;
-    let sorties = if report.feasible || compiled.ends_in_air() {
+    // A vehicle that cannot make progress somewhere cannot fly that part on any pack.
+    let stuck = matches!(report.shortfall, Some(Shortfall::NoProgress { .. }));
+    let sorties = if report.feasible || compiled.ends_in_air() || stuck {
         Sorties::one(report.feasible)
     } else {
         let mut flat = spec.clone();
@@ -516,6 +518,9 @@ fn plan_in(
     summary.batteries_required = sorties.batteries_required;
     summary.sorties = sorties.sorties;
     summary.warnings = compiled.warnings().to_vec();
+    summary
+        .warnings
+        .extend(edge_warnings(&report, vehicle.name()));
     summary
         .warnings
         .extend(sorties.note.map(|n| format!("not split into sorties: {n}")));

@@ -96,9 +96,10 @@ impl SegmentBand {
     }
 }
 
-/// Bands of the state of charge over time across the scenarios that were flown: at each time of
-/// a fixed grid, the 5th, 50th and 95th percentiles (a scenario that has landed keeps its last
-/// state). Resolution 0.1 % of state of charge.
+/// Bands of the state of charge over time across the scenarios flown to the end of the route: at
+/// each time of a fixed grid, the 5th, 50th and 95th percentiles (a scenario that has landed
+/// keeps its last state; one that ended early, its pack empty or a path it could not fly, is
+/// left out). Resolution 0.1 % of state of charge.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SocFan {
     /// Times of the grid, s.
@@ -192,10 +193,14 @@ impl FanHistogram {
     }
 }
 
-/// The sink of one scenario's samples: its state of charge at each grid time.
+/// The sink of one scenario's samples: its state of charge at each grid time, kept until the
+/// flight ends and added to the histogram only when it was flown to the end of the route
+/// ([`FanSink::finish`]): a flight that ends early (its pack empty, a path it cannot fly) is
+/// not in the fan.
 pub(super) struct FanSink<'h> {
     hist: &'h mut FanHistogram,
-    next: usize,
+    /// State of charge at each grid time reached so far (at most the grid's points).
+    at_grid: Vec<f64>,
     last_soc: Option<f64>,
     last_time_s: f64,
 }
@@ -204,29 +209,34 @@ impl<'h> FanSink<'h> {
     pub(super) fn new(hist: &'h mut FanHistogram) -> Self {
         Self {
             hist,
-            next: 0,
+            at_grid: Vec::new(),
             last_soc: None,
             last_time_s: 0.0,
         }
     }
 
-    /// After the flight: the grid times after it keep its last state of charge.
-    pub(super) fn finish(self) {
-        if let Some(soc) = self.last_soc {
-            for k in self.next..FAN_POINTS {
-                self.hist.add(k, soc);
-            }
-            self.hist.longest_s = self.hist.longest_s.max(self.last_time_s);
+    /// After the flight: a flight `completed` (flown to the end of the route) goes into the
+    /// histogram, the grid times after its landing keeping its last state of charge; any other
+    /// is dropped.
+    pub(super) fn finish(self, completed: bool) {
+        let Some(soc) = self.last_soc.filter(|_| completed) else {
+            return;
+        };
+        for (k, &s) in self.at_grid.iter().enumerate() {
+            self.hist.add(k, s);
         }
+        for k in self.at_grid.len()..FAN_POINTS {
+            self.hist.add(k, soc);
+        }
+        self.hist.longest_s = self.hist.longest_s.max(self.last_time_s);
     }
 }
 
 impl SampleSink for FanSink<'_> {
     fn take(&mut self, s: &Sample) -> Result<(), PlannerError> {
         let dt = self.hist.dt_s();
-        while self.next < FAN_POINTS && s.time_s >= self.next as f64 * dt {
-            self.hist.add(self.next, s.soc);
-            self.next += 1;
+        while self.at_grid.len() < FAN_POINTS && s.time_s >= self.at_grid.len() as f64 * dt {
+            self.at_grid.push(s.soc);
         }
         self.last_soc = Some(s.soc);
         self.last_time_s = s.time_s;
@@ -271,7 +281,21 @@ mod tests {
                 };
                 sink.take(&s).unwrap();
             }
-            sink.finish();
+            sink.finish(true);
+        }
+        // Twenty flights that end early (at 0.3) are left out: the bands are those of the 100
+        // (with them, the 5th percentile would be 0.3).
+        for _ in 0..20 {
+            let mut sink = FanSink::new(&mut h);
+            for t in 0..50 {
+                let s = Sample {
+                    time_s: f64::from(t),
+                    soc: 0.3,
+                    ..test_sample()
+                };
+                sink.take(&s).unwrap();
+            }
+            sink.finish(false);
         }
         let fan = h.bands().unwrap();
         // The grid stops at the longest flight (199 s), one grid step (1 s) beyond at most.

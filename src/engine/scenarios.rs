@@ -39,18 +39,26 @@
 //! deterministic plan, bit for bit.
 //!
 //! # What is counted
+//! Every scenario flies by the same rules as the plan: where its wind asks more than the
+//! vehicle's envelope allows, it flies slower at the limit (and takes longer and costs more);
+//! where it cannot make headway or hold its position at all, its flight ends there, infeasible.
+//!
 //! - `p_feasible`: scenarios that land with the reserve, over all scenarios. A scenario the
-//!   vehicle cannot fly (the take-off mass beyond the airframe's limit, a thrust or tilt beyond
-//!   its limits in that wind, a propulsion chain beyond its operating range) is infeasible, not an
-//!   error; inputs that are wrong whatever is drawn are still errors.
+//!   vehicle cannot fly (the take-off mass beyond the airframe's limit, a path it cannot make
+//!   headway along or hold its position on in that wind, a propulsion chain beyond its operating
+//!   range) is infeasible, not an error, and is counted in `cannot_fly_scenarios`; inputs that are
+//!   wrong whatever is drawn are still errors.
 //! - Percentiles of `energy_wh`, `end_soc`, `duration_s` and of each segment's end state of
 //!   charge: over the scenarios flown to the end of the route (feasible, or landing short of the
-//!   reserve); a scenario that runs out of charge or cannot be flown has no such figures. Nearest
-//!   rank: the `p`-th percentile of `n` values is the `ceil(p n / 100)`-th smallest, always a
-//!   value some scenario gave.
+//!   reserve: `completed_scenarios`). A scenario that ends early (its pack empty or below its
+//!   cut-off, or a path it cannot fly) has no such figures: its energy up to where it stopped is
+//!   not the mission's, and counting it would pull the percentiles down. The same scenarios make
+//!   the state-of-charge fan ([`Uncertainty::soc_fan`]). Nearest rank: the `p`-th percentile of
+//!   `n` values is the `ceil(p n / 100)`-th smallest, always a value some scenario gave.
 //! - `point_of_no_return_s`: over all scenarios, a scenario without a point of no return (safe to
-//!   turn back everywhere) counting as later than any time, and a scenario that cannot be flown
-//!   as a point of no return at take-off (0 s). So `p5` is the time up to which 95 % of the
+//!   turn back everywhere) counting as later than any time, a scenario that cannot be flown at
+//!   all as a point of no return at take-off (0 s), and one that cannot fly on somewhere as one
+//!   where it stops (if none came earlier). So `p5` is the time up to which 95 % of the
 //!   scenarios can still turn back: the point of no return with 95 % confidence. A percentile
 //!   that falls among the scenarios without one is omitted.
 
@@ -68,6 +76,7 @@ use super::flight::Flight;
 use super::flown::flown_spec;
 use super::loiter::resolve_loiter;
 use super::mission::{check_options, planner_options, Mission, MissionOptions};
+use super::summary::reason;
 use super::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };
@@ -266,8 +275,9 @@ pub struct Uncertainty {
     /// Scenarios flown to the end of the route (feasible or short of the reserve): those the
     /// percentiles of energy, state of charge and duration are over.
     pub completed_scenarios: u32,
-    /// Scenarios the vehicle cannot fly (beyond its tilt, thrust or take-off mass limit, or its
-    /// propulsion chain's range): infeasible, and not flown to the end.
+    /// Scenarios the vehicle cannot fly (a path it cannot make headway along or hold its
+    /// position on within its envelope, a take-off mass beyond its limit, its propulsion chain's
+    /// range): infeasible, and not flown to the end.
     pub cannot_fly_scenarios: u32,
     /// Why, in the first such scenario (by index).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -464,9 +474,7 @@ fn drawn_wind_spec(spec: &WindSpec, sc: &ScenarioOptions, d: &Draws) -> WindSpec
 /// than that the request is wrong.
 fn cannot_fly(e: &PlannerError) -> bool {
     match e {
-        PlannerError::BeyondVehicleLimit { .. }
-        | PlannerError::Propulsion(_)
-        | PlannerError::NoHeadway { .. } => true,
+        PlannerError::Propulsion(_) | PlannerError::NoHeadway { .. } => true,
         PlannerError::Unreachable { name, .. } => name.starts_with("take-off mass"),
         _ => false,
     }
@@ -596,20 +604,28 @@ impl Record {
         }
     }
 
-    fn of(r: &MissionReport, keep_segments: bool) -> Self {
+    fn of(r: &MissionReport, keep_segments: bool, vehicle: &str) -> Self {
+        // A path it cannot fly (no headway against the wind, no hover): the flight ends there;
+        // it could turn back until then at the latest.
+        let stuck = matches!(r.shortfall, Some(Shortfall::NoProgress { .. }));
+        let no_pnr = if stuck { r.duration_s } else { f64::INFINITY };
         Self {
             feasible: r.feasible,
             completed: matches!(r.shortfall, None | Some(Shortfall::Reserve { .. })),
             energy_wh: r.energy_wh,
             end_soc: r.end_soc,
             duration_s: r.duration_s,
-            pnr_s: r.point_of_no_return.map_or(f64::INFINITY, |p| p.time_s),
+            pnr_s: r.point_of_no_return.map_or(no_pnr, |p| p.time_s),
             segment_end_soc: if keep_segments {
                 r.segments.iter().map(|s| s.end_soc).collect()
             } else {
                 Vec::new()
             },
-            cannot_fly: None,
+            cannot_fly: r
+                .shortfall
+                .as_ref()
+                .filter(|_| stuck)
+                .map(|why| reason(why, &r.segments, vehicle)),
         }
     }
 }
@@ -686,13 +702,16 @@ impl<'a> MissionScenarios<'a> {
                 Some(h) => {
                     let mut sink = FanSink::new(h);
                     let r = flight.fly_into(&c, &mut sink);
-                    sink.finish();
+                    let completed = r.as_ref().is_ok_and(|r| {
+                        matches!(r.shortfall, None | Some(Shortfall::Reserve { .. }))
+                    });
+                    sink.finish(completed);
                     r
                 }
                 None => flight.fly_into(&c, &mut NoSamples),
             });
         match report {
-            Ok(r) => Ok(Record::of(&r, keep_segments)),
+            Ok(r) => Ok(Record::of(&r, keep_segments, self.vehicle)),
             Err(e) if cannot_fly(&e) => Ok(Record::cannot_fly(&e)),
             Err(e) => Err(mission_error(self.origin, self.vehicle, e)),
         }
@@ -740,14 +759,12 @@ pub fn plan_scenarios(
             let compiled = plan
                 .compile(&setup.spec, setup.payload_kg)
                 .map_err(|e| mission_error(setup.origin, setup.vehicle, e))?;
-            Some(
-                1.5 * compiled
-                    .pieces()
-                    .iter()
-                    .map(|p| p.duration_s())
-                    .sum::<f64>()
-                    .max(1.0),
-            )
+            let planned: f64 = compiled.pieces().iter().map(|p| p.duration_s()).sum();
+            // The plan as flown: the envelope may slow it beyond its planned time.
+            let flown = plan
+                .fly_into(&compiled, &mut NoSamples)
+                .map_or(0.0, |r| r.duration_s);
+            Some(1.5 * planned.max(flown).max(1.0))
         }
         false => None,
     };

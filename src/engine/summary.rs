@@ -4,7 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use aloft_missions::RouteFigures;
-use aloft_planner::MissionReport;
+use aloft_planner::{Limit, MissionReport, NoProgressWhy, SegmentReport, Shortfall};
 
 use super::flown::PlanningSpeed;
 use super::loiter::LoiterSummary;
@@ -33,6 +33,19 @@ pub struct SegmentSummary {
     pub peak_power_w: f64,
     /// State of charge at the end of the segment, fraction.
     pub end_soc: f64,
+    /// Time flown beyond the plan because the vehicle flew at the edge of its envelope, s
+    /// (absent when the segment was flown as planned).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_lost_s: Option<f64>,
+    /// The lowest speed along the path at cruise where the envelope slowed the vehicle, m/s
+    /// (over the ground; vertical for a climb or descent). Absent when the segment was flown as
+    /// planned, or only its speed changes at the ends were slowed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_ground_speed_mps: Option<f64>,
+    /// The limit the vehicle flew at where it was slowest: `tilt`, `thrust`, `airspeed`,
+    /// `climb` or `descent` (absent when flown as planned).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit: Option<Limit>,
 }
 
 /// Where the point of no return lies (flattened into the [`MissionSummary`]).
@@ -73,6 +86,10 @@ pub struct MissionSummary {
     pub payload_kg: f64,
     /// Flight time, s.
     pub duration_s: f64,
+    /// Time flown beyond the plan because the vehicle flew at the edge of its envelope (slower
+    /// than planned into a wind, a climb at the rate limit), s; absent when none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_lost_s: Option<f64>,
     /// Distance flown, m.
     pub distance_m: f64,
     /// Electrical energy drawn from the pack, Wh.
@@ -154,10 +171,15 @@ pub fn mission_summary(
         vehicle: vehicle_name.to_string(),
         battery: battery_name.to_string(),
         feasible: report.feasible,
-        reason: report.shortfall.as_ref().map(|s| s.to_string()),
+        reason: report
+            .shortfall
+            .as_ref()
+            .map(|s| reason(s, &report.segments, vehicle_name)),
         takeoff_mass_kg: report.takeoff_mass_kg,
         payload_kg,
         duration_s: report.duration_s,
+        time_lost_s: Some(report.segments.iter().map(|s| s.time_lost_s).sum::<f64>())
+            .filter(|&t| t > 0.0),
         distance_m: report.distance_m,
         energy_wh: report.energy_wh,
         pack_heat_wh: report.pack_heat_wh,
@@ -204,7 +226,95 @@ pub fn mission_summary(
                 mean_power_w: s.mean_power_w,
                 peak_power_w: s.peak_power_w,
                 end_soc: s.end_soc,
+                time_lost_s: s.edge.map(|_| s.time_lost_s),
+                min_ground_speed_mps: s.edge.and_then(|e| e.slowest_mps),
+                limit: s.edge.map(|e| e.limit),
             })
             .collect(),
     }
+}
+
+/// The segment `segment` (from 1) in words: `item 7 (leg)` for a segment from a planner file,
+/// else `segment 3 (leg)`.
+fn segment_name(segments: &[SegmentReport], segment: usize, kind: &str) -> String {
+    match segments.iter().find(|s| s.index == segment).and_then(|s| s.item) {
+        Some(i) => format!("item {i} ({kind})"),
+        None => format!("segment {segment} ({kind})"),
+    }
+}
+
+/// Why a mission falls short, in words: the planner's, with the operator's item and the
+/// vehicle's name where the vehicle cannot make progress.
+pub(super) fn reason(shortfall: &Shortfall, segments: &[SegmentReport], vehicle: &str) -> String {
+    let Shortfall::NoProgress {
+        time_s,
+        segment,
+        kind,
+        position_m,
+        wind_mps,
+        moving,
+        limit,
+        limit_value,
+        limit_unit,
+        max_airspeed_mps,
+    } = shortfall
+    else {
+        return shortfall.to_string();
+    };
+    let why = NoProgressWhy {
+        vehicle,
+        wind_mps: *wind_mps,
+        limit: *limit,
+        limit_value: *limit_value,
+        limit_unit,
+        max_airspeed_mps: *max_airspeed_mps,
+    };
+    format!(
+        "at {}, t = {}, {:.0} m up ({:.0} m east, {:.0} m north of home): {why}, so it cannot {}",
+        segment_name(segments, *segment, kind),
+        clock(*time_s),
+        position_m[2],
+        position_m[0],
+        position_m[1],
+        if *moving {
+            "make headway along the track"
+        } else {
+            "hold its position"
+        }
+    )
+}
+
+/// A time as `m:ss.s`.
+fn clock(t: f64) -> String {
+    let t = t.max(0.0);
+    format!("{}:{:04.1}", (t / 60.0).floor(), t % 60.0)
+}
+
+/// The warnings of the segments flown at the edge of the envelope: where, how slow, at which
+/// limit, in what wind, and the time lost.
+pub(super) fn edge_warnings(report: &MissionReport, vehicle: &str) -> Vec<String> {
+    report
+        .segments
+        .iter()
+        .filter_map(|s| {
+            let e = s.edge?;
+            let [we, wn, _] = e.wind_mps;
+            let wind = we.hypot(wn);
+            let from_deg = (-we).atan2(-wn).to_degrees().rem_euclid(360.0);
+            let name = segment_name(&report.segments, s.index, s.kind);
+            let held = match e.slowest_mps {
+                Some(v) => format!(
+                    "holds {v:.1} m/s along its path (planned {:.1} m/s)",
+                    e.planned_mps
+                ),
+                None => "changes speed more slowly than planned".to_string(),
+            };
+            Some(format!(
+                "{name}: in a {wind:.1} m/s wind from {from_deg:.0} deg at {:.0} m the {vehicle} {held} at its {} limit, {:.1} s longer than planned",
+                e.up_m,
+                e.limit.name(),
+                s.time_lost_s
+            ))
+        })
+        .collect()
 }

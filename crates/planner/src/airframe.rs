@@ -21,8 +21,13 @@ pub struct AirframeSpec {
     pub max_thrust_n: Option<f64>,
     /// Largest tilt of the thrust axis from the vertical, deg.
     pub max_tilt_deg: f64,
-    /// Largest horizontal ground speed, m/s.
+    /// Largest horizontal ground speed the autopilot commands, m/s (a faster planned speed is
+    /// flown at it).
     pub max_speed_mps: f64,
+    /// Largest horizontal airspeed, m/s (default: none; the tilt limit bounds the airspeed). A
+    /// planned state beyond it is flown slower ([`crate::envelope`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_airspeed_mps: Option<f64>,
     /// Largest climb rate, m/s.
     pub max_climb_rate_mps: f64,
     /// Largest descent rate, m/s.
@@ -65,8 +70,15 @@ type RangeCheck = (&'static str, f64, &'static str, f64, &'static str);
 /// The range checks of the optional values of the table, when given.
 fn optional_checks(
     spec: &AirframeSpec,
-) -> [(&'static str, Option<f64>, &'static str, f64, &'static str); 3] {
+) -> [(&'static str, Option<f64>, &'static str, f64, &'static str); 4] {
     [
+        (
+            "airframe max_airspeed_mps",
+            spec.max_airspeed_mps,
+            "m/s",
+            MAX_AIRSPEED_MPS,
+            "at most 150 m/s",
+        ),
         (
             "airframe acceptance_radius_m",
             spec.acceptance_radius_m,
@@ -239,6 +251,10 @@ impl Airframe {
     /// Largest horizontal speed, m/s.
     pub fn max_speed_mps(&self) -> f64 {
         self.spec.max_speed_mps
+    }
+    /// Largest horizontal airspeed, m/s, when the vehicle has one besides its tilt limit.
+    pub fn max_airspeed_mps(&self) -> Option<f64> {
+        self.spec.max_airspeed_mps
     }
     /// Largest climb rate, m/s.
     pub fn max_climb_rate_mps(&self) -> f64 {

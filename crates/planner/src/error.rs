@@ -82,30 +82,6 @@ pub enum PlannerError {
         /// Why.
         reason: &'static str,
     },
-    /// The force balance asks for more thrust or tilt than the vehicle has.
-    #[error("at t = {time_s:.1} s in segment {index} ({kind}) at E {east_m:.0} m, N {north_m:.0} m, alt {up_m:.0} m the mission needs {value:.2} {unit} of {name}, beyond the vehicle's limit of {limit:.2} {unit}")]
-    BeyondVehicleLimit {
-        /// Mission time, s.
-        time_s: f64,
-        /// Segment number, from 1.
-        index: usize,
-        /// Segment kind.
-        kind: &'static str,
-        /// East position, m.
-        east_m: f64,
-        /// North position, m.
-        north_m: f64,
-        /// Height above home, m.
-        up_m: f64,
-        /// `thrust` or `tilt`.
-        name: &'static str,
-        /// The value needed.
-        value: f64,
-        /// The limit.
-        limit: f64,
-        /// `N` or `deg`.
-        unit: &'static str,
-    },
     /// The gridded wind field does not cover a point of the route.
     #[error("the wind grid does not cover the route at t = {time_s:.1} s: E {east_m:.1} m, N {north_m:.1} m, alt {up_m:.1} m (grid spans E {min_m:?}..{max_m:?} m as [E, N, Up])")]
     OutsideWindGrid {
@@ -143,18 +119,6 @@ pub enum PlannerError {
         unit: &'static str,
         /// What is expected.
         expected: &'static str,
-    },
-    /// An orbit tighter than the vehicle can turn at that speed.
-    #[error("an orbit of radius {radius_m} m at {speed_mps} m/s needs more bank than the vehicle's {max_tilt_deg:.1} deg tilt limit: the radius must be at least {min_radius_m:.2} m at that speed")]
-    OrbitTooTight {
-        /// The radius asked for, m.
-        radius_m: f64,
-        /// The ground speed asked for, m/s.
-        speed_mps: f64,
-        /// The smallest radius at that speed, m.
-        min_radius_m: f64,
-        /// The vehicle's tilt limit, deg.
-        max_tilt_deg: f64,
     },
     /// A mission with more segments than the planner takes.
     #[error("the mission has {segments} segments, more than the {limit} a mission may have: split it into several missions")]

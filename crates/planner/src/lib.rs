@@ -17,6 +17,8 @@
 //! - [`trajectory`]: closed-form kinematics (trapezoidal speed, lines, arcs, holds);
 //! - [`wind`]: constant, power-law and logarithmic profiles, gridded field, seeded gusts;
 //! - [`trim`]: thrust vector from the force balance, attitude, electrical power;
+//! - [`envelope`]: the flight envelope (tilt, thrust, airspeed, climb and descent rates) as a
+//!   limit the vehicle flies at: where the plan asks for more, the same path slower;
 //! - [`ground_effect`]: survey seed eq (35);
 //! - [`battery`]: the pack model: charge counting, open-circuit voltage, resistance, cut-off;
 //! - [`pack_cursor`]: the pack model followed through a discharge, a block of steps at a time;
@@ -74,7 +76,8 @@
 //! # fn main() -> Result<(), PlannerError> {
 //! let airframe = Airframe::new(AirframeSpec {
 //!     mass_kg: 1.755, max_takeoff_mass_kg: 3.6, max_thrust_n: None, max_tilt_deg: 35.0,
-//!     max_speed_mps: 17.0, max_climb_rate_mps: 5.0, max_descent_rate_mps: 4.0,
+//!     max_speed_mps: 17.0, max_airspeed_mps: None, max_climb_rate_mps: 5.0,
+//!     max_descent_rate_mps: 4.0,
 //!     acceleration_mps2: 2.0, vertical_acceleration_mps2: 1.5, yaw_rate_deg_s: 60.0,
 //!     rotor_height_m: 0.3,
 //!     acceptance_radius_m: None,
@@ -124,6 +127,7 @@
 pub mod aircraft;
 pub mod airframe;
 pub mod battery;
+pub mod envelope;
 pub mod error;
 pub mod geodesy;
 pub mod ground_effect;
@@ -140,6 +144,7 @@ pub use aircraft::{Aircraft, PowerSource, Powered};
 pub use airframe::{Airframe, AirframeSpec};
 pub use aloft_power::AoaModel;
 pub use battery::{BatterySpec, Pack, PackDraw};
+pub use envelope::{Envelope, Limit};
 pub use error::PlannerError;
 pub use mission::{
     CornerMode, HomeSpec, Mission, MissionSpec, OrbitDirection, SegmentSpec, WindProfileKind,
@@ -147,8 +152,8 @@ pub use mission::{
 };
 pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{
-    plan, plan_into, MissionReport, NoSamples, PlanOptions, PointOfNoReturn, Sample, SampleSink,
-    SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
+    plan, plan_into, EdgeReport, MissionReport, NoProgressWhy, NoSamples, PlanOptions,
+    PointOfNoReturn, Sample, SampleSink, SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
 };
 pub use queries::{
     best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,

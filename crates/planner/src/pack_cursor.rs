@@ -162,6 +162,31 @@ impl PackCursor {
         m
     }
 
+    /// Draw `power_w[j]` for each step `j` in turn, taking `current * charge_per_amp[j]` after
+    /// each: [`Self::draw`] then [`Self::discharge`] step by step, for steps of different
+    /// durations (the steps the flight envelope slowed). Writes each step to `out` and returns
+    /// how many were drawn: all, or the index of the first the pack cannot deliver.
+    pub fn draw_each(
+        &mut self,
+        battery: &Pack,
+        power_w: &[f64],
+        charge_per_amp: &[f64],
+        out: &mut [PackStep],
+    ) -> usize {
+        for (j, (&p, &dq)) in power_w.iter().zip(charge_per_amp).enumerate() {
+            let Some(d) = self.draw(battery, p) else {
+                return j;
+            };
+            self.discharge(d.current_a * dq);
+            out[j] = PackStep {
+                current_a: d.current_a,
+                terminal_v: d.terminal_v,
+                soc_after: self.soc,
+            };
+        }
+        power_w.len()
+    }
+
     /// The fixed-point sweeps of [`Self::draw_block`] over up to [`LANES`] steps; `false` (with
     /// the cursor unchanged) when the block must be flown step by step.
     fn sweep_block(

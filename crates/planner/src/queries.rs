@@ -23,6 +23,7 @@ use serde::Serialize;
 
 use crate::aircraft::Powered;
 use crate::battery::Pack;
+use crate::envelope::Envelope;
 use crate::error::PlannerError;
 
 /// Points of the bracketing scan.
@@ -114,10 +115,11 @@ pub fn minimise(f: &dyn Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
 }
 
 /// Best-range airspeed along `course` in the horizontal wind `wind_mps`, searched over
-/// `(0, max_airspeed_mps]`.
+/// `(0, max_airspeed_mps]` and within the flight envelope (an airspeed whose steady flight along
+/// the course is beyond the tilt, thrust or airspeed limit is not flown: [`crate::envelope`]).
 ///
 /// # Errors
-/// [`PlannerError::NoHeadway`] when no airspeed in the range makes headway.
+/// [`PlannerError::NoHeadway`] when no airspeed in the range makes headway within the envelope.
 pub fn best_range(
     p: &Powered<'_>,
     course: [f64; 2],
@@ -125,9 +127,17 @@ pub fn best_range(
     max_airspeed_mps: f64,
 ) -> Result<BestRange, PlannerError> {
     let lo = 0.1;
+    let envelope = Envelope::of(p.aircraft().airframe(), p.aircraft().gravity_mps2());
+    let within = |vg: f64| {
+        let vel = [vg * course[0], vg * course[1], 0.0];
+        let wind = [wind_mps[0], wind_mps[1], 0.0];
+        envelope
+            .exceeded(p, [0.0; 3], vel, wind, course)
+            .is_none()
+    };
     let f = |v: f64| match power_along_course(p, course, wind_mps, v) {
-        Some((pw, vg)) => pw / vg,
-        None => PENALTY,
+        Some((pw, vg)) if within(vg) => pw / vg,
+        _ => PENALTY,
     };
     let (v, cost) = minimise(&f, lo, max_airspeed_mps);
     match power_along_course(p, course, wind_mps, v) {
@@ -234,15 +244,15 @@ pub fn stop_soc(battery: &Pack, reserve_fraction: f64) -> f64 {
 /// Mean electrical power on a circle of radius `radius_m` at ground speed `speed_mps` in the
 /// horizontal wind, W (72 points around the circle, centripetal acceleration included).
 ///
-/// The circle must be one the vehicle can turn: ground speed within its maximum, and the
-/// centripetal acceleration `v^2 / r` within what its tilt limit allows in still air,
-/// `g tan(tilt_max)` (the same limit a mission's orbit is held to), so the radius is at least
-/// `v^2 / (g tan(tilt_max))`.
+/// Where the circle is tighter than the vehicle can turn at that speed, or the wind at some
+/// point of it asks more than its envelope allows, that part of the circle is flown slower, at
+/// the limit, as a mission's orbit is ([`crate::envelope`]): a point flown at the fraction `q`
+/// of the speed takes `1 / q` of the time, so the mean is `sum(P_i / q_i) / sum(1 / q_i)`.
 ///
 /// # Errors
 /// A radius or speed that is not positive and finite, a speed beyond the vehicle's maximum, a
-/// circle tighter than the tilt limit allows ([`PlannerError::OrbitTooTight`]), a flight
-/// condition the model rejects.
+/// wind in which the vehicle cannot hold the circle at any speed ([`PlannerError::NoHeadway`]),
+/// a flight condition the model rejects.
 pub fn orbit_power_w(
     p: &Powered<'_>,
     radius_m: f64,
@@ -260,35 +270,47 @@ pub fn orbit_power_w(
             expected: "at most the vehicle's maximum speed",
         });
     }
+    let envelope = Envelope::of(airframe, p.aircraft().gravity_mps2());
     let ac = speed_mps * speed_mps / radius_m;
-    let max_ac = aloft_core::STANDARD_GRAVITY_MPS2 * airframe.max_tilt_rad().tan();
-    if ac > max_ac * (1.0 + 1e-9) {
-        return Err(PlannerError::OrbitTooTight {
-            radius_m,
-            speed_mps,
-            min_radius_m: speed_mps * speed_mps / max_ac,
-            max_tilt_deg: airframe.max_tilt_rad().to_degrees(),
-        });
-    }
+    let wind = [wind_mps[0], wind_mps[1], 0.0];
     let n = 72;
-    let mut sum = 0.0;
+    let (mut energy, mut time) = (0.0, 0.0);
     for k in 0..n {
         let phi = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
         let (s, c) = phi.sin_cos();
         let fwd = [-s, c];
+        let acc = [-ac * c, -ac * s, 0.0];
+        let vel = [fwd[0] * speed_mps, fwd[1] * speed_mps, 0.0];
+        let q = match envelope.fastest_fraction(p, acc, vel, wind, fwd) {
+            Ok(None) => 1.0,
+            Ok(Some((q, _))) => q,
+            // The wind alone is beyond the vehicle, or the circle is too tight to turn at even
+            // a hundredth of the speed.
+            Err(_) if envelope.exceeded(p, [0.0; 3], [0.0; 3], wind, fwd).is_some() => {
+                return Err(PlannerError::NoHeadway {
+                    min_mps: speed_mps * crate::envelope::MIN_FRACTION,
+                    max_mps: speed_mps,
+                })
+            }
+            Err(_) => {
+                return Err(PlannerError::InvalidParameter {
+                    name: "orbit radius_m",
+                    value: radius_m,
+                    unit: "m",
+                    expected: "a circle the vehicle can turn within its tilt limit at 1 % of the speed or more",
+                })
+            }
+        };
         let trim = p.trim(
-            [-ac * c, -ac * s, 0.0],
-            [
-                fwd[0] * speed_mps - wind_mps[0],
-                fwd[1] * speed_mps - wind_mps[1],
-                0.0,
-            ],
+            acc.map(|a| a * q * q),
+            [vel[0] * q - wind[0], vel[1] * q - wind[1], 0.0],
             fwd,
             1.0,
         )?;
-        sum += trim.electrical_w;
+        energy += trim.electrical_w / q;
+        time += 1.0 / q;
     }
-    Ok(sum / n as f64)
+    Ok(energy / time)
 }
 
 /// All the endurance queries for one vehicle at one mass.
@@ -328,7 +350,13 @@ pub fn endurance(
         });
     }
     let stop = stop_soc(battery, q.reserve_fraction);
-    let vmax = p.aircraft().airframe().max_speed_mps();
+    // The searches stay within the vehicle's speed and its envelope's steady airspeed.
+    let envelope = Envelope::of(p.aircraft().airframe(), p.aircraft().gravity_mps2());
+    let vmax = p
+        .aircraft()
+        .airframe()
+        .max_speed_mps()
+        .min(envelope.max_level_airspeed_mps(p).0);
     let hover_power_w = p.level_power_w([-q.wind_mps[0], -q.wind_mps[1]], q.course)?;
     let hover_endurance_s = endurance_at_power_s(battery, hover_power_w, q.start_soc, stop);
     // Best endurance: in the air mass, so along any heading in still air.

@@ -93,6 +93,7 @@ pub fn power_only_aircraft(
         max_thrust_n: None,
         max_tilt_deg: 89.0,
         max_speed_mps: 100.0,
+        max_airspeed_mps: None,
         max_climb_rate_mps: 100.0,
         max_descent_rate_mps: 100.0,
         acceleration_mps2: 100.0,

@@ -12,6 +12,7 @@ pub(crate) fn m100_airframe() -> Airframe {
         max_thrust_n: None,
         max_tilt_deg: 35.0,
         max_speed_mps: 17.0,
+        max_airspeed_mps: None,
         max_climb_rate_mps: 5.0,
         max_descent_rate_mps: 4.0,
         acceleration_mps2: 2.0,

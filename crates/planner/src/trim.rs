@@ -173,6 +173,20 @@ impl Powered<'_> {
         }
     }
 
+    /// The force balance alone (no power model): thrust, N, the unit thrust axis (ENU) and the
+    /// horizontal airspeed, m/s, exactly as [`Self::trim`] computes them. The flight envelope
+    /// ([`crate::envelope`]) searches on it.
+    #[inline]
+    pub(crate) fn thrust_axis(
+        &self,
+        acc_mps2: [f64; 3],
+        vel_air_mps: [f64; 3],
+        forward: [f64; 2],
+    ) -> (f64, [f64; 3], f64) {
+        let b = self.balance(acc_mps2, vel_air_mps, forward);
+        (b.thrust_n, b.axis, b.airspeed_mps)
+    }
+
     /// Electrical power of a balanced sample with vertical air speed `vz` and ground-effect
     /// factor `ground_factor`, W.
     #[inline(always)]

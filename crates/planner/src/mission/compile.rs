@@ -6,8 +6,6 @@
 //! straight path, a vertical one) are methods too, so a new kind is one more method built from
 //! them and one more arm in [`Compiler::segment`].
 
-use aloft_core::STANDARD_GRAVITY_MPS2;
-
 use super::checks::{home_position_m, Points, Seg};
 use super::corners::{pass_through, turn_rad, Role};
 use super::{CornerMode, Mission, MissionSpec, OrbitDirection, SegmentSpec};
@@ -99,8 +97,6 @@ struct Compiler<'a> {
     points: Points,
     /// Home, ENU m (height 0).
     home_m: [f64; 3],
-    /// The steepest turn in still air, `g tan(max tilt)`, m/s^2.
-    max_centripetal_mps2: f64,
     /// The segment being compiled (before the first, a placeholder that names the mission).
     seg: Seg,
     /// Where the vehicle is, ENU m.
@@ -159,7 +155,6 @@ impl<'a> Compiler<'a> {
             battery_mass_kg,
             points,
             home_m,
-            max_centripetal_mps2: STANDARD_GRAVITY_MPS2 * airframe.max_tilt_rad().tan(),
             seg: Seg {
                 index: 0,
                 kind: "mission",
@@ -305,13 +300,8 @@ impl<'a> Compiler<'a> {
             return Err(seg.out_of_order("the vehicle is already in the air"));
         }
         seg.positive("altitude_m", altitude_m, "m")?;
+        // A rate beyond the vehicle's is flown at its limit (the envelope slows the climb).
         seg.positive("climb_rate_mps", climb_rate_mps, "m/s")?;
-        seg.within(
-            "climb_rate_mps",
-            climb_rate_mps,
-            self.airframe.max_climb_rate_mps(),
-            "m/s",
-        )?;
         self.vertical_to(altitude_m, climb_rate_mps)?;
         self.airborne = true;
         Ok(())
@@ -412,13 +402,8 @@ impl<'a> Compiler<'a> {
         let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
         let up_m = altitude_m.unwrap_or(self.pos_m[2]);
         seg.positive("altitude_m", up_m, "m")?;
-        // Centripetal load in still air: v^2 / r <= g tan(tilt_max).
-        seg.within(
-            "centripetal acceleration v^2/r",
-            ground_speed_mps * ground_speed_mps / radius_m,
-            self.max_centripetal_mps2,
-            "m/s^2",
-        )?;
+        // A circle too tight for the speed (v^2 / r beyond what the tilt allows with the drag) is
+        // flown at the speed the vehicle can turn it at: the envelope slows it.
         let length_m = self.orbit_length_m(radius_m, ground_speed_mps, laps_or_duration_s)?;
         let phi0_rad = self.transit_to_circle(centre_m, radius_m, up_m, ground_speed_mps)?;
         let sign = match direction {
@@ -467,13 +452,8 @@ impl<'a> Compiler<'a> {
         let seg = self.seg;
         self.need_air()?;
         seg.positive("altitude_m", altitude_m, "m")?;
+        // A rate beyond the vehicle's is flown at its limit (the envelope slows the descent).
         seg.positive("rate_mps", rate_mps, "m/s")?;
-        seg.within(
-            "rate_mps",
-            rate_mps,
-            self.airframe.max_descent_rate_mps(),
-            "m/s",
-        )?;
         if altitude_m >= self.pos_m[2] {
             return Err(seg.invalid(
                 "altitude_m",
@@ -494,13 +474,8 @@ impl<'a> Compiler<'a> {
     ) -> Result<(), PlannerError> {
         let seg = self.seg;
         self.need_air()?;
+        // A rate beyond the vehicle's is flown at its limit (the envelope slows the descent).
         seg.positive("rate_mps", rate_mps, "m/s")?;
-        seg.within(
-            "rate_mps",
-            rate_mps,
-            self.airframe.max_descent_rate_mps(),
-            "m/s",
-        )?;
         self.vertical_to(0.0, rate_mps)?;
         self.airborne = false;
         self.change_payload(payload_after_kg)
@@ -519,9 +494,10 @@ impl<'a> Compiler<'a> {
         }
     }
 
-    /// A commanded ground speed is within the airframe's maximum speed.
-    /// The ground speed of this segment: its own, else the mission's default; positive and
-    /// within the vehicle's maximum (or, for a planner file, flown at the maximum with a warning).
+    /// The ground speed of this segment: its own, else the mission's default; positive, and
+    /// flown at the vehicle's maximum (with a warning) when beyond it, as an autopilot limits
+    /// its commanded speed (for a planner file, at the speed it can reach within its tilt
+    /// limit in still air when that is lower).
     fn ground_speed(&mut self, ground_speed_mps: Option<f64>) -> Result<f64, PlannerError> {
         let seg = self.seg;
         let v = ground_speed_mps.or(self.default_speed_mps).ok_or(
@@ -529,8 +505,12 @@ impl<'a> Compiler<'a> {
         )?;
         seg.positive("ground_speed_mps", v, "m/s")?;
         let max = self.airframe.max_speed_mps();
-        let clamp = self.clamp_to_mps.map_or(max, |c| c.min(max));
-        if self.clamp_speeds && v > clamp {
+        let clamp = match self.clamp_speeds {
+            true => self.clamp_to_mps.map_or(max, |c| c.min(max)),
+            false => max,
+        };
+        // 1e-9 relative: a value typed equal to the limit is within it despite rounding.
+        if v > clamp * (1.0 + 1e-9) {
             let why = if clamp < max {
                 format!("beyond the {clamp:.2} m/s the vehicle can reach within its tilt limit")
             } else {
@@ -542,7 +522,6 @@ impl<'a> Compiler<'a> {
             ));
             return Ok(clamp);
         }
-        seg.within("ground_speed_mps", v, max, "m/s")?;
         Ok(v)
     }
 
@@ -664,9 +643,8 @@ impl<'a> Compiler<'a> {
     }
 
     /// Speed and acceleration along a path `d` (m) with horizontal length `h` and length `len`
-    /// flown at a horizontal ground speed: the vertical rate that implies must be within the
-    /// climb or descent limit (for a mission that clamps its speeds, a planner file, the ground
-    /// speed is lowered until it is, with a warning), and neither acceleration limit is exceeded.
+    /// flown at a horizontal ground speed, within both acceleration limits. A vertical rate
+    /// beyond the climb or descent limit is flown at the limit (the envelope slows the leg).
     fn sloped_speed_and_acceleration(
         &mut self,
         d: [f64; 3],
@@ -676,26 +654,6 @@ impl<'a> Compiler<'a> {
     ) -> Result<(f64, f64), PlannerError> {
         let a_h = self.airframe.acceleration_mps2();
         let a_v = self.airframe.vertical_acceleration_mps2();
-        let vz = ground_speed_mps * d[2].abs() / h;
-        let (vlim, name) = if d[2] >= 0.0 {
-            (self.airframe.max_climb_rate_mps(), "climb rate of the leg")
-        } else {
-            (
-                self.airframe.max_descent_rate_mps(),
-                "descent rate of the leg",
-            )
-        };
-        let ground_speed_mps = if self.clamp_speeds && vz > vlim {
-            let slower = vlim * h / d[2].abs();
-            self.warnings.push(format!(
-                "{}: the {name} at {ground_speed_mps} m/s over the ground would be {vz:.2} m/s, beyond the vehicle's {vlim} m/s: flown at {slower:.2} m/s over the ground",
-                self.seg.name()
-            ));
-            slower
-        } else {
-            self.seg.within(name, vz, vlim, "m/s")?;
-            ground_speed_mps
-        };
         let acc = if d[2].abs() > 1e-9 {
             (a_h * len / h).min(a_v * len / d[2].abs())
         } else {

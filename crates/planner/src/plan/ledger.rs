@@ -15,7 +15,7 @@ use crate::trajectory::Piece;
 use crate::trim::attitude_rad;
 
 use super::report::{
-    MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
+    EdgeReport, MissionReport, PlanOptions, PointOfNoReturn, Sample, SegmentReport, Shortfall,
 };
 use super::sampler::BlockA;
 
@@ -28,6 +28,38 @@ struct SegmentTotals {
     peak_w: f64,
     end_soc: f64,
     reached: bool,
+    /// Time flown beyond the plan, s.
+    late_s: f64,
+    /// The slowest step flown at the edge of the envelope.
+    edge: Option<EdgeStep>,
+}
+
+/// A step flown at the edge of the envelope, as the ledger keeps the slowest of a segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct EdgeStep {
+    /// The limit it flew at.
+    pub(super) limit: crate::envelope::Limit,
+    /// Speed along the path flown, m/s.
+    pub(super) speed_mps: f64,
+    /// Speed along the path planned, m/s.
+    pub(super) planned_mps: f64,
+    /// Whether the step is in the piece's cruise (not a speed change at its ends).
+    pub(super) cruise: bool,
+    /// Wind, m/s.
+    pub(super) wind_mps: [f64; 3],
+    /// Height above home, m.
+    pub(super) up_m: f64,
+}
+
+impl EdgeStep {
+    /// Whether `self` is a slower cruise than `other` (a cruise step before any speed change).
+    fn slower_than(&self, other: &EdgeStep) -> bool {
+        match (self.cruise, other.cruise) {
+            (true, false) => true,
+            (false, true) => false,
+            _ => self.speed_mps < other.speed_mps,
+        }
+    }
 }
 
 /// The energy and peak power of the piece being flown, booked into its segment when the piece
@@ -159,44 +191,63 @@ impl<'p> Ledger<'p> {
         })
     }
 
-    /// The piece flown to its end, leaving the pack at `soc`.
-    pub(super) fn close(&mut self, tally: PieceTally, piece: &Piece, soc: f64) {
-        self.book_piece(tally, piece.duration_s(), piece.profile.length_m, soc);
+    /// A step of segment `segment` (from 0) flown at the edge of the envelope: kept when it is
+    /// the segment's slowest.
+    pub(super) fn note_edge(&mut self, segment: usize, step: EdgeStep) {
+        let a = &mut self.segments[segment];
+        if a.edge.is_none_or(|e| step.slower_than(&e)) {
+            a.edge = Some(step);
+        }
     }
 
-    /// The pack cannot deliver the step that starts `start_s` s into `piece` (`why`): the flight
-    /// ends before it, with the pack at `soc`; the piece's steps flown until then are booked
-    /// (their energy, peak and time) like those of a piece cut short by [`Ledger::stop_after`].
+    /// The piece flown to its end, `late_s` beyond its planned time, leaving the pack at `soc`.
+    pub(super) fn close(&mut self, tally: PieceTally, piece: &Piece, late_s: f64, soc: f64) {
+        let planned = piece.duration_s();
+        self.book_piece(tally, (planned, late_s), piece.profile.length_m, soc);
+    }
+
+    /// The pack cannot deliver the step that starts `start_s` s into `piece` by its plan, after
+    /// `late_s` flown beyond the plan (`why`): the flight ends before it, with the pack at `soc`;
+    /// the piece's steps flown until then are booked (their energy, peak and time) like those of
+    /// a piece cut short by [`Ledger::stop_after`].
     pub(super) fn stop_before(
         &mut self,
         tally: PieceTally,
         piece: &Piece,
-        start_s: f64,
+        (start_s, late_s): (f64, f64),
         soc: f64,
         why: Shortfall,
     ) {
         self.shortfall = Some(why);
-        self.book_piece(tally, start_s, piece.profile.at(start_s).0, soc);
+        self.book_piece(tally, (start_s, late_s), piece.profile.at(start_s).0, soc);
     }
 
-    /// The pack fails (`why`) in the step that ends `end_s` s into `piece`, leaving it at `soc`:
-    /// the flight ends after that step.
+    /// The pack fails (`why`) in the step that ends `end_s` s into `piece` by its plan, after
+    /// `late_s` flown beyond the plan, leaving it at `soc`: the flight ends after that step.
     pub(super) fn stop_after(
         &mut self,
         tally: PieceTally,
         piece: &Piece,
-        end_s: f64,
+        (end_s, late_s): (f64, f64),
         soc: f64,
         why: Shortfall,
     ) {
         self.shortfall = Some(why);
-        self.book_piece(tally, end_s, piece.profile.at(end_s).0, soc);
+        self.book_piece(tally, (end_s, late_s), piece.profile.at(end_s).0, soc);
     }
 
-    /// Book a piece's duration, distance, energy and peak into its segment and the mission.
-    fn book_piece(&mut self, tally: PieceTally, duration_s: f64, distance_m: f64, soc: f64) {
+    /// Book a piece's duration (planned and flown beyond the plan), distance, energy and peak
+    /// into its segment and the mission.
+    fn book_piece(
+        &mut self,
+        tally: PieceTally,
+        (planned_s, late_s): (f64, f64),
+        distance_m: f64,
+        soc: f64,
+    ) {
         let a = &mut self.segments[tally.segment];
-        a.duration_s += duration_s;
+        a.duration_s += planned_s + late_s;
+        a.late_s += late_s;
         a.distance_m += distance_m;
         a.energy_j += tally.energy_j;
         a.peak_w = tally.peak_w;
@@ -268,6 +319,14 @@ impl<'p> Ledger<'p> {
                 },
                 peak_power_w: a.peak_w,
                 end_soc: a.end_soc,
+                time_lost_s: a.late_s,
+                edge: a.edge.map(|e| EdgeReport {
+                    limit: e.limit,
+                    slowest_mps: e.cruise.then_some(e.speed_mps),
+                    planned_mps: e.planned_mps,
+                    wind_mps: e.wind_mps,
+                    up_m: e.up_m,
+                }),
             })
             .collect::<Vec<_>>()
     }

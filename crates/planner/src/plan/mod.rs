@@ -51,13 +51,23 @@
 //! step); ground effect once per piece at a fixed height. A unit test checks that this hoisting
 //! leaves the report unchanged, bit for bit, every sample included.
 //!
+//! # The flight envelope
+//! A sample that asks for more tilt, thrust, airspeed, climb or descent rate than the airframe
+//! has is flown as an autopilot flies it: along the same path, slower, at the largest fraction
+//! `q` of its planned velocity within the limits ([`crate::envelope`], found in pass A). Its step
+//! takes `h / q`; the time flown beyond the plan accumulates through the piece and the mission
+//! (samples keep their real times), and each segment reports it with the slowest speed it was
+//! held to and the limit ([`SegmentReport::time_lost_s`], [`SegmentReport::edge`]). A mission
+//! flown within the envelope takes exactly the steps and times it took before the envelope
+//! existed: a step's time is `t0 + (k + 1/2) h + 0`, bit for bit.
+//!
 //! # Feasibility
 //! The mission is infeasible (a valid result, not an error) when the pack cannot deliver the power,
 //! the current exceeds the pack's rating, the terminal voltage falls below the cut-off, the usable
-//! charge runs out, or the vehicle lands with less than the reserve. The simulation stops where
-//! the battery fails and reports the time, segment and position. Asking for more thrust or tilt
-//! than the airframe has is an error ([`PlannerError::BeyondVehicleLimit`]): the mission cannot be
-//! flown at all as written.
+//! charge runs out, the vehicle lands with less than the reserve, or it cannot fly the path at
+//! any speed within its envelope (it cannot make headway against the wind, or hold its position:
+//! [`Shortfall::NoProgress`]). The simulation stops there and reports the time, segment and
+//! position.
 //!
 //! # Point of no return
 //! Every `pnr_interval_s` while airborne the planner prices a straight return: fly home at the
@@ -87,19 +97,20 @@ use std::ops::ControlFlow;
 
 use crate::aircraft::{Aircraft, Powered};
 use crate::battery::{Pack, PackCursor, PackStep};
+use crate::envelope::Envelope;
 use crate::error::PlannerError;
 use crate::mission::Mission;
 use crate::trajectory::Piece;
 use crate::wind::Wind;
 
-use ledger::{Ledger, PieceTally};
+use ledger::{EdgeStep, Ledger, PieceTally};
 use report::CheckedOptions;
 use return_check::ReturnCheck;
-use sampler::{piece_steps, BlockA, PassA};
+use sampler::{piece_steps, BlockA, PassA, Stop};
 
 pub use report::{
-    MissionReport, NoSamples, PlanOptions, PointOfNoReturn, Sample, SampleSink, SegmentReport,
-    Shortfall, DEFAULT_MAX_SAMPLES,
+    EdgeReport, MissionReport, NoProgressWhy, NoSamples, PlanOptions, PointOfNoReturn, Sample,
+    SampleSink, SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
 };
 
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
@@ -255,7 +266,8 @@ struct PackPass<'p, 'a> {
 }
 
 /// The piece pass B is flying: its vehicle, start time, step, charge per ampere and step, the
-/// step its next block starts at, and its tally.
+/// step its next block starts at, the time flown beyond its plan before that block, and its
+/// tally.
 struct PieceRun<'r, 'a> {
     piece: &'r Piece,
     pw: &'r Powered<'a>,
@@ -263,6 +275,7 @@ struct PieceRun<'r, 'a> {
     h: f64,
     dq: f64,
     k0: usize,
+    late_s: f64,
     tally: PieceTally,
 }
 
@@ -294,6 +307,10 @@ impl<'p, 'a> PackPass<'p, 'a> {
             steps: [PackStep::default(); BLOCK],
             ledger: Ledger::new(mission, options, r_pack, empty, required),
             way_home: ReturnCheck::new(
+                Envelope::of(
+                    powered[0].aircraft().airframe(),
+                    powered[0].aircraft().gravity_mps2(),
+                ),
                 battery,
                 wind,
                 mission.home_m(),
@@ -312,23 +329,23 @@ impl<'p, 'a> PackPass<'p, 'a> {
     ) -> Result<(), PlannerError> {
         let mut t0 = 0.0;
         for piece in self.mission.pieces() {
-            if self.fly_piece(feed, piece, t0, sink)?.is_break() {
-                break;
+            match self.fly_piece(feed, piece, t0, sink)? {
+                ControlFlow::Break(()) => break,
+                ControlFlow::Continue(late_s) => t0 += piece.duration_s() + late_s,
             }
-            t0 += piece.duration_s();
         }
         Ok(())
     }
 
-    /// Fly `piece`, which starts at mission time `t0`, block by block; `Break` where the pack
-    /// fails.
+    /// Fly `piece`, which starts at mission time `t0`, block by block: the time flown beyond its
+    /// plan, or `Break` where the pack fails or the vehicle cannot fly on.
     fn fly_piece(
         &mut self,
         feed: &mut feed::Feed<'_, '_>,
         piece: &'p Piece,
         t0: f64,
         sink: &mut dyn SampleSink,
-    ) -> Result<ControlFlow<()>, PlannerError> {
+    ) -> Result<ControlFlow<(), f64>, PlannerError> {
         let (n, h) = piece_steps(piece, self.dt);
         let mut run = PieceRun {
             piece,
@@ -339,6 +356,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
             // step-to-step chain instead of a division.
             dq: h / self.charge_as,
             k0: 0,
+            late_s: 0.0,
             tally: self.ledger.open(piece.segment),
         };
         while run.k0 < n {
@@ -348,13 +366,25 @@ impl<'p, 'a> PackPass<'p, 'a> {
             if self.fly_block(block, &mut run, sink)?.is_break() {
                 return Ok(ControlFlow::Break(()));
             }
-            if let Some(e) = pending {
-                return Err(e);
+            match pending {
+                None => {}
+                Some(Stop::Error(e)) => return Err(e),
+                Some(Stop::NoProgress(why)) => {
+                    // The vehicle cannot fly the step after the last one flown: the flight ends
+                    // there, an answer.
+                    let start_s = (run.k0 + block.valid) as f64 * run.h;
+                    let at = (start_s, block.late_end_s);
+                    let soc = self.cursor.soc();
+                    self.ledger.stop_before(run.tally, piece, at, soc, why);
+                    return Ok(ControlFlow::Break(()));
+                }
             }
             run.k0 += block.m;
+            run.late_s = block.late_end_s;
         }
-        self.ledger.close(run.tally, piece, self.cursor.soc());
-        Ok(ControlFlow::Continue(()))
+        self.ledger
+            .close(run.tally, piece, run.late_s, self.cursor.soc());
+        Ok(ControlFlow::Continue(run.late_s))
     }
 
     /// The pack over `block` (its state of charge chains one step to the next; `draw_block`
@@ -376,7 +406,9 @@ impl<'p, 'a> PackPass<'p, 'a> {
         for j in 0..block.valid {
             let tm = ((run.k0 + j) as f64 + 0.5) * run.h;
             let pos = block.kins[j].pos_m;
-            let t = run.t0 + tm;
+            // The flown time: the plan's, and the time flown beyond it so far in the piece.
+            let t = run.t0 + tm + block.late_s[j];
+            let h = block.steps_s[j];
             let p = block.trims[j].electrical_w;
             let Some(draw) = self.delivered(j, drawn) else {
                 let soc = if j == 0 {
@@ -392,17 +424,23 @@ impl<'p, 'a> PackPass<'p, 'a> {
                     power_w: p,
                 };
                 let start_s = tm - 0.5 * run.h;
-                self.ledger.stop_before(tally, run.piece, start_s, soc, why);
+                let late = block.late_s[j] - 0.5 * (h - run.h);
+                self.ledger
+                    .stop_before(tally, run.piece, (start_s, late), soc, why);
                 return Ok(ControlFlow::Break(()));
             };
-            self.ledger.book(&mut tally, p, run.h, &draw);
+            self.ledger.book(&mut tally, p, h, &draw);
+            if block.slowed {
+                self.note_edge(block, j, run, tm);
+            }
             if record {
                 sink.take(&Ledger::sample(run.pw, block, j, t, seg, &draw)?)?;
             }
             if let Some(why) = self.pack_failure(&draw, t, seg, pos) {
                 let end_s = tm + 0.5 * run.h;
+                let late = block.late_s[j] + 0.5 * (h - run.h);
                 self.ledger
-                    .stop_after(tally, run.piece, end_s, draw.soc_after, why);
+                    .stop_after(tally, run.piece, (end_s, late), draw.soc_after, why);
                 return Ok(ControlFlow::Break(()));
             }
             if self.way_home.due(t, pos) {
@@ -417,6 +455,30 @@ impl<'p, 'a> PackPass<'p, 'a> {
         }
         run.tally = tally;
         Ok(ControlFlow::Continue(()))
+    }
+
+    /// Step `j` of `block`, `tm` s into its piece by the plan, into the ledger's record of the
+    /// segment's slowest step at the edge of the envelope, when the envelope slowed it.
+    fn note_edge(&mut self, block: &BlockA, j: usize, run: &PieceRun<'_, '_>, tm: f64) {
+        let Some(limit) = block.limits[j] else {
+            return;
+        };
+        let kin = &block.kins[j];
+        let v = kin.vel_mps;
+        let speed_mps = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let profile = &run.piece.profile;
+        self.ledger.note_edge(
+            run.piece.segment,
+            EdgeStep {
+                limit,
+                speed_mps,
+                // The step took h / q instead of h: the planned speed was the flown one / q.
+                planned_mps: speed_mps * block.steps_s[j] / run.h,
+                cruise: tm >= profile.t_accel_end_s && tm < profile.t_cruise_end_s,
+                wind_mps: block.winds[j],
+                up_m: kin.pos_m[2],
+            },
+        );
     }
 
     /// Count `steps` more steps from mission time `t_s`; more than [`PlanOptions::max_samples`]
@@ -442,6 +504,19 @@ impl<'p, 'a> PackPass<'p, 'a> {
         let mut powers = [0.0; BLOCK];
         for (p, t) in powers.iter_mut().zip(&block.trims[..valid]) {
             *p = t.electrical_w;
+        }
+        if block.slowed {
+            // Steps of their own durations: step by step, each its own charge per ampere.
+            let mut dqs = [0.0; BLOCK];
+            for (d, h) in dqs.iter_mut().zip(&block.steps_s[..valid]) {
+                *d = h / self.charge_as;
+            }
+            return self.cursor.draw_each(
+                self.battery,
+                &powers[..valid],
+                &dqs[..valid],
+                &mut self.steps[..valid],
+            );
         }
         self.cursor
             .draw_block(self.battery, &powers[..valid], dq, &mut self.steps[..valid])
@@ -625,5 +700,55 @@ mod tests {
             r.energy_wh
         );
         assert!(r.duration_s <= time_s && r.duration_s > time_s - opts.time_step_s);
+    }
+
+    #[test]
+    fn a_leg_steeper_than_the_climb_limit_is_flown_at_the_limit() {
+        // 30 m up over 20 m east, asked at 10 m/s over the ground (15 m/s up): the M100's climb
+        // limit is 5 m/s, so the leg is flown with its vertical speed at 5 m/s and its ground
+        // speed at 5 x 20 / 30 = 3.33 m/s where the plan asks for more.
+        let (aircraft, battery) = m100();
+        let text = r#"
+            [[segment]]
+            kind = "take-off"
+            altitude_m = 10.0
+            climb_rate_mps = 2.0
+            [[segment]]
+            kind = "leg"
+            east_m = 20.0
+            north_m = 0.0
+            altitude_m = 40.0
+            ground_speed_mps = 10.0
+            [[segment]]
+            kind = "landing"
+            rate_mps = 1.0
+        "#;
+        let mission = MissionSpec::from_toml_str(text)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
+        let opts = PlanOptions {
+            record_samples: true,
+            ..PlanOptions::default()
+        };
+        let r = plan(&aircraft, &battery, &mission, &Wind::calm(), &opts).unwrap();
+        assert!(r.feasible, "{:?}", r.shortfall);
+        let leg: Vec<&Sample> = r.samples.iter().filter(|s| s.segment == 2).collect();
+        let top = leg.iter().map(|s| s.vel_up_mps).fold(0.0, f64::max);
+        // The bisection stops within 1e-9 of the fraction; the rate check allows 1e-9 relative.
+        assert!((top - 5.0).abs() < 1e-6, "{top}");
+        let fast = leg.iter().find(|s| s.vel_up_mps > 5.0 - 1e-6).unwrap();
+        assert!((fast.vel_east_mps - 5.0 * 20.0 / 30.0).abs() < 1e-6, "{fast:?}");
+        let seg = &r.segments[1];
+        assert!(seg.time_lost_s > 0.1, "{seg:?}");
+        assert_eq!(seg.edge.unwrap().limit, crate::envelope::Limit::Climb);
+        // The segment's time is its samples' steps: the planned piece plus the time lost.
+        let planned: f64 = mission
+            .pieces()
+            .iter()
+            .filter(|p| p.segment == 1)
+            .map(|p| p.duration_s())
+            .sum();
+        assert!((seg.duration_s - planned - seg.time_lost_s).abs() < 1e-9);
     }
 }

@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::airframe::Airframe;
 use crate::battery::Pack;
+use crate::envelope::Limit;
 use crate::error::PlannerError;
 
 /// Options of a planning run.
@@ -180,6 +181,27 @@ pub struct SegmentReport {
     pub peak_power_w: f64,
     /// State of charge at the end of the segment.
     pub end_soc: f64,
+    /// Time flown beyond the plan because the envelope slowed the vehicle, s (0 when flown as
+    /// planned).
+    pub time_lost_s: f64,
+    /// How the segment was flown at the edge of the envelope, when it was.
+    pub edge: Option<EdgeReport>,
+}
+
+/// How a segment was flown at the edge of the flight envelope: the slowest it went and why.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct EdgeReport {
+    /// The limit the vehicle flew at there.
+    pub limit: Limit,
+    /// The slowest speed along the path at cruise, m/s (`None` when only the speed changes at
+    /// the segment's ends were slowed).
+    pub slowest_mps: Option<f64>,
+    /// The planned speed there, m/s.
+    pub planned_mps: f64,
+    /// The wind there (east, north, up), m/s.
+    pub wind_mps: [f64; 3],
+    /// Height above home there, m.
+    pub up_m: f64,
 }
 
 /// Why a valid mission cannot be flown with this pack.
@@ -225,6 +247,31 @@ pub enum Shortfall {
         position_m: [f64; 3],
         /// Power asked, W.
         power_w: f64,
+    },
+    /// The vehicle cannot fly the path here within its envelope: it cannot make headway along
+    /// the track against the wind, or cannot hold its position (a wind or a load beyond it).
+    NoProgress {
+        /// Mission time, s.
+        time_s: f64,
+        /// Segment number, from 1.
+        segment: usize,
+        /// Segment kind.
+        kind: &'static str,
+        /// Position, ENU m.
+        position_m: [f64; 3],
+        /// The wind there (east, north, up), m/s.
+        wind_mps: [f64; 3],
+        /// Whether the path moves over the ground there (else the vehicle holds a point or
+        /// climbs or descends in place).
+        moving: bool,
+        /// The limit that binds.
+        limit: Limit,
+        /// The limit's value, in `limit_unit`.
+        limit_value: f64,
+        /// The unit of `limit_value`.
+        limit_unit: &'static str,
+        /// The largest airspeed of steady level flight within the envelope at this mass, m/s.
+        max_airspeed_mps: f64,
     },
     /// The mission lands with less than the reserve.
     Reserve {
@@ -285,6 +332,34 @@ impl std::fmt::Display for Shortfall {
                 )?;
                 at(f, *time_s, *segment, kind, *position_m)
             }
+            Shortfall::NoProgress {
+                time_s,
+                segment,
+                kind,
+                position_m,
+                wind_mps,
+                moving,
+                limit,
+                limit_value,
+                limit_unit,
+                max_airspeed_mps,
+            } => {
+                let what = if *moving {
+                    "the vehicle cannot make headway along the track "
+                } else {
+                    "the vehicle cannot hold its position "
+                };
+                f.write_str(what)?;
+                at(f, *time_s, *segment, kind, *position_m)?;
+                write!(f, ": {}", NoProgressWhy {
+                    vehicle: "the vehicle",
+                    wind_mps: *wind_mps,
+                    limit: *limit,
+                    limit_value: *limit_value,
+                    limit_unit,
+                    max_airspeed_mps: *max_airspeed_mps,
+                })
+            }
             Shortfall::Reserve {
                 reserve_soc,
                 required_soc,
@@ -294,6 +369,47 @@ impl std::fmt::Display for Shortfall {
                 reserve_soc * 100.0,
                 required_soc * 100.0
             ),
+        }
+    }
+}
+
+/// Why a path cannot be flown, in words: the wind and what the vehicle can fly against (the
+/// tail of [`Shortfall::NoProgress`]'s message, which the engine reuses with the item number).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NoProgressWhy<'a> {
+    /// The vehicle in words (`the vehicle`, its name).
+    pub vehicle: &'a str,
+    /// The wind (east, north, up), m/s.
+    pub wind_mps: [f64; 3],
+    /// The limit that binds.
+    pub limit: Limit,
+    /// Its value, in `limit_unit`.
+    pub limit_value: f64,
+    /// Its unit.
+    pub limit_unit: &'a str,
+    /// The largest steady level airspeed within the envelope, m/s.
+    pub max_airspeed_mps: f64,
+}
+
+impl std::fmt::Display for NoProgressWhy<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let [e, n, _] = self.wind_mps;
+        let speed = e.hypot(n);
+        // The direction the wind blows from, clockwise from north.
+        let from_deg = (-e).atan2(-n).to_degrees().rem_euclid(360.0);
+        write!(f, "the wind there is {speed:.1} m/s from {from_deg:.0} deg; ")?;
+        if self.max_airspeed_mps < 0.05 {
+            write!(
+                f,
+                "{} cannot hover within its {} limit of {:.2} {}",
+                self.vehicle, self.limit, self.limit_value, self.limit_unit
+            )
+        } else {
+            write!(
+                f,
+                "{} flies at most {:.1} m/s of airspeed within its {} limit of {:.2} {}",
+                self.vehicle, self.max_airspeed_mps, self.limit, self.limit_value, self.limit_unit
+            )
         }
     }
 }

@@ -5,11 +5,13 @@
 //! none failed yet); [`ReturnCheck::check`] prices the straight return home from the present
 //! position and state of charge: the best-range leg home in the mean wind ([`ReturnCache`], one
 //! [`crate::queries::best_range`] per 0.5 deg of bearing, mass phase and wind), then the vertical
-//! descent over home. The point of no return is the last position that passed before the first
+//! descent over home, both within the flight envelope (a return the vehicle cannot fly against the
+//! wind, or a descent in a wind it cannot hover in, fails the check). The point of no return is the last position that passed before the first
 //! that failed.
 
 use crate::aircraft::Powered;
 use crate::battery::Pack;
+use crate::envelope::Envelope;
 use crate::queries::best_range;
 use crate::wind::Wind;
 
@@ -64,6 +66,7 @@ impl ReturnCache {
 
 /// The checks of one run and what they found.
 pub(super) struct ReturnCheck<'p> {
+    envelope: Envelope,
     battery: &'p Pack,
     wind: &'p Wind,
     home: [f64; 3],
@@ -84,6 +87,7 @@ impl<'p> ReturnCheck<'p> {
     /// The checks to `home` with `battery` in `wind`, down to `floor_soc`, descending at
     /// `descent_rate` m/s; none when `options` ask for no point of no return.
     pub(super) fn new(
+        envelope: Envelope,
         battery: &'p Pack,
         wind: &'p Wind,
         home: [f64; 3],
@@ -92,6 +96,7 @@ impl<'p> ReturnCheck<'p> {
         descent_rate: f64,
     ) -> Self {
         ReturnCheck {
+            envelope,
             battery,
             wind,
             home,
@@ -166,15 +171,16 @@ impl<'p> ReturnCheck<'p> {
             None
         };
         let descent_rate = self.descent_rate;
-        // Descent over home: air velocity is minus the wind, vertical -rate.
+        // Descent over home: air velocity is minus the wind, vertical -rate; it must be within
+        // the envelope (a wind the vehicle cannot hover in leaves no way down).
         let descent_w = match pw.trim(
             [0.0; 3],
             [-wh[0], -wh[1], -descent_rate - w[2]],
             [0.0, 1.0],
             1.0,
         ) {
-            Ok(t) => t.electrical_w,
-            Err(_) => return false,
+            Ok(t) if self.envelope.exceeded_by_trim(&t, -descent_rate).is_none() => t.electrical_w,
+            _ => return false,
         };
         let descent_s = pos[2] / descent_rate;
         let battery = self.battery;

@@ -8,11 +8,14 @@
 //!    ground-effect factor at the rotor height;
 //! 2. the trims ([`PassA::trim_samples`]): [`Powered::trim_block`], force balance for all, then
 //!    the power model for all, both in vector lanes;
-//! 3. the airframe's limits ([`PassA::within_limits`]).
+//! 3. the flight envelope ([`PassA::fly_at_the_edge`]): a sample beyond the airframe's tilt,
+//!    thrust, airspeed, climb or descent limit is flown at the largest fraction `q` of its
+//!    planned speed that is within them ([`crate::envelope`]), its step taking `h / q`; the
+//!    time flown beyond the plan accumulates per piece ([`BlockA::late_s`]).
 //!
-//! An error (a wind grid left, a flight condition the power model rejects, a thrust or tilt
-//! beyond the airframe) stops the block at that sample and travels with it ([`BlockA::pending`]),
-//! so the pack pass flies the samples before it first.
+//! What stops the flight (a wind grid left, a flight condition the power model rejects, a path
+//! the vehicle cannot fly at any speed) stops the block at that sample and travels with it
+//! ([`BlockA::pending`]), so the pack pass flies the samples before it first.
 //!
 //! # Hoisting of steady stretches
 //! On a level line or a hold at cruise in a steady wind that depends on height alone, every input
@@ -23,6 +26,7 @@
 //! `hoisting_steady_stretches_matches_the_per_sample_report` proves the reports equal bit for bit.
 
 use crate::aircraft::{Aircraft, Powered};
+use crate::envelope::{Envelope, Limit};
 use crate::error::PlannerError;
 use crate::ground_effect::thrust_factor;
 use crate::mission::Mission;
@@ -30,6 +34,7 @@ use crate::trajectory::{BlockSampler, Kinematics, Piece, Shape};
 use crate::trim::Trim;
 use crate::wind::Wind;
 
+use super::report::Shortfall;
 use super::BLOCK;
 
 const ZERO_TRIM: Trim = Trim {
@@ -59,39 +64,22 @@ fn steady_piece(piece: &Piece) -> bool {
     !matches!(piece.shape, Shape::Arc { .. }) && fixed_height_m(piece).is_some()
 }
 
-/// The error of a sample whose trim is beyond the airframe's thrust or tilt.
-#[cold]
-#[inline(never)]
-fn beyond_limit(
-    trim: &Trim,
-    t: f64,
-    seg: usize,
-    kind: &'static str,
-    pos: [f64; 3],
-    max_thrust: f64,
-    airframe: &crate::airframe::Airframe,
-) -> PlannerError {
-    let thrust = trim.thrust_n > max_thrust;
-    PlannerError::BeyondVehicleLimit {
-        time_s: t,
-        index: seg + 1,
-        kind,
-        east_m: pos[0],
-        north_m: pos[1],
-        up_m: pos[2],
-        name: if thrust { "thrust" } else { "tilt" },
-        value: if thrust {
-            trim.thrust_n
-        } else {
-            trim.axis[2].clamp(-1.0, 1.0).acos().to_degrees()
-        },
-        limit: if thrust {
-            max_thrust
-        } else {
-            airframe.max_tilt_rad().to_degrees()
-        },
-        unit: if thrust { "N" } else { "deg" },
-    }
+/// A trim that marks a sample the power model rejected beyond the envelope: the edge step
+/// slows it and trims it again.
+const BEYOND: Trim = Trim {
+    thrust_n: f64::INFINITY,
+    axis: [0.0; 3],
+    airspeed_mps: 0.0,
+    electrical_w: 0.0,
+};
+
+/// What stops a flight in pass A: an error, or a path the vehicle cannot fly (an answer).
+#[derive(Debug)]
+pub(super) enum Stop {
+    /// A wind grid left, a flight condition the power model rejects.
+    Error(PlannerError),
+    /// The vehicle cannot make headway or hold its position within its envelope.
+    NoProgress(Shortfall),
 }
 
 /// Steps of a piece at time step `dt` and the step that divides it evenly, s.
@@ -108,8 +96,18 @@ pub(super) struct BlockA {
     pub(super) m: usize,
     /// Steps pass A completed: `m`, or the index of the step that raised `pending`.
     pub(super) valid: usize,
-    /// The error that stopped pass A in this block.
-    pub(super) pending: Option<PlannerError>,
+    /// What stopped pass A in this block.
+    pub(super) pending: Option<Stop>,
+    /// Whether the envelope slowed any step of the block.
+    pub(super) slowed: bool,
+    /// Duration of each step, s: the piece's `h`, or `h / q` where the envelope slowed it.
+    pub(super) steps_s: [f64; BLOCK],
+    /// Time flown beyond the plan in the piece up to each step's midpoint, s.
+    pub(super) late_s: [f64; BLOCK],
+    /// Time flown beyond the plan in the piece up to the block's end, s.
+    pub(super) late_end_s: f64,
+    /// The limit each slowed step was flown at (`None`: as planned).
+    pub(super) limits: [Option<Limit>; BLOCK],
     pub(super) kins: [Kinematics; BLOCK],
     pub(super) winds: [[f64; 3]; BLOCK],
     pub(super) v_airs: [[f64; 3]; BLOCK],
@@ -125,6 +123,11 @@ impl BlockA {
         m: 0,
         valid: 0,
         pending: None,
+        slowed: false,
+        steps_s: [0.0; BLOCK],
+        late_s: [0.0; BLOCK],
+        late_end_s: 0.0,
+        limits: [None; BLOCK],
         kins: [Kinematics::ZERO; BLOCK],
         winds: [[0.0; 3]; BLOCK],
         v_airs: [[0.0; 3]; BLOCK],
@@ -146,6 +149,8 @@ struct PieceA {
     /// Whether the piece's cruise may reuse one trim (see `steady_piece`).
     steady: bool,
     steady_trim: Option<Trim>,
+    /// Time flown beyond the plan in the piece so far, s.
+    late_s: f64,
 }
 
 /// Pass A: kinematics, wind, trim, power and the airframe's limits for every block of the mission
@@ -162,12 +167,14 @@ pub(super) struct PassA<'p, 'a> {
     ground_effect: bool,
     r_rotor: f64,
     rotor_h: f64,
-    max_thrust: f64,
-    cos_tilt_max: f64,
+    envelope: Envelope,
+    /// The largest steady level airspeed within the envelope per mass phase, m/s, and the
+    /// limit that bounds it (for the message of a path that cannot be flown).
+    max_airspeed: Vec<(f64, Limit)>,
     kinds: &'p [&'static str],
-    airframe: &'p crate::airframe::Airframe,
     dt: f64,
-    /// Piece being walked, its next step and its start time.
+    /// Piece being walked, its next step and its start time (the flown time of the pieces
+    /// before it).
     index: usize,
     k0: usize,
     t0: f64,
@@ -193,6 +200,11 @@ impl<'p, 'a> PassA<'p, 'a> {
         } else {
             None
         };
+        let envelope = Envelope::of(airframe, g);
+        let max_airspeed = powered
+            .iter()
+            .map(|pw| envelope.max_level_airspeed_mps(pw))
+            .collect();
         PassA {
             pieces: mission.pieces(),
             powered,
@@ -203,10 +215,9 @@ impl<'p, 'a> PassA<'p, 'a> {
             ground_effect,
             r_rotor: aircraft.rotor_radius_m(),
             rotor_h: airframe.rotor_height_m(),
-            max_thrust: airframe.max_thrust_n(g),
-            cos_tilt_max: airframe.max_tilt_rad().cos(),
+            envelope,
+            max_airspeed,
             kinds: mission.segment_kinds(),
-            airframe,
             dt,
             index: 0,
             k0: 0,
@@ -249,13 +260,14 @@ impl<'p, 'a> PassA<'p, 'a> {
                     piece_ge,
                     steady: self.hoist && self.steady_wind && steady_piece(piece),
                     steady_trim: None,
+                    late_s: 0.0,
                 });
             }
             let pa = self.piece.as_ref().expect("set above");
             if self.k0 < pa.n {
                 break;
             }
-            self.t0 += piece.duration_s();
+            self.t0 += piece.duration_s() + pa.late_s;
             self.index += 1;
             self.k0 = 0;
             self.piece = None;
@@ -268,21 +280,25 @@ impl<'p, 'a> PassA<'p, 'a> {
         true
     }
 
-    /// Pass A over the block at `self.k0` of `piece`: the air, the trims, the limits.
+    /// Pass A over the block at `self.k0` of `piece`: the air, the trims, the envelope.
     fn fill(&self, piece: &Piece, pa: &mut PieceA, out: &mut BlockA) {
         let m = (pa.n - self.k0).min(BLOCK);
         out.k0 = self.k0;
         out.m = m;
         out.pending = None;
+        out.slowed = false;
         let valid = self.sample_air(pa, m, out);
         let valid = self.trim_samples(piece, pa, valid, out);
-        out.valid = self.within_limits(piece, pa, valid, out);
+        out.valid = self.fly_at_the_edge(piece, pa, valid, out);
     }
 
     /// Pass A1: kinematics, wind, air velocity and ground effect of the block's `m` samples; the
     /// samples done (`m`, or the first outside a wind grid, with its error in `out.pending`).
+    /// The wind of a block is taken at the times its steps would have with the time flown
+    /// beyond the plan before the block (a step slowed within the block shifts the rest by less
+    /// than that step's delay; only gusts change with time).
     fn sample_air(&self, pa: &mut PieceA, m: usize, out: &mut BlockA) -> usize {
-        let (k0, h, t0) = (self.k0, pa.h, self.t0);
+        let (k0, h, t0, late) = (self.k0, pa.h, self.t0, pa.late_s);
         let mut valid = m;
         pa.sampler.fill(k0, &mut out.kins[..m]);
         for j in 0..m {
@@ -290,11 +306,11 @@ impl<'p, 'a> PassA<'p, 'a> {
             let w = match self.uniform_wind {
                 Some(w) => w,
                 None => {
-                    let t = t0 + ((k0 + j) as f64 + 0.5) * h;
+                    let t = t0 + ((k0 + j) as f64 + 0.5) * h + late;
                     match self.wind.at(kin.pos_m, t) {
                         Some(w) => w,
                         None => {
-                            out.pending = Some(outside(self.wind, t, kin.pos_m));
+                            out.pending = Some(Stop::Error(outside(self.wind, t, kin.pos_m)));
                             valid = j;
                             break;
                         }
@@ -339,48 +355,159 @@ impl<'p, 'a> PassA<'p, 'a> {
                 out.trims[..valid].fill(st);
             }
             _ => {
-                if let Err((j, e)) = pw.trim_block(
-                    &out.accs[..valid],
-                    &out.v_airs[..valid],
-                    &out.fwds[..valid],
-                    &out.ges[..valid],
-                    &mut out.trims[..valid],
-                ) {
-                    valid = j;
-                    out.pending = Some(e);
-                }
+                valid = self.trim_block_or_mark(pw, valid, out);
                 if pa.steady && pa.steady_trim.is_none() {
                     pa.steady_trim = (0..valid)
                         .find(|&j| in_cruise(k0 + j))
                         .map(|j| out.trims[j]);
+                    // A stretch beyond the envelope is slowed sample by sample, not hoisted.
+                    if let Some(st) = pa.steady_trim {
+                        let v_up = out.kins[0].vel_mps[2];
+                        if self.envelope.exceeded_by_trim(&st, v_up).is_some() {
+                            pa.steady = false;
+                            pa.steady_trim = None;
+                        }
+                    }
                 }
             }
         }
         valid
     }
 
-    /// Pass A3: the airframe's thrust and tilt over the first `valid` samples; the samples within
-    /// them (the first beyond, with its error in `out.pending`).
-    fn within_limits(&self, piece: &Piece, pa: &PieceA, valid: usize, out: &mut BlockA) -> usize {
-        let (k0, h, t0) = (self.k0, pa.h, self.t0);
-        let seg = piece.segment;
-        for j in 0..valid {
-            let trim = &out.trims[j];
-            if trim.thrust_n > self.max_thrust || trim.axis[2] < self.cos_tilt_max {
-                let t = t0 + ((k0 + j) as f64 + 0.5) * h;
-                out.pending = Some(beyond_limit(
-                    trim,
-                    t,
-                    seg,
-                    self.kinds[seg],
-                    out.kins[j].pos_m,
-                    self.max_thrust,
-                    self.airframe,
-                ));
-                return j;
+    /// [`Powered::trim_block`] of the first `valid` samples; a sample the power model rejects is
+    /// marked [`BEYOND`] for the edge step when it is beyond the envelope (slowed, it may be a
+    /// condition the model takes), else it stops the block with its error. The samples done.
+    fn trim_block_or_mark(&self, pw: &Powered<'_>, valid: usize, out: &mut BlockA) -> usize {
+        let mut from = 0;
+        while from < valid {
+            let Err((j, e)) = pw.trim_block(
+                &out.accs[from..valid],
+                &out.v_airs[from..valid],
+                &out.fwds[from..valid],
+                &out.ges[from..valid],
+                &mut out.trims[from..valid],
+            ) else {
+                return valid;
+            };
+            let k = from + j;
+            let kin = &out.kins[k];
+            let beyond = self.envelope.exceeded(
+                pw,
+                kin.acc_mps2,
+                kin.vel_mps,
+                out.winds[k],
+                out.fwds[k],
+            );
+            if beyond.is_none() {
+                out.pending = Some(Stop::Error(e));
+                return k;
             }
+            out.trims[k] = BEYOND;
+            from = k + 1;
         }
         valid
+    }
+
+    /// Pass A3: the flight envelope over the first `valid` samples: each beyond it is flown at
+    /// the largest fraction of its planned velocity within it (its step `h / q`), and the time
+    /// flown beyond the plan accumulates; the samples done (up to the first the vehicle cannot
+    /// fly at any speed, with its shortfall in `out.pending`).
+    fn fly_at_the_edge(
+        &self,
+        piece: &Piece,
+        pa: &mut PieceA,
+        valid: usize,
+        out: &mut BlockA,
+    ) -> usize {
+        let h = pa.h;
+        let mut late = pa.late_s;
+        let mut done = valid;
+        for j in 0..valid {
+            out.limits[j] = None;
+            let v_up = out.kins[j].vel_mps[2];
+            if self.envelope.exceeded_by_trim(&out.trims[j], v_up).is_none() {
+                out.steps_s[j] = h;
+                out.late_s[j] = late;
+                continue;
+            }
+            match self.slow_down(piece, j, out) {
+                Ok((q, limit)) => {
+                    let step = h / q;
+                    out.late_s[j] = late + 0.5 * (step - h);
+                    late += step - h;
+                    out.steps_s[j] = step;
+                    out.limits[j] = Some(limit);
+                    out.slowed = true;
+                }
+                Err(stop) => {
+                    let stop = match stop {
+                        Stop::NoProgress(mut s) => {
+                            if let Shortfall::NoProgress { time_s, .. } = &mut s {
+                                *time_s = self.t0 + ((self.k0 + j) as f64 + 0.5) * h + late;
+                            }
+                            Stop::NoProgress(s)
+                        }
+                        e => e,
+                    };
+                    out.pending = Some(stop);
+                    done = j;
+                    break;
+                }
+            }
+        }
+        pa.late_s = late;
+        out.late_end_s = late;
+        done
+    }
+
+    /// Sample `j` of `out` flown at the edge: its velocity scaled by the largest fraction `q`
+    /// within the envelope and its acceleration by `q^2`, trimmed again; `(q, the limit it
+    /// flies at)`, or why it cannot be flown (the shortfall's time is set by the caller).
+    fn slow_down(&self, piece: &Piece, j: usize, out: &mut BlockA) -> Result<(f64, Limit), Stop> {
+        let pw = &self.powered[piece.mass_phase];
+        let kin = out.kins[j];
+        let wind = out.winds[j];
+        let edge = self
+            .envelope
+            .fastest_fraction(pw, kin.acc_mps2, kin.vel_mps, wind, out.fwds[j]);
+        let (q, limit) = match edge {
+            Ok(Some(edge)) => edge,
+            // Within at the planned speed after all (a marked sample the model rejected).
+            Ok(None) => (1.0, Limit::Tilt),
+            Err(limit) => return Err(self.no_progress(piece, &kin, wind, limit)),
+        };
+        let k = &mut out.kins[j];
+        k.vel_mps = kin.vel_mps.map(|v| v * q);
+        k.acc_mps2 = kin.acc_mps2.map(|a| a * q * q);
+        out.v_airs[j] = [
+            k.vel_mps[0] - wind[0],
+            k.vel_mps[1] - wind[1],
+            k.vel_mps[2] - wind[2],
+        ];
+        out.accs[j] = k.acc_mps2;
+        out.trims[j] = pw
+            .trim(out.accs[j], out.v_airs[j], out.fwds[j], out.ges[j])
+            .map_err(Stop::Error)?;
+        Ok((q, limit))
+    }
+
+    /// The shortfall of a sample that cannot be flown at any speed within the envelope (its time
+    /// set by the caller).
+    fn no_progress(&self, piece: &Piece, kin: &Kinematics, wind: [f64; 3], limit: Limit) -> Stop {
+        let (limit_value, limit_unit) = self.envelope.value_of(limit);
+        let seg = piece.segment;
+        Stop::NoProgress(Shortfall::NoProgress {
+            time_s: 0.0,
+            segment: seg + 1,
+            kind: self.kinds[seg],
+            position_m: kin.pos_m,
+            wind_mps: wind,
+            moving: kin.vel_mps[0].hypot(kin.vel_mps[1]) > 0.0,
+            limit,
+            limit_value,
+            limit_unit,
+            max_airspeed_mps: self.max_airspeed[piece.mass_phase].0,
+        })
     }
 }
 
