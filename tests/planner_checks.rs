@@ -353,7 +353,8 @@ fn bad_missions_are_clear_errors() {
         .compile(a.airframe(), b.mass_kg(), None)
         .unwrap();
     assert!(
-        fast.warnings()[0].contains("ground speed 30 m/s is beyond the vehicle's 17 m/s: flown at 17.00 m/s"),
+        fast.warnings()[0]
+            .contains("ground speed 30 m/s is beyond the vehicle's 17 m/s: flown at 17.00 m/s"),
         "{:?}",
         fast.warnings()
     );
@@ -405,7 +406,10 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
     else {
         panic!("{:?}", r.shortfall);
     };
-    assert_eq!((segment, moving, limit), (2, true, aloft_planner::Limit::Tilt));
+    assert_eq!(
+        (segment, moving, limit),
+        (2, true, aloft_planner::Limit::Tilt)
+    );
     let Some(Shortfall::NoProgress {
         wind_mps,
         position_m,
@@ -416,11 +420,18 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
     };
     // Where it stops, the wind is at least what it can fly against (the leg climbs, so the
     // vehicle's own climb leaves it a little less).
-    assert!(-wind_mps[0] > max_airspeed_mps - 1.0, "{wind_mps:?} {max_airspeed_mps}");
+    assert!(
+        -wind_mps[0] > max_airspeed_mps - 1.0,
+        "{wind_mps:?} {max_airspeed_mps}"
+    );
     assert!(max_airspeed_mps > 16.0 && max_airspeed_mps < 18.0);
     assert!(position_m[2] > 10.0 && position_m[2] < 40.0 && position_m[0] > 0.0);
     assert!(r.segments.len() == 2 && r.duration_s > 0.0);
-    assert!(r.shortfall.unwrap().to_string().contains("cannot make headway"));
+    assert!(r
+        .shortfall
+        .unwrap()
+        .to_string()
+        .contains("cannot make headway"));
     // a grid over 0..400 m east does not cover the 800 m leg
     let mut rows = vec![];
     for x in [-50.0, 400.0] {

@@ -76,10 +76,10 @@ use super::flight::Flight;
 use super::flown::flown_spec;
 use super::loiter::resolve_loiter;
 use super::mission::{check_options, planner_options, Mission, MissionOptions};
-use super::summary::reason;
 use super::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };
+use super::summary::reason;
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use super::{EnduranceOptions, MissionSummary};

@@ -237,7 +237,11 @@ pub fn mission_summary(
 /// The segment `segment` (from 1) in words: `item 7 (leg)` for a segment from a planner file,
 /// else `segment 3 (leg)`.
 fn segment_name(segments: &[SegmentReport], segment: usize, kind: &str) -> String {
-    match segments.iter().find(|s| s.index == segment).and_then(|s| s.item) {
+    match segments
+        .iter()
+        .find(|s| s.index == segment)
+        .and_then(|s| s.item)
+    {
         Some(i) => format!("item {i} ({kind})"),
         None => format!("segment {segment} ({kind})"),
     }

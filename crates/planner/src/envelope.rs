@@ -237,7 +237,9 @@ impl Envelope {
                 let limit = beyond(MIN_FRACTION);
                 match limit {
                     None => MIN_FRACTION,
-                    Some(l) => return Err(self.binding_at_rest(pw, wind_mps, forward).unwrap_or(l)),
+                    Some(l) => {
+                        return Err(self.binding_at_rest(pw, wind_mps, forward).unwrap_or(l))
+                    }
                 }
             }
         };
@@ -356,11 +358,22 @@ mod tests {
         let pw = aircraft.at_mass(2.355, AoaModel::Geometric).unwrap();
         let a = drag_limited_airspeed(2.355, aircraft.gravity_mps2(), 35.0);
         let (q, limit) = env
-            .fastest_fraction(&pw, [0.0; 3], [0.0, 12.0, 0.0], [0.0, -10.0, 0.0], [0.0, 1.0])
+            .fastest_fraction(
+                &pw,
+                [0.0; 3],
+                [0.0, 12.0, 0.0],
+                [0.0, -10.0, 0.0],
+                [0.0, 1.0],
+            )
             .unwrap()
             .unwrap();
         assert_eq!(limit, Limit::Tilt);
-        assert!((12.0 * q - (a - 10.0)).abs() < 1e-6, "{} vs {}", 12.0 * q, a - 10.0);
+        assert!(
+            (12.0 * q - (a - 10.0)).abs() < 1e-6,
+            "{} vs {}",
+            12.0 * q,
+            a - 10.0
+        );
         // A cross wind of 6 m/s: the vehicle crabs, v_g = sqrt(A^2 - 36) (along-track wind 0).
         let (q, _) = env
             .fastest_fraction(&pw, [0.0; 3], [0.0, 20.0, 0.0], [6.0, 0.0, 0.0], [0.0, 1.0])

@@ -131,9 +131,7 @@ pub fn best_range(
     let within = |vg: f64| {
         let vel = [vg * course[0], vg * course[1], 0.0];
         let wind = [wind_mps[0], wind_mps[1], 0.0];
-        envelope
-            .exceeded(p, [0.0; 3], vel, wind, course)
-            .is_none()
+        envelope.exceeded(p, [0.0; 3], vel, wind, course).is_none()
     };
     let f = |v: f64| match power_along_course(p, course, wind_mps, v) {
         Some((pw, vg)) if within(vg) => pw / vg,

@@ -738,7 +738,10 @@ mod tests {
         // The bisection stops within 1e-9 of the fraction; the rate check allows 1e-9 relative.
         assert!((top - 5.0).abs() < 1e-6, "{top}");
         let fast = leg.iter().find(|s| s.vel_up_mps > 5.0 - 1e-6).unwrap();
-        assert!((fast.vel_east_mps - 5.0 * 20.0 / 30.0).abs() < 1e-6, "{fast:?}");
+        assert!(
+            (fast.vel_east_mps - 5.0 * 20.0 / 30.0).abs() < 1e-6,
+            "{fast:?}"
+        );
         let seg = &r.segments[1];
         assert!(seg.time_lost_s > 0.1, "{seg:?}");
         assert_eq!(seg.edge.unwrap().limit, crate::envelope::Limit::Climb);

@@ -397,7 +397,10 @@ impl std::fmt::Display for NoProgressWhy<'_> {
         let speed = e.hypot(n);
         // The direction the wind blows from, clockwise from north.
         let from_deg = (-e).atan2(-n).to_degrees().rem_euclid(360.0);
-        write!(f, "the wind there is {speed:.1} m/s from {from_deg:.0} deg; ")?;
+        write!(
+            f,
+            "the wind there is {speed:.1} m/s from {from_deg:.0} deg; "
+        )?;
         if self.max_airspeed_mps < 0.05 {
             write!(
                 f,

@@ -391,13 +391,9 @@ impl<'p, 'a> PassA<'p, 'a> {
             };
             let k = from + j;
             let kin = &out.kins[k];
-            let beyond = self.envelope.exceeded(
-                pw,
-                kin.acc_mps2,
-                kin.vel_mps,
-                out.winds[k],
-                out.fwds[k],
-            );
+            let beyond =
+                self.envelope
+                    .exceeded(pw, kin.acc_mps2, kin.vel_mps, out.winds[k], out.fwds[k]);
             if beyond.is_none() {
                 out.pending = Some(Stop::Error(e));
                 return k;
@@ -425,7 +421,11 @@ impl<'p, 'a> PassA<'p, 'a> {
         for j in 0..valid {
             out.limits[j] = None;
             let v_up = out.kins[j].vel_mps[2];
-            if self.envelope.exceeded_by_trim(&out.trims[j], v_up).is_none() {
+            if self
+                .envelope
+                .exceeded_by_trim(&out.trims[j], v_up)
+                .is_none()
+            {
                 out.steps_s[j] = h;
                 out.late_s[j] = late;
                 continue;
