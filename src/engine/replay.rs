@@ -122,12 +122,14 @@ pub struct ReplayAnswer {
     /// Where the ground time comes from: `log` (the log's landed state), `detected` (height,
     /// speed and power) or `log_and_detected` (the log's state where it has one).
     pub ground_source: &'static str,
-    /// Mean measured power on the ground, W (absent without power or ground time).
+    /// Mean measured power on the ground over the record, W, over the ground time's own span
+    /// (not shifted by the lag); absent without power or ground time.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub idle_power_w: Option<f64>,
     /// Predicted energy of the airborne time, Wh (from the trajectory alone).
     pub predicted_airborne_energy_wh: f64,
-    /// Predicted energy of the ground time, Wh (at the measured idle power; 0 without power).
+    /// Predicted energy of the ground time, Wh: each ground stretch at its own mean measured
+    /// power (the record's where the power does not cover it), 0 without power.
     pub predicted_ground_energy_wh: f64,
     /// Measured energy of the airborne time, Wh.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -269,10 +271,7 @@ fn answer(
             (0, _) => "detected",
             _ => "log_and_detected",
         },
-        idle_power_w: books
-            .measured
-            .filter(|_| books.ground_s > 0.0)
-            .map(|m| m.ground_wh * 3600.0 / books.ground_s),
+        idle_power_w: books.idle_w.filter(|_| books.ground_s > 0.0),
         predicted_airborne_energy_wh: books.predicted_air_wh,
         predicted_ground_energy_wh: books.predicted_ground_wh,
         measured_airborne_energy_wh: books.measured.map(|m| m.air_wh),
@@ -522,33 +521,59 @@ struct Books {
     ground_s: f64,
     predicted_air_wh: f64,
     predicted_ground_wh: f64,
+    /// Mean measured power on the ground over the record, W.
+    idle_w: Option<f64>,
     measured: Option<MeasuredBooks>,
     spans: Vec<aloft_logs::Span>,
 }
 
-/// Price each stretch: airborne at the model's power along the trajectory, ground at the mean
-/// measured power of that stretch (its measured energy over its duration, so its predicted and
-/// measured energy agree), or 0 W without power. The measured side is shifted by the lag.
+/// The idle power of each stretch (`None` for airborne ones and for ground ones the power does
+/// not cover) and of the record: the mean measured power over the stretch's own time (not
+/// shifted by the lag, which relates power to motion, and at rest there is no motion).
+fn idle_powers(stretches: &[Stretch], m: &Measured) -> (Vec<Option<f64>>, Option<f64>) {
+    let (t0, t1) = (m.times[0], m.times[m.times.len() - 1]);
+    let (mut joules, mut seconds) = (0.0, 0.0);
+    let each = stretches
+        .iter()
+        .map(|st| {
+            let (s, e) = (st.start_s.max(t0), st.end_s.min(t1));
+            if st.airborne || e <= s {
+                return None;
+            }
+            let j = window_integral(&m.times, &m.power_w, s, e);
+            joules += j;
+            seconds += e - s;
+            Some(j / (e - s))
+        })
+        .collect();
+    (each, (seconds > 0.0).then(|| joules / seconds))
+}
+
+/// Price each stretch: airborne at the model's power along the trajectory, ground at the idle
+/// power of that stretch (of the record when the power does not cover the stretch; 0 W without
+/// power). The measured energies are over the same stretches shifted by the lag.
 fn book(
     stretches: &[Stretch],
     (times, predicted_w): (&[f64], &[f64]),
     measured: Option<&Measured>,
 ) -> Books {
+    let (idle, idle_w) = measured.map_or((vec![None; stretches.len()], None), |m| {
+        idle_powers(stretches, m)
+    });
     let mut books = Books {
         airborne_s: 0.0,
         ground_s: 0.0,
         predicted_air_wh: 0.0,
         predicted_ground_wh: 0.0,
+        idle_w,
         measured: measured.map(|_| MeasuredBooks {
             air_wh: 0.0,
             ground_wh: 0.0,
         }),
         spans: Vec::new(),
     };
-    for st in stretches {
+    for (st, idle) in stretches.iter().zip(idle) {
         let (s, e) = (st.start_s, st.end_s);
-        let measured_wh = measured
-            .map(|m| window_integral(&m.times, &m.power_w, s + m.lag_s, e + m.lag_s) / 3600.0);
         if st.airborne {
             books.airborne_s += e - s;
             books.predicted_air_wh += window_integral(times, predicted_w, s, e) / 3600.0;
@@ -558,14 +583,14 @@ fn book(
             });
         } else {
             books.ground_s += e - s;
-            // idle power x duration = the stretch's measured energy
-            books.predicted_ground_wh += measured_wh.unwrap_or(0.0);
+            books.predicted_ground_wh += idle.or(idle_w).unwrap_or(0.0) * (e - s) / 3600.0;
         }
-        if let (Some(m), Some(wh)) = (books.measured.as_mut(), measured_wh) {
+        if let (Some(mb), Some(m)) = (books.measured.as_mut(), measured) {
+            let wh = window_integral(&m.times, &m.power_w, s + m.lag_s, e + m.lag_s) / 3600.0;
             if st.airborne {
-                m.air_wh += wh;
+                mb.air_wh += wh;
             } else {
-                m.ground_wh += wh;
+                mb.ground_wh += wh;
             }
         }
     }

@@ -34,6 +34,12 @@
 //! spin-up at take-off, the touch-down at landing). A hover near the ground is not ground-like
 //! when the log has power (it draws hover power); without power, a hover under 1 m that lasts 2 s
 //! is called ground, since nothing in such a log tells the two apart.
+//!
+//! **Gaps.** A landing seen on the first point after a gap in the record (no point for longer
+//! than [`GroundOptions::max_gap_s`], 5 s: logging stopped, as ArduPilot does while disarmed, or
+//! a dropout) is dated at the start of the gap: the record cannot say when in the gap the
+//! vehicle landed, and time it does not cover is not flown. A take-off after a gap is dated at
+//! its first point, as always.
 
 use serde::Serialize;
 
@@ -57,6 +63,8 @@ pub struct GroundOptions {
     pub min_ground_s: f64,
     /// Time of other points that makes a take-off, s.
     pub min_air_s: f64,
+    /// Longest interval between points that is not a gap, s.
+    pub max_gap_s: f64,
 }
 
 impl Default for GroundOptions {
@@ -68,6 +76,7 @@ impl Default for GroundOptions {
             idle_max_w: None,
             min_ground_s: 2.0,
             min_air_s: 1.0,
+            max_gap_s: 5.0,
         }
     }
 }
@@ -143,8 +152,10 @@ pub struct GroundDetector {
     on_ground: bool,
     /// Start of the current airborne span.
     since_s: f64,
-    /// First point of evidence against the current state.
-    candidate_s: Option<f64>,
+    /// First point of evidence against the current state, and the time of the point before it.
+    candidate_s: Option<(f64, f64)>,
+    /// Time of the last point.
+    last_s: f64,
     /// Height of the ground the vehicle last stood on, m.
     ground_up_m: Option<f64>,
 }
@@ -159,6 +170,7 @@ impl GroundDetector {
             on_ground: true,
             since_s: 0.0,
             candidate_s: None,
+            last_s: f64::NAN,
             ground_up_m: None,
         }
     }
@@ -182,15 +194,17 @@ impl GroundDetector {
         still && (idle.is_some() || low.is_some()) && idle != Some(false) && low != Some(false)
     }
 
-    /// The state becomes `ground` at `t`.
-    fn set(&mut self, ground: bool, t: f64) {
+    /// The state becomes `ground` at `t`, the point after one at `before_s` (a landing after a gap
+    /// is dated at the start of the gap).
+    fn set(&mut self, ground: bool, t: f64, before_s: f64) {
         if ground == self.on_ground {
             return;
         }
         if ground {
+            let gap = t - before_s > self.options.max_gap_s;
             self.report.airborne.push(Span {
                 start_s: self.since_s,
-                end_s: t,
+                end_s: if gap { before_s.max(self.since_s) } else { t },
             });
         } else {
             self.since_s = t;
@@ -211,13 +225,15 @@ impl GroundDetector {
             self.since_s = t;
         }
         self.report.last_s = t;
+        let before_s = if self.last_s.is_nan() { t } else { self.last_s };
+        self.last_s = t;
         if let Some(landed) = p.landed {
             self.report.logged_points += 1;
             self.candidate_s = None;
-            self.set(landed, t);
+            self.set(landed, t, before_s);
         } else {
             self.report.detected_points += 1;
-            self.detect(p);
+            self.detect(p, before_s);
         }
         if self.on_ground && self.candidate_s.is_none() {
             self.ground_up_m = p.up_m.or(self.ground_up_m);
@@ -225,12 +241,12 @@ impl GroundDetector {
     }
 
     /// One step of the detection with hysteresis.
-    fn detect(&mut self, p: &GroundPoint) {
+    fn detect(&mut self, p: &GroundPoint, before_s: f64) {
         if self.ground_like(p) == self.on_ground {
             self.candidate_s = None;
             return;
         }
-        let since = *self.candidate_s.get_or_insert(p.time_s);
+        let (since, since_before) = *self.candidate_s.get_or_insert((p.time_s, before_s));
         let needed = if self.on_ground {
             self.options.min_air_s
         } else {
@@ -238,7 +254,7 @@ impl GroundDetector {
         };
         if p.time_s - since >= needed {
             self.candidate_s = None;
-            self.set(!self.on_ground, since);
+            self.set(!self.on_ground, since, since_before);
         }
     }
 
@@ -395,6 +411,32 @@ mod tests {
             "{s:?}"
         );
         assert_eq!((r.logged_points, r.detected_points), (100, 0));
+    }
+
+    #[test]
+    fn a_landing_after_a_gap_is_dated_at_its_start() {
+        // Airborne (by the log) from 1 s; no point from 3 s to 60 s; landed from 60 s on.
+        let mut pts = Vec::new();
+        for k in 0..90 {
+            let t = if k < 30 {
+                k as f64 * 0.1
+            } else {
+                57.0 + k as f64 * 0.1
+            };
+            pts.push(GroundPoint {
+                time_s: t,
+                landed: Some(!(1.0 - 0.05..60.0 - 0.05).contains(&t)),
+                ..GroundPoint::default()
+            });
+        }
+        let r = run(GroundOptions::default(), &pts);
+        assert_eq!(r.airborne.len(), 1);
+        let s = r.airborne[0];
+        // The last point before the gap is at 2.9 s.
+        assert!(
+            (s.start_s - 1.0).abs() < 0.05 && (s.end_s - 2.9).abs() < 0.05,
+            "{s:?}"
+        );
     }
 
     #[test]
