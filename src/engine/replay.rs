@@ -196,7 +196,8 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         origin: path.clone(),
         source: Box::new(e),
     })?;
-    let hover_w = powered.level_power_w([0.0; 2], [0.0, 1.0])?;
+    // A vehicle that cannot hover at this mass has no idle threshold (power is then not used).
+    let hover_w = powered.level_power_w([0.0; 2], [0.0, 1.0]).ok();
     let ground = ground_time(&log, hover_w);
     let mut notes = Vec::new();
     let measured = measured_series(&log, request, &mut notes)?;
@@ -395,10 +396,11 @@ fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajecto
 /// The ground time of the log: its own landed state where it has one, else detected from height,
 /// speed and power, with a power under [`IDLE_FRACTION_OF_HOVER`] of the model's hover power
 /// `hover_w` counting as idle ([`aloft_logs::ground`]).
-fn ground_time(log: &Log, hover_w: f64) -> GroundReport {
+fn ground_time(log: &Log, hover_w: Option<f64>) -> GroundReport {
     let mut detector = GroundDetector::new(GroundOptions {
-        idle_max_w: (hover_w.is_finite() && hover_w > 0.0)
-            .then_some(IDLE_FRACTION_OF_HOVER * hover_w),
+        idle_max_w: hover_w
+            .filter(|w| w.is_finite() && *w > 0.0)
+            .map(|w| IDLE_FRACTION_OF_HOVER * w),
         ..GroundOptions::default()
     });
     for s in &log.samples {
