@@ -28,7 +28,8 @@ pub struct MissionArgs {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
     pub vehicle: String,
-    /// Battery pack by name (default: the vehicle's default pack).
+    /// Battery pack by name (default: the vehicle's default pack). With --replay, the pack flown
+    /// in the log: its mass is part of the mass flown (airframe + pack + payload).
     #[arg(long)]
     pub battery: Option<String>,
     /// Payload at take-off, kg (overrides the mission file).
@@ -82,7 +83,7 @@ pub struct MissionArgs {
     #[arg(
         long,
         value_name = "LOG",
-        conflicts_with_all = ["mission", "timeseries", "plot", "mcap", "battery"]
+        conflicts_with_all = ["mission", "timeseries", "plot", "mcap"]
     )]
     pub replay: Option<PathBuf>,
     /// Log layout for --replay: kaist, px4 or a column-map TOML (default: detected).

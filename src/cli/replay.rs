@@ -31,6 +31,7 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
         acceleration_window_s: args.acceleration_window,
         aoa: args.aoa,
         wind: args.wind.steady.spec(),
+        battery: args.battery.clone(),
     };
     let answer = replay_log(&vehicle, &request)?;
     for n in &answer.context.notes {
@@ -46,9 +47,13 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
 }
 
 fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
+    let pack = a
+        .battery
+        .as_deref()
+        .map_or(String::new(), |b| format!(" with pack {b}"));
     writeln!(
         out,
-        "Replay of {}: {} trajectory points, {:.0} s, vehicle {} at {:.3} kg",
+        "Replay of {}: {} trajectory points, {:.0} s, vehicle {}{pack} at {:.3} kg",
         a.file, a.points, a.duration_s, a.vehicle, a.mass_kg
     )?;
     writeln!(
@@ -56,32 +61,71 @@ fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
         "Acceleration: {}; wind: {}",
         a.context.acceleration, a.context.wind
     )?;
-    writeln!(out)?;
-    let mut rows = vec![Row::new(
-        "predicted energy (trajectory only)",
-        format!("{:.1}", a.predicted_energy_wh),
-        "Wh",
-    )];
-    match a.measured_energy_wh {
-        Some(m) => {
-            rows.push(Row::new("measured energy (V x I)", format!("{m:.1}"), "Wh"));
-            rows.push(Row::new(
-                "error",
-                format!("{:+.2}", a.energy_error_percent.unwrap_or(0.0)),
-                "%",
-            ));
-            rows.push(Row::new(
-                "lag of power behind motion",
-                format!("{:.2}", a.lag_s.unwrap_or(0.0)),
-                "s",
-            ));
+    writeln!(
+        out,
+        "{} flight(s): {:.1} s airborne, {:.1} s on the ground ({}){}",
+        a.flights,
+        a.airborne_s,
+        a.ground_s,
+        match a.ground_source {
+            "log" => "the log's landed state",
+            "detected" => "detected from height, speed and power",
+            _ => "the log's landed state, detected where it has none",
+        },
+        match a.idle_power_w {
+            Some(w) => format!(", priced at the measured idle {w:.1} W"),
+            None if a.ground_s > 0.0 => ", priced at 0 W (no power in the log)".to_string(),
+            None => String::new(),
         }
-        None => rows.push(Row::new(
+    )?;
+    writeln!(out)?;
+    output::write_table(out, "Replay", &energy_rows(a))?;
+    Ok(())
+}
+
+/// The energy rows: predicted and measured, airborne and on the ground.
+fn energy_rows(a: &ReplayAnswer) -> Vec<Row<'_>> {
+    let wh = |x: f64| format!("{x:.2}");
+    let mut rows = vec![
+        Row::new(
+            "predicted energy, airborne (trajectory only)",
+            wh(a.predicted_airborne_energy_wh),
+            "Wh",
+        ),
+        Row::new(
+            "predicted energy, on the ground (idle)",
+            wh(a.predicted_ground_energy_wh),
+            "Wh",
+        ),
+        Row::new("predicted energy", wh(a.predicted_energy_wh), "Wh"),
+    ];
+    let Some(m) = a.measured_energy_wh else {
+        rows.push(Row::new(
             "measured energy",
             "no power in the log".to_string(),
             "",
-        )),
+        ));
+        return rows;
+    };
+    if let Some(air) = a.measured_airborne_energy_wh {
+        rows.push(Row::new("measured energy, airborne", wh(air), "Wh"));
     }
-    output::write_table(out, "Replay", &rows)?;
-    Ok(())
+    if let Some(g) = a.measured_ground_energy_wh {
+        rows.push(Row::new("measured energy, on the ground", wh(g), "Wh"));
+    }
+    rows.push(Row::new("measured energy (V x I)", wh(m), "Wh"));
+    if let Some(e) = a.airborne_energy_error_percent {
+        rows.push(Row::new("error, airborne", format!("{e:+.2}"), "%"));
+    }
+    rows.push(Row::new(
+        "error",
+        format!("{:+.2}", a.energy_error_percent.unwrap_or(0.0)),
+        "%",
+    ));
+    rows.push(Row::new(
+        "lag of power behind motion",
+        format!("{:.2}", a.lag_s.unwrap_or(0.0)),
+        "s",
+    ));
+    rows
 }

@@ -2,13 +2,20 @@
 //! accelerations differentiated from them or taken from the log, through the planner's force
 //! balance and power model; no power data used), next to the measured energy (V x I over the
 //! same span, shifted by the lag of power behind motion).
+//!
+//! Ground time is not flown: a record that starts before take-off, holds several flights or goes
+//! on after landing has its ground time found ([`aloft_logs::ground`]: the log's own landed state
+//! where it has one, else detected from height, speed and power) and priced at the measured idle
+//! power of each ground stretch (0 W when the log has no power), so the prediction is the
+//! model's only where the vehicle flies. Airborne and ground time and energy are reported apart.
 
 use std::path::PathBuf;
 
 use serde::Serialize;
 
 use aloft_core::trapezoid;
-use aloft_logs::Log;
+use aloft_logs::ground::IDLE_FRACTION_OF_HOVER;
+use aloft_logs::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Log};
 use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint};
 use aloft_power::{AoaModel, ModelOptions};
 
@@ -47,6 +54,9 @@ pub struct ReplayRequest {
     pub aoa: AoaModel,
     /// Wind where the log has none (default still air).
     pub wind: Option<aloft_planner::WindSpec>,
+    /// The pack flown, by name (`None`: the vehicle's default pack); its mass is part of the
+    /// mass flown.
+    pub battery: Option<String>,
 }
 
 impl Default for ReplayRequest {
@@ -60,17 +70,25 @@ impl Default for ReplayRequest {
             acceleration_window_s: 1.0,
             aoa: AoaModel::Geometric,
             wind: None,
+            battery: None,
         }
     }
 }
 
 /// The answer of [`replay_log`] (the JSON of `aloft mission --replay --format json`).
+///
+/// The span compared is split into airborne time, flown through the power model, and ground time
+/// (before, between and after flights), priced at the measured idle power; the energies of the
+/// two parts add up to the totals.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReplayAnswer {
     /// The log.
     pub file: String,
     /// Vehicle name.
     pub vehicle: String,
+    /// The pack flown (its mass is part of `mass_kg`); absent for a `[power]`-only vehicle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery: Option<String>,
     /// Mass flown, kg.
     pub mass_kg: f64,
     /// Trajectory points replayed.
@@ -82,7 +100,7 @@ pub struct ReplayAnswer {
     /// Lag of power behind motion applied, s.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lag_s: Option<f64>,
-    /// Predicted energy over the span, Wh.
+    /// Predicted energy over the span, Wh: airborne from the trajectory, ground at idle.
     pub predicted_energy_wh: f64,
     /// Predicted mean power, W.
     pub predicted_mean_power_w: f64,
@@ -95,6 +113,35 @@ pub struct ReplayAnswer {
     /// `(predicted - measured) / measured`, percent.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub energy_error_percent: Option<f64>,
+    /// Flights (airborne spans) in the span.
+    pub flights: usize,
+    /// Airborne time in the span, s.
+    pub airborne_s: f64,
+    /// Ground time in the span (before, between and after flights), s.
+    pub ground_s: f64,
+    /// Where the ground time comes from: `log` (the log's landed state), `detected` (height,
+    /// speed and power) or `log_and_detected` (the log's state where it has one).
+    pub ground_source: &'static str,
+    /// Mean measured power on the ground over the record, W, over the ground time's own span
+    /// (not shifted by the lag); absent without power or ground time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub idle_power_w: Option<f64>,
+    /// Predicted energy of the airborne time, Wh (from the trajectory alone).
+    pub predicted_airborne_energy_wh: f64,
+    /// Predicted energy of the ground time, Wh: each ground stretch at its own mean measured
+    /// power (the record's where the power does not cover it), 0 without power.
+    pub predicted_ground_energy_wh: f64,
+    /// Measured energy of the airborne time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured_airborne_energy_wh: Option<f64>,
+    /// Measured energy of the ground time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured_ground_energy_wh: Option<f64>,
+    /// `(predicted - measured) / measured` of the airborne time, percent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub airborne_energy_error_percent: Option<f64>,
+    /// The airborne spans, s from the start of the log.
+    pub airborne_spans: Vec<aloft_logs::Span>,
     /// The acceleration source and the wind, in words (not part of the JSON).
     #[serde(skip)]
     pub context: ReplayContext,
@@ -117,24 +164,29 @@ struct Trajectory {
     points: Vec<ReplayPoint>,
 }
 
+/// The aircraft flown and its mass.
+struct Flown {
+    aircraft: aloft_planner::Aircraft,
+    mass_kg: f64,
+    battery: Option<String>,
+}
+
 /// Replay the flight of `request.log` with `vehicle` (see the module docs). A vehicle with an
-/// airframe flies at airframe + default pack + payload; one with only a `[power]` table (a fit)
-/// at that table's mass + payload.
+/// airframe flies at airframe + pack (`request.battery`, else its default) + payload; one with
+/// only a `[power]` table (a fit) at that table's mass + payload.
+///
+/// Steps: the aircraft at its mass, the log, the trajectory, the model's power along it, the
+/// ground time, the measured power, the span both cover, the books of air and ground.
 ///
 /// # Errors
-/// An invalid payload, window or wind, an unreadable log, a log with fewer than two velocity
-/// samples, no acceleration in the log when asked for it, a power channel that does not overlap
-/// the trajectory.
+/// An invalid payload, window or wind, an unknown pack (or a pack for a vehicle without an
+/// airframe), an unreadable log, a log with fewer than two velocity samples, no acceleration in
+/// the log when asked for it, a power channel that does not overlap the trajectory.
 pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAnswer, Error> {
-    let (aircraft, mass_kg) = replay_aircraft(vehicle, request)?;
-    let powered = aircraft.at_mass(mass_kg, request.aoa)?;
-    let profile = request
-        .profile
-        .as_deref()
-        .map(aloft_logs::Profile::resolve)
-        .transpose()?;
-    let log = aloft_logs::read_log(&request.log, profile.as_ref(), &Default::default())?;
+    let flown = replay_aircraft(vehicle, request)?;
+    let powered = flown.aircraft.at_mass(flown.mass_kg, request.aoa)?;
     let path = request.log.display().to_string();
+    let log = read_replay_log(request)?;
     let trajectory = trajectory(&log, request, &path)?;
     let (wind, wind_text) = match &request.wind {
         Some(w) => (steady(w)?, describe_wind_spec(w)),
@@ -144,26 +196,63 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         origin: path.clone(),
         source: Box::new(e),
     })?;
+    // A vehicle that cannot hover at this mass has no idle threshold (power is then not used).
+    let hover_w = powered.level_power_w([0.0; 2], [0.0, 1.0]).ok();
+    let ground = ground_time(&log, hover_w);
     let mut notes = Vec::new();
-    let measured = measured_span(
-        &log,
-        request,
-        &trajectory.times,
-        &report.power_w,
-        &mut notes,
-        &path,
-    )?;
-    let (lag_s, measured_wh, predicted_wh, span_s) = match measured {
-        Some(m) => (Some(m.lag_s), Some(m.measured_wh), m.predicted_wh, m.span_s),
-        None => (None, None, report.energy_wh, report.duration_s),
-    };
-    let error = measured_wh.map(|m| 100.0 * (predicted_wh - m) / m);
+    let measured = measured_series(&log, request, &mut notes)?;
+    let window = compared_window(&trajectory.times, measured.as_ref(), &path)?;
+    let books = book(
+        &stretches(&ground, window),
+        (&trajectory.times, &report.power_w),
+        measured.as_ref(),
+    );
     let logged_wind = trajectory.points.iter().any(|p| p.wind_enu_mps.is_some());
-    let answer = ReplayAnswer {
-        file: path,
+    let context = ReplayContext {
+        acceleration: match request.acceleration {
+            ReplayAcceleration::Velocity => format!(
+                "differentiated velocity over {} s",
+                request.acceleration_window_s
+            ),
+            ReplayAcceleration::Log => "the log's".to_string(),
+        },
+        wind: if logged_wind {
+            "from the log".to_string()
+        } else {
+            wind_text
+        },
+        notes,
+    };
+    let answer = answer(
+        vehicle,
+        request,
+        flown,
+        (trajectory.points.len(), measured.map(|m| m.lag_s)),
+        (&ground, books, window),
+        context,
+    );
+    finite(answer, "replay", || request.log.display().to_string())
+}
+
+/// The answer from its parts (the keys documented on [`ReplayAnswer`]).
+fn answer(
+    vehicle: &Vehicle,
+    request: &ReplayRequest,
+    flown: Flown,
+    (points, lag_s): (usize, Option<f64>),
+    (ground, books, (a, b)): (&GroundReport, Books, (f64, f64)),
+    context: ReplayContext,
+) -> ReplayAnswer {
+    let span_s = b - a;
+    let predicted_wh = books.predicted_air_wh + books.predicted_ground_wh;
+    let measured_wh = books.measured.map(|m| m.air_wh + m.ground_wh);
+    let percent = |p: f64, m: f64| (m > 0.0).then(|| 100.0 * (p - m) / m);
+    ReplayAnswer {
+        file: request.log.display().to_string(),
         vehicle: vehicle.name().to_string(),
-        mass_kg,
-        points: trajectory.points.len(),
+        battery: flown.battery,
+        mass_kg: flown.mass_kg,
+        points,
         duration_s: span_s,
         acceleration: match request.acceleration {
             ReplayAcceleration::Velocity => "velocity",
@@ -174,32 +263,32 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         predicted_mean_power_w: predicted_wh * 3600.0 / span_s,
         measured_energy_wh: measured_wh,
         measured_mean_power_w: measured_wh.map(|m| m * 3600.0 / span_s),
-        energy_error_percent: error,
-        context: ReplayContext {
-            acceleration: match request.acceleration {
-                ReplayAcceleration::Velocity => format!(
-                    "differentiated velocity over {} s",
-                    request.acceleration_window_s
-                ),
-                ReplayAcceleration::Log => "the log's".to_string(),
-            },
-            wind: if logged_wind {
-                "from the log".to_string()
-            } else {
-                wind_text
-            },
-            notes,
+        energy_error_percent: measured_wh.and_then(|m| percent(predicted_wh, m)),
+        flights: books.spans.len(),
+        airborne_s: books.airborne_s,
+        ground_s: books.ground_s,
+        ground_source: match (ground.logged_points, ground.detected_points) {
+            (_, 0) => "log",
+            (0, _) => "detected",
+            _ => "log_and_detected",
         },
-    };
-    finite(answer, "replay", || request.log.display().to_string())
+        idle_power_w: books.idle_w.filter(|_| books.ground_s > 0.0),
+        predicted_airborne_energy_wh: books.predicted_air_wh,
+        predicted_ground_energy_wh: books.predicted_ground_wh,
+        measured_airborne_energy_wh: books.measured.map(|m| m.air_wh),
+        measured_ground_energy_wh: books.measured.map(|m| m.ground_wh),
+        airborne_energy_error_percent: books
+            .measured
+            .and_then(|m| percent(books.predicted_air_wh, m.air_wh)),
+        airborne_spans: books.spans,
+        context,
+    }
 }
 
-/// The aircraft at its replay mass: airframe + default pack + payload, or a `[power]`-only
-/// vehicle at its table's mass + payload.
-fn replay_aircraft(
-    vehicle: &Vehicle,
-    request: &ReplayRequest,
-) -> Result<(aloft_planner::Aircraft, f64), Error> {
+/// The aircraft at its replay mass: airframe + pack (the one named, else the default) +
+/// payload, as a planned mission flies, or a `[power]`-only vehicle at its table's mass + payload
+/// (that mass already is the whole vehicle: naming a pack for it is an error).
+fn replay_aircraft(vehicle: &Vehicle, request: &ReplayRequest) -> Result<Flown, Error> {
     let payload = request.payload_kg;
     if !(payload.is_finite() && payload >= 0.0) {
         return Err(Error::InvalidInput {
@@ -210,21 +299,49 @@ fn replay_aircraft(
         });
     }
     let file = vehicle.file();
-    let (aircraft, mass_kg) = if file.airframe.is_some() {
-        let aircraft = vehicle.aircraft()?.clone();
-        let pack = if file.batteries.is_empty() {
-            0.0
-        } else {
-            vehicle.battery(None)?.mass_kg()
-        };
-        let m = aircraft.airframe().mass_kg() + pack + payload;
-        (aircraft, m)
-    } else {
+    if file.airframe.is_none() {
+        if request.battery.is_some() {
+            return Err(Error::MissingTable {
+                vehicle: vehicle.name().to_string(),
+                table: "airframe",
+                needed_for: "--battery with --replay (a [power]-only vehicle's mass is the whole vehicle, pack included)",
+            });
+        }
         let power = vehicle.power_model()?.vehicle().clone();
-        let m = power.mass_kg() + payload;
-        (power_only_aircraft(power, ModelOptions::default())?, m)
+        let mass_kg = power.mass_kg() + payload;
+        return Ok(Flown {
+            aircraft: power_only_aircraft(power, ModelOptions::default())?,
+            mass_kg,
+            battery: None,
+        });
+    }
+    let aircraft = vehicle.aircraft()?.clone();
+    let pack = if file.batteries.is_empty() && request.battery.is_none() {
+        None
+    } else {
+        Some(vehicle.battery(request.battery.as_deref())?)
     };
-    Ok((aircraft, mass_kg))
+    let mass_kg =
+        aircraft.airframe().mass_kg() + pack.as_ref().map_or(0.0, |p| p.mass_kg()) + payload;
+    Ok(Flown {
+        aircraft,
+        mass_kg,
+        battery: pack.map(|p| p.name().to_string()),
+    })
+}
+
+/// The log, read whole (the replay needs every sample twice: the trajectory and the power).
+fn read_replay_log(request: &ReplayRequest) -> Result<Log, Error> {
+    let profile = request
+        .profile
+        .as_deref()
+        .map(aloft_logs::Profile::resolve)
+        .transpose()?;
+    Ok(aloft_logs::read_log(
+        &request.log,
+        profile.as_ref(),
+        &Default::default(),
+    )?)
 }
 
 /// The samples with a velocity, strictly increasing in time, with their accelerations.
@@ -276,35 +393,46 @@ fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajecto
     Ok(Trajectory { times, points })
 }
 
-/// The measured and predicted energy over the span both cover.
-struct MeasuredSpan {
-    lag_s: f64,
-    measured_wh: f64,
-    predicted_wh: f64,
-    span_s: f64,
+/// The ground time of the log: its own landed state where it has one, else detected from height,
+/// speed and power, with a power under [`IDLE_FRACTION_OF_HOVER`] of the model's hover power
+/// `hover_w` counting as idle ([`aloft_logs::ground`]).
+fn ground_time(log: &Log, hover_w: Option<f64>) -> GroundReport {
+    let mut detector = GroundDetector::new(GroundOptions {
+        idle_max_w: hover_w
+            .filter(|w| w.is_finite() && *w > 0.0)
+            .map(|w| IDLE_FRACTION_OF_HOVER * w),
+        ..GroundOptions::default()
+    });
+    for s in &log.samples {
+        detector.push(&GroundPoint::from(s));
+    }
+    detector.finish()
 }
 
-/// Measured energy (V x I) over the trajectory's span shifted by the lag, and the predicted
-/// energy over the same span; `None` when the log has no usable power channel.
-fn measured_span(
+/// The measured power (V x I) and the lag of power behind motion.
+struct Measured {
+    times: Vec<f64>,
+    power_w: Vec<f64>,
+    lag_s: f64,
+}
+
+/// The log's measured power and its lag; `None` when the log has no usable power channel.
+fn measured_series(
     log: &Log,
     request: &ReplayRequest,
-    times: &[f64],
-    predicted_w: &[f64],
     notes: &mut Vec<String>,
-    path: &str,
-) -> Result<Option<MeasuredSpan>, Error> {
-    let (pt, pp): (Vec<f64>, Vec<f64>) = log
+) -> Result<Option<Measured>, Error> {
+    let (times, power_w): (Vec<f64>, Vec<f64>) = log
         .samples
         .iter()
         .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
         .filter(|(t, p)| t.is_finite() && p.is_finite())
         .unzip();
-    let monotonic = pt.windows(2).all(|w| w[1] >= w[0]);
-    if pt.len() < 2 || !monotonic {
+    let monotonic = times.windows(2).all(|w| w[1] >= w[0]);
+    if times.len() < 2 || !monotonic {
         return Ok(None);
     }
-    let lag = match request.lag_s {
+    let lag_s = match request.lag_s {
         Some(l) => l,
         None => match align_flight(log, &AlignOptions::default()) {
             Ok(a) => a.lag_s,
@@ -314,20 +442,161 @@ fn measured_span(
             }
         },
     };
-    let a = times[0].max(pt[0] - lag);
-    let b = times[times.len() - 1].min(pt[pt.len() - 1] - lag);
-    if b <= a {
-        return Err(Error::NoOverlap {
-            origin: path.to_string(),
-            lag_s: lag,
+    Ok(Some(Measured {
+        times,
+        power_w,
+        lag_s,
+    }))
+}
+
+/// The span compared, in trajectory time: the trajectory, within the measured power shifted by
+/// the lag when there is power.
+fn compared_window(
+    times: &[f64],
+    measured: Option<&Measured>,
+    path: &str,
+) -> Result<(f64, f64), Error> {
+    let (mut a, mut b) = (times[0], times[times.len() - 1]);
+    if let Some(m) = measured {
+        a = a.max(m.times[0] - m.lag_s);
+        b = b.min(m.times[m.times.len() - 1] - m.lag_s);
+        if b <= a {
+            return Err(Error::NoOverlap {
+                origin: path.to_string(),
+                lag_s: m.lag_s,
+            });
+        }
+    }
+    Ok((a, b))
+}
+
+/// One part of the span: airborne or on the ground.
+struct Stretch {
+    start_s: f64,
+    end_s: f64,
+    airborne: bool,
+}
+
+/// The span `[a, b]` cut into airborne and ground stretches (each longer than zero).
+fn stretches(ground: &GroundReport, (a, b): (f64, f64)) -> Vec<Stretch> {
+    let mut out = Vec::new();
+    let mut at = a;
+    for span in &ground.airborne {
+        let (s, e) = (span.start_s.max(a), span.end_s.min(b));
+        if e <= s {
+            continue;
+        }
+        if s > at {
+            out.push(Stretch {
+                start_s: at,
+                end_s: s,
+                airborne: false,
+            });
+        }
+        out.push(Stretch {
+            start_s: s,
+            end_s: e,
+            airborne: true,
+        });
+        at = e;
+    }
+    if b > at {
+        out.push(Stretch {
+            start_s: at,
+            end_s: b,
+            airborne: false,
         });
     }
-    Ok(Some(MeasuredSpan {
-        lag_s: lag,
-        measured_wh: window_integral(&pt, &pp, a + lag, b + lag) / 3600.0,
-        predicted_wh: window_integral(times, predicted_w, a, b) / 3600.0,
-        span_s: b - a,
-    }))
+    out
+}
+
+/// Measured energy of the airborne and ground time, Wh.
+#[derive(Debug, Clone, Copy)]
+struct MeasuredBooks {
+    air_wh: f64,
+    ground_wh: f64,
+}
+
+/// The energy books of a replay: airborne time through the model, ground time at idle.
+struct Books {
+    airborne_s: f64,
+    ground_s: f64,
+    predicted_air_wh: f64,
+    predicted_ground_wh: f64,
+    /// Mean measured power on the ground over the record, W.
+    idle_w: Option<f64>,
+    measured: Option<MeasuredBooks>,
+    spans: Vec<aloft_logs::Span>,
+}
+
+/// The idle power of each stretch (`None` for airborne ones and for ground ones the power does
+/// not cover) and of the record: the mean measured power over the stretch's own time (not
+/// shifted by the lag, which relates power to motion, and at rest there is no motion).
+fn idle_powers(stretches: &[Stretch], m: &Measured) -> (Vec<Option<f64>>, Option<f64>) {
+    let (t0, t1) = (m.times[0], m.times[m.times.len() - 1]);
+    let (mut joules, mut seconds) = (0.0, 0.0);
+    let each = stretches
+        .iter()
+        .map(|st| {
+            let (s, e) = (st.start_s.max(t0), st.end_s.min(t1));
+            if st.airborne || e <= s {
+                return None;
+            }
+            let j = window_integral(&m.times, &m.power_w, s, e);
+            joules += j;
+            seconds += e - s;
+            Some(j / (e - s))
+        })
+        .collect();
+    (each, (seconds > 0.0).then(|| joules / seconds))
+}
+
+/// Price each stretch: airborne at the model's power along the trajectory, ground at the idle
+/// power of that stretch (of the record when the power does not cover the stretch; 0 W without
+/// power). The measured energies are over the same stretches shifted by the lag.
+fn book(
+    stretches: &[Stretch],
+    (times, predicted_w): (&[f64], &[f64]),
+    measured: Option<&Measured>,
+) -> Books {
+    let (idle, idle_w) = measured.map_or((vec![None; stretches.len()], None), |m| {
+        idle_powers(stretches, m)
+    });
+    let mut books = Books {
+        airborne_s: 0.0,
+        ground_s: 0.0,
+        predicted_air_wh: 0.0,
+        predicted_ground_wh: 0.0,
+        idle_w,
+        measured: measured.map(|_| MeasuredBooks {
+            air_wh: 0.0,
+            ground_wh: 0.0,
+        }),
+        spans: Vec::new(),
+    };
+    for (st, idle) in stretches.iter().zip(idle) {
+        let (s, e) = (st.start_s, st.end_s);
+        if st.airborne {
+            books.airborne_s += e - s;
+            books.predicted_air_wh += window_integral(times, predicted_w, s, e) / 3600.0;
+            books.spans.push(aloft_logs::Span {
+                start_s: s,
+                end_s: e,
+            });
+        } else {
+            books.ground_s += e - s;
+            books.predicted_ground_wh += idle.or(idle_w).unwrap_or(0.0) * (e - s) / 3600.0;
+        }
+        if let (Some(mb), Some(m)) = (books.measured.as_mut(), measured) {
+            let wh = window_integral(&m.times, &m.power_w, s + m.lag_s, e + m.lag_s) / 3600.0;
+            if st.airborne {
+                mb.air_wh += wh;
+            } else {
+                mb.ground_wh += wh;
+            }
+        }
+    }
+    books
 }
 
 /// Integral of the piecewise-linear `values(times)` over `[a, b]` (inside the data).

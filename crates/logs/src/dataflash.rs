@@ -17,6 +17,13 @@
 //!   `CURR` integers have no multiplier in the file: their scale (centi-units in the logs seen)
 //!   is chosen so the first non-zero voltage is 3.3-4.4 V per cell for some 1-14 cells. A
 //!   record counts when `Volt` > 0 (a battery that reads 0 V has no sensor).
+//! - The landed state ([`Sample::landed`]): `EV` events armed (10), disarmed (11) and land
+//!   complete (18) mean on the ground, not landed (28) in the air (the ids of ArduPilot's
+//!   `LogEvent`, kept stable across versions); an `ARM` record (armed or disarmed) means on the
+//!   ground (ArduCopter arms and disarms landed). Land complete maybe (17) is left out: the
+//!   vehicle may still be sliding or bouncing. `MODE` is not read for it: a flight mode says how
+//!   the vehicle is flown, not whether it is on the ground. An `EV` without a time stamp (old
+//!   logs) takes the boot time of the record before it (records are written in time order).
 //! - `PARM` (`BATT_CAPACITY`), `CTUN`, `MODE`, `CMD`: counted (and decoded by [`DataflashRecords`]).
 //!
 //! # Time
@@ -215,6 +222,8 @@ enum Role {
     Gps,
     Bat,
     Curr,
+    Event,
+    Arm,
     Parm,
     Fmtu,
     Mult,
@@ -229,6 +238,8 @@ fn role(name: &str) -> Role {
         "GPS" => Role::Gps,
         "BAT" => Role::Bat,
         "CURR" => Role::Curr,
+        "EV" => Role::Event,
+        "ARM" => Role::Arm,
         "PARM" => Role::Parm,
         "FMTU" => Role::Fmtu,
         "MULT" => Role::Mult,
@@ -401,6 +412,10 @@ pub struct DataflashDecoder {
     has_pos: bool,
     curr_scale: Option<f64>,
     untimed: u64,
+    /// Boot time of the last timed record read, s (for events without a time of their own).
+    last_time_s: Option<f64>,
+    /// Whether `EV` or `ARM` is declared.
+    events_declared: bool,
 }
 
 /// Boot time of a record, s: `TimeUS`, else `TimeMS` (not for GPS), else GPS `T` (ms). A time
@@ -438,6 +453,8 @@ impl DataflashDecoder {
             has_pos: false,
             curr_scale: None,
             untimed: 0,
+            last_time_s: None,
+            events_declared: false,
         }
     }
 
@@ -473,11 +490,13 @@ impl DataflashDecoder {
                     s.battery_capacity_ah = crate::binary::capacity_ah(v).or(s.battery_capacity_ah);
                 }
             }
+            Role::Event | Role::Arm => return self.landed(r, f, p),
             Role::Att | Role::Pos | Role::Gps | Role::Bat | Role::Curr => {
                 let Some(time_s) = boot_time_s(f, p) else {
                     self.untimed += 1;
                     return None;
                 };
+                self.last_time_s = Some(time_s);
                 let (stream, sample) = match r {
                     Role::Att => (Stream::Base, self.attitude(f, p)?),
                     Role::Pos => (Stream::Position, self.position(f, p)?),
@@ -493,6 +512,28 @@ impl DataflashDecoder {
             Role::Counted | Role::Other => {}
         }
         None
+    }
+
+    /// The landed state of an `EV` or `ARM` record (see the module docs), at its own time or
+    /// that of the record before it.
+    fn landed(&mut self, r: Role, f: &Format, p: &[u8]) -> Option<Event> {
+        let landed = match r {
+            Role::Arm => true,
+            _ => match f.num(p, "Id")? as u8 {
+                10 | 11 | 18 => true,
+                28 => false,
+                _ => return None,
+            },
+        };
+        let time_s = boot_time_s(f, p).or(self.last_time_s)?;
+        Some(Event {
+            time_s,
+            stream: Stream::Landed,
+            sample: Sample {
+                landed: Some(landed),
+                ..Sample::default()
+            },
+        })
     }
 
     fn attitude(&self, f: &Format, p: &[u8]) -> Option<Sample> {
@@ -623,6 +664,7 @@ impl DataflashDecoder {
         self.has_bat = names("BAT");
         self.has_pos = names("POS");
         s.battery_declared = self.has_bat || names("CURR");
+        self.events_declared = names("EV") || names("ARM");
     }
 }
 
@@ -643,7 +685,16 @@ impl Decoder for DataflashDecoder {
                 return None;
             };
             if t == FMT_TYPE {
+                let before = self.events_declared;
                 self.declare(s);
+                if self.events_declared && !before {
+                    // The join waits for the landed state from here (see `Stream::Landed`).
+                    return Some(Event {
+                        time_s: 0.0,
+                        stream: Stream::Landed,
+                        sample: Sample::default(),
+                    });
+                }
                 continue;
             }
             if let Some(e) = self.event(t, s) {
@@ -787,6 +838,55 @@ mod tests {
             "{:?}",
             s.warnings
         );
+    }
+
+    /// Arming and landing events become the landed state of the samples after them; an event
+    /// without a time stamp (old logs) takes the time of the record before it.
+    #[test]
+    fn events_give_the_landed_state() {
+        let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+        b.extend(dataflash_fmt(
+            1,
+            3 + 8 + 12,
+            "ATT",
+            "Qfff",
+            "TimeUS,Roll,Pitch,Yaw",
+        ));
+        b.extend(dataflash_fmt(2, 3 + 8 + 1, "EV", "QB", "TimeUS,Id"));
+        b.extend(dataflash_fmt(3, 3 + 1, "EV", "B", "Id"));
+        let ev = |t_us: u64, id: u8| {
+            let mut r = vec![0xA3, 0x95, 2];
+            r.extend(t_us.to_le_bytes());
+            r.push(id);
+            r
+        };
+        // Samples at 0.0, 0.1, ... 5.9 s; armed at 1 s, not landed at 2 s, land complete at
+        // 4 s (an event with no time of its own, after the ATT record at 4.0 s), disarmed at
+        // 5 s; 17 (land complete maybe) and 15 (auto armed) change nothing.
+        for k in 0..60u64 {
+            let t = k * 100_000;
+            b.extend(dataflash_record(1, t, &[0.0, 0.0, 0.0]));
+            match k {
+                10 => b.extend(ev(t, 10)),
+                15 => b.extend(ev(t, 15)),
+                20 => b.extend(ev(t, 28)),
+                38 => b.extend(ev(t, 17)),
+                40 => b.extend([0xA3, 0x95, 3, 18]),
+                50 => b.extend(ev(t, 11)),
+                _ => {}
+            }
+        }
+        let r = read_dataflash(&b[..], &BinaryOptions::default()).unwrap();
+        let s = &r.log.samples;
+        assert_eq!(s.len(), 60);
+        for (k, x) in s.iter().enumerate() {
+            let want = match k {
+                0..10 => None,
+                20..40 => Some(false),
+                _ => Some(true),
+            };
+            assert_eq!(x.landed, want, "sample {k}");
+        }
     }
 
     /// Fuzz finding `fixtures/fuzz/dataflash/f70328e305c524bd.bin`: a `BATT_CAPACITY` of

@@ -9,7 +9,8 @@
 //! records of that stream, never across an interval longer than the bracket, never extrapolated.
 //!
 //! # Memory
-//! A base record waits until every other stream has a record at or after its time, or until the
+//! A base record waits until every other stream (the landed state too, once it has a record) has
+//! a record at or after its time, or until the
 //! base stream has moved [`Joiner::SETTLE_S`] past it (a record that late could only bracket an
 //! interval longer than the bracket), or until [`Joiner::MAX_PENDING`] records wait. Other
 //! streams keep only the records a waiting base record can still use. Memory is bounded by the
@@ -38,6 +39,9 @@ pub enum Stream {
     Wind,
     /// Battery voltage and current.
     Battery,
+    /// The landed state ([`Sample::landed`]), held from one record to the next. A record
+    /// without a state declares that the log has the stream.
+    Landed,
 }
 
 const SECONDARY: [Stream; 5] = [
@@ -110,6 +114,9 @@ pub struct Joiner {
     max_bracket_s: f64,
     pending: VecDeque<(f64, Sample)>,
     tracks: [Track; 5],
+    /// Landed-state records a waiting base record may still need, in time order.
+    landed: VecDeque<(f64, bool)>,
+    landed_seen: bool,
     base_latest_s: f64,
     ready: VecDeque<(f64, Sample)>,
 }
@@ -127,6 +134,8 @@ impl Joiner {
             max_bracket_s,
             pending: VecDeque::new(),
             tracks: Default::default(),
+            landed: VecDeque::new(),
+            landed_seen: false,
             base_latest_s: f64::NEG_INFINITY,
             ready: VecDeque::new(),
         }
@@ -150,6 +159,17 @@ impl Joiner {
                 .map_or(0, |i| i + 1);
             self.pending.insert(at, (e.time_s, e.sample));
             self.base_latest_s = self.base_latest_s.max(e.time_s);
+        } else if e.stream == Stream::Landed {
+            // A record without a state declares the stream: base records wait for it from now.
+            self.landed_seen = true;
+            if let Some(l) = e.sample.landed {
+                let at = self
+                    .landed
+                    .iter()
+                    .rposition(|(u, _)| *u <= e.time_s)
+                    .map_or(0, |i| i + 1);
+                self.landed.insert(at, (e.time_s, l));
+            }
         } else if let Some(t) = self.track(e.stream) {
             t.insert(e.time_s, e.sample);
         }
@@ -170,7 +190,9 @@ impl Joiner {
         while let Some(&(t, _)) = self.pending.front() {
             let waited_out = self.base_latest_s >= t + self.max_bracket_s + Self::SETTLE_S
                 || self.pending.len() > Self::MAX_PENDING;
-            let covered = self.tracks.iter().all(|k| !k.seen || k.covers(t));
+            // A state record at or after `t` settles the state at `t` (sparse events wait out).
+            let covered = self.tracks.iter().all(|k| !k.seen || k.covers(t))
+                && (!self.landed_seen || self.landed.back().is_some_and(|(u, _)| *u >= t));
             if !(all || waited_out || covered) {
                 return;
             }
@@ -180,11 +202,22 @@ impl Joiner {
             for k in &mut self.tracks {
                 k.prune(t);
             }
+            // Keep the last state at or before `t`: later base records may still need it.
+            while self.landed.get(1).is_some_and(|(u, _)| *u <= t) {
+                self.landed.pop_front();
+            }
         }
     }
 
     fn fill(&self, t: f64, mut s: Sample) -> Sample {
         let max = self.max_bracket_s;
+        // 1e-9 s: time stamps are whole microseconds, so a record at `t` is at or before it.
+        s.landed = self
+            .landed
+            .iter()
+            .take_while(|(u, _)| *u <= t + 1e-9)
+            .last()
+            .map(|(_, l)| *l);
         for (k, stream) in self.tracks.iter().zip(SECONDARY) {
             let Some(v) = k.at(t, max) else { continue };
             match stream {
@@ -196,7 +229,7 @@ impl Joiner {
                     s.voltage_v = v.voltage_v;
                     s.current_a = v.current_a;
                 }
-                Stream::Base => {}
+                Stream::Base | Stream::Landed => {}
             }
         }
         s
@@ -295,6 +328,45 @@ mod tests {
         assert!((out[1].1.voltage_v.unwrap() - 11.0).abs() < 1e-12);
         // 3 s is past the last battery record: not extrapolated.
         assert_eq!(out[2].1.voltage_v, None);
+    }
+
+    fn landed(t: f64, l: bool) -> Event {
+        Event {
+            time_s: t,
+            stream: Stream::Landed,
+            sample: Sample {
+                landed: Some(l),
+                ..Sample::default()
+            },
+        }
+    }
+
+    #[test]
+    fn the_landed_state_holds_from_one_record_to_the_next() {
+        // Events 10 s apart (far beyond the 1 s bracket): each holds until the next.
+        let mut j = Joiner::new(1.0);
+        j.push(base(0.0));
+        j.push(landed(0.5, true));
+        for k in 1..40 {
+            j.push(base(k as f64 * 0.5));
+            if k == 10 {
+                j.push(landed(5.0, false));
+            }
+            if k == 30 {
+                j.push(landed(15.0, true));
+            }
+        }
+        j.finish();
+        let out: Vec<_> = std::iter::from_fn(|| j.pop()).collect();
+        assert_eq!(out.len(), 40);
+        for (t, s) in &out {
+            let want = if *t < 0.5 {
+                None
+            } else {
+                Some(!(5.0..15.0).contains(t))
+            };
+            assert_eq!(s.landed, want, "at {t} s");
+        }
     }
 
     #[test]

@@ -19,7 +19,8 @@
 //! Output: [`mcap_write`] writes JSON-encoded MCAP with JSON Schemas that Foxglove displays, for
 //! converted logs and for missions ([`write_mission_mcap`] takes plain slices).
 //!
-//! Analysis: [`InfoAccumulator`] (duration, rates, energy), [`estimate_lag_s`] (power vs motion).
+//! Analysis: [`InfoAccumulator`] (duration, rates, energy), [`estimate_lag_s`] (power vs motion),
+//! [`GroundDetector`] (airborne spans and ground time, from the log's landed state or detected).
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -43,6 +44,7 @@ pub mod csv_read;
 pub mod dataflash;
 pub mod error;
 pub mod frame;
+pub mod ground;
 pub mod info;
 pub mod join;
 pub mod lag;
@@ -63,6 +65,7 @@ pub use binary::{
 pub use column_map::ColumnMap;
 pub use csv_read::CsvSamples;
 pub use error::{LogError, Result};
+pub use ground::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Span};
 pub use info::{ChannelStats, InfoAccumulator, LogStats};
 pub use lag::{estimate_lag_s, resample_uniform, LagEstimate};
 pub use mcap_read::{McapOptions, McapSamples, McapTime, TopicInfo};

@@ -39,6 +39,11 @@ pub struct Sample {
     pub charge_ah: Option<f64>,
     /// Wind velocity east, north, up (the velocity of the air), m/s.
     pub wind_enu_mps: Option<[f64; 3]>,
+    /// On the ground, as the log itself records it: PX4 `vehicle_land_detected.landed`, ArduPilot
+    /// arming and landing events (`ARM`, `EV` armed, disarmed, land complete, not landed). A
+    /// state holds from its record to the next; `None` where the log records none (then
+    /// [`crate::ground`] detects it from height, speed and power).
+    pub landed: Option<bool>,
 }
 
 impl Sample {

@@ -17,7 +17,7 @@
 //! - `battery_status` of the chosen instance (multi_id): `voltage_v`, `current_a`; records with
 //!   `current_a` < 0 (unknown) or `voltage_v` <= 0 are dropped and counted.
 //! - `vehicle_air_data.rho` (mean air density) and `vehicle_land_detected.landed` (time in the
-//!   air), parameters `BAT1_N_CELLS` (or `BAT_N_CELLS`) and `BAT1_CAPACITY`.
+//!   air, and [`Sample::landed`] of every sample, held from one record to the next), parameters `BAT1_N_CELLS` (or `BAT_N_CELLS`) and `BAT1_CAPACITY`.
 //!
 //! # Robustness
 //! Every length is checked against the record and the record against the input before use;
@@ -646,7 +646,13 @@ impl UlogDecoder {
                 }
                 self.landed = Some((t, landed));
                 s.in_air_s = Some(self.in_air_s);
-                return None;
+                (
+                    Stream::Landed,
+                    Sample {
+                        landed: Some(landed),
+                        ..Sample::default()
+                    },
+                )
             }
         };
         Some(Event {
