@@ -122,6 +122,35 @@ fn a_route_one_pack_cannot_fly_is_split_into_sorties_that_each_land_with_the_res
 }
 
 #[test]
+fn a_survey_that_ends_in_the_air_is_priced_with_its_way_home_and_split_like_any_other() {
+    // The long survey as a QGroundControl survey often is: no return, no landing (the vehicle
+    // comes home by its mission-end action). aloft adds that way home (a return at the planning
+    // speed and RTL altitude, a landing at 1 m/s): the same flight as the survey that writes it
+    // out, so the same sorties, pack for pack.
+    let closed = long_survey();
+    let end = closed.find("[[segment]]\nkind = \"return\"").unwrap();
+    let open = format!("allow_end_in_air = true\n{}", &closed[..end]);
+    let (a, b) = (plan(&open), plan(&closed));
+    let (a, b) = (a.summary(), b.summary());
+    assert!(
+        a.warnings
+            .iter()
+            .any(|w| w.contains("ends in the air after item 49")),
+        "{:?}",
+        a.warnings
+    );
+    assert_eq!(a.segments.len(), b.segments.len());
+    assert!(a.batteries_required.is_some() && a.batteries_required == b.batteries_required);
+    for (x, y) in a.sorties.iter().zip(&b.sorties) {
+        assert_eq!(x.energy_wh, y.energy_wh);
+        assert_eq!(x.end_soc, y.end_soc);
+    }
+    // On one pack both run out at the same place.
+    assert_eq!(a.energy_wh, b.energy_wh);
+    assert_eq!(a.reason, b.reason);
+}
+
+#[test]
 fn a_mission_one_pack_flies_needs_one_battery_and_lists_no_sorties() {
     let s = plan(aloft::engine::DEMO_MISSION);
     assert!(s.summary().feasible);

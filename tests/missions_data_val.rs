@@ -149,16 +149,34 @@ fn fly(vehicle: &Vehicle, m: &Mission) -> Plan {
     plan_mission(vehicle, m, &MissionOptions::default()).unwrap()
 }
 
-/// Every segment carries an item number, and in order they are `items`; the answer's route is
-/// the mission's; energy and time are positive; a feasible plan takes one battery.
+/// Every segment carries an item number, and in order they are `items`, but for the way home a
+/// route that ends in the air is flown with (a return and a landing of no item, and a warning
+/// that says so); the answer's route is the mission's; energy and time are positive; a feasible
+/// plan takes one battery.
 fn check_flight(plan: &Plan, m: &Mission, items: &[u32]) {
     let s = plan.summary();
-    let got: Vec<u32> = s
-        .segments
+    let ends_in_air = m
+        .route()
+        .warnings
         .iter()
-        .map(|x| x.item.expect("an item"))
-        .collect();
+        .any(|w| w.contains("the route ends in the air"));
+    let (own, added) = s
+        .segments
+        .split_at(s.segments.len() - if ends_in_air { 2 } else { 0 });
+    let got: Vec<u32> = own.iter().map(|x| x.item.expect("an item")).collect();
     assert_eq!(got, items);
+    if ends_in_air {
+        let kinds: Vec<(&str, Option<u32>)> =
+            added.iter().map(|x| (x.kind.as_str(), x.item)).collect();
+        assert_eq!(kinds, [("return", None), ("landing", None)]);
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| w.contains("priced with the way home an autopilot flies")),
+            "{:?}",
+            s.warnings
+        );
+    }
     assert_eq!(&s.route, m.route());
     assert!(s.energy_wh > 0.0 && s.duration_s > 0.0);
     if s.feasible {
@@ -280,6 +298,20 @@ fn data_val_kasperg3_mission_ends_in_the_air() {
     }
     assert_eq!(expected.len(), 12);
     check_flight(&plan, &m, &expected);
+    // The way home is flown from the last waypoint: its return covers the distance from there
+    // to home (the leg in the tangent plane, as the route figures), and it lands 50 m. With
+    // pass-through corners the corner at the last waypoint cuts it short; stopping there, not.
+    let stop = aloft::engine::MissionOptions {
+        corners: Some(aloft::engine::CornerMode::Stop),
+        ..Default::default()
+    };
+    let plan = aloft::engine::plan_mission(&m100(), &m, &stop).unwrap();
+    let segs = &plan.summary().segments;
+    let (ret, land) = (&segs[segs.len() - 2], &segs[segs.len() - 1]);
+    let back = leg_m(latlon(items.last().unwrap()), home);
+    close(ret.distance_m, back, 1e-3, "return distance");
+    close(land.distance_m, 50.0, 1e-9, "landing distance");
+    assert_eq!(plan.summary().batteries_required, Some(1));
 }
 
 /// A waypoint at 5 m, LAND mid-mission, DO_GRIPPER on the ground, a waypoint at 10 m: a second

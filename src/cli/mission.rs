@@ -185,7 +185,10 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
-        Format::Json => output::write_json(&mut out, plan.summary())?,
+        Format::Json => {
+            output::warn(plan_warnings(&plan));
+            output::write_json(&mut out, plan.summary())?
+        }
         Format::Table | Format::Csv => write_table(&mut out, &plan)?,
     }
     Ok(if plan.report().feasible {
@@ -193,6 +196,12 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     } else {
         Outcome::Failed
     })
+}
+
+/// The warnings of a plan: the mission file's reader's, then the planner's.
+pub(super) fn plan_warnings(plan: &Plan) -> impl Iterator<Item = &String> {
+    let s = plan.summary();
+    s.route.warnings.iter().chain(&s.warnings)
 }
 
 /// Minutes and seconds, `m:ss`.
@@ -271,7 +280,7 @@ pub(super) fn header(plan: &Plan) -> Result<String> {
     for n in &c.notes {
         writeln!(head, "Note: {n}")?;
     }
-    for w in s.route.warnings.iter().chain(&s.warnings) {
+    for w in plan_warnings(plan) {
         writeln!(head, "Warning: {w}")?;
     }
     writeln!(head)?;

@@ -38,6 +38,15 @@ pub fn write_table(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> io::R
     Ok(())
 }
 
+/// The warnings of an answer on stderr, one line each (`aloft: warning: ...`): in JSON mode they
+/// are also in the answer's `warnings`, where a script reads them; a person at a terminal sees
+/// them here.
+pub fn warn(warnings: impl IntoIterator<Item = impl std::fmt::Display>) {
+    for w in warnings {
+        eprintln!("aloft: warning: {w}");
+    }
+}
+
 /// Write a serializable value as pretty JSON with a trailing newline.
 pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow::Result<()> {
     // An I/O failure inside serde_json (a closed pipe) comes back as an io::Error, so that

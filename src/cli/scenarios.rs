@@ -118,13 +118,16 @@ pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match run.format {
-        Format::Json => output::write_json(
-            &mut out,
-            &MissionWithUncertainty {
-                summary: plan.summary(),
-                uncertainty: &u,
-            },
-        )?,
+        Format::Json => {
+            output::warn(super::mission::plan_warnings(plan));
+            output::write_json(
+                &mut out,
+                &MissionWithUncertainty {
+                    summary: plan.summary(),
+                    uncertainty: &u,
+                },
+            )?
+        }
         Format::Table | Format::Csv => write_mission_table(&mut out, plan, &u)?,
     }
     Ok(if plan.report().feasible {

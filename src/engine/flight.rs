@@ -109,6 +109,60 @@ impl Flight<'_> {
     }
 }
 
+impl Flight<'_> {
+    /// `spec` as flown to the ground: a mission that ends in the air (no landing or return
+    /// after its last item, common in QGroundControl surveys, whose vehicle comes home by its
+    /// own mission-end action) gets the way home an autopilot flies then, a return to home at
+    /// the RTL altitude and a landing ([`Flight::way_home`]), with a note that says so; other
+    /// missions, and a route that ends in a loiter until the reserve (which prices its own way
+    /// home), are flown as they are.
+    pub(super) fn home_at_mission_end(
+        &self,
+        mut spec: MissionSpec,
+    ) -> (MissionSpec, Option<String>) {
+        if !ends_in_the_air(&spec.segments) {
+            return (spec, None);
+        }
+        let last = spec.segments.len();
+        let name = match spec.segments.last().and_then(SegmentSpec::item) {
+            Some(i) => format!("item {i}"),
+            None => format!("segment {last}"),
+        };
+        let rtl = spec
+            .rtl_altitude_m
+            .map_or("at its height".to_string(), |h| {
+                format!("at {h} m or higher")
+            });
+        let home = self.way_home(&spec);
+        let rate = match home[1] {
+            SegmentSpec::Landing { rate_mps, .. } => rate_mps,
+            _ => LANDING_RATE_MPS,
+        };
+        spec.segments.extend(home);
+        let note = format!(
+            "the mission ends in the air after {name}: priced with the way home an autopilot flies at mission end, a return to home {rtl} and a landing at {rate} m/s (segments {} and {})",
+            last + 1,
+            last + 2
+        );
+        (spec, Some(note))
+    }
+}
+
+/// Whether the vehicle is still in the air after the last of `segments` (a take-off not
+/// followed by a landing); a route that ends in a loiter until the reserve is not counted.
+pub(super) fn ends_in_the_air(segments: &[SegmentSpec]) -> bool {
+    let mut airborne = false;
+    for s in segments {
+        match s {
+            SegmentSpec::TakeOff { .. } => airborne = true,
+            SegmentSpec::Landing { .. } => airborne = false,
+            SegmentSpec::LoiterUntilReserve { .. } => return false,
+            _ => {}
+        }
+    }
+    airborne
+}
+
 /// The first ground speed the segments give.
 pub(super) fn first_speed(segments: &[SegmentSpec]) -> Option<f64> {
     segments.iter().find_map(|s| match *s {

@@ -491,6 +491,7 @@ fn plan_in(
             Some((flown, loiter)) => (flown, Some(loiter)),
             None => (spec, None),
         };
+    let (spec, way_home_note) = flight.home_at_mission_end(spec);
     let compiled = flight
         .compile(&spec, options.payload_kg)
         .map_err(in_mission)?;
@@ -518,6 +519,7 @@ fn plan_in(
     summary.batteries_required = sorties.batteries_required;
     summary.sorties = sorties.sorties;
     summary.warnings = compiled.warnings().to_vec();
+    summary.warnings.extend(way_home_note);
     summary
         .warnings
         .extend(edge_warnings(&report, vehicle.name()));

@@ -660,6 +660,8 @@ impl<'a> MissionScenarios<'a> {
             Ok(None) => spec,
             Err(e) => return Err(mission_error(mission.origin(), vehicle.name(), e)),
         };
+        // A mission that ends in the air flies home as the plan does.
+        let (spec, _) = flight.home_at_mission_end(spec);
         Ok(Self {
             aircraft,
             base_payload_kg: options.payload_kg.unwrap_or(spec.payload_kg),

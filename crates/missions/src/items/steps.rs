@@ -276,7 +276,7 @@ impl Flight<'_> {
         if self.airborne && end.is_none() {
             self.notes.add(
                 Place::File,
-                "the route ends in the air (no LAND or RETURN_TO_LAUNCH): no return is planned",
+                "the route ends in the air: no LAND or RETURN_TO_LAUNCH item",
             );
         }
         if self.segments.is_empty() {
