@@ -184,8 +184,15 @@ fn verdict(plan: &Plan, u: &Uncertainty) -> String {
     );
     if let Some(why) = &u.cannot_fly_reason {
         text.push_str(&format!(
-            "  {} of them cannot be flown at all; the first: {why}.\n",
+            "  {} of them cannot be flown (their flight ends where the vehicle cannot make headway or hold its position, or it cannot take off); the first: {why}.\n",
             u.cannot_fly_scenarios
+        ));
+    }
+    let ended_early = u.samples - u.completed_scenarios;
+    if ended_early > u.cannot_fly_scenarios {
+        text.push_str(&format!(
+            "  {} run out of charge on the way (below the empty point or the cut-off voltage).\n",
+            ended_early - u.cannot_fly_scenarios
         ));
     }
     match u.point_of_no_return_s.p5 {
