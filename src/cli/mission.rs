@@ -82,7 +82,7 @@ pub struct MissionArgs {
     #[arg(
         long,
         value_name = "LOG",
-        conflicts_with_all = ["mission", "timeseries", "plot", "mcap", "battery"]
+        conflicts_with_all = ["mission", "timeseries", "plot", "mcap"]
     )]
     pub replay: Option<PathBuf>,
     /// Log layout for --replay: kaist, px4 or a column-map TOML (default: detected).

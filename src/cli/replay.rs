@@ -22,6 +22,7 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
     let request = ReplayRequest {
         log: log.clone(),
         profile: args.profile.clone(),
+        battery: args.battery.clone(),
         payload_kg: args.payload_kg.unwrap_or(0.0),
         lag_s: args.lag,
         acceleration: match args.acceleration {
@@ -48,8 +49,8 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
 fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
     writeln!(
         out,
-        "Replay of {}: {} trajectory points, {:.0} s, vehicle {} at {:.3} kg",
-        a.file, a.points, a.duration_s, a.vehicle, a.mass_kg
+        "Replay of {}: {} trajectory points, {:.0} s, vehicle {} at {}",
+        a.file, a.points, a.duration_s, a.vehicle, a.context.mass
     )?;
     writeln!(
         out,

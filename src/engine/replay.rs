@@ -13,7 +13,7 @@ use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayP
 use aloft_power::{AoaModel, ModelOptions};
 
 use super::finite::finite;
-use super::vehicles::Vehicle;
+use super::vehicles::{TakeoffMass, Vehicle};
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions};
@@ -35,7 +35,9 @@ pub struct ReplayRequest {
     pub log: PathBuf,
     /// CSV profile: `kaist`, `px4` or a column-map TOML; `None`: recognised from the file.
     pub profile: Option<String>,
-    /// Payload added to the vehicle's mass, kg.
+    /// Pack by name (default: the vehicle's default pack), part of the take-off mass.
+    pub battery: Option<String>,
+    /// Payload, kg, part of the take-off mass.
     pub payload_kg: f64,
     /// Lag of the logged power behind the motion, s (`None`: estimated).
     pub lag_s: Option<f64>,
@@ -54,6 +56,7 @@ impl Default for ReplayRequest {
         Self {
             log: PathBuf::new(),
             profile: None,
+            battery: None,
             payload_kg: 0.0,
             lag_s: None,
             acceleration: ReplayAcceleration::Velocity,
@@ -103,6 +106,8 @@ pub struct ReplayAnswer {
 /// What a replay used, in words (not part of the JSON).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReplayContext {
+    /// The take-off mass and what it is made of.
+    pub mass: String,
     /// The acceleration source.
     pub acceleration: String,
     /// The wind.
@@ -117,17 +122,17 @@ struct Trajectory {
     points: Vec<ReplayPoint>,
 }
 
-/// Replay the flight of `request.log` with `vehicle` (see the module docs). A vehicle with an
-/// airframe flies at airframe + default pack + payload; one with only a `[power]` table (a fit)
-/// at that table's mass + payload.
+/// Replay the flight of `request.log` with `vehicle` (see the module docs) at its take-off mass
+/// ([`Vehicle::takeoff_mass`]): airframe + pack + payload for a vehicle with an airframe; one with
+/// only a `[power]` table (a fit) at that table's mass + payload.
 ///
 /// # Errors
 /// An invalid payload, window or wind, an unreadable log, a log with fewer than two velocity
 /// samples, no acceleration in the log when asked for it, a power channel that does not overlap
 /// the trajectory.
 pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAnswer, Error> {
-    let (aircraft, mass_kg) = replay_aircraft(vehicle, request)?;
-    let powered = aircraft.at_mass(mass_kg, request.aoa)?;
+    let (aircraft, mass) = replay_aircraft(vehicle, request)?;
+    let powered = aircraft.at_mass(mass.total_kg, request.aoa)?;
     let profile = request
         .profile
         .as_deref()
@@ -162,7 +167,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     let answer = ReplayAnswer {
         file: path,
         vehicle: vehicle.name().to_string(),
-        mass_kg,
+        mass_kg: mass.total_kg,
         points: trajectory.points.len(),
         duration_s: span_s,
         acceleration: match request.acceleration {
@@ -176,6 +181,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         measured_mean_power_w: measured_wh.map(|m| m * 3600.0 / span_s),
         energy_error_percent: error,
         context: ReplayContext {
+            mass: mass.describe(),
             acceleration: match request.acceleration {
                 ReplayAcceleration::Velocity => format!(
                     "differentiated velocity over {} s",
@@ -194,37 +200,20 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     finite(answer, "replay", || request.log.display().to_string())
 }
 
-/// The aircraft at its replay mass: airframe + default pack + payload, or a `[power]`-only
-/// vehicle at its table's mass + payload.
+/// The aircraft at its take-off mass ([`Vehicle::takeoff_mass`]); a vehicle without an airframe
+/// flies its `[power]` table alone.
 fn replay_aircraft(
     vehicle: &Vehicle,
     request: &ReplayRequest,
-) -> Result<(aloft_planner::Aircraft, f64), Error> {
-    let payload = request.payload_kg;
-    if !(payload.is_finite() && payload >= 0.0) {
-        return Err(Error::InvalidInput {
-            name: "payload_kg",
-            value: payload,
-            unit: "kg",
-            expected: "a mass of 0 kg or more",
-        });
-    }
-    let file = vehicle.file();
-    let (aircraft, mass_kg) = if file.airframe.is_some() {
-        let aircraft = vehicle.aircraft()?.clone();
-        let pack = if file.batteries.is_empty() {
-            0.0
-        } else {
-            vehicle.battery(None)?.mass_kg()
-        };
-        let m = aircraft.airframe().mass_kg() + pack + payload;
-        (aircraft, m)
+) -> Result<(aloft_planner::Aircraft, TakeoffMass), Error> {
+    let mass = vehicle.takeoff_mass(request.battery.as_deref(), request.payload_kg)?;
+    let aircraft = if vehicle.file().airframe.is_some() {
+        vehicle.aircraft()?.clone()
     } else {
-        let power = vehicle.power_model()?.vehicle().clone();
-        let m = power.mass_kg() + payload;
-        (power_only_aircraft(power, ModelOptions::default())?, m)
+        let power = vehicle.power_model_at(&mass)?.vehicle().clone();
+        power_only_aircraft(power, ModelOptions::default())?
     };
-    Ok((aircraft, mass_kg))
+    Ok((aircraft, mass))
 }
 
 /// The samples with a velocity, strictly increasing in time, with their accelerations.
