@@ -260,3 +260,83 @@ fn paper_case_is_a_power_model_alone() {
         );
     }
 }
+
+/// `aloft validate` flies the take-off mass of `--battery` and `--payload-kg` too: a heavier
+/// vehicle predicts more energy for the same logged flight, and the JSON names the mass.
+#[test]
+fn validate_flies_the_takeoff_mass_it_is_given() {
+    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
+    let run = |extra: &[&str]| {
+        let base = ["validate", "--log", log, "--profile", "kaist", "--lag", "0"];
+        let args = [
+            &base[..],
+            &["--vehicle", "dji-m100", "--format", "json"],
+            extra,
+        ]
+        .concat();
+        json(&args)
+    };
+    let light = run(&[]);
+    let heavy = run(&["--battery", "TB48D", "--payload-kg", "0.3"]);
+    assert!(close(
+        light["takeoff_mass_kg"].as_f64().unwrap(),
+        1.755 + 0.600,
+        1e-12
+    ));
+    assert!(close(
+        heavy["takeoff_mass_kg"].as_f64().unwrap(),
+        1.755 + 0.676 + 0.3,
+        1e-12
+    ));
+    let energy = |v: &serde_json::Value| v["flights"][0]["predicted_energy_wh"].as_f64().unwrap();
+    assert!(
+        energy(&heavy) > energy(&light),
+        "{} vs {}",
+        energy(&heavy),
+        energy(&light)
+    );
+    let o = aloft(&[
+        "validate",
+        "--log",
+        log,
+        "--profile",
+        "kaist",
+        "--lag",
+        "0",
+        "--vehicle",
+        "dji-m100",
+        "--payload-kg",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("3.600 kg limit"));
+}
+
+/// `aloft mission --replay` flies the take-off mass of `--battery` and `--payload-kg` (before,
+/// `--battery` was refused there and the default pack flown).
+#[test]
+fn replay_flies_the_takeoff_mass_it_is_given() {
+    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
+    let r = json(&[
+        "mission",
+        "--replay",
+        log,
+        "--profile",
+        "kaist",
+        "--lag",
+        "0",
+        "--vehicle",
+        "dji-m100",
+        "--battery",
+        "TB48D",
+        "--payload-kg",
+        "0.1",
+        "--format",
+        "json",
+    ]);
+    assert!(close(
+        r["mass_kg"].as_f64().unwrap(),
+        1.755 + 0.676 + 0.1,
+        1e-12
+    ));
+}

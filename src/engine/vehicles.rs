@@ -458,3 +458,80 @@ pub fn list_vehicles() -> Result<Vec<VehicleEntry>, Error> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn takeoff_mass_is_airframe_pack_and_payload() {
+        let m100 = Vehicle::builtin("dji-m100").unwrap();
+        let m = m100.takeoff_mass(Some("tb48d"), 0.5).unwrap();
+        // DJI: 1755 g airframe, 676 g TB48D.
+        assert!((m.total_kg - (1.755 + 0.676 + 0.5)).abs() < 1e-12);
+        assert_eq!(m.battery(), Some("TB48D"));
+        assert!((m.payload_kg() - 0.5).abs() < 1e-15);
+        assert_eq!(
+            m.describe(),
+            "take-off mass 2.931 kg (airframe 1.755 kg + TB48D 0.676 kg + payload 0.500 kg)"
+        );
+        // The default: the default pack, no payload; the cached model flies it.
+        let d = m100.takeoff_mass(None, 0.0).unwrap();
+        assert!((d.total_kg - 2.355).abs() < 1e-12);
+        let model = m100.power_model().unwrap();
+        assert!((model.vehicle().mass_kg() - d.total_kg).abs() < 1e-15);
+    }
+
+    #[test]
+    fn refused_masses_name_the_reason() {
+        let m100 = Vehicle::builtin("dji-m100").unwrap();
+        let e = m100.takeoff_mass(None, -0.1).unwrap_err().to_string();
+        assert!(e.contains("payload_kg") && e.contains("-0.1"), "{e}");
+        let e = m100.takeoff_mass(None, f64::NAN).unwrap_err().to_string();
+        assert!(e.contains("payload_kg"), "{e}");
+        let e = m100.takeoff_mass(Some("2xTB48D"), 0.5).unwrap_err();
+        assert!(matches!(e, Error::TooHeavy { .. }), "{e}");
+        assert!(e.to_string().contains("3.767 kg") && e.to_string().contains("3.600 kg limit"));
+        let paper = Vehicle::builtin("dji-m100-paper").unwrap();
+        let m = paper.takeoff_mass(None, 0.25).unwrap();
+        assert!((m.total_kg - 3.54).abs() < 1e-12 && m.battery().is_none());
+        let e = paper
+            .takeoff_mass(Some("TB47D"), 0.0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[airframe]"), "{e}");
+    }
+
+    #[test]
+    fn every_builtin_has_a_default_takeoff_mass_within_its_limit() {
+        for name in builtin_names() {
+            let v = Vehicle::builtin(name).unwrap();
+            let m = v.takeoff_mass(None, 0.0).unwrap();
+            if let Some(power) = &v.file().power {
+                let model = v.power_model().unwrap();
+                assert!(
+                    (model.vehicle().mass_kg() - m.total_kg).abs() < 1e-12,
+                    "{name}"
+                );
+                // Only a power model alone flies its table's mass.
+                if v.file().airframe.is_some() {
+                    assert!(matches!(m.parts, MassParts::Airframe { .. }), "{name}");
+                } else {
+                    assert!((power.mass_kg - m.total_kg).abs() < 1e-15, "{name}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_missing_path_is_no_such_file_and_a_wrong_name_lists_the_builtins() {
+        for path in ["no/such/dir/quad.toml", "quad.toml"] {
+            let e = Vehicle::load(path).unwrap_err();
+            assert!(matches!(e, Error::NoSuchVehicleFile { .. }), "{e}");
+            assert_eq!(e.to_string(), format!("vehicle file {path}: no such file"));
+        }
+        let e = Vehicle::load("dji-m300").unwrap_err();
+        assert!(matches!(e, Error::UnknownVehicle { .. }), "{e}");
+        assert!(e.to_string().contains("dji-m100-paper"), "{e}");
+    }
+}
