@@ -104,24 +104,21 @@ pub struct PowerContext {
 /// # Errors
 /// No `[power]` table, a take-off mass [`Vehicle::takeoff_mass`] refuses, or an invalid cutoff.
 pub fn power_model(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerModel, Error> {
-    let mass = vehicle.takeoff_mass(query.battery.as_deref(), query.payload_kg)?;
-    model_at(vehicle, &mass, query)
+    Ok(model_and_mass(vehicle, query)?.0)
 }
 
-/// The four-term model at `mass` with the query's terms and cutoff.
-fn model_at(
+/// The four-term model at the query's take-off mass with its terms and cutoff, and that mass.
+fn model_and_mass(
     vehicle: &Vehicle,
-    mass: &TakeoffMass,
     query: &PowerQuery,
-) -> Result<PowerModel, Error> {
+) -> Result<(PowerModel, TakeoffMass), Error> {
+    let (model, mass) = vehicle.power_model_with(query.battery.as_deref(), query.payload_kg)?;
     let options = ModelOptions {
         terms: Terms::all_but(&query.without),
         profile_cutoff_mps: query.profile_cutoff_mps,
     };
-    Ok(PowerModel::with_options(
-        vehicle.power_model_at(mass)?.vehicle().clone(),
-        options,
-    )?)
+    let model = PowerModel::with_options(model.vehicle().clone(), options)?;
+    Ok((model, mass))
 }
 
 /// Every term of the four-term model (power seed eqs 3-14) at one flight state, at the
@@ -132,8 +129,7 @@ fn model_at(
 /// angle-of-attack choice (geometric without a direction, the paper's with one); a state the
 /// model rejects (negative airspeed, tilt of 90 deg or more).
 pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer, Error> {
-    let mass = vehicle.takeoff_mass(query.battery.as_deref(), query.payload_kg)?;
-    let model = model_at(vehicle, &mass, query)?;
+    let (model, mass) = model_and_mass(vehicle, query)?;
     let aoa = aoa_input(query.aoa, query.air_direction_deg)?;
     let state = FlightState {
         airspeed_mps: query.airspeed_mps,

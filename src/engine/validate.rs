@@ -88,8 +88,8 @@ pub fn validate_logs(
     vehicle: &Vehicle,
     request: &ValidateRequest,
 ) -> Result<ValidateAnswer, Error> {
-    let mass = vehicle.takeoff_mass(request.battery.as_deref(), request.payload_kg)?;
-    let model = &vehicle.power_model_at(&mass)?;
+    let (model, mass) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
+    let model = &model;
     let flights = request.logs.load()?;
     let results = flights
         .iter()

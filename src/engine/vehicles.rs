@@ -208,8 +208,8 @@ impl Vehicle {
             Some(m) => Ok(m),
             // Rebuild to get the precise error (which table, or which mass).
             None => {
-                let mass = default_takeoff_mass(&self.file)?;
                 let table = self.file.power_vehicle()?;
+                let mass = default_takeoff_mass(&self.file)?;
                 table.with_mass(mass.total_kg)?;
                 Err(Error::MissingTable {
                     vehicle: self.file.name.clone(),
@@ -227,6 +227,21 @@ impl Vehicle {
     pub fn power_model_at(&self, mass: &TakeoffMass) -> Result<PowerModel, Error> {
         let table = self.file.power_vehicle()?;
         Ok(PowerModel::new(table.with_mass(mass.total_kg)?))
+    }
+
+    /// The four-term power model at the take-off mass of `battery` and `payload_kg`, and that
+    /// mass. A vehicle without a `[power]` table is refused for that first, whatever its mass.
+    ///
+    /// # Errors
+    /// No `[power]` table, then as [`Vehicle::takeoff_mass`].
+    pub fn power_model_with(
+        &self,
+        battery: Option<&str>,
+        payload_kg: f64,
+    ) -> Result<(PowerModel, TakeoffMass), Error> {
+        self.file.power_vehicle()?;
+        let mass = self.takeoff_mass(battery, payload_kg)?;
+        Ok((self.power_model_at(&mass)?, mass))
     }
 
     /// The mass every command flies the vehicle at: airframe + pack (`battery` by name, else the
@@ -500,6 +515,23 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("[airframe]"), "{e}");
+    }
+
+    /// A vehicle without a [power] table is refused for that, before its mass is looked at
+    /// (this one has an airframe but no pack either).
+    #[test]
+    fn a_missing_power_table_is_named_before_the_mass() {
+        let text = include_str!("../../fixtures/vehicles/dji-m100.toml");
+        let airframe = &text[text.find("[airframe]").unwrap()..text.find("[[battery]]").unwrap()];
+        let v = Vehicle::from_toml(&format!("name = \"frame\"\n{airframe}"), "test").unwrap();
+        for e in [
+            v.power_model_with(None, 0.0).unwrap_err(),
+            v.power_model().unwrap_err(),
+        ] {
+            assert!(e.to_string().contains("no [power] table"), "{e}");
+        }
+        let e = v.takeoff_mass(None, 0.0).unwrap_err().to_string();
+        assert!(e.contains("[battery]"), "{e}");
     }
 
     #[test]
