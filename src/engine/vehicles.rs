@@ -192,9 +192,10 @@ impl Vehicle {
         &self.file
     }
 
-    /// The overall efficiency `eta` of the four-term model, when the vehicle has one.
+    /// The overall efficiency `eta` of the four-term model, when the vehicle has one (whatever
+    /// the mass it flies).
     pub fn efficiency(&self) -> Option<f64> {
-        self.model.as_ref().map(|m| m.vehicle().efficiency())
+        self.file.power.as_ref().map(|p| p.efficiency)
     }
 
     /// The four-term power model at the vehicle's default take-off mass: airframe + default pack
