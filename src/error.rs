@@ -20,6 +20,12 @@ pub enum Error {
         /// The built-in names, comma-separated.
         known: String,
     },
+    /// A `--vehicle` that names a file (it has a directory or an extension) which does not exist.
+    #[error("vehicle file {path}: no such file")]
+    NoSuchVehicleFile {
+        /// The path as given.
+        path: String,
+    },
     /// A vehicle file that is not valid TOML or does not match the format.
     #[error("invalid vehicle description {origin}: {message}")]
     VehicleFormat {

@@ -12,10 +12,14 @@
 //! - [`identify`]: flight logs to the power model: lag alignment, fit samples, validation.
 //!
 //! ```
-//! let file = aloft::vehicle::VehicleFile::builtin("dji-m100")?;
+//! // The power seed's M100 at the paper's 3.29 kg hovers on 400-600 W (its Fig. 4).
+//! let file = aloft::vehicle::VehicleFile::builtin("dji-m100-paper")?;
 //! let model = aloft::power::PowerModel::new(file.power_vehicle()?);
 //! let hover = model.evaluate(&aloft::power::FlightState::new(0.0, 0.0, 0.0, 0.0))?;
 //! assert!(hover.electrical_w > 400.0 && hover.electrical_w < 600.0);
+//! // The aircraft missions fly: airframe + pack + payload (DJI: 2355 g with the TB47D).
+//! let m100 = aloft::engine::Vehicle::builtin("dji-m100")?;
+//! assert!((m100.takeoff_mass(Some("TB47D"), 0.0)?.total_kg - 2.355).abs() < 1e-12);
 //! # Ok::<(), aloft::Error>(())
 //! ```
 

@@ -7,7 +7,7 @@
 //! description = "..."
 //!
 //! [power]        # four-term power model parameters: aloft_power::VehicleParams
-//! mass_kg = 3.29
+//! mass_kg = 2.355  # the mass only of a vehicle without [airframe]
 //! # ...
 //!
 //! [propulsion]   # propulsion chain: aloft_propulsion::PropulsionSpec
@@ -27,6 +27,10 @@
 //!
 //! Tables are optional, so a vehicle can describe only the models it has data for; asking for a
 //! model whose table is missing is an [`Error::MissingTable`].
+//!
+//! One vehicle, one mass: a vehicle with an `[airframe]` flies at airframe + pack + payload in
+//! every command (`crate::engine::Vehicle::takeoff_mass`); the `[power]` table's `mass_kg` is the
+//! mass only of a vehicle without an airframe (a power model alone, e.g. `dji-m100-paper`).
 //! Built-in vehicles are compiled into the binary from `fixtures/vehicles/`.
 
 use serde::{Deserialize, Serialize};
@@ -63,6 +67,10 @@ pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
     BuiltinVehicle {
         name: "aec-quadrotor",
         toml: include_str!("../fixtures/vehicles/aec-quadrotor.toml"),
+    },
+    BuiltinVehicle {
+        name: "dji-m100-paper",
+        toml: include_str!("../fixtures/vehicles/dji-m100-paper.toml"),
     },
 ];
 
@@ -299,6 +307,38 @@ mod tests {
         assert!(e.contains("wingspan_m"), "{e}");
         let e = VehicleFile::builtin("dji-m200").unwrap_err().to_string();
         assert!(e.contains("dji-m200") && e.contains("dji-m100"), "{e}");
+    }
+
+    /// The paper-validation case is the M100's [power] table at the seed's 3.29 kg (section V):
+    /// the two files cannot drift apart.
+    #[test]
+    fn m100_paper_is_the_m100_power_table_at_3_29_kg() {
+        let paper = VehicleFile::builtin("dji-m100-paper").unwrap();
+        let m100 = VehicleFile::builtin("dji-m100").unwrap();
+        let mut p = paper.power.clone().unwrap();
+        assert_eq!(p.mass_kg.to_bits(), 3.29f64.to_bits());
+        p.mass_kg = m100.power.as_ref().unwrap().mass_kg;
+        assert_eq!(&p, m100.power.as_ref().unwrap());
+        assert!(paper.airframe.is_none() && paper.batteries.is_empty());
+        assert!(paper.propulsion.is_none());
+    }
+
+    /// The propulsion seed's 16.5 lb (S4) is the airframe's 9.5 lb plus four 1.75 lb packs (S5),
+    /// so `aloft propulsion` and the planner fly the same take-off mass.
+    #[test]
+    fn aec_empty_mass_is_airframe_plus_its_packs() {
+        let f = VehicleFile::builtin("aec-quadrotor").unwrap();
+        let lb = 0.45359237;
+        let airframe = f.airframe().unwrap().mass_kg();
+        let pack = f.battery(None).unwrap().mass_kg();
+        assert!((airframe - 9.5 * lb).abs() < 1e-9, "{airframe}");
+        assert!((pack - 4.0 * 1.75 * lb).abs() < 1e-9, "{pack}");
+        let empty = f.propulsion.as_ref().unwrap().empty_mass_kg;
+        assert!((empty - 16.5 * lb).abs() < 1e-9, "{empty}");
+        assert!((airframe + pack - empty).abs() < 1e-9);
+        // The worked example (S3: 26.5 lb) is within the largest mass flown (S6: 27.1 lb).
+        let max = f.airframe().unwrap().max_takeoff_mass_kg();
+        assert!((max - 27.1 * lb).abs() < 1e-9 && 26.5 * lb < max);
     }
 
     #[test]

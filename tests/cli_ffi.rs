@@ -209,4 +209,22 @@ fn endurance_and_power_answers_are_the_same_bytes() {
         "json",
     ];
     assert_eq!(cli(&args), ffi);
+    // The take-off mass's pack and payload, as the CLI's flags.
+    let state =
+        CString::new(r#"{"airspeed_mps": 4, "battery": "2xTB47D", "payload_kg": 0.2}"#).unwrap();
+    // SAFETY: as above.
+    let ffi = take(|out| unsafe { aloft_vehicle_power_json(m100.0, state.as_ptr(), out) });
+    let args = [
+        "power",
+        "--airspeed",
+        "4",
+        "--battery",
+        "2xTB47D",
+        "--payload-kg",
+        "0.2",
+        "--format",
+        "json",
+    ];
+    assert_eq!(cli(&args), ffi);
+    assert!(ffi.contains("\"takeoff_mass_kg\": 3.315"), "{ffi}");
 }

@@ -45,10 +45,18 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
     ] {
         assert!(v[key].is_f64(), "missing {key}: {v}");
     }
+    // The default vehicle flies its take-off mass: DJI's 1755 g airframe + the 600 g TB47D (the
+    // default pack), no payload.
+    assert_eq!(v["battery"].as_str(), Some("TB47D"));
+    assert_eq!(v["payload_kg"].as_f64(), Some(0.0));
+    let mass = 1.755 + 0.600;
+    assert!((v["takeoff_mass_kg"].as_f64().unwrap() - mass).abs() < 1e-12);
     let model = aloft::power::PowerModel::new(
         aloft::vehicle::VehicleFile::builtin("dji-m100")
             .unwrap()
             .power_vehicle()
+            .unwrap()
+            .with_mass(v["takeoff_mass_kg"].as_f64().unwrap())
             .unwrap(),
     );
     let p = model
@@ -143,6 +151,14 @@ fn bad_input_exits_2_naming_the_value() {
         ),
         (&["power", "--without", "drag"], "drag"),
         (&["power", "--vehicle", "aec-quadrotor"], "[power]"),
+        (&["power", "--payload-kg", "-1"], "payload_kg"),
+        (&["power", "--battery", "TB55"], "TB55"),
+        // 1.755 + 0.600 + 1.5 kg is above the M100's 3.6 kg.
+        (&["power", "--payload-kg", "1.5"], "3.600 kg limit"),
+        (
+            &["power", "--vehicle", "dji-m100-paper", "--battery", "TB47D"],
+            "[airframe]",
+        ),
         (&["propulsion", "--payload-kg", "-3"], "-3"),
         (&["propulsion", "--payload-kg", "40"], "current"),
         (&["propulsion", "--vehicle", "dji-m100"], "[propulsion]"),
@@ -166,20 +182,43 @@ fn bad_input_exits_2_naming_the_value() {
 fn vehicle_files_load_and_bad_files_are_named() {
     let dir = std::env::temp_dir().join(format!("aloft-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    // A power model alone flies its [power] table's mass (+ payload).
     let good = dir.join("heavy.toml");
-    let text = include_str!("../fixtures/vehicles/dji-m100.toml")
+    let text = include_str!("../fixtures/vehicles/dji-m100-paper.toml")
         .replace("mass_kg = 3.29", "mass_kg = 4.0");
     std::fs::write(&good, text).unwrap();
     let o = aloft(&[
         "power",
         "--vehicle",
         good.to_str().unwrap(),
+        "--payload-kg",
+        "0.5",
         "--format",
         "json",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
-    assert!((v["thrust_n"].as_f64().unwrap() - 4.0 * 9.8066).abs() < 1e-9);
+    assert!((v["thrust_n"].as_f64().unwrap() - 4.5 * 9.8066).abs() < 1e-9);
+    assert!(v.get("battery").is_none(), "{v}");
+    // A vehicle with an airframe flies airframe + pack + payload, whatever its [power] mass.
+    let framed = dir.join("framed.toml");
+    let text = include_str!("../fixtures/vehicles/dji-m100.toml")
+        .replace("mass_kg = 1.755", "mass_kg = 2.0")
+        .replace("mass_kg = 2.355", "mass_kg = 9.0");
+    std::fs::write(&framed, text).unwrap();
+    let o = aloft(&[
+        "power",
+        "--vehicle",
+        framed.to_str().unwrap(),
+        "--battery",
+        "tb48d",
+        "--format",
+        "json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!((v["thrust_n"].as_f64().unwrap() - (2.0 + 0.676) * 9.8066).abs() < 1e-9);
+    assert_eq!(v["battery"].as_str(), Some("TB48D"));
 
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[power]\nmass_lb = 3\n").unwrap();
@@ -190,6 +229,62 @@ fn vehicle_files_load_and_bad_files_are_named() {
         "{}",
         stderr(&o)
     );
+}
+
+/// A `--vehicle` that is a path names the missing file; a bare name that is neither a built-in
+/// nor a file lists the built-ins (issue 23, item 7).
+#[test]
+fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
+    let missing = std::env::temp_dir()
+        .join(format!("aloft-missing-{}", std::process::id()))
+        .join("my-quad.toml");
+    let path = missing.to_str().unwrap();
+    for command in ["power", "endurance", "mission"] {
+        let o = aloft(&[command, "--vehicle", path]);
+        assert_eq!(o.status.code(), Some(2), "{command}: {}", stderr(&o));
+        let err = stderr(&o);
+        assert!(err.contains("no such file") && err.contains(path), "{err}");
+        assert!(!err.contains("built-in"), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+    // A file name without a directory is a path too.
+    let o = aloft(&["power", "--vehicle", "my-quad.toml"]);
+    assert!(
+        stderr(&o).contains("my-quad.toml: no such file"),
+        "{}",
+        stderr(&o)
+    );
+    let o = aloft(&["endurance", "--vehicle", "dji-m300"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(
+        err.contains("dji-m300") && err.contains("dji-m100, dji-m600"),
+        "{err}"
+    );
+}
+
+/// The paper-validation case by its name: the seed's 3.29 kg, and eq (10)'s hover induced
+/// velocity with it, vh = sqrt(3.29 * 9.8066 / (2 * 1.225 * pi * 0.172^2)) = 11.9034 m/s (by
+/// hand, as `paper_val_eq10_hover_induced_velocity_of_the_m100`).
+#[test]
+fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
+    let o = aloft(&["power", "--vehicle", "dji-m100-paper", "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["takeoff_mass_kg"].as_f64(), Some(3.29));
+    assert!((v["hover_induced_velocity_mps"].as_f64().unwrap() - 11.9034).abs() < 1e-4);
+    let o = aloft(&["power", "--vehicle", "dji-m100-paper"]);
+    assert!(
+        stdout(&o).contains(
+            "take-off mass 3.290 kg ([power] table 3.290 kg + payload 0.000 kg; no [airframe])"
+        ),
+        "{}",
+        stdout(&o)
+    );
+    // It has no airframe: the planner's commands say so.
+    let o = aloft(&["endurance", "--vehicle", "dji-m100-paper"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("[airframe]"), "{}", stderr(&o));
 }
 
 #[test]
@@ -299,9 +394,25 @@ fn vehicles_lists_the_builtins() {
             "dji-m600",
             "dji-inspire1",
             "dji-inspire1-pro",
-            "aec-quadrotor"
+            "aec-quadrotor",
+            "dji-m100-paper"
         ]
     );
+    // Each lists the mass every command flies it at without payload: airframe + default pack,
+    // or, for the power model alone, its [power] table's (the seed's 3.29 kg).
+    let mass = |name: &str| {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["name"] == name)
+            .unwrap()["takeoff_mass_kg"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!((mass("dji-m100") - (1.755 + 0.600)).abs() < 1e-12);
+    assert!((mass("dji-m600") - (5.530 + 3.570)).abs() < 1e-12);
+    assert!((mass("aec-quadrotor") - 16.5 * 0.45359237).abs() < 1e-9);
+    assert_eq!(mass("dji-m100-paper"), 3.29);
     // Each DJI vehicle says what it was calibrated on and where the figures were published.
     for e in v.as_array().unwrap().iter().take(4) {
         assert!(e["source"]["calibrated_on"]

@@ -21,11 +21,13 @@ mod inflight_replan;
 fn power_point_example() {
     let mut out = Vec::new();
     let (hover_w, cruise_w) = power_point::run(&mut out).unwrap();
-    // The M100 hovers on 400-600 W in the paper's data (power seed Fig. 4) and its power curve
-    // dips below hover at moderate speed (translational lift).
+    // The M100 at the paper's 3.29 kg hovers on 400-600 W in the paper's data (power seed
+    // Fig. 4) and its power curve dips below hover at moderate speed (translational lift).
     assert!((400.0..600.0).contains(&hover_w), "{hover_w}");
     assert!(cruise_w < hover_w, "{cruise_w} vs {hover_w}");
-    assert!(String::from_utf8(out).unwrap().contains("\"electrical_w\""));
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("\"electrical_w\""));
+    assert!(text.contains("take-off mass 3.290 kg"), "{text}");
 }
 
 #[test]

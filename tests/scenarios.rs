@@ -235,35 +235,9 @@ fn scenarios_the_vehicle_cannot_fly_are_infeasible_not_errors() {
 fn a_power_scale_on_a_propulsion_chain_scales_its_energy() {
     // The AEC quadrotor is flown by its propulsion chain: the model error scales the chain's
     // power, so every scenario's energy is the plan's times its factor, and with the spread at
-    // zero it is the plan's exactly.
-    let extra = r#"
-[airframe]
-mass_kg = 6.0
-max_takeoff_mass_kg = 13.0
-max_tilt_deg = 35.0
-max_speed_mps = 15.0
-max_climb_rate_mps = 4.0
-max_descent_rate_mps = 3.0
-acceleration_mps2 = 2.0
-vertical_acceleration_mps2 = 1.5
-yaw_rate_deg_s = 60.0
-rotor_height_m = 0.3
-
-[[battery]]
-name = "4x TP8000-5S4PL"
-cells_series = 5
-capacity_mah = 32000.0
-nominal_v = 18.5
-energy_wh = 592.0
-mass_kg = 1.5
-internal_resistance_ohm = 0.0175
-cutoff_cell_v = 3.0
-"#;
-    let text = format!(
-        "{}\n{extra}",
-        include_str!("../fixtures/vehicles/aec-quadrotor.toml")
-    );
-    let v = Vehicle::from_toml(&text, "aec-quadrotor with an airframe and a pack").unwrap();
+    // zero it is the plan's exactly. (Its airframe and packs are the built-in's, from the
+    // propulsion seed.)
+    let v = Vehicle::builtin("aec-quadrotor").unwrap();
     let o = MissionOptions {
         time_step_s: Some(0.5),
         ..MissionOptions::default()

@@ -300,11 +300,15 @@ fn validate_json(
     let mut k = Kwargs::new("validate", options)?;
     let logs = options::flight_logs(&mut k, logs)?;
     let calibrate_first_s = k.f64("calibrate_first")?;
+    let battery = k.string("battery")?;
+    let payload_kg = k.f64_or("payload_kg", 0.0)?;
     k.finish()?;
     py.detach(|| {
         let v = Vehicle::load(&vehicle)?;
         let request = ValidateRequest {
             logs,
+            battery,
+            payload_kg,
             calibrate_first_s,
             series: false,
         };
@@ -390,7 +394,7 @@ fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<
         base.clone()
     };
     power_point(&v, &first).map_err(engine_error)?;
-    let model = power_model(&v, &base.without, base.profile_cutoff_mps).map_err(engine_error)?;
+    let model = power_model(&v, base).map_err(engine_error)?;
     let mut columns: Vec<Vec<f64>> = (0..POWER_KEYS.len())
         .map(|_| Vec::with_capacity(n))
         .collect();
@@ -462,6 +466,8 @@ fn power<'py>(
         })
         .collect::<PyResult<Vec<Term>>>()?;
     let base = PowerQuery {
+        battery: k.string("battery")?,
+        payload_kg: k.f64_or("payload_kg", 0.0)?,
         without,
         profile_cutoff_mps: k.f64("profile_cutoff")?,
         aoa: k.aoa()?,

@@ -77,7 +77,9 @@ def test_power_equals_cli_per_state(cli):
     for i, (va, vr, vp, vc) in enumerate(STATES):
         expected = cli.json("power", "--airspeed", repr(va), "--roll", repr(vr), "--pitch", repr(vp),
                             "--climb-rate", repr(vc))
-        assert set(expected) == set(aloft.POWER_KEYS)
+        # The CLI's JSON also names the take-off mass the arrays were computed at.
+        assert set(expected) == set(aloft.POWER_KEYS) | {"takeoff_mass_kg", "battery", "payload_kg"}
+        assert expected["takeoff_mass_kg"] == 1.755 + 0.600  # airframe + TB47D, no payload
         for k in aloft.POWER_KEYS:
             assert got[k][i] == expected[k], (k, i)  # bit for bit, no tolerance
 
@@ -92,6 +94,21 @@ def test_power_options_equal_cli(cli):
     got = aloft.power(14.0, 0.0, -16.0, profile_cutoff=10.0)
     expected = cli.json("power", "--airspeed", "14", "--pitch", "-16", "--profile-cutoff", "10")
     assert {k: float(got[k]) for k in aloft.POWER_KEYS} == {k: expected[k] for k in aloft.POWER_KEYS}
+
+
+def test_power_takeoff_mass_options_equal_cli(cli):
+    """`battery=` and `payload_kg=` are `--battery` and `--payload-kg`: the same take-off mass."""
+    got = aloft.power([0.0, 8.0], 0.0, [0.0, -9.0], vehicle="dji-m100", battery="TB48D",
+                      payload_kg=0.4)
+    for i, (va, vp) in enumerate([(0.0, 0.0), (8.0, -9.0)]):
+        expected = cli.json("power", "--airspeed", repr(va), "--pitch", repr(vp),
+                            "--battery", "TB48D", "--payload-kg", "0.4")
+        assert expected["takeoff_mass_kg"] == 1.755 + 0.676 + 0.4
+        for k in aloft.POWER_KEYS:
+            assert got[k][i] == expected[k], (k, i)
+    # The power seed's validation case flies its own 3.29 kg.
+    paper = aloft.power(0.0, 0.0, 0.0, vehicle="dji-m100-paper")
+    assert abs(paper["thrust_n"] - 3.29 * 9.8066) < 1e-9
 
 
 def test_timeseries_equals_cli_csv(cli, tmp_path):
@@ -134,6 +151,12 @@ def test_fit_and_validate_equal_cli(cli, repo, data, tmp_path):
     got = aloft.validate([test], str(py_toml), profile="kaist", calibrate_first=120)
     assert got == expected
     assert math.isfinite(got["flights"][0]["energy_error_percent"])
+    # The fitted vehicle is a power model alone: its [power] mass + the payload.
+    expected = cli.json("validate", "--log", str(test), "--profile", "kaist", "--vehicle",
+                        str(cli_toml), "--payload-kg", "0.5")
+    got = aloft.validate([test], str(py_toml), profile="kaist", payload_kg=0.5)
+    assert got == expected
+    assert got["takeoff_mass_kg"] == 8.0 + 0.5  # kaist-template's guessed 8 kg
 
 
 def test_monte_carlo_mission_equals_cli(cli):

@@ -28,6 +28,13 @@ def test_aloft_error_is_value_error():
       "--free", "k,nonsense", "-o", "/dev/null"]),
     (lambda: aloft.power(5.0, 0.0, -5.0, aoa="geometric"),
      ["power", "--airspeed", "5", "--pitch", "-5", "--aoa", "geometric"]),
+    (lambda: aloft.power(5.0, 0.0, -5.0, battery="TB55"),
+     ["power", "--airspeed", "5", "--pitch", "-5", "--battery", "TB55"]),
+    (lambda: aloft.power(0.0, 0.0, 0.0, payload_kg=2.0), ["power", "--payload-kg", "2"]),
+    (lambda: aloft.power(0.0, 0.0, 0.0, vehicle="dji-m100-paper", battery="TB47D"),
+     ["power", "--vehicle", "dji-m100-paper", "--battery", "TB47D"]),
+    (lambda: aloft.endurance(vehicle="no/such/quad.toml"),
+     ["endurance", "--vehicle", "no/such/quad.toml"]),
 ])
 def test_message_is_the_clis(cli, repo, monkeypatch, call, flags):
     monkeypatch.chdir(repo)

@@ -204,8 +204,12 @@ fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) 
     let c = &curve.context;
     writeln!(
         out,
-        "{} with {}, {:.3} kg, wind {}, course {:.0} deg: power curve",
-        c.vehicle, c.battery, c.takeoff_mass_kg, c.wind, course_deg
+        "{} with {}, {}, wind {}, course {:.0} deg: power curve",
+        c.vehicle,
+        c.battery,
+        c.mass.describe(),
+        c.wind,
+        course_deg
     )?;
     writeln!(
         out,
@@ -242,11 +246,11 @@ fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) 
 fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64) -> Result<()> {
     let r = &s.report;
     let title = format!(
-        "{} with {} ({} Wh), take-off mass {:.3} kg, wind {}, reserve {:.0} %",
+        "{} with {} ({} Wh), {}, wind {}, reserve {:.0} %",
         s.vehicle,
         s.battery,
         s.context.battery_energy_wh,
-        s.takeoff_mass_kg,
+        s.context.mass.describe(),
         s.context.wind,
         reserve_percent
     );

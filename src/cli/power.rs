@@ -20,6 +20,14 @@ pub struct PowerArgs {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
     #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
     vehicle: String,
+    /// Battery pack by name (default: the vehicle's default pack); its mass is part of the
+    /// take-off mass the model flies (airframe + pack + payload).
+    #[arg(long)]
+    battery: Option<String>,
+    /// Payload, kg, part of the take-off mass.
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG",
+        allow_negative_numbers = true)]
+    payload_kg: f64,
     /// Airspeed in m/s: the speed of the vehicle relative to the air (horizontal, as the paper assumes).
     #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     airspeed: f64,
@@ -64,6 +72,8 @@ pub struct PowerArgs {
 impl PowerArgs {
     fn query(&self) -> PowerQuery {
         PowerQuery {
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
             airspeed_mps: self.airspeed,
             roll_deg: self.roll,
             pitch_deg: self.pitch,
@@ -86,13 +96,7 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
         if args.aoa.is_some() || args.air_direction_deg.is_some() {
             bail!("in batch mode the angle of attack is per row: add an air_direction_deg column for the geometric model");
         }
-        power_csv_file(
-            &vehicle,
-            &args.without,
-            args.profile_cutoff,
-            path,
-            args.output.as_deref(),
-        )?;
+        power_csv_file(&vehicle, &args.query(), path, args.output.as_deref())?;
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;
@@ -133,8 +137,8 @@ fn write_csv(out: impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
 fn write_table(out: &mut impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
     let p = &a.power;
     let title = format!(
-        "{}: airspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
-        a.context.vehicle, args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
+        "{}, {}\nairspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
+        a.context.vehicle, a.context.mass, args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
     );
     let f1 = |v: f64| format!("{v:.1}");
     let f2 = |v: f64| format!("{v:.2}");

@@ -47,14 +47,10 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
 }
 
 fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
-    let pack = a
-        .battery
-        .as_deref()
-        .map_or(String::new(), |b| format!(" with pack {b}"));
     writeln!(
         out,
-        "Replay of {}: {} trajectory points, {:.0} s, vehicle {}{pack} at {:.3} kg",
-        a.file, a.points, a.duration_s, a.vehicle, a.mass_kg
+        "Replay of {}: {} trajectory points, {:.0} s, vehicle {} at {}",
+        a.file, a.points, a.duration_s, a.vehicle, a.context.mass
     )?;
     writeln!(
         out,

@@ -19,6 +19,13 @@ pub struct ValidateArgs {
     /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
     #[arg(long, value_name = "NAME|FILE")]
     vehicle: String,
+    /// Battery pack the flights carried, part of the take-off mass (default: the vehicle's
+    /// default pack; a vehicle without an airframe flies its [power] mass).
+    #[arg(long)]
+    battery: Option<String>,
+    /// Payload the flights carried, kg, part of the take-off mass.
+    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG")]
+    payload_kg: f64,
     /// Re-estimate only the efficiency from the first S seconds of each flight, as a ground
     /// station would in flight, and report the errors over the rest.
     #[arg(value_parser = super::args::finite(), long, value_name = "S")]
@@ -35,6 +42,8 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
     let vehicle = Vehicle::load(&args.vehicle)?;
     let request = ValidateRequest {
         logs: args.logs.logs(),
+        battery: args.battery.clone(),
+        payload_kg: args.payload_kg,
         calibrate_first_s: args.calibrate_first,
         series: args.plot.is_some(),
     };
@@ -100,8 +109,9 @@ fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
 fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
     writeln!(
         out,
-        "aloft validate: vehicle {}, {} flight(s)",
+        "aloft validate: vehicle {}, {}, {} flight(s)",
         r.vehicle,
+        r.mass,
         r.flights.len()
     )?;
     writeln!(

@@ -56,7 +56,7 @@ fn list(format: Format) -> Result<Outcome> {
             let mut w = csv::Writer::from_writer(out);
             w.write_record([
                 "name",
-                "mass_kg",
+                "takeoff_mass_kg",
                 "models",
                 "batteries",
                 "description",
@@ -64,7 +64,7 @@ fn list(format: Format) -> Result<Outcome> {
                 "published",
             ])?;
             for e in &entries {
-                let mass = e.mass_kg.map(|m| m.to_string()).unwrap_or_default();
+                let mass = e.takeoff_mass_kg.to_string();
                 let (cal, publ) = source_words(e);
                 w.write_record([
                     e.name,
@@ -96,10 +96,10 @@ fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
     writeln!(
         out,
         "{:<nw$}  {:>8}  {:<10}  {:<28}  description",
-        "name", "mass", "models", "batteries"
+        "name", "take-off", "models", "batteries"
     )?;
     for e in entries {
-        let mass = e.mass_kg.map(|m| format!("{m:.3} kg")).unwrap_or_default();
+        let mass = format!("{:.3} kg", e.takeoff_mass_kg);
         writeln!(
             out,
             "{:<nw$}  {:>8}  {:<10}  {:<28}  {}",

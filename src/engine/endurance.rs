@@ -10,7 +10,7 @@ use aloft_planner::{
 use aloft_power::AoaModel;
 
 use super::finite::finite;
-use super::vehicles::Vehicle;
+use super::vehicles::{TakeoffMass, Vehicle};
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
 
@@ -19,7 +19,7 @@ use crate::error::Error;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EnduranceOptions {
-    /// Pack pack by name (default: the vehicle's default pack).
+    /// Pack by name (default: the vehicle's default pack).
     pub battery: Option<String>,
     /// Payload, kg (default 0).
     pub payload_kg: f64,
@@ -70,7 +70,7 @@ impl EnduranceOptions {
 pub struct EnduranceSummary {
     /// Vehicle name.
     pub vehicle: String,
-    /// Pack pack name.
+    /// Pack name.
     pub battery: String,
     /// Take-off mass, kg.
     pub takeoff_mass_kg: f64,
@@ -83,8 +83,10 @@ pub struct EnduranceSummary {
 }
 
 /// The words and figures a reader wants beside the answers (not part of the JSON).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct EnduranceContext {
+    /// The take-off mass and what it is made of.
+    pub mass: TakeoffMass,
     /// The pack's rated energy, Wh.
     pub battery_energy_wh: f64,
     /// The wind in words.
@@ -118,14 +120,14 @@ pub struct PowerCurve {
 }
 
 /// What a power curve was computed for (not part of the JSON).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct CurveContext {
     /// Vehicle name.
     pub vehicle: String,
-    /// Pack pack name.
+    /// Pack name.
     pub battery: String,
-    /// Take-off mass, kg.
-    pub takeoff_mass_kg: f64,
+    /// The take-off mass and what it is made of.
+    pub mass: TakeoffMass,
     /// The wind in words.
     pub wind: String,
 }
@@ -144,9 +146,10 @@ pub fn endurance(vehicle: &Vehicle, options: &EnduranceOptions) -> Result<Endura
         EnduranceSummary {
             vehicle: vehicle.name().to_string(),
             battery: setup.battery.name().to_string(),
-            takeoff_mass_kg: setup.mass_kg,
+            takeoff_mass_kg: setup.mass.total_kg,
             report,
             context: EnduranceContext {
+                mass: setup.mass.clone(),
                 battery_energy_wh: setup.battery.rated_energy_wh(),
                 wind: setup.wind_text,
                 notes: vehicle.notes(),
@@ -177,7 +180,7 @@ pub fn power_curve(
             context: CurveContext {
                 vehicle: vehicle.name().to_string(),
                 battery: setup.battery.name().to_string(),
-                takeoff_mass_kg: setup.mass_kg,
+                mass: setup.mass,
                 wind: setup.wind_text,
             },
         },
@@ -196,7 +199,7 @@ pub fn power_curve(
 struct Setup<'a> {
     powered: Powered<'a>,
     battery: Pack,
-    mass_kg: f64,
+    mass: TakeoffMass,
     query: EnduranceQuery,
     wind_text: String,
 }
@@ -233,8 +236,8 @@ impl<'a> Setup<'a> {
         battery: Pack,
         options: &EnduranceOptions,
     ) -> Result<Self, Error> {
-        let mass_kg = takeoff_mass_kg(vehicle, &battery, options.payload_kg)?;
-        let powered = aircraft.at_mass(mass_kg, options.aoa)?;
+        let mass = vehicle.takeoff_mass_with(&battery, options.payload_kg)?;
+        let powered = aircraft.at_mass(mass.total_kg, options.aoa)?;
         let (wind, wind_text) = steady_wind(options.wind.as_ref())?;
         check_reserve(options.reserve_percent)?;
         let query = EnduranceQuery {
@@ -247,33 +250,11 @@ impl<'a> Setup<'a> {
         Ok(Self {
             powered,
             battery,
-            mass_kg,
+            mass,
             query,
             wind_text,
         })
     }
-}
-
-/// Airframe + pack + payload, checked against the airframe's limit.
-fn takeoff_mass_kg(vehicle: &Vehicle, battery: &Pack, payload_kg: f64) -> Result<f64, Error> {
-    if !(payload_kg.is_finite() && payload_kg >= 0.0) {
-        return Err(Error::InvalidInput {
-            name: "payload_kg",
-            value: payload_kg,
-            unit: "kg",
-            expected: "a mass, finite and not negative",
-        });
-    }
-    let airframe = vehicle.aircraft()?.airframe();
-    let mass = airframe.mass_kg() + battery.mass_kg() + payload_kg;
-    if mass > airframe.max_takeoff_mass_kg() {
-        return Err(Error::TooHeavy {
-            mass_kg: mass,
-            max_kg: airframe.max_takeoff_mass_kg(),
-            battery: battery.name().to_string(),
-        });
-    }
-    Ok(mass)
 }
 
 /// The options' steady wind (no gusts) and its description; still air without one.

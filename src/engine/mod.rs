@@ -8,7 +8,7 @@
 //!
 //! | concern | requests | answer | file |
 //! |---|---|---|---|
-//! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`] | [`Vehicle`], [`list_vehicles`] | `vehicles.rs` |
+//! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`]; [`Vehicle::takeoff_mass`] (the one mass every command flies) | [`Vehicle`], [`TakeoffMass`], [`list_vehicles`] | `vehicles.rs` |
 //! | calibrate | [`SpecSheet`] → [`calibrate_spec`]; a vehicle file → [`calibrate_hover`] | [`SpecCalibration`], [`HoverCalibration`] | `calibrate.rs` |
 //! | missions | [`Mission::load`] (aloft TOML or JSON, QGroundControl `.plan`, `.waypoints`, recognised from the content) + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`] with the [`RouteFigures`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
 //! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
@@ -115,7 +115,7 @@ pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, Segme
 pub use validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,
 };
-pub use vehicles::{list_vehicles, Vehicle, VehicleEntry};
+pub use vehicles::{list_vehicles, MassParts, TakeoffMass, Vehicle, VehicleEntry};
 
 /// A parser's message on one line (the CLI prints every error on one line).
 pub use aloft_core::one_line;

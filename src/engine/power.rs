@@ -15,12 +15,20 @@ use aloft_power::{Term, Terms};
 use super::files::open_input_file;
 use super::finite::finite;
 use super::power_batch::power_csv;
-use super::vehicles::Vehicle;
+use super::vehicles::{TakeoffMass, Vehicle};
 use crate::error::Error;
 
 /// A point query of the power model (the options of `aloft power`). Angles in degrees.
+///
+/// The model flies the vehicle's take-off mass ([`Vehicle::takeoff_mass`]): airframe + pack
+/// (`battery`, default the vehicle's default pack) + `payload_kg`, as `aloft endurance` and
+/// `aloft mission` do.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct PowerQuery {
+    /// Pack by name (default: the vehicle's default pack).
+    pub battery: Option<String>,
+    /// Payload, kg (default 0).
+    pub payload_kg: f64,
     /// Airspeed, m/s (horizontal, as the paper assumes).
     pub airspeed_mps: f64,
     /// Roll, deg (positive right side down).
@@ -56,6 +64,13 @@ pub struct PowerGradientDeg {
 /// `aloft power --format json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PowerAnswer {
+    /// The take-off mass the model flew, kg (airframe + pack + payload).
+    pub takeoff_mass_kg: f64,
+    /// The pack in that mass (absent for a vehicle without an airframe).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub battery: Option<String>,
+    /// The payload in that mass, kg.
+    pub payload_kg: f64,
     /// Every term of the model.
     #[serde(flatten)]
     pub power: PowerBreakdown,
@@ -72,6 +87,8 @@ pub struct PowerAnswer {
 pub struct PowerContext {
     /// Vehicle name.
     pub vehicle: String,
+    /// The take-off mass and what it is made of, in words.
+    pub mass: String,
     /// The model's efficiency `eta`.
     pub efficiency: f64,
     /// The angle-of-attack model in words.
@@ -80,32 +97,39 @@ pub struct PowerContext {
     pub removed: Vec<&'static str>,
 }
 
-/// The four-term model of `vehicle` with terms removed and an optional profile cutoff.
+/// The four-term model of `vehicle` at the query's take-off mass (its `battery` and
+/// `payload_kg`), with its terms removed and its profile cutoff; the state fields of the query
+/// are not read.
 ///
 /// # Errors
-/// No `[power]` table, or an invalid cutoff.
-pub fn power_model(
-    vehicle: &Vehicle,
-    without: &[Term],
-    profile_cutoff_mps: Option<f64>,
-) -> Result<PowerModel, Error> {
-    let options = ModelOptions {
-        terms: Terms::all_but(without),
-        profile_cutoff_mps,
-    };
-    Ok(PowerModel::with_options(
-        vehicle.power_model()?.vehicle().clone(),
-        options,
-    )?)
+/// No `[power]` table, a take-off mass [`Vehicle::takeoff_mass`] refuses, or an invalid cutoff.
+pub fn power_model(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerModel, Error> {
+    Ok(model_and_mass(vehicle, query)?.0)
 }
 
-/// Every term of the four-term model (power seed eqs 3-14) at one flight state.
+/// The four-term model at the query's take-off mass with its terms and cutoff, and that mass.
+fn model_and_mass(
+    vehicle: &Vehicle,
+    query: &PowerQuery,
+) -> Result<(PowerModel, TakeoffMass), Error> {
+    let (model, mass) = vehicle.power_model_with(query.battery.as_deref(), query.payload_kg)?;
+    let options = ModelOptions {
+        terms: Terms::all_but(&query.without),
+        profile_cutoff_mps: query.profile_cutoff_mps,
+    };
+    let model = PowerModel::with_options(model.vehicle().clone(), options)?;
+    Ok((model, mass))
+}
+
+/// Every term of the four-term model (power seed eqs 3-14) at one flight state, at the
+/// vehicle's take-off mass.
 ///
 /// # Errors
-/// No `[power]` table; a contradictory angle-of-attack choice (geometric without a direction,
-/// the paper's with one); a state the model rejects (negative airspeed, tilt of 90 deg or more).
+/// No `[power]` table; a take-off mass [`Vehicle::takeoff_mass`] refuses; a contradictory
+/// angle-of-attack choice (geometric without a direction, the paper's with one); a state the
+/// model rejects (negative airspeed, tilt of 90 deg or more).
 pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer, Error> {
-    let model = power_model(vehicle, &query.without, query.profile_cutoff_mps)?;
+    let (model, mass) = model_and_mass(vehicle, query)?;
     let aoa = aoa_input(query.aoa, query.air_direction_deg)?;
     let state = FlightState {
         airspeed_mps: query.airspeed_mps,
@@ -137,10 +161,14 @@ pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer,
     };
     finite(
         PowerAnswer {
+            takeoff_mass_kg: mass.total_kg,
+            battery: mass.battery().map(str::to_string),
+            payload_kg: mass.payload_kg(),
             power,
             electrical_gradient,
             context: PowerContext {
                 vehicle: vehicle.name().to_string(),
+                mass: mass.describe(),
                 efficiency: model.vehicle().efficiency(),
                 aoa: match aoa {
                     AoaInput::Paper => "paper eqs 3-4".to_string(),
@@ -174,20 +202,20 @@ fn aoa_input(aoa: Option<AoaModel>, air_direction_deg: Option<f64>) -> Result<Ao
     }
 }
 
-/// Stream the CSV of states at `input` through the model of `vehicle` (terms removed, cutoff)
-/// into `output`, or standard output when `None`, one row at a time (see [`power_csv`]).
-/// Returns the number of rows.
+/// Stream the CSV of states at `input` through the model of `vehicle` at the query's take-off
+/// mass, terms and cutoff ([`power_model`]; the states come from the rows) into `output`, or
+/// standard output when `None`, one row at a time (see [`power_csv`]). Returns the number of
+/// rows.
 ///
 /// # Errors
-/// As [`power_csv`], and files that cannot be opened or created.
+/// As [`power_model`] and [`power_csv`], and files that cannot be opened or created.
 pub fn power_csv_file(
     vehicle: &Vehicle,
-    without: &[Term],
-    profile_cutoff_mps: Option<f64>,
+    query: &PowerQuery,
     input: &Path,
     output: Option<&Path>,
 ) -> Result<u64, Error> {
-    let model = power_model(vehicle, without, profile_cutoff_mps)?;
+    let model = power_model(vehicle, query)?;
     let file = open_input_file(input, "CSV of states")?;
     let reader = BufReader::with_capacity(1 << 16, file);
     let origin = input.display().to_string();

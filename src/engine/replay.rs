@@ -20,7 +20,7 @@ use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayP
 use aloft_power::{AoaModel, ModelOptions};
 
 use super::finite::finite;
-use super::vehicles::Vehicle;
+use super::vehicles::{MassParts, Vehicle};
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions};
@@ -150,6 +150,8 @@ pub struct ReplayAnswer {
 /// What a replay used, in words (not part of the JSON).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReplayContext {
+    /// The take-off mass and what it is made of.
+    pub mass: String,
     /// The acceleration source.
     pub acceleration: String,
     /// The wind.
@@ -164,11 +166,13 @@ struct Trajectory {
     points: Vec<ReplayPoint>,
 }
 
-/// The aircraft flown and its mass.
+/// The aircraft flown and its take-off mass ([`Vehicle::takeoff_mass`]).
 struct Flown {
     aircraft: aloft_planner::Aircraft,
     mass_kg: f64,
     battery: Option<String>,
+    /// The take-off mass and what it is made of, in words.
+    described: String,
 }
 
 /// Replay the flight of `request.log` with `vehicle` (see the module docs). A vehicle with an
@@ -209,6 +213,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     );
     let logged_wind = trajectory.points.iter().any(|p| p.wind_enu_mps.is_some());
     let context = ReplayContext {
+        mass: flown.described.clone(),
         acceleration: match request.acceleration {
             ReplayAcceleration::Velocity => format!(
                 "differentiated velocity over {} s",
@@ -289,44 +294,22 @@ fn answer(
 /// payload, as a planned mission flies, or a `[power]`-only vehicle at its table's mass + payload
 /// (that mass already is the whole vehicle: naming a pack for it is an error).
 fn replay_aircraft(vehicle: &Vehicle, request: &ReplayRequest) -> Result<Flown, Error> {
-    let payload = request.payload_kg;
-    if !(payload.is_finite() && payload >= 0.0) {
-        return Err(Error::InvalidInput {
-            name: "payload_kg",
-            value: payload,
-            unit: "kg",
-            expected: "a mass of 0 kg or more",
-        });
-    }
-    let file = vehicle.file();
-    if file.airframe.is_none() {
-        if request.battery.is_some() {
-            return Err(Error::MissingTable {
-                vehicle: vehicle.name().to_string(),
-                table: "airframe",
-                needed_for: "--battery with --replay (a [power]-only vehicle's mass is the whole vehicle, pack included)",
-            });
-        }
-        let power = vehicle.power_model()?.vehicle().clone();
-        let mass_kg = power.mass_kg() + payload;
-        return Ok(Flown {
-            aircraft: power_only_aircraft(power, ModelOptions::default())?,
-            mass_kg,
-            battery: None,
-        });
-    }
-    let aircraft = vehicle.aircraft()?.clone();
-    let pack = if file.batteries.is_empty() && request.battery.is_none() {
-        None
+    let mass = vehicle.takeoff_mass(request.battery.as_deref(), request.payload_kg)?;
+    let aircraft = if vehicle.file().airframe.is_some() {
+        vehicle.aircraft()?.clone()
     } else {
-        Some(vehicle.battery(request.battery.as_deref())?)
+        let power = vehicle.power_model_at(&mass)?.vehicle().clone();
+        power_only_aircraft(power, ModelOptions::default())?
     };
-    let mass_kg =
-        aircraft.airframe().mass_kg() + pack.as_ref().map_or(0.0, |p| p.mass_kg()) + payload;
+    let battery = match &mass.parts {
+        MassParts::Airframe { battery, .. } => Some(battery.clone()),
+        MassParts::ModelTable { .. } => None,
+    };
     Ok(Flown {
         aircraft,
-        mass_kg,
-        battery: pack.map(|p| p.name().to_string()),
+        mass_kg: mass.total_kg,
+        battery,
+        described: mass.describe(),
     })
 }
 

@@ -15,6 +15,11 @@ use crate::identify::{predict, validate_flight, FlightValidation, AIRSPEED_BANDS
 pub struct ValidateRequest {
     /// The logs and how to align them.
     pub logs: FlightLogs,
+    /// The pack the flights carried, part of the take-off mass (default: the vehicle's default
+    /// pack).
+    pub battery: Option<String>,
+    /// The payload the flights carried, kg, part of the take-off mass.
+    pub payload_kg: f64,
     /// Re-estimate the efficiency from the first this many seconds of each flight, s.
     pub calibrate_first_s: Option<f64>,
     /// Also return the measured and predicted power of every flight (for a plot).
@@ -49,6 +54,12 @@ pub struct MeanRow {
 pub struct ValidateReport {
     /// Vehicle name.
     pub vehicle: String,
+    /// The take-off mass the model flew, kg (airframe + pack + payload, or a fitted vehicle's
+    /// `[power]` mass + payload).
+    pub takeoff_mass_kg: f64,
+    /// That mass and what it is made of, in words (not part of the JSON).
+    #[serde(skip)]
+    pub mass: String,
     /// Per flight.
     pub flights: Vec<FlightValidation>,
     /// Mean NRMSE over the flights, per dropped term and airspeed band (Table I layout).
@@ -67,16 +78,18 @@ pub struct ValidateAnswer {
     pub series: Vec<PowerSeries>,
 }
 
-/// Validate `vehicle`'s power model on the request's logs.
+/// Validate `vehicle`'s power model, at the take-off mass of the request's pack and payload
+/// ([`Vehicle::takeoff_mass`]), on the request's logs.
 ///
 /// # Errors
-/// Unreadable logs, logs without power or motion, a vehicle without `[power]`, a calibration
-/// window that does not fit a flight.
+/// Unreadable logs, logs without power or motion, a vehicle without `[power]`, a take-off mass
+/// the vehicle refuses, a calibration window that does not fit a flight.
 pub fn validate_logs(
     vehicle: &Vehicle,
     request: &ValidateRequest,
 ) -> Result<ValidateAnswer, Error> {
-    let model = vehicle.power_model()?;
+    let (model, mass) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
+    let model = &model;
     let flights = request.logs.load()?;
     let results = flights
         .iter()
@@ -97,6 +110,8 @@ pub fn validate_logs(
     let table_i = mean_table_i(&results);
     let report = ValidateReport {
         vehicle: vehicle.name().to_string(),
+        takeoff_mass_kg: mass.total_kg,
+        mass: mass.describe(),
         flights: results,
         table_i,
     };

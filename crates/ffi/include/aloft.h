@@ -26,7 +26,8 @@ enum AloftStatus
   ALOFT_STATUS_PARSE = 3,
   // A value outside its valid range, or a vehicle without the table the call needs.
   ALOFT_STATUS_INVALID_INPUT = 4,
-  // A name that is not known (built-in vehicle, battery pack).
+  // A name that is not known (built-in vehicle, battery pack), or a vehicle file that does
+  // not exist.
   ALOFT_STATUS_NOT_FOUND = 5,
   // The mission cannot be flown by this vehicle (segment beyond its limits, too heavy, out of
   // order). An infeasible mission (reserve not held) is NOT an error: see `feasible`.
@@ -88,7 +89,9 @@ AloftStatus aloft_vehicle_free(struct AloftVehicle *vehicle);
 
 // Electrical power of the four-term model in steady flight, W, into `*out_w`: airspeed in m/s,
 // roll and pitch in radians (the paper's angle of attack from them), climb rate in m/s (positive
-// up).
+// up). The vehicle flies its default take-off mass, airframe + default pack (no payload), as
+// `aloft power` does without `--battery` and `--payload-kg`; `aloft_vehicle_power_json` takes
+// both.
 //
 // # Safety
 // `vehicle` is NULL or a pointer (checked); `out_w` is NULL or a writable `double`.
@@ -99,9 +102,12 @@ AloftStatus aloft_vehicle_power_w(const struct AloftVehicle *vehicle,
                                   double climb_rate_mps,
                                   double *out_w);
 
-// Every term of the four-term model as JSON (keys as `aloft power --format json`'s breakdown:
-// `thrust_n`, `induced_w`, ..., `electrical_w`) for a flight state given as JSON:
-// `{"airspeed_mps": 5, "roll_deg": 0, "pitch_deg": -5, "climb_rate_mps": 0}` (missing keys are 0).
+// Every term of the four-term model as JSON (the keys of `aloft power --format json`:
+// `takeoff_mass_kg`, `battery`, `payload_kg`, `thrust_n`, `induced_w`, ..., `electrical_w`) for
+// a flight state given as JSON:
+// `{"airspeed_mps": 5, "roll_deg": 0, "pitch_deg": -5, "climb_rate_mps": 0}` (missing keys are
+// 0), with optionally the take-off mass's `"battery": "TB48D"` (default: the vehicle's default
+// pack) and `"payload_kg": 0.5` (default 0), as `aloft power --battery --payload-kg`.
 // The string written to `*out_json` is released with `aloft_string_free`.
 //
 // # Safety

@@ -69,7 +69,8 @@ pub enum AloftStatus {
     Parse = 3,
     /// A value outside its valid range, or a vehicle without the table the call needs.
     InvalidInput = 4,
-    /// A name that is not known (built-in vehicle, battery pack).
+    /// A name that is not known (built-in vehicle, battery pack), or a vehicle file that does
+    /// not exist.
     NotFound = 5,
     /// The mission cannot be flown by this vehicle (segment beyond its limits, too heavy, out of
     /// order). An infeasible mission (reserve not held) is NOT an error: see `feasible`.
@@ -193,7 +194,7 @@ impl Failure {
 impl From<Error> for Failure {
     fn from(e: Error) -> Self {
         let status = match &e {
-            Error::UnknownVehicle { .. } => AloftStatus::NotFound,
+            Error::UnknownVehicle { .. } | Error::NoSuchVehicleFile { .. } => AloftStatus::NotFound,
             Error::VehicleFormat { message, .. } if message.starts_with("no battery") => {
                 AloftStatus::NotFound
             }
@@ -500,7 +501,9 @@ pub unsafe extern "C" fn aloft_vehicle_free(vehicle: *mut AloftVehicle) -> Aloft
 
 /// Electrical power of the four-term model in steady flight, W, into `*out_w`: airspeed in m/s,
 /// roll and pitch in radians (the paper's angle of attack from them), climb rate in m/s (positive
-/// up).
+/// up). The vehicle flies its default take-off mass, airframe + default pack (no payload), as
+/// `aloft power` does without `--battery` and `--payload-kg`; `aloft_vehicle_power_json` takes
+/// both.
 ///
 /// # Safety
 /// `vehicle` is NULL or a pointer (checked); `out_w` is NULL or a writable `double`.
@@ -528,9 +531,12 @@ pub unsafe extern "C" fn aloft_vehicle_power_w(
     })
 }
 
-/// Every term of the four-term model as JSON (keys as `aloft power --format json`'s breakdown:
-/// `thrust_n`, `induced_w`, ..., `electrical_w`) for a flight state given as JSON:
-/// `{"airspeed_mps": 5, "roll_deg": 0, "pitch_deg": -5, "climb_rate_mps": 0}` (missing keys are 0).
+/// Every term of the four-term model as JSON (the keys of `aloft power --format json`:
+/// `takeoff_mass_kg`, `battery`, `payload_kg`, `thrust_n`, `induced_w`, ..., `electrical_w`) for
+/// a flight state given as JSON:
+/// `{"airspeed_mps": 5, "roll_deg": 0, "pitch_deg": -5, "climb_rate_mps": 0}` (missing keys are
+/// 0), with optionally the take-off mass's `"battery": "TB48D"` (default: the vehicle's default
+/// pack) and `"payload_kg": 0.5` (default 0), as `aloft power --battery --payload-kg`.
 /// The string written to `*out_json` is released with `aloft_string_free`.
 ///
 /// # Safety
@@ -549,6 +555,8 @@ pub unsafe extern "C" fn aloft_vehicle_power_json(
         roll_deg: f64,
         pitch_deg: f64,
         climb_rate_mps: f64,
+        battery: Option<String>,
+        payload_kg: f64,
     }
     guard(|| {
         // SAFETY: the caller's contract; the handle is checked against the registry.
@@ -558,6 +566,8 @@ pub unsafe extern "C" fn aloft_vehicle_power_json(
         let s: StateJson = serde_json::from_str(state)
             .map_err(|e| Failure::new(AloftStatus::Parse, format!("invalid flight state: {e}")))?;
         let query = PowerQuery {
+            battery: s.battery,
+            payload_kg: s.payload_kg,
             airspeed_mps: s.airspeed_mps,
             roll_deg: s.roll_deg,
             pitch_deg: s.pitch_deg,

@@ -141,6 +141,29 @@ fn power_matches_the_rust_model() {
     let b: serde_json::Value = serde_json::from_str(&take(json)).unwrap();
     // -5.7296 deg is -0.1 rad to 1e-16: the same power to rounding.
     assert!((b["electrical_w"].as_f64().unwrap() - rust).abs() < 1e-9 * rust);
+    // Both fly the M100's default take-off mass: 1755 g airframe + 600 g TB47D.
+    assert!((b["takeoff_mass_kg"].as_f64().unwrap() - 2.355).abs() < 1e-12);
+    assert_eq!(b["battery"].as_str(), Some("TB47D"));
+    // Another pack and a payload, as `aloft power --battery TB48D --payload-kg 0.5`: thrust in
+    // hover is (1.755 + 0.676 + 0.5) kg x g (the power seed's g = 9.8066).
+    let mut json = null_mut();
+    // SAFETY: as above.
+    let s = unsafe {
+        aloft_vehicle_power_json(
+            v,
+            c"{\"battery\": \"TB48D\", \"payload_kg\": 0.5}".as_ptr(),
+            &mut json,
+        )
+    };
+    assert_eq!(s, AloftStatus::Ok, "{}", last_error());
+    let b: serde_json::Value = serde_json::from_str(&take(json)).unwrap();
+    let mass = 1.755 + 0.676 + 0.5;
+    assert!((b["takeoff_mass_kg"].as_f64().unwrap() - mass).abs() < 1e-12);
+    assert!((b["thrust_n"].as_f64().unwrap() - mass * 9.8066).abs() < 1e-9);
+    // SAFETY: as above.
+    let s = unsafe { aloft_vehicle_power_json(v, c"{\"payload_kg\": 2}".as_ptr(), &mut json) };
+    assert_eq!(s, AloftStatus::Mission, "{}", last_error());
+    assert!(last_error().contains("3.600 kg limit"), "{}", last_error());
     // SAFETY: freed once.
     unsafe { aloft_vehicle_free(v) };
 }

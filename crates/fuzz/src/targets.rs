@@ -344,7 +344,8 @@ fn round_trip(m: &Mission, o: &mut Outcome) {
 
 fn power_csv_target(data: &[u8]) -> Outcome {
     static MODEL: OnceLock<PowerModel> = OnceLock::new();
-    let model = MODEL.get_or_init(|| power_model(m100(), &[], None).expect("dji-m100 has a model"));
+    let model = MODEL
+        .get_or_init(|| power_model(m100(), &PowerQuery::default()).expect("dji-m100 has a model"));
     let mut out = Vec::new();
     match power_csv(model, data, &mut out, "fuzz-states.csv") {
         Ok(_) => {

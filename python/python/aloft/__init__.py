@@ -129,7 +129,8 @@ def vehicles() -> List[Dict[str, Any]]:
     """The built-in vehicles: ``aloft vehicles --format json``.
 
     Returns:
-        One dict per vehicle: ``name``, ``description``, ``mass_kg``, ``models``, ``batteries``
+        One dict per vehicle: ``name``, ``description``, ``takeoff_mass_kg`` (airframe +
+        default pack, or a power model's own mass), ``models``, ``batteries``
         (the pack names for ``battery=``, default first) and, for the DJI vehicles, ``source``
         (``figures``, ``calibrated_on``, ``published``).
     """
@@ -188,7 +189,9 @@ def validate(
     Args:
         logs: One log or a list of logs.
         vehicle: Built-in name or TOML path of a vehicle with a ``[power]`` table.
-        **options: ``calibrate_first`` (s), ``profile``, ``aoa``, ``lag``, ``max_lag``,
+        **options: ``calibrate_first`` (s), ``battery`` and ``payload_kg`` (the take-off mass
+            the flights carried: airframe + pack + payload; a vehicle without an airframe flies
+            its ``[power]`` mass + payload), ``profile``, ``aoa``, ``lag``, ``max_lag``,
             ``battery_instance``.
     """
     return json.loads(_native.validate_json(_paths(logs), vehicle, options))
@@ -207,6 +210,8 @@ def power(
     climb_rate: Any = 0.0,
     vehicle: str = DEFAULT_VEHICLE,
     *,
+    battery: Optional[str] = None,
+    payload_kg: Optional[float] = None,
     without: Optional[Union[str, Sequence[str]]] = None,
     profile_cutoff: Optional[float] = None,
     aoa: Optional[str] = None,
@@ -224,6 +229,11 @@ def power(
         pitch: Pitch, degrees, positive nose up (``--pitch``; forward flight is negative).
         climb_rate: Vertical speed, m/s, positive up (``--climb-rate``).
         vehicle: Built-in name or vehicle TOML path.
+        battery: Pack by name (``--battery``; default the vehicle's default pack).
+        payload_kg: Payload, kg (``--payload-kg``; default 0). The model flies the vehicle's
+            take-off mass, airframe + pack + payload, as ``aloft power``, ``aloft endurance``
+            and ``aloft mission`` do (a vehicle without an airframe, such as
+            ``"dji-m100-paper"``, its ``[power]`` table's mass + payload).
         without: Terms removed (``"induced"``, ``"parasitic"``, ``"profile"``, ``"climb"``).
         profile_cutoff: Drop the profile term above this airspeed, m/s.
         aoa: ``"paper"`` (default) or ``"geometric"`` (needs ``air_direction_deg``).
@@ -238,7 +248,8 @@ def power(
 
     Raises:
         AloftError: A state the model refuses (the CLI's message, with the element's flat
-            index), a non-finite input, a vehicle without a ``[power]`` table.
+            index), a non-finite input, a vehicle without a ``[power]`` table, an unknown pack,
+            a take-off mass above the vehicle's limit.
     """
     inputs = [airspeed, roll, pitch, climb_rate]
     if air_direction_deg is not None:
@@ -251,6 +262,8 @@ def power(
     flat = [np.ascontiguousarray(np.broadcast_to(a, shape)).reshape(-1) for a in arrays]
     options = {
         "vehicle": vehicle,
+        "battery": battery,
+        "payload_kg": payload_kg,
         "without": without,
         "profile_cutoff": profile_cutoff,
         "aoa": aoa,
