@@ -227,10 +227,12 @@ pub(super) fn write_model_line(out: &mut impl Write, plan: &Plan) -> Result<()> 
     let c = plan.context();
     writeln!(
         out,
-        "Model: four-term power model (power seed) with {} angle of attack{}, force balance with the vehicle's cubic drag, pack by charge counting on a LiPo open-circuit curve with {:.3} ohm.",
-        match c.aoa {
-            AoaModel::Geometric => "geometric",
-            AoaModel::Paper => "the paper's",
+        "Model: {}{}{}, force balance with the vehicle's cubic drag, pack by charge counting on a LiPo open-circuit curve with {:.3} ohm.",
+        c.power_model,
+        match (c.power_model.starts_with("four-term"), c.aoa) {
+            (false, _) => "",
+            (true, AoaModel::Geometric) => " with geometric angle of attack",
+            (true, AoaModel::Paper) => " with the paper's angle of attack",
         },
         if c.ground_effect {
             ", ground effect near the ground (survey eq 35)"

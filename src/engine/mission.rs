@@ -271,6 +271,8 @@ pub struct PlanContext {
     pub wind: String,
     /// Notes on how the vehicle is modelled.
     pub notes: Vec<String>,
+    /// Where the electrical power comes from, in words.
+    pub power_model: &'static str,
     /// Angle-of-attack model of the power model.
     pub aoa: AoaModel,
     /// Whether ground effect was applied near the ground.
@@ -472,6 +474,8 @@ fn plan_in(
     (wind, wind_text): (&Wind, String),
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
+    // The aircraft first: a vehicle without an airframe is told so, before its packs.
+    let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
     let in_mission = |e| Error::Mission {
         origin: mission.origin.clone(),
@@ -480,7 +484,7 @@ fn plan_in(
     };
     check_options(options)?;
     let flight = Flight {
-        aircraft: vehicle.aircraft()?,
+        aircraft,
         pack: &battery,
         wind,
         options: planner_options(options, &mission.spec)?,
@@ -535,6 +539,12 @@ fn plan_in(
         battery: PackDescription::of(&battery),
         wind: wind_text,
         notes: vehicle.notes(),
+        power_model: match aircraft.source() {
+            aloft_planner::PowerSource::FourTerm { .. } => "four-term power model (power seed)",
+            aloft_planner::PowerSource::Chain(_) => {
+                "propulsion chain (propulsion seed: propeller, motor, ESC and pack per rotor)"
+            }
+        },
         aoa: options.aoa,
         ground_effect: options.ground_effect,
     };

@@ -637,6 +637,8 @@ impl<'a> MissionScenarios<'a> {
         options: &MissionOptions,
         sc: &ScenarioOptions,
     ) -> Result<Self, Error> {
+        // The aircraft first: a vehicle without an airframe is told so, before its packs.
+        let aircraft = vehicle.aircraft()?;
         let pack = vehicle.battery(options.battery.as_deref())?;
         check_options(options)?;
         let winds = Winds::new(vehicle, mission, options, sc)?;
@@ -645,7 +647,6 @@ impl<'a> MissionScenarios<'a> {
             second_thread: false,
             ..planner_options(options, mission.spec())?
         };
-        let aircraft = vehicle.aircraft()?;
         let (spec, _) = flown_spec(mission, vehicle, options);
         let flight = Flight {
             aircraft,
