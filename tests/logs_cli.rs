@@ -70,6 +70,64 @@ fn log_info_json_reports_duration_rates_and_energy() {
     assert_eq!(j["columns"].as_array().unwrap().len(), 20);
 }
 
+/// The rows of a CSV with a header, as columns by name.
+fn csv_columns(path: &Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let mut cols: std::collections::HashMap<String, Vec<f64>> =
+        names.iter().map(|n| (n.clone(), Vec::new())).collect();
+    for l in lines {
+        for (n, v) in names.iter().zip(l.split(',')) {
+            // Non-numeric columns (none expected among the ones used) read as NaN.
+            cols.get_mut(n).unwrap().push(v.parse().unwrap_or(f64::NAN));
+        }
+    }
+    cols
+}
+
+/// Issue 23: `log info` of `mission --mcap` output reported twice the samples and one
+/// "non-monotonic" step per sample. Sample count = rows of the time series aloft writes beside
+/// the MCAP, no step back, and the energy of V x I by trapezoids over those rows (computed here).
+#[test]
+fn log_info_of_a_mission_mcap_has_the_time_series_rows() {
+    let (csv, mcap) = (tmp("demo.csv"), tmp("demo.mcap"));
+    let o = aloft(&[
+        "mission",
+        "--timeseries",
+        csv.to_str().unwrap(),
+        "--mcap",
+        mcap.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let cols = csv_columns(&csv);
+    let (t, v, i) = (&cols["time_s"], &cols["voltage_v"], &cols["current_a"]);
+    assert!(t.len() > 100, "{} rows", t.len());
+    let wh = (1..t.len())
+        .map(|k| 0.5 * (v[k - 1] * i[k - 1] + v[k] * i[k]) * (t[k] - t[k - 1]))
+        .sum::<f64>()
+        / 3600.0;
+    let o = aloft(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["samples"], t.len() as u64);
+    assert_eq!(j["time"]["non_monotonic_count"], 0);
+    assert_eq!(j["time"]["gap_count"], 0);
+    // Times pass through whole nanoseconds of the MCAP log time: 1e-9 relative.
+    let got = j["energy_wh"].as_f64().unwrap();
+    assert!((got - wh).abs() < 1e-9 * wh, "{got} Wh vs {wh} Wh");
+    let span = t[t.len() - 1] - t[0];
+    assert!((j["duration_s"].as_f64().unwrap() - span).abs() < 1e-6);
+    for c in j["channels"].as_array().unwrap() {
+        assert_eq!(c["samples"], t.len() as u64, "{c}");
+    }
+}
+
 #[test]
 fn log_info_table_reports_gaps() {
     let o = aloft(&[

@@ -402,14 +402,19 @@ fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions)
     match convert_log(path, options, &out) {
         Ok(c) => {
             o.json("convert", &c);
-            let source = log_info(path, options, None).map(|i| i.duration_s);
+            let source = log_info(path, options, None).map(|i| (i.duration_s, i.samples));
             match (log_info(&out, &LogReadOptions::default(), None), source) {
-                (Ok(i), Ok(d)) if (i.duration_s - d).abs() <= 1e-6 * d.abs().max(1.0) => {
+                (Ok(i), Ok((d, n)))
+                    if (i.duration_s - d).abs() <= 1e-6 * d.abs().max(1.0) && i.samples == n =>
+                {
                     o.json("log info of the MCAP", &i);
                 }
-                (Ok(i), Ok(d)) => o.broken.push(Problem {
+                (Ok(i), Ok((d, n))) => o.broken.push(Problem {
                     check: "mcap-round-trip",
-                    detail: format!("{d} s converted, {} s read back", i.duration_s),
+                    detail: format!(
+                        "{n} samples over {d} s converted, {} over {} s read back",
+                        i.samples, i.duration_s
+                    ),
                 }),
                 (Err(e), _) => o.broken.push(Problem {
                     check: "mcap-round-trip",
