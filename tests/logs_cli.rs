@@ -246,10 +246,41 @@ fn power_lag_needs_power_data() {
         p.to_str().unwrap(),
         "--profile",
         &fixture("custom.toml"),
-        "--lag",
+        "--max-lag",
         "1",
     ]);
     // custom.csv has power but no velocity.
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("velocity"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-lag"), "{}", stderr(&o));
+}
+
+/// Issue 23, item 7: `--lag` was the search window in `log info` and the lag itself in `fit`,
+/// `validate` and `mission --replay`. The window is `--max-lag` now; the old name is refused
+/// (exit 2, one line naming the new flag with the value given), never taken as an alias.
+#[test]
+fn the_old_lag_flag_of_log_info_names_max_lag() {
+    for (args, value) in [(&["--lag", "5"][..], "5"), (&["--lag"][..], "MAX_S")] {
+        let mut all = vec!["log", "info", "x.csv"];
+        all.extend_from_slice(args);
+        let o = aloft(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(
+            e.contains("--lag of log info is now --max-lag")
+                && e.contains(&format!("--max-lag {value} searches")),
+            "{e}"
+        );
+    }
+    // The window under its new name (and a lag estimated within it).
+    let log = fixture("kaist_small.csv");
+    let o = aloft(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        j["lag"]["lag_s"].as_f64().unwrap().abs() <= 0.3 + 1e-9,
+        "{}",
+        j["lag"]
+    );
 }

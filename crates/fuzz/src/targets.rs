@@ -147,8 +147,8 @@ pub fn target(name: &str) -> Option<&'static Target> {
 /// The line between the column map and the CSV log in an input of the `column-map` target.
 pub const MAP_SEPARATOR: &[u8] = b"\n#--- csv ---\n";
 
-/// The lag search window of `log info --lag` on every 4th log input, s (the seeds are 0.5 to 2 s
-/// long, and a search needs a log of twice its window).
+/// The lag search window of `log info --max-lag` on every 4th log input, s (the seeds are 0.5
+/// to 2 s long, and a search needs a log of twice its window).
 pub const LAG_WINDOW_S: f64 = 0.2;
 
 /// The line between the tables of an input of the `px4-csv` target.
@@ -360,9 +360,9 @@ fn power_csv_target(data: &[u8]) -> Outcome {
     }
 }
 
-/// `log_info` of `path` (and the lag search when `lag`), as `aloft log info`.
-fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, lag: Option<f64>) -> bool {
-    match log_info(path, options, lag) {
+/// `log_info` of `path` (and the lag search within +-`max_lag` s when given), as `aloft log info`.
+fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, max_lag: Option<f64>) -> bool {
+    match log_info(path, options, max_lag) {
         Ok(i) => {
             o.json("log info", &i);
             true
