@@ -127,7 +127,7 @@ pub enum Error {
         channel: &'static str,
     },
     /// Power and velocity that share too little time for a lag estimate.
-    #[error("{origin}: --lag needs power and velocity over a common span of at least 10 samples; power covers {power}, velocity {velocity} ({shared} samples of {step} shared)")]
+    #[error("{origin}: --max-lag needs power and velocity over a common span of at least 10 samples; power covers {power}, velocity {velocity} ({shared} samples of {step} shared)")]
     NoCommonSpan {
         /// File.
         origin: String,

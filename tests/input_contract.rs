@@ -105,7 +105,7 @@ fn non_finite_numeric_flags_are_refused_naming_the_flag() {
             "--takeoff-mass-kg",
         ),
         (&["rotor", "--voltage", "NaN"], "--voltage"),
-        (&["log", "info", "x.csv", "--lag", "inf"], "--lag"),
+        (&["log", "info", "x.csv", "--max-lag", "inf"], "--max-lag"),
         (
             &[
                 "fit",

@@ -70,6 +70,64 @@ fn log_info_json_reports_duration_rates_and_energy() {
     assert_eq!(j["columns"].as_array().unwrap().len(), 20);
 }
 
+/// The rows of a CSV with a header, as columns by name.
+fn csv_columns(path: &Path) -> std::collections::HashMap<String, Vec<f64>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let names: Vec<String> = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_string)
+        .collect();
+    let mut cols: std::collections::HashMap<String, Vec<f64>> =
+        names.iter().map(|n| (n.clone(), Vec::new())).collect();
+    for l in lines {
+        for (n, v) in names.iter().zip(l.split(',')) {
+            // Non-numeric columns (none expected among the ones used) read as NaN.
+            cols.get_mut(n).unwrap().push(v.parse().unwrap_or(f64::NAN));
+        }
+    }
+    cols
+}
+
+/// Issue 23: `log info` of `mission --mcap` output reported twice the samples and one
+/// "non-monotonic" step per sample. Sample count = rows of the time series aloft writes beside
+/// the MCAP, no step back, and the energy of V x I by trapezoids over those rows (computed here).
+#[test]
+fn log_info_of_a_mission_mcap_has_the_time_series_rows() {
+    let (csv, mcap) = (tmp("demo.csv"), tmp("demo.mcap"));
+    let o = aloft(&[
+        "mission",
+        "--timeseries",
+        csv.to_str().unwrap(),
+        "--mcap",
+        mcap.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let cols = csv_columns(&csv);
+    let (t, v, i) = (&cols["time_s"], &cols["voltage_v"], &cols["current_a"]);
+    assert!(t.len() > 100, "{} rows", t.len());
+    let wh = (1..t.len())
+        .map(|k| 0.5 * (v[k - 1] * i[k - 1] + v[k] * i[k]) * (t[k] - t[k - 1]))
+        .sum::<f64>()
+        / 3600.0;
+    let o = aloft(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["samples"], t.len() as u64);
+    assert_eq!(j["time"]["non_monotonic_count"], 0);
+    assert_eq!(j["time"]["gap_count"], 0);
+    // Times pass through whole nanoseconds of the MCAP log time: 1e-9 relative.
+    let got = j["energy_wh"].as_f64().unwrap();
+    assert!((got - wh).abs() < 1e-9 * wh, "{got} Wh vs {wh} Wh");
+    let span = t[t.len() - 1] - t[0];
+    assert!((j["duration_s"].as_f64().unwrap() - span).abs() < 1e-6);
+    for c in j["channels"].as_array().unwrap() {
+        assert_eq!(c["samples"], t.len() as u64, "{c}");
+    }
+}
+
 #[test]
 fn log_info_table_reports_gaps() {
     let o = aloft(&[
@@ -188,10 +246,41 @@ fn power_lag_needs_power_data() {
         p.to_str().unwrap(),
         "--profile",
         &fixture("custom.toml"),
-        "--lag",
+        "--max-lag",
         "1",
     ]);
     // custom.csv has power but no velocity.
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("velocity"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-lag"), "{}", stderr(&o));
+}
+
+/// Issue 23, item 7: `--lag` was the search window in `log info` and the lag itself in `fit`,
+/// `validate` and `mission --replay`. The window is `--max-lag` now; the old name is refused
+/// (exit 2, one line naming the new flag with the value given), never taken as an alias.
+#[test]
+fn the_old_lag_flag_of_log_info_names_max_lag() {
+    for (args, value) in [(&["--lag", "5"][..], "5"), (&["--lag"][..], "MAX_S")] {
+        let mut all = vec!["log", "info", "x.csv"];
+        all.extend_from_slice(args);
+        let o = aloft(&all);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        let e = stderr(&o);
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(
+            e.contains("--lag of log info is now --max-lag")
+                && e.contains(&format!("--max-lag {value} searches")),
+            "{e}"
+        );
+    }
+    // The window under its new name (and a lag estimated within it).
+    let log = fixture("kaist_small.csv");
+    let o = aloft(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        j["lag"]["lag_s"].as_f64().unwrap().abs() <= 0.3 + 1e-9,
+        "{}",
+        j["lag"]
+    );
 }

@@ -245,7 +245,7 @@ fn fifos_directories_and_devices_exit_2_at_once() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `log info --lag` on a log whose power and velocity do not share time (the MCAP the fuzz
+/// `log info --max-lag` on a log whose power and velocity do not share time (the MCAP the fuzz
 /// harness found panicking, `fixtures/fuzz/mcap/144f24e1775ed450.bin`): exit 2 saying so, with
 /// both spans, whatever the search window.
 #[test]
@@ -254,7 +254,7 @@ fn lag_on_series_without_a_common_span_says_so() {
     let path = tmp("no-common-span.mcap");
     std::fs::copy(&src, &path).unwrap();
     for lag in ["0.1", "5"] {
-        let o = aloft_limited(&["log", "info", path.to_str().unwrap(), "--lag", lag]);
+        let o = aloft_limited(&["log", "info", path.to_str().unwrap(), "--max-lag", lag]);
         assert_refused(&o, &path, &["common span", "power covers", "velocity"]);
     }
 }

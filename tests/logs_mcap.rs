@@ -8,8 +8,8 @@ use std::process::Command;
 
 use aloft_logs::cdr::CdrWriter;
 use aloft_logs::{
-    read_log, write_log_mcap, write_mission_mcap, Attitude, BatteryPoint, Channel, LogError,
-    McapOptions, McapSamples, MissionSample, PathPoint, PowerTerms, Profile,
+    read_log, write_log_mcap, write_mission_mcap, Attitude, BatteryPoint, Channel, InfoAccumulator,
+    LogError, McapOptions, McapSamples, MissionSample, PathPoint, PowerTerms, Profile, Sample,
 };
 
 fn tmp(name: &str) -> PathBuf {
@@ -144,6 +144,10 @@ fn ros2_cdr_topics_are_chosen_by_type_without_mixing_sources() {
     // 10 Hz from the log times.
     assert!((topics[0].rate_hz().unwrap() - 10.0).abs() < 1e-6);
     assert!(samples.last().unwrap().time_s > 0.89);
+    // A foreign file's messages are not joined, even at one time (above: 30 samples), and
+    // three messages at one time are not time going back.
+    let time = r.time_report();
+    assert_eq!((time.samples, time.non_monotonic_count), (30, 0));
 }
 
 #[test]
@@ -305,8 +309,17 @@ fn converted_log_reads_back_equal() {
     let (log, out) = log_round_trip_file();
     let back = read_log(&out, None, &McapOptions::default()).unwrap();
     // Auto-selection: /aloft/state comes first and provides position, velocity and attitude, so
-    // /aloft/pose is not decoded (sources are not mixed); battery from /aloft/battery.
-    assert_eq!(back.samples.len(), 40);
+    // /aloft/pose is not decoded (sources are not mixed); battery from /aloft/battery. The state
+    // and battery messages of one sample are one sample again (issue 23: they were two, and
+    // each equal time was reported as time going back).
+    assert_eq!(back.samples.len(), 20);
+    assert!(back.time.is_clean(), "{:?}", back.time);
+    for (a, b) in log.samples.iter().zip(&back.samples) {
+        assert!((a.time_s - b.time_s).abs() < 1e-9, "{a:?} {b:?}");
+        assert!((a.voltage_v.unwrap() - b.voltage_v.unwrap()).abs() < TOL);
+        assert!((a.current_a.unwrap() - b.current_a.unwrap()).abs() < TOL);
+        assert!(b.pos_enu_m.is_some() && b.attitude.is_some() && b.vel_enu_mps.is_some());
+    }
     let pos: Vec<_> = back.samples.iter().filter_map(|s| s.pos_enu_m).collect();
     let att: Vec<_> = back.samples.iter().filter_map(|s| s.attitude).collect();
     let vel: Vec<_> = back.samples.iter().filter_map(|s| s.vel_enu_mps).collect();
@@ -349,6 +362,17 @@ fn converted_log_reads_back_equal() {
         assert!((a.pitch_rad - b.pitch_rad).abs() < TOL);
         assert!((a.yaw_rad - b.yaw_rad).abs() < TOL);
     }
+    // Pose and battery by name: aloft's pose topic joins its instant too.
+    let o = McapOptions {
+        topics: vec!["/aloft/pose".into(), "/aloft/battery".into()],
+        ..McapOptions::default()
+    };
+    let named = read_log(&out, None, &o).unwrap();
+    assert_eq!(named.samples.len(), 20);
+    assert!(named
+        .samples
+        .iter()
+        .all(|s| s.pos_enu_m.is_some() && s.voltage_v.is_some()));
     // Same relative times; the absolute start (1 s of boot time) is kept as log_time.
     assert!((back.samples.last().unwrap().time_s - 1.9).abs() < 1e-6);
     assert!((back.start_time_s - 1.0).abs() < 1e-6);
@@ -491,6 +515,107 @@ fn mission_mcap_has_all_topics_and_reads_back() {
         ]
     });
     python_check(&out, &expect);
+}
+
+/// Issue 23: `log info` of `mission --mcap` output counted a state and a battery message of one
+/// instant as two samples, and each equal time as time going back. One instant is one sample,
+/// and the energy is the trapezoid of the mission's own V x I, computed here.
+#[test]
+fn a_mission_mcap_reads_back_one_sample_per_instant_with_its_energy() {
+    let (samples, path) = mission();
+    let out = tmp("mission_instants.mcap");
+    write_mission_mcap(&out, &samples, &path).unwrap();
+    let mut r = McapSamples::open(&out, McapOptions::default()).unwrap();
+    let back: Vec<Sample> = r.by_ref().collect::<Result<_, _>>().unwrap();
+    assert_eq!(back.len(), samples.len());
+    let time = r.time_report();
+    assert_eq!((time.non_monotonic_count, time.gap_count), (0, 0));
+    let mut acc = InfoAccumulator::new();
+    for (m, b) in samples.iter().zip(&back) {
+        acc.push(b);
+        assert!((m.time_s - b.time_s).abs() < 1e-9, "{m:?} {b:?}");
+        let p = b.pos_enu_m.unwrap();
+        assert!((0..3).all(|k| (p[k] - m.pos_enu_m[k]).abs() < TOL), "{p:?}");
+        assert!((b.voltage_v.unwrap() - m.battery.unwrap().voltage_v).abs() < TOL);
+    }
+    let stats = acc.finish();
+    let vi: Vec<(f64, f64)> = samples
+        .iter()
+        .map(|m| {
+            let b = m.battery.unwrap();
+            (m.time_s, b.voltage_v * b.current_a)
+        })
+        .collect();
+    let wh = vi
+        .windows(2)
+        .map(|w| 0.5 * (w[0].1 + w[1].1) * (w[1].0 - w[0].0))
+        .sum::<f64>()
+        / 3600.0;
+    // Times pass through whole nanoseconds: 1e-9 relative.
+    let got = stats.energy_wh.unwrap();
+    assert!((got - wh).abs() < 1e-9 * wh, "{got} Wh vs {wh} Wh");
+    assert_eq!(stats.energy_skipped_steps, 0);
+}
+
+/// The join of one instant keeps the source's samples apart: two samples at one time (both
+/// with motion, or both with battery), a battery-only sample before a motion-only one at one
+/// time, and a sample with no channel all read back as they were written.
+#[test]
+fn samples_of_one_time_read_back_as_written() {
+    let full = |t: f64, x: f64| Sample {
+        time_s: t,
+        pos_enu_m: Some([x, 0.0, 5.0]),
+        vel_enu_mps: Some([1.0, 0.0, 0.0]),
+        voltage_v: Some(16.0 - x),
+        current_a: Some(10.0),
+        ..Sample::default()
+    };
+    let battery = |t: f64, v: f64| Sample {
+        time_s: t,
+        voltage_v: Some(v),
+        current_a: Some(5.0),
+        ..Sample::default()
+    };
+    let motion = |t: f64, x: f64| Sample {
+        time_s: t,
+        pos_enu_m: Some([x, 1.0, 2.0]),
+        ..Sample::default()
+    };
+    let written = vec![
+        full(0.0, 0.0),
+        full(0.0, 1.0),
+        battery(0.1, 15.5),
+        motion(0.1, 2.0),
+        Sample {
+            time_s: 0.2,
+            ..Sample::default()
+        },
+        battery(0.2, 15.0),
+        battery(0.2, 14.5),
+        motion(0.3, 3.0),
+        motion(0.3, 4.0),
+        full(0.4, 5.0),
+    ];
+    let log = aloft_logs::Log {
+        samples: written.clone(),
+        ..aloft_logs::Log::default()
+    };
+    let out = tmp("one_time.mcap");
+    write_log_mcap(&out, &log).unwrap();
+    let back = read_log(&out, None, &McapOptions::default()).unwrap();
+    assert_eq!(back.samples.len(), written.len());
+    for (i, (a, b)) in written.iter().zip(&back.samples).enumerate() {
+        // The battery message carries V x I as its power: the power channel is compared as
+        // the electrical power.
+        for c in Channel::ALL.into_iter().filter(|c| *c != Channel::Power) {
+            assert_eq!(c.present_in(a), c.present_in(b), "sample {i}, {c:?}: {b:?}");
+        }
+        assert_eq!(a.electrical_power_w(), b.electrical_power_w(), "sample {i}");
+        assert!((a.time_s - b.time_s).abs() < 1e-9, "sample {i}");
+        assert_eq!(a.voltage_v, b.voltage_v, "sample {i}");
+        assert_eq!(a.pos_enu_m, b.pos_enu_m, "sample {i}");
+    }
+    assert_eq!(back.time.non_monotonic_count, 0);
 }
 
 #[test]

@@ -248,10 +248,15 @@ fn log_info_json(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
     let mut k = Kwargs::new("log_info", options)?;
+    k.renamed(
+        "lag",
+        "max_lag",
+        "the search window of the lag estimate, s; 'lag' is the lag itself in fit and validate",
+    )?;
     let read = options::log_read(&mut k)?;
-    let lag = k.f64("lag")?;
+    let max_lag = k.f64("max_lag")?;
     k.finish()?;
-    py.detach(|| json_of(&log_info(&path, &read, lag)?))
+    py.detach(|| json_of(&log_info(&path, &read, max_lag)?))
         .map_err(engine_error)
 }
 

@@ -210,6 +210,18 @@ impl<'py> Kwargs<'py> {
         })
     }
 
+    /// Refuse the old name `old` of the option `new`, saying what it is now (a clear error,
+    /// never a silent alias).
+    pub fn renamed(&self, old: &str, new: &str, what: &str) -> PyResult<()> {
+        if self.values.contains_key(old) {
+            return Err(aloft_error(format!(
+                "'{old}' of aloft.{} is now '{new}' ({what})",
+                self.function
+            )));
+        }
+        Ok(())
+    }
+
     /// Refuse a key that is left over: unknown here (or not yet known to this version).
     pub fn finish(self) -> PyResult<()> {
         if let Some(key) = self.values.keys().next() {

@@ -130,8 +130,8 @@ def test_log_info_equals_cli(cli, repo, data):
     log = repo / "fixtures" / "logs" / "kaist_small.csv"
     assert aloft.log_info(log) == cli.json("log", "info", str(log))
     log = sorted((data / "kaist_energy_drone").glob("2018-08-03*.csv"))[0]
-    assert aloft.log_info(str(log), profile="kaist", lag=5.0) == cli.json(
-        "log", "info", str(log), "--profile", "kaist", "--lag", "5")
+    assert aloft.log_info(str(log), profile="kaist", max_lag=5.0) == cli.json(
+        "log", "info", str(log), "--profile", "kaist", "--max-lag", "5")
 
 
 def test_fit_and_validate_equal_cli(cli, repo, data, tmp_path):

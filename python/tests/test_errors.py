@@ -70,6 +70,16 @@ def test_unknown_option_named():
         aloft.endurance(wind=5)
 
 
+def test_old_lag_of_log_info_says_its_new_name(cli, repo, monkeypatch):
+    # `log info --lag` is now `--max-lag` (a search window; `lag` is the lag itself in fit and
+    # validate): the old name is refused with the new one, never taken silently.
+    monkeypatch.chdir(repo)
+    log = "fixtures/logs/kaist_small.csv"
+    with pytest.raises(aloft.AloftError, match="'lag' of aloft.log_info is now 'max_lag'"):
+        aloft.log_info(log, lag=5.0)
+    assert "--lag of log info is now --max-lag" in cli.error("log", "info", log, "--lag", "5")
+
+
 def test_pairs_that_need_each_other():
     with pytest.raises(aloft.AloftError, match="'wind_speed' .* needs 'wind_from'"):
         aloft.mission(wind_speed=5)

@@ -66,9 +66,14 @@ struct InfoArgs {
     file: PathBuf,
     #[command(flatten)]
     read: ReadOptions,
-    /// Also estimate the lag of power behind ground speed by cross-correlation (search +-N s).
+    /// Also estimate the lag of power behind ground speed by cross-correlation, searched within
+    /// +-MAX_S seconds.
     #[arg(value_parser = super::args::finite(), long, value_name = "MAX_S")]
-    lag: Option<f64>,
+    max_lag: Option<f64>,
+    /// The old name of --max-lag, refused with a message: --lag is the lag itself in fit,
+    /// validate and mission --replay.
+    #[arg(long, hide = true, num_args = 0..=1, value_name = "S")]
+    lag: Option<Option<String>>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -81,7 +86,13 @@ pub fn run(args: LogArgs) -> Result<Outcome> {
 }
 
 fn info(args: InfoArgs) -> Result<Outcome> {
-    let info = log_info(&args.file, &args.read.options(), args.lag)?;
+    if let Some(value) = &args.lag {
+        let value = value.as_deref().unwrap_or("MAX_S");
+        anyhow::bail!(
+            "--lag of log info is now --max-lag: --max-lag {value} searches the lag of power behind ground speed within +-{value} s (--lag is the lag itself in fit, validate and mission --replay)"
+        );
+    }
+    let info = log_info(&args.file, &args.read.options(), args.max_lag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {

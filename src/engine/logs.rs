@@ -248,7 +248,7 @@ pub struct LogInfo {
     /// The first ten of them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dropped: Vec<DroppedValue>,
-    /// With a lag search: the lag of power behind ground speed.
+    /// With a lag search (`--max-lag`): the lag of power behind ground speed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lag: Option<LagInfo>,
     /// ULog and DataFlash: records, battery records, parameters.
@@ -322,15 +322,15 @@ impl LagSeries {
 }
 
 /// Summarise the log at `path`: duration, rates, channels or topics, energy used, the regularity
-/// of the time base; with `lag_window_s`, the lag of power behind ground speed searched within
-/// +-that many seconds.
+/// of the time base; with `max_lag_s` (`--max-lag`), the lag of power behind ground speed
+/// searched within +-that many seconds.
 ///
 /// # Errors
 /// A log that cannot be opened or decoded; a lag search on a log without power or velocity.
 pub fn log_info(
     path: &Path,
     options: &LogReadOptions,
-    lag_window_s: Option<f64>,
+    max_lag_s: Option<f64>,
 ) -> Result<LogInfo, Error> {
     let (mut reader, profile) = options.open(path)?;
     let mut acc = InfoAccumulator::new();
@@ -338,7 +338,7 @@ pub fn log_info(
     for s in reader.by_ref() {
         let s = s?;
         acc.push(&s);
-        if lag_window_s.is_some() {
+        if max_lag_s.is_some() {
             series.push(&s);
         }
     }
@@ -349,7 +349,7 @@ pub fn log_info(
     let file = path.display().to_string();
     let (energy_wh, power_available, warnings, log) =
         power_facts(&reader, &stats, options.battery_instance);
-    let lag = match lag_window_s {
+    let lag = match max_lag_s {
         None => None,
         Some(max) => Some(lag_of(&file, &series, time.nominal_period_s, max)?),
     };
@@ -415,14 +415,14 @@ fn lag_of(
     if s.power_w.is_empty() {
         return Err(Error::MissingChannel {
             origin: file.to_string(),
-            needed_for: "--lag",
+            needed_for: "--max-lag",
             channel: "power data (voltage and current)",
         });
     }
     if s.speed_mps.is_empty() {
         return Err(Error::MissingChannel {
             origin: file.to_string(),
-            needed_for: "--lag",
+            needed_for: "--max-lag",
             channel: "velocity data",
         });
     }
@@ -630,7 +630,8 @@ mod tests {
 
     /// Regression (found by aloft-fuzz on an MCAP log): power and velocity series that do not
     /// overlap in time (the power ends before the velocity starts) made the grid offset exceed
-    /// the power grid, and `log info --lag` panicked slicing it. It is now an error.
+    /// the power grid, and `log info --lag` (now `--max-lag`) panicked slicing it. It is now an
+    /// error.
     #[test]
     fn a_lag_search_on_series_that_do_not_overlap_is_an_error() {
         let s = LagSeries {

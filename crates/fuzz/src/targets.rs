@@ -147,8 +147,8 @@ pub fn target(name: &str) -> Option<&'static Target> {
 /// The line between the column map and the CSV log in an input of the `column-map` target.
 pub const MAP_SEPARATOR: &[u8] = b"\n#--- csv ---\n";
 
-/// The lag search window of `log info --lag` on every 4th log input, s (the seeds are 0.5 to 2 s
-/// long, and a search needs a log of twice its window).
+/// The lag search window of `log info --max-lag` on every 4th log input, s (the seeds are 0.5
+/// to 2 s long, and a search needs a log of twice its window).
 pub const LAG_WINDOW_S: f64 = 0.2;
 
 /// The line between the tables of an input of the `px4-csv` target.
@@ -361,9 +361,9 @@ fn power_csv_target(data: &[u8]) -> Outcome {
     }
 }
 
-/// `log_info` of `path` (and the lag search when `lag`), as `aloft log info`.
-fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, lag: Option<f64>) -> bool {
-    match log_info(path, options, lag) {
+/// `log_info` of `path` (and the lag search within +-`max_lag` s when given), as `aloft log info`.
+fn info(o: &mut Outcome, path: &Path, options: &LogReadOptions, max_lag: Option<f64>) -> bool {
+    match log_info(path, options, max_lag) {
         Ok(i) => {
             o.json("log info", &i);
             true
@@ -403,14 +403,19 @@ fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions)
     match convert_log(path, options, &out) {
         Ok(c) => {
             o.json("convert", &c);
-            let source = log_info(path, options, None).map(|i| i.duration_s);
+            let source = log_info(path, options, None).map(|i| (i.duration_s, i.samples));
             match (log_info(&out, &LogReadOptions::default(), None), source) {
-                (Ok(i), Ok(d)) if (i.duration_s - d).abs() <= 1e-6 * d.abs().max(1.0) => {
+                (Ok(i), Ok((d, n)))
+                    if (i.duration_s - d).abs() <= 1e-6 * d.abs().max(1.0) && i.samples == n =>
+                {
                     o.json("log info of the MCAP", &i);
                 }
-                (Ok(i), Ok(d)) => o.broken.push(Problem {
+                (Ok(i), Ok((d, n))) => o.broken.push(Problem {
                     check: "mcap-round-trip",
-                    detail: format!("{d} s converted, {} s read back", i.duration_s),
+                    detail: format!(
+                        "{n} samples over {d} s converted, {} over {} s read back",
+                        i.samples, i.duration_s
+                    ),
                 }),
                 (Err(e), _) => o.broken.push(Problem {
                     check: "mcap-round-trip",

@@ -1,4 +1,5 @@
-//! Streaming MCAP reader: decodes the supported topics of a file into [`Sample`]s, one per message.
+//! Streaming MCAP reader: decodes the supported topics of a file into [`Sample`]s, one per message,
+//! or one per instant for the topics aloft writes.
 //!
 //! # Memory
 //! The file is read front to back from any `std::io::Read` (pipes too; a file truncated or
@@ -34,6 +35,19 @@
 //! type are counted but not decoded, so two pose sources are never mixed. Named topics are decoded
 //! in the order given; a named topic that is missing or of an unsupported type is an error.
 //!
+//! # Samples
+//! A message of a foreign file is one sample: its channels, at its time. aloft writes one
+//! instant of a log or a mission as consecutive messages at one time (`/aloft/state`, then
+//! `/aloft/pose`, `/aloft/power`, `/aloft/battery`: [`crate::mcap_write`]), and those are joined
+//! back into one sample: a decoded message of a topic aloft writes (schema `aloft.*`, or
+//! `foxglove.PoseInFrame` on `/aloft/pose`) joins the sample before it when that sample came
+//! from such topics too, has the same time, and holds no message of the same topic yet (its
+//! model channels are still empty). Anything else starts a new sample. The join holds one
+//! sample at a time (the instant being assembled), so memory does not grow with the file, and a
+//! log converted with `aloft convert` reads back with the samples of the original. (Two samples
+//! of a source at one time are kept apart when both have motion or both battery data; a
+//! battery-only sample followed by a motion-only one at the same time would be joined.)
+//!
 //! # Time
 //! `time_s` is the message `log_time` (or, with [`McapTime::HeaderStamp`], the header stamp when
 //! present) minus that of the first decoded message. Out-of-order times are reported in the
@@ -50,6 +64,7 @@ use serde::Serialize;
 
 use crate::error::{LogError, Result};
 use crate::mcap_records::{self, record_name, ChannelView, McapPlace, McapProblem};
+use crate::mcap_write::TOPIC_POSE;
 use crate::ros::{decode_cdr, decode_json, Decoded, MessageKind, RosDecodeOptions, SUPPORTED};
 use crate::sample::{Channel, Sample, TimeChecker, TimeReport};
 
@@ -150,6 +165,69 @@ struct ChanState {
     /// The channels this topic feeds (a copy of `TopicInfo::used_for`, kept here so the hot
     /// loop does not allocate).
     keep: [bool; 9],
+    /// Whether the topic is one aloft writes: its messages of one instant are one sample.
+    aloft: bool,
+}
+
+/// The sample being assembled from the messages of one instant (see the module docs).
+#[derive(Debug, Clone, Copy)]
+struct Instant {
+    sample: Sample,
+    /// The model channels of the topics that fed it (their [`ChanState::keep`] together).
+    fed: [bool; 9],
+    /// Whether another message at its time may still join it (it came from aloft's topics).
+    open: bool,
+}
+
+impl Instant {
+    /// Join the message `s` of a topic whose channels are `keep`, when it belongs to this
+    /// instant; otherwise give it back.
+    fn join(&mut self, s: Sample, keep: [bool; 9], aloft: bool) -> Option<Sample> {
+        let same_time = self.sample.time_s.total_cmp(&s.time_s).is_eq();
+        let disjoint = self.fed.iter().zip(&keep).all(|(a, b)| !(*a && *b));
+        if !(aloft && self.open && same_time && disjoint) {
+            return Some(s);
+        }
+        merge(&mut self.sample, &s);
+        for (f, k) in self.fed.iter_mut().zip(keep) {
+            *f |= k;
+        }
+        None
+    }
+}
+
+/// Fill the channels `a` lacks from `b`. Every field is named, so a channel added to
+/// [`Sample`] must be added here too.
+fn merge(a: &mut Sample, b: &Sample) {
+    let Sample {
+        time_s: _,
+        pos_enu_m,
+        vel_enu_mps,
+        acc_enu_mps2,
+        attitude,
+        voltage_v,
+        current_a,
+        power_w,
+        charge_ah,
+        wind_enu_mps,
+        landed,
+    } = *b;
+    a.pos_enu_m = a.pos_enu_m.or(pos_enu_m);
+    a.vel_enu_mps = a.vel_enu_mps.or(vel_enu_mps);
+    a.acc_enu_mps2 = a.acc_enu_mps2.or(acc_enu_mps2);
+    a.attitude = a.attitude.or(attitude);
+    a.voltage_v = a.voltage_v.or(voltage_v);
+    a.current_a = a.current_a.or(current_a);
+    a.power_w = a.power_w.or(power_w);
+    a.charge_ah = a.charge_ah.or(charge_ah);
+    a.wind_enu_mps = a.wind_enu_mps.or(wind_enu_mps);
+    a.landed = a.landed.or(landed);
+}
+
+/// Whether a channel is one aloft writes ([`crate::mcap_write`]): a schema of its own
+/// (`aloft.VehicleState`, `aloft.BatteryState`, ...) or its pose topic.
+fn written_by_aloft(topic: &str, schema: &str) -> bool {
+    schema.starts_with("aloft.") || (topic == TOPIC_POSE && schema == "foxglove.PoseInFrame")
 }
 
 /// Samples of one MCAP file, decoded message by message.
@@ -285,6 +363,8 @@ struct RecordDecoder {
     start_log_time_ns: Option<u64>,
     checker: TimeChecker,
     messages: u64,
+    /// The sample being assembled (one instant), not yet given out.
+    instant: Option<Instant>,
 }
 
 impl McapSamples<std::io::BufReader<File>> {
@@ -359,6 +439,7 @@ impl<R: Read> McapSamples<R> {
                 start_log_time_ns: None,
                 checker: TimeChecker::new(),
                 messages: 0,
+                instant: None,
             },
             done: false,
         }
@@ -421,6 +502,9 @@ impl<R: Read> McapSamples<R> {
                 Step::Sample(s) => return Ok(Some(s)),
                 Step::More => {}
                 Step::End => {
+                    if let Some(s) = self.records.flush() {
+                        return Ok(Some(s));
+                    }
                     self.done = true;
                     self.records.finish_checks()?;
                     return Ok(None);
@@ -724,6 +808,7 @@ impl RecordDecoder {
         let (schema, schema_encoding) =
             self.schemas.get(&ch.schema_id).cloned().unwrap_or_default();
         let decoder = decoder_for(&schema, &schema_encoding, ch.message_encoding);
+        let aloft = written_by_aloft(ch.topic, &schema);
         let info = self.topics.len();
         let named = self.options.topics.iter().position(|t| *t == ch.topic);
         if !self.options.topics.is_empty() && named.is_some() && decoder.is_none() {
@@ -765,6 +850,7 @@ impl RecordDecoder {
                 info,
                 decoder: if used_for.is_empty() { None } else { decoder },
                 keep,
+                aloft,
             },
         );
         Ok(())
@@ -796,8 +882,34 @@ impl RecordDecoder {
         let mut s = decoded.sample;
         mask(&mut s, &st.keep);
         s.time_s = self.sample_time_s(header.log_time, decoded.stamp_s);
+        Ok(self.join(s, st.keep, st.aloft))
+    }
+
+    /// A decoded message, into the instant being assembled (see the module docs): the sample
+    /// that instant completes, if any.
+    fn join(&mut self, s: Sample, keep: [bool; 9], aloft: bool) -> Option<Sample> {
+        let s = match self.instant.as_mut() {
+            Some(instant) => instant.join(s, keep, aloft)?,
+            None => s,
+        };
+        let done = self.instant.replace(Instant {
+            sample: s,
+            fed: keep,
+            open: aloft,
+        });
+        done.map(|i| self.emit(i.sample))
+    }
+
+    /// The instant still being assembled, at the end of the file.
+    fn flush(&mut self) -> Option<Sample> {
+        let i = self.instant.take()?;
+        Some(self.emit(i.sample))
+    }
+
+    /// A sample given out: its time is checked.
+    fn emit(&mut self, s: Sample) -> Sample {
         self.checker.push(s.time_s);
-        Ok(Some(s))
+        s
     }
 
     /// Decode message `index` of topic `info`.

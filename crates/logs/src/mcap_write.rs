@@ -11,6 +11,10 @@
 //! | `/aloft/power` | `aloft.PowerTerms` | `induced_w`, `parasitic_w`, `profile_w`, `acceleration_w`, `climb_w`, `electrical_w` |
 //! | `/aloft/path` | `foxglove.PosesInFrame` | the planned path, once |
 //!
+//! One sample of a log (or instant of a mission) is written as consecutive messages at one time,
+//! `/aloft/state` first (every sample has one), and [`crate::mcap_read`] joins them back into one
+//! sample.
+//!
 //! Every message has `timestamp` `{sec, nsec}`; the MCAP `log_time` is the same instant. Values that
 //! do not exist are omitted (never NaN); non-finite input is refused with [`LogError::NonFinite`].
 //! The writer streams: memory is one chunk (the `mcap` crate's default, zstd-compressed).
@@ -275,17 +279,22 @@ impl<W: Write + Seek> McapWriter<W> {
         Ok(cid)
     }
 
+    /// The `log_time` of `time_s`: the start plus whole nanoseconds, added as integers (a Unix
+    /// time in nanoseconds as an `f64` keeps only about 256 ns, and two samples of one instant
+    /// must get one time).
     fn time_ns(&self, time_s: f64, index: usize) -> Result<u64> {
         let t = check("time_s", index, time_s)?;
-        let ns = self.start_ns as f64 + t * 1e9;
-        if ns < 0.0 {
-            return Err(LogError::InvalidArgument {
-                name: "time_s",
-                value: time_s,
-                reason: "before the Unix epoch",
-            });
-        }
-        Ok(ns.round() as u64)
+        // A float-to-integer cast saturates: far out of range stays out of range.
+        let ns = i128::from(self.start_ns) + (t * 1e9).round() as i128;
+        u64::try_from(ns).map_err(|_| LogError::InvalidArgument {
+            name: "time_s",
+            value: time_s,
+            reason: if ns < 0 {
+                "before the Unix epoch"
+            } else {
+                "after the year 2554 (the last time MCAP stores)"
+            },
+        })
     }
 
     fn put(
@@ -360,9 +369,11 @@ impl<W: Write + Seek> McapWriter<W> {
         Ok(())
     }
 
-    /// Write one log sample: state (when it has any motion, attitude or wind channel, or no
-    /// channel at all) and pose (when it has position), battery (when it has any battery
-    /// channel), so every channel and every time of the sample is in the file.
+    /// Write one log sample: state (always: with the time alone when the sample has no motion,
+    /// attitude or wind channel), pose (when it has position), battery (when it has any battery
+    /// channel), so every channel and every time of the sample is in the file. The messages of
+    /// one sample share one time and the state comes first: the reader makes one sample of
+    /// them again ([`crate::mcap_read`]), and two samples at one time stay two.
     pub fn write_sample(&mut self, index: usize, s: &Sample) -> Result<()> {
         let state = StateFields {
             time_s: s.time_s,
@@ -376,11 +387,7 @@ impl<W: Write + Seek> McapWriter<W> {
             || s.current_a.is_some()
             || s.power_w.is_some()
             || s.charge_ah.is_some();
-        // A sample with no usable channel keeps its time (a state message with the time alone),
-        // so the file has the source's samples and span.
-        if state.any() || !battery {
-            self.state(index, &state)?;
-        }
+        self.state(index, &state)?;
         if battery {
             let ns = self.time_ns(s.time_s, index)?;
             let mut m = Map::new();
@@ -533,14 +540,4 @@ struct StateFields {
     acc: Option<[f64; 3]>,
     att: Option<Attitude>,
     wind: Option<[f64; 3]>,
-}
-
-impl StateFields {
-    fn any(&self) -> bool {
-        self.pos.is_some()
-            || self.vel.is_some()
-            || self.acc.is_some()
-            || self.att.is_some()
-            || self.wind.is_some()
-    }
 }

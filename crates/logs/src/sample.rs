@@ -16,7 +16,8 @@ pub struct Attitude {
 }
 
 /// One instant of a flight log. Fields a source does not provide are `None`; a CSV source fills
-/// every mapped channel on every row, an MCAP source fills the channels of one message per sample.
+/// every mapped channel on every row, an MCAP source fills the channels of one message per sample
+/// (of one instant, for the topics aloft writes).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct Sample {
     /// Time since the first sample of the log, s.
@@ -147,7 +148,7 @@ pub struct Gap {
     pub to_s: f64,
 }
 
-/// Time going backwards (or repeating) between consecutive samples.
+/// Time going backwards between consecutive samples (an equal time is not a step back).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct NonMonotonic {
     /// 0-based index of the offending sample.
@@ -172,7 +173,7 @@ pub struct TimeReport {
     pub gap_count: u64,
     /// The first [`TimeChecker::MAX_EVENTS`] gaps.
     pub gaps: Vec<Gap>,
-    /// Steps where time decreased or repeated.
+    /// Steps where time decreased (strictly: two samples at one instant are not counted).
     pub non_monotonic_count: u64,
     /// The first [`TimeChecker::MAX_EVENTS`] such steps.
     pub non_monotonic: Vec<NonMonotonic>,
@@ -220,7 +221,9 @@ impl TimeChecker {
         }
         if let Some(prev) = self.last_s {
             let dt = time_s - prev;
-            if dt <= 0.0 {
+            // Only a strictly earlier time goes back; an equal one (two records of one
+            // instant) is neither a step back nor an interval of the nominal period.
+            if dt < 0.0 {
                 self.report.non_monotonic_count += 1;
                 if self.report.non_monotonic.len() < Self::MAX_EVENTS {
                     self.report.non_monotonic.push(NonMonotonic {
@@ -229,17 +232,25 @@ impl TimeChecker {
                         time_s,
                     });
                 }
-            } else if let Some(nominal) = self.report.nominal_period_s {
-                self.check_gap(index, prev, time_s, nominal);
-            } else {
-                self.warmup.push((index, prev, time_s));
-                if self.warmup.len() == Self::WARMUP {
-                    self.settle();
-                }
+            } else if dt > 0.0 {
+                self.interval(index, prev, time_s);
             }
         }
         self.last_s = Some(time_s);
         self.max_s = self.max_s.max(time_s);
+    }
+
+    /// A positive interval: a gap once the nominal period is known, else one more interval to
+    /// estimate it from.
+    fn interval(&mut self, index: u64, from_s: f64, to_s: f64) {
+        if let Some(nominal) = self.report.nominal_period_s {
+            self.check_gap(index, from_s, to_s, nominal);
+        } else {
+            self.warmup.push((index, from_s, to_s));
+            if self.warmup.len() == Self::WARMUP {
+                self.settle();
+            }
+        }
     }
 
     fn check_gap(&mut self, index: u64, from_s: f64, to_s: f64, nominal: f64) {
@@ -386,6 +397,30 @@ mod tests {
         assert_eq!(r.non_monotonic[0].index, 51);
         // Duration is max - first, 10 s; 1e-12 covers the rounding of 0.1 multiples.
         assert!((r.duration_s - 10.0).abs() < 1e-12);
+        assert!((r.nominal_period_s.unwrap() - 0.1).abs() < 1e-12);
+    }
+
+    /// Regression (issue 23): two records of one instant (a state and a battery message of an
+    /// MCAP aloft wrote) were counted as time going back. Only a strictly earlier time is, and
+    /// an equal time is no interval: it neither shortens the nominal period nor hides a gap.
+    #[test]
+    fn an_equal_time_is_not_a_step_back() {
+        let mut c = TimeChecker::new();
+        for i in 0..40 {
+            let t = i as f64 * 0.1;
+            c.push(t);
+            c.push(t);
+        }
+        c.push(10.0); // gap of 6.1 s
+        c.push(10.0);
+        c.push(9.9); // back
+        let r = c.finish();
+        assert_eq!(r.samples, 83);
+        assert_eq!(r.non_monotonic_count, 1);
+        assert_eq!(r.non_monotonic[0].index, 82);
+        assert_eq!(r.gap_count, 1);
+        assert_eq!(r.gaps[0].index, 80);
+        // The median of the positive intervals: 0.1 s (zero steps are no intervals).
         assert!((r.nominal_period_s.unwrap() - 0.1).abs() < 1e-12);
     }
 

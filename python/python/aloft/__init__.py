@@ -159,8 +159,8 @@ def log_info(path: PathLike, **options: Any) -> Dict[str, Any]:
     Args:
         path: A CSV file (or PX4 CSV tables' prefix), MCAP, PX4 ULog or ArduPilot DataFlash log.
         **options: ``profile`` (``"kaist"``, ``"px4"`` or a column-map TOML), ``topics`` (MCAP),
-            ``header_time``, ``battery_current_positive``, ``battery_instance``, ``lag``
-            (search window of the power lag estimate, s).
+            ``header_time``, ``battery_current_positive``, ``battery_instance``, ``max_lag``
+            (search window of the power lag estimate, s; ``--max-lag``).
     """
     return json.loads(_native.log_info_json(os.fspath(path), options))
 

@@ -104,7 +104,7 @@ def log_info(
     header_time: bool = False,
     battery_current_positive: bool = False,
     battery_instance: Optional[int] = None,
-    lag: Optional[float] = None,
+    max_lag: Optional[float] = None,
 ) -> Dict[str, Any]: ...
 def fit(
     logs: Union[PathLike, Sequence[PathLike]],
