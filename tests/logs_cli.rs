@@ -284,3 +284,22 @@ fn the_old_lag_flag_of_log_info_names_max_lag() {
         j["lag"]
     );
 }
+
+#[test]
+fn log_info_json_warnings_go_to_stderr_as_well_as_into_the_answer() {
+    let dir = std::env::var("ALOFT_DATA_DIR").unwrap_or_else(|_| "../shared/data".to_string());
+    let log = format!("{dir}/flight_logs/pyulog_sample_log_small.ulg");
+    let o = aloft(&["log", "info", &log, "--format", "json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let warnings: Vec<String> = v["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| format!("aloft: warning: {}", w.as_str().unwrap()))
+        .collect();
+    // This log has a dropout and an estimator without position: something to warn about.
+    assert!(!warnings.is_empty());
+    let err = stderr(&o);
+    assert_eq!(err.lines().collect::<Vec<_>>(), warnings);
+}

@@ -315,3 +315,35 @@ fn corners_pass_through_by_default_and_stop_on_request() {
         "{err}"
     );
 }
+
+#[test]
+fn json_mode_warnings_go_to_stderr_as_well_as_into_the_answer() {
+    // A planner file that ends in the air, with no take-off: the reader's warnings and the
+    // planner's (the way home added) are in the JSON and, one line each, on stderr.
+    let dir = std::env::var("ALOFT_DATA_DIR").unwrap_or_else(|_| "../shared/data".to_string());
+    let plan = format!("{dir}/missions/kasperg3_mission.plan");
+    let (code, out, err) = aloft(&["mission", &plan, "--format", "json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let mut warnings: Vec<String> = v["route"]["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .chain(v["warnings"].as_array().unwrap())
+        .map(|w| format!("aloft: warning: {}", w.as_str().unwrap()))
+        .collect();
+    assert!(warnings.len() >= 3, "{warnings:?}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(
+        lines,
+        warnings.iter().map(String::as_str).collect::<Vec<_>>()
+    );
+    // The table shows them in its header instead; stderr stays quiet.
+    let (code, out, err) = aloft(&["mission", &plan]);
+    assert_eq!(code, 0);
+    assert!(err.is_empty(), "{err}");
+    for w in warnings.drain(..) {
+        let w = w.replace("aloft: warning: ", "Warning: ");
+        assert!(out.contains(&w), "'{w}' missing in:\n{out}");
+    }
+}

@@ -330,7 +330,8 @@ fn battery_with_replay_is_part_of_the_mass_and_an_unknown_one_is_bad_input() {
     let out = aloft(&args);
     let table = String::from_utf8_lossy(&out.stdout).to_string();
     assert!(
-        table.contains("with pack TB48D") && table.contains(&format!("{:.3} kg", airframe + pack)),
+        table.contains("TB48D")
+            && table.contains(&format!("take-off mass {:.3} kg", airframe + pack)),
         "{table}"
     );
 

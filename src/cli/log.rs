@@ -96,7 +96,10 @@ fn info(args: InfoArgs) -> Result<Outcome> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {
-        Format::Json => output::write_json(&mut out, &info)?,
+        Format::Json => {
+            output::warn(&info.warnings);
+            output::write_json(&mut out, &info)?
+        }
         Format::Table | Format::Csv => write_table(&mut out, &info)?,
     }
     Ok(Outcome::Ok)
