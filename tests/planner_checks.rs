@@ -396,28 +396,15 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
     )
     .unwrap();
     assert!(!r.feasible);
-    let Some(Shortfall::NoProgress {
-        segment,
-        moving,
-        limit,
-        max_airspeed_mps,
-        ..
-    }) = r.shortfall
-    else {
+    let Some(Shortfall::NoProgress(stuck)) = &r.shortfall else {
         panic!("{:?}", r.shortfall);
     };
     assert_eq!(
-        (segment, moving, limit),
+        (stuck.segment, stuck.moving, stuck.limit),
         (2, true, aloft_planner::Limit::Tilt)
     );
-    let Some(Shortfall::NoProgress {
-        wind_mps,
-        position_m,
-        ..
-    }) = r.shortfall
-    else {
-        unreachable!()
-    };
+    let (wind_mps, position_m, max_airspeed_mps) =
+        (stuck.wind_mps, stuck.position_m, stuck.max_airspeed_mps);
     // Where it stops, the wind is at least what it can fly against (the leg climbs, so the
     // vehicle's own climb leaves it a little less).
     assert!(

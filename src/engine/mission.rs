@@ -501,7 +501,7 @@ fn plan_in(
         .map_err(in_mission)?;
     let (report, plot_samples) = fly_into_outputs(&flight, &compiled, outputs, in_mission)?;
     // A vehicle that cannot make progress somewhere cannot fly that part on any pack.
-    let stuck = matches!(report.shortfall, Some(Shortfall::NoProgress { .. }));
+    let stuck = matches!(report.shortfall, Some(Shortfall::NoProgress(_)));
     let sorties = if report.feasible || compiled.ends_in_air() || stuck {
         Sorties::one(report.feasible)
     } else {

@@ -607,7 +607,7 @@ impl Record {
     fn of(r: &MissionReport, keep_segments: bool, vehicle: &str) -> Self {
         // A path it cannot fly (no headway against the wind, no hover): the flight ends there;
         // it could turn back until then at the latest.
-        let stuck = matches!(r.shortfall, Some(Shortfall::NoProgress { .. }));
+        let stuck = matches!(r.shortfall, Some(Shortfall::NoProgress(_)));
         let no_pnr = if stuck { r.duration_s } else { f64::INFINITY };
         Self {
             feasible: r.feasible,

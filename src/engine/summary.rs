@@ -4,7 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use aloft_missions::RouteFigures;
-use aloft_planner::{Limit, MissionReport, NoProgressWhy, SegmentReport, Shortfall};
+use aloft_planner::wind::speed_and_from_deg;
+use aloft_planner::{Limit, MissionReport, SegmentReport, Shortfall};
 
 use super::flown::PlanningSpeed;
 use super::loiter::LoiterSummary;
@@ -250,37 +251,19 @@ fn segment_name(segments: &[SegmentReport], segment: usize, kind: &str) -> Strin
 /// Why a mission falls short, in words: the planner's, with the operator's item and the
 /// vehicle's name where the vehicle cannot make progress.
 pub(super) fn reason(shortfall: &Shortfall, segments: &[SegmentReport], vehicle: &str) -> String {
-    let Shortfall::NoProgress {
-        time_s,
-        segment,
-        kind,
-        position_m,
-        wind_mps,
-        moving,
-        limit,
-        limit_value,
-        limit_unit,
-        max_airspeed_mps,
-    } = shortfall
-    else {
+    let Shortfall::NoProgress(stuck) = shortfall else {
         return shortfall.to_string();
     };
-    let why = NoProgressWhy {
-        vehicle,
-        wind_mps: *wind_mps,
-        limit: *limit,
-        limit_value: *limit_value,
-        limit_unit,
-        max_airspeed_mps: *max_airspeed_mps,
-    };
+    let p = stuck.position_m;
     format!(
-        "at {}, t = {}, {:.0} m up ({:.0} m east, {:.0} m north of home): {why}, so it cannot {}",
-        segment_name(segments, *segment, kind),
-        clock(*time_s),
-        position_m[2],
-        position_m[0],
-        position_m[1],
-        if *moving {
+        "at {}, t = {}, {:.0} m up ({:.0} m east, {:.0} m north of home): {}, so it cannot {}",
+        segment_name(segments, stuck.segment, stuck.kind),
+        clock(stuck.time_s),
+        p[2],
+        p[0],
+        p[1],
+        stuck.why(vehicle),
+        if stuck.moving {
             "make headway along the track"
         } else {
             "hold its position"
@@ -302,9 +285,7 @@ pub(super) fn edge_warnings(report: &MissionReport, vehicle: &str) -> Vec<String
         .iter()
         .filter_map(|s| {
             let e = s.edge?;
-            let [we, wn, _] = e.wind_mps;
-            let wind = we.hypot(wn);
-            let from_deg = (-we).atan2(-wn).to_degrees().rem_euclid(360.0);
+            let (wind, from_deg) = speed_and_from_deg(e.wind_mps);
             let name = segment_name(&report.segments, s.index, s.kind);
             let held = match e.slowest_mps {
                 Some(v) => format!(

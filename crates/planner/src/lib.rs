@@ -153,7 +153,7 @@ pub use mission::{
 pub use pack_cursor::{PackCursor, PackStep};
 pub use plan::{
     plan, plan_into, EdgeReport, MissionReport, NoProgressWhy, NoSamples, PlanOptions,
-    PointOfNoReturn, Sample, SampleSink, SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
+    PointOfNoReturn, Sample, SampleSink, SegmentReport, Shortfall, Stuck, DEFAULT_MAX_SAMPLES,
 };
 pub use queries::{
     best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,

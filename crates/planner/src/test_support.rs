@@ -77,3 +77,21 @@ pub(crate) fn tb48d() -> BatterySpec {
         ..tb47d()
     }
 }
+
+/// A leg steeper than the M100's 5 m/s climb limit allows at its ground speed: 30 m up over
+/// 20 m east at 10 m/s over the ground (15 m/s up).
+pub(crate) const STEEP_LEG: &str = r#"
+    [[segment]]
+    kind = "take-off"
+    altitude_m = 10.0
+    climb_rate_mps = 2.0
+    [[segment]]
+    kind = "leg"
+    east_m = 20.0
+    north_m = 0.0
+    altitude_m = 40.0
+    ground_speed_mps = 10.0
+    [[segment]]
+    kind = "landing"
+    rate_mps = 1.0
+"#;

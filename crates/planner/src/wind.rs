@@ -271,6 +271,13 @@ pub fn toward_unit(from_rad: f64) -> [f64; 2] {
     [-s, -c]
 }
 
+/// The horizontal speed of a wind `[east, north, up]`, m/s, and the direction it blows from,
+/// degrees clockwise from north in `[0, 360)`.
+pub fn speed_and_from_deg(wind_mps: [f64; 3]) -> (f64, f64) {
+    let [e, n, _] = wind_mps;
+    (e.hypot(n), (-e).atan2(-n).to_degrees().rem_euclid(360.0))
+}
+
 impl Wind {
     /// Still air.
     pub fn calm() -> Self {

@@ -365,21 +365,7 @@ mod tests {
     /// mission and a planner file alike.
     #[test]
     fn a_steep_leg_compiles_as_planned() {
-        let text = r#"
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 10.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = 20.0
-            north_m = 0.0
-            altitude_m = 40.0
-            ground_speed_mps = 10.0
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-        "#;
+        let text = crate::test_support::STEEP_LEG;
         let mut spec = MissionSpec::from_toml_str(text).unwrap();
         let aloft = spec.compile(&m100_airframe(), 0.68, None).unwrap();
         spec.clamp_speeds = true;

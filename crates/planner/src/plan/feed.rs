@@ -205,10 +205,7 @@ mod tests {
                     if t.segments.iter().any(|s| s.time_lost_s > 0.0) {
                         slowed += 1;
                     }
-                    if matches!(
-                        t.shortfall,
-                        Some(super::super::Shortfall::NoProgress { .. })
-                    ) {
+                    if matches!(t.shortfall, Some(super::super::Shortfall::NoProgress(_))) {
                         stuck += 1;
                     }
                 }

@@ -110,7 +110,7 @@ use sampler::{piece_steps, BlockA, PassA, Stop};
 
 pub use report::{
     EdgeReport, MissionReport, NoProgressWhy, NoSamples, PlanOptions, PointOfNoReturn, Sample,
-    SampleSink, SegmentReport, Shortfall, DEFAULT_MAX_SAMPLES,
+    SampleSink, SegmentReport, Shortfall, Stuck, DEFAULT_MAX_SAMPLES,
 };
 
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
@@ -708,21 +708,7 @@ mod tests {
         // limit is 5 m/s, so the leg is flown with its vertical speed at 5 m/s and its ground
         // speed at 5 x 20 / 30 = 3.33 m/s where the plan asks for more.
         let (aircraft, battery) = m100();
-        let text = r#"
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 10.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = 20.0
-            north_m = 0.0
-            altitude_m = 40.0
-            ground_speed_mps = 10.0
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-        "#;
+        let text = crate::test_support::STEEP_LEG;
         let mission = MissionSpec::from_toml_str(text)
             .unwrap()
             .compile(aircraft.airframe(), battery.mass_kg(), None)

@@ -8,6 +8,7 @@ use crate::airframe::Airframe;
 use crate::battery::Pack;
 use crate::envelope::Limit;
 use crate::error::PlannerError;
+use crate::wind::speed_and_from_deg;
 
 /// Options of a planning run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -250,29 +251,7 @@ pub enum Shortfall {
     },
     /// The vehicle cannot fly the path here within its envelope: it cannot make headway along
     /// the track against the wind, or cannot hold its position (a wind or a load beyond it).
-    NoProgress {
-        /// Mission time, s.
-        time_s: f64,
-        /// Segment number, from 1.
-        segment: usize,
-        /// Segment kind.
-        kind: &'static str,
-        /// Position, ENU m.
-        position_m: [f64; 3],
-        /// The wind there (east, north, up), m/s.
-        wind_mps: [f64; 3],
-        /// Whether the path moves over the ground there (else the vehicle holds a point or
-        /// climbs or descends in place).
-        moving: bool,
-        /// The limit that binds.
-        limit: Limit,
-        /// The limit's value, in `limit_unit`.
-        limit_value: f64,
-        /// The unit of `limit_value`.
-        limit_unit: &'static str,
-        /// The largest airspeed of steady level flight within the envelope at this mass, m/s.
-        max_airspeed_mps: f64,
-    },
+    NoProgress(Stuck),
     /// The mission lands with less than the reserve.
     Reserve {
         /// Usable charge left at landing, fraction of capacity.
@@ -332,33 +311,14 @@ impl std::fmt::Display for Shortfall {
                 )?;
                 at(f, *time_s, *segment, kind, *position_m)
             }
-            Shortfall::NoProgress {
-                time_s,
-                segment,
-                kind,
-                position_m,
-                wind_mps,
-                moving,
-                limit,
-                limit_value,
-                limit_unit,
-                max_airspeed_mps,
-            } => {
-                let what = if *moving {
+            Shortfall::NoProgress(stuck) => {
+                f.write_str(if stuck.moving {
                     "the vehicle cannot make headway along the track "
                 } else {
                     "the vehicle cannot hold its position "
-                };
-                f.write_str(what)?;
-                at(f, *time_s, *segment, kind, *position_m)?;
-                write!(f, ": {}", NoProgressWhy {
-                    vehicle: "the vehicle",
-                    wind_mps: *wind_mps,
-                    limit: *limit,
-                    limit_value: *limit_value,
-                    limit_unit,
-                    max_airspeed_mps: *max_airspeed_mps,
-                })
+                })?;
+                at(f, stuck.time_s, stuck.segment, stuck.kind, stuck.position_m)?;
+                write!(f, ": {}", stuck.why("the vehicle"))
             }
             Shortfall::Reserve {
                 reserve_soc,
@@ -369,6 +329,46 @@ impl std::fmt::Display for Shortfall {
                 reserve_soc * 100.0,
                 required_soc * 100.0
             ),
+        }
+    }
+}
+
+/// Where and why the vehicle cannot fly on ([`Shortfall::NoProgress`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Stuck {
+    /// Mission time, s.
+    pub time_s: f64,
+    /// Segment number, from 1.
+    pub segment: usize,
+    /// Segment kind.
+    pub kind: &'static str,
+    /// Position, ENU m.
+    pub position_m: [f64; 3],
+    /// The wind there (east, north, up), m/s.
+    pub wind_mps: [f64; 3],
+    /// Whether the path moves over the ground there (else the vehicle holds a point or climbs
+    /// or descends in place).
+    pub moving: bool,
+    /// The limit that binds.
+    pub limit: Limit,
+    /// The limit's value, in `limit_unit`.
+    pub limit_value: f64,
+    /// The unit of `limit_value`.
+    pub limit_unit: &'static str,
+    /// The largest airspeed of steady level flight within the envelope at this mass, m/s.
+    pub max_airspeed_mps: f64,
+}
+
+impl Stuck {
+    /// Why, in words, with the vehicle called `vehicle` (`the vehicle`, its name).
+    pub fn why<'a>(&'a self, vehicle: &'a str) -> NoProgressWhy<'a> {
+        NoProgressWhy {
+            vehicle,
+            wind_mps: self.wind_mps,
+            limit: self.limit,
+            limit_value: self.limit_value,
+            limit_unit: self.limit_unit,
+            max_airspeed_mps: self.max_airspeed_mps,
         }
     }
 }
@@ -393,10 +393,7 @@ pub struct NoProgressWhy<'a> {
 
 impl std::fmt::Display for NoProgressWhy<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let [e, n, _] = self.wind_mps;
-        let speed = e.hypot(n);
-        // The direction the wind blows from, clockwise from north.
-        let from_deg = (-e).atan2(-n).to_degrees().rem_euclid(360.0);
+        let (speed, from_deg) = speed_and_from_deg(self.wind_mps);
         write!(
             f,
             "the wind there is {speed:.1} m/s from {from_deg:.0} deg; "

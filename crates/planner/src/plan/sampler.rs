@@ -34,7 +34,7 @@ use crate::trajectory::{BlockSampler, Kinematics, Piece, Shape};
 use crate::trim::Trim;
 use crate::wind::Wind;
 
-use super::report::Shortfall;
+use super::report::{Shortfall, Stuck};
 use super::BLOCK;
 
 const ZERO_TRIM: Trim = Trim {
@@ -442,8 +442,8 @@ impl<'p, 'a> PassA<'p, 'a> {
                 Err(stop) => {
                     let stop = match stop {
                         Stop::NoProgress(mut s) => {
-                            if let Shortfall::NoProgress { time_s, .. } = &mut s {
-                                *time_s = self.t0 + ((self.k0 + j) as f64 + 0.5) * h + late;
+                            if let Shortfall::NoProgress(stuck) = &mut s {
+                                stuck.time_s = self.t0 + ((self.k0 + j) as f64 + 0.5) * h + late;
                             }
                             Stop::NoProgress(s)
                         }
@@ -496,7 +496,7 @@ impl<'p, 'a> PassA<'p, 'a> {
     fn no_progress(&self, piece: &Piece, kin: &Kinematics, wind: [f64; 3], limit: Limit) -> Stop {
         let (limit_value, limit_unit) = self.envelope.value_of(limit);
         let seg = piece.segment;
-        Stop::NoProgress(Shortfall::NoProgress {
+        Stop::NoProgress(Shortfall::NoProgress(Stuck {
             time_s: 0.0,
             segment: seg + 1,
             kind: self.kinds[seg],
@@ -507,7 +507,7 @@ impl<'p, 'a> PassA<'p, 'a> {
             limit_value,
             limit_unit,
             max_airspeed_mps: self.max_airspeed[piece.mass_phase].0,
-        })
+        }))
     }
 }
 
