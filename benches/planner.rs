@@ -116,9 +116,10 @@ fn bench_mission(c: &mut Criterion) {
 
 /// The one-hour mission in a 12 m/s wind: the upwind half of every lap of the 8 m/s orbit asks
 /// for more than the M100's 35 deg of tilt, so it is flown slower at the limit: a third of the
-/// samples take the envelope's search (scan and bisection on the force balance, then a trim).
-/// Target: at most 60 ms (four times `one_hour`'s target: the search is some 60 force balances
-/// per slowed sample).
+/// samples take the envelope's search (a bracket from the sample before, regula falsi on the
+/// force balance, about five force balances, then a trim), and their blocks the pack's step-by-
+/// step path. Target: at most four times `one_hour` in the same run (a mission at the edge may
+/// cost a few times one within the envelope, not orders of magnitude).
 fn bench_at_the_edge(
     c: &mut Criterion,
     (aircraft, battery, mission): (&aloft_planner::Aircraft, &Pack, &aloft_planner::Mission),

@@ -279,7 +279,7 @@ pub fn orbit_power_w(
         let fwd = [-s, c];
         let acc = [-ac * c, -ac * s, 0.0];
         let vel = [fwd[0] * speed_mps, fwd[1] * speed_mps, 0.0];
-        let q = match envelope.fastest_fraction(p, acc, vel, wind, fwd) {
+        let q = match envelope.fastest_fraction(p, (acc, vel), wind, fwd, None) {
             Ok(None) => 1.0,
             Ok(Some((q, _))) => q,
             // The wind alone is beyond the vehicle, or the circle is too tight to turn at even

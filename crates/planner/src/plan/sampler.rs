@@ -151,6 +151,9 @@ struct PieceA {
     steady_trim: Option<Trim>,
     /// Time flown beyond the plan in the piece so far, s.
     late_s: f64,
+    /// The fraction of its planned speed the last slowed sample of the piece flew at: where the
+    /// search of the next starts.
+    last_fraction: Option<f64>,
 }
 
 /// Pass A: kinematics, wind, trim, power and the airframe's limits for every block of the mission
@@ -261,6 +264,7 @@ impl<'p, 'a> PassA<'p, 'a> {
                     steady: self.hoist && self.steady_wind && steady_piece(piece),
                     steady_trim: None,
                     late_s: 0.0,
+                    last_fraction: None,
                 });
             }
             let pa = self.piece.as_ref().expect("set above");
@@ -430,8 +434,9 @@ impl<'p, 'a> PassA<'p, 'a> {
                 out.late_s[j] = late;
                 continue;
             }
-            match self.slow_down(piece, j, out) {
+            match self.slow_down(piece, j, out, pa.last_fraction) {
                 Ok((q, limit)) => {
+                    pa.last_fraction = Some(q);
                     let step = h / q;
                     out.late_s[j] = late + 0.5 * (step - h);
                     late += step - h;
@@ -463,13 +468,26 @@ impl<'p, 'a> PassA<'p, 'a> {
     /// Sample `j` of `out` flown at the edge: its velocity scaled by the largest fraction `q`
     /// within the envelope and its acceleration by `q^2`, trimmed again; `(q, the limit it
     /// flies at)`, or why it cannot be flown (the shortfall's time is set by the caller).
-    fn slow_down(&self, piece: &Piece, j: usize, out: &mut BlockA) -> Result<(f64, Limit), Stop> {
+    fn slow_down(
+        &self,
+        piece: &Piece,
+        j: usize,
+        out: &mut BlockA,
+        hint: Option<f64>,
+    ) -> Result<(f64, Limit), Stop> {
         let pw = &self.powered[piece.mass_phase];
         let kin = out.kins[j];
         let wind = out.winds[j];
-        let edge = self
-            .envelope
-            .fastest_fraction(pw, kin.acc_mps2, kin.vel_mps, wind, out.fwds[j]);
+        // The margin at the planned speed is the trim's (a sample the power model rejected is
+        // marked with an infinite thrust: beyond).
+        let top = self.envelope.slack_of_trim(&out.trims[j], kin.vel_mps[2]);
+        let edge = self.envelope.fastest_fraction_beyond(
+            pw,
+            (kin.acc_mps2, kin.vel_mps),
+            (wind, out.fwds[j]),
+            hint,
+            top,
+        );
         let (q, limit) = match edge {
             Ok(Some(edge)) => edge,
             // Within at the planned speed after all (a marked sample the model rejected).
