@@ -47,6 +47,18 @@ def test_planner_file_and_infeasible_mission_equal_cli(cli, data):
     assert got["feasible"] is False
 
 
+def test_windy_missions_fly_at_the_envelope_and_equal_cli(cli):
+    # 12 m/s: the upwind lines are flown slower at the tilt limit (an answer with the time lost).
+    slowed = aloft.mission(wind_speed=12, wind_from=250)
+    assert slowed == cli.json("mission", "--wind-speed", "12", "--wind-from", "250")
+    assert slowed["feasible"] is True and slowed["time_lost_s"] > 10
+    assert {s.get("limit") for s in slowed["segments"]} >= {"tilt"}
+    # 20 m/s: beyond the M100; infeasible (the CLI exits 1), with the reason, not an error.
+    stuck = aloft.mission(wind_speed=20, wind_from=250)
+    assert stuck == cli.json("mission", "--wind-speed", "20", "--wind-from", "250", code=1)
+    assert stuck["feasible"] is False and "cannot hold its position" in stuck["reason"]
+
+
 @pytest.mark.parametrize("options, flags", [
     ({}, []),
     ({"payload_kg": 0.4, "wind_speed": 7, "wind_from": 90, "course": 45, "reserve_percent": 20},

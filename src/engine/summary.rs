@@ -277,12 +277,17 @@ fn clock(t: f64) -> String {
     format!("{}:{:04.1}", (t / 60.0).floor(), t % 60.0)
 }
 
-/// The warnings of the segments flown at the edge of the envelope: where, how slow, at which
-/// limit, in what wind, and the time lost.
+/// Time lost at the edge below which a segment gets no warning, s: it rounds to 0.0 s in the
+/// message (its keys in the answer still say it).
+const WARN_FROM_S: f64 = 0.05;
+
+/// The warnings of the segments flown at the edge of the envelope that lost 0.1 s or more:
+/// where, how slow, at which limit, in what wind, and the time lost.
 pub(super) fn edge_warnings(report: &MissionReport, vehicle: &str) -> Vec<String> {
     report
         .segments
         .iter()
+        .filter(|s| s.time_lost_s >= WARN_FROM_S)
         .filter_map(|s| {
             let e = s.edge?;
             let (wind, from_deg) = speed_and_from_deg(e.wind_mps);

@@ -122,8 +122,8 @@ fn bracket(
 }
 
 /// The edge within a bracket `[lo, hi]` (`lo` within, `hi` beyond) by regula falsi with the
-/// Illinois modification, to 1e-10 of the fraction: the last fraction within and the limit the
-/// last one beyond exceeded.
+/// Illinois modification, to 1e-10 (of a fraction, or in m/s of an airspeed): the last value
+/// within and the limit the last one beyond exceeded.
 fn illinois(slack: &impl Fn(f64) -> (f64, Limit), lo: Probe, hi: Probe) -> (f64, Limit) {
     let ((mut a, mut fa, _), (mut b, mut fb, mut limit)) = (lo, hi);
     // Which end the last step moved: +1 the low one, -1 the high one.
@@ -416,38 +416,25 @@ impl Envelope {
     /// limit that bounds it (heading into the air velocity); 0 when not even a hover in still
     /// air is within it.
     pub fn max_level_airspeed_mps(&self, pw: &Powered<'_>) -> (f64, Limit) {
-        let beyond = |v: f64| self.exceeded(pw, [0.0; 3], [0.0, v, 0.0], [0.0; 3], [0.0, 1.0]);
-        if let Some(l) = beyond(0.0) {
-            return (0.0, l);
+        // Level, unaccelerated, heading into the air velocity, at airspeed `v`.
+        let at = |v: f64| self.margin(pw, ([0.0; 3], [0.0, v, 0.0]), ([0.0; 3], [0.0, 1.0]), 1.0);
+        let rest = at(0.0);
+        if rest.0 < 0.0 {
+            return (0.0, rest.1);
         }
-        // A scan in steps of 2.5 m/s from the bottom for the first airspeed beyond, then
-        // bisection below it (drag laws need not be monotonic over the whole range; none
-        // turns within 2.5 m/s).
-        let points = (MAX_AIRSPEED_SEARCHED_MPS / 2.5) as usize;
-        let mut lo = 0.0;
-        let mut hi_limit = None;
-        for k in 1..=points {
+        // A scan in steps of 2.5 m/s from the bottom for the first airspeed beyond (drag laws
+        // need not be monotonic over the whole range; none turns within 2.5 m/s), then the edge
+        // below it by regula falsi, as for a fraction of the speed.
+        let mut lo = (0.0, rest.0, rest.1);
+        for k in 1..=(MAX_AIRSPEED_SEARCHED_MPS / 2.5) as usize {
             let v = k as f64 * 2.5;
-            match beyond(v) {
-                None => lo = v,
-                Some(l) => {
-                    hi_limit = Some((v, l));
-                    break;
-                }
+            let (m, l) = at(v);
+            if m < 0.0 {
+                return illinois(&at, lo, (v, m, l));
             }
+            lo = (v, m, l);
         }
-        let Some((mut hi, limit)) = hi_limit else {
-            return (MAX_AIRSPEED_SEARCHED_MPS, Limit::Airspeed);
-        };
-        for _ in 0..45 {
-            let mid = 0.5 * (lo + hi);
-            if beyond(mid).is_none() {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (lo, limit)
+        (MAX_AIRSPEED_SEARCHED_MPS, Limit::Airspeed)
     }
 }
 

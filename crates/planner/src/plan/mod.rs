@@ -113,6 +113,27 @@ pub use report::{
     SampleSink, SegmentReport, Shortfall, Stuck, DEFAULT_MAX_SAMPLES,
 };
 
+/// The airframe's envelope and, per mass phase, its steady airspeed limit and the limit that
+/// bounds it: computed once per flight for the sampler and the return check.
+pub(super) struct Limits {
+    pub(super) envelope: Envelope,
+    pub(super) max_airspeed: Vec<(f64, crate::envelope::Limit)>,
+}
+
+impl Limits {
+    pub(super) fn of(aircraft: &Aircraft, powered: &[Powered<'_>]) -> Self {
+        let envelope = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
+        let max_airspeed = powered
+            .iter()
+            .map(|pw| envelope.max_level_airspeed_mps(pw))
+            .collect();
+        Self {
+            envelope,
+            max_airspeed,
+        }
+    }
+}
+
 /// Steps per block of the two-pass loop: small enough for the block to stay in the L1 cache,
 /// large enough that the loop overhead of a pass is negligible.
 const BLOCK: usize = 64;
@@ -210,17 +231,25 @@ fn fly(
 ) -> Result<MissionReport, PlannerError> {
     let checked = options.check(battery, aircraft.airframe())?;
     let powered = powered_by_mass_phase(aircraft, battery, mission, options)?;
+    let limits = Limits::of(aircraft, &powered);
     let dt = checked.time_step_s;
     let pass_a = PassA::new(
         aircraft,
         mission,
-        &powered,
+        (&powered, &limits),
         wind,
         options.ground_effect,
         hoist,
         dt,
     );
-    let mut pass_b = PackPass::new(battery, mission, &powered, wind, options, &checked);
+    let mut pass_b = PackPass::new(
+        battery,
+        mission,
+        (&powered, &limits),
+        wind,
+        options,
+        &checked,
+    );
     // An error found in pass A (a thrust beyond the airframe, a wind grid left) is raised only
     // after pass B has flown the samples before it, so a battery that fails first is still
     // reported as the result.
@@ -283,7 +312,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
     fn new(
         battery: &'p Pack,
         mission: &'p Mission,
-        powered: &'p [Powered<'a>],
+        (powered, limits): (&'p [Powered<'a>], &Limits),
         wind: &'p Wind,
         options: &PlanOptions,
         checked: &CheckedOptions,
@@ -307,10 +336,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
             steps: [PackStep::default(); BLOCK],
             ledger: Ledger::new(mission, options, r_pack, empty, required),
             way_home: ReturnCheck::new(
-                Envelope::of(
-                    powered[0].aircraft().airframe(),
-                    powered[0].aircraft().gravity_mps2(),
-                ),
+                limits,
                 battery,
                 wind,
                 mission.home_m(),

@@ -13,6 +13,8 @@ use crate::aircraft::Powered;
 use crate::battery::Pack;
 use crate::envelope::Envelope;
 use crate::queries::best_range;
+
+use super::Limits;
 use crate::wind::Wind;
 
 use super::report::{PlanOptions, PointOfNoReturn};
@@ -22,6 +24,8 @@ const BEARING_BINS: usize = 720;
 
 /// Cached return cost per bearing bin for one mass phase and wind.
 struct ReturnCache {
+    /// The steady airspeed limit of the envelope per mass phase, m/s.
+    max_airspeed_mps: Vec<f64>,
     phase: usize,
     wind: [f64; 2],
     bins: Vec<Option<(f64, f64)>>,
@@ -51,7 +55,12 @@ impl ReturnCache {
             None => {
                 let b = (bin as f64 + 0.5) / BEARING_BINS as f64 * std::f64::consts::TAU;
                 let course = [b.sin(), b.cos()];
-                let max_air = pw.aircraft().airframe().max_speed_mps();
+                // Within the vehicle's speed and the envelope's steady airspeed at this mass.
+                let max_air = pw
+                    .aircraft()
+                    .airframe()
+                    .max_speed_mps()
+                    .min(self.max_airspeed_mps[self.phase]);
                 match best_range(pw, course, wh, max_air) {
                     Ok(r) => {
                         self.bins[bin] = Some((r.power_w, r.ground_speed_mps));
@@ -87,7 +96,7 @@ impl<'p> ReturnCheck<'p> {
     /// The checks to `home` with `battery` in `wind`, down to `floor_soc`, descending at
     /// `descent_rate` m/s; none when `options` ask for no point of no return.
     pub(super) fn new(
-        envelope: Envelope,
+        limits: &Limits,
         battery: &'p Pack,
         wind: &'p Wind,
         home: [f64; 3],
@@ -96,7 +105,7 @@ impl<'p> ReturnCheck<'p> {
         descent_rate: f64,
     ) -> Self {
         ReturnCheck {
-            envelope,
+            envelope: limits.envelope,
             battery,
             wind,
             home,
@@ -109,6 +118,7 @@ impl<'p> ReturnCheck<'p> {
             pnr: None,
             done: !options.point_of_no_return,
             cache: ReturnCache {
+                max_airspeed_mps: limits.max_airspeed.iter().map(|a| a.0).collect(),
                 phase: usize::MAX,
                 wind: [f64::NAN; 2],
                 bins: vec![None; BEARING_BINS],

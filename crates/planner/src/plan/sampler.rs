@@ -190,24 +190,18 @@ impl<'p, 'a> PassA<'p, 'a> {
     pub(super) fn new(
         aircraft: &'p Aircraft,
         mission: &'p Mission,
-        powered: &'p [Powered<'a>],
+        (powered, limits): (&'p [Powered<'a>], &super::Limits),
         wind: &'p Wind,
         ground_effect: bool,
         hoist: bool,
         dt: f64,
     ) -> Self {
         let airframe = aircraft.airframe();
-        let g = aircraft.gravity_mps2();
         let uniform_wind = if wind.is_uniform() {
             wind.mean_at([0.0; 3])
         } else {
             None
         };
-        let envelope = Envelope::of(airframe, g);
-        let max_airspeed = powered
-            .iter()
-            .map(|pw| envelope.max_level_airspeed_mps(pw))
-            .collect();
         PassA {
             pieces: mission.pieces(),
             powered,
@@ -218,8 +212,8 @@ impl<'p, 'a> PassA<'p, 'a> {
             ground_effect,
             r_rotor: aircraft.rotor_radius_m(),
             rotor_h: airframe.rotor_height_m(),
-            envelope,
-            max_airspeed,
+            envelope: limits.envelope,
+            max_airspeed: limits.max_airspeed.clone(),
             kinds: mission.segment_kinds(),
             dt,
             index: 0,
@@ -616,7 +610,16 @@ mod tests {
                 .with_gusts(Gusts::new(1.0, 3).unwrap()),
         ];
         for wind in &winds {
-            let mut pass = PassA::new(&aircraft, &mission, &powered, wind, true, true, 0.05);
+            let limits = super::super::Limits::of(&aircraft, &powered);
+            let mut pass = PassA::new(
+                &aircraft,
+                &mission,
+                (&powered, &limits),
+                wind,
+                true,
+                true,
+                0.05,
+            );
             let mut block = Box::new(BlockA::EMPTY);
             let mut samples = 0;
             while pass.next_block(&mut block) {
