@@ -890,6 +890,10 @@ impl RecordDecoder {
     fn join(&mut self, s: Sample, keep: [bool; 9], aloft: bool) -> Option<Sample> {
         let s = match self.instant.as_mut() {
             Some(instant) => instant.join(s, keep, aloft)?,
+            // A message of another writer with nothing held: nothing can join it, so it is a
+            // sample as it is (the common case of a foreign file, without a copy into the
+            // instant and out).
+            None if !aloft => return Some(self.emit(s)),
             None => s,
         };
         let done = self.instant.replace(Instant {
