@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::MissionSpec;
 
-use super::mission::{Mission, MissionOptions};
+use super::mission_file::Mission;
+use super::mission_options::MissionOptions;
 use super::vehicles::Vehicle;
 
 /// The planning speed a mission was flown with and where it came from (in the answer when the
@@ -52,13 +53,4 @@ pub(super) fn flown_spec(
         .or(spec.rtl_altitude_m);
     spec.corners = Some(options.corners.or(spec.corners).unwrap_or_default());
     (spec, speed)
-}
-
-/// A vehicle's defaults for missions (the autopilot settings of its `[airframe]`).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct FlightDefaults {
-    /// Ground speed of a mission's legs that give none, m/s.
-    pub(crate) cruise_speed_mps: Option<f64>,
-    /// Lowest height of a return to home, m.
-    pub(crate) rtl_altitude_m: Option<f64>,
 }

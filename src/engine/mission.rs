@@ -1,251 +1,24 @@
 //! Missions: load one (a file, text, the built-in demo), plan it with a vehicle, and what the
 //! plan answers (summary, samples, what is left after a time, files for other tools).
 
-use std::path::{Path, PathBuf};
-
 use aloft_core::Trapezoid;
-use aloft_missions::{route_figures, RouteFigures, SourceFormat};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
-use aloft_planner::{
-    CornerMode, MissionReport, MissionSpec, Pack, PlanOptions, Sample, Shortfall, Wind, WindSpec,
-};
+use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Shortfall, Wind};
 use aloft_power::AoaModel;
 
-use super::files::read_text_file;
 use super::finite::finite;
 use super::flight::Flight;
 use super::flown::flown_spec;
 use super::loiter::resolve_loiter;
+use super::mission_file::Mission;
+use super::mission_options::MissionOptions;
 use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use super::sorties::{split, Sorties};
 use super::summary::{edge_warnings, mission_summary, MissionSummary};
 use super::vehicles::Vehicle;
-use super::wind::{mission_wind, GustSpec};
+use super::wind::mission_wind;
 use crate::error::Error;
-
-/// The built-in demonstration mission (identical to `fixtures/missions/demo-survey.toml`): four
-/// survey lines and a two-lap orbit in a 6 m/s breeze.
-pub const DEMO_MISSION: &str = include_str!("../../fixtures/missions/demo-survey.toml");
-
-/// Origin the CLI gives the built-in demonstration mission (its name when the file has none).
-pub const DEMO_ORIGIN: &str = "built-in demo";
-
-/// A mission to plan: the parsed mission file, where it came from, and its route figures (the
-/// file's own geometry, with what the reader of a planner file noticed).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Mission {
-    spec: MissionSpec,
-    origin: String,
-    route: RouteFigures,
-}
-
-impl Mission {
-    /// The mission file at `path` in any of the four formats, recognised from its content (see
-    /// [`Mission::from_text`]), or the built-in demonstration mission when `path` is `None`.
-    ///
-    /// # Errors
-    /// [`Error::Io`] when the file cannot be read, [`Error::MissionFormat`] or
-    /// [`Error::MissionImport`] when it does not parse.
-    pub fn load(path: Option<&Path>) -> Result<Self, Error> {
-        match path {
-            None => Ok(Self::demo()),
-            Some(p) => {
-                let text = read_text_file(p, "mission file")?;
-                Self::from_text(&text, &p.display().to_string())
-            }
-        }
-    }
-
-    /// The built-in demonstration mission ([`DEMO_MISSION`]).
-    pub fn demo() -> Self {
-        // Parsed once per call; the text is compiled in and checked by a unit test.
-        // Unreachable failure for the committed fixture; an empty mission fails cleanly at
-        // planning.
-        let spec = MissionSpec::from_toml_str(DEMO_MISSION).unwrap_or_default();
-        Self::of_spec(spec, DEMO_ORIGIN, SourceFormat::AloftToml)
-    }
-
-    /// An aloft mission spec from `format`, with its route figures.
-    fn of_spec(spec: MissionSpec, origin: &str, format: SourceFormat) -> Self {
-        Self {
-            route: route_figures(&spec, format, Vec::new()),
-            spec,
-            origin: origin.to_string(),
-        }
-    }
-
-    /// A mission from TOML text (the mission file format); `origin` names it in messages and is
-    /// the mission's name in the summary when the file has no `name`.
-    ///
-    /// # Errors
-    /// [`Error::MissionFormat`] with the parser's line, column and key.
-    pub fn from_toml(text: &str, origin: &str) -> Result<Self, Error> {
-        let spec = MissionSpec::from_toml_str(text).map_err(|e| Error::MissionFormat {
-            origin: origin.to_string(),
-            message: match e {
-                aloft_planner::PlannerError::MissionFormat { message } => message,
-                other => other.to_string(),
-            },
-        })?;
-        Ok(Self::of_spec(spec, origin, SourceFormat::AloftToml))
-    }
-
-    /// A mission from JSON text: the mission file's structure, e.g.
-    /// `{"name": "m", "segment": [{"kind": "take-off", "altitude_m": 20, "climb_rate_mps": 2}, ...]}`.
-    ///
-    /// # Errors
-    /// [`Error::MissionFormat`] with the parser's line, column and key.
-    pub fn from_json(text: &str, origin: &str) -> Result<Self, Error> {
-        let spec: MissionSpec = serde_json::from_str(text).map_err(|e| Error::MissionFormat {
-            origin: origin.to_string(),
-            message: e.to_string(),
-        })?;
-        Ok(Self::of_spec(spec, origin, SourceFormat::AloftJson))
-    }
-
-    /// A mission from a planner file: a QGroundControl `.plan` or a `QGC WPL 110` `.waypoints`
-    /// (see the `aloft-missions` crate for what each MAVLink command flies). Every segment
-    /// carries the operator's item number; the route figures carry the reader's warnings.
-    ///
-    /// # Errors
-    /// [`Error::MissionImport`] naming the item (or row, or line) and the command or key.
-    pub fn from_planner_file(text: &str, origin: &str) -> Result<Self, Error> {
-        let imported = aloft_missions::import(text).map_err(|source| Error::MissionImport {
-            origin: origin.to_string(),
-            source,
-        })?;
-        Ok(Self {
-            spec: imported.spec,
-            origin: origin.to_string(),
-            route: imported.route,
-        })
-    }
-
-    /// Any of the four formats, recognised from the content (not the file name): a
-    /// QGroundControl `.plan` (JSON with a `fileType` key), a `.waypoints` file (`QGC WPL`),
-    /// an aloft mission in JSON (another JSON object) or in TOML (anything else).
-    ///
-    /// # Errors
-    /// As [`Mission::from_planner_file`], [`Mission::from_json`] or [`Mission::from_toml`].
-    pub fn from_text(text: &str, origin: &str) -> Result<Self, Error> {
-        match aloft_missions::detect(text) {
-            SourceFormat::QgcPlan | SourceFormat::QgcWpl => Self::from_planner_file(text, origin),
-            SourceFormat::AloftJson => Self::from_json(text, origin),
-            SourceFormat::AloftToml => Self::from_toml(text, origin),
-        }
-    }
-
-    /// The mission as JSON text that [`Mission::from_json`] reads back.
-    ///
-    /// # Errors
-    /// [`Error::OptionsFormat`] if serialisation fails (non-finite numbers cannot occur in a
-    /// parsed mission, so in practice it does not).
-    pub fn to_json(&self) -> Result<String, Error> {
-        serde_json::to_string(&self.spec).map_err(|e| Error::OptionsFormat {
-            what: "mission",
-            message: e.to_string(),
-        })
-    }
-
-    /// The parsed mission file.
-    pub fn spec(&self) -> &MissionSpec {
-        &self.spec
-    }
-
-    /// Where it came from.
-    pub fn origin(&self) -> &str {
-        &self.origin
-    }
-
-    /// The route figures: the file's own geometry, its format and the reader's warnings.
-    pub fn route(&self) -> &RouteFigures {
-        &self.route
-    }
-
-    /// The name the summary reports: the file's `name`, else the origin.
-    pub fn display_name(&self) -> &str {
-        if self.spec.name.is_empty() {
-            &self.origin
-        } else {
-            &self.spec.name
-        }
-    }
-}
-
-/// Options of [`plan_mission`]: the options of `aloft mission` (JSON keys as the field names;
-/// every key optional, unknown keys rejected).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct MissionOptions {
-    /// Pack pack by name (default: the vehicle's default pack).
-    pub battery: Option<String>,
-    /// Payload at take-off, kg (overrides the mission file's).
-    pub payload_kg: Option<f64>,
-    /// Wind, as a mission file's `[wind]` table (overrides the mission file's; default: the
-    /// mission file's, else still air).
-    pub wind: Option<WindSpec>,
-    /// Gridded wind field: a CSV file with columns `x_m,y_m,z_m,u_mps,v_mps,w_mps` (east, north,
-    /// up), interpolated trilinearly; it replaces `wind` and the mission file's wind.
-    pub wind_field: Option<PathBuf>,
-    /// Seeded gusts added to whichever wind the mission flies in.
-    pub gusts: Option<GustSpec>,
-    /// Reserve required at landing, percent of the usable capacity (default: the mission's, else 20).
-    pub reserve_percent: Option<f64>,
-    /// State of charge at take-off, percent (default 100).
-    pub start_percent: f64,
-    /// Sampling step, s (default: the mission's, else 0.1).
-    pub time_step_s: Option<f64>,
-    /// Angle-of-attack model (default geometric).
-    pub aoa: AoaModel,
-    /// Ground effect near the ground, survey eq (35) (default true).
-    pub ground_effect: bool,
-    /// Keep every sample in the [`Plan`] (needed by [`Plan::remaining`]; default false).
-    pub record_samples: bool,
-    /// Planning speed, m/s: the ground speed of the legs, orbits and returns that give none
-    /// (overrides the vehicle's `cruise_speed_mps` and the mission's default, e.g. a `.plan`'s
-    /// `hoverSpeed`).
-    pub speed_mps: Option<f64>,
-    /// Lowest height of a return to home, m (overrides the vehicle's and the mission's).
-    pub rtl_altitude_m: Option<f64>,
-    /// Corners: `pass` (through waypoints without a hold, as autopilots fly) or `stop`
-    /// (overrides the mission's; default pass).
-    pub corners: Option<CornerMode>,
-}
-
-impl Default for MissionOptions {
-    fn default() -> Self {
-        Self {
-            battery: None,
-            payload_kg: None,
-            wind: None,
-            wind_field: None,
-            gusts: None,
-            reserve_percent: None,
-            start_percent: 100.0,
-            time_step_s: None,
-            aoa: AoaModel::Geometric,
-            ground_effect: true,
-            record_samples: false,
-            speed_mps: None,
-            rtl_altitude_m: None,
-            corners: None,
-        }
-    }
-}
-
-impl MissionOptions {
-    /// Options from JSON text, e.g. `{"payload_kg": 0.5, "wind": {"speed_mps": 5, "from_deg": 270}}`.
-    ///
-    /// # Errors
-    /// [`Error::OptionsFormat`] for malformed JSON or unknown keys.
-    pub fn from_json(text: &str) -> Result<Self, Error> {
-        serde_json::from_str(text).map_err(|e| Error::OptionsFormat {
-            what: "mission options",
-            message: e.to_string(),
-        })
-    }
-}
 
 /// A planned mission: the planner's report, its summary and what it was planned for.
 #[derive(Debug, Clone)]
@@ -478,7 +251,7 @@ fn plan_in(
     let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
     let in_mission = |e| Error::Mission {
-        origin: mission.origin.clone(),
+        origin: mission.origin().to_string(),
         vehicle: vehicle.name().to_string(),
         source: Box::new(e),
     };
@@ -487,7 +260,7 @@ fn plan_in(
         aircraft,
         pack: &battery,
         wind,
-        options: planner_options(options, &mission.spec)?,
+        options: planner_options(options, mission.spec())?,
     };
     let (spec, planning_speed) = flown_spec(mission, vehicle, options);
     let (spec, loiter) =
@@ -517,7 +290,7 @@ fn plan_in(
         battery.name(),
         payload,
     );
-    summary.route = mission.route.clone();
+    summary.route = mission.route().clone();
     summary.planning_speed = planning_speed;
     summary.loiter = loiter;
     summary.batteries_required = sorties.batteries_required;
@@ -531,11 +304,11 @@ fn plan_in(
         .warnings
         .extend(sorties.note.map(|n| format!("not split into sorties: {n}")));
     let summary = finite(summary, "mission", || {
-        format!("mission {} with {}", mission.origin, vehicle.name())
+        format!("mission {} with {}", mission.origin(), vehicle.name())
     })?;
     let context = PlanContext {
-        origin: mission.origin.clone(),
-        description: mission.spec.description.clone(),
+        origin: mission.origin().to_string(),
+        description: mission.spec().description.clone(),
         battery: PackDescription::of(&battery),
         wind: wind_text,
         notes: vehicle.notes(),
@@ -637,7 +410,8 @@ pub(super) fn planner_options(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::{endurance, EnduranceOptions, FlightState};
+    use crate::engine::{endurance, EnduranceOptions, FlightState, SourceFormat};
+    use crate::engine::{DEMO_MISSION, DEMO_ORIGIN};
 
     #[test]
     fn demo_mission_parses() {

@@ -52,6 +52,8 @@ mod flown;
 mod logs;
 mod loiter;
 mod mission;
+mod mission_file;
+mod mission_options;
 mod mission_outputs;
 mod payload_sweep;
 mod power;
@@ -87,9 +89,10 @@ pub use logs::{
 };
 pub use loiter::LoiterSummary;
 pub use mission::{
-    plan_mission, plan_mission_in, plan_mission_with, Mission, MissionOptions, PackDescription,
-    Plan, PlanContext, Remaining, DEMO_MISSION, DEMO_ORIGIN,
+    plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
 };
+pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
+pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
 pub use payload_sweep::{
     payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
@@ -126,7 +129,7 @@ pub use crate::error::{Error, SweepProblem};
 
 /// The vehicle every command uses when none is named.
 pub use crate::vehicle::DEFAULT_VEHICLE;
-pub use wind::{describe_wind_spec, GustSpec};
+pub use wind::describe_wind_spec;
 
 /// Model types that appear in requests and answers, re-exported so callers of the engine (the
 /// command line among them) need no model crate.

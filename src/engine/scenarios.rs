@@ -75,7 +75,9 @@ use super::finite::finite;
 use super::flight::Flight;
 use super::flown::flown_spec;
 use super::loiter::resolve_loiter;
-use super::mission::{check_options, planner_options, Mission, MissionOptions};
+use super::mission::{check_options, planner_options};
+use super::mission_file::Mission;
+use super::mission_options::MissionOptions;
 use super::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };

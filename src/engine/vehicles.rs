@@ -318,9 +318,9 @@ impl Vehicle {
     }
 
     /// The vehicle's defaults for missions: its cruise speed and RTL altitude.
-    pub(crate) fn flight_defaults(&self) -> super::flown::FlightDefaults {
+    pub(crate) fn flight_defaults(&self) -> FlightDefaults {
         let airframe = self.file.airframe.as_ref();
-        super::flown::FlightDefaults {
+        FlightDefaults {
             cruise_speed_mps: airframe.and_then(|a| a.cruise_speed_mps),
             rtl_altitude_m: airframe.and_then(|a| a.rtl_altitude_m),
         }
@@ -473,6 +473,15 @@ pub fn list_vehicles() -> Result<Vec<VehicleEntry>, Error> {
             })
         })
         .collect()
+}
+
+/// A vehicle's defaults for missions (the autopilot settings of its `[airframe]`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct FlightDefaults {
+    /// Ground speed of a mission's legs that give none, m/s.
+    pub(crate) cruise_speed_mps: Option<f64>,
+    /// Lowest height of a return to home, m.
+    pub(crate) rtl_altitude_m: Option<f64>,
 }
 
 #[cfg(test)]

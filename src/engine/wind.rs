@@ -11,29 +11,13 @@
 
 use std::path::Path;
 
-use serde::{Deserialize, Serialize};
-
 use aloft_planner::{Gusts, Wind, WindGrid, WindProfileKind, WindSpec};
 
 use super::files::{check_csv_header, read_text_file};
-use super::mission::{Mission, MissionOptions};
+use super::mission_file::Mission;
+use super::mission_options::MissionOptions;
 use super::vehicles::Vehicle;
 use crate::error::Error;
-
-/// Seeded gusts added to a mission's wind: a standard deviation per horizontal axis.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GustSpec {
-    /// Standard deviation per horizontal axis, m/s.
-    pub std_mps: f64,
-    /// Seed of the gust sequence (default 1).
-    #[serde(default = "default_seed")]
-    pub seed: u64,
-}
-
-fn default_seed() -> u64 {
-    1
-}
 
 /// A `[wind]` table in words: `6.0 m/s from 250 deg at 10 m, power law exponent 0.143`, with
 /// its gusts when it has them.
