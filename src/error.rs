@@ -252,6 +252,13 @@ pub enum Error {
         /// What is wrong, with the value and its unit.
         message: String,
     },
+    /// An option given by keyword (Python) that is unknown, of the wrong kind, out of range, or
+    /// without the option it needs; the message names the keyword and the function.
+    #[error("{message}")]
+    Keyword {
+        /// The message, naming the keyword as the caller wrote it.
+        message: String,
+    },
     /// An option document (JSON) that does not parse or has unknown keys.
     #[error("invalid {what}: {message}")]
     OptionsFormat {

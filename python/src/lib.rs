@@ -26,15 +26,17 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use aloft::engine::flags::{
+    EnduranceFlags, FitFlags, LogInfoFlags, MissionFlags, MissionScenarioFlags, PowerModelFlags,
+    ValidateFlags,
+};
 use aloft::engine::{
-    calibrate_spec_file, endurance, fit_logs, fit_parameter, list_vehicles, log_info,
+    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, list_vehicles, log_info,
     payload_sweep, plan_mission, plan_scenarios, power_curve, power_model, power_point,
-    power_values, validate_logs, FitRequest, Mission, MissionWithUncertainty, PowerQuery, Term,
-    ValidateRequest, Vehicle, POWER_KEYS,
+    power_values, validate_logs, EnduranceWithUncertainty, Mission, MissionWithUncertainty,
+    PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
-
-use options::{EnduranceCurve, Kwargs};
 
 create_exception!(
     aloft,
@@ -65,7 +67,7 @@ fn cli_message(e: &(dyn std::error::Error + 'static)) -> String {
 }
 
 /// An engine error as Python sees it.
-fn engine_error(e: aloft::Error) -> PyErr {
+pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
     aloft_error(cli_message(&e))
 }
 
@@ -85,13 +87,11 @@ fn mission_json(
     path: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut k = Kwargs::new("mission", options)?;
-    let vehicle = options::vehicle(&mut k)?;
-    let opts = options::mission(&mut k)?;
-    let scenarios = options::scenarios(&mut k)?;
-    k.finish()?;
+    let flags: MissionScenarioFlags = options::parse("mission", &[], options)?;
+    let opts = flags.mission.options();
+    let scenarios = flags.scenarios.options(false);
     py.detach(|| {
-        let v = Vehicle::load(&vehicle)?;
+        let v = Vehicle::load(&flags.mission.vehicle)?;
         let m = Mission::load(path.as_deref())?;
         let plan = plan_mission(&v, &m, &opts)?;
         match scenarios {
@@ -115,13 +115,11 @@ fn timeseries_columns<'py>(
     path: Option<PathBuf>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Vec<(String, Bound<'py, PyAny>)>> {
-    let mut k = Kwargs::new("timeseries", options)?;
-    let vehicle = options::vehicle(&mut k)?;
-    let mut opts = options::mission(&mut k)?;
-    k.finish()?;
+    let flags: MissionFlags = options::parse("timeseries", &[], options)?;
+    let mut opts = flags.options();
     opts.record_samples = true;
     let table = py.detach(|| -> Result<Table, aloft::Error> {
-        let v = Vehicle::load(&vehicle)?;
+        let v = Vehicle::load(&flags.vehicle)?;
         let m = Mission::load(path.as_deref())?;
         let plan = plan_mission(&v, &m, &opts)?;
         Table::of_samples(&plan.report().samples)
@@ -203,16 +201,31 @@ impl Table {
 #[pyfunction]
 #[pyo3(signature = (options=None))]
 fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<String> {
-    let mut k = Kwargs::new("endurance", options)?;
-    let vehicle = options::vehicle(&mut k)?;
-    let (opts, sweep) = options::endurance(&mut k)?;
-    k.finish()?;
+    let flags: EnduranceFlags = options::parse("endurance", &[], options)?;
+    let opts = flags.options();
+    let scenarios = flags.scenarios.options(false);
+    if scenarios.is_some() && flags.sweep_speed.is_some() {
+        // As the CLI: scenarios are drawn around the queries, not a curve.
+        return Err(aloft_error(
+            "the option 'samples' of aloft.endurance cannot be used with 'sweep_speed'",
+        ));
+    }
     py.detach(|| {
-        let v = Vehicle::load(&vehicle)?;
-        match sweep {
-            EnduranceCurve::Speed(step) => json_of(&power_curve(&v, &opts, step)?),
-            EnduranceCurve::Payload(s) => json_of(&payload_sweep(&v, &opts, &s)?),
-            EnduranceCurve::None => endurance(&v, &opts)?.to_json(),
+        let v = Vehicle::load(&flags.vehicle)?;
+        if let Some(sweep) = &flags.payload_sweep {
+            return json_of(&payload_sweep(&v, &opts, sweep)?);
+        }
+        if let Some(step) = flags.sweep_speed {
+            return json_of(&power_curve(&v, &opts, step)?);
+        }
+        let summary = endurance(&v, &opts)?;
+        match scenarios {
+            None => summary.to_json(),
+            // As `aloft endurance --samples N --format json`: the answer with its uncertainty.
+            Some(sc) => json_of(&EnduranceWithUncertainty {
+                summary: &summary,
+                uncertainty: &endurance_scenarios(&v, &opts, &sc)?,
+            }),
         }
     })
     .map_err(engine_error)
@@ -247,16 +260,16 @@ fn log_info_json(
     path: PathBuf,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut k = Kwargs::new("log_info", options)?;
-    k.renamed(
+    options::refuse_renamed(
+        "log_info",
+        options,
         "lag",
         "max_lag",
         "the search window of the lag estimate, s; 'lag' is the lag itself in fit and validate",
     )?;
-    let read = options::log_read(&mut k)?;
-    let max_lag = k.f64("max_lag")?;
-    k.finish()?;
-    py.detach(|| json_of(&log_info(&path, &read, max_lag)?))
+    let flags: LogInfoFlags = options::parse("log_info", &[], options)?;
+    let read = flags.read.options();
+    py.detach(|| json_of(&log_info(&path, &read, flags.max_lag)?))
         .map_err(engine_error)
 }
 
@@ -269,26 +282,14 @@ fn fit_json(
     vehicle_template: String,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut k = Kwargs::new("fit", options)?;
-    let logs = options::flight_logs(&mut k, logs)?;
-    let free = k.strings("free")?.unwrap_or_else(|| vec!["k".to_string()]);
-    let no_drag = k.flag("no_drag")?;
-    let output = k.path("output")?;
-    k.finish()?;
+    let positional = [
+        ("log", options::paths(&logs)),
+        ("vehicle_template", options::text(&vehicle_template)),
+    ];
+    let flags: FitFlags = options::parse("fit", &positional, options)?;
     py.detach(|| {
-        let template = Vehicle::load(&vehicle_template)?;
-        let free = free
-            .iter()
-            .map(|n| fit_parameter(n))
-            .collect::<Result<Vec<_>, _>>()?;
-        let request = FitRequest {
-            logs,
-            free,
-            no_drag,
-            output,
-            progress: None,
-        };
-        json_of(&fit_logs(&template, &request)?)
+        let template = Vehicle::load(&flags.vehicle_template)?;
+        json_of(&fit_logs(&template, &flags.request()?)?)
     })
     .map_err(engine_error)
 }
@@ -302,22 +303,14 @@ fn validate_json(
     vehicle: String,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let mut k = Kwargs::new("validate", options)?;
-    let logs = options::flight_logs(&mut k, logs)?;
-    let calibrate_first_s = k.f64("calibrate_first")?;
-    let battery = k.string("battery")?;
-    let payload_kg = k.f64_or("payload_kg", 0.0)?;
-    k.finish()?;
+    let positional = [
+        ("log", options::paths(&logs)),
+        ("vehicle", options::text(&vehicle)),
+    ];
+    let flags: ValidateFlags = options::parse("validate", &positional, options)?;
     py.detach(|| {
-        let v = Vehicle::load(&vehicle)?;
-        let request = ValidateRequest {
-            logs,
-            battery,
-            payload_kg,
-            calibrate_first_s,
-            series: false,
-        };
-        json_of(&validate_logs(&v, &request)?.report)
+        let v = Vehicle::load(&flags.vehicle)?;
+        json_of(&validate_logs(&v, &flags.request(false))?.report)
     })
     .map_err(engine_error)
 }
@@ -458,27 +451,9 @@ fn power<'py>(
     air_direction_deg: Option<PyReadonlyArray1<'py, f64>>,
     options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut k = Kwargs::new("power", options)?;
-    let vehicle = options::vehicle(&mut k)?;
-    let without = k
-        .strings("without")?
-        .unwrap_or_default()
-        .iter()
-        .map(|t| {
-            t.trim()
-                .parse::<Term>()
-                .map_err(|e| aloft_error(format!("invalid value '{t}' for 'without': {e}")))
-        })
-        .collect::<PyResult<Vec<Term>>>()?;
-    let base = PowerQuery {
-        battery: k.string("battery")?,
-        payload_kg: k.f64_or("payload_kg", 0.0)?,
-        without,
-        profile_cutoff_mps: k.f64("profile_cutoff")?,
-        aoa: k.aoa()?,
-        ..PowerQuery::default()
-    };
-    k.finish()?;
+    let flags: PowerModelFlags = options::parse("power", &[], options)?;
+    let vehicle = flags.vehicle.clone();
+    let base = flags.query();
     let states = States {
         airspeed: airspeed.as_slice()?,
         roll: roll.as_slice()?,

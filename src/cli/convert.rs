@@ -7,7 +7,8 @@ use clap::Args;
 
 use aloft::engine::convert_log;
 
-use super::log::ReadOptions;
+use aloft::engine::flags::LogReadFlags;
+
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -16,8 +17,9 @@ pub struct ConvertArgs {
     /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), an MCAP file, a
     /// PX4 ULog (.ulg) or an ArduPilot DataFlash log (.bin).
     log: PathBuf,
+    /// How the log is read.
     #[command(flatten)]
-    read: ReadOptions,
+    read: LogReadFlags,
     /// The MCAP file to write.
     #[arg(long, short = 'o', value_name = "MCAP")]
     output: PathBuf,

@@ -6,109 +6,41 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
-use clap::builder::{StringValueParser, TypedValueParser};
 use clap::{ArgGroup, Args};
 
+use aloft::engine::flags::EnduranceFlags;
 use aloft::engine::{
-    endurance, endurance_scenarios, payload_sweep, power_curve, AoaModel, EnduranceOptions,
-    EnduranceSummary, EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
+    endurance, endurance_scenarios, payload_sweep, power_curve, EnduranceOptions, EnduranceSummary,
+    EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
-use super::args::{aoa_parser, SteadyWindArgs};
 use super::output::{self, Row};
-use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
+use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("curve").args(["sweep_speed", "payload_sweep"])))]
 pub struct EnduranceArgs {
-    /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
-    vehicle: String,
-    /// Battery pack by name (default: the vehicle's default pack).
-    #[arg(long)]
-    battery: Option<String>,
-    /// Payload, kg.
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG")]
-    payload_kg: f64,
+    /// The engine's endurance options (vehicle, pack, payload, wind, queries, curves, scenarios).
     #[command(flatten)]
-    wind: SteadyWindArgs,
-    /// Course of the range query, degrees clockwise from north.
-    #[arg(value_parser = super::args::finite(),
-        long,
-        default_value_t = 0.0,
-        value_name = "DEG",
-        allow_negative_numbers = true
-    )]
-    course: f64,
-    /// Reserve kept, percent of the usable capacity.
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "PERCENT")]
-    reserve_percent: f64,
-    /// Orbit radius for the orbit-endurance query, m.
-    #[arg(value_parser = super::args::finite(), long, value_name = "M", requires = "orbit_speed")]
-    orbit_radius: Option<f64>,
-    /// Orbit ground speed, m/s.
-    #[arg(value_parser = super::args::finite(), long, value_name = "M/S", requires = "orbit_radius")]
-    orbit_speed: Option<f64>,
-    /// Angle-of-attack model of the power model.
-    #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
-    aoa: AoaModel,
-    /// The power curve instead: power, endurance and range against airspeed, in steps of this
-    /// many m/s up to the vehicle's maximum speed.
-    #[arg(value_parser = super::args::finite(), long, value_name = "STEP_M/S")]
-    sweep_speed: Option<f64>,
-    /// Endurance against payload instead, one curve per pack (every pack of the vehicle unless
-    /// --battery names one): hover endurance, best endurance and best range at payloads from
-    /// START to STOP kg in steps of STEP kg (e.g. 0:1:0.25; at most 1000 payloads). A pack's
-    /// curve stops at the maximum take-off mass.
-    #[arg(long, value_name = "START:STOP:STEP", value_parser = payload_sweep_parser(),
-        allow_hyphen_values = true, conflicts_with_all = ["payload_kg", "samples"])]
-    payload_sweep: Option<PayloadSweep>,
+    flags: EnduranceFlags,
     /// With --sweep-speed or --payload-sweep: also draw the curves to this SVG.
     #[arg(long, value_name = "SVG", requires = "curve")]
     plot: Option<PathBuf>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
-    /// Monte-Carlo scenarios (--samples N and the spreads; no gusts).
-    #[command(flatten)]
-    scenarios: super::scenarios::ScenarioArgs,
-}
-
-impl EnduranceArgs {
-    fn options(&self) -> EnduranceOptions {
-        EnduranceOptions {
-            battery: self.battery.clone(),
-            payload_kg: self.payload_kg,
-            wind: self.wind.spec(),
-            course_deg: self.course,
-            reserve_percent: self.reserve_percent,
-            orbit_radius_m: self.orbit_radius,
-            orbit_speed_mps: self.orbit_speed,
-            aoa: self.aoa,
-        }
-    }
-}
-
-/// `START:STOP:STEP`, parsed and checked by the engine (clap names the flag and the value).
-fn payload_sweep_parser() -> impl TypedValueParser<Value = PayloadSweep> {
-    StringValueParser::new().try_map(|text: String| {
-        PayloadSweep::parse(&text).map_err(|e| match e {
-            Error::PayloadSweep { problem, .. } => problem.to_string(),
-            other => other.to_string(),
-        })
-    })
 }
 
 pub fn run(args: EnduranceArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.vehicle)?;
-    let options = args.options();
-    if let Some(sweep) = &args.payload_sweep {
+    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+    let options = args.flags.options();
+    if let Some(sweep) = &args.flags.payload_sweep {
         return run_payload_sweep(&args, &vehicle, &options, sweep);
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    if let Some(step) = args.sweep_speed {
-        args.scenarios.refuse_with("--sweep-speed")?;
+    if let Some(step) = args.flags.sweep_speed {
+        super::args::refuse_samples(&args.flags.scenarios, "--sweep-speed")?;
         let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
             plot_sweep(p, &curve.context.vehicle, &curve.rows)
@@ -117,7 +49,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
         match args.format {
             Format::Json => output::write_json(&mut out, &curve)?,
             Format::Csv => write_curve_csv(out, &curve.rows)?,
-            Format::Table => write_curve_table(&mut out, &curve, args.course)?,
+            Format::Table => write_curve_table(&mut out, &curve, args.flags.course)?,
         }
         return Ok(Outcome::Ok);
     }
@@ -125,7 +57,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
         bail!("aloft endurance writes table or json (csv with --sweep-speed or --payload-sweep)");
     }
     let summary = endurance(&vehicle, &options)?;
-    let uncertainty = match args.scenarios.options(false) {
+    let uncertainty = match args.flags.scenarios.options(false) {
         Some(sc) => Some(endurance_scenarios(&vehicle, &options, &sc)?),
         None => None,
     };
@@ -139,7 +71,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
             },
         )?,
         (Format::Csv | Format::Table, _) => {
-            write_table(&mut out, &summary, args.reserve_percent)?;
+            write_table(&mut out, &summary, args.flags.reserve_percent)?;
             if let Some(u) = &uncertainty {
                 writeln!(out)?;
                 super::scenarios::write_endurance_lines(&mut out, u)?;

@@ -1,58 +1,39 @@
 //! `aloft fit`: identify the power model of a vehicle from flight logs.
 
 use std::io::{IsTerminal, Write};
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::Result;
 use clap::Args;
 
-use aloft::engine::{fit_logs, fit_parameter, FitAnswer, FitRequest, Vehicle};
+use aloft::engine::flags::FitFlags;
+use aloft::engine::{fit_logs, FitAnswer, FitRequest, Vehicle};
 
-use super::flights::{file_name, FlightLogArgs};
+use super::flights::file_name;
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
+// The command line always writes the fitted vehicle: -o is required here (optional in Python).
+#[command(mut_arg("output", |a| a.required(true)))]
 pub struct FitArgs {
+    /// The engine's fit options (logs, alignment, template, constants, output file).
     #[command(flatten)]
-    logs: FlightLogArgs,
-    /// Vehicle to start from (its [power] table): built-in name or TOML file.
-    #[arg(long, value_name = "NAME|FILE")]
-    vehicle_template: String,
-    /// Where to write the fitted vehicle TOML.
-    #[arg(short = 'o', long, value_name = "TOML")]
-    output: PathBuf,
-    /// Lumped constants to fit: k (= m g / eta), vh, profile, mu1, mu2, mu3 (comma-separated).
-    /// Default: k. Drag (mu1..mu3) is fitted from the force balance when the logs carry
-    /// acceleration, unless --aoa paper and mu* are listed here.
-    #[arg(long, value_delimiter = ',', default_value = "k")]
-    free: Vec<String>,
-    /// Do not fit drag from the force balance (keep the template's mu1..mu3).
-    #[arg(long)]
-    no_drag: bool,
+    flags: FitFlags,
     /// Output format of the report (stdout).
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
 pub fn run(args: FitArgs) -> Result<Outcome> {
-    let template = Vehicle::load(&args.vehicle_template)?;
-    let free = args
-        .free
-        .iter()
-        .map(|n| fit_parameter(n))
-        .collect::<Result<Vec<_>, _>>()?;
+    let template = Vehicle::load(&args.flags.vehicle_template)?;
+    let request = args.flags.request()?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.set_message("fitting");
         bar
     });
     let request = FitRequest {
-        logs: args.logs.logs(),
-        free,
-        no_drag: args.no_drag,
-        output: Some(args.output.clone()),
         progress: bar.clone().map(|b| {
             Arc::new(move |i: u64, cost: f64| {
                 b.set_message(format!(
@@ -61,6 +42,7 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
                 b.tick();
             }) as aloft::engine::FitProgress
         }),
+        ..request
     };
     let answer = fit_logs(&template, &request);
     if let Some(bar) = bar {

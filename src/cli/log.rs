@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 
-use aloft::engine::{log_info, LogFormat, LogInfo, LogReadOptions};
+use aloft::engine::flags::LogInfoFlags;
+use aloft::engine::{log_info, LogFormat, LogInfo};
 
 use super::output::{self, Row};
 use super::{Format, Outcome};
@@ -24,52 +25,14 @@ enum LogCommand {
     Info(InfoArgs),
 }
 
-/// Options shared by the commands that read a log.
-#[derive(Debug, Args)]
-pub struct ReadOptions {
-    /// CSV profile: kaist, px4, or a column-map TOML file. Default: recognised from the file
-    /// (MCAP by magic, KAIST by header, PX4 by table name).
-    #[arg(long, value_name = "PROFILE")]
-    pub profile: Option<String>,
-    /// MCAP: decode only these topics (repeatable); default: chosen by message type.
-    #[arg(long = "topic", value_name = "TOPIC")]
-    pub topics: Vec<String>,
-    /// MCAP: use the header stamps instead of the recording's log time.
-    #[arg(long)]
-    pub header_time: bool,
-    /// MCAP: take sensor_msgs/BatteryState current as positive while discharging (the message
-    /// definition says negative; some drivers publish the opposite).
-    #[arg(long)]
-    pub battery_current_positive: bool,
-    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
-    #[arg(long, default_value_t = 0, value_name = "N")]
-    pub battery_instance: u8,
-}
-
-impl ReadOptions {
-    /// The engine's read options.
-    pub fn options(&self) -> LogReadOptions {
-        LogReadOptions {
-            profile: self.profile.clone(),
-            topics: self.topics.clone(),
-            header_time: self.header_time,
-            battery_current_positive: self.battery_current_positive,
-            battery_instance: self.battery_instance,
-        }
-    }
-}
-
 #[derive(Debug, Args)]
 struct InfoArgs {
     /// The log: a CSV file, one PX4 topic table (or the tables' common prefix), an MCAP file, a
     /// PX4 ULog (.ulg) or an ArduPilot DataFlash log (.bin).
     file: PathBuf,
+    /// How the log is read, and the lag search.
     #[command(flatten)]
-    read: ReadOptions,
-    /// Also estimate the lag of power behind ground speed by cross-correlation, searched within
-    /// +-MAX_S seconds.
-    #[arg(value_parser = super::args::finite(), long, value_name = "MAX_S")]
-    max_lag: Option<f64>,
+    flags: LogInfoFlags,
     /// The old name of --max-lag, refused with a message: --lag is the lag itself in fit,
     /// validate and mission --replay.
     #[arg(long, hide = true, num_args = 0..=1, value_name = "S")]
@@ -92,7 +55,7 @@ fn info(args: InfoArgs) -> Result<Outcome> {
             "--lag of log info is now --max-lag: --max-lag {value} searches the lag of power behind ground speed within +-{value} s (--lag is the lag itself in fit, validate and mission --replay)"
         );
     }
-    let info = log_info(&args.file, &args.read.options(), args.max_lag)?;
+    let info = log_info(&args.file, &args.flags.read.options(), args.flags.max_lag)?;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     match args.format {

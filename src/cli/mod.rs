@@ -9,6 +9,8 @@ mod fit;
 mod flights;
 mod log;
 mod mission;
+mod mission_args;
+mod mission_view;
 mod output;
 mod payload_sweep;
 mod plot;
@@ -54,7 +56,7 @@ enum Command {
     /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
     Validate(validate::ValidateArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
-    Mission(Box<mission::MissionArgs>),
+    Mission(Box<mission_args::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
     Endurance(endurance::EnduranceArgs),
 }
@@ -151,6 +153,3 @@ fn message(e: &anyhow::Error) -> String {
     }
     text
 }
-
-/// The default vehicle name, for clap defaults.
-pub const DEFAULT_VEHICLE_ARG: &str = aloft::engine::DEFAULT_VEHICLE;

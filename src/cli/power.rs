@@ -7,52 +7,33 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::{
-    power_csv_file, power_point, power_values, AoaModel, PowerAnswer, PowerQuery, Term, Vehicle,
-    POWER_KEYS,
+    power_csv_file, power_point, power_values, PowerAnswer, PowerQuery, Vehicle, POWER_KEYS,
 };
 
-use super::args::aoa_parser;
 use super::output::{self, Row};
-use super::{Format, Outcome, DEFAULT_VEHICLE_ARG};
+use super::{Format, Outcome};
+use aloft::engine::flags::{finite, PowerModelFlags};
 
 #[derive(Debug, Args)]
 pub struct PowerArgs {
-    /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE_ARG)]
-    vehicle: String,
-    /// Battery pack by name (default: the vehicle's default pack); its mass is part of the
-    /// take-off mass the model flies (airframe + pack + payload).
-    #[arg(long)]
-    battery: Option<String>,
-    /// Payload, kg, part of the take-off mass.
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG",
-        allow_negative_numbers = true)]
-    payload_kg: f64,
+    /// The engine's model options (vehicle, pack, payload, terms, angle of attack).
+    #[command(flatten)]
+    model: PowerModelFlags,
     /// Airspeed in m/s: the speed of the vehicle relative to the air (horizontal, as the paper assumes).
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     airspeed: f64,
     /// Roll in degrees (positive: right side down).
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     roll: f64,
     /// Pitch in degrees (positive: nose up; forward flight pitches the nose down, e.g. -8).
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     pitch: f64,
     /// Vertical speed in m/s, positive up (only the climb term, eq 13, uses it).
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, allow_negative_numbers = true)]
     climb_rate: f64,
-    /// Remove terms from the model (the ablation rows of the paper's Table I), comma-separated:
-    /// induced, parasitic, profile, climb.
-    #[arg(long, value_delimiter = ',', value_name = "TERMS")]
-    without: Vec<Term>,
-    /// Hybrid model: drop the profile term above this airspeed, m/s (the paper's conclusion).
-    #[arg(value_parser = super::args::finite(), long, value_name = "M/S")]
-    profile_cutoff: Option<f64>,
-    /// Angle-of-attack model. Default: paper, or geometric when --air-direction-deg is given.
-    #[arg(long, value_parser = aoa_parser())]
-    aoa: Option<AoaModel>,
     /// Direction of the air-relative velocity in degrees from the nose (0 forward, 90 to the
     /// right); selects the geometric angle of attack.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true, value_name = "DEG")]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true, value_name = "DEG")]
     air_direction_deg: Option<f64>,
     /// Also report the gradient of electrical power with respect to airspeed, roll and pitch.
     #[arg(long)]
@@ -72,28 +53,24 @@ pub struct PowerArgs {
 impl PowerArgs {
     fn query(&self) -> PowerQuery {
         PowerQuery {
-            battery: self.battery.clone(),
-            payload_kg: self.payload_kg,
             airspeed_mps: self.airspeed,
             roll_deg: self.roll,
             pitch_deg: self.pitch,
             climb_rate_mps: self.climb_rate,
-            without: self.without.clone(),
-            profile_cutoff_mps: self.profile_cutoff,
-            aoa: self.aoa,
             air_direction_deg: self.air_direction_deg,
             gradient: self.gradient,
+            ..self.model.query()
         }
     }
 }
 
 pub fn run(args: PowerArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.vehicle)?;
+    let vehicle = Vehicle::load(&args.model.vehicle)?;
     if let Some(path) = &args.input {
         if matches!(args.format, Some(Format::Json | Format::Table)) {
             bail!("batch mode (--input) writes CSV only; drop --format or use --format csv");
         }
-        if args.aoa.is_some() || args.air_direction_deg.is_some() {
+        if args.model.aoa.is_some() || args.air_direction_deg.is_some() {
             bail!("in batch mode the angle of attack is per row: add an air_direction_deg column for the geometric model");
         }
         power_csv_file(&vehicle, &args.query(), path, args.output.as_deref())?;

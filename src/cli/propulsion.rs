@@ -9,6 +9,8 @@ use clap::Args;
 
 use aloft::engine::{hover, hover_sweep, HoverRequest, HoverResult, SweepPoint, Vehicle};
 
+use aloft::engine::flags::finite;
+
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -18,7 +20,7 @@ pub struct PropulsionArgs {
     #[arg(long, default_value = "aec-quadrotor")]
     vehicle: String,
     /// Payload in kg, added to the vehicle's empty mass.
-    #[arg(value_parser = super::args::finite(),
+    #[arg(value_parser = finite(),
         long,
         default_value_t = 0.0,
         allow_negative_numbers = true,
@@ -26,7 +28,7 @@ pub struct PropulsionArgs {
     )]
     payload_kg: f64,
     /// Take-off mass in kg (instead of --payload-kg).
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     takeoff_mass_kg: Option<f64>,
     /// Sweep take-off mass FROM:TO:STEP in kg (e.g. 7:13:0.5), the seed's Fig. 13.
     #[arg(long, value_name = "FROM:TO:STEP", conflicts_with_all = ["payload_kg", "takeoff_mass_kg"])]

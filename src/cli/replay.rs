@@ -4,7 +4,7 @@ use anyhow::{bail, Result};
 
 use aloft::engine::{replay_log, ReplayAcceleration, ReplayAnswer, ReplayRequest, Vehicle};
 
-use super::mission::{AccelArg, MissionArgs};
+use super::mission_args::{AccelArg, MissionArgs};
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -15,23 +15,23 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
     if args.format == Format::Csv {
         bail!("aloft mission --replay writes table or json");
     }
-    if args.wind.wind_field.is_some() || args.wind.gust_std.is_some() {
+    if args.flags.wind_field.is_some() || args.flags.gust_std.is_some() {
         bail!("--replay takes a steady wind (--wind-speed, --wind-from) for logs without one; a field or gusts belong to a planned mission");
     }
-    let vehicle = Vehicle::load(&args.vehicle)?;
+    let vehicle = Vehicle::load(&args.flags.vehicle)?;
     let request = ReplayRequest {
         log: log.clone(),
         profile: args.profile.clone(),
-        payload_kg: args.payload_kg.unwrap_or(0.0),
+        payload_kg: args.flags.payload_kg.unwrap_or(0.0),
         lag_s: args.lag,
         acceleration: match args.acceleration {
             AccelArg::Velocity => ReplayAcceleration::Velocity,
             AccelArg::Log => ReplayAcceleration::Log,
         },
         acceleration_window_s: args.acceleration_window,
-        aoa: args.aoa,
-        wind: args.wind.steady.spec(),
-        battery: args.battery.clone(),
+        aoa: args.flags.aoa,
+        wind: args.flags.wind.spec(),
+        battery: args.flags.battery.clone(),
     };
     let answer = replay_log(&vehicle, &request)?;
     for n in &answer.context.notes {

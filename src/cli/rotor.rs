@@ -7,6 +7,8 @@ use clap::Args;
 
 use aloft::engine::{rotor_response, EscProtocol, RotorAnswer, RotorOverrides, RotorRequest};
 
+use aloft::engine::flags::finite;
+
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -16,40 +18,40 @@ pub struct RotorArgs {
     #[arg(long, value_name = "NAME|FILE")]
     rotor: Option<String>,
     /// Motor velocity constant Kv, rpm/V.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     motor_kv: Option<f64>,
     /// Motor (armature + ESC) resistance, ohm.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     motor_resistance: Option<f64>,
     /// No-load current, A.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     no_load_current: Option<f64>,
     /// Supply voltage, V.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     voltage: Option<f64>,
     /// Motor mass, g.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     motor_mass: Option<f64>,
     /// Motor outer diameter, mm.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     motor_diameter: Option<f64>,
     /// Propeller mass, g.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     prop_mass: Option<f64>,
     /// Propeller diameter, inches.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     prop_diameter: Option<f64>,
     /// Load-torque coefficient c of tau = c omega^2, N m s^2.
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     torque_coefficient: Option<f64>,
     /// ESC protocol whose latency (seed Table 4) is added: pwm, oneshot125, oneshot42, multishot, dshot150, dshot300, dshot600, ...
     #[arg(long)]
     protocol: Option<EscProtocol>,
     /// Step start speed, rad/s (default 0: from rest).
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     step_from: Option<f64>,
     /// Step end speed, rad/s (default: the steady speed at full voltage).
-    #[arg(value_parser = super::args::finite(), long, allow_negative_numbers = true)]
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true)]
     step_to: Option<f64>,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]

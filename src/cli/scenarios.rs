@@ -6,95 +6,15 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{bail, Context, Result};
-use clap::builder::TypedValueParser;
-use clap::Args;
 
 use aloft::engine::{
     plan_scenarios, EnduranceUncertainty, Mission, MissionOptions, MissionWithUncertainty,
-    Percentiles, Plan, Sample, ScenarioOptions, Uncertainty, Vehicle, DEFAULT_POWER_SD_PERCENT,
-    MAX_SCENARIOS,
+    Percentiles, Plan, Sample, ScenarioOptions, Uncertainty, Vehicle,
 };
 
-use super::mission::mmss;
+use super::mission_view::{self, mmss};
 use super::output::{self, Row};
 use super::{Format, Outcome};
-
-/// A spread: a finite number from 0 to `max` (the flag is named in the message).
-fn spread(max: f64) -> impl TypedValueParser<Value = f64> {
-    super::args::finite().try_map(move |v: f64| {
-        if (0.0..=max).contains(&v) {
-            Ok(v)
-        } else {
-            Err(format!("a standard deviation from 0 to {max}"))
-        }
-    })
-}
-
-/// Monte-Carlo scenarios: how many, from what seed, and the spread (one standard deviation) of
-/// each source drawn.
-#[derive(Debug, Args)]
-pub struct ScenarioArgs {
-    /// Draw and fly this many scenarios (1 to 100000): p_feasible and percentiles of energy,
-    /// battery, time and point of no return (README, "How sure is the answer").
-    #[arg(long, value_name = "N",
-        value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SCENARIOS)))]
-    pub samples: Option<u32>,
-    /// Seed of the scenarios' draws (the same seed gives the same answer).
-    #[arg(long, requires = "samples", default_value_t = 1)]
-    pub seed: u64,
-    /// Spread of the wind speed, m/s (normal, clipped at 0).
-    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
-        value_name = "M/S", allow_negative_numbers = true)]
-    pub wind_speed_sd: f64,
-    /// Spread of the wind direction, degrees (normal).
-    #[arg(long, requires = "samples", value_parser = spread(180.0), default_value_t = 0.0,
-        value_name = "DEG", allow_negative_numbers = true)]
-    pub wind_from_sd: f64,
-    /// Spread of the take-off payload, kg (normal, clipped at 0).
-    #[arg(long, requires = "samples", value_parser = spread(1000.0), default_value_t = 0.0,
-        value_name = "KG", allow_negative_numbers = true)]
-    pub payload_sd_kg: f64,
-    /// Spread of the pack's capacity (health), percent of its rating (normal).
-    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
-        value_name = "PERCENT", allow_negative_numbers = true)]
-    pub capacity_sd_percent: f64,
-    /// Spread of the model's electrical power, percent (normal; default 3, aloft's own
-    /// whole-flight energy errors).
-    #[arg(long, requires = "samples", value_parser = spread(50.0),
-        default_value_t = DEFAULT_POWER_SD_PERCENT, value_name = "PERCENT",
-        allow_negative_numbers = true)]
-    pub power_sd_percent: f64,
-    /// Threads for the scenarios (0: one per core); the answer does not depend on it.
-    #[arg(long, requires = "samples", default_value_t = 0, value_name = "N",
-        value_parser = clap::value_parser!(u16).range(0..=1024))]
-    pub threads: u16,
-}
-
-impl ScenarioArgs {
-    /// The engine's scenario options, when `--samples` was given (`fan`: follow the state of
-    /// charge for a chart).
-    pub fn options(&self, fan: bool) -> Option<ScenarioOptions> {
-        Some(ScenarioOptions {
-            samples: self.samples?,
-            seed: self.seed,
-            wind_speed_sd_mps: self.wind_speed_sd,
-            wind_from_sd_deg: self.wind_from_sd,
-            payload_sd_kg: self.payload_sd_kg,
-            capacity_sd_percent: self.capacity_sd_percent,
-            power_sd_percent: self.power_sd_percent,
-            threads: usize::from(self.threads),
-            soc_fan: fan,
-        })
-    }
-
-    /// Refuse `--samples` with an option it does not apply to.
-    pub fn refuse_with(&self, other: &str) -> Result<()> {
-        if self.samples.is_some() {
-            bail!("--samples draws scenarios of a planned answer; it cannot be used with {other}");
-        }
-        Ok(())
-    }
-}
 
 /// What a mission's scenarios are drawn around and rendered with.
 pub struct MissionRun<'a> {
@@ -119,7 +39,7 @@ pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome
     let mut out = stdout.lock();
     match run.format {
         Format::Json => {
-            output::warn(super::mission::plan_warnings(plan));
+            output::warn(mission_view::plan_warnings(plan));
             output::write_json(
                 &mut out,
                 &MissionWithUncertainty {
@@ -139,10 +59,10 @@ pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome
 
 /// The mission's table with the scenarios' line, bands and segment columns.
 fn write_mission_table(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<()> {
-    out.write_all(super::mission::header(plan)?.as_bytes())?;
+    out.write_all(mission_view::header(plan)?.as_bytes())?;
     out.write_all(verdict(plan, u).as_bytes())?;
     writeln!(out)?;
-    output::write_table(out, "Summary", &super::mission::summary_rows(plan.report()))?;
+    output::write_table(out, "Summary", &mission_view::summary_rows(plan.report()))?;
     writeln!(out)?;
     output::write_table(
         out,
@@ -155,8 +75,8 @@ fn write_mission_table(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Re
     writeln!(out)?;
     write_segments(out, plan, u)?;
     writeln!(out)?;
-    super::mission::write_sorties(out, plan.summary())?;
-    super::mission::write_model_line(out, plan)
+    mission_view::write_sorties(out, plan.summary())?;
+    mission_view::write_model_line(out, plan)
 }
 
 /// The drawn spreads in words.
@@ -301,7 +221,7 @@ fn write_segments(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<
     Ok(())
 }
 
-use super::mission::Area;
+use super::mission_view::Area;
 
 /// The state-of-charge fan over time (the plan's own line in it) and the ground track with the
 /// plan's point of no return and the one that holds with 95 % confidence.
@@ -410,7 +330,7 @@ fn plot_track(area: &Area<'_>, plan: &Plan, u: &Uncertainty, s: &[Sample]) -> Re
         .p5
         .and_then(|t| sample_at(s, t))
         .map(|x| (x.east_m, x.north_m));
-    super::mission::plot_track(area, plan.report(), s, plan.home_m(), confident)
+    mission_view::plot_track(area, plan.report(), s, plan.home_m(), confident)
 }
 
 /// The endurance table's lines for the scenarios.

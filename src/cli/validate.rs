@@ -7,29 +7,17 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::Args;
 
-use aloft::engine::{validate_logs, PowerSeries, ValidateReport, ValidateRequest, Vehicle};
+use aloft::engine::flags::ValidateFlags;
+use aloft::engine::{validate_logs, PowerSeries, ValidateReport, Vehicle};
 
-use super::flights::{file_name, FlightLogArgs};
+use super::flights::file_name;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
+    /// The engine's validation options (logs, alignment, vehicle, pack, payload).
     #[command(flatten)]
-    logs: FlightLogArgs,
-    /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
-    #[arg(long, value_name = "NAME|FILE")]
-    vehicle: String,
-    /// Battery pack the flights carried, part of the take-off mass (default: the vehicle's
-    /// default pack; a vehicle without an airframe flies its [power] mass).
-    #[arg(long)]
-    battery: Option<String>,
-    /// Payload the flights carried, kg, part of the take-off mass.
-    #[arg(value_parser = super::args::finite(), long, default_value_t = 0.0, value_name = "KG")]
-    payload_kg: f64,
-    /// Re-estimate only the efficiency from the first S seconds of each flight, as a ground
-    /// station would in flight, and report the errors over the rest.
-    #[arg(value_parser = super::args::finite(), long, value_name = "S")]
-    calibrate_first: Option<f64>,
+    flags: ValidateFlags,
     /// Also write an SVG of measured against predicted power, one panel per flight.
     #[arg(long, value_name = "SVG")]
     plot: Option<PathBuf>,
@@ -39,14 +27,8 @@ pub struct ValidateArgs {
 }
 
 pub fn run(args: ValidateArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.vehicle)?;
-    let request = ValidateRequest {
-        logs: args.logs.logs(),
-        battery: args.battery.clone(),
-        payload_kg: args.payload_kg,
-        calibrate_first_s: args.calibrate_first,
-        series: args.plot.is_some(),
-    };
+    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+    let request = args.flags.request(args.plot.is_some());
     let answer = validate_logs(&vehicle, &request)?;
     for f in &answer.report.flights {
         eprintln!(

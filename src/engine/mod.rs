@@ -47,8 +47,10 @@ mod estimator;
 mod files;
 mod finite;
 mod fit;
+pub mod flags;
 mod flight;
 mod flown;
+mod keywords;
 mod logs;
 mod loiter;
 mod mission;
@@ -83,6 +85,7 @@ pub use estimator::InFlightEstimator;
 pub use files::read_text_file;
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use flown::PlanningSpeed;
+pub use keywords::{keywords, parse_keywords, FlagGroup, Keyword};
 pub use logs::{
     convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
     LogReadOptions, LogTime, LogTopic, TopicCount,

@@ -1,0 +1,580 @@
+//! Requests from flags: the one description of the options a user names, shared by every front
+//! end that takes options by name.
+//!
+//! Each group below is a [`clap::Args`] description (names, defaults, ranges, the options that
+//! need or exclude each other) and the mapping from what was given to the engine's request
+//! (precedence included). The `aloft` command line flattens these groups into its subcommands;
+//! the Python package parses its keyword arguments with the very same groups
+//! ([`super::keywords`]), so an option's name, default and range are written once. Python's
+//! keyword is the flag's long name in snake_case (`--payload-kg` is `payload_kg=`).
+//!
+//! What only one front end has (output formats, files to write, progress) stays with it.
+
+use std::path::PathBuf;
+
+use clap::builder::{PossibleValue, PossibleValuesParser, StringValueParser, TypedValueParser};
+use clap::Args;
+
+use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
+use aloft_power::{AoaModel, Term};
+
+use super::fit::{fit_parameter, FitRequest};
+use super::logs::{FlightLogs, LogReadOptions};
+use super::mission_options::{GustSpec, MissionOptions};
+use super::payload_sweep::PayloadSweep;
+use super::power::PowerQuery;
+use super::scenarios::{ScenarioOptions, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
+use super::validate::ValidateRequest;
+use super::EnduranceOptions;
+use crate::error::Error;
+use crate::vehicle::DEFAULT_VEHICLE;
+
+/// Every numeric option: a finite number (`nan`, `inf` and overflowing text like `1e999` are
+/// refused with the option's name; the engine checks each value's physical range and unit).
+pub fn finite() -> impl TypedValueParser<Value = f64> {
+    StringValueParser::new().try_map(|text: String| match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err("not a finite number".to_string()),
+        Err(_) => Err("not a number".to_string()),
+    })
+}
+
+/// A spread: a finite number from 0 to `max`.
+fn spread(max: f64) -> impl TypedValueParser<Value = f64> {
+    finite().try_map(move |v: f64| {
+        if (0.0..=max).contains(&v) {
+            Ok(v)
+        } else {
+            Err(format!("a standard deviation from 0 to {max}"))
+        }
+    })
+}
+
+/// `geometric|paper`, parsed into the engine's [`AoaModel`].
+pub fn aoa_parser() -> impl TypedValueParser<Value = AoaModel> {
+    PossibleValuesParser::new([
+        PossibleValue::new("geometric")
+            .help("Exact angle between the air-relative velocity and the rotor plane"),
+        PossibleValue::new("paper").help("The power seed's eqs (3)-(4) from roll and pitch"),
+    ])
+    .map(|s| match s.as_str() {
+        "paper" => AoaModel::Paper,
+        _ => AoaModel::Geometric,
+    })
+}
+
+/// `pass|stop`, parsed into the engine's [`CornerMode`].
+fn corners_parser() -> impl TypedValueParser<Value = CornerMode> {
+    PossibleValuesParser::new([
+        PossibleValue::new("pass").help(
+            "Through waypoints without a hold at the speed the turn allows (as autopilots fly)",
+        ),
+        PossibleValue::new("stop").help("Stop at every waypoint, yaw, go on"),
+    ])
+    .map(|s| match s.as_str() {
+        "stop" => CornerMode::Stop,
+        _ => CornerMode::Pass,
+    })
+}
+
+/// `uniform|power-law|log`, parsed into the engine's [`WindProfileKind`].
+fn profile_parser() -> impl TypedValueParser<Value = WindProfileKind> {
+    PossibleValuesParser::new([
+        PossibleValue::new("uniform").help("The same speed at every height"),
+        PossibleValue::new("power-law").help("S (z / z_ref)^exponent"),
+        PossibleValue::new("log").help("S ln(z / z0) / ln(z_ref / z0)"),
+    ])
+    .map(|s| match s.as_str() {
+        "power-law" => WindProfileKind::PowerLaw,
+        "log" => WindProfileKind::Log,
+        _ => WindProfileKind::Uniform,
+    })
+}
+
+/// `START:STOP:STEP`, parsed and checked by [`PayloadSweep::parse`] (the option is named in the
+/// message).
+fn payload_sweep_parser() -> impl TypedValueParser<Value = PayloadSweep> {
+    StringValueParser::new().try_map(|text: String| {
+        PayloadSweep::parse(&text).map_err(|e| match e {
+            Error::PayloadSweep { problem, .. } => problem.to_string(),
+            other => other.to_string(),
+        })
+    })
+}
+
+/// A steady wind: speed, direction and how it varies with height.
+#[derive(Debug, Clone, Args)]
+pub struct WindFlags {
+    /// Wind speed in m/s (at the reference height when a profile is given).
+    #[arg(value_parser = finite(), long, value_name = "M/S", requires = "wind_from")]
+    pub wind_speed: Option<f64>,
+    /// Direction the wind blows FROM, degrees clockwise from north (270 = a westerly).
+    #[arg(value_parser = finite(),
+        long,
+        value_name = "DEG",
+        allow_negative_numbers = true,
+        requires = "wind_speed"
+    )]
+    pub wind_from: Option<f64>,
+    /// Variation of the wind with height (needs --wind-speed).
+    #[arg(long, value_parser = profile_parser(), requires = "wind_speed")]
+    pub wind_profile: Option<WindProfileKind>,
+    /// Reference height of the profile, m.
+    #[arg(value_parser = finite(), long, default_value_t = 10.0, value_name = "M")]
+    pub wind_reference_height: f64,
+    /// Power-law exponent.
+    #[arg(value_parser = finite(), long, default_value_t = 1.0 / 7.0)]
+    pub wind_exponent: f64,
+    /// Roughness length of the log profile, m (0.03 open grass, 0.1-0.25 crops and hedges).
+    #[arg(value_parser = finite(), long, default_value_t = 0.03, value_name = "M")]
+    pub wind_roughness: f64,
+}
+
+impl WindFlags {
+    /// The wind as the engine's `[wind]` table, when a speed and direction were given.
+    pub fn spec(&self) -> Option<WindSpec> {
+        let (speed_mps, from_deg) = self.wind_speed.zip(self.wind_from)?;
+        let profile = self.wind_profile.unwrap_or_default();
+        let uses = |p: WindProfileKind| profile == p;
+        let profiled = !uses(WindProfileKind::Uniform);
+        Some(WindSpec {
+            speed_mps,
+            from_deg,
+            profile,
+            reference_height_m: profiled.then_some(self.wind_reference_height),
+            exponent: uses(WindProfileKind::PowerLaw).then_some(self.wind_exponent),
+            roughness_m: uses(WindProfileKind::Log).then_some(self.wind_roughness),
+            gust_std_mps: None,
+            gust_seed: None,
+        })
+    }
+}
+
+/// The options of `aloft mission` (and of Python's `aloft.mission`, `aloft.timeseries`).
+#[derive(Debug, Clone, Args)]
+pub struct MissionFlags {
+    /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
+    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    pub vehicle: String,
+    /// Battery pack by name (default: the vehicle's default pack). With --replay, the pack flown
+    /// in the log: its mass is part of the mass flown (airframe + pack + payload).
+    #[arg(long)]
+    pub battery: Option<String>,
+    /// Payload at take-off, kg (overrides the mission file).
+    #[arg(value_parser = finite(), long, value_name = "KG")]
+    pub payload_kg: Option<f64>,
+    /// The steady wind.
+    #[command(flatten)]
+    pub wind: WindFlags,
+    /// Gridded wind field: CSV with columns x_m,y_m,z_m,u_mps,v_mps,w_mps (east, north, up),
+    /// interpolated trilinearly; the route must stay inside it.
+    #[arg(long, value_name = "CSV", conflicts_with_all = ["wind_speed", "wind_profile"])]
+    pub wind_field: Option<PathBuf>,
+    /// Add seeded gusts with this standard deviation per horizontal axis, m/s.
+    #[arg(value_parser = finite(), long, value_name = "M/S")]
+    pub gust_std: Option<f64>,
+    /// Seed of the gusts.
+    #[arg(long, default_value_t = 1)]
+    pub gust_seed: u64,
+    /// Reserve required at landing, percent of the usable capacity (default: the mission's, else 20).
+    #[arg(value_parser = finite(), long, value_name = "PERCENT")]
+    pub reserve_percent: Option<f64>,
+    /// State of charge at take-off, percent.
+    #[arg(value_parser = finite(), long, default_value_t = 100.0, value_name = "PERCENT")]
+    pub start_percent: f64,
+    /// Sampling step, s (default: the mission's, else 0.1).
+    #[arg(value_parser = finite(), long, value_name = "S")]
+    pub time_step: Option<f64>,
+    /// Planning speed, m/s: the ground speed of legs without one of their own (overrides the
+    /// vehicle's cruise_speed_mps and the file's, e.g. a .plan's hoverSpeed).
+    #[arg(value_parser = finite(), long, value_name = "M/S")]
+    pub speed: Option<f64>,
+    /// Lowest height of a return to launch, m (overrides the vehicle's rtl_altitude_m and the
+    /// mission's): a return below it climbs first.
+    #[arg(value_parser = finite(), long, value_name = "M")]
+    pub rtl_altitude_m: Option<f64>,
+    /// How waypoints without a hold are flown (default: the mission's, else pass).
+    #[arg(long, value_parser = corners_parser(), value_name = "MODE")]
+    pub corners: Option<CornerMode>,
+    /// Angle-of-attack model of the power model.
+    #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
+    pub aoa: AoaModel,
+    /// Leave out ground effect (survey eq 35) near the ground.
+    #[arg(long)]
+    pub no_ground_effect: bool,
+}
+
+impl MissionFlags {
+    /// The engine's mission options of these flags.
+    pub fn options(&self) -> MissionOptions {
+        MissionOptions {
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            wind: self.wind.spec(),
+            wind_field: self.wind_field.clone(),
+            gusts: self.gust_std.map(|std_mps| GustSpec {
+                std_mps,
+                seed: self.gust_seed,
+            }),
+            reserve_percent: self.reserve_percent,
+            start_percent: self.start_percent,
+            time_step_s: self.time_step,
+            aoa: self.aoa,
+            ground_effect: !self.no_ground_effect,
+            record_samples: false,
+            speed_mps: self.speed,
+            rtl_altitude_m: self.rtl_altitude_m,
+            corners: self.corners,
+        }
+    }
+}
+
+/// Monte-Carlo scenarios: how many, from what seed, and the spread (one standard deviation) of
+/// each source drawn.
+#[derive(Debug, Clone, Args)]
+pub struct ScenarioFlags {
+    /// Draw and fly this many scenarios (1 to 100000): p_feasible and percentiles of energy,
+    /// battery, time and point of no return (docs/guide.md, "How sure is the answer").
+    #[arg(long, value_name = "N",
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SCENARIOS)))]
+    pub samples: Option<u32>,
+    /// Seed of the scenarios' draws (the same seed gives the same answer).
+    #[arg(long, requires = "samples", default_value_t = 1)]
+    pub seed: u64,
+    /// Spread of the wind speed, m/s (normal, clipped at 0).
+    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
+        value_name = "M/S", allow_negative_numbers = true)]
+    pub wind_speed_sd: f64,
+    /// Spread of the wind direction, degrees (normal).
+    #[arg(long, requires = "samples", value_parser = spread(180.0), default_value_t = 0.0,
+        value_name = "DEG", allow_negative_numbers = true)]
+    pub wind_from_sd: f64,
+    /// Spread of the take-off payload, kg (normal, clipped at 0).
+    #[arg(long, requires = "samples", value_parser = spread(1000.0), default_value_t = 0.0,
+        value_name = "KG", allow_negative_numbers = true)]
+    pub payload_sd_kg: f64,
+    /// Spread of the pack's capacity (health), percent of its rating (normal).
+    #[arg(long, requires = "samples", value_parser = spread(50.0), default_value_t = 0.0,
+        value_name = "PERCENT", allow_negative_numbers = true)]
+    pub capacity_sd_percent: f64,
+    /// Spread of the model's electrical power, percent (normal; default 3, aloft's own
+    /// whole-flight energy errors).
+    #[arg(long, requires = "samples", value_parser = spread(50.0),
+        default_value_t = DEFAULT_POWER_SD_PERCENT, value_name = "PERCENT",
+        allow_negative_numbers = true)]
+    pub power_sd_percent: f64,
+    /// Threads for the scenarios (0: one per core); the answer does not depend on it.
+    #[arg(long, requires = "samples", default_value_t = 0, value_name = "N",
+        value_parser = clap::value_parser!(u16).range(0..=1024))]
+    pub threads: u16,
+}
+
+impl ScenarioFlags {
+    /// The engine's scenario options, when `--samples` was given (`fan`: follow the state of
+    /// charge for a chart).
+    pub fn options(&self, fan: bool) -> Option<ScenarioOptions> {
+        Some(ScenarioOptions {
+            samples: self.samples?,
+            seed: self.seed,
+            wind_speed_sd_mps: self.wind_speed_sd,
+            wind_from_sd_deg: self.wind_from_sd,
+            payload_sd_kg: self.payload_sd_kg,
+            capacity_sd_percent: self.capacity_sd_percent,
+            power_sd_percent: self.power_sd_percent,
+            threads: usize::from(self.threads),
+            soc_fan: fan,
+        })
+    }
+}
+
+/// The options of `aloft endurance`: the queries at one payload, the power curve
+/// (`--sweep-speed`) or endurance against payload (`--payload-sweep`), with its scenarios.
+#[derive(Debug, Clone, Args)]
+pub struct EnduranceFlags {
+    /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
+    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    pub vehicle: String,
+    /// Battery pack by name (default: the vehicle's default pack).
+    #[arg(long)]
+    pub battery: Option<String>,
+    /// Payload, kg.
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, value_name = "KG")]
+    pub payload_kg: f64,
+    /// The steady wind.
+    #[command(flatten)]
+    pub wind: WindFlags,
+    /// Course of the range query, degrees clockwise from north.
+    #[arg(value_parser = finite(),
+        long,
+        default_value_t = 0.0,
+        value_name = "DEG",
+        allow_negative_numbers = true
+    )]
+    pub course: f64,
+    /// Reserve kept, percent of the usable capacity.
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, value_name = "PERCENT")]
+    pub reserve_percent: f64,
+    /// Orbit radius for the orbit-endurance query, m.
+    #[arg(value_parser = finite(), long, value_name = "M", requires = "orbit_speed")]
+    pub orbit_radius: Option<f64>,
+    /// Orbit ground speed, m/s.
+    #[arg(value_parser = finite(), long, value_name = "M/S", requires = "orbit_radius")]
+    pub orbit_speed: Option<f64>,
+    /// Angle-of-attack model of the power model.
+    #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
+    pub aoa: AoaModel,
+    /// The power curve instead: power, endurance and range against airspeed, in steps of this
+    /// many m/s up to the vehicle's maximum speed.
+    #[arg(value_parser = finite(), long, value_name = "STEP_M/S")]
+    pub sweep_speed: Option<f64>,
+    /// Endurance against payload instead, one curve per pack (every pack of the vehicle unless
+    /// --battery names one): hover endurance, best endurance and best range at payloads from
+    /// START to STOP kg in steps of STEP kg (e.g. 0:1:0.25; at most 1000 payloads). A pack's
+    /// curve stops at the maximum take-off mass.
+    #[arg(long, value_name = "START:STOP:STEP", value_parser = payload_sweep_parser(),
+        allow_hyphen_values = true,
+        conflicts_with_all = ["payload_kg", "sweep_speed", "samples"])]
+    pub payload_sweep: Option<PayloadSweep>,
+    /// Monte-Carlo scenarios (--samples N and the spreads; no gusts).
+    #[command(flatten)]
+    pub scenarios: ScenarioFlags,
+}
+
+impl EnduranceFlags {
+    /// The engine's endurance options of these flags.
+    pub fn options(&self) -> EnduranceOptions {
+        EnduranceOptions {
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            wind: self.wind.spec(),
+            course_deg: self.course,
+            reserve_percent: self.reserve_percent,
+            orbit_radius_m: self.orbit_radius,
+            orbit_speed_mps: self.orbit_speed,
+            aoa: self.aoa,
+        }
+    }
+}
+
+/// How a log is read: its layout and, for MCAP, ULog and DataFlash, what to take from it.
+#[derive(Debug, Clone, Args)]
+pub struct LogReadFlags {
+    /// CSV profile: kaist, px4, or a column-map TOML file. Default: recognised from the file
+    /// (MCAP by magic, KAIST by header, PX4 by table name).
+    #[arg(long, value_name = "PROFILE")]
+    pub profile: Option<String>,
+    /// MCAP: decode only these topics (repeatable or comma-separated); default: chosen by
+    /// message type.
+    #[arg(
+        long,
+        visible_alias = "topic",
+        value_delimiter = ',',
+        value_name = "TOPIC"
+    )]
+    pub topics: Vec<String>,
+    /// MCAP: use the header stamps instead of the recording's log time.
+    #[arg(long)]
+    pub header_time: bool,
+    /// MCAP: take sensor_msgs/BatteryState current as positive while discharging (the message
+    /// definition says negative; some drivers publish the opposite).
+    #[arg(long)]
+    pub battery_current_positive: bool,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub battery_instance: u8,
+}
+
+impl LogReadFlags {
+    /// The engine's read options of these flags.
+    pub fn options(&self) -> LogReadOptions {
+        LogReadOptions {
+            profile: self.profile.clone(),
+            topics: self.topics.clone(),
+            header_time: self.header_time,
+            battery_current_positive: self.battery_current_positive,
+            battery_instance: self.battery_instance,
+        }
+    }
+}
+
+/// The options of `aloft log info`.
+#[derive(Debug, Clone, Args)]
+pub struct LogInfoFlags {
+    /// How the log is read.
+    #[command(flatten)]
+    pub read: LogReadFlags,
+    /// Also estimate the lag of power behind ground speed by cross-correlation, searched within
+    /// +-MAX_S seconds.
+    #[arg(value_parser = finite(), long, value_name = "MAX_S")]
+    pub max_lag: Option<f64>,
+}
+
+/// The flight logs of `aloft fit` and `aloft validate` and how to align power with motion in
+/// them.
+#[derive(Debug, Clone, Args)]
+pub struct FlightLogFlags {
+    /// Flight logs (CSV, MCAP, PX4 ULog or ArduPilot DataFlash).
+    #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
+    pub log: Vec<PathBuf>,
+    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
+    #[arg(long)]
+    pub profile: Option<String>,
+    /// Angle-of-attack model for the logged states: geometric (drag work is in the attitude;
+    /// drag is fitted from the force balance) or paper (drag can be fitted from power).
+    #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
+    pub aoa: AoaModel,
+    /// Use this lag of power behind motion (s) instead of estimating it.
+    #[arg(value_parser = finite(), long, allow_negative_numbers = true, value_name = "S")]
+    pub lag: Option<f64>,
+    /// Search window of the lag estimate, s.
+    #[arg(value_parser = finite(), long, default_value_t = 10.0, value_name = "S")]
+    pub max_lag: f64,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    pub battery_instance: u8,
+}
+
+impl FlightLogFlags {
+    /// The engine's description of the logs.
+    pub fn logs(&self) -> FlightLogs {
+        FlightLogs {
+            logs: self.log.clone(),
+            profile: self.profile.clone(),
+            aoa: self.aoa,
+            lag_s: self.lag,
+            max_lag_s: self.max_lag,
+            battery_instance: self.battery_instance,
+        }
+    }
+}
+
+/// The options of `aloft fit`.
+#[derive(Debug, Clone, Args)]
+pub struct FitFlags {
+    /// The flight logs.
+    #[command(flatten)]
+    pub logs: FlightLogFlags,
+    /// Vehicle to start from (its [power] table): built-in name or TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub vehicle_template: String,
+    /// Where to write the fitted vehicle TOML.
+    #[arg(short = 'o', long, value_name = "TOML")]
+    pub output: Option<PathBuf>,
+    /// Lumped constants to fit: k (= m g / eta), vh, profile, mu1, mu2, mu3 (comma-separated).
+    /// Default: k. Drag (mu1..mu3) is fitted from the force balance when the logs carry
+    /// acceleration, unless --aoa paper and mu* are listed here.
+    #[arg(long, value_delimiter = ',', default_value = "k")]
+    pub free: Vec<String>,
+    /// Do not fit drag from the force balance (keep the template's mu1..mu3).
+    #[arg(long)]
+    pub no_drag: bool,
+}
+
+impl FitFlags {
+    /// The engine's fit request of these flags (without progress reports).
+    ///
+    /// # Errors
+    /// [`Error::UnknownParameter`]-style errors of [`fit_parameter`] for a name in `free` that
+    /// is not a constant of the model.
+    pub fn request(&self) -> Result<FitRequest, Error> {
+        Ok(FitRequest {
+            logs: self.logs.logs(),
+            free: self
+                .free
+                .iter()
+                .map(|n| fit_parameter(n))
+                .collect::<Result<Vec<_>, _>>()?,
+            no_drag: self.no_drag,
+            output: self.output.clone(),
+            progress: None,
+        })
+    }
+}
+
+/// The options of `aloft validate`.
+#[derive(Debug, Clone, Args)]
+pub struct ValidateFlags {
+    /// The flight logs.
+    #[command(flatten)]
+    pub logs: FlightLogFlags,
+    /// Vehicle with a [power] table (e.g. from `aloft fit`): built-in name or TOML file.
+    #[arg(long, value_name = "NAME|FILE")]
+    pub vehicle: String,
+    /// Battery pack the flights carried, part of the take-off mass (default: the vehicle's
+    /// default pack; a vehicle without an airframe flies its [power] mass).
+    #[arg(long)]
+    pub battery: Option<String>,
+    /// Payload the flights carried, kg, part of the take-off mass.
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, value_name = "KG")]
+    pub payload_kg: f64,
+    /// Re-estimate only the efficiency from the first S seconds of each flight, as a ground
+    /// station would in flight, and report the errors over the rest.
+    #[arg(value_parser = finite(), long, value_name = "S")]
+    pub calibrate_first: Option<f64>,
+}
+
+impl ValidateFlags {
+    /// The engine's validation request of these flags (`series`: keep the power series for a
+    /// chart).
+    pub fn request(&self, series: bool) -> ValidateRequest {
+        ValidateRequest {
+            logs: self.logs.logs(),
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            calibrate_first_s: self.calibrate_first,
+            series,
+        }
+    }
+}
+
+/// The model options of `aloft power` (the flight state and the output are the caller's).
+#[derive(Debug, Clone, Args)]
+pub struct PowerModelFlags {
+    /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
+    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    pub vehicle: String,
+    /// Battery pack by name (default: the vehicle's default pack); its mass is part of the
+    /// take-off mass the model flies (airframe + pack + payload).
+    #[arg(long)]
+    pub battery: Option<String>,
+    /// Payload, kg, part of the take-off mass.
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, value_name = "KG",
+        allow_negative_numbers = true)]
+    pub payload_kg: f64,
+    /// Remove terms from the model (the ablation rows of the paper's Table I), comma-separated:
+    /// induced, parasitic, profile, climb.
+    #[arg(long, value_delimiter = ',', value_name = "TERMS")]
+    pub without: Vec<Term>,
+    /// Hybrid model: drop the profile term above this airspeed, m/s (the paper's conclusion).
+    #[arg(value_parser = finite(), long, value_name = "M/S")]
+    pub profile_cutoff: Option<f64>,
+    /// Angle-of-attack model. Default: paper, or geometric when --air-direction-deg is given.
+    #[arg(long, value_parser = aoa_parser())]
+    pub aoa: Option<AoaModel>,
+}
+
+impl PowerModelFlags {
+    /// The engine's power query of these options, in hover (the caller sets the state).
+    pub fn query(&self) -> PowerQuery {
+        PowerQuery {
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            without: self.without.clone(),
+            profile_cutoff_mps: self.profile_cutoff,
+            aoa: self.aoa,
+            ..PowerQuery::default()
+        }
+    }
+}
+
+/// The options of a mission with its scenarios, in one group (for callers that take them in
+/// one call, as Python's `aloft.mission`).
+#[derive(Debug, Clone, Args)]
+pub struct MissionScenarioFlags {
+    /// The mission's options.
+    #[command(flatten)]
+    pub mission: MissionFlags,
+    /// Its scenarios.
+    #[command(flatten)]
+    pub scenarios: ScenarioFlags,
+}
