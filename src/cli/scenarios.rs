@@ -35,7 +35,7 @@ fn spread(max: f64) -> impl TypedValueParser<Value = f64> {
 #[derive(Debug, Args)]
 pub struct ScenarioArgs {
     /// Draw and fly this many scenarios (1 to 100000): p_feasible and percentiles of energy,
-    /// battery, time and point of no return (README, "How sure is the answer").
+    /// battery, time and point of no return (docs/guide.md, "How sure is the answer").
     #[arg(long, value_name = "N",
         value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SCENARIOS)))]
     pub samples: Option<u32>,
