@@ -5,11 +5,11 @@
 //! model, the trim, the wind and the pack; `planner/endurance/queries`, all endurance queries of
 //! one vehicle in at most 1 ms.
 //!
-//! Measured on the 2-core machine in quiet runs (figures in the README): `one_hour` 9.6-10.6
-//! ms with pass A on a second thread, `one_hour_one_thread` 13.7-14.5 ms, `one_hour_without_pnr`
-//! about the same as `one_hour` (the checks run while the other thread works),
-//! `endurance/queries` 24.7-27 us. While the host steals CPU time from the machine all of them
-//! are far slower.
+//! Measured on the 2-core machine in quiet runs (figures in docs/architecture.md): `one_hour`
+//! 9.6-10.6 ms with pass A on a second thread, `one_hour_one_thread` 13.7-14.5 ms,
+//! `one_hour_without_pnr` about the same as `one_hour` (the checks run while the other thread
+//! works), `endurance/queries` 24.7-27 us. While the host steals CPU time from the machine all
+//! of them are far slower.
 
 use std::hint::black_box;
 

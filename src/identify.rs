@@ -16,9 +16,9 @@
 //!
 //! # Flight state from a log
 //! Air-relative velocity = ground velocity - wind when the log carries wind, otherwise the ground
-//! velocity (no wind: an assumption, reported in the README). Airspeed is its horizontal norm (the
-//! paper's level-flight inputs), climb rate its vertical component, the angle of attack the exact
-//! geometry with the air direction `course - yaw` from the nose.
+//! velocity (no wind: an assumption, reported in docs/validation.md). Airspeed is its horizontal
+//! norm (the paper's level-flight inputs), climb rate its vertical component, the angle of attack
+//! the exact geometry with the air direction `course - yaw` from the nose.
 
 use aloft_logs::{Log, Sample};
 use aloft_power::{

@@ -171,7 +171,7 @@ fn data_val_kaist_calibrated_rmse_below_the_best_constant() {
 /// would make it; a 120 s window cannot estimate the rest of the flight better than that. The
 /// target is kept as stated and this test is ignored, not loosened: run it with `--ignored`.
 #[test]
-#[ignore = "target missed on 2 of 5 flights (-2.10 %, +2.19 %): unmeasured wind, see the doc comment and README"]
+#[ignore = "target missed on 2 of 5 flights (-2.10 %, +2.19 %): unmeasured wind, see the doc comment and docs/validation.md"]
 fn data_val_kaist_calibrated_energy_within_2_percent() {
     let v = kaist_validation();
     for f in v["flights"].as_array().unwrap() {
@@ -181,7 +181,7 @@ fn data_val_kaist_calibrated_energy_within_2_percent() {
 }
 
 /// PX4 quadrotor (5 flights of 42-76 s with take-off, climb and landing): fit across all flights
-/// and validate on each. No target in the issue; the figures are reported (README). The check here
+/// and validate on each. No target in the issue; the figures are reported (docs/validation.md). The check here
 /// is only that the pipeline runs end to end on the joined per-topic tables and that ground time
 /// is recognised.
 #[test]

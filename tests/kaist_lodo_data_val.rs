@@ -246,7 +246,7 @@ fn data_val_kaist_lodo_recalibration_no_worse_than_none_on_average() {
 /// drag enter the validated power with the logged attitude. Kept as stated; run with
 /// `--ignored`.
 #[test]
-#[ignore = "missed on 9 of 11 held-out flights (worst +4.71 %): a day-level offset, see the doc comment and README"]
+#[ignore = "missed on 9 of 11 held-out flights (worst +4.71 %): a day-level offset, see the doc comment and docs/validation.md"]
 fn data_val_kaist_lodo_energy_within_3_percent_uncalibrated() {
     for j in lodo() {
         assert!(j.uncalibrated_percent.abs() <= 3.0, "{j:?}");
@@ -258,7 +258,7 @@ fn data_val_kaist_lodo_energy_within_3_percent_uncalibrated() {
 /// predicted power ratio wanders by about 2 % between stretches of one flight, which two
 /// minutes cannot foresee. Kept as stated; run with `--ignored`.
 #[test]
-#[ignore = "missed on 4 of 11 held-out flights (worst +2.89 %): see the doc comment and README"]
+#[ignore = "missed on 4 of 11 held-out flights (worst +2.89 %): see the doc comment and docs/validation.md"]
 fn data_val_kaist_lodo_energy_within_2_percent_calibrated() {
     for j in lodo() {
         assert!(j.calibrated_percent.abs() <= 2.0, "{j:?}");

@@ -22,7 +22,7 @@ pub struct VehiclesArgs {
 #[derive(Debug, Subcommand)]
 enum VehiclesAction {
     /// Make a vehicle file from a spec sheet: rotors, masses, battery and one published hover time
-    /// (the efficiency is calibrated on it; see the README's "A vehicle from its spec sheet").
+    /// (the efficiency is calibrated on it; see "A vehicle from its spec sheet" in docs/guide.md).
     Calibrate(CalibrateArgs),
 }
 

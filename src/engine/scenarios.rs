@@ -28,9 +28,9 @@
 //! model it is exactly the efficiency `eta / s` for every term (see
 //! `aloft_power::Vehicle::with_power_scale`); for a propulsion chain, the summed supply and climb
 //! power is scaled. Its default, 3 %, is aloft's own validation: whole-flight energy errors of
-//! +2.1 to +4.7 % on the five KAIST validation flights (`aloft validate`, README "Real flights"),
-//! +1.2 to +3.7 % when those flights are replayed from their trajectories, and the M100 hover
-//! table's -2.6 to +2.2 % (README "Published figures").
+//! +2.1 to +4.7 % on the five KAIST validation flights (`aloft validate`, docs/validation.md
+//! "Real flights"), +1.2 to +3.7 % when those flights are replayed from their trajectories, and
+//! the M100 hover table's -2.6 to +2.2 % (docs/validation.md "Published figures").
 //!
 //! # Reproducible
 //! Scenario `i` draws from its own counter-based stream (splitmix64 of the seed and `i`), so its
@@ -263,7 +263,7 @@ impl ScenarioOptions {
 }
 
 /// The answer of [`plan_scenarios`]: the `uncertainty` object of `aloft mission --samples N
-/// --format json` (keys in the README).
+/// --format json` (keys in docs/guide.md).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Uncertainty {
     /// Scenarios drawn.

@@ -67,7 +67,7 @@ pub struct PointOfNoReturnSummary {
 
 /// The summary of a planned mission: its JSON is exactly that of `aloft mission --format json`
 /// (same keys in the same order, same values; absent values omitted). The keys are documented in
-/// the README's JSON section.
+/// `aloft mission`'s JSON keys in docs/guide.md.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MissionSummary {
     /// Mission name (the file's `name`, else its origin).

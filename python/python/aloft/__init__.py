@@ -142,7 +142,7 @@ def calibrate_vehicle(spec: PathLike, output: PathLike) -> Dict[str, Any]:
 
     Args:
         spec: The spec sheet (TOML: ``name``, ``rotors``, ``rotor_diameter_m``,
-            ``frame_mass_kg``, ``[battery]``, ``[published_hover]``; see the README).
+            ``frame_mass_kg``, ``[battery]``, ``[published_hover]``; see docs/guide.md).
         output: Where to write the vehicle file; every function accepts it as ``vehicle=``.
 
     Returns:
