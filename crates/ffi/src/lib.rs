@@ -666,6 +666,26 @@ pub unsafe extern "C" fn aloft_plan_json(
     })
 }
 
+/// One value of a plan into `*out`: the plan checked against the registry, `out` checked for
+/// NULL.
+///
+/// # Safety
+/// `plan` is NULL or a pointer (checked); `out` is NULL or a writable `T`.
+unsafe fn plan_value<T>(
+    plan: *const AloftPlan,
+    out: *mut T,
+    out_name: &'static str,
+    value: impl FnOnce(&Plan) -> T,
+) -> AloftStatus {
+    guard(|| {
+        // SAFETY: checked against the registry; `out` checked for NULL.
+        let p = unsafe { self::plan(plan, "plan")? };
+        let out = unsafe { out_value(out, out_name)? };
+        *out = value(p);
+        Ok(())
+    })
+}
+
 /// Electrical energy of the planned mission, Wh (the summary's `energy_wh`), into `*out_wh`.
 ///
 /// # Safety
@@ -675,13 +695,8 @@ pub unsafe extern "C" fn aloft_plan_energy_wh(
     plan: *const AloftPlan,
     out_wh: *mut f64,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: checked against the registry.
-        let p = unsafe { self::plan(plan, "plan")? };
-        let out_wh = unsafe { out_value(out_wh, "out_wh")? };
-        *out_wh = p.energy_wh();
-        Ok(())
-    })
+    // SAFETY: the caller's contract; both pointers are checked.
+    unsafe { plan_value(plan, out_wh, "out_wh", |p| p.energy_wh()) }
 }
 
 /// Whether the planned mission is feasible (lands with the reserve): 1 or 0 into `*out_feasible`.
@@ -693,13 +708,12 @@ pub unsafe extern "C" fn aloft_plan_feasible(
     plan: *const AloftPlan,
     out_feasible: *mut c_int,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: checked against the registry.
-        let p = unsafe { self::plan(plan, "plan")? };
-        let out_feasible = unsafe { out_value(out_feasible, "out_feasible")? };
-        *out_feasible = c_int::from(p.summary().feasible);
-        Ok(())
-    })
+    // SAFETY: the caller's contract; both pointers are checked.
+    unsafe {
+        plan_value(plan, out_feasible, "out_feasible", |p| {
+            c_int::from(p.summary().feasible)
+        })
+    }
 }
 
 /// Release a plan. NULL is a no-op; a pointer that is not a live plan returns
