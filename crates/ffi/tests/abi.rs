@@ -209,16 +209,23 @@ fn endurance_json_has_the_cli_keys() {
     unsafe { aloft_vehicle_free(v) };
 }
 
+/// Each case (what, the status a call returned, the status wanted) failed as wanted, with a
+/// message. The message is read after all the calls were made: it is the last one's.
+fn assert_failures(cases: Vec<(&str, AloftStatus, AloftStatus)>) {
+    for (what, got, want) in cases {
+        let msg = last_error();
+        assert_eq!(got, want, "{what}: {msg}");
+        assert!(!msg.is_empty(), "{what}: no message");
+    }
+}
+
 #[test]
-fn bad_input_is_an_error_code_and_a_message_never_a_crash() {
-    let v = m100();
-    let mut plan = null_mut();
+fn null_pointers_are_an_error_code_and_a_message_never_a_crash() {
     let mut out = null_mut();
-    let bad_utf8 = [b'{', 0xc3, 0x28, 0];
-    // SAFETY: every pointer is NULL, a NUL-terminated string, a live handle or a writable out;
-    // the deliberately wrong ones are checked by the library before use.
+    // SAFETY: every pointer is NULL, a NUL-terminated string or a writable out; the NULL ones are
+    // checked by the library before use.
     unsafe {
-        let cases: Vec<(&str, AloftStatus, AloftStatus)> = vec![
+        assert_failures(vec![
             (
                 "NULL name",
                 aloft_vehicle_builtin(std::ptr::null(), &mut null_mut()),
@@ -230,6 +237,26 @@ fn bad_input_is_an_error_code_and_a_message_never_a_crash() {
                 AloftStatus::NullPointer,
             ),
             (
+                "NULL plan",
+                aloft_plan_json(std::ptr::null(), &mut out),
+                AloftStatus::NullPointer,
+            ),
+        ]);
+    }
+    assert!(out.is_null(), "out pointers are NULL after a failure");
+}
+
+#[test]
+fn invalid_utf8_is_an_error_code_and_a_message_never_a_crash() {
+    let v = m100();
+    let mut plan = null_mut();
+    let mut out = null_mut();
+    let bad_utf8 = [b'{', 0xc3, 0x28, 0];
+    // SAFETY: every pointer is NULL, a NUL-terminated string, a live handle or a writable out;
+    // the invalid UTF-8 is checked by the library before use.
+    unsafe {
+        assert_failures(vec![
+            (
                 "invalid UTF-8 mission",
                 aloft_mission_plan(v, bad_utf8.as_ptr().cast(), std::ptr::null(), &mut plan),
                 AloftStatus::InvalidUtf8,
@@ -239,6 +266,22 @@ fn bad_input_is_an_error_code_and_a_message_never_a_crash() {
                 aloft_mission_json(v, std::ptr::null(), bad_utf8.as_ptr().cast(), &mut out),
                 AloftStatus::InvalidUtf8,
             ),
+        ]);
+        assert!(
+            plan.is_null() && out.is_null(),
+            "out pointers are NULL after a failure"
+        );
+        assert_eq!(aloft_vehicle_free(v), AloftStatus::Ok);
+    }
+}
+
+#[test]
+fn bad_missions_and_options_are_an_error_code_and_a_message_never_a_crash() {
+    let v = m100();
+    let mut out = null_mut();
+    // SAFETY: every pointer is NULL, a NUL-terminated string, a live handle or a writable out.
+    unsafe {
+        assert_failures(vec![
             (
                 "malformed JSON mission",
                 aloft_mission_json(
@@ -300,11 +343,20 @@ fn bad_input_is_an_error_code_and_a_message_never_a_crash() {
                 ),
                 AloftStatus::Parse,
             ),
-            (
-                "NULL plan",
-                aloft_plan_json(std::ptr::null(), &mut out),
-                AloftStatus::NullPointer,
-            ),
+        ]);
+        assert!(out.is_null(), "out pointers are NULL after a failure");
+        assert_eq!(aloft_vehicle_free(v), AloftStatus::Ok);
+    }
+}
+
+#[test]
+fn wrong_handles_are_an_error_code_and_a_message_and_a_success_clears_it() {
+    let v = m100();
+    let mut out = null_mut();
+    // SAFETY: every pointer is a live handle, a string aloft did not make or a writable out; the
+    // wrong ones are checked by the library before use.
+    unsafe {
+        assert_failures(vec![
             (
                 "vehicle passed as a plan",
                 aloft_plan_json(v.cast(), &mut out),
@@ -315,16 +367,8 @@ fn bad_input_is_an_error_code_and_a_message_never_a_crash() {
                 aloft_string_free(CString::new("mine").unwrap().into_raw()),
                 AloftStatus::BadHandle,
             ),
-        ];
-        for (what, got, want) in cases {
-            let msg = last_error();
-            assert_eq!(got, want, "{what}: {msg}");
-            assert!(!msg.is_empty(), "{what}: no message");
-        }
-        assert!(
-            plan.is_null() && out.is_null(),
-            "out pointers are NULL after a failure"
-        );
+        ]);
+        assert!(out.is_null(), "out pointers are NULL after a failure");
         assert_eq!(aloft_vehicle_free(v), AloftStatus::Ok);
         assert_eq!(last_error(), "", "a success clears the message");
         assert_eq!(aloft_vehicle_free(v), AloftStatus::BadHandle);

@@ -32,6 +32,7 @@
 
 pub mod alloc;
 pub mod check;
+pub mod inputs;
 pub mod log_fields;
 pub mod mutate;
 pub mod rng;

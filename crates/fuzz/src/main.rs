@@ -148,7 +148,7 @@ fn write_seeds(targets: &[&Target], dir: &std::path::Path) -> ExitCode {
             }
         }
     }
-    aloft_fuzz::targets::remove_scratch();
+    aloft_fuzz::inputs::remove_scratch();
     ExitCode::SUCCESS
 }
 

@@ -12,9 +12,10 @@ use serde_json::Value;
 
 use crate::alloc;
 use crate::check::{problems, Answer, Outcome, Problem};
+use crate::inputs::remove_scratch;
 use crate::mutate::Mutator;
 use crate::rng::{fnv1a, Rng};
-use crate::targets::{remove_scratch, Target};
+use crate::targets::Target;
 
 /// The limits of one input.
 #[derive(Debug, Clone, PartialEq)]

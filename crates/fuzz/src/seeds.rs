@@ -16,7 +16,7 @@ use aloft_logs::cdr::CdrWriter;
 use aloft_logs::synth;
 use serde_json::{json, Value};
 
-use crate::targets::{scratch, MAP_SEPARATOR, TABLE_SEPARATOR};
+use crate::inputs::{scratch, MAP_SEPARATOR, TABLE_SEPARATOR};
 
 /// The repository's root (fixtures are read from it).
 pub fn repo_root() -> PathBuf {
@@ -508,7 +508,7 @@ mod tests {
         assert_eq!(px4_csv().len(), 2);
         // truncated.mcap, two converted logs and their two re-encodings, ROS 2, mission.
         assert_eq!(mcap().len(), 1 + 2 * 3 + 1 + 1);
-        crate::targets::remove_scratch();
+        crate::inputs::remove_scratch();
         // Made in code, and the shared files when the folder is there.
         let shared = usize::from(data_dir().is_some());
         assert!(qgc_plan_files().len() >= 2 + 6 * shared);

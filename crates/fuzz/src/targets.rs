@@ -4,7 +4,6 @@
 //! A new parser joins by one more [`Target`] in [`TARGETS`]: a name, its format, a function that
 //! gives its seeds and a function that runs one input and returns the [`Outcome`].
 
-use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -17,6 +16,7 @@ use aloft::power::{ModelOptions, PowerModel};
 use aloft_planner::Aircraft;
 
 use crate::check::{Outcome, Problem};
+use crate::inputs::{scratch, MAP_SEPARATOR, TABLE_SEPARATOR};
 use crate::mutate::Format;
 use crate::rng::fnv1a;
 use crate::seeds;
@@ -144,53 +144,13 @@ pub fn target(name: &str) -> Option<&'static Target> {
     TARGETS.iter().find(|t| t.name == name)
 }
 
-/// The line between the column map and the CSV log in an input of the `column-map` target.
-pub const MAP_SEPARATOR: &[u8] = b"\n#--- csv ---\n";
-
 /// The lag search window of `log info --max-lag` on every 4th log input, s (the seeds are 0.5
 /// to 2 s long, and a search needs a log of twice its window).
 pub const LAG_WINDOW_S: f64 = 0.2;
 
-/// The line between the tables of an input of the `px4-csv` target.
-pub const TABLE_SEPARATOR: &[u8] = b"\n#--- table ---\n";
-
 /// Most steps one fuzzed flight is planned with: a longer mission is planned with a coarser time
 /// step (duration / this), so that one input stays fast.
 pub const MAX_PLAN_STEPS: f64 = 2_000.0;
-
-thread_local! {
-    static SCRATCH: RefCell<Option<PathBuf>> = const { RefCell::new(None) };
-}
-
-/// A file in this thread's scratch directory (on tmpfs, `/dev/shm`, when there is one): the
-/// engine's log readers take paths, so an input is written there and read back.
-pub fn scratch(name: &str) -> PathBuf {
-    SCRATCH.with(|s| {
-        let mut s = s.borrow_mut();
-        let dir = s.get_or_insert_with(|| {
-            static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-            let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let base = if Path::new("/dev/shm").is_dir() {
-                PathBuf::from("/dev/shm")
-            } else {
-                std::env::temp_dir()
-            };
-            let dir = base.join(format!("aloft-fuzz-{}-{n}", std::process::id()));
-            let _ = std::fs::create_dir_all(&dir);
-            dir
-        });
-        dir.join(name)
-    })
-}
-
-/// Remove this thread's scratch directory.
-pub fn remove_scratch() {
-    SCRATCH.with(|s| {
-        if let Some(dir) = s.borrow_mut().take() {
-            let _ = std::fs::remove_dir_all(dir);
-        }
-    });
-}
 
 fn write_scratch(name: &str, data: &[u8]) -> PathBuf {
     let path = scratch(name);

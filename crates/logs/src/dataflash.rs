@@ -39,7 +39,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::binary::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
+use crate::binary_samples::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
 use crate::bytes::ByteWindow;
 use crate::csv_read::wrap_pi;
 use crate::error::{LogError, Result};
@@ -487,7 +487,8 @@ impl DataflashDecoder {
                 let name = f.text(p, "Name")?;
                 let v = f.num(p, "Value")?;
                 if name == "BATT_CAPACITY" {
-                    s.battery_capacity_ah = crate::binary::capacity_ah(v).or(s.battery_capacity_ah);
+                    s.battery_capacity_ah =
+                        crate::binary_samples::capacity_ah(v).or(s.battery_capacity_ah);
                 }
             }
             Role::Event | Role::Arm => return self.landed(r, f, p),

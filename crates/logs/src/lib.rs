@@ -37,6 +37,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod binary;
+mod binary_samples;
 pub mod bytes;
 pub mod cdr;
 pub mod column_map;

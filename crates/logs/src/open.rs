@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::binary::{BinaryOptions, BinarySamples, BinarySummary};
+use crate::binary_samples::{BinaryOptions, BinarySamples, BinarySummary};
 use crate::column_map::ColumnMap;
 use crate::csv_read::CsvSamples;
 use crate::dataflash::{dataflash_samples, is_dataflash, DataflashDecoder};

@@ -31,7 +31,7 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use crate::binary::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
+use crate::binary_samples::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
 use crate::bytes::{le, ByteWindow};
 use crate::error::{LogError, Result};
 use crate::frame::{attitude_from_ned_frd_quat, ned_to_enu};
@@ -505,8 +505,8 @@ impl UlogDecoder {
             Some("BAT_N_CELLS") if v >= 1.0 && s.battery_cells.is_none() => {
                 s.battery_cells = Some(v as u32)
             }
-            Some("BAT1_CAPACITY") if crate::binary::capacity_ah(v).is_some() => {
-                s.battery_capacity_ah = crate::binary::capacity_ah(v);
+            Some("BAT1_CAPACITY") if crate::binary_samples::capacity_ah(v).is_some() => {
+                s.battery_capacity_ah = crate::binary_samples::capacity_ah(v);
             }
             _ => {}
         }

@@ -34,10 +34,11 @@
 use aloft_planner::{OrbitDirection, SegmentSpec};
 
 use crate::commands::{self, role, CommandName, Role};
-use crate::error::{ImportError, Place};
+use crate::error::ImportError;
 use crate::geo::{distance_m, LatLon};
 use crate::jumps::{flying_order, JumpsBy};
 use crate::notes::Notes;
+use crate::raw_item::RawItem;
 use crate::ItemCounts;
 
 /// Lowest height a position item is flown at, m: a height at or below the ground (a waypoint at
@@ -50,23 +51,6 @@ const LAND_SLOW_HEIGHT_M: f64 = 10.0;
 
 /// ArduPilot's default circle rate (`CIRCLE_RATE`), rad/s.
 const CIRCLE_RATE_RADPS: f64 = 20.0 * std::f64::consts::PI / 180.0;
-
-/// One mission item as both formats store it.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct RawItem {
-    /// Where it is, for messages (an item of a `.plan`, a row of a `.waypoints` file).
-    pub(crate) at: Place,
-    /// The operator's item number (MAVLink sequence number; a `.waypoints` INDEX).
-    pub(crate) number: u32,
-    /// MAV_CMD.
-    pub(crate) command: u32,
-    /// MAV_FRAME.
-    pub(crate) frame: u32,
-    /// p1-p4, latitude, longitude, altitude; NaN when not set.
-    pub(crate) params: [f64; 7],
-    /// A `.plan`'s `doJumpId`.
-    pub(crate) jump_id: Option<i64>,
-}
 
 /// The autopilot a file was planned for, where their semantics differ.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,8 +12,8 @@
 
 use crate::commands::DO_JUMP;
 use crate::error::ImportError;
-use crate::items::RawItem;
 use crate::notes::Notes;
+use crate::raw_item::RawItem;
 
 /// Most items the route may pass with its jumps unrolled: 20,000 (a survey of a 500 KB `.plan`
 /// has about 2,000); each becomes up to three segments, within the planner's 50,000.

@@ -11,6 +11,7 @@
 //! - `plan.rs`: [`read_plan`], the `.plan` reader (JSON; `fileType` "Plan", mission version 2,
 //!   SimpleItems in the V1, V2 and V3 item layouts, surveys and corridor scans flattened);
 //! - `wpl.rs`: [`read_waypoints`], the `.waypoints` reader (12 tab-separated fields, home row);
+//! - `raw_item.rs`: a mission item as both readers hand it on;
 //! - `items.rs`: the MAVLink command semantics both readers share (its docs hold the table of
 //!   what aloft flies for each command), `jumps.rs` the DO_JUMP unrolling;
 //! - `route.rs`: [`route_figures`], the planned horizontal path, climb, descent and holds of a
@@ -51,6 +52,7 @@ mod items;
 mod jumps;
 mod notes;
 mod plan;
+mod raw_item;
 mod route;
 mod wpl;
 

@@ -25,9 +25,10 @@ use serde_json::{Map, Value};
 
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
-use crate::items::{translate, Autopilot, RawItem, Source};
+use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
 use crate::notes::Notes;
+use crate::raw_item::RawItem;
 use crate::{assemble, Imported, SourceFormat};
 
 /// QGroundControl's default multirotor planning speed (`hoverSpeed`), m/s, for a file without one.

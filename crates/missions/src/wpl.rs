@@ -15,9 +15,10 @@
 
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
-use crate::items::{translate, Autopilot, RawItem, Source};
+use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
 use crate::notes::Notes;
+use crate::raw_item::RawItem;
 use crate::{assemble, Imported, SourceFormat};
 
 /// ArduPilot's default waypoint speed (`WPNAV_SPEED`, 1000 cm/s), m/s: the planning speed of a

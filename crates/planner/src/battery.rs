@@ -36,12 +36,13 @@
 //! [`Pack::draw`] is the plain model. A mission draws from the pack through a [`PackCursor`]
 //! ([`crate::pack_cursor`]), which gives the same draws bit for bit with a shorter chain from one
 //! step to the next, and solves a block of steps at once.
+//!
+//! [`PackCursor`]: crate::pack_cursor::PackCursor
 
 use aloft_propulsion::OcvCurve;
 
 use crate::error::PlannerError;
 
-pub use crate::pack_cursor::{PackCursor, PackStep};
 pub use aloft_propulsion::BatterySpec;
 
 /// Points of the uniform open-circuit table (0.5 % of state of charge apart).
@@ -106,13 +107,6 @@ impl Pack {
             current_a,
             terminal_v: v_oc - current_a * self.resistance_ohm,
         })
-    }
-
-    /// A cursor that follows the state of charge from `soc` through a discharge, giving the same
-    /// draws as [`Self::draw`] bit for bit with a shorter chain from one step to the next (the
-    /// table interval is kept between steps instead of being found again).
-    pub fn cursor(&self, soc: f64) -> PackCursor {
-        PackCursor::new(soc)
     }
 
     /// Energy the pack can deliver from `from_soc` down to `to_soc` with no resistive loss

@@ -42,6 +42,15 @@ pub struct PackCursor {
     x_hi: f64,
 }
 
+impl Pack {
+    /// A cursor that follows the state of charge from `soc` through a discharge, giving the same
+    /// draws as [`Self::draw`] bit for bit with a shorter chain from one step to the next (the
+    /// table interval is kept between steps instead of being found again).
+    pub fn cursor(&self, soc: f64) -> PackCursor {
+        PackCursor::new(soc)
+    }
+}
+
 impl PackCursor {
     /// A cursor at `soc`, located in its table interval ([`Pack::cursor`]).
     pub(crate) fn new(soc: f64) -> Self {

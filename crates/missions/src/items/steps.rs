@@ -4,11 +4,12 @@
 use aloft_planner::mission::MAX_SEGMENTS;
 use aloft_planner::SegmentSpec;
 
-use super::{Autopilot, Flight, RawItem, Target, Translation, LAND_SLOW_HEIGHT_M, MIN_HEIGHT_M};
+use super::{Autopilot, Flight, Target, Translation, LAND_SLOW_HEIGHT_M, MIN_HEIGHT_M};
 use crate::commands::{role, CommandName, Role};
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 use crate::notes::places_text;
+use crate::raw_item::RawItem;
 use crate::ItemCounts;
 
 /// MAV_FRAME values with a position: 0 GLOBAL and 5 GLOBAL_INT (AMSL), 3 GLOBAL_RELATIVE_ALT

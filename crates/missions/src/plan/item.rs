@@ -5,8 +5,8 @@ use serde_json::{Map, Value};
 
 use super::SIMPLE_KEYS;
 use crate::error::{ImportError, Place};
-use crate::items::RawItem;
 use crate::notes::Notes;
+use crate::raw_item::RawItem;
 
 /// The SimpleItem `obj`, numbered `number`.
 pub(super) fn simple_item(

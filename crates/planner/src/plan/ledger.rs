@@ -8,9 +8,9 @@
 //! ([`Ledger::report`]): the reserve left, the shortfall if any, and the [`MissionReport`].
 
 use crate::aircraft::Powered;
-use crate::battery::PackStep;
 use crate::error::PlannerError;
 use crate::mission::Mission;
+use crate::pack_cursor::PackStep;
 use crate::trajectory::Piece;
 use crate::trim::attitude_rad;
 

@@ -96,10 +96,11 @@ mod test_mission;
 use std::ops::ControlFlow;
 
 use crate::aircraft::{Aircraft, Powered};
-use crate::battery::{Pack, PackCursor, PackStep};
+use crate::battery::Pack;
 use crate::envelope::Envelope;
 use crate::error::PlannerError;
 use crate::mission::Mission;
+use crate::pack_cursor::{PackCursor, PackStep};
 use crate::trajectory::Piece;
 use crate::wind::Wind;
 
