@@ -11,7 +11,8 @@ use aloft::engine::{plan_mission_with, Mission, MissionReport, Plan, Sample, Veh
 
 use super::mission_args::MissionArgs;
 use super::mission_view::{
-    header, mmss, plan_warnings, plot_track, summary_rows, write_model_line, write_sorties, Area,
+    header, plan_warnings, plot_track, segment_cells, summary_rows, write_model_line,
+    write_segments_head, write_sorties, Area,
 };
 use super::output;
 use super::{Format, Outcome};
@@ -79,44 +80,28 @@ fn write_table(out: &mut impl Write, plan: &Plan) -> Result<()> {
 
 /// The segments; with the operator's item numbers when the mission came from a planner file.
 fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
-    let items = r.segments.iter().any(|s| s.item.is_some());
     // A column of the time lost at the edge of the envelope, when the wind or a limit slowed
     // any segment.
     let slowed = r.segments.iter().any(|s| s.edge.is_some());
-    writeln!(out, "Segments")?;
-    writeln!(
+    write_segments_head(
         out,
-        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>11}{}",
-        "#",
-        if items { "item " } else { "" },
-        "kind",
-        "time",
-        "distance",
-        "energy",
-        "mean power",
-        "peak power",
-        "battery end",
-        if slowed { "   time lost (limit)" } else { "" }
+        r,
+        format_args!(
+            " {:>11} {:>11}{}",
+            "peak power",
+            "battery end",
+            if slowed { "   time lost (limit)" } else { "" }
+        ),
     )?;
     for s in &r.segments {
-        let item = match (items, s.item) {
-            (false, _) => String::new(),
-            (true, Some(i)) => format!("{i:>4} "),
-            (true, None) => "     ".to_string(),
-        };
         let lost = match s.edge {
             Some(e) => format!("  {:>8.1} s ({})", s.time_lost_s, e.limit.name()),
             _ => String::new(),
         };
         writeln!(
             out,
-            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.0} W {:>9.1} %{lost}",
-            s.index,
-            s.kind,
-            mmss(s.duration_s),
-            s.distance_m,
-            s.energy_wh,
-            s.mean_power_w,
+            "{} {:>9.0} W {:>9.1} %{lost}",
+            segment_cells(r, s),
             s.peak_power_w,
             s.end_soc * 100.0
         )?;

@@ -7,7 +7,9 @@ use std::io::Write;
 
 use anyhow::Result;
 
-use aloft::engine::{AoaModel, MissionReport, Plan, RouteFigures, Sample, Shortfall, SourceFormat};
+use aloft::engine::{
+    AoaModel, MissionReport, Plan, RouteFigures, Sample, SegmentReport, Shortfall, SourceFormat,
+};
 
 use super::output::Row;
 
@@ -306,4 +308,49 @@ pub(super) fn plot_track(
         .border_style(BLACK)
         .draw()?;
     Ok(())
+}
+
+/// The first columns of a segment table's head (number, item when the mission came from a
+/// planner file, kind, time, distance, energy, mean power), after the title line.
+pub(super) fn write_segments_head(
+    out: &mut impl Write,
+    r: &MissionReport,
+    rest: std::fmt::Arguments<'_>,
+) -> Result<()> {
+    writeln!(out, "Segments")?;
+    writeln!(
+        out,
+        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11}{rest}",
+        "#",
+        if has_items(r) { "item " } else { "" },
+        "kind",
+        "time",
+        "distance",
+        "energy",
+        "mean power",
+    )?;
+    Ok(())
+}
+
+/// Whether the segments carry the operator's item numbers.
+fn has_items(r: &MissionReport) -> bool {
+    r.segments.iter().any(|s| s.item.is_some())
+}
+
+/// The first cells of a segment's row, as [`write_segments_head`] names them.
+pub(super) fn segment_cells(r: &MissionReport, s: &SegmentReport) -> String {
+    let item = match (has_items(r), s.item) {
+        (false, _) => String::new(),
+        (true, Some(i)) => format!("{i:>4} "),
+        (true, None) => "     ".to_string(),
+    };
+    format!(
+        "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W",
+        s.index,
+        s.kind,
+        mmss(s.duration_s),
+        s.distance_m,
+        s.energy_wh,
+        s.mean_power_w,
+    )
 }

@@ -180,39 +180,18 @@ fn band_rows(u: &Uncertainty) -> Vec<Row<'static>> {
 /// The segments with the 5th and 95th percentiles of the battery at each segment's end.
 fn write_segments(out: &mut impl Write, plan: &Plan, u: &Uncertainty) -> Result<()> {
     let r = plan.report();
-    let items = r.segments.iter().any(|s| s.item.is_some());
-    writeln!(out, "Segments")?;
-    writeln!(
+    mission_view::write_segments_head(
         out,
-        "  {:>2}  {}{:<9} {:>8} {:>9} {:>9} {:>11} {:>11} {:>9} {:>9}",
-        "#",
-        if items { "item " } else { "" },
-        "kind",
-        "time",
-        "distance",
-        "energy",
-        "mean power",
-        "battery end",
-        "p5 end",
-        "p95 end"
+        r,
+        format_args!(" {:>11} {:>9} {:>9}", "battery end", "p5 end", "p95 end"),
     )?;
     for s in &r.segments {
-        let item = match (items, s.item) {
-            (false, _) => String::new(),
-            (true, Some(i)) => format!("{i:>4} "),
-            (true, None) => "     ".to_string(),
-        };
         let band = u.segments.iter().find(|b| b.index == s.index);
         let pct = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{:.1} %", x * 100.0));
         writeln!(
             out,
-            "  {:>2}  {item}{:<9} {:>8} {:>7.0} m {:>6.2} Wh {:>9.0} W {:>9.1} % {:>9} {:>9}",
-            s.index,
-            s.kind,
-            mmss(s.duration_s),
-            s.distance_m,
-            s.energy_wh,
-            s.mean_power_w,
+            "{} {:>9.1} % {:>9} {:>9}",
+            mission_view::segment_cells(r, s),
             s.end_soc * 100.0,
             pct(band.map(|b| b.end_soc.p5)),
             pct(band.map(|b| b.end_soc.p95)),

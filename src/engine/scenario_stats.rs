@@ -309,33 +309,8 @@ mod tests {
 
     fn test_sample() -> Sample {
         Sample {
-            time_s: 0.0,
             segment: 1,
-            east_m: 0.0,
-            north_m: 0.0,
-            up_m: 0.0,
-            vel_east_mps: 0.0,
-            vel_north_mps: 0.0,
-            vel_up_mps: 0.0,
-            acc_east_mps2: 0.0,
-            acc_north_mps2: 0.0,
-            acc_up_mps2: 0.0,
-            wind_east_mps: 0.0,
-            wind_north_mps: 0.0,
-            airspeed_mps: 0.0,
-            thrust_n: 0.0,
-            roll_deg: 0.0,
-            pitch_deg: 0.0,
-            yaw_deg: 0.0,
-            power_w: 0.0,
-            current_a: 0.0,
-            voltage_v: 0.0,
-            soc: 0.0,
-            induced_w: None,
-            parasitic_w: None,
-            profile_w: None,
-            acceleration_w: None,
-            climb_w: None,
+            ..Sample::default()
         }
     }
 }

@@ -101,7 +101,7 @@ impl Default for PlanOptions {
 }
 
 /// One sample of the time series (at the midpoint of an integration step).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
 pub struct Sample {
     /// Mission time, s.
     pub time_s: f64,
