@@ -50,45 +50,68 @@ fn spread(max: f64) -> impl TypedValueParser<Value = f64> {
     })
 }
 
+/// One of a few words, each with its help and the engine's value it stands for.
+fn words<T: Clone + Send + Sync + 'static, const N: usize>(
+    choices: [(&'static str, &'static str, T); N],
+) -> impl TypedValueParser<Value = T> {
+    let values: Vec<(&'static str, T)> = choices.iter().map(|(w, _, v)| (*w, v.clone())).collect();
+    PossibleValuesParser::new(choices.map(|(word, help, _)| PossibleValue::new(word).help(help)))
+        .try_map(move |s: String| {
+            values
+                .iter()
+                .find(|(w, _)| *w == s)
+                .map(|(_, v)| v.clone())
+                .ok_or("not one of the words")
+        })
+}
+
 /// `geometric|paper`, parsed into the engine's [`AoaModel`].
 pub fn aoa_parser() -> impl TypedValueParser<Value = AoaModel> {
-    PossibleValuesParser::new([
-        PossibleValue::new("geometric")
-            .help("Exact angle between the air-relative velocity and the rotor plane"),
-        PossibleValue::new("paper").help("The power seed's eqs (3)-(4) from roll and pitch"),
+    words([
+        (
+            "geometric",
+            "Exact angle between the air-relative velocity and the rotor plane",
+            AoaModel::Geometric,
+        ),
+        (
+            "paper",
+            "The power seed's eqs (3)-(4) from roll and pitch",
+            AoaModel::Paper,
+        ),
     ])
-    .map(|s| match s.as_str() {
-        "paper" => AoaModel::Paper,
-        _ => AoaModel::Geometric,
-    })
 }
 
 /// `pass|stop`, parsed into the engine's [`CornerMode`].
 fn corners_parser() -> impl TypedValueParser<Value = CornerMode> {
-    PossibleValuesParser::new([
-        PossibleValue::new("pass").help(
+    words([
+        (
+            "pass",
             "Through waypoints without a hold at the speed the turn allows (as autopilots fly)",
+            CornerMode::Pass,
         ),
-        PossibleValue::new("stop").help("Stop at every waypoint, yaw, go on"),
+        (
+            "stop",
+            "Stop at every waypoint, yaw, go on",
+            CornerMode::Stop,
+        ),
     ])
-    .map(|s| match s.as_str() {
-        "stop" => CornerMode::Stop,
-        _ => CornerMode::Pass,
-    })
 }
 
 /// `uniform|power-law|log`, parsed into the engine's [`WindProfileKind`].
 fn profile_parser() -> impl TypedValueParser<Value = WindProfileKind> {
-    PossibleValuesParser::new([
-        PossibleValue::new("uniform").help("The same speed at every height"),
-        PossibleValue::new("power-law").help("S (z / z_ref)^exponent"),
-        PossibleValue::new("log").help("S ln(z / z0) / ln(z_ref / z0)"),
+    words([
+        (
+            "uniform",
+            "The same speed at every height",
+            WindProfileKind::Uniform,
+        ),
+        (
+            "power-law",
+            "S (z / z_ref)^exponent",
+            WindProfileKind::PowerLaw,
+        ),
+        ("log", "S ln(z / z0) / ln(z_ref / z0)", WindProfileKind::Log),
     ])
-    .map(|s| match s.as_str() {
-        "power-law" => WindProfileKind::PowerLaw,
-        "log" => WindProfileKind::Log,
-        _ => WindProfileKind::Uniform,
-    })
 }
 
 /// `START:STOP:STEP`, parsed and checked by [`PayloadSweep::parse`] (the option is named in the
