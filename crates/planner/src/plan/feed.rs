@@ -143,7 +143,7 @@ mod tests {
     use super::super::test_mission::{m100, SURVEY};
     use super::super::{plan_with, sampler::piece_steps, PlanOptions};
     use super::*;
-    use crate::mission::MissionSpec;
+    use crate::test_support::compile_mission;
     use crate::wind::Wind;
 
     #[test]
@@ -152,10 +152,7 @@ mod tests {
         // thread; the report must be the in-line one exactly, samples included, whether the
         // mission completes, the pack runs out part-way, or pass A meets an error.
         let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(SURVEY, &aircraft, &battery);
         let steps: usize = mission
             .pieces()
             .iter()

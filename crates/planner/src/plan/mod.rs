@@ -604,7 +604,7 @@ mod tests {
     use super::test_mission::{m100, SURVEY};
     use super::*;
     use crate::ground_effect::thrust_factor;
-    use crate::mission::MissionSpec;
+    use crate::test_support::compile_mission;
     use aloft_power::AoaModel;
 
     #[test]
@@ -612,10 +612,7 @@ mod tests {
         // The block path against `Powered::trim` and `Pack::draw` called per sample, over the
         // recorded samples of a survey in wind.
         let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(SURVEY, &aircraft, &battery);
         let wind = Wind::constant(6.0, 250.0).unwrap();
         let opts = PlanOptions {
             time_step_s: 0.05,
@@ -686,10 +683,7 @@ mod tests {
             kind = "landing"
             rate_mps = 1.0
         "#;
-        let mission = MissionSpec::from_toml_str(fast_leg)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(fast_leg, &aircraft, &battery);
         let opts = PlanOptions {
             record_samples: true,
             ..PlanOptions::default()
@@ -736,10 +730,7 @@ mod tests {
         // speed at 5 x 20 / 30 = 3.33 m/s where the plan asks for more.
         let (aircraft, battery) = m100();
         let text = crate::test_support::STEEP_LEG;
-        let mission = MissionSpec::from_toml_str(text)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(text, &aircraft, &battery);
         let opts = PlanOptions {
             record_samples: true,
             ..PlanOptions::default()

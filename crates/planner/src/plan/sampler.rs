@@ -544,16 +544,13 @@ mod tests {
     use super::super::test_mission::{m100, SURVEY};
     use super::super::{plan_with, PlanOptions};
     use super::*;
-    use crate::mission::MissionSpec;
+    use crate::test_support::compile_mission;
     use crate::wind::{Gusts, Profile};
 
     #[test]
     fn hoisting_steady_stretches_matches_the_per_sample_report() {
         let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(SURVEY, &aircraft, &battery);
         let power_law = Profile::PowerLaw {
             reference_height_m: 10.0,
             exponent: 1.0 / 7.0,
@@ -591,10 +588,7 @@ mod tests {
         // model's batch path, and the hoisted trim of steady stretches) against its plain
         // reference, `Powered::trim` of each sample's own inputs: the same bits.
         let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(SURVEY, &aircraft, &battery);
         let powered = [aircraft
             .at_mass(
                 aircraft.airframe().mass_kg() + battery.mass_kg(),
