@@ -178,12 +178,12 @@ pub enum PlannerError {
     },
 }
 
-/// `value` when `ok`, else the [`PlannerError::InvalidParameter`] that names it.
-pub(crate) fn require(
-    ok: bool,
+/// `value` when `ok`, else [`PlannerError::InvalidParameter`] saying what was `expected`.
+pub(crate) fn parameter(
     name: &'static str,
     value: f64,
     unit: &'static str,
+    ok: bool,
     expected: &'static str,
 ) -> Result<f64, PlannerError> {
     if ok {
@@ -205,7 +205,7 @@ pub(crate) fn positive(
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
     let ok = value.is_finite() && value > 0.0;
-    require(ok, name, value, unit, "a positive finite number")
+    parameter(name, value, unit, ok, "a positive finite number")
 }
 
 /// Reject NaN, infinities and negative values.
@@ -215,7 +215,7 @@ pub(crate) fn non_negative(
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
     let ok = value.is_finite() && value >= 0.0;
-    require(ok, name, value, unit, "a finite number, not negative")
+    parameter(name, value, unit, ok, "a finite number, not negative")
 }
 
 /// Check that `value` lies in `[min, max]` (a finite range), naming the range in the error.
@@ -226,13 +226,14 @@ pub(crate) fn within(
     unit: &'static str,
     expected: &'static str,
 ) -> Result<f64, PlannerError> {
-    require((min..=max).contains(&value), name, value, unit, expected)
+    let ok = (min..=max).contains(&value);
+    parameter(name, value, unit, ok, expected)
 }
 
 /// A reserve: a fraction of the capacity in `[0, 1)`.
 pub(crate) fn reserve_fraction(value: f64) -> Result<f64, PlannerError> {
     let ok = (0.0..1.0).contains(&value);
-    require(ok, "reserve_fraction", value, "", "a fraction in [0, 1)")
+    parameter("reserve_fraction", value, "", ok, "a fraction in [0, 1)")
 }
 
 /// `, item 7` after a segment's kind when it came from a planner file, else nothing.

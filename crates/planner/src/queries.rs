@@ -329,7 +329,7 @@ pub fn endurance(
         });
     }
     let ok = q.start_soc > 0.0 && q.start_soc <= 1.0;
-    crate::error::require(ok, "start_soc", q.start_soc, "", "a fraction in (0, 1]")?;
+    crate::error::parameter("start_soc", q.start_soc, "", ok, "a fraction in (0, 1]")?;
     crate::error::reserve_fraction(q.reserve_fraction)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     // The searches stay within the vehicle's speed and its envelope's steady airspeed.
@@ -404,7 +404,7 @@ pub fn sweep_speed(
     crate::error::positive("sweep max_airspeed_mps", max_airspeed_mps, "m/s")?;
     let n = (max_airspeed_mps / step_mps + 1e-9).floor() as usize + 1;
     let expected = "a step giving at most 10 000 rows";
-    crate::error::require(n <= 10_000, "sweep step_mps", step_mps, "m/s", expected)?;
+    crate::error::parameter("sweep step_mps", step_mps, "m/s", n <= 10_000, expected)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     let mut rows = Vec::with_capacity(n);
     for k in 0..n {

@@ -211,10 +211,10 @@ impl Points {
                 (None, None, Some(la), Some(lo)) => {
                     let ok = la.is_finite() && la.abs() < 90.0;
                     let expected = "a latitude within (-90, 90)";
-                    crate::error::require(ok, "home latitude_deg", la, "deg", expected)?;
+                    crate::error::parameter("home latitude_deg", la, "deg", ok, expected)?;
                     let ok = lo.is_finite() && lo.abs() <= 180.0;
                     let expected = "a longitude within [-180, 180]";
-                    crate::error::require(ok, "home longitude_deg", lo, "deg", expected)?;
+                    crate::error::parameter("home longitude_deg", lo, "deg", ok, expected)?;
                     Some((la, lo))
                 }
                 (_, _, None, None) => None,
