@@ -601,7 +601,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::test_mission::{m100, SURVEY};
+    use super::test_mission::{m100, m100_survey};
     use super::*;
     use crate::ground_effect::thrust_factor;
     use crate::test_support::compile_mission;
@@ -611,8 +611,7 @@ mod tests {
     fn block_passes_match_the_sample_by_sample_trim() {
         // The block path against `Powered::trim` and `Pack::draw` called per sample, over the
         // recorded samples of a survey in wind.
-        let (aircraft, battery) = m100();
-        let mission = compile_mission(SURVEY, &aircraft, &battery);
+        let (aircraft, battery, mission) = m100_survey();
         let wind = Wind::constant(6.0, 250.0).unwrap();
         let opts = PlanOptions {
             time_step_s: 0.05,
