@@ -402,7 +402,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                     let start_s = (run.k0 + block.valid) as f64 * run.h;
                     let at = (start_s, block.late_end_s);
                     let soc = self.cursor.soc();
-                    self.ledger.stop_before(run.tally, piece, at, soc, why);
+                    self.ledger.stop_at(run.tally, piece, at, soc, why);
                     return Ok(ControlFlow::Break(()));
                 }
             }
@@ -453,7 +453,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                 let start_s = tm - 0.5 * run.h;
                 let late = block.late_s[j] - 0.5 * (h - run.h);
                 self.ledger
-                    .stop_before(tally, run.piece, (start_s, late), soc, why);
+                    .stop_at(tally, run.piece, (start_s, late), soc, why);
                 return Ok(ControlFlow::Break(()));
             };
             self.ledger.book(&mut tally, p, h, &draw);
@@ -467,7 +467,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                 let end_s = tm + 0.5 * run.h;
                 let late = block.late_s[j] + 0.5 * (h - run.h);
                 self.ledger
-                    .stop_after(tally, run.piece, (end_s, late), draw.soc_after, why);
+                    .stop_at(tally, run.piece, (end_s, late), draw.soc_after, why);
                 return Ok(ControlFlow::Break(()));
             }
             if self.way_home.due(t, pos) {
