@@ -33,30 +33,28 @@ fn shrank(size: usize) {
     LIVE.fetch_sub(size, Relaxed);
 }
 
+/// Count a fresh allocation of `size` bytes that gave `p`: a refused request (null) still counts
+/// as the largest asked for.
+fn allocated(p: *mut u8, size: usize) -> *mut u8 {
+    if p.is_null() {
+        LARGEST.fetch_max(size, Relaxed);
+    } else {
+        grew(size);
+    }
+    p
+}
+
 // SAFETY: every call is forwarded to `System` with the same layout; the counters are atomics
 // and the functions neither allocate nor panic.
 unsafe impl GlobalAlloc for CountingAlloc {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         SEEN.store(true, Relaxed);
-        let p = unsafe { System.alloc(layout) };
-        if p.is_null() {
-            // A refused request still counts as the largest asked for.
-            LARGEST.fetch_max(layout.size(), Relaxed);
-        } else {
-            grew(layout.size());
-        }
-        p
+        allocated(unsafe { System.alloc(layout) }, layout.size())
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
         SEEN.store(true, Relaxed);
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if p.is_null() {
-            LARGEST.fetch_max(layout.size(), Relaxed);
-        } else {
-            grew(layout.size());
-        }
-        p
+        allocated(unsafe { System.alloc_zeroed(layout) }, layout.size())
     }
 
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {

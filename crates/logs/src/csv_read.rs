@@ -913,6 +913,14 @@ mod tests {
         }
     }
 
+    /// `e` is [`LogError::Implausible`] for `channel`.
+    fn assert_implausible(e: &LogError, channel: &str) {
+        assert!(
+            matches!(e, LogError::Implausible { channel: c, .. } if *c == channel),
+            "{e}"
+        );
+    }
+
     #[test]
     fn wrong_units_are_implausible() {
         // Voltage in mV declared as V.
@@ -936,16 +944,7 @@ mod tests {
         );
         // Time in us declared as s.
         let e = read("t,v\n0,12\n100000,12\n", &map).unwrap_err();
-        assert!(
-            matches!(
-                e,
-                LogError::Implausible {
-                    channel: "time",
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        assert_implausible(&e, "time");
         // KAIST power without the 0.1 scale.
         let mut k = ColumnMap::kaist();
         k.power.as_mut().unwrap().scale = 1.0;
@@ -953,16 +952,7 @@ mod tests {
             "{KAIST_HEADER}1000000,0.634769,2.223,89.0,0.1,-0.2,0.5,1.0,2.0,-0.5,0,0,0,0,0,0,12150,48.0,25.0,12000\n"
         );
         let e = read(&text, &k).unwrap_err();
-        assert!(
-            matches!(
-                e,
-                LogError::Implausible {
-                    channel: "power",
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        assert_implausible(&e, "power");
         // Degrees declared as radians.
         let mut m = ColumnMap::new("m", "t", crate::column_map::TimeUnit::S);
         m.attitude = Some(AttitudeColumns::Euler {
@@ -970,16 +960,7 @@ mod tests {
             unit: crate::column_map::AngleUnit::Rad,
         });
         let e = read("t,r,p,y\n0,10,5,90\n", &m).unwrap_err();
-        assert!(
-            matches!(
-                e,
-                LogError::Implausible {
-                    channel: "roll",
-                    ..
-                }
-            ),
-            "{e}"
-        );
+        assert_implausible(&e, "roll");
     }
 
     /// Fuzz findings `fixtures/fuzz/log-csv/*.bin`: a power of 1e308 (with the voltage missing,

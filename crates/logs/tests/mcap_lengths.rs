@@ -127,6 +127,16 @@ fn expect_error(bytes: &[u8], what: &str) -> LogError {
     }
 }
 
+/// [`expect_error`], and that error is a corrupt MCAP whose problem names `field`.
+fn expect_corrupt_field(bytes: &[u8], what: &str, field: &str) {
+    match expect_error(bytes, what) {
+        LogError::McapCorrupt { problem, .. } => {
+            assert!(problem.to_string().contains(field), "{what}: {problem}")
+        }
+        e => panic!("{what}: {e}"),
+    }
+}
+
 // ---- Building MCAP files ----
 
 /// A ROS 2 log: PoseStamped at 100 Hz and BatteryState at 10 Hz, schemas with text, a channel
@@ -448,12 +458,7 @@ fn string_lengths_beyond_their_record_are_errors_naming_the_field() {
                         c = as_zstd(&c, &unchanged);
                     }
                     let what = format!("{name}: {field} at {at} claims {claimed}");
-                    match expect_error(&c, &what) {
-                        LogError::McapCorrupt { problem, .. } => {
-                            assert!(problem.to_string().contains(field), "{what}: {problem}")
-                        }
-                        e => panic!("{what}: {e}"),
-                    }
+                    expect_corrupt_field(&c, &what, field);
                     seen += 1;
                 }
             }
@@ -493,12 +498,7 @@ fn map_entries_beyond_their_map_are_errors() {
             let mut c = b.clone();
             put_u32(&mut c, at, claimed);
             let what = format!("channel at {}: {field} claims {claimed}", r.at);
-            match expect_error(&c, &what) {
-                LogError::McapCorrupt { problem, .. } => {
-                    assert!(problem.to_string().contains(field), "{what}: {problem}")
-                }
-                e => panic!("{what}: {e}"),
-            }
+            expect_corrupt_field(&c, &what, field);
             seen += 1;
         }
     }

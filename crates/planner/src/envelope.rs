@@ -441,9 +441,16 @@ impl Envelope {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::aircraft::Aircraft;
     use crate::test_support::m100_aircraft;
     use aloft_core::STANDARD_GRAVITY_MPS2;
     use aloft_power::AoaModel;
+
+    /// The envelope of `aircraft` and the aircraft at 2.355 kg (the M100 with a TB47D).
+    fn envelope_at_2355(aircraft: &Aircraft) -> (Envelope, Powered<'_>) {
+        let env = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
+        (env, aircraft.at_mass(2.355, AoaModel::Geometric).unwrap())
+    }
 
     /// The airspeed at which the M100's cubic drag tilts the thrust to `tilt_deg` in level
     /// flight, `f_D(v) = m g tan(tilt)` with `f_D = mu1 v + mu2 v^2 + mu3 v^3` (power seed eq 6,
@@ -485,8 +492,7 @@ mod tests {
         // is beyond the tilt limit; the vehicle holds `v_g = A - 10` with A the drag-limited
         // airspeed (no acceleration, no cross wind), so q = (A - 10) / 12.
         let aircraft = m100_aircraft();
-        let env = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
-        let pw = aircraft.at_mass(2.355, AoaModel::Geometric).unwrap();
+        let (env, pw) = envelope_at_2355(&aircraft);
         let a = drag_limited_airspeed(2.355, aircraft.gravity_mps2(), 35.0);
         let (q, limit) = env
             .fastest_fraction(
@@ -523,8 +529,7 @@ mod tests {
     #[test]
     fn a_wind_beyond_the_vehicle_cannot_be_flown_against_or_hovered_in() {
         let aircraft = m100_aircraft();
-        let env = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
-        let pw = aircraft.at_mass(2.355, AoaModel::Geometric).unwrap();
+        let (env, pw) = envelope_at_2355(&aircraft);
         let a = drag_limited_airspeed(2.355, STANDARD_GRAVITY_MPS2, 35.0);
         let wind = [0.0, -(a + 1.0), 0.0];
         assert_eq!(
@@ -546,8 +551,7 @@ mod tests {
     #[test]
     fn a_climb_beyond_the_rate_limit_is_flown_at_the_limit() {
         let aircraft = m100_aircraft();
-        let env = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
-        let pw = aircraft.at_mass(2.355, AoaModel::Geometric).unwrap();
+        let (env, pw) = envelope_at_2355(&aircraft);
         let max = aircraft.airframe().max_climb_rate_mps();
         let (q, limit) = env
             .fastest_fraction(
@@ -607,8 +611,7 @@ mod tests {
     #[test]
     fn the_search_finds_the_edge_the_plain_bisection_finds_with_and_without_a_hint() {
         let aircraft = m100_aircraft();
-        let env = Envelope::of(aircraft.airframe(), aircraft.gravity_mps2());
-        let pw = aircraft.at_mass(2.355, AoaModel::Geometric).unwrap();
+        let (env, pw) = envelope_at_2355(&aircraft);
         // States around a circle and along lines, in winds from every side, with climbs and
         // centripetal accelerations: a deterministic sweep (no random seed to reproduce).
         let mut checked = 0;

@@ -178,22 +178,34 @@ pub enum PlannerError {
     },
 }
 
-/// Reject NaN, infinities and values that are zero or negative.
-pub(crate) fn positive(
+/// `value` when `ok`, else [`PlannerError::InvalidParameter`] saying what was `expected`.
+pub(crate) fn parameter(
     name: &'static str,
     value: f64,
     unit: &'static str,
+    ok: bool,
+    expected: &'static str,
 ) -> Result<f64, PlannerError> {
-    if value.is_finite() && value > 0.0 {
+    if ok {
         Ok(value)
     } else {
         Err(PlannerError::InvalidParameter {
             name,
             value,
             unit,
-            expected: "a positive finite number",
+            expected,
         })
     }
+}
+
+/// Reject NaN, infinities and values that are zero or negative.
+pub(crate) fn positive(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+) -> Result<f64, PlannerError> {
+    let ok = value.is_finite() && value > 0.0;
+    parameter(name, value, unit, ok, "a positive finite number")
 }
 
 /// Reject NaN, infinities and negative values.
@@ -202,16 +214,8 @@ pub(crate) fn non_negative(
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(PlannerError::InvalidParameter {
-            name,
-            value,
-            unit,
-            expected: "a finite number, not negative",
-        })
-    }
+    let ok = value.is_finite() && value >= 0.0;
+    parameter(name, value, unit, ok, "a finite number, not negative")
 }
 
 /// Check that `value` lies in `[min, max]` (a finite range), naming the range in the error.
@@ -222,16 +226,14 @@ pub(crate) fn within(
     unit: &'static str,
     expected: &'static str,
 ) -> Result<f64, PlannerError> {
-    if (min..=max).contains(&value) {
-        Ok(value)
-    } else {
-        Err(PlannerError::InvalidParameter {
-            name,
-            value,
-            unit,
-            expected,
-        })
-    }
+    let ok = (min..=max).contains(&value);
+    parameter(name, value, unit, ok, expected)
+}
+
+/// A reserve: a fraction of the capacity in `[0, 1)`.
+pub(crate) fn reserve_fraction(value: f64) -> Result<f64, PlannerError> {
+    let ok = (0.0..1.0).contains(&value);
+    parameter("reserve_fraction", value, "", ok, "a fraction in [0, 1)")
 }
 
 /// `, item 7` after a segment's kind when it came from a planner file, else nothing.

@@ -121,6 +121,19 @@ impl PackCursor {
         battery.draw_at_ocv(power_w, v_oc)
     }
 
+    /// One step: [`Self::draw`] of `power_w`, then [`Self::discharge`] of
+    /// `current * charge_per_amp`; `None` (nothing taken) when the pack cannot deliver it.
+    #[inline]
+    fn step(&mut self, battery: &Pack, power_w: f64, charge_per_amp: f64) -> Option<PackStep> {
+        let d = self.draw(battery, power_w)?;
+        self.discharge(d.current_a * charge_per_amp);
+        Some(PackStep {
+            current_a: d.current_a,
+            terminal_v: d.terminal_v,
+            soc_after: self.soc,
+        })
+    }
+
     /// Draw `power_w[j]` for each step `j` in turn, taking `current * charge_per_amp` after each:
     /// the same as [`Self::draw`] then [`Self::discharge`] step by step, bit for bit. Writes each
     /// step to `out` (at least as long as `power_w`) and returns how many steps were drawn: all of
@@ -155,15 +168,10 @@ impl PackCursor {
                 &mut out[done..end],
             ) {
                 for j in done..end {
-                    let Some(d) = self.draw(battery, power_w[j]) else {
+                    let Some(step) = self.step(battery, power_w[j], charge_per_amp) else {
                         return j;
                     };
-                    self.discharge(d.current_a * charge_per_amp);
-                    out[j] = PackStep {
-                        current_a: d.current_a,
-                        terminal_v: d.terminal_v,
-                        soc_after: self.soc,
-                    };
+                    out[j] = step;
                 }
             }
             done = end;
@@ -183,15 +191,10 @@ impl PackCursor {
         out: &mut [PackStep],
     ) -> usize {
         for (j, (&p, &dq)) in power_w.iter().zip(charge_per_amp).enumerate() {
-            let Some(d) = self.draw(battery, p) else {
+            let Some(step) = self.step(battery, p, dq) else {
                 return j;
             };
-            self.discharge(d.current_a * dq);
-            out[j] = PackStep {
-                current_a: d.current_a,
-                terminal_v: d.terminal_v,
-                soc_after: self.soc,
-            };
+            out[j] = step;
         }
         power_w.len()
     }

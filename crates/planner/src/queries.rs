@@ -328,22 +328,9 @@ pub fn endurance(
             expected: "a unit vector",
         });
     }
-    if !(q.start_soc > 0.0 && q.start_soc <= 1.0) {
-        return Err(PlannerError::InvalidParameter {
-            name: "start_soc",
-            value: q.start_soc,
-            unit: "",
-            expected: "a fraction in (0, 1]",
-        });
-    }
-    if !(q.reserve_fraction >= 0.0 && q.reserve_fraction < 1.0) {
-        return Err(PlannerError::InvalidParameter {
-            name: "reserve_fraction",
-            value: q.reserve_fraction,
-            unit: "",
-            expected: "a fraction in [0, 1)",
-        });
-    }
+    let ok = q.start_soc > 0.0 && q.start_soc <= 1.0;
+    crate::error::parameter("start_soc", q.start_soc, "", ok, "a fraction in (0, 1]")?;
+    crate::error::reserve_fraction(q.reserve_fraction)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     // The searches stay within the vehicle's speed and its envelope's steady airspeed.
     let envelope = Envelope::of(p.aircraft().airframe(), p.aircraft().gravity_mps2());
@@ -416,14 +403,8 @@ pub fn sweep_speed(
     crate::error::positive("sweep step_mps", step_mps, "m/s")?;
     crate::error::positive("sweep max_airspeed_mps", max_airspeed_mps, "m/s")?;
     let n = (max_airspeed_mps / step_mps + 1e-9).floor() as usize + 1;
-    if n > 10_000 {
-        return Err(PlannerError::InvalidParameter {
-            name: "sweep step_mps",
-            value: step_mps,
-            unit: "m/s",
-            expected: "a step giving at most 10 000 rows",
-        });
-    }
+    let expected = "a step giving at most 10 000 rows";
+    crate::error::parameter("sweep step_mps", step_mps, "m/s", n <= 10_000, expected)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     let mut rows = Vec::with_capacity(n);
     for k in 0..n {

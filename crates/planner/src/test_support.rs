@@ -2,7 +2,8 @@
 
 use crate::aircraft::Aircraft;
 use crate::airframe::{Airframe, AirframeSpec};
-use crate::battery::BatterySpec;
+use crate::battery::{BatterySpec, Pack};
+use crate::mission::{Mission, MissionSpec};
 
 /// The M100 airframe of `fixtures/vehicles/dji-m100.toml` (DJI's specification).
 pub(crate) fn m100_airframe() -> Airframe {
@@ -28,7 +29,13 @@ pub(crate) fn m100_airframe() -> Airframe {
 
 /// The M100 with the power seed's constants and the calibrated efficiency.
 pub(crate) fn m100_aircraft() -> Aircraft {
-    let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
+    let vehicle = aloft_power::Vehicle::new(m100_vehicle_params()).unwrap();
+    Aircraft::four_term(m100_airframe(), vehicle, Default::default())
+}
+
+/// The M100's power-model parameters: the power seed's constants and the calibrated efficiency.
+pub(crate) fn m100_vehicle_params() -> aloft_power::VehicleParams {
+    aloft_power::VehicleParams {
         mass_kg: 3.29,
         gravity_mps2: 9.8066,
         air_density_kg_m3: 1.225,
@@ -44,9 +51,7 @@ pub(crate) fn m100_aircraft() -> Aircraft {
         mu2_x_n_s2_per_m2: None,
         mu2_y_n_s2_per_m2: None,
         efficiency_relative_sd: None,
-    })
-    .unwrap();
-    Aircraft::four_term(m100_airframe(), vehicle, Default::default())
+    }
 }
 
 /// DJI's TB47D pack (6S, 4500 mAh, 99.9 Wh, 600 g) with the fixture's assumed resistance.
@@ -76,6 +81,14 @@ pub(crate) fn tb48d() -> BatterySpec {
         internal_resistance_ohm: Some(0.04),
         ..tb47d()
     }
+}
+
+/// `text` read as a mission and compiled for `aircraft` carrying `battery`.
+pub(crate) fn compile_mission(text: &str, aircraft: &Aircraft, battery: &Pack) -> Mission {
+    MissionSpec::from_toml_str(text)
+        .unwrap()
+        .compile(aircraft.airframe(), battery.mass_kg(), None)
+        .unwrap()
 }
 
 /// A leg steeper than the M100's 5 m/s climb limit allows at its ground speed: 30 m up over

@@ -366,28 +366,16 @@ impl Powered<'_> {
 #[cfg(test)]
 mod tests {
     use crate::aircraft::Aircraft;
-    use crate::test_support::{m100_aircraft, m100_airframe};
+    use crate::test_support::{m100_aircraft, m100_airframe, m100_vehicle_params};
     use aloft_power::AoaModel;
 
     /// The M100 with body-axis drag `[mu2_x, mu2_y]`.
     fn with_axes(mu2: [f64; 2]) -> Aircraft {
         // test_support's M100 with the two keys added.
         let vehicle = aloft_power::Vehicle::new(aloft_power::VehicleParams {
-            mass_kg: 3.29,
-            gravity_mps2: 9.8066,
-            air_density_kg_m3: 1.225,
-            rotor_count: 4,
-            rotor_radius_m: 0.172,
-            disk_area: aloft_power::DiskArea::OneRotor,
-            mu1_n_s_per_m: 0.1816,
-            mu2_n_s2_per_m2: -0.02326,
-            mu3_n_s3_per_m3: 0.004045,
-            kappa1_w_per_n1_5: 0.275,
-            kappa2_w_s2_per_m2_n0_5: 0.0,
-            efficiency: 0.9703,
             mu2_x_n_s2_per_m2: Some(mu2[0]),
             mu2_y_n_s2_per_m2: Some(mu2[1]),
-            efficiency_relative_sd: None,
+            ..m100_vehicle_params()
         })
         .unwrap();
         Aircraft::four_term(m100_airframe(), vehicle, Default::default())

@@ -278,6 +278,19 @@ pub fn speed_and_from_deg(wind_mps: [f64; 3]) -> (f64, f64) {
     (e.hypot(n), (-e).atan2(-n).to_degrees().rem_euclid(360.0))
 }
 
+/// A profile's reference height: positive and at most [`MAX_REFERENCE_HEIGHT_M`].
+fn check_reference_height(reference_height_m: f64) -> Result<f64, PlannerError> {
+    crate::error::positive("reference_height_m", reference_height_m, "m")?;
+    let range = (0.0, MAX_REFERENCE_HEIGHT_M);
+    crate::error::within(
+        "reference_height_m",
+        reference_height_m,
+        range,
+        "m",
+        "at most 10000 m",
+    )
+}
+
 impl Wind {
     /// Still air.
     pub fn calm() -> Self {
@@ -318,16 +331,7 @@ impl Wind {
                 reference_height_m,
                 exponent,
             } => {
-                crate::error::positive("reference_height_m", reference_height_m, "m")?;
-                let range = (0.0, MAX_REFERENCE_HEIGHT_M);
-                let expected = "at most 10000 m";
-                crate::error::within(
-                    "reference_height_m",
-                    reference_height_m,
-                    range,
-                    "m",
-                    expected,
-                )?;
+                check_reference_height(reference_height_m)?;
                 crate::error::non_negative("power_law_exponent", exponent, "")?;
                 let expected = "at most 1 (open country 0.14, cities 0.4)";
                 crate::error::within("power_law_exponent", exponent, (0.0, 1.0), "", expected)?;
@@ -336,16 +340,7 @@ impl Wind {
                 reference_height_m,
                 roughness_m,
             } => {
-                crate::error::positive("reference_height_m", reference_height_m, "m")?;
-                let range = (0.0, MAX_REFERENCE_HEIGHT_M);
-                let expected = "at most 10000 m";
-                crate::error::within(
-                    "reference_height_m",
-                    reference_height_m,
-                    range,
-                    "m",
-                    expected,
-                )?;
+                check_reference_height(reference_height_m)?;
                 crate::error::positive("roughness_m", roughness_m, "m")?;
                 if roughness_m >= reference_height_m {
                     return Err(PlannerError::InvalidParameter {

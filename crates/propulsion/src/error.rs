@@ -171,7 +171,7 @@ pub const MAX_RESISTANCE_OHM: f64 = 1e3;
 pub const MAX_KV_RPM_PER_V: f64 = 1e5;
 
 /// `value` when `ok`, else [`PropulsionError::InvalidParameter`] saying what was `expected`.
-fn parameter(
+pub(crate) fn parameter(
     name: &'static str,
     value: f64,
     unit: &'static str,

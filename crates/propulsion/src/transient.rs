@@ -38,7 +38,9 @@
 //! protocol, dshot150. The seed itself assumes the ESC "only provides a time delay at the start of
 //! the response" (section 4.2).
 
-use crate::error::{kv, mass, non_negative, positive, resistance, voltage, PropulsionError};
+use crate::error::{
+    kv, mass, non_negative, parameter, positive, resistance, voltage, PropulsionError,
+};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -532,14 +534,9 @@ impl RotorTransient {
         let duration_s = positive("duration_s", duration_s, "s")?;
         let dt_s = positive("dt_s", dt_s, "s")?;
         let steps = (duration_s / dt_s).ceil();
-        if steps > 1e8 {
-            return Err(PropulsionError::InvalidParameter {
-                name: "dt_s",
-                value: dt_s,
-                unit: "s",
-                expected: "at most 1e8 steps per simulation",
-            });
-        }
+        // `steps` is positive (NaN cannot reach here): `<=` is the negation of `>`.
+        let expected = "at most 1e8 steps per simulation";
+        parameter("dt_s", dt_s, "s", steps <= 1e8, expected)?;
         let steps = steps as usize;
         let v0 = self.equilibrium_voltage_v(from);
         let v1 = self.equilibrium_voltage_v(to);

@@ -209,22 +209,12 @@ impl Points {
                 home.longitude_deg,
             ) {
                 (None, None, Some(la), Some(lo)) => {
-                    if !(la.is_finite() && la.abs() < 90.0) {
-                        return Err(PlannerError::InvalidParameter {
-                            name: "home latitude_deg",
-                            value: la,
-                            unit: "deg",
-                            expected: "a latitude within (-90, 90)",
-                        });
-                    }
-                    if !(lo.is_finite() && lo.abs() <= 180.0) {
-                        return Err(PlannerError::InvalidParameter {
-                            name: "home longitude_deg",
-                            value: lo,
-                            unit: "deg",
-                            expected: "a longitude within [-180, 180]",
-                        });
-                    }
+                    let ok = la.is_finite() && la.abs() < 90.0;
+                    let expected = "a latitude within (-90, 90)";
+                    crate::error::parameter("home latitude_deg", la, "deg", ok, expected)?;
+                    let ok = lo.is_finite() && lo.abs() <= 180.0;
+                    let expected = "a longitude within [-180, 180]";
+                    crate::error::parameter("home longitude_deg", lo, "deg", ok, expected)?;
                     Some((la, lo))
                 }
                 (_, _, None, None) => None,

@@ -140,10 +140,9 @@ impl<'p, 'a: 'p> Feed<'p, 'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_mission::{m100, SURVEY};
+    use super::super::test_mission::m100_survey;
     use super::super::{plan_with, sampler::piece_steps, PlanOptions};
     use super::*;
-    use crate::mission::MissionSpec;
     use crate::wind::Wind;
 
     #[test]
@@ -151,11 +150,7 @@ mod tests {
         // At a 10 ms step the survey has over 4096 steps, so `plan` runs pass A on a second
         // thread; the report must be the in-line one exactly, samples included, whether the
         // mission completes, the pack runs out part-way, or pass A meets an error.
-        let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let (aircraft, battery, mission) = m100_survey();
         let steps: usize = mission
             .pieces()
             .iter()

@@ -3,7 +3,7 @@
 //! Per step ([`Ledger::book`]): the electrical energy `P h` into the segment's tally, the heat
 //! `I^2 R h` in the pack, the peaks of power and current, the lowest terminal voltage; when asked,
 //! the sample of the time series ([`Ledger::record`]). Per piece flown ([`Ledger::close`]) or cut
-//! short where the pack fails ([`Ledger::stop_before`], [`Ledger::stop_after`]): its duration,
+//! short where the pack fails ([`Ledger::stop_at`]): its duration,
 //! distance, energy, peak power and the state of charge it ends at. At the end
 //! ([`Ledger::report`]): the reserve left, the shortfall if any, and the [`MissionReport`].
 
@@ -206,34 +206,20 @@ impl<'p> Ledger<'p> {
         self.book_piece(tally, (planned, late_s), piece.profile.length_m, soc);
     }
 
-    /// The pack cannot deliver the step that starts `start_s` s into `piece` by its plan, after
-    /// `late_s` flown beyond the plan (`why`): the flight ends before it, with the pack at `soc`;
-    /// the piece's steps flown until then are booked (their energy, peak and time) like those of
-    /// a piece cut short by [`Ledger::stop_after`].
-    pub(super) fn stop_before(
+    /// The flight ends `at_s` s into `piece` by its plan, after `late_s` flown beyond the plan
+    /// (`why`), with the pack at `soc`: before a step the pack cannot deliver (`at_s` its start)
+    /// or after the step in which the pack fails (`at_s` its end). The piece's steps flown until
+    /// then are booked (their energy, peak and time).
+    pub(super) fn stop_at(
         &mut self,
         tally: PieceTally,
         piece: &Piece,
-        (start_s, late_s): (f64, f64),
+        (at_s, late_s): (f64, f64),
         soc: f64,
         why: Shortfall,
     ) {
         self.shortfall = Some(why);
-        self.book_piece(tally, (start_s, late_s), piece.profile.at(start_s).0, soc);
-    }
-
-    /// The pack fails (`why`) in the step that ends `end_s` s into `piece` by its plan, after
-    /// `late_s` flown beyond the plan, leaving it at `soc`: the flight ends after that step.
-    pub(super) fn stop_after(
-        &mut self,
-        tally: PieceTally,
-        piece: &Piece,
-        (end_s, late_s): (f64, f64),
-        soc: f64,
-        why: Shortfall,
-    ) {
-        self.shortfall = Some(why);
-        self.book_piece(tally, (end_s, late_s), piece.profile.at(end_s).0, soc);
+        self.book_piece(tally, (at_s, late_s), piece.profile.at(at_s).0, soc);
     }
 
     /// Book a piece's duration (planned and flown beyond the plan), distance, energy and peak

@@ -402,7 +402,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                     let start_s = (run.k0 + block.valid) as f64 * run.h;
                     let at = (start_s, block.late_end_s);
                     let soc = self.cursor.soc();
-                    self.ledger.stop_before(run.tally, piece, at, soc, why);
+                    self.ledger.stop_at(run.tally, piece, at, soc, why);
                     return Ok(ControlFlow::Break(()));
                 }
             }
@@ -453,7 +453,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                 let start_s = tm - 0.5 * run.h;
                 let late = block.late_s[j] - 0.5 * (h - run.h);
                 self.ledger
-                    .stop_before(tally, run.piece, (start_s, late), soc, why);
+                    .stop_at(tally, run.piece, (start_s, late), soc, why);
                 return Ok(ControlFlow::Break(()));
             };
             self.ledger.book(&mut tally, p, h, &draw);
@@ -467,7 +467,7 @@ impl<'p, 'a> PackPass<'p, 'a> {
                 let end_s = tm + 0.5 * run.h;
                 let late = block.late_s[j] + 0.5 * (h - run.h);
                 self.ledger
-                    .stop_after(tally, run.piece, (end_s, late), draw.soc_after, why);
+                    .stop_at(tally, run.piece, (end_s, late), draw.soc_after, why);
                 return Ok(ControlFlow::Break(()));
             }
             if self.way_home.due(t, pos) {
@@ -601,21 +601,17 @@ impl<'p, 'a> PackPass<'p, 'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::test_mission::{m100, SURVEY};
+    use super::test_mission::{m100, m100_survey};
     use super::*;
     use crate::ground_effect::thrust_factor;
-    use crate::mission::MissionSpec;
+    use crate::test_support::compile_mission;
     use aloft_power::AoaModel;
 
     #[test]
     fn block_passes_match_the_sample_by_sample_trim() {
         // The block path against `Powered::trim` and `Pack::draw` called per sample, over the
         // recorded samples of a survey in wind.
-        let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let (aircraft, battery, mission) = m100_survey();
         let wind = Wind::constant(6.0, 250.0).unwrap();
         let opts = PlanOptions {
             time_step_s: 0.05,
@@ -686,10 +682,7 @@ mod tests {
             kind = "landing"
             rate_mps = 1.0
         "#;
-        let mission = MissionSpec::from_toml_str(fast_leg)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(fast_leg, &aircraft, &battery);
         let opts = PlanOptions {
             record_samples: true,
             ..PlanOptions::default()
@@ -736,10 +729,7 @@ mod tests {
         // speed at 5 x 20 / 30 = 3.33 m/s where the plan asks for more.
         let (aircraft, battery) = m100();
         let text = crate::test_support::STEEP_LEG;
-        let mission = MissionSpec::from_toml_str(text)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let mission = compile_mission(text, &aircraft, &battery);
         let opts = PlanOptions {
             record_samples: true,
             ..PlanOptions::default()

@@ -483,22 +483,10 @@ impl PlanOptions {
         airframe: &Airframe,
     ) -> Result<CheckedOptions, PlannerError> {
         let dt = crate::error::positive("time_step_s", self.time_step_s, "s")?;
-        if !(self.reserve_fraction >= 0.0 && self.reserve_fraction < 1.0) {
-            return Err(PlannerError::InvalidParameter {
-                name: "reserve_fraction",
-                value: self.reserve_fraction,
-                unit: "",
-                expected: "a fraction in [0, 1)",
-            });
-        }
-        if !(self.start_soc > battery.empty_soc() && self.start_soc <= 1.0) {
-            return Err(PlannerError::InvalidParameter {
-                name: "start_soc",
-                value: self.start_soc,
-                unit: "",
-                expected: "a fraction in (empty point, 1]",
-            });
-        }
+        crate::error::reserve_fraction(self.reserve_fraction)?;
+        let ok = self.start_soc > battery.empty_soc() && self.start_soc <= 1.0;
+        let expected = "a fraction in (empty point, 1]";
+        crate::error::parameter("start_soc", self.start_soc, "", ok, expected)?;
         crate::error::positive("pnr_interval_s", self.pnr_interval_s, "s")?;
         let return_rate = match self.return_descent_rate_mps {
             Some(r) => crate::error::positive("return_descent_rate_mps", r, "m/s")?,

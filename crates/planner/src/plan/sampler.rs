@@ -541,19 +541,14 @@ fn outside(wind: &Wind, t: f64, p: [f64; 3]) -> PlannerError {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_mission::{m100, SURVEY};
+    use super::super::test_mission::m100_survey;
     use super::super::{plan_with, PlanOptions};
     use super::*;
-    use crate::mission::MissionSpec;
     use crate::wind::{Gusts, Profile};
 
     #[test]
     fn hoisting_steady_stretches_matches_the_per_sample_report() {
-        let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let (aircraft, battery, mission) = m100_survey();
         let power_law = Profile::PowerLaw {
             reference_height_m: 10.0,
             exponent: 1.0 / 7.0,
@@ -590,11 +585,7 @@ mod tests {
         // The fast path of pass A (`Powered::trim_block`: force balance in vector lanes, the power
         // model's batch path, and the hoisted trim of steady stretches) against its plain
         // reference, `Powered::trim` of each sample's own inputs: the same bits.
-        let (aircraft, battery) = m100();
-        let mission = MissionSpec::from_toml_str(SURVEY)
-            .unwrap()
-            .compile(aircraft.airframe(), battery.mass_kg(), None)
-            .unwrap();
+        let (aircraft, battery, mission) = m100_survey();
         let powered = [aircraft
             .at_mass(
                 aircraft.airframe().mass_kg() + battery.mass_kg(),

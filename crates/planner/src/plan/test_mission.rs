@@ -2,11 +2,19 @@
 
 use crate::aircraft::Aircraft;
 use crate::battery::Pack;
-use crate::test_support::{m100_aircraft, tb48d};
+use crate::mission::Mission;
+use crate::test_support::{compile_mission, m100_aircraft, tb48d};
 
 /// The M100 and its TB48D pack.
 pub(super) fn m100() -> (Aircraft, Pack) {
     (m100_aircraft(), Pack::new(&tb48d()).unwrap())
+}
+
+/// The M100, its TB48D pack and [`SURVEY`] compiled for them.
+pub(super) fn m100_survey() -> (Aircraft, Pack, Mission) {
+    let (aircraft, battery) = m100();
+    let mission = compile_mission(SURVEY, &aircraft, &battery);
+    (aircraft, battery, mission)
 }
 
 /// A survey: take-off, a leg, a hover, a climbing leg, an orbit, the return, the landing.

@@ -109,13 +109,7 @@ fn fit_axis(rows: &[(f64, f64)], outlier_sigma: f64) -> Option<(f64, f64, usize)
     };
     let (c, _) = solve(rows)?;
     let residuals: Vec<f64> = rows.iter().map(|r| r.1 - c * r.0).collect();
-    let (median, robust_sd) = super::median_and_robust_sd(&residuals);
-    let kept: Vec<(f64, f64)> = rows
-        .iter()
-        .zip(&residuals)
-        .filter(|(_, r)| robust_sd <= 0.0 || (**r - median).abs() <= outlier_sigma * robust_sd)
-        .map(|(row, _)| *row)
-        .collect();
+    let kept = super::within_robust_sd(rows, &residuals, outlier_sigma);
     let (c, sxx) = solve(&kept)?;
     let residuals: Vec<f64> = kept.iter().map(|r| r.1 - c * r.0).collect();
     let n = residuals.len() as f64;

@@ -125,13 +125,7 @@ pub fn fit_drag(
         .iter()
         .map(|&(v, y)| y - v * (c[0] + v * (c[1] + v * c[2])))
         .collect();
-    let (median, robust_sd) = super::median_and_robust_sd(&residuals);
-    let kept: Vec<(f64, f64)> = rows
-        .iter()
-        .zip(&residuals)
-        .filter(|(_, r)| robust_sd <= 0.0 || (**r - median).abs() <= outlier_sigma * robust_sd)
-        .map(|(row, _)| *row)
-        .collect();
+    let kept = super::within_robust_sd(&rows, &residuals, outlier_sigma);
     let (c, inv, ssr) = solve(&kept).ok_or_else(singular)?;
     let n = kept.len();
     let sigma2 = ssr / (n.saturating_sub(3).max(1)) as f64;

@@ -32,6 +32,22 @@ pub(crate) fn median_and_robust_sd(values: &[f64]) -> (f64, f64) {
     (median, 1.4826 * median_of(&mut deviations))
 }
 
+/// The rows whose residual lies within `outlier_sigma` robust standard deviations of the median
+/// residual: all of them when the residuals have no spread. The drag fits' one pass of outlier
+/// rejection.
+pub(crate) fn within_robust_sd<T: Copy>(
+    rows: &[T],
+    residuals: &[f64],
+    outlier_sigma: f64,
+) -> Vec<T> {
+    let (median, robust_sd) = median_and_robust_sd(residuals);
+    rows.iter()
+        .zip(residuals)
+        .filter(|(_, r)| robust_sd <= 0.0 || (**r - median).abs() <= outlier_sigma * robust_sd)
+        .map(|(row, _)| *row)
+        .collect()
+}
+
 /// Median of `v` (sorts it); 0 when empty.
 fn median_of(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);

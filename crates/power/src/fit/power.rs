@@ -783,6 +783,15 @@ mod tests {
     use crate::four_term::PowerModel;
     use crate::vehicle::tests::m100_params;
 
+    /// The M100 with its efficiency set to `efficiency`.
+    fn m100_with_efficiency(efficiency: f64) -> Vehicle {
+        Vehicle::new(VehicleParams {
+            efficiency,
+            ..m100_params()
+        })
+        .unwrap()
+    }
+
     /// Synthetic flights of a vehicle: hover, forward flight 0-14 m/s with the pitch that balances
     /// drag, turns with roll, climbs and descents.
     fn flights(truth: &Vehicle, noise_w: f64) -> Vec<FitSample> {
@@ -828,11 +837,7 @@ mod tests {
 
     #[test]
     fn recovers_the_parameters_of_a_known_vehicle() {
-        let truth = Vehicle::new(VehicleParams {
-            efficiency: 0.7,
-            ..m100_params()
-        })
-        .unwrap();
+        let truth = m100_with_efficiency(0.7);
         let data = flights(&truth, 0.0);
         // Start from a wrong template: eta 0.9, drag doubled, profile halved.
         let start = Vehicle::new(VehicleParams {
@@ -924,11 +929,7 @@ mod tests {
 
     #[test]
     fn geometric_samples_identify_k_and_profile_but_refuse_drag() {
-        let truth = Vehicle::new(VehicleParams {
-            efficiency: 0.7,
-            ..m100_params()
-        })
-        .unwrap();
+        let truth = m100_with_efficiency(0.7);
         let data = flights_with(&truth, 0.0, true);
         let e = fit_power_model(&truth, &data, &FitOptions::known_geometry()).unwrap_err();
         assert!(matches!(e, FitError::DragNotInPower { .. }), "{e}");
@@ -959,17 +960,9 @@ mod tests {
     fn held_constants_keep_their_physical_values_when_eta_moves() {
         // Regression: held drag and profile constants were held in lumped units (mu / eta), so
         // their physical values drifted with the fitted eta.
-        let truth = Vehicle::new(VehicleParams {
-            efficiency: 0.7,
-            ..m100_params()
-        })
-        .unwrap();
+        let truth = m100_with_efficiency(0.7);
         let data = flights_with(&truth, 0.0, true);
-        let start = Vehicle::new(VehicleParams {
-            efficiency: 0.95,
-            ..m100_params()
-        })
-        .unwrap();
+        let start = m100_with_efficiency(0.95);
         let opts = FitOptions {
             free: vec![FitParameter::WeightOverEfficiency],
             ..FitOptions::known_geometry()
