@@ -1,23 +1,11 @@
 //! End-to-end tests of `aloft power`, `aloft vehicles`, `aloft propulsion` and `aloft rotor`:
 //! output keys, agreement with the library, exit codes and error messages.
 
+mod common;
+use common::{aloft, stderr, stdout};
+
 use std::io::Write;
-use std::process::{Command, Output, Stdio};
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).unwrap()
-}
+use std::process::{Command, Stdio};
 
 #[test]
 fn power_json_has_the_contract_keys_and_matches_the_library() {

@@ -2,27 +2,18 @@
 //! the shared data: the output contract, "no battery data" as an answer, and the MCAP written
 //! read back by the Python `mcap` reader.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, stderr};
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::Path;
+use std::process::Command;
 
 fn shared(name: &str) -> String {
-    let d = std::env::var("ALOFT_DATA_DIR").unwrap_or_else(|_| "../shared/data".into());
-    PathBuf::from(d)
+    common::data_dir()
         .join("flight_logs")
         .join(name)
         .display()
         .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn info(name: &str) -> serde_json::Value {

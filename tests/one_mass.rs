@@ -4,34 +4,14 @@
 //! vehicle and every pack. The expected hover power is computed here in closed form from the
 //! constants of the vehicle files, read as plain TOML (not through aloft's vehicle types).
 
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, ok_json as json};
 
 use toml::Value;
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-/// The JSON answer of a successful run.
-fn json(args: &[&str]) -> serde_json::Value {
-    let o = aloft(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
-
 /// The vehicle file of a built-in, as plain TOML.
 fn fixture(name: &str) -> Value {
-    let path = format!(
-        "{}/fixtures/vehicles/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let path = common::fixture("vehicles", &format!("{name}.toml"));
     toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 

@@ -2,7 +2,8 @@
 //! `payload_sweep`): each row is the endurance answer at that payload, the curves stop at the
 //! maximum take-off mass with a note, and the CLI's table, JSON, CSV, chart and refusals.
 
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, ok_stdout as stdout_of};
 
 use aloft::engine::{
     endurance, payload_sweep, EnduranceOptions, PayloadCurve, PayloadSweep, Vehicle,
@@ -211,24 +212,6 @@ fn every_number_of_a_sweep_is_finite_and_none_is_null() {
 }
 
 // ---- the command line ----
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-fn stdout_of(args: &[&str]) -> String {
-    let o = aloft(args);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
-}
 
 /// Exit 2, exactly one stderr line holding every needle, nothing on stdout, no panic.
 fn assert_refused(args: &[&str], needles: &[&str]) {

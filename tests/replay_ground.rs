@@ -5,17 +5,12 @@
 //! trapezoids of the rows' V x I, the predicted airborne power from the four-term model in
 //! closed form at hover.
 
+mod common;
+use common::aloft;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("aloft runs")
-}
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("aloft-replay-ground-{}-{name}", std::process::id()));

@@ -1,20 +1,13 @@
 //! `aloft vehicles calibrate`: a vehicle file from a spec sheet, end to end, and bad spec sheets
 //! refused with exit 2 and one stderr line naming the key.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+use common::aloft;
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("aloft-vehicles-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("vehicles-cli", name)
 }
 
 const SPEC: &str = r#"
