@@ -2,14 +2,14 @@
 //! output keys, agreement with the library, exit codes and error messages.
 
 mod common;
-use common::{aloft, stderr, stdout};
+use common::{aloft, ok_json, stderr, stdout};
 
 use std::io::Write;
 use std::process::{Command, Stdio};
 
 #[test]
 fn power_json_has_the_contract_keys_and_matches_the_library() {
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--airspeed",
         "6",
@@ -18,8 +18,6 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     for key in [
         "thrust_n",
         "induced_velocity_mps",
@@ -64,7 +62,7 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
 
 #[test]
 fn power_without_terms_removes_them() {
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--airspeed",
         "6",
@@ -75,8 +73,6 @@ fn power_without_terms_removes_them() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(v["profile_w"].as_f64(), Some(0.0));
     assert_eq!(v["parasitic_w"].as_f64(), Some(0.0));
     let sum = v["induced_w"].as_f64().unwrap() + v["climb_w"].as_f64().unwrap();
@@ -175,7 +171,7 @@ fn vehicle_files_load_and_bad_files_are_named() {
     let text = include_str!("../fixtures/vehicles/dji-m100-paper.toml")
         .replace("mass_kg = 3.29", "mass_kg = 4.0");
     std::fs::write(&good, text).unwrap();
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--vehicle",
         good.to_str().unwrap(),
@@ -184,8 +180,6 @@ fn vehicle_files_load_and_bad_files_are_named() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert!((v["thrust_n"].as_f64().unwrap() - 4.5 * 9.8066).abs() < 1e-9);
     assert!(v.get("battery").is_none(), "{v}");
     // A vehicle with an airframe flies airframe + pack + payload, whatever its [power] mass.
@@ -194,7 +188,7 @@ fn vehicle_files_load_and_bad_files_are_named() {
         .replace("mass_kg = 1.755", "mass_kg = 2.0")
         .replace("mass_kg = 2.355", "mass_kg = 9.0");
     std::fs::write(&framed, text).unwrap();
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--vehicle",
         framed.to_str().unwrap(),
@@ -203,8 +197,6 @@ fn vehicle_files_load_and_bad_files_are_named() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert!((v["thrust_n"].as_f64().unwrap() - (2.0 + 0.676) * 9.8066).abs() < 1e-9);
     assert_eq!(v["battery"].as_str(), Some("TB48D"));
 
@@ -256,9 +248,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
 /// hand, as `paper_val_eq10_hover_induced_velocity_of_the_m100`).
 #[test]
 fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
-    let o = aloft(&["power", "--vehicle", "dji-m100-paper", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["power", "--vehicle", "dji-m100-paper", "--format", "json"]);
     assert_eq!(v["takeoff_mass_kg"].as_f64(), Some(3.29));
     assert!((v["hover_induced_velocity_mps"].as_f64().unwrap() - 11.9034).abs() < 1e-4);
     let o = aloft(&["power", "--vehicle", "dji-m100-paper"]);
@@ -366,9 +356,7 @@ fn broken_pipe_exits_quietly() {
 
 #[test]
 fn vehicles_lists_the_builtins() {
-    let o = aloft(&["vehicles", "--format", "json"]);
-    assert!(o.status.success());
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["vehicles", "--format", "json"]);
     let names: Vec<&str> = v
         .as_array()
         .unwrap()
@@ -420,7 +408,7 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
     // 3 kW, draws 42.5 A per pack, dissipates 505 W in the packs, flies a little over 9 min.
     // Tolerances are the issue's (10 %, 10 %, 15 %, 9-10.5 min); heat and time are not independent
     // of the pack resistance and capacity derived from the same sentence (see aec-quadrotor.toml).
-    let o = aloft(&[
+    let v = ok_json(&[
         "propulsion",
         "--vehicle",
         "aec-quadrotor",
@@ -429,8 +417,6 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("missing {k}"));
     for k in [
         "takeoff_mass_kg",
@@ -453,9 +439,7 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
 
 #[test]
 fn rotor_mn1806_settles_within_the_issue_band() {
-    let o = aloft(&["rotor", "--rotor", "mn1806-6x2", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["rotor", "--rotor", "mn1806-6x2", "--format", "json"]);
     for k in [
         "motor_inertia_kgm2",
         "prop_inertia_kgm2",

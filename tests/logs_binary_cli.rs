@@ -3,7 +3,7 @@
 //! read back by the Python `mcap` reader.
 
 mod common;
-use common::{aloft, stderr};
+use common::{aloft, ok_json, stderr};
 
 use std::path::Path;
 use std::process::Command;
@@ -17,9 +17,7 @@ fn shared(name: &str) -> String {
 }
 
 fn info(name: &str) -> serde_json::Value {
-    let o = aloft(&["log", "info", &shared(name), "--format", "json"]);
-    assert!(o.status.success(), "{name}: {}", stderr(&o));
-    serde_json::from_slice(&o.stdout).unwrap()
+    ok_json(&["log", "info", &shared(name), "--format", "json"])
 }
 
 #[test]
@@ -79,9 +77,7 @@ fn a_truncated_ulog_gives_its_prefix_and_a_warning_with_the_offset() {
     let bytes = std::fs::read(shared("upgradeenergy_test.ulg")).unwrap();
     let p = Path::new(env!("CARGO_TARGET_TMPDIR")).join("truncated.ulg");
     std::fs::write(&p, &bytes[..bytes.len() * 2 / 3 + 7]).unwrap();
-    let o = aloft(&["log", "info", p.to_str().unwrap(), "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", p.to_str().unwrap(), "--format", "json"]);
     let w = j["warnings"].to_string();
     assert!(w.contains("at byte"), "{w}");
     assert!(j["samples"].as_u64().unwrap() > 100);
@@ -94,7 +90,7 @@ fn data_val_converted_ulog_and_dataflash_open_in_the_python_mcap_reader() {
         ("sitl_ac47_00000002.BIN", 405),
     ] {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.mcap"));
-        let o = aloft(&[
+        let j = ok_json(&[
             "convert",
             &shared(name),
             "-o",
@@ -102,8 +98,6 @@ fn data_val_converted_ulog_and_dataflash_open_in_the_python_mcap_reader() {
             "--format",
             "json",
         ]);
-        assert!(o.status.success(), "{name}: {}", stderr(&o));
-        let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
         assert_eq!(j["samples"], samples);
         let has_mcap = Command::new("python3")
             .args(["-c", "import mcap"])

@@ -1,7 +1,7 @@
 //! End-to-end `aloft log info` and `aloft convert`: output keys, exit codes, and clean failures.
 
 mod common;
-use common::{aloft, stderr};
+use common::{aloft, ok_json, stderr};
 
 use std::path::{Path, PathBuf};
 
@@ -15,15 +15,13 @@ fn tmp(name: &str) -> PathBuf {
 
 #[test]
 fn log_info_json_reports_duration_rates_and_energy() {
-    let o = aloft(&[
+    let j = ok_json(&[
         "log",
         "info",
         &fixture("kaist_small.csv"),
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["format"], "csv");
     assert_eq!(j["profile"], "kaist");
     assert_eq!(j["samples"], 20);
@@ -99,9 +97,7 @@ fn log_info_of_a_mission_mcap_has_the_time_series_rows() {
         .map(|k| 0.5 * (v[k - 1] * i[k - 1] + v[k] * i[k]) * (t[k] - t[k - 1]))
         .sum::<f64>()
         / 3600.0;
-    let o = aloft(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
     assert_eq!(j["samples"], t.len() as u64);
     assert_eq!(j["time"]["non_monotonic_count"], 0);
     assert_eq!(j["time"]["gap_count"], 0);
@@ -176,7 +172,7 @@ fn bad_inputs_exit_2_with_the_file_named() {
 #[test]
 fn convert_writes_mcap_that_reads_back() {
     let out = tmp("conv.mcap");
-    let o = aloft(&[
+    let j = ok_json(&[
         "convert",
         &fixture("custom.csv"),
         "--profile",
@@ -186,12 +182,8 @@ fn convert_writes_mcap_that_reads_back() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["samples"], 10);
-    let o = aloft(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
     assert_eq!(j["format"], "mcap");
     let topics: Vec<&str> = j["topics"]
         .as_array()
@@ -262,9 +254,7 @@ fn the_old_lag_flag_of_log_info_names_max_lag() {
     }
     // The window under its new name (and a lag estimated within it).
     let log = fixture("kaist_small.csv");
-    let o = aloft(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
     assert!(
         j["lag"]["lag_s"].as_f64().unwrap().abs() <= 0.3 + 1e-9,
         "{}",

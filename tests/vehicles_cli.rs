@@ -2,7 +2,7 @@
 //! refused with exit 2 and one stderr line naming the key.
 
 mod common;
-use common::aloft;
+use common::{aloft, ok_json};
 
 use std::path::PathBuf;
 
@@ -36,7 +36,7 @@ fn calibrate_writes_a_vehicle_every_command_accepts() {
         "/fixtures/vehicles/specs/dji-m600.toml"
     );
     let out = scratch("m600.toml");
-    let o = aloft(&[
+    let v = ok_json(&[
         "vehicles",
         "calibrate",
         spec,
@@ -45,20 +45,16 @@ fn calibrate_writes_a_vehicle_every_command_accepts() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let eta = v["efficiency"].as_f64().unwrap();
     assert!((eta - 0.4995).abs() < 1e-4, "{eta}");
     assert!(!v["defaults"].as_array().unwrap().is_empty());
-    let o = aloft(&[
+    let e = ok_json(&[
         "endurance",
         "--vehicle",
         out.to_str().unwrap(),
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let e: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let minutes = e["hover_endurance_s"].as_f64().unwrap() / 60.0;
     assert!((minutes - 35.0).abs() < 0.01, "{minutes}");
     let o = aloft(&[
