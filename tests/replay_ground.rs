@@ -6,7 +6,7 @@
 //! closed form at hover.
 
 mod common;
-use common::aloft;
+use common::{aloft, ok_json};
 
 use std::path::{Path, PathBuf};
 
@@ -112,7 +112,7 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
     let csv = kaist_csv(&d);
     let vehicle = d.join("vehicle.toml");
     std::fs::write(&vehicle, VEHICLE).unwrap();
-    let out = aloft(&[
+    let v = ok_json(&[
         "mission",
         "--replay",
         csv.to_str().unwrap(),
@@ -125,12 +125,6 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
         "--format",
         "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
 
     // Detected (the CSV has no landed state) at the rows where the stretches change: take-off at
     // the first airborne row, landing at the first ground row. Row times are multiples of 0.1 s
@@ -231,7 +225,7 @@ fn ground_time_is_free_when_the_log_has_no_power() {
     .unwrap();
     let vehicle = d.join("vehicle.toml");
     std::fs::write(&vehicle, VEHICLE).unwrap();
-    let out = aloft(&[
+    let v = ok_json(&[
         "mission",
         "--replay",
         csv.to_str().unwrap(),
@@ -242,12 +236,6 @@ fn ground_time_is_free_when_the_log_has_no_power() {
         "--format",
         "json",
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["flights"], 2);
     close(num(&v, "airborne_s"), 70.0, 1e-9, "airborne_s");
     assert_eq!(num(&v, "predicted_ground_energy_wh"), 0.0);
@@ -310,13 +298,7 @@ fn battery_with_replay_is_part_of_the_mass_and_an_unknown_one_is_bad_input() {
         "--format",
         "json",
     ]);
-    let out = aloft(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = ok_json(&args);
     assert_eq!(v["battery"], "TB48D");
     close(num(&v, "mass_kg"), airframe + pack + 0.25, 1e-12, "mass_kg");
     // The table prints the mass and the pack.
