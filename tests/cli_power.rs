@@ -2,7 +2,7 @@
 //! output keys, agreement with the library, exit codes and error messages.
 
 mod common;
-use common::{aloft, ok_json, stderr, stdout};
+use common::{aloft, ok_json, refused, stderr, stdout};
 
 use std::io::Write;
 use std::process::{Command, Stdio};
@@ -81,7 +81,7 @@ fn power_without_terms_removes_them() {
 
 #[test]
 fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
-    let o = aloft(&[
+    let err = refused(&[
         "power",
         "--airspeed",
         "6",
@@ -90,8 +90,7 @@ fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
         "--aoa",
         "geometric",
     ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--air-direction-deg"), "{}", stderr(&o));
+    assert!(err.contains("--air-direction-deg"), "{err}");
     let paper = aloft(&[
         "power",
         "--airspeed",
@@ -155,10 +154,9 @@ fn bad_input_exits_2_naming_the_value() {
         (&["rotor", "--motor-kv", "2300"], "--motor-resistance"),
     ];
     for (args, needle) in cases {
-        let o = aloft(args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
-        assert!(!stderr(&o).contains("panicked"), "{args:?}");
+        let err = refused(args);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}");
     }
 }
 
@@ -202,13 +200,8 @@ fn vehicle_files_load_and_bad_files_are_named() {
 
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[power]\nmass_lb = 3\n").unwrap();
-    let o = aloft(&["power", "--vehicle", bad.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("mass_lb") && stderr(&o).contains("bad.toml"),
-        "{}",
-        stderr(&o)
-    );
+    let err = refused(&["power", "--vehicle", bad.to_str().unwrap()]);
+    assert!(err.contains("mass_lb") && err.contains("bad.toml"), "{err}");
 }
 
 /// A `--vehicle` that is a path names the missing file; a bare name that is neither a built-in
@@ -220,9 +213,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
         .join("my-quad.toml");
     let path = missing.to_str().unwrap();
     for command in ["power", "endurance", "mission"] {
-        let o = aloft(&[command, "--vehicle", path]);
-        assert_eq!(o.status.code(), Some(2), "{command}: {}", stderr(&o));
-        let err = stderr(&o);
+        let err = refused(&[command, "--vehicle", path]);
         assert!(err.contains("no such file") && err.contains(path), "{err}");
         assert!(!err.contains("built-in"), "{err}");
         assert_eq!(err.lines().count(), 1, "{err}");
@@ -234,9 +225,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
         "{}",
         stderr(&o)
     );
-    let o = aloft(&["endurance", "--vehicle", "dji-m300"]);
-    assert_eq!(o.status.code(), Some(2));
-    let err = stderr(&o);
+    let err = refused(&["endurance", "--vehicle", "dji-m300"]);
     assert!(
         err.contains("dji-m300") && err.contains("dji-m100, dji-m600"),
         "{err}"
@@ -260,9 +249,8 @@ fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
         stdout(&o)
     );
     // It has no airframe: the planner's commands say so.
-    let o = aloft(&["endurance", "--vehicle", "dji-m100-paper"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("[airframe]"), "{}", stderr(&o));
+    let err = refused(&["endurance", "--vehicle", "dji-m100-paper"]);
+    assert!(err.contains("[airframe]"), "{err}");
 }
 
 #[test]
@@ -310,12 +298,10 @@ fn batch_mode_streams_csv_and_reports_bad_rows() {
 
     let missing = dir.join("missing.csv");
     std::fs::write(&missing, "airspeed_mps,pitch_deg\n1,2\n").unwrap();
-    let o = aloft(&["power", "--input", missing.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("roll_deg"), "{}", stderr(&o));
-    let o = aloft(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("nope.csv"), "{}", stderr(&o));
+    let err = refused(&["power", "--input", missing.to_str().unwrap()]);
+    assert!(err.contains("roll_deg"), "{err}");
+    let err = refused(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
+    assert!(err.contains("nope.csv"), "{err}");
 }
 
 #[test]

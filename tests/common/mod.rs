@@ -118,3 +118,11 @@ pub fn files_like(sub: &str, prefix: &str, suffix: &str) -> Vec<PathBuf> {
 pub fn strings(paths: &[PathBuf]) -> Vec<String> {
     paths.iter().map(|p| p.display().to_string()).collect()
 }
+
+/// The stderr of `aloft args`, which must be refused with exit 2.
+pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
+    let o = aloft(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "aloft {args:?}: {err}");
+    err
+}
