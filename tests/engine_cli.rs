@@ -2,25 +2,9 @@
 //! exactly what `aloft mission --format json` and `aloft endurance --format json` print.
 
 mod common;
-use common::cli;
+use common::{cli, uniform_wind as wind};
 
-use aloft::engine::{
-    endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle, WindProfileKind,
-    WindSpec,
-};
-
-fn wind(speed_mps: f64, from_deg: f64) -> Option<WindSpec> {
-    Some(WindSpec {
-        speed_mps,
-        from_deg,
-        profile: WindProfileKind::Uniform,
-        reference_height_m: None,
-        exponent: None,
-        roughness_m: None,
-        gust_std_mps: None,
-        gust_seed: None,
-    })
-}
+use aloft::engine::{endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle};
 
 #[test]
 fn mission_summary_is_the_cli_json() {

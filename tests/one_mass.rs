@@ -241,20 +241,30 @@ fn paper_case_is_a_power_model_alone() {
     }
 }
 
+/// The small KAIST log of the fixtures.
+const KAIST_SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
+
+/// `command flag <the small KAIST log> --profile kaist --lag 0 --vehicle dji-m100 extra...`.
+fn on_kaist_small<'a>(command: &'a str, flag: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let base = [
+        command,
+        flag,
+        KAIST_SMALL,
+        "--profile",
+        "kaist",
+        "--lag",
+        "0",
+    ];
+    [&base[..], &["--vehicle", "dji-m100"], extra].concat()
+}
+
 /// `aloft validate` flies the take-off mass of `--battery` and `--payload-kg` too: a heavier
 /// vehicle predicts more energy for the same logged flight, and the JSON names the mass.
 #[test]
 fn validate_flies_the_takeoff_mass_it_is_given() {
-    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
     let run = |extra: &[&str]| {
-        let base = ["validate", "--log", log, "--profile", "kaist", "--lag", "0"];
-        let args = [
-            &base[..],
-            &["--vehicle", "dji-m100", "--format", "json"],
-            extra,
-        ]
-        .concat();
-        json(&args)
+        let extra = [&["--format", "json"][..], extra].concat();
+        json(&on_kaist_small("validate", "--log", &extra))
     };
     let light = run(&[]);
     let heavy = run(&["--battery", "TB48D", "--payload-kg", "0.3"]);
@@ -275,19 +285,7 @@ fn validate_flies_the_takeoff_mass_it_is_given() {
         energy(&heavy),
         energy(&light)
     );
-    let err = refused(&[
-        "validate",
-        "--log",
-        log,
-        "--profile",
-        "kaist",
-        "--lag",
-        "0",
-        "--vehicle",
-        "dji-m100",
-        "--payload-kg",
-        "2",
-    ]);
+    let err = refused(&on_kaist_small("validate", "--log", &["--payload-kg", "2"]));
     assert!(err.contains("3.600 kg limit"));
 }
 
@@ -295,23 +293,14 @@ fn validate_flies_the_takeoff_mass_it_is_given() {
 /// `--battery` was refused there and the default pack flown).
 #[test]
 fn replay_flies_the_takeoff_mass_it_is_given() {
-    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
-    let r = json(&[
-        "mission",
-        "--replay",
-        log,
-        "--profile",
-        "kaist",
-        "--lag",
-        "0",
-        "--vehicle",
-        "dji-m100",
+    let extra = [
         "--battery",
         "TB48D",
         "--payload-kg",
         "0.1",
         "--format",
         "json",
-    ]);
+    ];
+    let r = json(&on_kaist_small("mission", "--replay", &extra));
     assert_close(r["mass_kg"].as_f64().unwrap(), 1.755 + 0.676 + 0.1, 1e-12);
 }

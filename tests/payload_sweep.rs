@@ -7,7 +7,6 @@ use common::{aloft, ok_stdout as stdout_of};
 
 use aloft::engine::{
     endurance, payload_sweep, EnduranceOptions, PayloadCurve, PayloadSweep, Vehicle,
-    WindProfileKind, WindSpec,
 };
 use aloft::vehicle::VehicleFile;
 
@@ -19,16 +18,7 @@ fn m100() -> Vehicle {
 /// reserve and an orbit.
 fn windy() -> EnduranceOptions {
     EnduranceOptions {
-        wind: Some(WindSpec {
-            speed_mps: 5.0,
-            from_deg: 30.0,
-            profile: WindProfileKind::Uniform,
-            reference_height_m: None,
-            exponent: None,
-            roughness_m: None,
-            gust_std_mps: None,
-            gust_seed: None,
-        }),
+        wind: common::uniform_wind(5.0, 30.0),
         course_deg: 90.0,
         reserve_percent: 20.0,
         orbit_radius_m: Some(40.0),

@@ -126,3 +126,17 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     assert_eq!(o.status.code(), Some(2), "aloft {args:?}: {err}");
     err
 }
+
+/// A uniform wind of `speed_mps` from `from_deg`, without gusts.
+pub fn uniform_wind(speed_mps: f64, from_deg: f64) -> Option<aloft::engine::WindSpec> {
+    Some(aloft::engine::WindSpec {
+        speed_mps,
+        from_deg,
+        profile: aloft::engine::WindProfileKind::Uniform,
+        reference_height_m: None,
+        exponent: None,
+        roughness_m: None,
+        gust_std_mps: None,
+        gust_seed: None,
+    })
+}
