@@ -99,6 +99,29 @@ fn num(v: &Value, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("{key} missing in {v}"))
 }
 
+/// The test vehicle, written into the folder `d`.
+fn vehicle_in(d: &Path) -> PathBuf {
+    let vehicle = d.join("vehicle.toml");
+    std::fs::write(&vehicle, VEHICLE).unwrap();
+    vehicle
+}
+
+/// The JSON of `aloft mission --replay csv --profile profile --vehicle <the test vehicle>
+/// extra... --format json`, which must succeed.
+fn replay_json(d: &Path, csv: &Path, profile: &str, extra: &[&str]) -> Value {
+    let vehicle = vehicle_in(d);
+    let base = [
+        "mission",
+        "--replay",
+        csv.to_str().unwrap(),
+        "--profile",
+        profile,
+        "--vehicle",
+        vehicle.to_str().unwrap(),
+    ];
+    ok_json(&[&base[..], extra, &["--format", "json"]].concat())
+}
+
 fn close(a: f64, b: f64, rel: f64, what: &str) {
     assert!(
         (a - b).abs() <= rel * b.abs().max(1e-12),
@@ -110,21 +133,7 @@ fn close(a: f64, b: f64, rel: f64, what: &str) {
 fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
     let d = dir("two");
     let csv = kaist_csv(&d);
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
-    let v = ok_json(&[
-        "mission",
-        "--replay",
-        csv.to_str().unwrap(),
-        "--profile",
-        "kaist",
-        "--vehicle",
-        vehicle.to_str().unwrap(),
-        "--lag",
-        "0",
-        "--format",
-        "json",
-    ]);
+    let v = replay_json(&d, &csv, "kaist", &["--lag", "0"]);
 
     // Detected (the CSV has no landed state) at the rows where the stretches change: take-off at
     // the first airborne row, landing at the first ground row. Row times are multiples of 0.1 s
@@ -223,19 +232,7 @@ fn ground_time_is_free_when_the_log_has_no_power() {
         "name = \"no power\"\n[time]\ncolumn = \"t_s\"\nunit = \"s\"\n[position]\ntype = \"local\"\ncolumns = [\"x\", \"y\", \"z\"]\nframe = \"enu\"\nunit = \"m\"\n[velocity]\ncolumns = [\"vx\", \"vy\", \"vz\"]\nframe = \"enu\"\nunit = \"m/s\"\n",
     )
     .unwrap();
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
-    let v = ok_json(&[
-        "mission",
-        "--replay",
-        csv.to_str().unwrap(),
-        "--profile",
-        map.to_str().unwrap(),
-        "--vehicle",
-        vehicle.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let v = replay_json(&d, &csv, map.to_str().unwrap(), &[]);
     assert_eq!(v["flights"], 2);
     close(num(&v, "airborne_s"), 70.0, 1e-9, "airborne_s");
     assert_eq!(num(&v, "predicted_ground_energy_wh"), 0.0);
@@ -313,8 +310,7 @@ fn battery_with_replay_is_part_of_the_mass_and_an_unknown_one_is_bad_input() {
     );
 
     // Bad input: exit 2 with one line naming the value.
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
+    let vehicle = vehicle_in(&d);
     let vehicle = vehicle.to_str().unwrap();
     for (extra, needle) in [
         (["--vehicle", "dji-m100", "--battery", "NOPE"], "NOPE"),
