@@ -146,32 +146,23 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
         assert!((num(s, "start_s") - a).abs() < 1e-6, "{s}");
         assert!((num(s, "end_s") - b).abs() < 1e-6, "{s}");
     }
+    // The key of the answer to 1e-9, relative.
+    let close_v = |key: &str, want: f64, what: &str| close(num(&v, key), want, 1e-9, what);
     // The span is the first to the last row, 0 to 129.9 s.
     let (air_s, ground_s) = (70.0, 129.9 - 70.0);
-    close(num(&v, "duration_s"), 129.9, 1e-9, "duration_s");
-    close(num(&v, "airborne_s"), air_s, 1e-9, "airborne_s");
-    close(num(&v, "ground_s"), ground_s, 1e-9, "ground_s");
+    close_v("duration_s", 129.9, "duration_s");
+    close_v("airborne_s", air_s, "airborne_s");
+    close_v("ground_s", ground_s, "ground_s");
 
     // Measured: trapezoids of the rows over each part. The ground stretches end at a take-off
     // row, so each of the two holds one 0.1 s interval that ramps from 15 W to 1200 W.
     let ground_j = measured_j(0.0, 20.0) + measured_j(60.0, 80.0) + measured_j(110.0, 129.9);
     let air_j = measured_j(20.0, 60.0) + measured_j(80.0, 110.0);
-    close(
-        num(&v, "measured_ground_energy_wh"),
-        ground_j / 3600.0,
-        1e-9,
-        "ground",
-    );
-    close(
-        num(&v, "measured_airborne_energy_wh"),
-        air_j / 3600.0,
-        1e-9,
-        "air",
-    );
-    close(
-        num(&v, "measured_energy_wh"),
+    close_v("measured_ground_energy_wh", ground_j / 3600.0, "ground");
+    close_v("measured_airborne_energy_wh", air_j / 3600.0, "air");
+    close_v(
+        "measured_energy_wh",
         (ground_j + air_j) / 3600.0,
-        1e-9,
         "measured",
     );
     // Idle: the ground energy over the ground time; the two ramps add 2 x 59.25 J over 59.9 s
@@ -185,28 +176,24 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
 
     // Predicted: the hover power on the airborne time only, the ground at idle.
     let hover = hover_w();
-    close(
-        num(&v, "predicted_airborne_energy_wh"),
+    close_v(
+        "predicted_airborne_energy_wh",
         hover * air_s / 3600.0,
-        1e-9,
         "predicted airborne",
     );
-    close(
-        num(&v, "predicted_ground_energy_wh"),
+    close_v(
+        "predicted_ground_energy_wh",
         ground_j / 3600.0,
-        1e-9,
         "predicted ground",
     );
-    close(
-        num(&v, "predicted_energy_wh"),
+    close_v(
+        "predicted_energy_wh",
         (hover * air_s + ground_j) / 3600.0,
-        1e-9,
         "predicted",
     );
-    close(
-        num(&v, "airborne_energy_error_percent"),
+    close_v(
+        "airborne_energy_error_percent",
         100.0 * (hover * air_s - air_j) / air_j,
-        1e-9,
         "airborne error",
     );
     // Flying the whole record would have cost the hover power over the ground time as well.
