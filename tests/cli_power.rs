@@ -404,17 +404,7 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
         "json",
     ]);
     let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("missing {k}"));
-    for k in [
-        "takeoff_mass_kg",
-        "thrust_per_rotor_n",
-        "rotor_speed_rpm",
-        "motor_current_a",
-        "pack_current_a",
-        "power_required_w",
-        "power_drawn_w",
-        "battery_heat_w",
-        "flight_time_min",
-    ] {
+    for k in common::HOVER_KEYS {
         get(k);
     }
     assert!((get("power_required_w") / 3000.0 - 1.0).abs() <= 0.10);

@@ -140,3 +140,16 @@ pub fn uniform_wind(speed_mps: f64, from_deg: f64) -> Option<aloft::engine::Wind
         gust_seed: None,
     })
 }
+
+/// The keys of a propulsion hover answer (`aloft propulsion --format json`), all numbers.
+pub const HOVER_KEYS: [&str; 9] = [
+    "takeoff_mass_kg",
+    "thrust_per_rotor_n",
+    "rotor_speed_rpm",
+    "motor_current_a",
+    "pack_current_a",
+    "power_required_w",
+    "power_drawn_w",
+    "battery_heat_w",
+    "flight_time_min",
+];
