@@ -4,10 +4,22 @@
 mod common;
 use common::{aloft, ok_json};
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 fn scratch(name: &str) -> PathBuf {
     common::scratch("vehicles-cli", name)
+}
+
+/// `aloft vehicles calibrate spec -o out`.
+fn calibrate(spec: &Path, out: &Path) -> Output {
+    aloft(&[
+        "vehicles",
+        "calibrate",
+        spec.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ])
 }
 
 const SPEC: &str = r#"
@@ -100,13 +112,7 @@ fn bad_spec_sheets_are_refused_naming_the_key() {
         let path = scratch(&format!("bad{k}.toml"));
         std::fs::write(&path, SPEC.replacen(from, to, 1)).unwrap();
         let out = scratch(&format!("bad{k}-out.toml"));
-        let o = aloft(&[
-            "vehicles",
-            "calibrate",
-            path.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        let o = calibrate(&path, &out);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{to}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{to}: {err}");
@@ -117,13 +123,7 @@ fn bad_spec_sheets_are_refused_naming_the_key() {
     let path = scratch("good.toml");
     std::fs::write(&path, SPEC).unwrap();
     let out = scratch("good-out.toml");
-    let o = aloft(&[
-        "vehicles",
-        "calibrate",
-        path.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = calibrate(&path, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
@@ -133,13 +133,7 @@ fn impossible_hover_time_says_the_longest_possible() {
     let path = scratch("long.toml");
     std::fs::write(&path, SPEC.replacen("minutes = 18", "minutes = 40", 1)).unwrap();
     let out = scratch("long-out.toml");
-    let o = aloft(&[
-        "vehicles",
-        "calibrate",
-        path.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = calibrate(&path, &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2));
     assert!(
