@@ -2,26 +2,19 @@
 //! they print the same JSON, byte for byte (the CLI adds only a final newline). Each case is a
 //! set of CLI flags and the C ABI's options document that asks for the same thing.
 
+mod common;
+
 use std::ffi::{c_char, CStr, CString};
-use std::process::Command;
 
 use aloft_ffi::{
     aloft_endurance_json, aloft_mission_json, aloft_string_free, aloft_vehicle_builtin,
     aloft_vehicle_free, aloft_vehicle_power_json, AloftStatus, AloftVehicle,
 };
 
+/// The stdout of `aloft args` (exit 0 or 1) without its final newline.
 fn cli(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft");
-    assert!(
-        out.status.code() == Some(0) || out.status.code() == Some(1),
-        "aloft {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8(out.stdout).expect("UTF-8");
-    text.strip_suffix('\n')
+    common::cli(args)
+        .strip_suffix('\n')
         .expect("a final newline")
         .to_string()
 }

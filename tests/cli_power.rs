@@ -1,27 +1,15 @@
 //! End-to-end tests of `aloft power`, `aloft vehicles`, `aloft propulsion` and `aloft rotor`:
 //! output keys, agreement with the library, exit codes and error messages.
 
+mod common;
+use common::{aloft, ok_json, refused, stderr, stdout};
+
 use std::io::Write;
-use std::process::{Command, Output, Stdio};
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8(o.stdout.clone()).unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8(o.stderr.clone()).unwrap()
-}
+use std::process::{Command, Stdio};
 
 #[test]
 fn power_json_has_the_contract_keys_and_matches_the_library() {
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--airspeed",
         "6",
@@ -30,8 +18,6 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     for key in [
         "thrust_n",
         "induced_velocity_mps",
@@ -76,7 +62,7 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
 
 #[test]
 fn power_without_terms_removes_them() {
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--airspeed",
         "6",
@@ -87,8 +73,6 @@ fn power_without_terms_removes_them() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(v["profile_w"].as_f64(), Some(0.0));
     assert_eq!(v["parasitic_w"].as_f64(), Some(0.0));
     let sum = v["induced_w"].as_f64().unwrap() + v["climb_w"].as_f64().unwrap();
@@ -97,7 +81,7 @@ fn power_without_terms_removes_them() {
 
 #[test]
 fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
-    let o = aloft(&[
+    let err = refused(&[
         "power",
         "--airspeed",
         "6",
@@ -106,8 +90,7 @@ fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
         "--aoa",
         "geometric",
     ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("--air-direction-deg"), "{}", stderr(&o));
+    assert!(err.contains("--air-direction-deg"), "{err}");
     let paper = aloft(&[
         "power",
         "--airspeed",
@@ -171,10 +154,9 @@ fn bad_input_exits_2_naming_the_value() {
         (&["rotor", "--motor-kv", "2300"], "--motor-resistance"),
     ];
     for (args, needle) in cases {
-        let o = aloft(args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-        assert!(stderr(&o).contains(needle), "{args:?}: {}", stderr(&o));
-        assert!(!stderr(&o).contains("panicked"), "{args:?}");
+        let err = refused(args);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}");
     }
 }
 
@@ -187,7 +169,7 @@ fn vehicle_files_load_and_bad_files_are_named() {
     let text = include_str!("../fixtures/vehicles/dji-m100-paper.toml")
         .replace("mass_kg = 3.29", "mass_kg = 4.0");
     std::fs::write(&good, text).unwrap();
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--vehicle",
         good.to_str().unwrap(),
@@ -196,8 +178,6 @@ fn vehicle_files_load_and_bad_files_are_named() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert!((v["thrust_n"].as_f64().unwrap() - 4.5 * 9.8066).abs() < 1e-9);
     assert!(v.get("battery").is_none(), "{v}");
     // A vehicle with an airframe flies airframe + pack + payload, whatever its [power] mass.
@@ -206,7 +186,7 @@ fn vehicle_files_load_and_bad_files_are_named() {
         .replace("mass_kg = 1.755", "mass_kg = 2.0")
         .replace("mass_kg = 2.355", "mass_kg = 9.0");
     std::fs::write(&framed, text).unwrap();
-    let o = aloft(&[
+    let v = ok_json(&[
         "power",
         "--vehicle",
         framed.to_str().unwrap(),
@@ -215,20 +195,13 @@ fn vehicle_files_load_and_bad_files_are_named() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert!((v["thrust_n"].as_f64().unwrap() - (2.0 + 0.676) * 9.8066).abs() < 1e-9);
     assert_eq!(v["battery"].as_str(), Some("TB48D"));
 
     let bad = dir.join("bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[power]\nmass_lb = 3\n").unwrap();
-    let o = aloft(&["power", "--vehicle", bad.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        stderr(&o).contains("mass_lb") && stderr(&o).contains("bad.toml"),
-        "{}",
-        stderr(&o)
-    );
+    let err = refused(&["power", "--vehicle", bad.to_str().unwrap()]);
+    assert!(err.contains("mass_lb") && err.contains("bad.toml"), "{err}");
 }
 
 /// A `--vehicle` that is a path names the missing file; a bare name that is neither a built-in
@@ -240,9 +213,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
         .join("my-quad.toml");
     let path = missing.to_str().unwrap();
     for command in ["power", "endurance", "mission"] {
-        let o = aloft(&[command, "--vehicle", path]);
-        assert_eq!(o.status.code(), Some(2), "{command}: {}", stderr(&o));
-        let err = stderr(&o);
+        let err = refused(&[command, "--vehicle", path]);
         assert!(err.contains("no such file") && err.contains(path), "{err}");
         assert!(!err.contains("built-in"), "{err}");
         assert_eq!(err.lines().count(), 1, "{err}");
@@ -254,9 +225,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
         "{}",
         stderr(&o)
     );
-    let o = aloft(&["endurance", "--vehicle", "dji-m300"]);
-    assert_eq!(o.status.code(), Some(2));
-    let err = stderr(&o);
+    let err = refused(&["endurance", "--vehicle", "dji-m300"]);
     assert!(
         err.contains("dji-m300") && err.contains("dji-m100, dji-m600"),
         "{err}"
@@ -268,9 +237,7 @@ fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
 /// hand, as `paper_val_eq10_hover_induced_velocity_of_the_m100`).
 #[test]
 fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
-    let o = aloft(&["power", "--vehicle", "dji-m100-paper", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["power", "--vehicle", "dji-m100-paper", "--format", "json"]);
     assert_eq!(v["takeoff_mass_kg"].as_f64(), Some(3.29));
     assert!((v["hover_induced_velocity_mps"].as_f64().unwrap() - 11.9034).abs() < 1e-4);
     let o = aloft(&["power", "--vehicle", "dji-m100-paper"]);
@@ -282,9 +249,8 @@ fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
         stdout(&o)
     );
     // It has no airframe: the planner's commands say so.
-    let o = aloft(&["endurance", "--vehicle", "dji-m100-paper"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("[airframe]"), "{}", stderr(&o));
+    let err = refused(&["endurance", "--vehicle", "dji-m100-paper"]);
+    assert!(err.contains("[airframe]"), "{err}");
 }
 
 #[test]
@@ -332,12 +298,10 @@ fn batch_mode_streams_csv_and_reports_bad_rows() {
 
     let missing = dir.join("missing.csv");
     std::fs::write(&missing, "airspeed_mps,pitch_deg\n1,2\n").unwrap();
-    let o = aloft(&["power", "--input", missing.to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("roll_deg"), "{}", stderr(&o));
-    let o = aloft(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("nope.csv"), "{}", stderr(&o));
+    let err = refused(&["power", "--input", missing.to_str().unwrap()]);
+    assert!(err.contains("roll_deg"), "{err}");
+    let err = refused(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
+    assert!(err.contains("nope.csv"), "{err}");
 }
 
 #[test]
@@ -378,9 +342,7 @@ fn broken_pipe_exits_quietly() {
 
 #[test]
 fn vehicles_lists_the_builtins() {
-    let o = aloft(&["vehicles", "--format", "json"]);
-    assert!(o.status.success());
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["vehicles", "--format", "json"]);
     let names: Vec<&str> = v
         .as_array()
         .unwrap()
@@ -432,7 +394,7 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
     // 3 kW, draws 42.5 A per pack, dissipates 505 W in the packs, flies a little over 9 min.
     // Tolerances are the issue's (10 %, 10 %, 15 %, 9-10.5 min); heat and time are not independent
     // of the pack resistance and capacity derived from the same sentence (see aec-quadrotor.toml).
-    let o = aloft(&[
+    let v = ok_json(&[
         "propulsion",
         "--vehicle",
         "aec-quadrotor",
@@ -441,20 +403,8 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let get = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("missing {k}"));
-    for k in [
-        "takeoff_mass_kg",
-        "thrust_per_rotor_n",
-        "rotor_speed_rpm",
-        "motor_current_a",
-        "pack_current_a",
-        "power_required_w",
-        "power_drawn_w",
-        "battery_heat_w",
-        "flight_time_min",
-    ] {
+    for k in common::HOVER_KEYS {
         get(k);
     }
     assert!((get("power_required_w") / 3000.0 - 1.0).abs() <= 0.10);
@@ -465,9 +415,7 @@ fn paper_val_propulsion_worked_example_from_the_cli() {
 
 #[test]
 fn rotor_mn1806_settles_within_the_issue_band() {
-    let o = aloft(&["rotor", "--rotor", "mn1806-6x2", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v = ok_json(&["rotor", "--rotor", "mn1806-6x2", "--format", "json"]);
     for k in [
         "motor_inertia_kgm2",
         "prop_inertia_kgm2",

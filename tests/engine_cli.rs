@@ -1,38 +1,10 @@
 //! `aloft::engine` is a drop-in for the CLI's JSON: for the same inputs its summaries serialise to
 //! exactly what `aloft mission --format json` and `aloft endurance --format json` print.
 
-use std::process::Command;
+mod common;
+use common::{cli, uniform_wind as wind};
 
-use aloft::engine::{
-    endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle, WindProfileKind,
-    WindSpec,
-};
-
-fn cli(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft");
-    assert!(
-        out.status.code() == Some(0) || out.status.code() == Some(1),
-        "aloft {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("UTF-8")
-}
-
-fn wind(speed_mps: f64, from_deg: f64) -> Option<WindSpec> {
-    Some(WindSpec {
-        speed_mps,
-        from_deg,
-        profile: WindProfileKind::Uniform,
-        reference_height_m: None,
-        exponent: None,
-        roughness_m: None,
-        gust_std_mps: None,
-        gust_seed: None,
-    })
-}
+use aloft::engine::{endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle};
 
 #[test]
 fn mission_summary_is_the_cli_json() {

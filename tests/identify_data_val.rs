@@ -4,48 +4,12 @@
 //! (issue 5). PX4 quadrotor: fit and validate across its five flights; figures reported, no target.
 //! Data from `ALOFT_DATA_DIR` (default `../shared/data`).
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
+use common::ok_stdout as aloft;
 
-fn data_dir() -> PathBuf {
-    let dir = std::env::var("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need ../shared/data",
-        dir.display()
-    );
-    dir
-}
-
+/// The `<prefix>*<suffix>` files of the data folder `folder`, as command-line words.
 fn files(folder: &str, prefix: &str, suffix: &str) -> Vec<String> {
-    let dir = data_dir().join(folder);
-    let mut out: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let n = p.file_name().unwrap().to_str().unwrap();
-            n.starts_with(prefix) && n.ends_with(suffix)
-        })
-        .map(|p| p.display().to_string())
-        .collect();
-    out.sort();
-    assert!(!out.is_empty(), "no {prefix}*{suffix} in {}", dir.display());
-    out
-}
-
-fn aloft(args: &[String]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "aloft {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
+    common::strings(&common::files_like(folder, prefix, suffix))
 }
 
 fn args(words: &[&str], logs: &[String], rest: &[&str]) -> Vec<String> {

@@ -2,17 +2,13 @@
 //! input ends with exit 2 and one stderr line naming what is wrong, in bounded time and memory;
 //! never a signal, never NaN or inf in an output.
 
+mod common;
+use common::aloft;
+
 use std::io::Write as _;
 use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
 
 /// `aloft args` under a virtual-memory limit (KiB) and a time limit: its exit code (None for a
 /// signal, or when it had to be killed), stderr, and how long it took.

@@ -12,52 +12,17 @@
 //! The fits and validations run once (a `OnceLock`) and the tests read the shared result. Data
 //! from `ALOFT_DATA_DIR` (default `../shared/data`).
 
-use std::path::PathBuf;
-use std::process::Command;
+mod common;
+use common::ok_json as aloft;
+
 use std::sync::OnceLock;
 
-const DAYS: [&str; 3] = ["2018-08-03", "2018-08-06", "2018-08-08"];
-
-fn data_dir() -> PathBuf {
-    let dir = std::env::var("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need ../shared/data",
-        dir.display()
-    );
-    dir
-}
-
+/// The flights of one day, as command-line words.
 fn kaist(day: &str) -> Vec<String> {
-    let dir = data_dir().join("kaist_energy_drone");
-    let mut out: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let n = p.file_name().unwrap().to_str().unwrap();
-            n.starts_with(day) && n.ends_with(".csv")
-        })
-        .map(|p| p.display().to_string())
-        .collect();
-    out.sort();
-    assert!(!out.is_empty(), "no {day}*.csv in {}", dir.display());
-    out
+    common::strings(&common::files_like("kaist_energy_drone", day, ".csv"))
 }
 
-fn aloft(args: &[String]) -> serde_json::Value {
-    let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "aloft {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
+const DAYS: [&str; 3] = ["2018-08-03", "2018-08-06", "2018-08-08"];
 
 fn words(w: &[&str]) -> Vec<String> {
     w.iter().map(|s| s.to_string()).collect()

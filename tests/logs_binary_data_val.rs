@@ -3,16 +3,15 @@
 //! 1.3.0, pymavlink 2.4.50), recomputed by those readers here when Python has them, and the
 //! `ardupilot-binlog` crate's decoding of every DataFlash record aloft uses.
 
+mod common;
+use common::data_dir;
+
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::Command;
 
 use aloft_logs::dataflash::DataflashRecords;
 use aloft_logs::{read_dataflash, read_ulog, BinaryLog, BinaryOptions};
-
-fn data_dir() -> PathBuf {
-    PathBuf::from(std::env::var("ALOFT_DATA_DIR").unwrap_or_else(|_| "../shared/data".into()))
-}
 
 fn path(name: &str) -> PathBuf {
     data_dir().join("flight_logs").join(name)

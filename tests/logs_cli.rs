@@ -1,42 +1,27 @@
 //! End-to-end `aloft log info` and `aloft convert`: output keys, exit codes, and clean failures.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, ok_json, refused, stderr};
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("fixtures/logs")
-        .join(name)
-        .display()
-        .to_string()
+    common::fixture("logs", name).display().to_string()
 }
 
 fn tmp(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("logs_cli-{}-{name}", std::process::id()))
 }
 
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 #[test]
 fn log_info_json_reports_duration_rates_and_energy() {
-    let o = aloft(&[
+    let j = ok_json(&[
         "log",
         "info",
         &fixture("kaist_small.csv"),
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["format"], "csv");
     assert_eq!(j["profile"], "kaist");
     assert_eq!(j["samples"], 20);
@@ -112,9 +97,7 @@ fn log_info_of_a_mission_mcap_has_the_time_series_rows() {
         .map(|k| 0.5 * (v[k - 1] * i[k - 1] + v[k] * i[k]) * (t[k] - t[k - 1]))
         .sum::<f64>()
         / 3600.0;
-    let o = aloft(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", mcap.to_str().unwrap(), "--format", "json"]);
     assert_eq!(j["samples"], t.len() as u64);
     assert_eq!(j["time"]["non_monotonic_count"], 0);
     assert_eq!(j["time"]["gap_count"], 0);
@@ -178,9 +161,7 @@ fn bad_inputs_exit_2_with_the_file_named() {
             "flight.mcap",
         ),
     ] {
-        let o = aloft(&args);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-        let e = stderr(&o);
+        let e = refused(&args);
         assert!(e.contains(needle), "{args:?}: {e}");
         assert!(!e.contains("panicked"), "{e}");
     }
@@ -189,7 +170,7 @@ fn bad_inputs_exit_2_with_the_file_named() {
 #[test]
 fn convert_writes_mcap_that_reads_back() {
     let out = tmp("conv.mcap");
-    let o = aloft(&[
+    let j = ok_json(&[
         "convert",
         &fixture("custom.csv"),
         "--profile",
@@ -199,12 +180,8 @@ fn convert_writes_mcap_that_reads_back() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["samples"], 10);
-    let o = aloft(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
     assert_eq!(j["format"], "mcap");
     let topics: Vec<&str> = j["topics"]
         .as_array()
@@ -224,7 +201,7 @@ fn convert_writes_mcap_that_reads_back() {
 #[test]
 fn failed_convert_leaves_no_output_file() {
     let out = tmp("bad.mcap");
-    let o = aloft(&[
+    let err = refused(&[
         "convert",
         &fixture("custom_bad_number.csv"),
         "--profile",
@@ -232,8 +209,7 @@ fn failed_convert_leaves_no_output_file() {
         "-o",
         out.to_str().unwrap(),
     ]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("row 6"), "{}", stderr(&o));
+    assert!(err.contains("row 6"), "{err}");
     assert!(!out.exists());
 }
 
@@ -263,9 +239,7 @@ fn the_old_lag_flag_of_log_info_names_max_lag() {
     for (args, value) in [(&["--lag", "5"][..], "5"), (&["--lag"][..], "MAX_S")] {
         let mut all = vec!["log", "info", "x.csv"];
         all.extend_from_slice(args);
-        let o = aloft(&all);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-        let e = stderr(&o);
+        let e = refused(&all);
         assert_eq!(e.lines().count(), 1, "{e}");
         assert!(
             e.contains("--lag of log info is now --max-lag")
@@ -275,9 +249,7 @@ fn the_old_lag_flag_of_log_info_names_max_lag() {
     }
     // The window under its new name (and a lag estimated within it).
     let log = fixture("kaist_small.csv");
-    let o = aloft(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let j = ok_json(&["log", "info", &log, "--max-lag", "0.3", "--format", "json"]);
     assert!(
         j["lag"]["lag_s"].as_f64().unwrap().abs() <= 0.3 + 1e-9,
         "{}",

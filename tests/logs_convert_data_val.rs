@@ -4,35 +4,13 @@
 //!
 //! Run with `--nocapture` to see the figures of every log.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::files;
+
+use std::path::Path;
 
 use aloft::engine::{convert_log, log_info, LogInfo, LogReadOptions};
 use aloft_logs::{read_log, McapOptions};
-
-/// `ALOFT_DATA_DIR`, or `../shared/data` from the workspace root. Panics when missing: these
-/// tests must not pass silently without data.
-fn data_dir() -> PathBuf {
-    let dir = match std::env::var_os("ALOFT_DATA_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    };
-    assert!(
-        dir.is_dir(),
-        "real-data directory {} not found: set ALOFT_DATA_DIR to the shared data folder",
-        dir.display()
-    );
-    dir
-}
-
-fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(data_dir().join(sub))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
-        .collect();
-    v.sort();
-    v
-}
 
 fn name(p: &Path) -> String {
     p.file_name().unwrap().to_string_lossy().into_owned()

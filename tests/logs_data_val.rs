@@ -4,36 +4,14 @@
 //!
 //! Run with `--nocapture` to see the figures each test reports.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::files;
+
+use std::path::Path;
 
 use aloft_logs::{
     estimate_lag_s, read_log, InfoAccumulator, LogError, McapOptions, McapSamples, Profile,
 };
-
-/// `ALOFT_DATA_DIR`, or `../shared/data` from the workspace root. Panics when missing: these
-/// tests must not pass silently without data.
-fn data_dir() -> PathBuf {
-    let dir = match std::env::var_os("ALOFT_DATA_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    };
-    assert!(
-        dir.is_dir(),
-        "real-data directory {} not found: set ALOFT_DATA_DIR to the shared data folder",
-        dir.display()
-    );
-    dir
-}
-
-fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(data_dir().join(sub))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
-        .collect();
-    v.sort();
-    v
-}
 
 #[test]
 fn data_val_mcap_foreign_decodes_all_poses_on_cub1() {

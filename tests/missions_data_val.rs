@@ -11,27 +11,15 @@
 //! Vincenty's formula, so the tolerance is 1e-4 relative (a tenth of a metre on a kilometre).
 //! Heights are sums of exact file values: 1e-9 m.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::data_dir;
+
+use std::path::PathBuf;
 
 use aloft::engine::{
     plan_mission, ItemCounts, Mission, MissionOptions, Plan, SourceFormat, Vehicle,
 };
 use serde_json::Value;
-
-/// `ALOFT_DATA_DIR`, or `../shared/data` from the workspace root. Panics when missing: these
-/// tests must not pass silently without data.
-fn data_dir() -> PathBuf {
-    let dir = match std::env::var_os("ALOFT_DATA_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    };
-    assert!(
-        dir.is_dir(),
-        "real-data directory {} not found: set ALOFT_DATA_DIR to the shared data folder",
-        dir.display()
-    );
-    dir
-}
 
 fn path(name: &str) -> PathBuf {
     data_dir().join("missions").join(name)

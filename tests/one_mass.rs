@@ -4,34 +4,14 @@
 //! vehicle and every pack. The expected hover power is computed here in closed form from the
 //! constants of the vehicle files, read as plain TOML (not through aloft's vehicle types).
 
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, cli, ok_json as json, refused};
 
 use toml::Value;
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-/// The JSON answer of a successful run.
-fn json(args: &[&str]) -> serde_json::Value {
-    let o = aloft(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    serde_json::from_slice(&o.stdout).unwrap()
-}
-
 /// The vehicle file of a built-in, as plain TOML.
 fn fixture(name: &str) -> Value {
-    let path = format!(
-        "{}/fixtures/vehicles/{name}.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let path = common::fixture("vehicles", &format!("{name}.toml"));
     toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
@@ -97,6 +77,11 @@ fn chain_hover_w(propulsion: &Value, mass_kg: f64) -> f64 {
 
 fn close(got: f64, want: f64, rel: f64) -> bool {
     (got / want - 1.0).abs() <= rel
+}
+
+/// Asserts `close(got, want, rel)`, naming both values.
+fn assert_close(got: f64, want: f64, rel: f64) {
+    assert!(close(got, want, rel), "{got} vs {want} (rel {rel})");
 }
 
 /// Every built-in vehicle with an airframe, every pack, with and without payload: `aloft power`
@@ -179,9 +164,9 @@ fn the_default_is_airframe_plus_default_pack_and_the_tables_say_so() {
     let m100 = fixture("dji-m100");
     let mass = takeoff_mass_kg(&m100, "TB47D", 0.0);
     let p = json(&["power", "--format", "json"]);
-    assert!(close(p["takeoff_mass_kg"].as_f64().unwrap(), mass, 1e-12));
+    assert_close(p["takeoff_mass_kg"].as_f64().unwrap(), mass, 1e-12);
     let expected = four_term_hover_w(&m100["power"], mass);
-    assert!(close(p["electrical_w"].as_f64().unwrap(), expected, 1e-9));
+    assert_close(p["electrical_w"].as_f64().unwrap(), expected, 1e-9);
     let line = "take-off mass 2.355 kg (airframe 1.755 kg + TB47D 0.600 kg + payload 0.000 kg)";
     for command in ["power", "endurance"] {
         let o = aloft(&[command]);
@@ -203,27 +188,28 @@ fn aec_quadrotor_answers_endurance_and_mission() {
         "--format",
         "json",
     ]);
-    assert!(close(
+    assert_close(
         e["takeoff_mass_kg"].as_f64().unwrap(),
         16.5 * 0.45359237,
-        1e-9
-    ));
-    assert_eq!(e["battery"].as_str(), Some("4xTP8000-5S4PL"));
-    let m = aloft(&["mission", "--vehicle", "aec-quadrotor", "--format", "json"]);
-    assert!(
-        matches!(m.status.code(), Some(0 | 1)),
-        "{}",
-        String::from_utf8_lossy(&m.stderr)
+        1e-9,
     );
-    let s: serde_json::Value = serde_json::from_slice(&m.stdout).unwrap();
-    assert!(close(
+    assert_eq!(e["battery"].as_str(), Some("4xTP8000-5S4PL"));
+    // Exit 0 or 1: feasible or not, the mission is answered.
+    let s: serde_json::Value = serde_json::from_str(&cli(&[
+        "mission",
+        "--vehicle",
+        "aec-quadrotor",
+        "--format",
+        "json",
+    ]))
+    .unwrap();
+    assert_close(
         s["takeoff_mass_kg"].as_f64().unwrap(),
         16.5 * 0.45359237,
-        1e-9
-    ));
-    let o = aloft(&["power", "--vehicle", "aec-quadrotor"]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("[power]"));
+        1e-9,
+    );
+    let err = refused(&["power", "--vehicle", "aec-quadrotor"]);
+    assert!(err.contains("[power]"));
 }
 
 /// The seed's 3.29 kg is the named validation case `dji-m100-paper`: a power model alone, whose
@@ -241,19 +227,13 @@ fn paper_case_is_a_power_model_alone() {
         "--format",
         "json",
     ]);
-    assert!(close(
-        p["takeoff_mass_kg"].as_f64().unwrap(),
-        3.29 + 0.5,
-        1e-12
-    ));
+    assert_close(p["takeoff_mass_kg"].as_f64().unwrap(), 3.29 + 0.5, 1e-12);
     assert!(p.get("battery").is_none());
     let expected = four_term_hover_w(&paper["power"], 3.79);
-    assert!(close(p["electrical_w"].as_f64().unwrap(), expected, 1e-9));
+    assert_close(p["electrical_w"].as_f64().unwrap(), expected, 1e-9);
     // The planner names the first table it misses ([airframe], or the [[battery]] packs).
     for command in ["endurance", "mission"] {
-        let o = aloft(&[command, "--vehicle", "dji-m100-paper"]);
-        assert_eq!(o.status.code(), Some(2), "{command}");
-        let err = String::from_utf8_lossy(&o.stderr);
+        let err = refused(&[command, "--vehicle", "dji-m100-paper"]);
         assert!(
             err.contains("dji-m100-paper' has no [") && err.contains("mission planner"),
             "{err}"
@@ -261,33 +241,43 @@ fn paper_case_is_a_power_model_alone() {
     }
 }
 
+/// The small KAIST log of the fixtures.
+const KAIST_SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
+
+/// `command flag <the small KAIST log> --profile kaist --lag 0 --vehicle dji-m100 extra...`.
+fn on_kaist_small<'a>(command: &'a str, flag: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let base = [
+        command,
+        flag,
+        KAIST_SMALL,
+        "--profile",
+        "kaist",
+        "--lag",
+        "0",
+    ];
+    [&base[..], &["--vehicle", "dji-m100"], extra].concat()
+}
+
 /// `aloft validate` flies the take-off mass of `--battery` and `--payload-kg` too: a heavier
 /// vehicle predicts more energy for the same logged flight, and the JSON names the mass.
 #[test]
 fn validate_flies_the_takeoff_mass_it_is_given() {
-    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
     let run = |extra: &[&str]| {
-        let base = ["validate", "--log", log, "--profile", "kaist", "--lag", "0"];
-        let args = [
-            &base[..],
-            &["--vehicle", "dji-m100", "--format", "json"],
-            extra,
-        ]
-        .concat();
-        json(&args)
+        let extra = [&["--format", "json"][..], extra].concat();
+        json(&on_kaist_small("validate", "--log", &extra))
     };
     let light = run(&[]);
     let heavy = run(&["--battery", "TB48D", "--payload-kg", "0.3"]);
-    assert!(close(
+    assert_close(
         light["takeoff_mass_kg"].as_f64().unwrap(),
         1.755 + 0.600,
-        1e-12
-    ));
-    assert!(close(
+        1e-12,
+    );
+    assert_close(
         heavy["takeoff_mass_kg"].as_f64().unwrap(),
         1.755 + 0.676 + 0.3,
-        1e-12
-    ));
+        1e-12,
+    );
     let energy = |v: &serde_json::Value| v["flights"][0]["predicted_energy_wh"].as_f64().unwrap();
     assert!(
         energy(&heavy) > energy(&light),
@@ -295,48 +285,22 @@ fn validate_flies_the_takeoff_mass_it_is_given() {
         energy(&heavy),
         energy(&light)
     );
-    let o = aloft(&[
-        "validate",
-        "--log",
-        log,
-        "--profile",
-        "kaist",
-        "--lag",
-        "0",
-        "--vehicle",
-        "dji-m100",
-        "--payload-kg",
-        "2",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("3.600 kg limit"));
+    let err = refused(&on_kaist_small("validate", "--log", &["--payload-kg", "2"]));
+    assert!(err.contains("3.600 kg limit"));
 }
 
 /// `aloft mission --replay` flies the take-off mass of `--battery` and `--payload-kg` (before,
 /// `--battery` was refused there and the default pack flown).
 #[test]
 fn replay_flies_the_takeoff_mass_it_is_given() {
-    let log = concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/logs/kaist_small.csv");
-    let r = json(&[
-        "mission",
-        "--replay",
-        log,
-        "--profile",
-        "kaist",
-        "--lag",
-        "0",
-        "--vehicle",
-        "dji-m100",
+    let extra = [
         "--battery",
         "TB48D",
         "--payload-kg",
         "0.1",
         "--format",
         "json",
-    ]);
-    assert!(close(
-        r["mass_kg"].as_f64().unwrap(),
-        1.755 + 0.676 + 0.1,
-        1e-12
-    ));
+    ];
+    let r = json(&on_kaist_small("mission", "--replay", &extra));
+    assert_close(r["mass_kg"].as_f64().unwrap(), 1.755 + 0.676 + 0.1, 1e-12);
 }

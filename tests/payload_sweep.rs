@@ -2,11 +2,11 @@
 //! `payload_sweep`): each row is the endurance answer at that payload, the curves stop at the
 //! maximum take-off mass with a note, and the CLI's table, JSON, CSV, chart and refusals.
 
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, ok_stdout as stdout_of};
 
 use aloft::engine::{
     endurance, payload_sweep, EnduranceOptions, PayloadCurve, PayloadSweep, Vehicle,
-    WindProfileKind, WindSpec,
 };
 use aloft::vehicle::VehicleFile;
 
@@ -18,16 +18,7 @@ fn m100() -> Vehicle {
 /// reserve and an orbit.
 fn windy() -> EnduranceOptions {
     EnduranceOptions {
-        wind: Some(WindSpec {
-            speed_mps: 5.0,
-            from_deg: 30.0,
-            profile: WindProfileKind::Uniform,
-            reference_height_m: None,
-            exponent: None,
-            roughness_m: None,
-            gust_std_mps: None,
-            gust_seed: None,
-        }),
+        wind: common::uniform_wind(5.0, 30.0),
         course_deg: 90.0,
         reserve_percent: 20.0,
         orbit_radius_m: Some(40.0),
@@ -211,24 +202,6 @@ fn every_number_of_a_sweep_is_finite_and_none_is_null() {
 }
 
 // ---- the command line ----
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft")
-}
-
-fn stdout_of(args: &[&str]) -> String {
-    let o = aloft(args);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
-}
 
 /// Exit 2, exactly one stderr line holding every needle, nothing on stdout, no panic.
 fn assert_refused(args: &[&str], needles: &[&str]) {

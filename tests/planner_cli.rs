@@ -1,23 +1,12 @@
 //! End-to-end checks of `aloft mission` and `aloft endurance`: outputs, JSON keys, exit codes.
 
+mod common;
+use common::run as aloft;
+
 use std::process::Command;
 
-fn aloft(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 fn tmp(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("aloft-planner-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("planner-cli", name)
 }
 
 #[test]

@@ -4,7 +4,8 @@
 //! power seed eq (6) with the vehicle file's constants, solved by bisection in the test). A wind
 //! beyond the vehicle is an infeasible mission (exit 1 with the answer), never "bad input".
 
-use std::process::Command;
+mod common;
+use common::run as aloft;
 
 use aloft::power::ModelOptions;
 use aloft::vehicle::VehicleFile;
@@ -223,18 +224,6 @@ fn an_orbit_too_tight_for_its_speed_is_flown_at_the_speed_the_bank_allows() {
     // Three laps of 62.8 m at `want` instead of 10 m/s.
     let laps_m = 3.0 * std::f64::consts::TAU * 10.0;
     assert!((orbit.time_lost_s - (laps_m / want - laps_m / 10.0)).abs() < 3.0);
-}
-
-fn aloft(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
 }
 
 #[test]

@@ -3,32 +3,15 @@
 //!
 //! Protocol: every fit uses the even rows of a run and is judged on the odd rows it never saw.
 
+mod common;
+use common::data_dir;
+
 use aloft_propulsion::fit::motor::{fit_motor, LossForm};
 use aloft_propulsion::fit::propeller::{fit_static_table, fit_thrust_stand};
 use aloft_propulsion::motor::kt_nm_per_a;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const GRAVITY_MPS2: f64 = 9.80665;
-
-/// `ALOFT_DATA_DIR`, or `../shared/data` relative to the workspace root. Panics with a clear
-/// message when missing: these tests must not silently pass without data.
-fn data_dir() -> PathBuf {
-    let dir = match std::env::var_os("ALOFT_DATA_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => {
-            // The workspace root is the first ancestor of the manifest dir holding `fixtures/`.
-            let mut root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-            while !root.join("fixtures").is_dir() && root.pop() {}
-            root.join("../shared/data")
-        }
-    };
-    assert!(
-        dir.is_dir(),
-        "real-data directory {} not found: set ALOFT_DATA_DIR to the shared data folder",
-        dir.display()
-    );
-    dir
-}
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))

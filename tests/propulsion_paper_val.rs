@@ -2,6 +2,8 @@
 //! (`../shared/seeds/propulsion-system-design.txt`, `rotor-transient-response.txt`), plus the
 //! typed errors for bad input.
 
+mod common;
+
 use aloft::vehicle::VehicleFile;
 use aloft_propulsion::battery::{Battery, InternalResistance};
 use aloft_propulsion::motor::{kt_oz_in_per_a, KV_KT_HOBBY};
@@ -76,17 +78,7 @@ fn paper_val_worked_example_aec_quadrotor() {
     assert!(h.motor_current_a < 55.0);
     // JSON contract keys.
     let json = serde_json::to_value(h).unwrap();
-    for key in [
-        "takeoff_mass_kg",
-        "thrust_per_rotor_n",
-        "rotor_speed_rpm",
-        "motor_current_a",
-        "pack_current_a",
-        "power_required_w",
-        "power_drawn_w",
-        "battery_heat_w",
-        "flight_time_min",
-    ] {
+    for key in common::HOVER_KEYS {
         assert!(json.get(key).and_then(|v| v.as_f64()).is_some(), "{key}");
     }
 }

@@ -4,6 +4,9 @@
 //!
 //! Data from `ALOFT_DATA_DIR` (default `../shared/data` from the workspace root).
 
+mod common;
+use common::files_like;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -12,32 +15,9 @@ use aloft::power::fit::FitParameter;
 use aloft::power::{fit_drag, fit_power_model, FitOptions};
 use aloft::vehicle::VehicleFile;
 
-fn data_dir() -> PathBuf {
-    let dir = std::env::var("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need the shared data \
-         (set ALOFT_DATA_DIR or place it at ../shared/data)",
-        dir.display()
-    );
-    dir
-}
-
+/// The KAIST flights `<prefix>*.csv`.
 fn kaist(prefix: &str) -> Vec<PathBuf> {
-    let dir = data_dir().join("kaist_energy_drone");
-    let mut out: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let n = p.file_name().unwrap().to_str().unwrap();
-            n.starts_with(prefix) && n.ends_with(".csv")
-        })
-        .collect();
-    out.sort();
-    assert!(!out.is_empty(), "no {prefix}*.csv in {}", dir.display());
-    out
+    files_like("kaist_energy_drone", prefix, ".csv")
 }
 
 /// The fitted vehicle file (TOML text) from the 2018-08-03 flights: drag from the force balance

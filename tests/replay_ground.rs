@@ -5,17 +5,12 @@
 //! trapezoids of the rows' V x I, the predicted airborne power from the four-term model in
 //! closed form at hover.
 
+mod common;
+use common::{aloft, ok_json};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("aloft runs")
-}
 
 fn dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("aloft-replay-ground-{}-{name}", std::process::id()));
@@ -104,6 +99,29 @@ fn num(v: &Value, key: &str) -> f64 {
         .unwrap_or_else(|| panic!("{key} missing in {v}"))
 }
 
+/// The test vehicle, written into the folder `d`.
+fn vehicle_in(d: &Path) -> PathBuf {
+    let vehicle = d.join("vehicle.toml");
+    std::fs::write(&vehicle, VEHICLE).unwrap();
+    vehicle
+}
+
+/// The JSON of `aloft mission --replay csv --profile profile --vehicle <the test vehicle>
+/// extra... --format json`, which must succeed.
+fn replay_json(d: &Path, csv: &Path, profile: &str, extra: &[&str]) -> Value {
+    let vehicle = vehicle_in(d);
+    let base = [
+        "mission",
+        "--replay",
+        csv.to_str().unwrap(),
+        "--profile",
+        profile,
+        "--vehicle",
+        vehicle.to_str().unwrap(),
+    ];
+    ok_json(&[&base[..], extra, &["--format", "json"]].concat())
+}
+
 fn close(a: f64, b: f64, rel: f64, what: &str) {
     assert!(
         (a - b).abs() <= rel * b.abs().max(1e-12),
@@ -115,27 +133,7 @@ fn close(a: f64, b: f64, rel: f64, what: &str) {
 fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
     let d = dir("two");
     let csv = kaist_csv(&d);
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
-    let out = aloft(&[
-        "mission",
-        "--replay",
-        csv.to_str().unwrap(),
-        "--profile",
-        "kaist",
-        "--vehicle",
-        vehicle.to_str().unwrap(),
-        "--lag",
-        "0",
-        "--format",
-        "json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = replay_json(&d, &csv, "kaist", &["--lag", "0"]);
 
     // Detected (the CSV has no landed state) at the rows where the stretches change: take-off at
     // the first airborne row, landing at the first ground row. Row times are multiples of 0.1 s
@@ -148,32 +146,23 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
         assert!((num(s, "start_s") - a).abs() < 1e-6, "{s}");
         assert!((num(s, "end_s") - b).abs() < 1e-6, "{s}");
     }
+    // The key of the answer to 1e-9, relative.
+    let close_v = |key: &str, want: f64, what: &str| close(num(&v, key), want, 1e-9, what);
     // The span is the first to the last row, 0 to 129.9 s.
     let (air_s, ground_s) = (70.0, 129.9 - 70.0);
-    close(num(&v, "duration_s"), 129.9, 1e-9, "duration_s");
-    close(num(&v, "airborne_s"), air_s, 1e-9, "airborne_s");
-    close(num(&v, "ground_s"), ground_s, 1e-9, "ground_s");
+    close_v("duration_s", 129.9, "duration_s");
+    close_v("airborne_s", air_s, "airborne_s");
+    close_v("ground_s", ground_s, "ground_s");
 
     // Measured: trapezoids of the rows over each part. The ground stretches end at a take-off
     // row, so each of the two holds one 0.1 s interval that ramps from 15 W to 1200 W.
     let ground_j = measured_j(0.0, 20.0) + measured_j(60.0, 80.0) + measured_j(110.0, 129.9);
     let air_j = measured_j(20.0, 60.0) + measured_j(80.0, 110.0);
-    close(
-        num(&v, "measured_ground_energy_wh"),
-        ground_j / 3600.0,
-        1e-9,
-        "ground",
-    );
-    close(
-        num(&v, "measured_airborne_energy_wh"),
-        air_j / 3600.0,
-        1e-9,
-        "air",
-    );
-    close(
-        num(&v, "measured_energy_wh"),
+    close_v("measured_ground_energy_wh", ground_j / 3600.0, "ground");
+    close_v("measured_airborne_energy_wh", air_j / 3600.0, "air");
+    close_v(
+        "measured_energy_wh",
         (ground_j + air_j) / 3600.0,
-        1e-9,
         "measured",
     );
     // Idle: the ground energy over the ground time; the two ramps add 2 x 59.25 J over 59.9 s
@@ -187,28 +176,24 @@ fn ground_time_before_between_and_after_two_flights_is_priced_at_idle() {
 
     // Predicted: the hover power on the airborne time only, the ground at idle.
     let hover = hover_w();
-    close(
-        num(&v, "predicted_airborne_energy_wh"),
+    close_v(
+        "predicted_airborne_energy_wh",
         hover * air_s / 3600.0,
-        1e-9,
         "predicted airborne",
     );
-    close(
-        num(&v, "predicted_ground_energy_wh"),
+    close_v(
+        "predicted_ground_energy_wh",
         ground_j / 3600.0,
-        1e-9,
         "predicted ground",
     );
-    close(
-        num(&v, "predicted_energy_wh"),
+    close_v(
+        "predicted_energy_wh",
         (hover * air_s + ground_j) / 3600.0,
-        1e-9,
         "predicted",
     );
-    close(
-        num(&v, "airborne_energy_error_percent"),
+    close_v(
+        "airborne_energy_error_percent",
         100.0 * (hover * air_s - air_j) / air_j,
-        1e-9,
         "airborne error",
     );
     // Flying the whole record would have cost the hover power over the ground time as well.
@@ -234,25 +219,7 @@ fn ground_time_is_free_when_the_log_has_no_power() {
         "name = \"no power\"\n[time]\ncolumn = \"t_s\"\nunit = \"s\"\n[position]\ntype = \"local\"\ncolumns = [\"x\", \"y\", \"z\"]\nframe = \"enu\"\nunit = \"m\"\n[velocity]\ncolumns = [\"vx\", \"vy\", \"vz\"]\nframe = \"enu\"\nunit = \"m/s\"\n",
     )
     .unwrap();
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
-    let out = aloft(&[
-        "mission",
-        "--replay",
-        csv.to_str().unwrap(),
-        "--profile",
-        map.to_str().unwrap(),
-        "--vehicle",
-        vehicle.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = replay_json(&d, &csv, map.to_str().unwrap(), &[]);
     assert_eq!(v["flights"], 2);
     close(num(&v, "airborne_s"), 70.0, 1e-9, "airborne_s");
     assert_eq!(num(&v, "predicted_ground_energy_wh"), 0.0);
@@ -315,13 +282,7 @@ fn battery_with_replay_is_part_of_the_mass_and_an_unknown_one_is_bad_input() {
         "--format",
         "json",
     ]);
-    let out = aloft(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = ok_json(&args);
     assert_eq!(v["battery"], "TB48D");
     close(num(&v, "mass_kg"), airframe + pack + 0.25, 1e-12, "mass_kg");
     // The table prints the mass and the pack.
@@ -336,8 +297,7 @@ fn battery_with_replay_is_part_of_the_mass_and_an_unknown_one_is_bad_input() {
     );
 
     // Bad input: exit 2 with one line naming the value.
-    let vehicle = d.join("vehicle.toml");
-    std::fs::write(&vehicle, VEHICLE).unwrap();
+    let vehicle = vehicle_in(&d);
     let vehicle = vehicle.to_str().unwrap();
     for (extra, needle) in [
         (["--vehicle", "dji-m100", "--battery", "NOPE"], "NOPE"),

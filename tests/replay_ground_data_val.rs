@@ -10,23 +10,13 @@
 //!
 //! Data from `ALOFT_DATA_DIR` (default `../shared/data` from the workspace root).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::{data_dir, ok_json as aloft_json};
+
+use std::path::Path;
 
 use aloft_logs::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Span};
 use serde_json::Value;
-
-fn data_dir() -> PathBuf {
-    let dir = std::env::var("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need the shared data",
-        dir.display()
-    );
-    dir
-}
 
 const FLUGDROHNE: [&str; 5] = [
     "1x_wo_Last_5m",
@@ -223,19 +213,6 @@ fn data_val_ardupilot_airborne_spans_match_the_arming_and_landing_events() {
         );
         assert_same_spans(name, &ours, &theirs, 1e-6);
     }
-}
-
-fn aloft_json(args: &[&str]) -> Value {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
 }
 
 fn spans_json(v: &Value) -> Vec<Span> {

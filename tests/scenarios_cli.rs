@@ -1,19 +1,8 @@
 //! `--samples N` end to end (issue 17): the JSON `uncertainty`, the table's line and bands, the
 //! chart, the endurance percentiles, and bad values exiting 2 with the flag named.
 
-use std::process::Command;
-
-fn aloft(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .expect("run aloft");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::run as aloft;
 
 #[test]
 fn mission_json_carries_the_uncertainty_keys() {

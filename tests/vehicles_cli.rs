@@ -1,20 +1,25 @@
 //! `aloft vehicles calibrate`: a vehicle file from a spec sheet, end to end, and bad spec sheets
 //! refused with exit 2 and one stderr line naming the key.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
+use common::{aloft, ok_json};
 
-fn aloft(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::{Path, PathBuf};
+use std::process::Output;
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("aloft-vehicles-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    common::scratch("vehicles-cli", name)
+}
+
+/// `aloft vehicles calibrate spec -o out`.
+fn calibrate(spec: &Path, out: &Path) -> Output {
+    aloft(&[
+        "vehicles",
+        "calibrate",
+        spec.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ])
 }
 
 const SPEC: &str = r#"
@@ -43,7 +48,7 @@ fn calibrate_writes_a_vehicle_every_command_accepts() {
         "/fixtures/vehicles/specs/dji-m600.toml"
     );
     let out = scratch("m600.toml");
-    let o = aloft(&[
+    let v = ok_json(&[
         "vehicles",
         "calibrate",
         spec,
@@ -52,20 +57,16 @@ fn calibrate_writes_a_vehicle_every_command_accepts() {
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let eta = v["efficiency"].as_f64().unwrap();
     assert!((eta - 0.4995).abs() < 1e-4, "{eta}");
     assert!(!v["defaults"].as_array().unwrap().is_empty());
-    let o = aloft(&[
+    let e = ok_json(&[
         "endurance",
         "--vehicle",
         out.to_str().unwrap(),
         "--format",
         "json",
     ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let e: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let minutes = e["hover_endurance_s"].as_f64().unwrap() / 60.0;
     assert!((minutes - 35.0).abs() < 0.01, "{minutes}");
     let o = aloft(&[
@@ -111,13 +112,7 @@ fn bad_spec_sheets_are_refused_naming_the_key() {
         let path = scratch(&format!("bad{k}.toml"));
         std::fs::write(&path, SPEC.replacen(from, to, 1)).unwrap();
         let out = scratch(&format!("bad{k}-out.toml"));
-        let o = aloft(&[
-            "vehicles",
-            "calibrate",
-            path.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
+        let o = calibrate(&path, &out);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{to}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{to}: {err}");
@@ -128,13 +123,7 @@ fn bad_spec_sheets_are_refused_naming_the_key() {
     let path = scratch("good.toml");
     std::fs::write(&path, SPEC).unwrap();
     let out = scratch("good-out.toml");
-    let o = aloft(&[
-        "vehicles",
-        "calibrate",
-        path.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = calibrate(&path, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
@@ -144,13 +133,7 @@ fn impossible_hover_time_says_the_longest_possible() {
     let path = scratch("long.toml");
     std::fs::write(&path, SPEC.replacen("minutes = 18", "minutes = 40", 1)).unwrap();
     let out = scratch("long-out.toml");
-    let o = aloft(&[
-        "vehicles",
-        "calibrate",
-        path.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let o = calibrate(&path, &out);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2));
     assert!(

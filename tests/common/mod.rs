@@ -1,0 +1,155 @@
+//! Helpers shared by the integration tests: running the `aloft` binary, the shared real-data
+//! folder and the repository's fixtures. Each test file takes what it needs with `mod common;`.
+#![allow(dead_code)] // not every test file uses every helper
+
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the `aloft` binary built for this test with `args`.
+pub fn aloft<S: AsRef<OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(args)
+        .output()
+        .expect("run aloft")
+}
+
+/// The exit code (-1 when killed by a signal), stdout and stderr of `aloft args`.
+pub fn run(args: &[&str]) -> (i32, String, String) {
+    let out = aloft(args);
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The standard output of a run, which must be UTF-8.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).expect("stdout is UTF-8")
+}
+
+/// The standard error of a run, which must be UTF-8.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8(o.stderr.clone()).expect("stderr is UTF-8")
+}
+
+/// The stdout of `aloft args`, which must exit 0 (success) or 1 (a plan that is not feasible).
+pub fn cli(args: &[&str]) -> String {
+    let out = aloft(args);
+    assert!(
+        out.status.code() == Some(0) || out.status.code() == Some(1),
+        "aloft {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8")
+}
+
+/// The stdout of `aloft args`, which must succeed.
+pub fn ok_stdout<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
+    let o = aloft(args);
+    assert!(
+        o.status.success(),
+        "aloft {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).expect("stdout is UTF-8")
+}
+
+/// The JSON answer of `aloft args`, which must succeed.
+pub fn ok_json<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> serde_json::Value {
+    serde_json::from_str(&ok_stdout(args)).expect("stdout is JSON")
+}
+
+/// A file of the repository's `fixtures/<folder>`.
+pub fn fixture(folder: &str, name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures")
+        .join(folder)
+        .join(name)
+}
+
+/// A scratch file `name` in a folder of the system's temporary directory that is this test
+/// process's own (`aloft-<tag>-<pid>`, created if need be).
+pub fn scratch(tag: &str, name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("aloft-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// The shared real-data folder: `ALOFT_DATA_DIR`, or `../shared/data` beside the repository.
+pub fn data_dir() -> PathBuf {
+    let dir = std::env::var_os("ALOFT_DATA_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    assert!(
+        dir.is_dir(),
+        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need the shared data \
+         (set ALOFT_DATA_DIR or place it at ../shared/data)",
+        dir.display()
+    );
+    dir
+}
+
+/// The files of the data folder `sub` whose names pass `filter`, sorted.
+pub fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
+    let dir = data_dir().join(sub);
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The files `<prefix>*<suffix>` of the data folder `sub`, sorted; there must be some.
+pub fn files_like(sub: &str, prefix: &str, suffix: &str) -> Vec<PathBuf> {
+    let v = files(sub, |n| n.starts_with(prefix) && n.ends_with(suffix));
+    assert!(
+        !v.is_empty(),
+        "no {prefix}*{suffix} in {}",
+        data_dir().join(sub).display()
+    );
+    v
+}
+
+/// The same paths as strings, for the command line.
+pub fn strings(paths: &[PathBuf]) -> Vec<String> {
+    paths.iter().map(|p| p.display().to_string()).collect()
+}
+
+/// The stderr of `aloft args`, which must be refused with exit 2.
+pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
+    let o = aloft(args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "aloft {args:?}: {err}");
+    err
+}
+
+/// A uniform wind of `speed_mps` from `from_deg`, without gusts.
+pub fn uniform_wind(speed_mps: f64, from_deg: f64) -> Option<aloft::engine::WindSpec> {
+    Some(aloft::engine::WindSpec {
+        speed_mps,
+        from_deg,
+        profile: aloft::engine::WindProfileKind::Uniform,
+        reference_height_m: None,
+        exponent: None,
+        roughness_m: None,
+        gust_std_mps: None,
+        gust_seed: None,
+    })
+}
+
+/// The keys of a propulsion hover answer (`aloft propulsion --format json`), all numbers.
+pub const HOVER_KEYS: [&str; 9] = [
+    "takeoff_mass_kg",
+    "thrust_per_rotor_n",
+    "rotor_speed_rpm",
+    "motor_current_a",
+    "pack_current_a",
+    "power_required_w",
+    "power_drawn_w",
+    "battery_heat_w",
+    "flight_time_min",
+];
