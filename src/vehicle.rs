@@ -46,32 +46,24 @@ pub struct BuiltinVehicle {
     pub toml: &'static str,
 }
 
+/// A built-in vehicle: its name and the text of `fixtures/vehicles/<name>.toml`.
+macro_rules! builtin {
+    ($name:literal) => {
+        BuiltinVehicle {
+            name: $name,
+            toml: include_str!(concat!("../fixtures/vehicles/", $name, ".toml")),
+        }
+    };
+}
+
 /// The built-in vehicles, the default first.
 pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
-    BuiltinVehicle {
-        name: "dji-m100",
-        toml: include_str!("../fixtures/vehicles/dji-m100.toml"),
-    },
-    BuiltinVehicle {
-        name: "dji-m600",
-        toml: include_str!("../fixtures/vehicles/dji-m600.toml"),
-    },
-    BuiltinVehicle {
-        name: "dji-inspire1",
-        toml: include_str!("../fixtures/vehicles/dji-inspire1.toml"),
-    },
-    BuiltinVehicle {
-        name: "dji-inspire1-pro",
-        toml: include_str!("../fixtures/vehicles/dji-inspire1-pro.toml"),
-    },
-    BuiltinVehicle {
-        name: "aec-quadrotor",
-        toml: include_str!("../fixtures/vehicles/aec-quadrotor.toml"),
-    },
-    BuiltinVehicle {
-        name: "dji-m100-paper",
-        toml: include_str!("../fixtures/vehicles/dji-m100-paper.toml"),
-    },
+    builtin!("dji-m100"),
+    builtin!("dji-m600"),
+    builtin!("dji-inspire1"),
+    builtin!("dji-inspire1-pro"),
+    builtin!("aec-quadrotor"),
+    builtin!("dji-m100-paper"),
 ];
 
 /// Name of the default vehicle.

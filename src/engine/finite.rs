@@ -248,35 +248,27 @@ impl ser::SerializeMap for Part<'_> {
     }
 }
 
-impl ser::SerializeStruct for Part<'_> {
-    type Ok = ();
-    type Error = Found;
-    fn serialize_field<T: Serialize + ?Sized>(
-        &mut self,
-        key: &'static str,
-        value: &T,
-    ) -> Result<(), Found> {
-        self.field(key, value)
-    }
-    fn end(self) -> Result<(), Found> {
-        Ok(())
-    }
+/// The serializers of structs: every field is a part named by its key.
+macro_rules! fields_are_parts {
+    ($($trait:ident),+) => {$(
+        impl ser::$trait for Part<'_> {
+            type Ok = ();
+            type Error = Found;
+            fn serialize_field<T: Serialize + ?Sized>(
+                &mut self,
+                key: &'static str,
+                value: &T,
+            ) -> Result<(), Found> {
+                self.field(key, value)
+            }
+            fn end(self) -> Result<(), Found> {
+                Ok(())
+            }
+        }
+    )+};
 }
 
-impl ser::SerializeStructVariant for Part<'_> {
-    type Ok = ();
-    type Error = Found;
-    fn serialize_field<T: Serialize + ?Sized>(
-        &mut self,
-        key: &'static str,
-        value: &T,
-    ) -> Result<(), Found> {
-        self.field(key, value)
-    }
-    fn end(self) -> Result<(), Found> {
-        Ok(())
-    }
-}
+fields_are_parts!(SerializeStruct, SerializeStructVariant);
 
 #[cfg(test)]
 mod tests {

@@ -435,17 +435,30 @@ fn factor(sd_percent: f64, z: f64) -> f64 {
     (1.0 + sd_percent * z / 100.0).max(0.01)
 }
 
+/// `value` scaled by `factor(sd_percent, z)` through `scale` when the spread is on, else
+/// borrowed as it is.
+fn scaled<'a, T: Clone, E>(
+    value: &'a T,
+    sd_percent: f64,
+    z: f64,
+    scale: impl FnOnce(&T, f64) -> Result<T, E>,
+) -> Result<Cow<'a, T>, E> {
+    Ok(if sd_percent > 0.0 {
+        Cow::Owned(scale(value, factor(sd_percent, z))?)
+    } else {
+        Cow::Borrowed(value)
+    })
+}
+
 /// The aircraft of a scenario: scaled by its model error when the spread is on.
 fn scaled_aircraft<'a>(
     aircraft: &'a Aircraft,
     sc: &ScenarioOptions,
     d: &Draws,
 ) -> Result<Cow<'a, Aircraft>, Error> {
-    Ok(if sc.power_sd_percent > 0.0 {
-        Cow::Owned(aircraft.with_power_scale(factor(sc.power_sd_percent, d.power))?)
-    } else {
-        Cow::Borrowed(aircraft)
-    })
+    Ok(scaled(aircraft, sc.power_sd_percent, d.power, |a, f| {
+        a.with_power_scale(f)
+    })?)
 }
 
 /// The pack of a scenario: its capacity drawn when the spread is on.
@@ -454,11 +467,9 @@ fn scaled_pack<'a>(
     sc: &ScenarioOptions,
     d: &Draws,
 ) -> Result<Cow<'a, Pack>, Error> {
-    Ok(if sc.capacity_sd_percent > 0.0 {
-        Cow::Owned(pack.with_capacity_factor(factor(sc.capacity_sd_percent, d.capacity))?)
-    } else {
-        Cow::Borrowed(pack)
-    })
+    Ok(scaled(pack, sc.capacity_sd_percent, d.capacity, |p, f| {
+        p.with_capacity_factor(f)
+    })?)
 }
 
 /// A steady wind drawn around `spec` (gusts left out: they are added by the caller).
