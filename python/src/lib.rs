@@ -204,12 +204,6 @@ fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResu
     let flags: EnduranceFlags = options::parse("endurance", &[], options)?;
     let opts = flags.options();
     let scenarios = flags.scenarios.options(false);
-    if scenarios.is_some() && flags.sweep_speed.is_some() {
-        // As the CLI: scenarios are drawn around the queries, not a curve.
-        return Err(aloft_error(
-            "the option 'samples' of aloft.endurance cannot be used with 'sweep_speed'",
-        ));
-    }
     py.detach(|| {
         let v = Vehicle::load(&flags.vehicle)?;
         if let Some(sweep) = &flags.payload_sweep {

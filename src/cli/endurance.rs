@@ -40,7 +40,6 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     if let Some(step) = args.flags.sweep_speed {
-        super::args::refuse_samples(&args.flags.scenarios, "--sweep-speed")?;
         let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
             plot_sweep(p, &curve.context.vehicle, &curve.rows)

@@ -19,7 +19,6 @@ use super::{Format, Outcome};
 
 pub fn run(args: MissionArgs) -> Result<Outcome> {
     if args.replay.is_some() {
-        super::args::refuse_samples(&args.scenarios, "--replay")?;
         return super::replay::run(&args);
     }
     if args.format == Format::Csv {

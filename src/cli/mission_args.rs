@@ -41,7 +41,7 @@ pub struct MissionArgs {
     #[arg(
         long,
         value_name = "LOG",
-        conflicts_with_all = ["mission", "timeseries", "plot", "mcap"]
+        conflicts_with_all = ["mission", "timeseries", "plot", "mcap", "samples"]
     )]
     pub replay: Option<PathBuf>,
     /// Log layout for --replay: kaist, px4 or a column-map TOML (default: detected).

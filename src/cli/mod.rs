@@ -2,7 +2,6 @@
 //! its arguments become an engine request (`aloft::engine`), the engine answers, and the answer is
 //! rendered as a table, JSON or CSV. Exit codes are decided here, once.
 
-mod args;
 mod convert;
 mod endurance;
 mod fit;

@@ -347,8 +347,9 @@ pub struct EnduranceFlags {
     #[arg(long, value_parser = aoa_parser(), default_value = "geometric")]
     pub aoa: AoaModel,
     /// The power curve instead: power, endurance and range against airspeed, in steps of this
-    /// many m/s up to the vehicle's maximum speed.
-    #[arg(value_parser = finite(), long, value_name = "STEP_M/S")]
+    /// many m/s up to the vehicle's maximum speed (scenarios are drawn around the queries, not a
+    /// curve).
+    #[arg(value_parser = finite(), long, value_name = "STEP_M/S", conflicts_with = "samples")]
     pub sweep_speed: Option<f64>,
     /// Endurance against payload instead, one curve per pack (every pack of the vehicle unless
     /// --battery names one): hover endurance, best endurance and best range at payloads from
