@@ -58,6 +58,7 @@ pub mod ros;
 pub mod sample;
 #[doc(hidden)]
 pub mod synth;
+pub mod telemetry;
 pub mod ulog;
 
 pub use binary::{

@@ -1,0 +1,120 @@
+//! What a flight reports while it flies, whatever carries it: a MAVLink link or telemetry log
+//! (the `aloft-link` crate), or a flight log replayed as if live. One event type, aloft's units
+//! (SI, ENU from a stream origin, seconds from the stream's start), so `aloft live` follows every
+//! source with the same code.
+//!
+//! The MAVLink messages each event comes from are named beside it; a flight log's topics map to
+//! the same events (a sample per record, `Heartbeat` from its arming and mode records where it
+//! has them).
+
+use crate::sample::{GeoOrigin, Sample};
+
+/// One event of a flight, at a time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Telemetry {
+    /// Time since the start of the stream, s (the tlog's clock, the log's, or the link's arrival).
+    pub time_s: f64,
+    /// What happened.
+    pub event: Event,
+}
+
+/// What a flight reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Event {
+    /// The state at an instant: the channels the message carried, the others `None`
+    /// (GLOBAL_POSITION_INT: position and velocity; ATTITUDE; SYS_STATUS/BATTERY_STATUS: voltage
+    /// and current; WIND; EXTENDED_SYS_STATE: landed). `sample.time_s` equals the event's time.
+    Sample(Sample),
+    /// The geodetic origin of the samples' ENU positions, sent once before the first position (a
+    /// source that only has local positions sends none).
+    Origin(GeoOrigin),
+    /// Home, ENU from the origin, m (HOME_POSITION).
+    Home([f64; 3]),
+    /// HEARTBEAT of the vehicle: armed, flight mode by name, MAV_TYPE.
+    Heartbeat(Heartbeat),
+    /// The battery as the autopilot states it (SYS_STATUS `battery_remaining`, BATTERY_STATUS
+    /// `current_consumed`).
+    Battery(BatteryState),
+    /// Airspeed and ground speed as the autopilot states them (VFR_HUD), m/s.
+    Speeds {
+        /// Airspeed, m/s (an estimate on most multirotors).
+        airspeed_mps: f64,
+        /// Ground speed, m/s.
+        groundspeed_mps: f64,
+    },
+    /// The mission item being flown (MISSION_CURRENT `seq`).
+    MissionCurrent(u32),
+    /// The whole mission, as the vehicle holds it (MISSION_COUNT and every MISSION_ITEM(_INT) of
+    /// one upload or download, in sequence order).
+    Mission(Vec<MissionItem>),
+    /// The vehicle restarted (its boot time went back): what was learned of the flight so far no
+    /// longer holds.
+    Reboot,
+}
+
+/// The vehicle's HEARTBEAT.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Heartbeat {
+    /// Motors armed.
+    pub armed: bool,
+    /// Flight mode by the autopilot's name (`AUTO`, `LOITER`, `RTL`, PX4 `MISSION`, ...), or
+    /// `custom N` where the autopilot is not known.
+    pub mode: String,
+    /// MAV_TYPE (2 quadrotor, 13 hexarotor, 14 octorotor, ...).
+    pub vehicle_type: u8,
+}
+
+/// The battery as the autopilot states it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BatteryState {
+    /// State of charge, 0-1 (`battery_remaining` percent / 100); `None` where not sent (-1).
+    pub soc: Option<f64>,
+    /// Charge drawn since the start, A h; `None` where not sent (-1).
+    pub consumed_ah: Option<f64>,
+}
+
+/// One mission item as a MAVLink link or log carries it (MISSION_ITEM_INT, MISSION_ITEM,
+/// DataFlash `CMD`): the fields of a `.waypoints` row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MissionItem {
+    /// Sequence number, from 0 (0 is home on ArduPilot).
+    pub seq: u32,
+    /// MAV_FRAME.
+    pub frame: u32,
+    /// MAV_CMD.
+    pub command: u32,
+    /// param1-param4, latitude (deg), longitude (deg), altitude (m), as a `.waypoints` row.
+    pub params: [f64; 7],
+}
+
+/// A source of telemetry: a link, a telemetry log, a flight log replayed.
+pub trait TelemetrySource {
+    /// The next event, `None` at the end of the stream. An error ends the stream (a file that
+    /// cannot be read further); damaged frames inside a stream are skipped, not errors.
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String>;
+
+    /// What the source has passed over so far (corrupt frames, bytes skipped), for the status
+    /// line; empty by default.
+    fn skipped(&self) -> String {
+        String::new()
+    }
+}
+
+/// What `aloft live` sends back on a link, so a ground station shows it without a plugin.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Reply {
+    /// A named value (NAMED_VALUE_FLOAT: name of at most 10 characters).
+    Value {
+        /// The name, at most 10 ASCII characters.
+        name: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// A text (STATUSTEXT, at most 50 characters), at warning severity or as information.
+    Text {
+        /// The text.
+        text: String,
+        /// WARNING severity (else INFO).
+        warning: bool,
+    },
+}
