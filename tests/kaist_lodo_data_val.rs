@@ -38,6 +38,11 @@ struct Judged {
     calibrated_percent: f64,
     calibrated_efficiency: f64,
     replay_percent: f64,
+    /// `aloft live --route log`: the error of `remaining_wh.p50` and of the naive rate at each
+    /// checkpoint (label, percent, percent, inside p5-p95).
+    live: Vec<(String, f64, f64, bool)>,
+    /// `aloft live --route log`: fraction of the updates whose p5-p95 holds the measured rest.
+    live_coverage: f64,
 }
 
 /// RMS sideslip of a log: `atan2(rms v_right, rms v_forward)` over samples faster than 1 m/s.
@@ -65,6 +70,29 @@ fn sideslip_deg(path: &str) -> f64 {
         r2 += right * right;
     }
     r2.sqrt().atan2(f2.sqrt()).to_degrees()
+}
+
+/// `aloft live --replay FLIGHT --route log --every 10` with `vehicle`: its last line, the check
+/// (an update every 10 s: the checkpoints at 40, 60 and 80 % fall on the first update after
+/// them).
+fn live_check(path: &str, vehicle: &str) -> serde_json::Value {
+    let out = common::ok_stdout(&words(&[
+        "live",
+        "--replay",
+        path,
+        "--profile",
+        "kaist",
+        "--route",
+        "log",
+        "--vehicle",
+        vehicle,
+        "--every",
+        "10",
+        "--format",
+        "json",
+    ]));
+    let last = out.lines().last().unwrap();
+    serde_json::from_str::<serde_json::Value>(last).unwrap()["check"].clone()
 }
 
 /// Fit on every day but `held_out`, then judge each flight of `held_out`.
@@ -114,7 +142,22 @@ fn judge_day(held_out: &'static str) -> Vec<Judged> {
                 "--format",
                 "json",
             ]));
+            let live = live_check(path, &vehicle);
             Judged {
+                live: live["checkpoints"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|c| {
+                        (
+                            c["at"].as_str().unwrap().to_string(),
+                            c["error_percent"].as_f64().unwrap(),
+                            c["naive_error_percent"].as_f64().unwrap(),
+                            c["in_band"].as_bool().unwrap(),
+                        )
+                    })
+                    .collect(),
+                live_coverage: live["band_coverage"].as_f64().unwrap(),
                 day: held_out,
                 file: std::path::Path::new(path)
                     .file_name()
@@ -228,4 +271,46 @@ fn data_val_kaist_lodo_energy_within_2_percent_calibrated() {
     for j in lodo() {
         assert!(j.calibrated_percent.abs() <= 2.0, "{j:?}");
     }
+}
+
+/// The live estimate at 120 s (`aloft live --route log`) is the 120 s calibration of `aloft
+/// validate --calibrate-first 120`, reached by another path: the same shrunk ratio applied to the
+/// rest of the flight (the two split the samples one sample apart: within 0.05 points).
+#[test]
+fn data_val_kaist_lodo_live_at_120_s_is_the_calibrated_validation() {
+    for j in lodo() {
+        let (_, live, _, _) = j.live.iter().find(|c| c.0 == "120 s").unwrap();
+        assert!((live - j.calibrated_percent).abs() < 0.05, "{j:?}");
+    }
+}
+
+/// The median of `v` (sorted copy).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    (v[(n - 1) / 2] + v[n / 2]) / 2.0
+}
+
+/// Issue 25 targets on the held-out days: the error of `remaining_wh.p50` at 120 s and at 40,
+/// 60 and 80 % of each flight, median at most 3 %, worst at most 8 %; and not worse than the
+/// naive rate (mean measured power so far times the time left), by the median.
+#[test]
+fn data_val_kaist_lodo_live_remaining_within_3_percent_median_8_worst() {
+    let errors: Vec<f64> = lodo()
+        .iter()
+        .flat_map(|j| j.live.iter().map(|c| c.1.abs()))
+        .collect();
+    let naive: Vec<f64> = lodo()
+        .iter()
+        .flat_map(|j| j.live.iter().map(|c| c.2.abs()))
+        .collect();
+    let worst = errors.iter().copied().fold(0.0, f64::max);
+    let naive_worst = naive.iter().copied().fold(0.0, f64::max);
+    let (m, mn) = (median(errors.clone()), median(naive));
+    println!(
+        "live remaining_wh.p50 over {} checkpoints: median |error| {m:.2} %, worst {worst:.2} %; naive rate: median {mn:.2} %, worst {naive_worst:.2} %",
+        errors.len()
+    );
+    assert_eq!(errors.len(), 44);
+    assert!(m <= 3.0 && worst <= 8.0, "median {m}, worst {worst}");
 }

@@ -6,6 +6,7 @@ mod convert;
 mod endurance;
 mod fit;
 mod flights;
+mod live;
 mod log;
 mod mission;
 mod mission_args;
@@ -54,6 +55,8 @@ enum Command {
     Fit(fit::FitArgs),
     /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
     Validate(validate::ValidateArgs),
+    /// Follow a flight as it flies: the energy of the rest, its spread, and what to do.
+    Live(live::LiveArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
     Mission(Box<mission_args::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
@@ -95,6 +98,7 @@ pub fn main() -> ExitCode {
         Command::Convert(args) => convert::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Validate(args) => validate::run(args),
+        Command::Live(args) => live::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
     };

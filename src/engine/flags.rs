@@ -19,6 +19,7 @@ use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
 use super::fit::{fit_parameter, FitRequest};
+use super::live::LiveReplayRequest;
 use super::logs::{FlightLogs, LogReadOptions};
 use super::mission_options::{GustSpec, MissionOptions};
 use super::payload_sweep::PayloadSweep;
@@ -601,4 +602,54 @@ pub struct MissionScenarioFlags {
     /// Its scenarios.
     #[command(flatten)]
     pub scenarios: ScenarioFlags,
+}
+
+/// The route ahead of `aloft live` (`--route`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum RouteFlag {
+    /// The rest of the logged path (a replay): the prediction at each time is checked against
+    /// the energy the log measured from then to the end.
+    Log,
+}
+
+/// The options of `aloft live`.
+#[derive(Debug, Clone, Args)]
+pub struct LiveFlags {
+    /// Follow a flight log (CSV, MCAP, PX4 ULog or ArduPilot DataFlash) as if live.
+    #[arg(long, value_name = "LOG")]
+    pub replay: PathBuf,
+    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
+    #[arg(long)]
+    pub profile: Option<String>,
+    /// The route ahead: `log`, the rest of the logged path (the validation mode).
+    #[arg(long, value_enum)]
+    pub route: RouteFlag,
+    /// Vehicle with a power model: built-in name or TOML file (e.g. from `aloft fit`).
+    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
+    pub vehicle: String,
+    /// Battery pack flown (default: the vehicle's default pack).
+    #[arg(long)]
+    pub battery: Option<String>,
+    /// Payload flown, kg.
+    #[arg(value_parser = finite(), long, default_value_t = 0.0, value_name = "KG")]
+    pub payload_kg: f64,
+    /// An update every S seconds of flight time.
+    #[arg(value_parser = finite(), long, default_value_t = 1.0, value_name = "S")]
+    pub every: f64,
+}
+
+impl LiveFlags {
+    /// The engine's request of these flags.
+    pub fn request(&self) -> LiveReplayRequest {
+        LiveReplayRequest {
+            logs: FlightLogs {
+                logs: vec![self.replay.clone()],
+                profile: self.profile.clone(),
+                ..FlightLogs::default()
+            },
+            battery: self.battery.clone(),
+            payload_kg: self.payload_kg,
+            every_s: self.every,
+        }
+    }
 }

@@ -96,7 +96,27 @@ impl Mission {
     /// # Errors
     /// [`Error::MissionImport`] naming the item (or row, or line) and the command or key.
     pub fn from_planner_file(text: &str, origin: &str) -> Result<Self, Error> {
-        let imported = aloft_missions::import(text).map_err(|source| Error::MissionImport {
+        Self::of_imported(aloft_missions::import(text), origin)
+    }
+
+    /// A mission as a MAVLink link or log carries it (MISSION_ITEM_INT, DataFlash `CMD`; item 0
+    /// is home on ArduPilot), flown as its `.waypoints` file would be; `origin` names it.
+    ///
+    /// # Errors
+    /// [`Error::MissionImport`] naming the item and the command.
+    pub fn from_items(
+        items: &[aloft_logs::telemetry::MissionItem],
+        origin: &str,
+    ) -> Result<Self, Error> {
+        Self::of_imported(aloft_missions::read_items(items), origin)
+    }
+
+    /// What an importer read, or its error naming `origin`.
+    fn of_imported(
+        imported: Result<aloft_missions::Imported, aloft_missions::ImportError>,
+        origin: &str,
+    ) -> Result<Self, Error> {
+        let imported = imported.map_err(|source| Error::MissionImport {
             origin: origin.to_string(),
             source,
         })?;
@@ -115,7 +135,9 @@ impl Mission {
     /// As [`Mission::from_planner_file`], [`Mission::from_json`] or [`Mission::from_toml`].
     pub fn from_text(text: &str, origin: &str) -> Result<Self, Error> {
         match aloft_missions::detect(text) {
-            SourceFormat::QgcPlan | SourceFormat::QgcWpl => Self::from_planner_file(text, origin),
+            SourceFormat::QgcPlan | SourceFormat::QgcWpl | SourceFormat::MavlinkItems => {
+                Self::from_planner_file(text, origin)
+            }
             SourceFormat::AloftJson => Self::from_json(text, origin),
             SourceFormat::AloftToml => Self::from_toml(text, origin),
         }

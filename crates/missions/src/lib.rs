@@ -66,7 +66,7 @@ pub use items::MIN_HEIGHT_M;
 pub use jumps::MAX_FLOWN_ITEMS;
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
-pub use wpl::read_waypoints;
+pub use wpl::{read_items, read_waypoints};
 
 /// The format a mission text is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
@@ -81,6 +81,8 @@ pub enum SourceFormat {
     AloftToml,
     /// aloft's own mission file in JSON.
     AloftJson,
+    /// Mission items as a MAVLink link or log carries them ([`read_items`]).
+    MavlinkItems,
 }
 
 impl SourceFormat {
@@ -89,6 +91,7 @@ impl SourceFormat {
         match self {
             SourceFormat::QgcPlan => "qgc_plan",
             SourceFormat::QgcWpl => "qgc_wpl",
+            SourceFormat::MavlinkItems => "mavlink_items",
             SourceFormat::AloftToml => "aloft_toml",
             SourceFormat::AloftJson => "aloft_json",
         }
@@ -138,9 +141,11 @@ pub fn import(text: &str) -> Result<Imported, ImportError> {
     match detect(text) {
         SourceFormat::QgcPlan => read_plan(text),
         SourceFormat::QgcWpl => read_waypoints(text),
-        SourceFormat::AloftToml | SourceFormat::AloftJson => Err(ImportError::UnknownFormat {
-            found: text.trim_start().chars().take(24).collect(),
-        }),
+        SourceFormat::AloftToml | SourceFormat::AloftJson | SourceFormat::MavlinkItems => {
+            Err(ImportError::UnknownFormat {
+                found: text.trim_start().chars().take(24).collect(),
+            })
+        }
     }
 }
 

@@ -62,6 +62,44 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
             rows.push(row(k + 1, line)?);
         }
     }
+    from_rows(rows, SourceFormat::QgcWpl, "QGC WPL 110 waypoints")
+}
+
+/// Read a mission as a MAVLink link or log carries it (MISSION_ITEM_INT, DataFlash `CMD`): the
+/// rows of a `.waypoints` file, ArduPilot's semantics (item 0 is home when it is a home row).
+/// Messages name an item by its sequence number.
+///
+/// # Errors
+/// A parameter that is not finite (naming the item), and the errors of [`read_waypoints`].
+pub fn read_items(items: &[aloft_logs::telemetry::MissionItem]) -> Result<Imported, ImportError> {
+    let mut rows = Vec::with_capacity(items.len());
+    for item in items {
+        if let Some(k) = item.params.iter().position(|p| !p.is_finite()) {
+            return Err(ImportError::BadField {
+                line: item.seq as usize,
+                field: FIELDS[4 + k],
+                found: format!("{}", item.params[k]),
+            });
+        }
+        rows.push(RawItem {
+            at: Place::Item(item.seq),
+            number: item.seq,
+            command: item.command,
+            frame: item.frame,
+            params: item.params,
+            jump_id: None,
+        });
+    }
+    from_rows(rows, SourceFormat::MavlinkItems, "MAVLink mission")
+}
+
+/// The home row apart, then the items' semantics: what a `.waypoints` file and a link's
+/// mission share.
+fn from_rows(
+    rows: Vec<RawItem>,
+    format: SourceFormat,
+    what: &str,
+) -> Result<Imported, ImportError> {
     let mut notes = Notes::default();
     let (home, home_amsl_m, items) = split_home(rows, &mut notes)?;
     let source = Source {
@@ -72,13 +110,8 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
         default_speed_mps: ARDUPILOT_WPNAV_SPEED_MPS,
     };
     let translation = translate(&items, &source, notes)?;
-    let description = format!("QGC WPL 110 waypoints, {} items", items.len());
-    Ok(assemble(
-        translation,
-        &source,
-        SourceFormat::QgcWpl,
-        description,
-    ))
+    let description = format!("{what}, {} items", items.len());
+    Ok(assemble(translation, &source, format, description))
 }
 
 /// One line (number `line`, from 1) as an item.
