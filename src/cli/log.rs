@@ -56,15 +56,10 @@ fn info(args: InfoArgs) -> Result<Outcome> {
         );
     }
     let info = log_info(&args.file, &args.flags.read.options(), args.flags.max_lag)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => {
-            output::warn(&info.warnings);
-            output::write_json(&mut out, &info)?
-        }
-        Format::Table | Format::Csv => write_table(&mut out, &info)?,
+    if args.format == Format::Json {
+        output::warn(&info.warnings);
     }
+    output::print_table_or_json(args.format, &info, |out| write_table(out, &info))?;
     Ok(Outcome::Ok)
 }
 
@@ -150,7 +145,7 @@ fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
 fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     writeln!(out, "channels")?;
     for c in &j.channels {
-        let rate = c.rate_hz.map_or("-".into(), |r| format!("{r:.2} Hz"));
+        let rate = rate(c.rate_hz);
         writeln!(
             out,
             "  {:<13} {:>9} samples  {rate}",
@@ -164,7 +159,7 @@ fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     if let Some(topics) = &j.topics {
         writeln!(out, "topics")?;
         for t in topics {
-            let rate = t.rate_hz.map_or("-".into(), |r| format!("{r:.2} Hz"));
+            let rate = rate(t.rate_hz);
             let used: Vec<&str> = t.used_for.iter().map(|c| c.name()).collect();
             let used = if used.is_empty() {
                 "not decoded".to_string()
@@ -181,24 +176,27 @@ fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     Ok(())
 }
 
+/// A rate in Hz with two decimals, or `-` when there is none.
+fn rate(hz: Option<f64>) -> String {
+    hz.map_or("-".into(), |r| format!("{r:.2} Hz"))
+}
+
 /// The first gaps, dropped values and backward steps of the time base.
 fn write_time_notes(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     for g in j.time.gaps.iter().take(5) {
-        writeln!(
-            out,
-            "gap: {:.3} s -> {:.3} s (sample {})",
-            g.from_s, g.to_s, g.index
-        )?;
+        write_step(out, "gap", g.from_s, g.to_s, g.index)?;
     }
     for d in j.dropped.iter().take(5) {
         writeln!(out, "dropped: row {} {} = {:.1}", d.row, d.channel, d.value)?;
     }
     for n in j.time.non_monotonic.iter().take(5) {
-        writeln!(
-            out,
-            "time goes back: {:.3} s -> {:.3} s (sample {})",
-            n.previous_s, n.time_s, n.index
-        )?;
+        write_step(out, "time goes back", n.previous_s, n.time_s, n.index)?;
     }
+    Ok(())
+}
+
+/// A step of the time base: `what: FROM s -> TO s (sample INDEX)`.
+fn write_step(out: &mut impl Write, what: &str, from_s: f64, to_s: f64, index: u64) -> Result<()> {
+    writeln!(out, "{what}: {from_s:.3} s -> {to_s:.3} s (sample {index})")?;
     Ok(())
 }

@@ -5,7 +5,9 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
-use anyhow::Result;
+use std::path::Path;
+
+use anyhow::{bail, Result};
 
 use aloft::engine::{
     AoaModel, MissionReport, Plan, RouteFigures, Sample, SegmentReport, Shortfall, SourceFormat,
@@ -237,9 +239,31 @@ pub(super) fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
 pub(super) type Area<'a> =
     plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
 
+/// A mission's chart file: `upper` draws a chart over time in the upper half, the ground track
+/// is below it (`confident`: see [`plot_track`]).
+pub(super) fn plot_over_track(
+    path: &Path,
+    plan: &Plan,
+    confident: Option<(f64, f64)>,
+    upper: impl FnOnce(&Area<'_>) -> Result<()>,
+) -> Result<()> {
+    use plotters::prelude::*;
+    let samples = plan.plot_samples();
+    if samples.is_empty() {
+        bail!("no samples to plot");
+    }
+    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(400);
+    upper(&top)?;
+    plot_track(&bottom, plan.report(), samples, plan.home_m(), confident)?;
+    root.present()?;
+    Ok(())
+}
+
 /// The ground track (equal scales) with home and the point of no return; with `confident`, also
 /// the point of no return that holds with 95 % confidence over the scenarios (east, north).
-pub(super) fn plot_track(
+fn plot_track(
     area: &Area<'_>,
     report: &MissionReport,
     s: &[Sample],
@@ -271,13 +295,8 @@ pub(super) fn plot_track(
         .x_desc("east (m)")
         .y_desc("north (m)")
         .draw()?;
-    track
-        .draw_series(LineSeries::new(
-            s.iter().map(|x| (x.east_m, x.north_m)),
-            &RED,
-        ))?
-        .label("track")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    let points = s.iter().map(|x| (x.east_m, x.north_m));
+    super::plot::labelled_line(&mut track, points, RED, "track", RED)?;
     track
         .draw_series([Circle::new((home[0], home[1]), 6, GREEN.filled())])?
         .label("home")
@@ -302,12 +321,7 @@ pub(super) fn plot_track(
             .label("point of no return, 95 % confidence")
             .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, style));
     }
-    track
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
+    super::plot::legend(&mut track, SeriesLabelPosition::MiddleRight)
 }
 
 /// The first columns of a segment table's head (number, item when the mission came from a
