@@ -221,10 +221,9 @@ fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
         .fold(0.0, f64::max)
         * 1.1
         + 1.0;
-    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = super::plot::dual_lines(
-        &root,
+    super::plot::dual_lines_file(
+        path,
+        (900, 500),
         format!("{name}: power curve (level flight, still air)"),
         (0.0..v_max, "airspeed (m/s)"),
         super::plot::Line {
@@ -242,8 +241,5 @@ fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
                 .map(|r| (r.airspeed_mps, r.endurance_s / 60.0))
                 .collect(),
         },
-    )?;
-    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
-    root.present()?;
-    Ok(())
+    )
 }

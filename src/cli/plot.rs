@@ -1,6 +1,8 @@
 //! The charts the subcommands share: two lines against one x axis, each on its own y axis
 //! ([`dual_lines`]), and several labelled lines against one y axis ([`lines`]).
 
+use std::path::Path;
+
 use anyhow::Result;
 use plotters::chart::{ChartContext, DualCoordChartContext};
 use plotters::coord::types::RangedCoordf64;
@@ -59,6 +61,24 @@ pub fn dual_lines<'a, 'b>(
         .label(right.desc)
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], rc));
     Ok(chart)
+}
+
+/// A chart file of [`dual_lines`] over the whole picture (`size` in pixels), the legend at the
+/// middle right.
+pub fn dual_lines_file(
+    path: &Path,
+    size: (u32, u32),
+    caption: String,
+    x: (std::ops::Range<f64>, &str),
+    left: Line<'_>,
+    right: Line<'_>,
+) -> Result<()> {
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = dual_lines(&root, caption, x, left, right)?;
+    legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+    root.present()?;
+    Ok(())
 }
 
 /// Draw `points` as a line in `style`, with `label` in the legend beside a short stroke in `key`.

@@ -211,10 +211,9 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
         .map(|(_, h)| h.power_required_w)
         .fold(0.0, f64::max)
         * 1.1;
-    let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = super::plot::dual_lines(
-        &root,
+    super::plot::dual_lines_file(
+        path,
+        (800, 500),
         format!("{name}: flight time and power against take-off mass"),
         (x0..x1, "take-off mass (kg)"),
         super::plot::Line {
@@ -229,8 +228,5 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
             color: RED,
             points: ok.iter().map(|(m, h)| (*m, h.power_required_w)).collect(),
         },
-    )?;
-    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
-    root.present()?;
-    Ok(())
+    )
 }
