@@ -263,13 +263,18 @@ fn drag_fit(
     Ok((Some(d), bounded.fitted))
 }
 
+/// A fit of drag from the force balance: from the template's `mu` (N s/m, N s^2/m^2,
+/// N s^3/m^3), mass (kg) and gravity (m/s^2) over force samples, with the lowest airspeed used
+/// (m/s) and the outlier threshold (robust sigma).
+type DragFitFn<T> = fn([f64; 3], f64, f64, &[ForceSample], f64, f64) -> T;
+
 /// A drag fit from the force balance (`fit`: the scalar or the body-axis one) over `forces`,
 /// started from the vehicle's drag with its mass and gravity, on the samples faster than 1 m/s,
 /// outliers beyond 5 robust sigma dropped.
 fn with_drag_inputs<T>(
     vehicle: &aloft_power::Vehicle,
     forces: &[ForceSample],
-    fit: fn([f64; 3], f64, f64, &[ForceSample], f64, f64) -> T,
+    fit: DragFitFn<T>,
 ) -> T {
     let (mu1, mu2, mu3) = vehicle.drag().coefficients();
     let (min_airspeed_mps, outlier_sigma) = (1.0, 5.0);
