@@ -90,10 +90,10 @@ fn title(j: &LogInfo) -> String {
 fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
     let mut rows = vec![
         Row::new("samples", j.samples.to_string(), ""),
-        Row::new("duration", format!("{:.2}", j.duration_s), "s"),
+        Row::num("duration", j.duration_s, 2, "s"),
     ];
     if let Some(p) = j.time.nominal_period_s {
-        rows.push(Row::new("nominal period", format!("{p:.4}"), "s"));
+        rows.push(Row::num("nominal period", p, 4, "s"));
     }
     rows.push(Row::new(
         "gaps (> 3 periods)",
@@ -113,14 +113,14 @@ fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
         ));
     }
     match j.energy_wh {
-        Some(e) => rows.push(Row::new("energy used (V x I)", format!("{e:.2}"), "Wh")),
+        Some(e) => rows.push(Row::num("energy used (V x I)", e, 2, "Wh")),
         None => rows.push(Row::new("energy used", "n/a: no power data".into(), "")),
     }
     if let Some(p) = j.mean_power_w {
-        rows.push(Row::new("mean power", format!("{p:.1}"), "W"));
+        rows.push(Row::num("mean power", p, 1, "W"));
     }
     if let Some(p) = j.max_power_w {
-        rows.push(Row::new("max power", format!("{p:.1}"), "W"));
+        rows.push(Row::num("max power", p, 1, "W"));
     }
     if let Some(l) = &j.lag {
         rows.push(Row::new(

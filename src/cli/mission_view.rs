@@ -212,27 +212,15 @@ pub(super) fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
     };
     vec![
         Row::new("flight time", format!("{} min:s", mmss(r.duration_s)), ""),
-        Row::new("distance flown", format!("{:.0}", r.distance_m), "m"),
-        Row::new("energy used", format!("{:.1}", r.energy_wh), "Wh"),
-        Row::new("mean power", format!("{mean_w:.0}"), "W"),
-        Row::new("peak power", format!("{:.0}", r.peak_power_w), "W"),
-        Row::new("peak current", format!("{:.1}", r.peak_current_a), "A"),
-        Row::new(
-            "battery at take-off",
-            format!("{:.0}", r.start_soc * 100.0),
-            "%",
-        ),
-        Row::new(
-            "battery at the end",
-            format!("{:.1}", r.end_soc * 100.0),
-            "%",
-        ),
-        Row::new(
-            "lowest pack voltage",
-            format!("{:.2}", r.min_voltage_v),
-            "V",
-        ),
-        Row::new("heat in the pack", format!("{:.1}", r.pack_heat_wh), "Wh"),
+        Row::num("distance flown", r.distance_m, 0, "m"),
+        Row::num("energy used", r.energy_wh, 1, "Wh"),
+        Row::num("mean power", mean_w, 0, "W"),
+        Row::num("peak power", r.peak_power_w, 0, "W"),
+        Row::num("peak current", r.peak_current_a, 1, "A"),
+        Row::num("battery at take-off", r.start_soc * 100.0, 0, "%"),
+        Row::num("battery at the end", r.end_soc * 100.0, 1, "%"),
+        Row::num("lowest pack voltage", r.min_voltage_v, 2, "V"),
+        Row::num("heat in the pack", r.pack_heat_wh, 1, "Wh"),
     ]
 }
 
