@@ -150,14 +150,19 @@ struct MotionSeries {
     tilt_rad: Vec<f64>,
 }
 
-/// The log's electrical power series.
-fn power_series(log: &Log) -> Result<PowerSeries, Error> {
-    let (times_s, power_w): (Vec<f64>, Vec<f64>) = log
-        .samples
+/// The times and electrical power (V x I) of the log's samples where both are logged and finite,
+/// in the log's order.
+pub(crate) fn power_samples(log: &Log) -> (Vec<f64>, Vec<f64>) {
+    log.samples
         .iter()
         .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
         .filter(|(t, p)| t.is_finite() && p.is_finite())
-        .unzip();
+        .unzip()
+}
+
+/// The log's electrical power series.
+fn power_series(log: &Log) -> Result<PowerSeries, Error> {
+    let (times_s, power_w) = power_samples(log);
     if times_s.len() < 2 {
         return Err(Error::NoPower {
             origin: log.source.clone(),

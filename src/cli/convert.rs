@@ -30,26 +30,19 @@ pub struct ConvertArgs {
 
 pub fn run(args: ConvertArgs) -> Result<Outcome> {
     let json = convert_log(&args.log, &args.read.options(), &args.output)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &json)?,
-        Format::Table | Format::Csv => {
-            let rows: Vec<Row<'_>> = json
-                .topics
-                .iter()
-                .map(|t| Row::new(&t.topic, t.messages.to_string(), "messages"))
-                .collect();
-            output::write_table(
-                &mut out,
-                &format!(
-                    "{} -> {} ({} samples)",
-                    json.input, json.output, json.samples
-                ),
-                &rows,
-            )?;
-        }
-    }
+    output::print_table_or_json(args.format, &json, |out| {
+        let rows: Vec<Row<'_>> = json
+            .topics
+            .iter()
+            .map(|t| Row::new(&t.topic, t.messages.to_string(), "messages"))
+            .collect();
+        let title = format!(
+            "{} -> {} ({} samples)",
+            json.input, json.output, json.samples
+        );
+        output::write_table(out, &title, &rows)?;
+        Ok(())
+    })?;
     if let Some((gaps, backwards)) = json.time_notes {
         eprintln!(
             "aloft: note: the input's time base has {gaps} gap(s) and {backwards} non-monotonic step(s); they are kept as they are"

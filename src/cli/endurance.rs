@@ -37,19 +37,18 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
     if let Some(sweep) = &args.flags.payload_sweep {
         return run_payload_sweep(&args, &vehicle, &options, sweep);
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
     if let Some(step) = args.flags.sweep_speed {
         let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
             plot_sweep(p, &curve.context.vehicle, &curve.rows)
                 .with_context(|| format!("cannot draw {}", p.display()))?;
         }
-        match args.format {
-            Format::Json => output::write_json(&mut out, &curve)?,
-            Format::Csv => write_curve_csv(out, &curve.rows)?,
-            Format::Table => write_curve_table(&mut out, &curve, args.flags.course)?,
-        }
+        output::print(
+            args.format,
+            &curve,
+            |out| write_curve_csv(out, &curve.rows),
+            |out| write_curve_table(out, &curve, args.flags.course),
+        )?;
         return Ok(Outcome::Ok);
     }
     if args.format == Format::Csv {
@@ -60,6 +59,7 @@ pub fn run(args: EnduranceArgs) -> Result<Outcome> {
         Some(sc) => Some(endurance_scenarios(&vehicle, &options, &sc)?),
         None => None,
     };
+    let mut out = std::io::stdout().lock();
     match (args.format, &uncertainty) {
         (Format::Json, None) => output::write_json(&mut out, &summary)?,
         (Format::Json, Some(u)) => output::write_json(
@@ -98,37 +98,34 @@ fn run_payload_sweep(
         super::payload_sweep::plot(p, &curve)
             .with_context(|| format!("cannot draw {}", p.display()))?;
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &curve)?,
-        Format::Csv => super::payload_sweep::write_csv(out, &curve)?,
-        Format::Table => super::payload_sweep::write_table(&mut out, &curve)?,
-    }
+    output::print(
+        args.format,
+        &curve,
+        |out| super::payload_sweep::write_csv(out, &curve),
+        |out| super::payload_sweep::write_table(out, &curve),
+    )?;
     Ok(Outcome::Ok)
 }
 
 fn write_curve_csv(out: impl Write, rows: &[SweepRow]) -> Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record([
+    let header = [
         "airspeed_mps",
         "ground_speed_mps",
         "power_w",
         "endurance_s",
         "range_m",
-    ])?;
-    for r in rows {
-        let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
-        w.write_record([
+    ];
+    let opt = |v: Option<f64>| v.map(|x| x.to_string()).unwrap_or_default();
+    let records = rows.iter().map(|r| {
+        [
             r.airspeed_mps.to_string(),
             opt(r.ground_speed_mps),
             r.power_w.to_string(),
             r.endurance_s.to_string(),
             opt(r.range_m),
-        ])?;
-    }
-    w.flush()?;
-    Ok(())
+        ]
+    });
+    output::write_csv(out, &header, records)
 }
 
 fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) -> Result<()> {
@@ -142,16 +139,12 @@ fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) 
         c.wind,
         course_deg
     )?;
-    writeln!(
-        out,
-        "  {:>9} {:>9} {:>9} {:>10} {:>9}",
-        "airspeed", "ground", "power", "endurance", "range"
-    )?;
-    writeln!(
-        out,
-        "  {:>9} {:>9} {:>9} {:>10} {:>9}",
-        "m/s", "m/s", "W", "min", "km"
-    )?;
+    for [v, g, p, e, r] in [
+        ["airspeed", "ground", "power", "endurance", "range"],
+        ["m/s", "m/s", "W", "min", "km"],
+    ] {
+        writeln!(out, "  {v:>9} {g:>9} {p:>9} {e:>10} {r:>9}")?;
+    }
     for r in &curve.rows {
         let g = r
             .ground_speed_mps
@@ -185,40 +178,30 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
         s.context.wind,
         reserve_percent
     );
-    let min = |s: f64| format!("{:.1}", s / 60.0);
+    let min = |s: f64| output::fixed(s / 60.0, 1);
     let mut rows = vec![
-        Row::new("hover power", format!("{:.0}", r.hover_power_w), "W"),
+        Row::num("hover power", r.hover_power_w, 0, "W"),
         Row::new("hover endurance", min(r.hover_endurance_s), "min"),
-        Row::new(
+        Row::num(
             "best-endurance airspeed",
-            format!("{:.1}", r.max_endurance_speed_mps),
+            r.max_endurance_speed_mps,
+            1,
             "m/s",
         ),
-        Row::new(
-            "  power there",
-            format!("{:.0}", r.max_endurance_power_w),
-            "W",
-        ),
+        Row::num("  power there", r.max_endurance_power_w, 0, "W"),
         Row::new("  endurance", min(r.max_endurance_s), "min"),
-        Row::new(
-            "best-range airspeed",
-            format!("{:.1}", r.max_range_speed_mps),
-            "m/s",
-        ),
-        Row::new(
+        Row::num("best-range airspeed", r.max_range_speed_mps, 1, "m/s"),
+        Row::num(
             "  ground speed on course",
-            format!("{:.1}", r.max_range_ground_speed_mps),
+            r.max_range_ground_speed_mps,
+            1,
             "m/s",
         ),
-        Row::new("  power there", format!("{:.0}", r.max_range_power_w), "W"),
-        Row::new(
-            "  range on course",
-            format!("{:.2}", r.max_range_m / 1000.0),
-            "km",
-        ),
+        Row::num("  power there", r.max_range_power_w, 0, "W"),
+        Row::num("  range on course", r.max_range_m / 1000.0, 2, "km"),
     ];
     if let (Some(p), Some(e)) = (r.orbit_power_w, r.orbit_endurance_s) {
-        rows.push(Row::new("orbit power", format!("{p:.0}"), "W"));
+        rows.push(Row::num("orbit power", p, 0, "W"));
         rows.push(Row::new("orbit endurance", min(e), "min"));
     }
     output::write_table(out, &title, &rows)?;
@@ -238,10 +221,9 @@ fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
         .fold(0.0, f64::max)
         * 1.1
         + 1.0;
-    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = super::plot::dual_lines(
-        &root,
+    super::plot::dual_lines_file(
+        path,
+        (900, 500),
         format!("{name}: power curve (level flight, still air)"),
         (0.0..v_max, "airspeed (m/s)"),
         super::plot::Line {
@@ -259,8 +241,5 @@ fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
                 .map(|r| (r.airspeed_mps, r.endurance_s / 60.0))
                 .collect(),
         },
-    )?;
-    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
-    root.present()?;
-    Ok(())
+    )
 }

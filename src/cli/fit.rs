@@ -62,26 +62,26 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
     for n in &answer.notes {
         eprintln!("aloft fit: {n}");
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &answer)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.write_record(["name", "value", "std_error", "unit"])?;
-            for p in &answer.power.parameters {
-                w.write_record([
-                    p.name,
-                    &p.value.to_string(),
-                    &p.std_error.to_string(),
-                    p.unit,
-                ])?;
-            }
-            w.flush()?;
-        }
-        Format::Table => render(&mut out, &answer)?,
-    }
+    output::print(
+        args.format,
+        &answer,
+        |out| write_csv(out, &answer),
+        |out| render(out, &answer),
+    )?;
     Ok(Outcome::Ok)
+}
+
+/// The fitted constants: name, value, standard error and unit.
+fn write_csv(out: impl Write, r: &FitAnswer) -> Result<()> {
+    let records = r.power.parameters.iter().map(|p| {
+        [
+            p.name.to_string(),
+            p.value.to_string(),
+            p.std_error.to_string(),
+            p.unit.to_string(),
+        ]
+    });
+    output::write_csv(out, &["name", "value", "std_error", "unit"], records)
 }
 
 fn render(out: &mut impl Write, r: &FitAnswer) -> Result<()> {

@@ -56,15 +56,10 @@ fn info(args: InfoArgs) -> Result<Outcome> {
         );
     }
     let info = log_info(&args.file, &args.flags.read.options(), args.flags.max_lag)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => {
-            output::warn(&info.warnings);
-            output::write_json(&mut out, &info)?
-        }
-        Format::Table | Format::Csv => write_table(&mut out, &info)?,
+    if args.format == Format::Json {
+        output::warn(&info.warnings);
     }
+    output::print_table_or_json(args.format, &info, |out| write_table(out, &info))?;
     Ok(Outcome::Ok)
 }
 
@@ -95,10 +90,10 @@ fn title(j: &LogInfo) -> String {
 fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
     let mut rows = vec![
         Row::new("samples", j.samples.to_string(), ""),
-        Row::new("duration", format!("{:.2}", j.duration_s), "s"),
+        Row::num("duration", j.duration_s, 2, "s"),
     ];
     if let Some(p) = j.time.nominal_period_s {
-        rows.push(Row::new("nominal period", format!("{p:.4}"), "s"));
+        rows.push(Row::num("nominal period", p, 4, "s"));
     }
     rows.push(Row::new(
         "gaps (> 3 periods)",
@@ -118,14 +113,14 @@ fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
         ));
     }
     match j.energy_wh {
-        Some(e) => rows.push(Row::new("energy used (V x I)", format!("{e:.2}"), "Wh")),
+        Some(e) => rows.push(Row::num("energy used (V x I)", e, 2, "Wh")),
         None => rows.push(Row::new("energy used", "n/a: no power data".into(), "")),
     }
     if let Some(p) = j.mean_power_w {
-        rows.push(Row::new("mean power", format!("{p:.1}"), "W"));
+        rows.push(Row::num("mean power", p, 1, "W"));
     }
     if let Some(p) = j.max_power_w {
-        rows.push(Row::new("max power", format!("{p:.1}"), "W"));
+        rows.push(Row::num("max power", p, 1, "W"));
     }
     if let Some(l) = &j.lag {
         rows.push(Row::new(
@@ -150,7 +145,7 @@ fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
 fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     writeln!(out, "channels")?;
     for c in &j.channels {
-        let rate = c.rate_hz.map_or("-".into(), |r| format!("{r:.2} Hz"));
+        let rate = rate(c.rate_hz);
         writeln!(
             out,
             "  {:<13} {:>9} samples  {rate}",
@@ -164,7 +159,7 @@ fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     if let Some(topics) = &j.topics {
         writeln!(out, "topics")?;
         for t in topics {
-            let rate = t.rate_hz.map_or("-".into(), |r| format!("{r:.2} Hz"));
+            let rate = rate(t.rate_hz);
             let used: Vec<&str> = t.used_for.iter().map(|c| c.name()).collect();
             let used = if used.is_empty() {
                 "not decoded".to_string()
@@ -181,24 +176,27 @@ fn write_contents(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     Ok(())
 }
 
+/// A rate in Hz with two decimals, or `-` when there is none.
+fn rate(hz: Option<f64>) -> String {
+    hz.map_or("-".into(), |r| format!("{r:.2} Hz"))
+}
+
 /// The first gaps, dropped values and backward steps of the time base.
 fn write_time_notes(out: &mut impl Write, j: &LogInfo) -> Result<()> {
     for g in j.time.gaps.iter().take(5) {
-        writeln!(
-            out,
-            "gap: {:.3} s -> {:.3} s (sample {})",
-            g.from_s, g.to_s, g.index
-        )?;
+        write_step(out, "gap", g.from_s, g.to_s, g.index)?;
     }
     for d in j.dropped.iter().take(5) {
         writeln!(out, "dropped: row {} {} = {:.1}", d.row, d.channel, d.value)?;
     }
     for n in j.time.non_monotonic.iter().take(5) {
-        writeln!(
-            out,
-            "time goes back: {:.3} s -> {:.3} s (sample {})",
-            n.previous_s, n.time_s, n.index
-        )?;
+        write_step(out, "time goes back", n.previous_s, n.time_s, n.index)?;
     }
+    Ok(())
+}
+
+/// A step of the time base: `what: FROM s -> TO s (sample INDEX)`.
+fn write_step(out: &mut impl Write, what: &str, from_s: f64, to_s: f64, index: u64) -> Result<()> {
+    writeln!(out, "{what}: {from_s:.3} s -> {to_s:.3} s (sample {index})")?;
     Ok(())
 }

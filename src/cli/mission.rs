@@ -3,7 +3,6 @@
 //! return lies. `--replay` predicts a recorded flight instead (see `replay.rs`).
 
 use std::io::Write;
-use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 
@@ -11,7 +10,7 @@ use aloft::engine::{plan_mission_with, Mission, MissionReport, Plan, Sample, Veh
 
 use super::mission_args::MissionArgs;
 use super::mission_view::{
-    header, plan_warnings, plot_track, segment_cells, summary_rows, write_model_line,
+    header, plan_warnings, plot_over_track, segment_cells, summary_rows, write_model_line,
     write_segments_head, write_sorties, Area,
 };
 use super::output;
@@ -40,24 +39,14 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     }
     if let Some(path) = &args.plot {
         let name = mission.spec().name.as_str();
-        plot(
-            path,
-            name,
-            plan.report(),
-            plan.plot_samples(),
-            plan.home_m(),
-        )
-        .with_context(|| format!("cannot draw {}", path.display()))?;
+        let power = |top: &Area<'_>| plot_power(top, name, plan.report(), plan.plot_samples());
+        plot_over_track(path, &plan, None, power)
+            .with_context(|| format!("cannot draw {}", path.display()))?;
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => {
-            output::warn(plan_warnings(&plan));
-            output::write_json(&mut out, plan.summary())?
-        }
-        Format::Table | Format::Csv => write_table(&mut out, &plan)?,
+    if args.format == Format::Json {
+        output::warn(plan_warnings(&plan));
     }
+    output::print_table_or_json(args.format, plan.summary(), |out| write_table(out, &plan))?;
     Ok(if plan.report().feasible {
         Outcome::Ok
     } else {
@@ -108,27 +97,7 @@ fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
     Ok(())
 }
 
-/// Power and state of charge against time, and the ground track with the point of no return.
-fn plot(
-    path: &Path,
-    name: &str,
-    report: &MissionReport,
-    samples: &[Sample],
-    home: [f64; 3],
-) -> Result<()> {
-    use plotters::prelude::*;
-    if samples.is_empty() {
-        bail!("no samples to plot");
-    }
-    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (top, bottom) = root.split_vertically(400);
-    plot_power(&top, name, report, samples)?;
-    plot_track(&bottom, report, samples, home, None)?;
-    root.present()?;
-    Ok(())
-}
-
+/// Power and state of charge against time (above the ground track).
 fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample]) -> Result<()> {
     use plotters::prelude::*;
     let t_max = s[s.len() - 1].time_s.max(1.0);
@@ -159,13 +128,14 @@ fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample])
         .label("reserve floor")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.mix(0.4)));
     if let Some(t) = report.point_of_no_return.map(|p| p.time_s) {
-        chart
-            .draw_series(LineSeries::new(
-                [(t, 0.0), (t, p_max)],
-                BLACK.stroke_width(2),
-            ))?
-            .label("point of no return")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+        let style = BLACK.stroke_width(2);
+        super::plot::labelled_line(
+            &mut chart,
+            [(t, 0.0), (t, p_max)],
+            style,
+            "point of no return",
+            BLACK,
+        )?;
     }
     super::plot::legend(&mut chart, SeriesLabelPosition::LowerLeft)?;
     Ok(())

@@ -5,7 +5,9 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
-use anyhow::Result;
+use std::path::Path;
+
+use anyhow::{bail, Result};
 
 use aloft::engine::{
     AoaModel, MissionReport, Plan, RouteFigures, Sample, SegmentReport, Shortfall, SourceFormat,
@@ -210,36 +212,46 @@ pub(super) fn summary_rows(r: &MissionReport) -> Vec<Row<'static>> {
     };
     vec![
         Row::new("flight time", format!("{} min:s", mmss(r.duration_s)), ""),
-        Row::new("distance flown", format!("{:.0}", r.distance_m), "m"),
-        Row::new("energy used", format!("{:.1}", r.energy_wh), "Wh"),
-        Row::new("mean power", format!("{mean_w:.0}"), "W"),
-        Row::new("peak power", format!("{:.0}", r.peak_power_w), "W"),
-        Row::new("peak current", format!("{:.1}", r.peak_current_a), "A"),
-        Row::new(
-            "battery at take-off",
-            format!("{:.0}", r.start_soc * 100.0),
-            "%",
-        ),
-        Row::new(
-            "battery at the end",
-            format!("{:.1}", r.end_soc * 100.0),
-            "%",
-        ),
-        Row::new(
-            "lowest pack voltage",
-            format!("{:.2}", r.min_voltage_v),
-            "V",
-        ),
-        Row::new("heat in the pack", format!("{:.1}", r.pack_heat_wh), "Wh"),
+        Row::num("distance flown", r.distance_m, 0, "m"),
+        Row::num("energy used", r.energy_wh, 1, "Wh"),
+        Row::num("mean power", mean_w, 0, "W"),
+        Row::num("peak power", r.peak_power_w, 0, "W"),
+        Row::num("peak current", r.peak_current_a, 1, "A"),
+        Row::num("battery at take-off", r.start_soc * 100.0, 0, "%"),
+        Row::num("battery at the end", r.end_soc * 100.0, 1, "%"),
+        Row::num("lowest pack voltage", r.min_voltage_v, 2, "V"),
+        Row::num("heat in the pack", r.pack_heat_wh, 1, "Wh"),
     ]
 }
 
 pub(super) type Area<'a> =
     plotters::drawing::DrawingArea<plotters::backend::SVGBackend<'a>, plotters::coord::Shift>;
 
+/// A mission's chart file: `upper` draws a chart over time in the upper half, the ground track
+/// is below it (`confident`: see [`plot_track`]).
+pub(super) fn plot_over_track(
+    path: &Path,
+    plan: &Plan,
+    confident: Option<(f64, f64)>,
+    upper: impl FnOnce(&Area<'_>) -> Result<()>,
+) -> Result<()> {
+    use plotters::prelude::*;
+    let samples = plan.plot_samples();
+    if samples.is_empty() {
+        bail!("no samples to plot");
+    }
+    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (top, bottom) = root.split_vertically(400);
+    upper(&top)?;
+    plot_track(&bottom, plan.report(), samples, plan.home_m(), confident)?;
+    root.present()?;
+    Ok(())
+}
+
 /// The ground track (equal scales) with home and the point of no return; with `confident`, also
 /// the point of no return that holds with 95 % confidence over the scenarios (east, north).
-pub(super) fn plot_track(
+fn plot_track(
     area: &Area<'_>,
     report: &MissionReport,
     s: &[Sample],
@@ -271,13 +283,8 @@ pub(super) fn plot_track(
         .x_desc("east (m)")
         .y_desc("north (m)")
         .draw()?;
-    track
-        .draw_series(LineSeries::new(
-            s.iter().map(|x| (x.east_m, x.north_m)),
-            &RED,
-        ))?
-        .label("track")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    let points = s.iter().map(|x| (x.east_m, x.north_m));
+    super::plot::labelled_line(&mut track, points, RED, "track", RED)?;
     track
         .draw_series([Circle::new((home[0], home[1]), 6, GREEN.filled())])?
         .label("home")
@@ -302,12 +309,7 @@ pub(super) fn plot_track(
             .label("point of no return, 95 % confidence")
             .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, style));
     }
-    track
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
+    super::plot::legend(&mut track, SeriesLabelPosition::MiddleRight)
 }
 
 /// The first columns of a segment table's head (number, item when the mission came from a

@@ -1,6 +1,8 @@
 //! Small rendering helpers shared by the subcommands.
 
-use std::io::{self, Write};
+use std::io::{self, StdoutLock, Write};
+
+use super::Format;
 
 /// True when the error chain holds a broken pipe (the reader went away: exit quietly).
 pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
@@ -24,6 +26,16 @@ impl<'a> Row<'a> {
     pub fn new(label: &'a str, value: String, unit: &'a str) -> Self {
         Self { label, value, unit }
     }
+
+    /// A row of one number shown with `decimals` digits after the point.
+    pub fn num(label: &'a str, value: f64, decimals: usize, unit: &'a str) -> Self {
+        Self::new(label, fixed(value, decimals), unit)
+    }
+}
+
+/// A number with `decimals` digits after the point, as tables show it.
+pub fn fixed(value: f64, decimals: usize) -> String {
+    format!("{value:.decimals$}")
 }
 
 /// Write rows as an aligned two-column table with units.
@@ -59,5 +71,61 @@ pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow
         }
     })?;
     writeln!(out)?;
+    Ok(())
+}
+
+/// Print an answer on stdout in `format`: JSON from the answer itself, CSV and the table by the
+/// command's own writers.
+pub fn print<T: serde::Serialize>(
+    format: Format,
+    answer: &T,
+    csv: impl FnOnce(StdoutLock<'static>) -> anyhow::Result<()>,
+    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let mut out = io::stdout().lock();
+    match format {
+        Format::Json => write_json(&mut out, answer),
+        Format::Csv => csv(out),
+        Format::Table => table(&mut out),
+    }
+}
+
+/// [`print`] for an answer without a CSV of its own: `--format csv` prints the table.
+pub fn print_table_or_json<T: serde::Serialize>(
+    format: Format,
+    answer: &T,
+    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let mut out = io::stdout().lock();
+    match format {
+        Format::Json => write_json(&mut out, answer),
+        Format::Table | Format::Csv => table(&mut out),
+    }
+}
+
+/// Write a CSV: the header, then one line per record.
+pub fn write_csv<R>(
+    out: impl Write,
+    header: &[&str],
+    records: impl IntoIterator<Item = R>,
+) -> anyhow::Result<()>
+where
+    R: IntoIterator,
+    R::Item: AsRef<[u8]>,
+{
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(header)?;
+    for r in records {
+        w.write_record(r)?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// Write one value as a CSV of one line, its field names the header.
+pub fn write_csv_value(out: impl Write, value: &impl serde::Serialize) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.serialize(value)?;
+    w.flush()?;
     Ok(())
 }

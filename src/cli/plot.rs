@@ -1,8 +1,10 @@
 //! The charts the subcommands share: two lines against one x axis, each on its own y axis
 //! ([`dual_lines`]), and several labelled lines against one y axis ([`lines`]).
 
+use std::path::Path;
+
 use anyhow::Result;
-use plotters::chart::DualCoordChartContext;
+use plotters::chart::{ChartContext, DualCoordChartContext};
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -14,6 +16,10 @@ pub type DualChart<'a, 'b> = DualCoordChartContext<
     Cartesian2d<RangedCoordf64, RangedCoordf64>,
     Cartesian2d<RangedCoordf64, RangedCoordf64>,
 >;
+
+/// A chart of one x and one y axis (the primary part of a [`DualChart`]).
+pub type Chart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// One line of the chart with its axis: description, axis maximum, colour and points.
 pub struct Line<'s> {
@@ -49,10 +55,7 @@ pub fn dual_lines<'a, 'b>(
         .draw()?;
     chart.configure_secondary_axes().y_desc(right.desc).draw()?;
     let (lc, rc) = (left.color, right.color);
-    chart
-        .draw_series(LineSeries::new(left.points, &lc))?
-        .label(left.desc)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], lc));
+    labelled_line(&mut chart, left.points, lc, left.desc, lc)?;
     chart
         .draw_secondary_series(LineSeries::new(right.points, &rc))?
         .label(right.desc)
@@ -60,11 +63,43 @@ pub fn dual_lines<'a, 'b>(
     Ok(chart)
 }
 
-/// Draw the legend of a chart from [`dual_lines`] at `position`.
-pub fn legend<'a, 'b: 'a>(
-    chart: &mut DualChart<'a, 'b>,
-    position: SeriesLabelPosition,
+/// A chart file of [`dual_lines`] over the whole picture (`size` in pixels), the legend at the
+/// middle right.
+pub fn dual_lines_file(
+    path: &Path,
+    size: (u32, u32),
+    caption: String,
+    x: (std::ops::Range<f64>, &str),
+    left: Line<'_>,
+    right: Line<'_>,
 ) -> Result<()> {
+    let root = SVGBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE)?;
+    let mut chart = dual_lines(&root, caption, x, left, right)?;
+    legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+    root.present()?;
+    Ok(())
+}
+
+/// Draw `points` as a line in `style`, with `label` in the legend beside a short stroke in `key`.
+pub fn labelled_line(
+    chart: &mut Chart<'_, '_>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: impl Into<ShapeStyle>,
+    label: &str,
+    key: impl Into<ShapeStyle>,
+) -> Result<()> {
+    let key = key.into();
+    chart
+        .draw_series(LineSeries::new(points, style))?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], key));
+    Ok(())
+}
+
+/// Draw the legend of a chart (or of a [`DualChart`], whose legend is its primary's) at
+/// `position`, on a white background in a black frame.
+pub fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, position: SeriesLabelPosition) -> Result<()> {
     chart
         .configure_series_labels()
         .position(position)
@@ -124,17 +159,9 @@ pub fn lines(
         .draw()?;
     for s in series {
         let c = s.color;
-        chart
-            .draw_series(LineSeries::new(s.points.clone(), c.stroke_width(2)))?
-            .label(s.label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        let style = c.stroke_width(2);
+        labelled_line(&mut chart, s.points.clone(), style, &s.label, style)?;
         chart.draw_series(s.points.into_iter().map(|p| Circle::new(p, 3, c.filled())))?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
+    legend(&mut chart, SeriesLabelPosition::UpperRight)
 }

@@ -77,18 +77,16 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format.unwrap_or_default() {
-        Format::Json => output::write_json(&mut out, &answer)?,
-        Format::Csv => write_csv(out, &args, &answer)?,
-        Format::Table => write_table(&mut out, &args, &answer)?,
-    }
+    output::print(
+        args.format.unwrap_or_default(),
+        &answer,
+        |out| write_csv(out, &args, &answer),
+        |out| write_table(out, &args, &answer),
+    )?;
     Ok(Outcome::Ok)
 }
 
 fn write_csv(out: impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
-    let mut w = csv::Writer::from_writer(out);
     let mut header = vec!["airspeed_mps", "roll_deg", "pitch_deg", "climb_rate_mps"];
     header.extend(POWER_KEYS);
     let mut row = vec![args.airspeed, args.roll, args.pitch, args.climb_rate];
@@ -105,10 +103,7 @@ fn write_csv(out: impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
             g.d_pitch_w_per_deg,
         ]);
     }
-    w.write_record(&header)?;
-    w.write_record(row.iter().map(|v| v.to_string()))?;
-    w.flush()?;
-    Ok(())
+    output::write_csv(out, &header, [row.iter().map(|v| v.to_string())])
 }
 
 fn write_table(out: &mut impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
@@ -117,37 +112,38 @@ fn write_table(out: &mut impl Write, args: &PowerArgs, a: &PowerAnswer) -> Resul
         "{}, {}\nairspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
         a.context.vehicle, a.context.mass, args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
     );
-    let f1 = |v: f64| format!("{v:.1}");
-    let f2 = |v: f64| format!("{v:.2}");
     let mut rows = vec![
-        Row::new("thrust", f2(p.thrust_n), "N"),
-        Row::new("induced velocity", f2(p.induced_velocity_mps), "m/s"),
-        Row::new(
+        Row::num("thrust", p.thrust_n, 2, "N"),
+        Row::num("induced velocity", p.induced_velocity_mps, 2, "m/s"),
+        Row::num(
             "hover induced velocity",
-            f2(p.hover_induced_velocity_mps),
+            p.hover_induced_velocity_mps,
+            2,
             "m/s",
         ),
-        Row::new("induced power (eq 8)", f1(p.induced_w), "W"),
-        Row::new("parasitic power (eq 11)", f1(p.parasitic_w), "W"),
-        Row::new("profile power (eq 12)", f1(p.profile_w), "W"),
-        Row::new(
+        Row::num("induced power (eq 8)", p.induced_w, 1, "W"),
+        Row::num("parasitic power (eq 11)", p.parasitic_w, 1, "W"),
+        Row::num("profile power (eq 12)", p.profile_w, 1, "W"),
+        Row::num(
             "acceleration work (eq 8, exact AoA)",
-            f1(p.acceleration_w),
+            p.acceleration_w,
+            1,
             "W",
         ),
-        Row::new("climb power (eq 13)", f1(p.climb_w), "W"),
-        Row::new("aerodynamic total (eq 7)", f1(p.aero_w), "W"),
-        Row::new("electrical (eq 14)", f1(p.electrical_w), "W"),
-        Row::new("efficiency eta", format!("{:.4}", a.context.efficiency), ""),
+        Row::num("climb power (eq 13)", p.climb_w, 1, "W"),
+        Row::num("aerodynamic total (eq 7)", p.aero_w, 1, "W"),
+        Row::num("electrical (eq 14)", p.electrical_w, 1, "W"),
+        Row::num("efficiency eta", a.context.efficiency, 4, ""),
     ];
     if let Some(g) = &a.electrical_gradient {
-        rows.push(Row::new(
+        rows.push(Row::num(
             "dP/d airspeed",
-            f2(g.d_airspeed_w_per_mps),
+            g.d_airspeed_w_per_mps,
+            2,
             "W per m/s",
         ));
-        rows.push(Row::new("dP/d roll", f2(g.d_roll_w_per_deg), "W per deg"));
-        rows.push(Row::new("dP/d pitch", f2(g.d_pitch_w_per_deg), "W per deg"));
+        rows.push(Row::num("dP/d roll", g.d_roll_w_per_deg, 2, "W per deg"));
+        rows.push(Row::num("dP/d pitch", g.d_pitch_w_per_deg, 2, "W per deg"));
     }
     output::write_table(out, &title, &rows)?;
     if !a.context.removed.is_empty() {

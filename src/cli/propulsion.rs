@@ -51,13 +51,12 @@ pub fn run(args: PropulsionArgs) -> Result<Outcome> {
             plot_sweep(path, vehicle.name(), &sweep.points)
                 .with_context(|| format!("cannot write the plot {}", path.display()))?;
         }
-        let stdout = std::io::stdout();
-        let mut out = stdout.lock();
-        match args.format {
-            Format::Json => output::write_json(&mut out, &sweep)?,
-            Format::Csv => write_sweep_csv(out, &sweep.points)?,
-            Format::Table => write_sweep_table(&mut out, vehicle.name(), &sweep.points)?,
-        }
+        output::print(
+            args.format,
+            &sweep,
+            |out| write_sweep_csv(out, &sweep.points),
+            |out| write_sweep_table(out, vehicle.name(), &sweep.points),
+        )?;
         return Ok(Outcome::Ok);
     }
     let request = match args.takeoff_mass_kg {
@@ -65,17 +64,12 @@ pub fn run(args: PropulsionArgs) -> Result<Outcome> {
         None => HoverRequest::Payload(args.payload_kg),
     };
     let h = hover(&vehicle, request)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &h)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.serialize(h)?;
-            w.flush()?;
-        }
-        Format::Table => write_table(&mut out, vehicle.name(), &h)?,
-    }
+    output::print(
+        args.format,
+        &h,
+        |out| output::write_csv_value(out, &h),
+        |out| write_table(out, vehicle.name(), &h),
+    )?;
     Ok(Outcome::Ok)
 }
 
@@ -94,8 +88,7 @@ fn parse_range(spec: &str) -> Result<(f64, f64, f64)> {
 }
 
 fn write_sweep_csv(out: impl Write, points: &[SweepPoint]) -> Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record([
+    let header = [
         "takeoff_mass_kg",
         "thrust_per_rotor_n",
         "rotor_speed_rpm",
@@ -106,30 +99,31 @@ fn write_sweep_csv(out: impl Write, points: &[SweepPoint]) -> Result<()> {
         "battery_heat_w",
         "flight_time_min",
         "error",
-    ])?;
-    for p in points {
-        let mut row = vec![p.takeoff_mass_kg.to_string()];
-        match &p.result {
-            Some(h) => row.extend(
-                [
-                    h.thrust_per_rotor_n,
-                    h.rotor_speed_rpm,
-                    h.motor_current_a,
-                    h.pack_current_a,
-                    h.power_required_w,
-                    h.power_drawn_w,
-                    h.battery_heat_w,
-                    h.flight_time_min,
-                ]
-                .map(|v| v.to_string()),
-            ),
-            None => row.extend(std::iter::repeat_n(String::new(), 8)),
-        }
-        row.push(p.error.clone().unwrap_or_default());
-        w.write_record(&row)?;
+    ];
+    output::write_csv(out, &header, points.iter().map(sweep_record))
+}
+
+/// A mass of the sweep: the hover's figures, or empty cells and the reason it cannot hover.
+fn sweep_record(p: &SweepPoint) -> Vec<String> {
+    let mut row = vec![p.takeoff_mass_kg.to_string()];
+    match &p.result {
+        Some(h) => row.extend(
+            [
+                h.thrust_per_rotor_n,
+                h.rotor_speed_rpm,
+                h.motor_current_a,
+                h.pack_current_a,
+                h.power_required_w,
+                h.power_drawn_w,
+                h.battery_heat_w,
+                h.flight_time_min,
+            ]
+            .map(|v| v.to_string()),
+        ),
+        None => row.extend(std::iter::repeat_n(String::new(), 8)),
     }
-    w.flush()?;
-    Ok(())
+    row.push(p.error.clone().unwrap_or_default());
+    row
 }
 
 fn write_sweep_table(out: &mut impl Write, name: &str, points: &[SweepPoint]) -> Result<()> {
@@ -172,33 +166,17 @@ fn write_table(out: &mut impl Write, name: &str, h: &HoverResult) -> Result<()> 
         name, h.takeoff_mass_kg, h.rotor_count, h.pack_count
     );
     let rows = vec![
-        Row::new(
-            "thrust per rotor",
-            format!("{:.2}", h.thrust_per_rotor_n),
-            "N",
-        ),
-        Row::new("rotor speed", format!("{:.0}", h.rotor_speed_rpm), "rpm"),
-        Row::new("rotor torque", format!("{:.3}", h.torque_nm), "N m"),
-        Row::new("motor current", format!("{:.2}", h.motor_current_a), "A"),
-        Row::new("motor voltage", format!("{:.2}", h.motor_voltage_v), "V"),
-        Row::new("pack current", format!("{:.2}", h.pack_current_a), "A"),
-        Row::new(
-            "pack terminal voltage",
-            format!("{:.2}", h.pack_terminal_voltage_v),
-            "V",
-        ),
-        Row::new(
-            "power required (all motors)",
-            format!("{:.0}", h.power_required_w),
-            "W",
-        ),
-        Row::new(
-            "power drawn from packs",
-            format!("{:.0}", h.power_drawn_w),
-            "W",
-        ),
-        Row::new("heat in packs", format!("{:.0}", h.battery_heat_w), "W"),
-        Row::new("flight time", format!("{:.2}", h.flight_time_min), "min"),
+        Row::num("thrust per rotor", h.thrust_per_rotor_n, 2, "N"),
+        Row::num("rotor speed", h.rotor_speed_rpm, 0, "rpm"),
+        Row::num("rotor torque", h.torque_nm, 3, "N m"),
+        Row::num("motor current", h.motor_current_a, 2, "A"),
+        Row::num("motor voltage", h.motor_voltage_v, 2, "V"),
+        Row::num("pack current", h.pack_current_a, 2, "A"),
+        Row::num("pack terminal voltage", h.pack_terminal_voltage_v, 2, "V"),
+        Row::num("power required (all motors)", h.power_required_w, 0, "W"),
+        Row::num("power drawn from packs", h.power_drawn_w, 0, "W"),
+        Row::num("heat in packs", h.battery_heat_w, 0, "W"),
+        Row::num("flight time", h.flight_time_min, 2, "min"),
     ];
     output::write_table(out, &title, &rows)?;
     if h.motor_voltage_v > h.pack_terminal_voltage_v {
@@ -233,10 +211,9 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
         .map(|(_, h)| h.power_required_w)
         .fold(0.0, f64::max)
         * 1.1;
-    let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = super::plot::dual_lines(
-        &root,
+    super::plot::dual_lines_file(
+        path,
+        (800, 500),
         format!("{name}: flight time and power against take-off mass"),
         (x0..x1, "take-off mass (kg)"),
         super::plot::Line {
@@ -251,8 +228,5 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
             color: RED,
             points: ok.iter().map(|(m, h)| (*m, h.power_required_w)).collect(),
         },
-    )?;
-    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
-    root.present()?;
-    Ok(())
+    )
 }

@@ -37,12 +37,7 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
     for n in &answer.context.notes {
         eprintln!("aloft mission --replay: {n}");
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &answer)?,
-        Format::Table | Format::Csv => write_table(&mut out, &answer)?,
-    }
+    output::print_table_or_json(args.format, &answer, |out| write_table(out, &answer))?;
     Ok(Outcome::Ok)
 }
 

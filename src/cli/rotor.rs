@@ -82,17 +82,12 @@ impl RotorArgs {
 
 pub fn run(args: RotorArgs) -> Result<Outcome> {
     let answer = rotor_response(&args.request())?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &answer)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.serialize(answer.result)?;
-            w.flush()?;
-        }
-        Format::Table => write_table(&mut out, &answer)?,
-    }
+    output::print(
+        args.format,
+        &answer,
+        |out| output::write_csv_value(out, &answer.result),
+        |out| write_table(out, &answer),
+    )?;
     Ok(Outcome::Ok)
 }
 
@@ -115,11 +110,7 @@ fn write_table(out: &mut impl Write, answer: &RotorAnswer) -> Result<()> {
             format!("{:.3e}", r.prop_inertia_kgm2),
             "kg m^2",
         ),
-        Row::new(
-            "torque constant K_T = K_E",
-            format!("{:.5}", r.kt_nm_per_a),
-            "N m/A",
-        ),
+        Row::num("torque constant K_T = K_E", r.kt_nm_per_a, 5, "N m/A"),
         Row::new("time constant (eq 7)", ms(r.time_constant_s), "ms"),
         Row::new(
             "linearised time constant",
@@ -134,12 +125,8 @@ fn write_table(out: &mut impl Write, answer: &RotorAnswer) -> Result<()> {
             ms(r.settling_time_s),
             "ms",
         ),
-        Row::new(
-            "settling band",
-            format!("{:.0}", r.settling_band_fraction * 100.0),
-            "%",
-        ),
-        Row::new("steady current", format!("{:.2}", r.steady_current_a), "A"),
+        Row::num("settling band", r.settling_band_fraction * 100.0, 0, "%"),
+        Row::num("steady current", r.steady_current_a, 2, "A"),
     ];
     output::write_table(out, &title, &rows)?;
     Ok(())

@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 
 use aloft::engine::{
     plan_scenarios, EnduranceUncertainty, Mission, MissionOptions, MissionWithUncertainty,
@@ -14,6 +14,7 @@ use aloft::engine::{
 
 use super::mission_view::{self, mmss};
 use super::output::{self, Row};
+use super::plot::labelled_line;
 use super::{Format, Outcome};
 
 /// What a mission's scenarios are drawn around and rendered with.
@@ -35,21 +36,16 @@ pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome
         let name = run.mission.spec().name.as_str();
         plot(path, name, plan, &u).with_context(|| format!("cannot draw {}", path.display()))?;
     }
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match run.format {
-        Format::Json => {
-            output::warn(mission_view::plan_warnings(plan));
-            output::write_json(
-                &mut out,
-                &MissionWithUncertainty {
-                    summary: plan.summary(),
-                    uncertainty: &u,
-                },
-            )?
-        }
-        Format::Table | Format::Csv => write_mission_table(&mut out, plan, &u)?,
+    if run.format == Format::Json {
+        output::warn(mission_view::plan_warnings(plan));
     }
+    let answer = MissionWithUncertainty {
+        summary: plan.summary(),
+        uncertainty: &u,
+    };
+    output::print_table_or_json(run.format, &answer, |out| {
+        write_mission_table(out, plan, &u)
+    })?;
     Ok(if plan.report().feasible {
         Outcome::Ok
     } else {
@@ -205,18 +201,12 @@ use super::mission_view::Area;
 /// The state-of-charge fan over time (the plan's own line in it) and the ground track with the
 /// plan's point of no return and the one that holds with 95 % confidence.
 fn plot(path: &Path, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
-    use plotters::prelude::*;
-    let samples = plan.plot_samples();
-    if samples.is_empty() {
-        bail!("no samples to plot");
-    }
-    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (top, bottom) = root.split_vertically(400);
-    plot_fan(&top, name, plan, u)?;
-    plot_track(&bottom, plan, u, samples)?;
-    root.present()?;
-    Ok(())
+    let confident = u
+        .point_of_no_return_s
+        .p5
+        .and_then(|t| sample_at(plan.plot_samples(), t))
+        .map(|x| (x.east_m, x.north_m));
+    mission_view::plot_over_track(path, plan, confident, |top| plot_fan(top, name, plan, u))
 }
 
 fn plot_fan(area: &Area<'_>, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
@@ -255,61 +245,34 @@ fn plot_fan(area: &Area<'_>, name: &str, plan: &Plan, u: &Uncertainty) -> Result
             )])?
             .label("5th-95th percentile")
             .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], band.filled()));
-        chart
-            .draw_series(LineSeries::new(
-                f.time_s.iter().zip(&f.p50).map(|(&t, &v)| (t, v * 100.0)),
-                BLUE.mix(0.6).stroke_width(1),
-            ))?
-            .label("median")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.mix(0.6)));
+        let median = f.time_s.iter().zip(&f.p50).map(|(&t, &v)| (t, v * 100.0));
+        let style = BLUE.mix(0.6);
+        labelled_line(&mut chart, median, style.stroke_width(1), "median", style)?;
     }
-    chart
-        .draw_series(LineSeries::new(
-            s.iter().map(|x| (x.time_s, x.soc * 100.0)),
-            BLUE.stroke_width(2),
-        ))?
-        .label("plan")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    let own = s.iter().map(|x| (x.time_s, x.soc * 100.0));
+    labelled_line(&mut chart, own, BLUE.stroke_width(2), "plan", BLUE)?;
     let r = plan.report();
     let floor = (r.empty_soc + r.required_reserve_soc) * 100.0;
-    chart
-        .draw_series(LineSeries::new(
-            [(0.0, floor), (t_max, floor)],
-            RED.mix(0.6),
-        ))?
-        .label("reserve floor")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.mix(0.6)));
+    let style = RED.mix(0.6);
+    labelled_line(
+        &mut chart,
+        [(0.0, floor), (t_max, floor)],
+        style,
+        "reserve floor",
+        style,
+    )?;
     if let Some(t) = u.point_of_no_return_s.p5 {
-        chart
-            .draw_series(LineSeries::new(
-                [(t, 0.0), (t, 100.0)],
-                BLACK.stroke_width(2),
-            ))?
-            .label("point of no return, 95 % confidence")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+        let line = [(t, 0.0), (t, 100.0)];
+        let label = "point of no return, 95 % confidence";
+        labelled_line(&mut chart, line, BLACK.stroke_width(2), label, BLACK)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerLeft)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    Ok(())
+    super::plot::legend(&mut chart, SeriesLabelPosition::LowerLeft)
 }
 
 /// The plan's sample nearest to time `t_s`.
 fn sample_at(s: &[Sample], t_s: f64) -> Option<&Sample> {
     let k = s.partition_point(|x| x.time_s < t_s);
     s.get(k.min(s.len().saturating_sub(1)))
-}
-
-fn plot_track(area: &Area<'_>, plan: &Plan, u: &Uncertainty, s: &[Sample]) -> Result<()> {
-    let confident = u
-        .point_of_no_return_s
-        .p5
-        .and_then(|t| sample_at(s, t))
-        .map(|x| (x.east_m, x.north_m));
-    mission_view::plot_track(area, plan.report(), s, plan.home_m(), confident)
 }
 
 /// The endurance table's lines for the scenarios.

@@ -11,6 +11,7 @@ use aloft::engine::flags::ValidateFlags;
 use aloft::engine::{validate_logs, PowerSeries, ValidateReport, Vehicle};
 
 use super::flights::file_name;
+use super::output;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -42,19 +43,17 @@ pub fn run(args: ValidateArgs) -> Result<Outcome> {
             .with_context(|| format!("cannot write the plot {}", path.display()))?;
     }
     let report = &answer.report;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => super::output::write_json(&mut out, report)?,
-        Format::Csv => write_csv(out, report)?,
-        Format::Table => render(&mut out, report)?,
-    }
+    output::print(
+        args.format,
+        report,
+        |out| write_csv(out, report),
+        |out| render(out, report),
+    )?;
     Ok(Outcome::Ok)
 }
 
 fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record([
+    let header = [
         "file",
         "duration_s",
         "lag_s",
@@ -66,11 +65,11 @@ fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
         "calibrated_energy_error_percent",
         "calibrated_rmse_w",
         "best_constant_rmse_w",
-    ])?;
-    for f in &report.flights {
+    ];
+    let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
+    let records = report.flights.iter().map(|f| {
         let c = f.calibration.as_ref();
-        let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
-        w.write_record([
+        [
             f.file.clone(),
             f.duration_s.to_string(),
             f.lag_s.to_string(),
@@ -82,10 +81,9 @@ fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
             opt(c.map(|c| c.energy_error_percent)),
             opt(c.map(|c| c.rmse_w)),
             opt(c.map(|c| c.best_constant_rmse_w)),
-        ])?;
-    }
-    w.flush()?;
-    Ok(())
+        ]
+    });
+    output::write_csv(out, &header, records)
 }
 
 fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
@@ -206,25 +204,11 @@ fn plot(path: &Path, series: &[PowerSeries]) -> Result<()> {
             .x_desc("time (s)")
             .y_desc("power (W)")
             .draw()?;
-        chart
-            .draw_series(LineSeries::new(
-                t.iter().zip(measured).map(|(x, y)| (x - t0, *y)),
-                &BLUE,
-            ))?
-            .label("measured")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-        chart
-            .draw_series(LineSeries::new(
-                t.iter().zip(predicted).map(|(x, y)| (x - t0, *y)),
-                &RED,
-            ))?
-            .label("model")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()?;
+        for (values, color, label) in [(measured, BLUE, "measured"), (predicted, RED, "model")] {
+            let line = t.iter().zip(values).map(|(x, y)| (x - t0, *y));
+            super::plot::labelled_line(&mut chart, line, color, label, color)?;
+        }
+        super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
     }
     root.present()?;
     Ok(())

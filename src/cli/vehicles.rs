@@ -48,39 +48,38 @@ pub fn run(args: VehiclesArgs) -> Result<Outcome> {
 
 fn list(format: Format) -> Result<Outcome> {
     let entries = list_vehicles()?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match format {
-        Format::Json => output::write_json(&mut out, &entries)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.write_record([
-                "name",
-                "takeoff_mass_kg",
-                "models",
-                "batteries",
-                "description",
-                "calibrated_on",
-                "published",
-            ])?;
-            for e in &entries {
-                let mass = e.takeoff_mass_kg.to_string();
-                let (cal, publ) = source_words(e);
-                w.write_record([
-                    e.name,
-                    &mass,
-                    &e.models.join(" "),
-                    &e.batteries.join(" "),
-                    &e.description,
-                    cal,
-                    publ,
-                ])?;
-            }
-            w.flush()?;
-        }
-        Format::Table => list_table(&mut out, &entries)?,
-    }
+    output::print(
+        format,
+        &entries,
+        |out| list_csv(out, &entries),
+        |out| list_table(out, &entries),
+    )?;
     Ok(Outcome::Ok)
+}
+
+fn list_csv(out: impl Write, entries: &[VehicleEntry]) -> Result<()> {
+    let header = [
+        "name",
+        "takeoff_mass_kg",
+        "models",
+        "batteries",
+        "description",
+        "calibrated_on",
+        "published",
+    ];
+    let records = entries.iter().map(|e| {
+        let (cal, publ) = source_words(e);
+        [
+            e.name.to_string(),
+            e.takeoff_mass_kg.to_string(),
+            e.models.join(" "),
+            e.batteries.join(" "),
+            e.description.clone(),
+            cal.to_string(),
+            publ.to_string(),
+        ]
+    });
+    output::write_csv(out, &header, records)
 }
 
 /// What the efficiency was calibrated on and where it was published, or empty.
@@ -121,35 +120,35 @@ fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
 fn calibrate(args: CalibrateArgs) -> Result<Outcome> {
     let c = calibrate_spec_file(&args.spec)?;
     c.write_vehicle_file(&args.output)?;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    match args.format {
-        Format::Json => output::write_json(&mut out, &c)?,
-        Format::Csv => {
-            let mut w = csv::Writer::from_writer(out);
-            w.write_record([
-                "name",
-                "battery",
-                "takeoff_mass_kg",
-                "published_minutes",
-                "efficiency",
-                "hover_power_w",
-                "max_minutes_at_unit_efficiency",
-            ])?;
-            w.write_record([
-                c.name.clone(),
-                c.battery.clone(),
-                c.takeoff_mass_kg.to_string(),
-                c.published_minutes.to_string(),
-                c.calibration.efficiency.to_string(),
-                c.calibration.hover_power_w.to_string(),
-                c.calibration.max_minutes_at_unit_efficiency.to_string(),
-            ])?;
-            w.flush()?;
-        }
-        Format::Table => calibrate_table(&mut out, &c, &args.output)?,
-    }
+    output::print(
+        args.format,
+        &c,
+        |out| calibrate_csv(out, &c),
+        |out| calibrate_table(out, &c, &args.output),
+    )?;
     Ok(Outcome::Ok)
+}
+
+fn calibrate_csv(out: impl Write, c: &SpecCalibration) -> Result<()> {
+    let header = [
+        "name",
+        "battery",
+        "takeoff_mass_kg",
+        "published_minutes",
+        "efficiency",
+        "hover_power_w",
+        "max_minutes_at_unit_efficiency",
+    ];
+    let record = [
+        c.name.clone(),
+        c.battery.clone(),
+        c.takeoff_mass_kg.to_string(),
+        c.published_minutes.to_string(),
+        c.calibration.efficiency.to_string(),
+        c.calibration.hover_power_w.to_string(),
+        c.calibration.max_minutes_at_unit_efficiency.to_string(),
+    ];
+    output::write_csv(out, &header, [record])
 }
 
 fn calibrate_table(

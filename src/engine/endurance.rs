@@ -101,10 +101,7 @@ impl EnduranceSummary {
     /// # Errors
     /// [`Error::OptionsFormat`] if serialisation fails (it does not for finite numbers).
     pub fn to_json(&self) -> Result<String, Error> {
-        serde_json::to_string_pretty(self).map_err(|e| Error::OptionsFormat {
-            what: "endurance summary",
-            message: e.to_string(),
-        })
+        super::summary::pretty_json(self, "endurance summary")
     }
 }
 

@@ -249,15 +249,7 @@ fn drag_fit(
         );
         return Ok((None, Vec::new()));
     }
-    let (mu1, mu2, mu3) = vehicle.drag().coefficients();
-    let bounded = fit_drag_bounded(
-        [mu1, mu2, mu3],
-        vehicle.mass_kg(),
-        vehicle.gravity_mps2(),
-        forces,
-        1.0,
-        5.0,
-    );
+    let bounded = with_drag_inputs(vehicle, forces, fit_drag_bounded);
     kept.extend(bounded.kept);
     let Some(d) = bounded.fit else {
         return Ok((None, bounded.fitted));
@@ -266,6 +258,31 @@ fn drag_fit(
     [p.mu1_n_s_per_m, p.mu2_n_s2_per_m2, p.mu3_n_s3_per_m3] = d.mu_n;
     *vehicle = aloft_power::Vehicle::new(p)?;
     Ok((Some(d), bounded.fitted))
+}
+
+/// A fit of drag from the force balance: from the template's `mu` (N s/m, N s^2/m^2,
+/// N s^3/m^3), mass (kg) and gravity (m/s^2) over force samples, with the lowest airspeed used
+/// (m/s) and the outlier threshold (robust sigma).
+type DragFitFn<T> = fn([f64; 3], f64, f64, &[ForceSample], f64, f64) -> T;
+
+/// A drag fit from the force balance (`fit`: the scalar or the body-axis one) over `forces`,
+/// started from the vehicle's drag with its mass and gravity, on the samples faster than 1 m/s,
+/// outliers beyond 5 robust sigma dropped.
+fn with_drag_inputs<T>(
+    vehicle: &aloft_power::Vehicle,
+    forces: &[ForceSample],
+    fit: DragFitFn<T>,
+) -> T {
+    let (mu1, mu2, mu3) = vehicle.drag().coefficients();
+    let (min_airspeed_mps, outlier_sigma) = (1.0, 5.0);
+    fit(
+        [mu1, mu2, mu3],
+        vehicle.mass_kg(),
+        vehicle.gravity_mps2(),
+        forces,
+        min_airspeed_mps,
+        outlier_sigma,
+    )
 }
 
 /// Relative change of the efficiency from one day to another that a fit cannot see in its own
@@ -284,16 +301,10 @@ fn body_axis_fit(
     fitted: &mut Vec<&'static str>,
     vehicle: &mut aloft_power::Vehicle,
 ) -> Result<Option<BodyAxisDragFit>, Error> {
-    let (mu1, mu2, mu3) = vehicle.drag().coefficients();
+    // What each axis keeps when the fit cannot tell them apart: the scalar mu2.
+    let (_, mu2, _) = vehicle.drag().coefficients();
     let mut p = vehicle.params().clone();
-    let answer = fit_body_axis_drag(
-        [mu1, mu2, mu3],
-        vehicle.mass_kg(),
-        vehicle.gravity_mps2(),
-        forces,
-        1.0,
-        5.0,
-    );
+    let answer = with_drag_inputs(vehicle, forces, fit_body_axis_drag);
     let fit = match answer {
         Ok(fit) => fit,
         Err(refusal) => {

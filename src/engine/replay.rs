@@ -23,7 +23,7 @@ use super::finite::finite;
 use super::vehicles::{MassParts, Vehicle};
 use super::wind::{describe_wind_spec, steady};
 use crate::error::Error;
-use crate::identify::{align_flight, AlignOptions};
+use crate::identify::{align_flight, power_samples, AlignOptions};
 
 /// Where the replay takes the acceleration from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -397,12 +397,7 @@ fn measured_series(
     request: &ReplayRequest,
     notes: &mut Vec<String>,
 ) -> Result<Option<Measured>, Error> {
-    let (times, power_w): (Vec<f64>, Vec<f64>) = log
-        .samples
-        .iter()
-        .filter_map(|s| s.electrical_power_w().map(|p| (s.time_s, p)))
-        .filter(|(t, p)| t.is_finite() && p.is_finite())
-        .unzip();
+    let (times, power_w) = power_samples(log);
     let monotonic = times.windows(2).all(|w| w[1] >= w[0]);
     if times.len() < 2 || !monotonic {
         return Ok(None);

@@ -329,10 +329,7 @@ impl MissionWithUncertainty<'_> {
     /// # Errors
     /// [`Error::OptionsFormat`] if serialisation fails (it does not for finite numbers).
     pub fn to_json(&self) -> Result<String, Error> {
-        serde_json::to_string_pretty(self).map_err(|e| Error::OptionsFormat {
-            what: "mission summary",
-            message: e.to_string(),
-        })
+        super::summary::pretty_json(self, "mission summary")
     }
 }
 
@@ -450,26 +447,35 @@ fn scaled<'a, T: Clone, E>(
     })
 }
 
-/// The aircraft of a scenario: scaled by its model error when the spread is on.
-fn scaled_aircraft<'a>(
+/// The aircraft and pack of a scenario: the aircraft scaled by its model error and the pack's
+/// capacity drawn, each when its spread is on.
+fn scaled_models<'a>(
     aircraft: &'a Aircraft,
-    sc: &ScenarioOptions,
-    d: &Draws,
-) -> Result<Cow<'a, Aircraft>, Error> {
-    Ok(scaled(aircraft, sc.power_sd_percent, d.power, |a, f| {
-        a.with_power_scale(f)
-    })?)
-}
-
-/// The pack of a scenario: its capacity drawn when the spread is on.
-fn scaled_pack<'a>(
     pack: &'a Pack,
     sc: &ScenarioOptions,
     d: &Draws,
-) -> Result<Cow<'a, Pack>, Error> {
-    Ok(scaled(pack, sc.capacity_sd_percent, d.capacity, |p, f| {
+) -> Result<(Cow<'a, Aircraft>, Cow<'a, Pack>), Error> {
+    let aircraft = scaled(aircraft, sc.power_sd_percent, d.power, |a, f| {
+        a.with_power_scale(f)
+    })?;
+    let pack = scaled(pack, sc.capacity_sd_percent, d.capacity, |p, f| {
         p.with_capacity_factor(f)
-    })?)
+    })?;
+    Ok((aircraft, pack))
+}
+
+/// Still air, as a wind table: what scenarios draw around when the request names no wind.
+fn calm_spec() -> WindSpec {
+    WindSpec {
+        speed_mps: 0.0,
+        from_deg: 0.0,
+        profile: WindProfileKind::Uniform,
+        reference_height_m: None,
+        exponent: None,
+        roughness_m: None,
+        gust_std_mps: None,
+        gust_seed: None,
+    }
 }
 
 /// A steady wind drawn around `spec` (gusts left out: they are added by the caller).
@@ -533,16 +539,7 @@ impl Winds {
                 })
             }
             Some(_) => None,
-            None => Some(options.wind.clone().or_else(|| mission.spec().wind.clone()).unwrap_or(WindSpec {
-                speed_mps: 0.0,
-                from_deg: 0.0,
-                profile: WindProfileKind::Uniform,
-                reference_height_m: None,
-                exponent: None,
-                roughness_m: None,
-                gust_std_mps: None,
-                gust_seed: None,
-            })),
+            None => Some(options.wind.clone().or_else(|| mission.spec().wind.clone()).unwrap_or_else(calm_spec)),
         };
         let gust_std_mps = options
             .gusts
@@ -698,8 +695,7 @@ impl<'a> MissionScenarios<'a> {
         fan: Option<&mut FanHistogram>,
     ) -> Result<Record, Error> {
         let d = Draws::of(sc.seed, index);
-        let aircraft = scaled_aircraft(self.aircraft, sc, &d)?;
-        let pack = scaled_pack(&self.pack, sc, &d)?;
+        let (aircraft, pack) = scaled_models(self.aircraft, &self.pack, sc, &d)?;
         let wind = self.winds.of(sc, &d)?;
         let payload_kg = if sc.payload_sd_kg > 0.0 {
             Some((self.base_payload_kg + sc.payload_sd_kg * d.payload).max(0.0))
@@ -953,7 +949,7 @@ pub fn endurance_scenarios(
     let aircraft = vehicle.aircraft()?;
     let pack = vehicle.battery(options.battery.as_deref())?;
     let n = sc.samples as usize;
-    let base_wind = options.wind.clone();
+    let base_wind = options.wind.clone().unwrap_or_else(calm_spec);
     let (reports, _) = run_indexed(
         n,
         sc.thread_count(n),
@@ -965,20 +961,9 @@ pub fn endurance_scenarios(
                 o.payload_kg = (options.payload_kg + sc.payload_sd_kg * d.payload).max(0.0);
             }
             if sc.draws_wind() {
-                let calm = WindSpec {
-                    speed_mps: 0.0,
-                    from_deg: 0.0,
-                    profile: WindProfileKind::Uniform,
-                    reference_height_m: None,
-                    exponent: None,
-                    roughness_m: None,
-                    gust_std_mps: None,
-                    gust_seed: None,
-                };
-                o.wind = Some(drawn_wind_spec(base_wind.as_ref().unwrap_or(&calm), sc, &d));
+                o.wind = Some(drawn_wind_spec(&base_wind, sc, &d));
             }
-            let a = scaled_aircraft(aircraft, sc, &d)?;
-            let p = scaled_pack(&pack, sc, &d)?;
+            let (a, p) = scaled_models(aircraft, &pack, sc, &d)?;
             match super::endurance::endurance_report(vehicle, &a, &p, &o) {
                 Ok(r) => Ok(Some(r)),
                 Err(Error::TooHeavy { .. }) => Ok(None),

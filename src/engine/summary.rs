@@ -146,11 +146,17 @@ impl MissionSummary {
     /// # Errors
     /// [`Error::OptionsFormat`] if serialisation fails (it does not for finite numbers).
     pub fn to_json(&self) -> Result<String, Error> {
-        serde_json::to_string_pretty(self).map_err(|e| Error::OptionsFormat {
-            what: "mission summary",
-            message: e.to_string(),
-        })
+        pretty_json(self, "mission summary")
     }
+}
+
+/// Pretty JSON of an answer (`what` names it in the error), as the CLI prints it (without the
+/// CLI's trailing newline).
+pub(super) fn pretty_json(answer: &impl Serialize, what: &'static str) -> Result<String, Error> {
+    serde_json::to_string_pretty(answer).map_err(|e| Error::OptionsFormat {
+        what,
+        message: e.to_string(),
+    })
 }
 
 /// The summary of `report`, as `aloft mission --format json` prints it: `mission_name` is the
