@@ -203,18 +203,14 @@ impl<'a> Compiler<'a> {
                 item: _,
             } => self.take_off(altitude_m, climb_rate_mps),
             SegmentSpec::Leg {
-                east_m,
-                north_m,
-                latitude_deg,
-                longitude_deg,
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
                 acceptance_radius_m,
-                item: _,
+                ..
             } => self.leg_to(
                 acceptance_radius_m,
-                [east_m, north_m, latitude_deg, longitude_deg],
+                spec.point(),
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
@@ -225,24 +221,15 @@ impl<'a> Compiler<'a> {
                 item: _,
             } => self.return_home(ground_speed_mps, altitude_m),
             SegmentSpec::Orbit {
-                centre_east_m,
-                centre_north_m,
-                centre_latitude_deg,
-                centre_longitude_deg,
                 altitude_m,
                 radius_m,
                 ground_speed_mps,
                 direction,
                 laps,
                 duration_s,
-                item: _,
+                ..
             } => self.orbit(
-                [
-                    centre_east_m,
-                    centre_north_m,
-                    centre_latitude_deg,
-                    centre_longitude_deg,
-                ],
+                spec.point(),
                 altitude_m,
                 radius_m,
                 ground_speed_mps,
