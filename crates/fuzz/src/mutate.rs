@@ -76,47 +76,20 @@ fn is_word_byte(b: u8) -> bool {
     b.is_ascii_alphanumeric() || b == b'_' || b == b'-'
 }
 
-/// Spans of identifier-like words (start, end) in `text`.
-fn word_spans(text: &[u8]) -> Vec<(usize, usize)> {
+/// Spans (start, end) of the tokens of `text`: each starts at a byte where `starts(i)` holds
+/// and takes the bytes after it while `continues(i)` holds.
+fn token_spans(
+    text: &[u8],
+    starts: impl Fn(usize) -> bool,
+    continues: impl Fn(usize) -> bool,
+) -> Vec<(usize, usize)> {
     let mut spans = Vec::new();
     let mut i = 0;
     while i < text.len() {
-        if is_word_byte(text[i]) {
-            // A run of word bytes is a word when it starts with a letter (`1e-3` is not).
-            let s = i;
-            while i < text.len() && is_word_byte(text[i]) {
-                i += 1;
-            }
-            if text[s].is_ascii_alphabetic() || text[s] == b'_' {
-                spans.push((s, i));
-            }
-        } else {
-            i += 1;
-        }
-    }
-    spans
-}
-
-/// Spans of number-like tokens (start, end) in `text`: a digit, or a sign or point before one,
-/// not inside a word, and what follows it of digits, points, signs and exponents.
-fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
-    let mut spans = Vec::new();
-    let mut i = 0;
-    while i < text.len() {
-        let starts = text[i].is_ascii_digit()
-            || (matches!(text[i], b'-' | b'+' | b'.')
-                && text.get(i + 1).is_some_and(u8::is_ascii_digit));
-        let in_word = i > 0 && (text[i - 1].is_ascii_alphabetic() || text[i - 1] == b'_');
-        if starts && !in_word {
+        if starts(i) {
             let s = i;
             i += 1;
-            while i < text.len() {
-                let c = text[i];
-                let exponent_sign = matches!(c, b'-' | b'+') && matches!(text[i - 1], b'e' | b'E');
-                if !(c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'E' | b'_') || exponent_sign)
-                {
-                    break;
-                }
+            while i < text.len() && continues(i) {
                 i += 1;
             }
             spans.push((s, i));
@@ -125,6 +98,33 @@ fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
         }
     }
     spans
+}
+
+/// Spans of identifier-like words (start, end) in `text`.
+fn word_spans(text: &[u8]) -> Vec<(usize, usize)> {
+    let word = |i: usize| is_word_byte(text[i]);
+    let mut spans = token_spans(text, word, word);
+    // A run of word bytes is a word when it starts with a letter (`1e-3` is not).
+    spans.retain(|&(s, _)| text[s].is_ascii_alphabetic() || text[s] == b'_');
+    spans
+}
+
+/// Spans of number-like tokens (start, end) in `text`: a digit, or a sign or point before one,
+/// not inside a word, and what follows it of digits, points, signs and exponents.
+fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
+    let starts = |i: usize| {
+        let digit_ahead = text.get(i + 1).is_some_and(u8::is_ascii_digit);
+        let starts =
+            text[i].is_ascii_digit() || (matches!(text[i], b'-' | b'+' | b'.') && digit_ahead);
+        let in_word = i > 0 && (text[i - 1].is_ascii_alphabetic() || text[i - 1] == b'_');
+        starts && !in_word
+    };
+    let continues = |i: usize| {
+        let c = text[i];
+        let exponent_sign = matches!(c, b'-' | b'+') && matches!(text[i - 1], b'e' | b'E');
+        c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'E' | b'_') || exponent_sign
+    };
+    token_spans(text, starts, continues)
 }
 
 /// Line spans (start, end including the line break).
