@@ -389,10 +389,12 @@ fn insert_chunk(rng: &mut Rng, data: &mut Vec<u8>, other: &[u8]) {
     };
     let repeat = if rng.one_in(8) { rng.small_len(256) } else { 1 };
     let at = rng.below(data.len() + 1);
-    let mut block = Vec::with_capacity(chunk.len() * repeat);
-    for _ in 0..repeat {
-        block.extend_from_slice(&chunk);
-    }
+    insert_repeated(data, at, &chunk, repeat);
+}
+
+/// `chunk` `times` over, cut to [`MAX_INPUT`] bytes, inserted at `at`.
+fn insert_repeated(data: &mut Vec<u8>, at: usize, chunk: &[u8], times: usize) {
+    let mut block = chunk.repeat(times);
     block.truncate(MAX_INPUT);
     data.splice(at..at, block);
 }
@@ -513,12 +515,7 @@ fn duplicate_line(rng: &mut Rng, data: &mut Vec<u8>) {
     } else {
         1
     };
-    let mut block = Vec::with_capacity(line.len() * times);
-    for _ in 0..times {
-        block.extend_from_slice(&line);
-    }
-    block.truncate(MAX_INPUT);
-    data.splice(a..a, block);
+    insert_repeated(data, a, &line, times);
 }
 
 fn swap_lines(rng: &mut Rng, data: &mut Vec<u8>) {
@@ -590,14 +587,20 @@ mod tests {
         assert_eq!(w, [&b"mass_kg"[..], b"v", b"x1"]);
     }
 
+    /// The generator of the first seed below 1000 whose draws `wanted` accepts (drawn from a
+    /// copy, so the generator returned starts with them).
+    fn seed_where(wanted: impl Fn(&mut Rng) -> bool) -> Rng {
+        (0..1000)
+            .map(Rng::new)
+            .find(|r| wanted(&mut r.clone()))
+            .unwrap()
+    }
+
     #[test]
     fn a_column_is_repeated_on_every_line() {
         let mut d = b"a,b,c\n1,2,3\n".to_vec();
         // Find a seed whose first draw picks column 1.
-        let mut rng = (0..1000)
-            .map(Rng::new)
-            .find(|r| r.clone().below(12) == 1)
-            .unwrap();
+        let mut rng = seed_where(|r| r.below(12) == 1);
         duplicate_column(&mut rng, &mut d);
         assert_eq!(d, b"a,b,b,c\n1,2,2,3\n");
     }
@@ -605,14 +608,7 @@ mod tests {
     #[test]
     fn lines_swap_whole() {
         let mut d = b"a\nb\nc".to_vec();
-        let mut rng = (0..1000)
-            .map(Rng::new)
-            .find(|r| {
-                let mut r = r.clone();
-                let (x, y) = (r.below(3), r.below(3));
-                (x, y) == (0, 2)
-            })
-            .unwrap();
+        let mut rng = seed_where(|r| (r.below(3), r.below(3)) == (0, 2));
         swap_lines(&mut rng, &mut d);
         assert_eq!(d, b"c\nb\na\n");
     }
