@@ -11,7 +11,7 @@ use super::corners::{pass_through, turn_rad, Role};
 use super::{CornerMode, Mission, MissionSpec, OrbitDirection, SegmentSpec};
 use crate::airframe::Airframe;
 use crate::error::PlannerError;
-use crate::trajectory::{Piece, Profile, Shape};
+use crate::trajectory::{Circle, Piece, Profile, Shape};
 
 impl MissionSpec {
     /// Validate and compile for `airframe`. `payload_kg` overrides the file's take-off payload.
@@ -400,13 +400,13 @@ impl<'a> Compiler<'a> {
         let tangent = [-sign * phi0_rad.sin(), sign * phi0_rad.cos()];
         self.yaw_to(tangent)?;
         self.fly_arc(
-            Shape::Arc {
+            Shape::Arc(Circle {
                 centre_m,
                 radius_m,
                 up_m,
                 phi0_rad,
                 sign,
-            },
+            }),
             Profile::rest_to_rest(
                 length_m,
                 ground_speed_mps,
