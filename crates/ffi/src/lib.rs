@@ -414,6 +414,54 @@ fn parse_mission_options(options: Option<&str>) -> Result<MissionOptions, Failur
     })
 }
 
+/// The mission argument: TOML or JSON text, or NULL for the demonstration mission.
+///
+/// # Safety
+/// `mission` is NULL or a NUL-terminated string that outlives the call.
+unsafe fn mission_arg(mission: *const c_char) -> Result<Mission, Failure> {
+    // SAFETY: forwarded contract.
+    parse_mission(unsafe { optional_text(mission, "mission")? })
+}
+
+/// The shape of every entry point that answers about a handle: panics caught, the out pointer
+/// `out` (named `out_name`) checked and cleared, then the handle `h` (named `name`) checked
+/// against the registry, then `answer` with the value behind the handle and the out pointer.
+///
+/// # Safety
+/// `h` is NULL or a pointer (checked); `out` is NULL or a writable pointer.
+unsafe fn with_handle<H: Handle, T>(
+    (h, name): (*const H, &str),
+    (out, out_name): (*mut *mut T, &str),
+    answer: impl FnOnce(&H::Inner, &mut *mut T) -> Result<(), Failure>,
+) -> AloftStatus {
+    guard(|| {
+        // SAFETY: the caller's contract; the handle is checked against the registry.
+        let out = unsafe { out_ptr(out, out_name)? };
+        let inner = unsafe { borrow(h, name)? };
+        answer(inner, out)
+    })
+}
+
+/// The shape of the constructors of a vehicle from one text argument `arg` (named `name`):
+/// panics caught, `out` checked and cleared, then the text, then the vehicle `make` builds.
+///
+/// # Safety
+/// `arg` is NULL or a NUL-terminated string; `out` is NULL or a writable pointer.
+unsafe fn new_vehicle(
+    arg: *const c_char,
+    name: &str,
+    out: *mut *mut AloftVehicle,
+    make: impl FnOnce(&str) -> Result<Vehicle, Error>,
+) -> AloftStatus {
+    guard(|| {
+        // SAFETY: the caller's contract.
+        let out = unsafe { out_ptr(out, "out")? };
+        let arg = unsafe { text(arg, name)? };
+        give(make(arg)?, out);
+        Ok(())
+    })
+}
+
 static VERSION: LazyLock<CString> =
     LazyLock::new(|| CString::new(env!("CARGO_PKG_VERSION")).unwrap_or_default());
 
@@ -458,13 +506,8 @@ pub unsafe extern "C" fn aloft_vehicle_builtin(
     name: *const c_char,
     out: *mut *mut AloftVehicle,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract.
-        let out = unsafe { out_ptr(out, "out")? };
-        let name = unsafe { text(name, "name")? };
-        give(Vehicle::builtin(name)?, out);
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe { new_vehicle(name, "name", out, Vehicle::builtin) }
 }
 
 /// Load a vehicle from the text of a vehicle file (TOML) into `*out`.
@@ -476,16 +519,12 @@ pub unsafe extern "C" fn aloft_vehicle_from_toml(
     toml: *const c_char,
     out: *mut *mut AloftVehicle,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract.
-        let out = unsafe { out_ptr(out, "out")? };
-        let toml = unsafe { text(toml, "toml")? };
-        give(
-            Vehicle::from_toml(toml, "vehicle text from the C caller")?,
-            out,
-        );
-        Ok(())
-    })
+    // SAFETY: the caller's contract.
+    unsafe {
+        new_vehicle(toml, "toml", out, |t| {
+            Vehicle::from_toml(t, "vehicle text from the C caller")
+        })
+    }
 }
 
 /// Release a vehicle. NULL is a no-op; a pointer that is not a live vehicle (e.g. freed already)
@@ -558,26 +597,27 @@ pub unsafe extern "C" fn aloft_vehicle_power_json(
         battery: Option<String>,
         payload_kg: f64,
     }
-    guard(|| {
-        // SAFETY: the caller's contract; the handle is checked against the registry.
-        let out = unsafe { out_ptr(out_json, "out_json")? };
-        let v = unsafe { self::vehicle(vehicle, "vehicle")? };
-        let state = unsafe { text(state_json, "state_json")? };
-        let s: StateJson = serde_json::from_str(state)
-            .map_err(|e| Failure::new(AloftStatus::Parse, format!("invalid flight state: {e}")))?;
-        let query = PowerQuery {
-            battery: s.battery,
-            payload_kg: s.payload_kg,
-            airspeed_mps: s.airspeed_mps,
-            roll_deg: s.roll_deg,
-            pitch_deg: s.pitch_deg,
-            climb_rate_mps: s.climb_rate_mps,
-            ..PowerQuery::default()
-        };
-        let json = serde_json::to_string_pretty(&power_point(v, &query)?)
-            .map_err(|e| Failure::new(AloftStatus::InvalidInput, e.to_string()))?;
-        give_string(json, out)
-    })
+    // SAFETY: the caller's contract; the handle is checked against the registry.
+    unsafe {
+        with_handle((vehicle, "vehicle"), (out_json, "out_json"), |v, out| {
+            let state = text(state_json, "state_json")?;
+            let s: StateJson = serde_json::from_str(state).map_err(|e| {
+                Failure::new(AloftStatus::Parse, format!("invalid flight state: {e}"))
+            })?;
+            let query = PowerQuery {
+                battery: s.battery,
+                payload_kg: s.payload_kg,
+                airspeed_mps: s.airspeed_mps,
+                roll_deg: s.roll_deg,
+                pitch_deg: s.pitch_deg,
+                climb_rate_mps: s.climb_rate_mps,
+                ..PowerQuery::default()
+            };
+            let json = serde_json::to_string_pretty(&power_point(v, &query)?)
+                .map_err(|e| Failure::new(AloftStatus::InvalidInput, e.to_string()))?;
+            give_string(json, out)
+        })
+    }
 }
 
 /// Plan a mission with `vehicle` into `*out`. `mission` is TOML or JSON text, or NULL for the
@@ -595,17 +635,15 @@ pub unsafe extern "C" fn aloft_mission_plan(
     options_json: *const c_char,
     out: *mut *mut AloftPlan,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract; the handle is checked against the registry.
-        let out = unsafe { out_ptr(out, "out")? };
-        let v = unsafe { self::vehicle(vehicle, "vehicle")? };
-        let mission = parse_mission(unsafe { optional_text(mission, "mission")? })?;
-        let options =
-            parse_mission_options(unsafe { optional_text(options_json, "options_json")? })?;
-        let p = plan_mission(v, &mission, &options)?;
-        give(p, out);
-        Ok(())
-    })
+    // SAFETY: the caller's contract; the handle is checked against the registry.
+    unsafe {
+        with_handle((vehicle, "vehicle"), (out, "out"), |v, out| {
+            let mission = mission_arg(mission)?;
+            let options = parse_mission_options(optional_text(options_json, "options_json")?)?;
+            give(plan_mission(v, &mission, &options)?, out);
+            Ok(())
+        })
+    }
 }
 
 /// One call from text to text: plan `mission` (TOML, JSON or NULL for the demo) with `vehicle`
@@ -626,26 +664,26 @@ pub unsafe extern "C" fn aloft_mission_json(
     options_json: *const c_char,
     out_json: *mut *mut c_char,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract; the handle is checked against the registry.
-        let out = unsafe { out_ptr(out_json, "out_json")? };
-        let v = unsafe { self::vehicle(vehicle, "vehicle")? };
-        let mission = parse_mission(unsafe { optional_text(mission, "mission")? })?;
-        let (options, scenarios) = match unsafe { optional_text(options_json, "options_json")? } {
-            None => (MissionOptions::default(), None),
-            Some(t) => options_from_json(t)?,
-        };
-        let plan = plan_mission(v, &mission, &options)?;
-        let json = match scenarios {
-            None => plan.to_json()?,
-            Some(sc) => MissionWithUncertainty {
-                summary: plan.summary(),
-                uncertainty: &plan_scenarios(v, &mission, &options, &sc)?,
-            }
-            .to_json()?,
-        };
-        give_string(json, out)
-    })
+    // SAFETY: the caller's contract; the handle is checked against the registry.
+    unsafe {
+        with_handle((vehicle, "vehicle"), (out_json, "out_json"), |v, out| {
+            let mission = mission_arg(mission)?;
+            let (options, scenarios) = match optional_text(options_json, "options_json")? {
+                None => (MissionOptions::default(), None),
+                Some(t) => options_from_json(t)?,
+            };
+            let plan = plan_mission(v, &mission, &options)?;
+            let json = match scenarios {
+                None => plan.to_json()?,
+                Some(sc) => MissionWithUncertainty {
+                    summary: plan.summary(),
+                    uncertainty: &plan_scenarios(v, &mission, &options, &sc)?,
+                }
+                .to_json()?,
+            };
+            give_string(json, out)
+        })
+    }
 }
 
 /// The summary of a plan as JSON (exactly `aloft mission --format json` without its final
@@ -658,12 +696,12 @@ pub unsafe extern "C" fn aloft_plan_json(
     plan: *const AloftPlan,
     out_json: *mut *mut c_char,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract; the handle is checked against the registry.
-        let out = unsafe { out_ptr(out_json, "out_json")? };
-        let p = unsafe { self::plan(plan, "plan")? };
-        give_string(p.to_json()?, out)
-    })
+    // SAFETY: the caller's contract; the handle is checked against the registry.
+    unsafe {
+        with_handle((plan, "plan"), (out_json, "out_json"), |p: &Plan, out| {
+            give_string(p.to_json()?, out)
+        })
+    }
 }
 
 /// One value of a plan into `*out`: the plan checked against the registry, `out` checked for
@@ -741,16 +779,16 @@ pub unsafe extern "C" fn aloft_endurance_json(
     options_json: *const c_char,
     out_json: *mut *mut c_char,
 ) -> AloftStatus {
-    guard(|| {
-        // SAFETY: the caller's contract; the handle is checked against the registry.
-        let out = unsafe { out_ptr(out_json, "out_json")? };
-        let v = unsafe { self::vehicle(vehicle, "vehicle")? };
-        let options = match unsafe { optional_text(options_json, "options_json")? } {
-            None => EnduranceOptions::default(),
-            Some(t) => EnduranceOptions::from_json(t)?,
-        };
-        give_string(endurance(v, &options)?.to_json()?, out)
-    })
+    // SAFETY: the caller's contract; the handle is checked against the registry.
+    unsafe {
+        with_handle((vehicle, "vehicle"), (out_json, "out_json"), |v, out| {
+            let options = match optional_text(options_json, "options_json")? {
+                None => EnduranceOptions::default(),
+                Some(t) => EnduranceOptions::from_json(t)?,
+            };
+            give_string(endurance(v, &options)?.to_json()?, out)
+        })
+    }
 }
 
 /// Release a string returned by aloft. NULL is a no-op; a pointer that aloft did not return, or

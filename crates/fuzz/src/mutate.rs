@@ -76,47 +76,20 @@ fn is_word_byte(b: u8) -> bool {
     b.is_ascii_alphanumeric() || b == b'_' || b == b'-'
 }
 
-/// Spans of identifier-like words (start, end) in `text`.
-fn word_spans(text: &[u8]) -> Vec<(usize, usize)> {
+/// Spans (start, end) of the tokens of `text`: each starts at a byte where `starts(i)` holds
+/// and takes the bytes after it while `continues(i)` holds.
+fn token_spans(
+    text: &[u8],
+    starts: impl Fn(usize) -> bool,
+    continues: impl Fn(usize) -> bool,
+) -> Vec<(usize, usize)> {
     let mut spans = Vec::new();
     let mut i = 0;
     while i < text.len() {
-        if is_word_byte(text[i]) {
-            // A run of word bytes is a word when it starts with a letter (`1e-3` is not).
-            let s = i;
-            while i < text.len() && is_word_byte(text[i]) {
-                i += 1;
-            }
-            if text[s].is_ascii_alphabetic() || text[s] == b'_' {
-                spans.push((s, i));
-            }
-        } else {
-            i += 1;
-        }
-    }
-    spans
-}
-
-/// Spans of number-like tokens (start, end) in `text`: a digit, or a sign or point before one,
-/// not inside a word, and what follows it of digits, points, signs and exponents.
-fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
-    let mut spans = Vec::new();
-    let mut i = 0;
-    while i < text.len() {
-        let starts = text[i].is_ascii_digit()
-            || (matches!(text[i], b'-' | b'+' | b'.')
-                && text.get(i + 1).is_some_and(u8::is_ascii_digit));
-        let in_word = i > 0 && (text[i - 1].is_ascii_alphabetic() || text[i - 1] == b'_');
-        if starts && !in_word {
+        if starts(i) {
             let s = i;
             i += 1;
-            while i < text.len() {
-                let c = text[i];
-                let exponent_sign = matches!(c, b'-' | b'+') && matches!(text[i - 1], b'e' | b'E');
-                if !(c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'E' | b'_') || exponent_sign)
-                {
-                    break;
-                }
+            while i < text.len() && continues(i) {
                 i += 1;
             }
             spans.push((s, i));
@@ -125,6 +98,33 @@ fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
         }
     }
     spans
+}
+
+/// Spans of identifier-like words (start, end) in `text`.
+fn word_spans(text: &[u8]) -> Vec<(usize, usize)> {
+    let word = |i: usize| is_word_byte(text[i]);
+    let mut spans = token_spans(text, word, word);
+    // A run of word bytes is a word when it starts with a letter (`1e-3` is not).
+    spans.retain(|&(s, _)| text[s].is_ascii_alphabetic() || text[s] == b'_');
+    spans
+}
+
+/// Spans of number-like tokens (start, end) in `text`: a digit, or a sign or point before one,
+/// not inside a word, and what follows it of digits, points, signs and exponents.
+fn number_spans(text: &[u8]) -> Vec<(usize, usize)> {
+    let starts = |i: usize| {
+        let digit_ahead = text.get(i + 1).is_some_and(u8::is_ascii_digit);
+        let starts =
+            text[i].is_ascii_digit() || (matches!(text[i], b'-' | b'+' | b'.') && digit_ahead);
+        let in_word = i > 0 && (text[i - 1].is_ascii_alphabetic() || text[i - 1] == b'_');
+        starts && !in_word
+    };
+    let continues = |i: usize| {
+        let c = text[i];
+        let exponent_sign = matches!(c, b'-' | b'+') && matches!(text[i - 1], b'e' | b'E');
+        c.is_ascii_digit() || matches!(c, b'.' | b'e' | b'E' | b'_') || exponent_sign
+    };
+    token_spans(text, starts, continues)
 }
 
 /// Line spans (start, end including the line break).
@@ -389,10 +389,12 @@ fn insert_chunk(rng: &mut Rng, data: &mut Vec<u8>, other: &[u8]) {
     };
     let repeat = if rng.one_in(8) { rng.small_len(256) } else { 1 };
     let at = rng.below(data.len() + 1);
-    let mut block = Vec::with_capacity(chunk.len() * repeat);
-    for _ in 0..repeat {
-        block.extend_from_slice(&chunk);
-    }
+    insert_repeated(data, at, &chunk, repeat);
+}
+
+/// `chunk` `times` over, cut to [`MAX_INPUT`] bytes, inserted at `at`.
+fn insert_repeated(data: &mut Vec<u8>, at: usize, chunk: &[u8], times: usize) {
+    let mut block = chunk.repeat(times);
     block.truncate(MAX_INPUT);
     data.splice(at..at, block);
 }
@@ -513,12 +515,7 @@ fn duplicate_line(rng: &mut Rng, data: &mut Vec<u8>) {
     } else {
         1
     };
-    let mut block = Vec::with_capacity(line.len() * times);
-    for _ in 0..times {
-        block.extend_from_slice(&line);
-    }
-    block.truncate(MAX_INPUT);
-    data.splice(a..a, block);
+    insert_repeated(data, a, &line, times);
 }
 
 fn swap_lines(rng: &mut Rng, data: &mut Vec<u8>) {
@@ -590,14 +587,20 @@ mod tests {
         assert_eq!(w, [&b"mass_kg"[..], b"v", b"x1"]);
     }
 
+    /// The generator of the first seed below 1000 whose draws `wanted` accepts (drawn from a
+    /// copy, so the generator returned starts with them).
+    fn seed_where(wanted: impl Fn(&mut Rng) -> bool) -> Rng {
+        (0..1000)
+            .map(Rng::new)
+            .find(|r| wanted(&mut r.clone()))
+            .unwrap()
+    }
+
     #[test]
     fn a_column_is_repeated_on_every_line() {
         let mut d = b"a,b,c\n1,2,3\n".to_vec();
         // Find a seed whose first draw picks column 1.
-        let mut rng = (0..1000)
-            .map(Rng::new)
-            .find(|r| r.clone().below(12) == 1)
-            .unwrap();
+        let mut rng = seed_where(|r| r.below(12) == 1);
         duplicate_column(&mut rng, &mut d);
         assert_eq!(d, b"a,b,b,c\n1,2,2,3\n");
     }
@@ -605,14 +608,7 @@ mod tests {
     #[test]
     fn lines_swap_whole() {
         let mut d = b"a\nb\nc".to_vec();
-        let mut rng = (0..1000)
-            .map(Rng::new)
-            .find(|r| {
-                let mut r = r.clone();
-                let (x, y) = (r.below(3), r.below(3));
-                (x, y) == (0, 2)
-            })
-            .unwrap();
+        let mut rng = seed_where(|r| (r.below(3), r.below(3)) == (0, 2));
         swap_lines(&mut rng, &mut d);
         assert_eq!(d, b"c\nb\na\n");
     }

@@ -49,6 +49,39 @@ pub(crate) fn capacity_ah(mah: f64) -> Option<f64> {
     (mah > 0.0 && mah <= MAX_BATTERY_CAPACITY_MAH).then_some(mah / 1000.0)
 }
 
+/// After a record that cannot be valid at `from`: skip byte by byte to the next offset where a
+/// record starts that `plausible` accepts (its length from its first `peek` bytes) and that is
+/// followed by another plausible record or by the end of the input; `false` when the input ends
+/// first. The skipped bytes go to `s` as corrupt `what` ("ULog record", "DataFlash data").
+///
+/// Both binary formats have a three-byte record header; `peek` may be longer when `plausible`
+/// needs more (a ULog data record's message id).
+pub(crate) fn resync<R: Read>(
+    w: &mut ByteWindow<R>,
+    s: &mut BinarySummary,
+    from: u64,
+    (what, peek): (&str, usize),
+    plausible: impl Fn(&[u8]) -> Option<usize>,
+) -> bool {
+    w.consume(1);
+    loop {
+        let h = w.peek_max(peek);
+        if h.len() < 3 {
+            break;
+        }
+        if let Some(len) = plausible(h) {
+            let next = w.peek_max(len + peek);
+            if next.len() == len || next.get(len..).and_then(&plausible).is_some() {
+                s.resynchronised(what, from, w.offset());
+                return true;
+            }
+        }
+        w.consume(1);
+    }
+    s.lost_to_end(what, from, w.offset() + w.remaining() as u64 - from);
+    false
+}
+
 /// What a binary log holds besides its samples.
 #[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct BinarySummary {

@@ -39,7 +39,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::binary_samples::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
+use crate::binary_samples::{self, BinaryOptions, BinarySamples, BinarySummary, Decoder};
 use crate::bytes::ByteWindow;
 use crate::csv_read::wrap_pi;
 use crate::error::{LogError, Result};
@@ -283,27 +283,7 @@ impl Framer {
 
     /// Skip to the next record header of a declared type followed by another (or the end).
     fn resync<R: Read>(&self, w: &mut ByteWindow<R>, s: &mut BinarySummary, from: u64) -> bool {
-        w.consume(1);
-        loop {
-            let h = w.peek_max(3);
-            if h.len() < 3 {
-                break;
-            }
-            if let Some(len) = self.plausible(h) {
-                let next = w.peek_max(len + 3);
-                if next.len() == len || self.plausible(&next[len.min(next.len())..]).is_some() {
-                    s.resynchronised("DataFlash data", from, w.offset());
-                    return true;
-                }
-            }
-            w.consume(1);
-        }
-        s.lost_to_end(
-            "DataFlash data",
-            from,
-            w.offset() + w.remaining() as u64 - from,
-        );
-        false
+        binary_samples::resync(w, s, from, ("DataFlash data", 3), |h| self.plausible(h))
     }
 
     /// The next record: its offset, type and payload (copied into `payload`). `None` at the end.

@@ -31,7 +31,7 @@ use std::collections::HashMap;
 use std::io::Read;
 use std::path::Path;
 
-use crate::binary_samples::{BinaryOptions, BinarySamples, BinarySummary, Decoder};
+use crate::binary_samples::{self, BinaryOptions, BinarySamples, BinarySummary, Decoder};
 use crate::bytes::{le, ByteWindow};
 use crate::error::{LogError, Result};
 use crate::frame::{attitude_from_ned_frd_quat, ned_to_enu};
@@ -344,29 +344,7 @@ impl UlogDecoder {
     /// After a record that cannot be valid at `from`: skip to the next offset where two
     /// consecutive plausible records start. `false` when the input ends first.
     fn resync<R: Read>(&self, w: &mut ByteWindow<R>, s: &mut BinarySummary, from: u64) -> bool {
-        w.consume(1);
-        loop {
-            let h = w.peek_max(5);
-            if h.len() < 3 {
-                break;
-            }
-            if let Some(len) = self.plausible(h) {
-                let next = w.peek_max(len + 5);
-                if next.len() == len
-                    || (next.len() >= len + 3 && self.plausible(&next[len..]).is_some())
-                {
-                    s.resynchronised("ULog record", from, w.offset());
-                    return true;
-                }
-            }
-            w.consume(1);
-        }
-        s.lost_to_end(
-            "ULog record",
-            from,
-            w.offset() + w.remaining() as u64 - from,
-        );
-        false
+        binary_samples::resync(w, s, from, ("ULog record", 5), |h| self.plausible(h))
     }
 
     /// Skip to an appended-data section when the record at `at` (of `len` bytes) runs into it.

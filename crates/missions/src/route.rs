@@ -132,15 +132,8 @@ impl Walk {
     fn segment(&mut self, k: usize, s: &SegmentSpec) {
         match s {
             SegmentSpec::TakeOff { altitude_m, .. } => self.climb_or_descend_to(Some(*altitude_m)),
-            SegmentSpec::Leg {
-                east_m,
-                north_m,
-                latitude_deg,
-                longitude_deg,
-                altitude_m,
-                ..
-            } => {
-                self.move_to(point([*east_m, *north_m, *latitude_deg, *longitude_deg]));
+            SegmentSpec::Leg { altitude_m, .. } => {
+                self.move_to(point(s.point()));
                 self.climb_or_descend_to(*altitude_m);
             }
             SegmentSpec::Orbit { .. } => self.orbit(k, s),
@@ -163,10 +156,6 @@ impl Walk {
     /// An orbit: to its centre, to its height, then its circles.
     fn orbit(&mut self, k: usize, s: &SegmentSpec) {
         let SegmentSpec::Orbit {
-            centre_east_m,
-            centre_north_m,
-            centre_latitude_deg,
-            centre_longitude_deg,
             altitude_m,
             radius_m,
             ground_speed_mps,
@@ -177,13 +166,7 @@ impl Walk {
         else {
             return;
         };
-        let centre = [
-            *centre_east_m,
-            *centre_north_m,
-            *centre_latitude_deg,
-            *centre_longitude_deg,
-        ];
-        self.move_to(point(centre));
+        self.move_to(point(s.point()));
         self.climb_or_descend_to(*altitude_m);
         let circle_m = std::f64::consts::TAU * radius_m.abs();
         let speed = ground_speed_mps.or(self.default_speed_mps);

@@ -168,14 +168,14 @@ pub fn replay(
     points: &[ReplayPoint],
     wind: &Wind,
 ) -> Result<ReplayReport, PlannerError> {
-    if points.len() < 2 {
-        return Err(PlannerError::InvalidParameter {
-            name: "trajectory points",
-            value: points.len() as f64,
-            unit: "",
-            expected: "at least two",
-        });
-    }
+    let n = points.len() as f64;
+    crate::error::parameter(
+        "trajectory points",
+        n,
+        "",
+        points.len() >= 2,
+        "at least two",
+    )?;
     if let Some(w) = points
         .windows(2)
         .find(|w| !(w[0].time_s.is_finite() && w[1].time_s > w[0].time_s))

@@ -26,25 +26,47 @@ pub enum Shape {
         /// Unit direction, ENU.
         dir: [f64; 3],
     },
-    /// Circle of radius `radius_m` about `centre_m` at height `up_m`, starting at angle `phi0_rad`
-    /// (from east, anticlockwise); `sign` +1 anticlockwise, -1 clockwise seen from above.
-    Arc {
-        /// Centre, east and north, m.
-        centre_m: [f64; 2],
-        /// Radius, m.
-        radius_m: f64,
-        /// Height above home, m.
-        up_m: f64,
-        /// Start angle from east, anticlockwise, rad.
-        phi0_rad: f64,
-        /// +1 anticlockwise, -1 clockwise.
-        sign: f64,
-    },
+    /// A circle at constant height.
+    Arc(Circle),
     /// Fixed point.
     Hold {
         /// Position, ENU m.
         pos_m: [f64; 3],
     },
+}
+
+/// Circle of radius `radius_m` about `centre_m` at height `up_m`, starting at angle `phi0_rad`
+/// (from east, anticlockwise); `sign` +1 anticlockwise, -1 clockwise seen from above.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Circle {
+    /// Centre, east and north, m.
+    pub centre_m: [f64; 2],
+    /// Radius, m.
+    pub radius_m: f64,
+    /// Height above home, m.
+    pub up_m: f64,
+    /// Start angle from east, anticlockwise, rad.
+    pub phi0_rad: f64,
+    /// +1 anticlockwise, -1 clockwise.
+    pub sign: f64,
+}
+
+impl Circle {
+    /// The point at the angle whose cosine and sine are `cp` and `sp`, ENU m.
+    #[inline]
+    pub fn point(&self, cp: f64, sp: f64) -> [f64; 3] {
+        [
+            self.centre_m[0] + self.radius_m * cp,
+            self.centre_m[1] + self.radius_m * sp,
+            self.up_m,
+        ]
+    }
+
+    /// The unit tangent in the direction of travel at that angle, east and north.
+    #[inline]
+    pub fn tangent(&self, cp: f64, sp: f64) -> [f64; 2] {
+        [-self.sign * sp, self.sign * cp]
+    }
 }
 
 /// Trapezoidal speed profile along a path of length `length_m`: from `start_mps` up to the
@@ -233,26 +255,15 @@ impl Piece {
                 acc_mps2: [dir[0] * at, dir[1] * at, dir[2] * at],
                 forward: self.forward,
             },
-            Shape::Arc {
-                centre_m,
-                radius_m,
-                up_m,
-                phi0_rad,
-                sign,
-            } => {
-                let phi = phi0_rad + sign * s / radius_m;
+            Shape::Arc(c) => {
+                let phi = c.phi0_rad + c.sign * s / c.radius_m;
                 // libm's sincos (musl's kernels) is about twice as fast as std's, within 1 ulp.
                 let (sp, cp) = libm::sincos(phi);
                 // Unit tangent in the direction of travel, and the centripetal term towards the centre.
-                let tx = -sign * sp;
-                let ty = sign * cp;
-                let ac = v * v / radius_m;
+                let [tx, ty] = c.tangent(cp, sp);
+                let ac = v * v / c.radius_m;
                 Kinematics {
-                    pos_m: [
-                        centre_m[0] + radius_m * cp,
-                        centre_m[1] + radius_m * sp,
-                        up_m,
-                    ],
+                    pos_m: c.point(cp, sp),
                     vel_mps: [tx * v, ty * v, 0.0],
                     acc_mps2: [tx * at - ac * cp, ty * at - ac * sp, 0.0],
                     forward: [tx, ty],
@@ -298,10 +309,8 @@ impl BlockSampler {
     /// A sampler of `piece` at step `step_s`, for blocks of up to `block` samples.
     pub fn new(piece: &Piece, step_s: f64, block: usize) -> Self {
         let rotation = match piece.shape {
-            Shape::Arc { radius_m, sign, .. }
-                if piece.profile.t_cruise_end_s > piece.profile.t_accel_end_s =>
-            {
-                let delta = sign * piece.profile.peak_mps * step_s / radius_m;
+            Shape::Arc(c) if piece.profile.t_cruise_end_s > piece.profile.t_accel_end_s => {
+                let delta = c.sign * piece.profile.peak_mps * step_s / c.radius_m;
                 Some(
                     (0..block)
                         .map(|j| {
@@ -327,34 +336,19 @@ impl BlockSampler {
         let p = &self.piece.profile;
         let t_first = (first as f64 + 0.5) * h;
         let t_last = ((first + out.len()) as f64 - 0.5) * h;
-        if let (
-            Some(rot),
-            Shape::Arc {
-                centre_m,
-                radius_m,
-                up_m,
-                phi0_rad,
-                sign,
-            },
-        ) = (&self.rotation, self.piece.shape)
-        {
+        if let (Some(rot), Shape::Arc(c)) = (&self.rotation, self.piece.shape) {
             if out.len() <= rot.len() && t_first >= p.t_accel_end_s && t_last < p.t_cruise_end_s {
                 // The first sample as `Piece::at` computes it (the rotation by 0 is exact); the
                 // rest rotated from it.
                 let (s, v, _) = p.at(t_first);
-                let (sp0, cp0) = libm::sincos(phi0_rad + sign * s / radius_m);
-                let ac = v * v / radius_m;
+                let (sp0, cp0) = libm::sincos(c.phi0_rad + c.sign * s / c.radius_m);
+                let ac = v * v / c.radius_m;
                 for (o, &(cj, sj)) in out.iter_mut().zip(rot) {
                     let cp = cp0 * cj - sp0 * sj;
                     let sp = sp0 * cj + cp0 * sj;
-                    let tx = -sign * sp;
-                    let ty = sign * cp;
+                    let [tx, ty] = c.tangent(cp, sp);
                     *o = Kinematics {
-                        pos_m: [
-                            centre_m[0] + radius_m * cp,
-                            centre_m[1] + radius_m * sp,
-                            up_m,
-                        ],
+                        pos_m: c.point(cp, sp),
                         vel_mps: [tx * v, ty * v, 0.0],
                         acc_mps2: [-ac * cp, -ac * sp, 0.0],
                         forward: [tx, ty],
@@ -390,13 +384,13 @@ mod tests {
     #[test]
     fn arc_acceleration_is_centripetal_at_cruise() {
         let piece = Piece {
-            shape: Shape::Arc {
+            shape: Shape::Arc(Circle {
                 centre_m: [10.0, -5.0],
                 radius_m: 25.0,
                 up_m: 30.0,
                 phi0_rad: 0.3,
                 sign: -1.0,
-            },
+            }),
             profile: Profile::rest_to_rest(500.0, 5.0, 1.0),
             segment: 0,
             mass_phase: 0,
@@ -423,13 +417,13 @@ mod block_tests {
     fn block_sampler_matches_piece_at_on_a_long_orbit() {
         // 3400 s of a 300 m orbit at 8 m/s: the angle reaches 90 rad.
         let piece = Piece {
-            shape: Shape::Arc {
+            shape: Shape::Arc(Circle {
                 centre_m: [600.0, 300.0],
                 radius_m: 300.0,
                 up_m: 40.0,
                 phi0_rad: -1.5,
                 sign: -1.0,
-            },
+            }),
             profile: Profile::rest_to_rest(8.0 * 3400.0, 8.0, 2.0),
             segment: 0,
             mass_phase: 0,

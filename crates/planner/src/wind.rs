@@ -317,14 +317,8 @@ impl Wind {
         crate::error::non_negative("wind_speed_mps", speed_mps, "m/s")?;
         let range = (0.0, MAX_WIND_MPS);
         crate::error::within("wind_speed_mps", speed_mps, range, "m/s", "at most 100 m/s")?;
-        if !from_deg.is_finite() {
-            return Err(PlannerError::InvalidParameter {
-                name: "wind_from_deg",
-                value: from_deg,
-                unit: "deg",
-                expected: "a finite direction",
-            });
-        }
+        let ok = from_deg.is_finite();
+        crate::error::parameter("wind_from_deg", from_deg, "deg", ok, "a finite direction")?;
         match profile {
             Profile::Uniform => {}
             Profile::PowerLaw {
@@ -342,14 +336,14 @@ impl Wind {
             } => {
                 check_reference_height(reference_height_m)?;
                 crate::error::positive("roughness_m", roughness_m, "m")?;
-                if roughness_m >= reference_height_m {
-                    return Err(PlannerError::InvalidParameter {
-                        name: "roughness_m",
-                        value: roughness_m,
-                        unit: "m",
-                        expected: "below the reference height",
-                    });
-                }
+                let ok = roughness_m < reference_height_m;
+                crate::error::parameter(
+                    "roughness_m",
+                    roughness_m,
+                    "m",
+                    ok,
+                    "below the reference height",
+                )?;
             }
         }
         let toward = toward_unit(from_deg.to_radians());

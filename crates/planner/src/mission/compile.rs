@@ -11,7 +11,7 @@ use super::corners::{pass_through, turn_rad, Role};
 use super::{CornerMode, Mission, MissionSpec, OrbitDirection, SegmentSpec};
 use crate::airframe::Airframe;
 use crate::error::PlannerError;
-use crate::trajectory::{Piece, Profile, Shape};
+use crate::trajectory::{Circle, Piece, Profile, Shape};
 
 impl MissionSpec {
     /// Validate and compile for `airframe`. `payload_kg` overrides the file's take-off payload.
@@ -222,18 +222,14 @@ impl<'a> Compiler<'a> {
                 item: _,
             } => self.take_off(altitude_m, climb_rate_mps),
             SegmentSpec::Leg {
-                east_m,
-                north_m,
-                latitude_deg,
-                longitude_deg,
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
                 acceptance_radius_m,
-                item: _,
+                ..
             } => self.leg_to(
                 acceptance_radius_m,
-                [east_m, north_m, latitude_deg, longitude_deg],
+                spec.point(),
                 altitude_m,
                 ground_speed_mps,
                 payload_after_kg,
@@ -244,24 +240,15 @@ impl<'a> Compiler<'a> {
                 item: _,
             } => self.return_home(ground_speed_mps, altitude_m),
             SegmentSpec::Orbit {
-                centre_east_m,
-                centre_north_m,
-                centre_latitude_deg,
-                centre_longitude_deg,
                 altitude_m,
                 radius_m,
                 ground_speed_mps,
                 direction,
                 laps,
                 duration_s,
-                item: _,
+                ..
             } => self.orbit(
-                [
-                    centre_east_m,
-                    centre_north_m,
-                    centre_latitude_deg,
-                    centre_longitude_deg,
-                ],
+                spec.point(),
                 altitude_m,
                 radius_m,
                 ground_speed_mps,
@@ -432,13 +419,13 @@ impl<'a> Compiler<'a> {
         let tangent = [-sign * phi0_rad.sin(), sign * phi0_rad.cos()];
         self.yaw_to(tangent)?;
         self.fly_arc(
-            Shape::Arc {
+            Shape::Arc(Circle {
                 centre_m,
                 radius_m,
                 up_m,
                 phi0_rad,
                 sign,
-            },
+            }),
             Profile::rest_to_rest(
                 length_m,
                 ground_speed_mps,

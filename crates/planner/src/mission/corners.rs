@@ -32,7 +32,7 @@
 use aloft_core::STANDARD_GRAVITY_MPS2;
 
 use crate::airframe::Airframe;
-use crate::trajectory::{Piece, Profile, Shape};
+use crate::trajectory::{Circle, Piece, Profile, Shape};
 
 /// Slowest corner flown through, m/s: a slower one is a stop-and-turn.
 pub const MIN_CORNER_SPEED_MPS: f64 = 0.5;
@@ -273,13 +273,13 @@ fn corner_arc(a: &Piece, b: &Piece, c: &Corner) -> Option<Piece> {
     let length_m = c.radius_m * turn_rad(u, w);
     let v = c.speed_mps;
     Some(Piece {
-        shape: Shape::Arc {
+        shape: Shape::Arc(Circle {
             centre_m,
             radius_m: c.radius_m,
             up_m: waypoint[2],
             phi0_rad,
             sign,
-        },
+        }),
         profile: Profile::between(length_m, (v, v, v), 1.0),
         segment: a.segment,
         mass_phase: a.mass_phase,
@@ -416,7 +416,7 @@ mod tests {
             .pieces()
             .iter()
             .filter_map(|p| match p.shape {
-                Shape::Arc { radius_m, .. } => Some((radius_m, p.profile.peak_mps)),
+                Shape::Arc(c) => Some((c.radius_m, p.profile.peak_mps)),
                 _ => None,
             })
             .collect();

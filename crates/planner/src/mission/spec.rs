@@ -160,6 +160,34 @@ impl SegmentSpec {
         }
     }
 
+    /// The horizontal point the segment names, as written: `[east_m, north_m, latitude_deg,
+    /// longitude_deg]` of a leg's waypoint or an orbit's centre (local, geographic or
+    /// incomplete, as the file gives it); all `None` for the kinds that name none.
+    pub fn point(&self) -> [Option<f64>; 4] {
+        match *self {
+            SegmentSpec::Leg {
+                east_m,
+                north_m,
+                latitude_deg,
+                longitude_deg,
+                ..
+            } => [east_m, north_m, latitude_deg, longitude_deg],
+            SegmentSpec::Orbit {
+                centre_east_m,
+                centre_north_m,
+                centre_latitude_deg,
+                centre_longitude_deg,
+                ..
+            } => [
+                centre_east_m,
+                centre_north_m,
+                centre_latitude_deg,
+                centre_longitude_deg,
+            ],
+            _ => [None; 4],
+        }
+    }
+
     /// The operator's mission item number, when the segment came from a planner file.
     pub fn item(&self) -> Option<u32> {
         match *self {

@@ -192,29 +192,14 @@ pub(crate) fn plan_with(
     hoist: bool,
     parallel: bool,
 ) -> Result<MissionReport, PlannerError> {
-    if !options.record_samples {
-        let threads = (hoist, parallel);
-        return fly(
-            aircraft,
-            battery,
-            mission,
-            wind,
-            options,
-            threads,
-            &mut NoSamples,
-        );
-    }
-    let mut samples = Vec::new();
     let threads = (hoist, parallel);
-    let mut report = fly(
-        aircraft,
-        battery,
-        mission,
-        wind,
-        options,
-        threads,
-        &mut samples,
-    )?;
+    let mut samples = Vec::new();
+    let sink: &mut dyn SampleSink = if options.record_samples {
+        &mut samples
+    } else {
+        &mut NoSamples
+    };
+    let mut report = fly(aircraft, battery, mission, wind, options, threads, sink)?;
     report.samples = samples;
     Ok(report)
 }

@@ -49,7 +49,7 @@ const ZERO_TRIM: Trim = Trim {
 fn fixed_height_m(piece: &Piece) -> Option<f64> {
     match piece.shape {
         Shape::Hold { pos_m } => Some(pos_m[2]),
-        Shape::Arc { up_m, .. } => Some(up_m),
+        Shape::Arc(c) => Some(c.up_m),
         Shape::Line { start_m, dir } => (dir[2] == 0.0).then_some(start_m[2]),
     }
 }
@@ -61,7 +61,7 @@ fn fixed_height_m(piece: &Piece) -> Option<f64> {
 /// any wind but calm; a line that climbs or descends changes height. Both take the per-sample
 /// path.
 fn steady_piece(piece: &Piece) -> bool {
-    !matches!(piece.shape, Shape::Arc { .. }) && fixed_height_m(piece).is_some()
+    !matches!(piece.shape, Shape::Arc(_)) && fixed_height_m(piece).is_some()
 }
 
 /// A trim that marks a sample the power model rejected beyond the envelope: the edge step

@@ -39,13 +39,9 @@ impl PowerModel {
         conditions: &[FlightCondition],
         out: &mut [PowerBreakdown],
     ) -> Result<()> {
-        check_lengths(conditions.len(), out.len())?;
-        let mut block = Block::new();
-        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            load_block(cc, &mut block)?;
-            self.terms_of_block(cc, &block, oc)?;
-        }
-        Ok(())
+        by_blocks(conditions, out, |cc, block, oc| {
+            self.terms_of_block(cc, block, oc)
+        })
     }
 
     /// The roots of a block in vector lanes (`kernels/lanes.rs`), then the terms of each
@@ -72,13 +68,10 @@ impl PowerModel {
         conditions: &[FlightCondition],
         out: &mut [f64],
     ) -> Result<()> {
-        check_lengths(conditions.len(), out.len())?;
-        let mut block = Block::new();
         let mut roots = [0.0f64; CHUNK];
         let mut watts = [0.0f64; CHUNK];
-        for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
-            load_block(cc, &mut block)?;
-            electrical_of_block(self, &block, &mut roots, &mut watts);
+        by_blocks(conditions, out, |cc, block, oc| {
+            electrical_of_block(self, block, &mut roots, &mut watts);
             for (((c, &x), &w), o) in cc
                 .iter()
                 .zip(roots.iter())
@@ -92,8 +85,8 @@ impl PowerModel {
                     w
                 };
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 
     /// A block root `x = v_i / vh`, or the safeguarded solver's where the fast path left it (NaN).
@@ -105,6 +98,24 @@ impl PowerModel {
             Ok(x)
         }
     }
+}
+
+/// The passes over resolved conditions: `conditions` and `out` (checked to be of one length)
+/// [`CHUNK`] at a time, each block of conditions validated and laid out in the lanes of one
+/// [`Block`] before `each` writes its outputs; stops at the first error.
+#[inline(always)]
+fn by_blocks<T>(
+    conditions: &[FlightCondition],
+    out: &mut [T],
+    mut each: impl FnMut(&[FlightCondition], &Block, &mut [T]) -> Result<()>,
+) -> Result<()> {
+    check_lengths(conditions.len(), out.len())?;
+    let mut block = Block::new();
+    for (cc, oc) in conditions.chunks(CHUNK).zip(out.chunks_mut(CHUNK)) {
+        load_block(cc, &mut block)?;
+        each(cc, &block, oc)?;
+    }
+    Ok(())
 }
 
 /// Validate up to [`CHUNK`] resolved conditions and lay them out in `block`'s lanes.
