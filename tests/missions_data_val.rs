@@ -12,7 +12,7 @@
 //! Heights are sums of exact file values: 1e-9 m.
 
 mod common;
-use common::data_dir;
+use common::{assert_warned, data_dir};
 
 use std::path::PathBuf;
 
@@ -157,13 +157,7 @@ fn check_flight(plan: &Plan, m: &Mission, items: &[u32]) {
         let kinds: Vec<(&str, Option<u32>)> =
             added.iter().map(|x| (x.kind.as_str(), x.item)).collect();
         assert_eq!(kinds, [("return", None), ("landing", None)]);
-        assert!(
-            s.warnings
-                .iter()
-                .any(|w| w.contains("priced with the way home an autopilot flies")),
-            "{:?}",
-            s.warnings
-        );
+        assert_warned(&s.warnings, "priced with the way home an autopilot flies");
     }
     assert_eq!(&s.route, m.route());
     assert!(s.energy_wh > 0.0 && s.duration_s > 0.0);

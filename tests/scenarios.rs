@@ -8,6 +8,9 @@ use aloft::engine::{
 };
 use proptest::prelude::*;
 
+mod common;
+use common::mission_toml::{landing, leg, return_home, take_off};
+
 fn m100() -> Vehicle {
     Vehicle::builtin("dji-m100").unwrap()
 }
@@ -294,31 +297,15 @@ fn endurance_scenarios_give_ordered_percentiles_around_the_answer() {
 
 /// A short mission for the property tests: take-off, one leg, home, landing.
 fn short_mission() -> Mission {
-    Mission::from_toml(
-        r#"
-        name = "short"
-        [wind]
-        speed_mps = 4.0
-        from_deg = 270.0
-        [[segment]]
-        kind = "take-off"
-        altitude_m = 20.0
-        climb_rate_mps = 3.0
-        [[segment]]
-        kind = "leg"
-        east_m = 300.0
-        north_m = 0.0
-        ground_speed_mps = 10.0
-        [[segment]]
-        kind = "return"
-        ground_speed_mps = 10.0
-        [[segment]]
-        kind = "landing"
-        rate_mps = 2.0
-        "#,
-        "test",
-    )
-    .unwrap()
+    let text = [
+        "name = \"short\"\n[wind]\nspeed_mps = 4.0\nfrom_deg = 270.0\n".to_string(),
+        take_off(20.0, 3.0),
+        leg(300.0, 0.0, 10.0),
+        return_home(10.0),
+        landing(2.0),
+    ]
+    .concat();
+    Mission::from_toml(&text, "test").unwrap()
 }
 
 proptest! {

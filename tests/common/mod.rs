@@ -2,6 +2,8 @@
 //! folder and the repository's fixtures. Each test file takes what it needs with `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
 
+pub mod mission_toml;
+
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -125,6 +127,14 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "aloft {args:?}: {err}");
     err
+}
+
+/// Asserts that one of `warnings` contains `needle`.
+pub fn assert_warned(warnings: &[String], needle: &str) {
+    assert!(
+        warnings.iter().any(|w| w.contains(needle)),
+        "no warning with {needle:?}: {warnings:?}"
+    );
 }
 
 /// A uniform wind of `speed_mps` from `from_deg`, without gusts.
