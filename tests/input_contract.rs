@@ -342,15 +342,12 @@ fn a_repeated_csv_column_is_refused() {
         &["roll_deg", "twice"],
     );
     let grid = tmp("dup-grid.csv");
-    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps,u_mps\n");
-    for x in [-500, 500] {
-        for y in [-500, 500] {
-            for z in [0, 100] {
-                text.push_str(&format!("{x},{y},{z},1,0,0,2\n"));
-            }
-        }
-    }
-    std::fs::write(&grid, text).unwrap();
+    common::write_wind_grid(
+        &grid,
+        "x_m,y_m,z_m,u_mps,v_mps,w_mps,u_mps",
+        [[-500.0, 500.0], [-500.0, 500.0], [0.0, 100.0]],
+        "1,0,0,2",
+    );
     assert_refused(
         &["mission", "--wind-field", grid.to_str().unwrap()],
         &["u_mps", "twice"],

@@ -1,10 +1,11 @@
 //! MCAP reading (ROS 2 CDR and JSON), writing, round trips, bad files, and the independent check
 //! of what aloft writes with the Python `mcap` package (`tests/python/check_mcap.py`).
 
+mod common;
+
 use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use aloft_logs::cdr::CdrWriter;
 use aloft_logs::{
@@ -378,40 +379,6 @@ fn converted_log_reads_back_equal() {
     assert!((back.start_time_s - 1.0).abs() < 1e-6);
 }
 
-fn python_has_mcap() -> bool {
-    Command::new("python3")
-        .args(["-c", "import mcap"])
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// Run the Python check; skipped (with a notice) only outside CI when `mcap` is not installed.
-fn python_check(file: &Path, expect: &serde_json::Value) -> bool {
-    if !python_has_mcap() {
-        if std::env::var_os("CI").is_some() {
-            panic!("CI is set but `python3 -c 'import mcap'` fails: install it (python3 -m pip install mcap)");
-        }
-        eprintln!("NOTICE: skipping the Python MCAP check: python3 with the `mcap` package is not available (set CI to make this an error)");
-        return false;
-    }
-    let exp = file.with_extension("expect.json");
-    std::fs::write(&exp, serde_json::to_vec_pretty(expect).unwrap()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(file)
-        .arg(&exp)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "check_mcap.py failed:\n{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    true
-}
-
 #[test]
 fn python_mcap_reads_a_converted_log() {
     let (log, out) = log_round_trip_file();
@@ -432,7 +399,7 @@ fn python_mcap_reads_a_converted_log() {
             {"topic": "/aloft/state", "index": 0, "path": "time_s", "value": 0.0, "tol": 0.0},
         ]
     });
-    python_check(&out, &expect);
+    common::check_mcap_with_python(&out, &expect);
 }
 
 fn mission() -> (Vec<MissionSample>, Vec<PathPoint>) {
@@ -514,7 +481,7 @@ fn mission_mcap_has_all_topics_and_reads_back() {
             {"topic": "/aloft/battery", "index": 49, "path": "state_of_charge", "value": 1.0 - 0.01 * 24.5, "tol": 1e-12},
         ]
     });
-    python_check(&out, &expect);
+    common::check_mcap_with_python(&out, &expect);
 }
 
 /// Issue 23: `log info` of `mission --mcap` output counted a state and a battery message of one

@@ -129,6 +129,59 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     err
 }
 
+/// Writes a wind-field CSV to `path`: the `columns` line, then one row at each corner of the box
+/// `x_m` × `y_m` × `z_m` (two points an axis), `x,y,z,` followed by `values`.
+pub fn write_wind_grid(path: &Path, columns: &str, box_m: [[f64; 2]; 3], values: &str) {
+    let [xs, ys, zs] = box_m;
+    let mut text = format!("{columns}\n");
+    for x in xs {
+        for y in ys {
+            for z in zs {
+                text.push_str(&format!("{x},{y},{z},{values}\n"));
+            }
+        }
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// Whether `python3` can import the `mcap` package.
+fn python_has_mcap() -> bool {
+    Command::new("python3")
+        .args(["-c", "import mcap"])
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Checks the MCAP `file` with the independent reader, the Python `mcap` package
+/// (`tests/python/check_mcap.py`), against `expect` (topics with counts and schemas, values at
+/// paths with tolerances), which is written beside it. Skipped (with a notice) only outside CI
+/// when `mcap` is not installed; returns whether it ran.
+pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
+    if !python_has_mcap() {
+        if std::env::var_os("CI").is_some() {
+            panic!("CI is set but `python3 -c 'import mcap'` fails: install it (python3 -m pip install mcap)");
+        }
+        eprintln!("NOTICE: skipping the Python MCAP check: python3 with the `mcap` package is not available (set CI to make this an error)");
+        return false;
+    }
+    let exp = file.with_extension("expect.json");
+    std::fs::write(&exp, serde_json::to_vec_pretty(expect).unwrap()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
+    let out = Command::new("python3")
+        .arg(script)
+        .arg(file)
+        .arg(&exp)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "check_mcap.py failed:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    true
+}
+
 /// Asserts that one of `warnings` contains `needle`.
 pub fn assert_warned(warnings: &[String], needle: &str) {
     assert!(
@@ -162,4 +215,15 @@ pub const HOVER_KEYS: [&str; 9] = [
     "power_drawn_w",
     "battery_heat_w",
     "flight_time_min",
+];
+
+/// The numbers of an endurance answer (`aloft endurance --format json`) that every vehicle and
+/// payload has, and that a payload sweep gives for each row.
+pub const ENDURANCE_KEYS: [&str; 6] = [
+    "hover_power_w",
+    "hover_endurance_s",
+    "max_endurance_speed_mps",
+    "max_endurance_s",
+    "max_range_speed_mps",
+    "max_range_m",
 ];
