@@ -75,12 +75,7 @@ fn mission_answers_are_the_same_bytes() {
     let m100 = CVehicle::builtin("dji-m100");
     let example = std::fs::read_to_string("fixtures/missions/example.toml").unwrap();
     let grid = std::env::temp_dir().join("aloft-cli-ffi-grid.csv");
-    common::write_wind_grid(
-        &grid,
-        "x_m,y_m,z_m,u_mps,v_mps,w_mps",
-        [[-1000.0, 1000.0], [-1000.0, 1000.0], [0.0, 200.0]],
-        "2,-1,0",
-    );
+    common::write_wind_grid(&grid, [1000.0, 200.0], "2,-1,0");
     let grid = grid.display().to_string();
     let cases: Vec<(Vec<&str>, Option<&str>, String)> = vec![
         (vec![], None, "{}".into()),

@@ -342,10 +342,10 @@ fn a_repeated_csv_column_is_refused() {
         &["roll_deg", "twice"],
     );
     let grid = tmp("dup-grid.csv");
-    common::write_wind_grid(
+    common::write_wind_grid_with_columns(
         &grid,
         "x_m,y_m,z_m,u_mps,v_mps,w_mps,u_mps",
-        [[-500.0, 500.0], [-500.0, 500.0], [0.0, 100.0]],
+        [500.0, 100.0],
         "1,0,0,2",
     );
     assert_refused(

@@ -2,6 +2,7 @@
 //! of what aloft writes with the Python `mcap` package (`tests/python/check_mcap.py`).
 
 mod common;
+use common::ros2::{battery_state, message_header, pose_stamped, ros2_channel};
 
 use std::collections::BTreeMap;
 use std::io::Cursor;
@@ -27,34 +28,15 @@ fn fixture(name: &str) -> PathBuf {
 // quaternion <-> Euler conversions cost a few ulps: 1e-9.
 const TOL: f64 = 1e-9;
 
+/// A pose at (x, 2, 3) m in `map`, level and facing east.
 fn pose_cdr(sec: i32, x: f64) -> Vec<u8> {
-    let mut w = CdrWriter::new();
-    w.header(sec, 0, "map").f64(x).f64(2.0).f64(3.0);
-    for q in [0.0, 0.0, 0.0, 1.0] {
-        w.f64(q);
-    }
-    w.finish()
+    pose_stamped(sec, 0, "map", [x, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0])
 }
 
+/// A pack at `v` volts drawing `i` amperes (negative: discharging), 80 % full.
 fn battery_cdr(sec: i32, v: f32, i: f32) -> Vec<u8> {
-    let mut w = CdrWriter::new();
-    w.header(sec, 0, "")
-        .f32(v)
-        .f32(f32::NAN)
-        .f32(i)
-        .f32(f32::NAN)
-        .f32(f32::NAN)
-        .f32(5.0)
-        .f32(0.8)
-        .u8(2)
-        .u8(1)
-        .u8(3)
-        .u8(1)
-        .u32(0)
-        .u32(0)
-        .string("")
-        .string("");
-    w.finish()
+    let nan = f32::NAN;
+    battery_state(sec, [v, nan, i, nan, nan, 5.0, 0.8], &[])
 }
 
 fn twist_cdr(sec: i32, frame: &str) -> Vec<u8> {
@@ -94,12 +76,7 @@ fn ros2_file(path: &Path) {
     let c_other = w.add_channel(s_other, "/status", "cdr", &meta).unwrap();
     for k in 0..10u32 {
         let ns = 1_000_000_000 + u64::from(k) * 100_000_000;
-        let hdr = |ch: u16| mcap::records::MessageHeader {
-            channel_id: ch,
-            sequence: k,
-            log_time: ns,
-            publish_time: ns,
-        };
+        let hdr = |ch: u16| message_header(ch, k, ns);
         w.write_to_known_channel(&hdr(c_pose), &pose_cdr(1, f64::from(k)))
             .unwrap();
         w.write_to_known_channel(&hdr(c_pose2), &pose_cdr(1, 100.0))
@@ -193,17 +170,8 @@ fn body_frame_twist_is_not_taken_as_enu() {
     let p = tmp("twist-body.mcap");
     let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
     let mut w = mcap::Writer::new(f).unwrap();
-    let s = w
-        .add_schema("geometry_msgs/msg/TwistStamped", "ros2msg", b"")
-        .unwrap();
-    let c = w.add_channel(s, "/v", "cdr", &BTreeMap::new()).unwrap();
-    let hdr = mcap::records::MessageHeader {
-        channel_id: c,
-        sequence: 0,
-        log_time: 1,
-        publish_time: 1,
-    };
-    w.write_to_known_channel(&hdr, &twist_cdr(1, "base_link"))
+    let c = ros2_channel(&mut w, "geometry_msgs/msg/TwistStamped", "/v");
+    w.write_to_known_channel(&message_header(c, 0, 1), &twist_cdr(1, "base_link"))
         .unwrap();
     w.finish().unwrap();
     let log = read_log(&p, None, &McapOptions::default()).unwrap();
@@ -216,21 +184,13 @@ fn corrupt_cdr_payload_names_topic_and_message() {
     let p = tmp("cdr-bad.mcap");
     let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
     let mut w = mcap::Writer::new(f).unwrap();
-    let s = w
-        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"")
-        .unwrap();
-    let c = w.add_channel(s, "/pose", "cdr", &BTreeMap::new()).unwrap();
+    let c = ros2_channel(&mut w, "geometry_msgs/msg/PoseStamped", "/pose");
     for (k, data) in [pose_cdr(1, 0.0), pose_cdr(1, 0.0)[..30].to_vec()]
         .iter()
         .enumerate()
     {
-        let hdr = mcap::records::MessageHeader {
-            channel_id: c,
-            sequence: k as u32,
-            log_time: k as u64,
-            publish_time: k as u64,
-        };
-        w.write_to_known_channel(&hdr, data).unwrap();
+        w.write_to_known_channel(&message_header(c, k as u32, k as u64), data)
+            .unwrap();
     }
     w.finish().unwrap();
     let e = read_log(&p, None, &McapOptions::default()).unwrap_err();

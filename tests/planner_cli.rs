@@ -4,7 +4,7 @@ mod common;
 use common::mission_toml::{hover, landing, orbit, take_off, OrbitFor};
 use common::run as aloft;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
     common::scratch("planner-cli", name)
@@ -17,15 +17,17 @@ fn mission_file(name: &str, segments: &[String]) -> PathBuf {
     path
 }
 
-/// Flies the demo writing the output files of `outputs` (a flag and its file each); it must
-/// succeed.
-fn demo_writing(outputs: &[(&str, &Path)]) {
+/// Flies the demo writing an output file for each (flag, file name) of `outputs` in this test's
+/// scratch folder; it must succeed. The files' paths, in order.
+fn demo_writing<const N: usize>(outputs: [(&str, &str); N]) -> [PathBuf; N] {
+    let files = outputs.map(|(_, name)| tmp(name));
     let mut args = vec!["mission".to_string()];
-    for (flag, file) in outputs {
+    for ((flag, _), file) in outputs.iter().zip(&files) {
         args.push(flag.to_string());
         args.push(file.display().to_string());
     }
     common::ok_stdout(&args);
+    files
 }
 
 #[test]
@@ -116,12 +118,7 @@ fn bad_input_exits_2_with_a_clear_message() {
     assert!(err.contains("no segments"), "{err}");
     // A wind grid that does not reach the demo's survey area.
     let grid = tmp("small-grid.csv");
-    common::write_wind_grid(
-        &grid,
-        "x_m,y_m,z_m,u_mps,v_mps,w_mps",
-        [[-10.0, 10.0], [-10.0, 10.0], [0.0, 50.0]],
-        "3,0,0",
-    );
+    common::write_wind_grid(&grid, [10.0, 50.0], "3,0,0");
     let (code, _, err) = aloft(&["mission", "--wind-field", grid.to_str().unwrap()]);
     assert_eq!(code, 2);
     assert!(err.contains("does not cover"), "{err}");
@@ -132,9 +129,7 @@ fn bad_input_exits_2_with_a_clear_message() {
 
 #[test]
 fn timeseries_and_plot_are_written() {
-    let csv = tmp("demo.csv");
-    let svg = tmp("demo.svg");
-    demo_writing(&[("--timeseries", &csv), ("--plot", &svg)]);
+    let [csv, svg] = demo_writing([("--timeseries", "demo.csv"), ("--plot", "demo.svg")]);
     let text = std::fs::read_to_string(&csv).unwrap();
     let header = text.lines().next().unwrap();
     for k in [
@@ -184,9 +179,10 @@ fn endurance_json_has_the_contract_keys() {
 
 #[test]
 fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
-    let mcap = tmp("demo.mcap");
-    let csv = tmp("demo-for-mcap.csv");
-    demo_writing(&[("--mcap", &mcap), ("--timeseries", &csv)]);
+    let [mcap, csv] = demo_writing([
+        ("--mcap", "demo.mcap"),
+        ("--timeseries", "demo-for-mcap.csv"),
+    ]);
     let bytes = std::fs::read(&mcap).unwrap();
     // MCAP magic at both ends (MCAP spec: 0x89 "MCAP0" CR LF).
     let magic = b"\x89MCAP0\r\n";

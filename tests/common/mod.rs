@@ -3,6 +3,7 @@
 #![allow(dead_code)] // not every test file uses every helper
 
 pub mod mission_toml;
+pub mod ros2;
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -129,14 +130,20 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     err
 }
 
-/// Writes a wind-field CSV to `path`: the `columns` line, then one row at each corner of the box
-/// `x_m` × `y_m` × `z_m` (two points an axis), `x,y,z,` followed by `values`.
-pub fn write_wind_grid(path: &Path, columns: &str, box_m: [[f64; 2]; 3], values: &str) {
-    let [xs, ys, zs] = box_m;
+/// Writes a wind-field CSV to `path` (`x_m,y_m,z_m,u_mps,v_mps,w_mps`): the same `wind` (`u,v,w`
+/// in m/s) at each corner of the box `[half_width_m, top_m]`, ±`half_width_m` east and north of
+/// home from the ground to `top_m`.
+pub fn write_wind_grid(path: &Path, box_m: [f64; 2], wind: &str) {
+    write_wind_grid_with_columns(path, "x_m,y_m,z_m,u_mps,v_mps,w_mps", box_m, wind);
+}
+
+/// [`write_wind_grid`] with other `columns`: each row is `x,y,z,` and `values`.
+pub fn write_wind_grid_with_columns(path: &Path, columns: &str, box_m: [f64; 2], values: &str) {
+    let [half_width_m, top_m] = box_m;
     let mut text = format!("{columns}\n");
-    for x in xs {
-        for y in ys {
-            for z in zs {
+    for x in [-half_width_m, half_width_m] {
+        for y in [-half_width_m, half_width_m] {
+            for z in [0.0, top_m] {
                 text.push_str(&format!("{x},{y},{z},{values}\n"));
             }
         }
