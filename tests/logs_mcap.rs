@@ -91,6 +91,15 @@ fn ros2_file(path: &Path) {
     w.finish().unwrap();
 }
 
+/// The log of the MCAP at `path` read from the named `topics` only.
+fn read_topics(path: &Path, topics: &[&str]) -> Result<aloft_logs::Log, LogError> {
+    let o = McapOptions {
+        topics: topics.iter().map(|t| t.to_string()).collect(),
+        ..McapOptions::default()
+    };
+    read_log(path, None, &o)
+}
+
 #[test]
 fn ros2_cdr_topics_are_chosen_by_type_without_mixing_sources() {
     let p = tmp("ros2.mcap");
@@ -132,11 +141,7 @@ fn ros2_cdr_topics_are_chosen_by_type_without_mixing_sources() {
 fn named_topics_select_decode_and_fail_clearly() {
     let p = tmp("ros2-named.mcap");
     ros2_file(&p);
-    let o = McapOptions {
-        topics: vec!["/mocap/pose".into()],
-        ..McapOptions::default()
-    };
-    let log = read_log(&p, None, &o).unwrap();
+    let log = read_topics(&p, &["/mocap/pose"]).unwrap();
     assert_eq!(log.samples.len(), 10);
     assert!(log
         .samples
@@ -145,22 +150,14 @@ fn named_topics_select_decode_and_fail_clearly() {
     let e = log.power_series().unwrap_err();
     assert!(matches!(e, LogError::NoPowerData { .. }), "{e}");
 
-    let o = McapOptions {
-        topics: vec!["/nope".into()],
-        ..McapOptions::default()
-    };
-    let e = read_log(&p, None, &o).unwrap_err();
+    let e = read_topics(&p, &["/nope"]).unwrap_err();
     assert!(matches!(e, LogError::TopicNotFound { .. }), "{e}");
     assert!(
         e.to_string().contains("/vehicle/pose"),
         "lists what exists: {e}"
     );
 
-    let o = McapOptions {
-        topics: vec!["/status".into()],
-        ..McapOptions::default()
-    };
-    let e = read_log(&p, None, &o).unwrap_err();
+    let e = read_topics(&p, &["/status"]).unwrap_err();
     assert!(matches!(e, LogError::UnsupportedTopic { .. }), "{e}");
     assert!(e.to_string().contains("std_msgs/msg/String"), "{e}");
 }
@@ -311,11 +308,7 @@ fn converted_log_reads_back_equal() {
         assert!((s.current_a.unwrap() - cur[i]).abs() < TOL);
     }
     // The pose topic alone: attitude through the ROS quaternion and back.
-    let o = McapOptions {
-        topics: vec!["/aloft/pose".into()],
-        ..McapOptions::default()
-    };
-    let poses = read_log(&out, None, &o).unwrap();
+    let poses = read_topics(&out, &["/aloft/pose"]).unwrap();
     assert_eq!(poses.samples.len(), 20);
     for (s, b) in log.samples.iter().zip(&poses.samples) {
         let (a, b) = (s.attitude.unwrap(), b.attitude.unwrap());
@@ -324,11 +317,7 @@ fn converted_log_reads_back_equal() {
         assert!((a.yaw_rad - b.yaw_rad).abs() < TOL);
     }
     // Pose and battery by name: aloft's pose topic joins its instant too.
-    let o = McapOptions {
-        topics: vec!["/aloft/pose".into(), "/aloft/battery".into()],
-        ..McapOptions::default()
-    };
-    let named = read_log(&out, None, &o).unwrap();
+    let named = read_topics(&out, &["/aloft/pose", "/aloft/battery"]).unwrap();
     assert_eq!(named.samples.len(), 20);
     assert!(named
         .samples

@@ -151,12 +151,27 @@ pub fn write_wind_grid_with_columns(path: &Path, columns: &str, box_m: [f64; 2],
     std::fs::write(path, text).unwrap();
 }
 
-/// Whether `python3` can import the `mcap` package.
-fn python_has_mcap() -> bool {
+/// Whether `python3` can import `modules` (as an `import` statement names them: `a, b`).
+pub fn python_has(modules: &str) -> bool {
     Command::new("python3")
-        .args(["-c", "import mcap"])
-        .status()
-        .is_ok_and(|s| s.success())
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// The standard output of `python3 -c script args`, which must succeed.
+pub fn python_stdout(script: &str, args: &[&str]) -> String {
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .args(args)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "python3 {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8")
 }
 
 /// Checks the MCAP `file` with the independent reader, the Python `mcap` package
@@ -164,7 +179,7 @@ fn python_has_mcap() -> bool {
 /// paths with tolerances), which is written beside it. Skipped (with a notice) only outside CI
 /// when `mcap` is not installed; returns whether it ran.
 pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
-    if !python_has_mcap() {
+    if !python_has("mcap") {
         if std::env::var_os("CI").is_some() {
             panic!("CI is set but `python3 -c 'import mcap'` fails: install it (python3 -m pip install mcap)");
         }
@@ -187,6 +202,12 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
         String::from_utf8_lossy(&out.stderr)
     );
     true
+}
+
+/// The `key` string of each element of the JSON array `array`.
+pub fn strs_of<'a>(array: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+    let items = array.as_array().expect("a JSON array");
+    items.iter().map(|x| x[key].as_str().unwrap()).collect()
 }
 
 /// Asserts that one of `warnings` contains `needle`.
