@@ -426,61 +426,34 @@ fn propulsion_sweep_writes_csv_and_svg() {
 
 #[test]
 fn fit_and_validate_reject_bad_input() {
-    let out = common::scratch("fitbad", "out.toml");
+    let out = common::scratch("fitbad", "out.toml").display().to_string();
     let fixture = |name: &str| format!("{}/fixtures/logs/{name}", env!("CARGO_MANIFEST_DIR"));
+    // `aloft fit` of the fixture `log` (KAIST layout) on the vehicle `template`, and `more`.
+    let fit = |log: &str, template: &str, more: &[&str]| -> Vec<String> {
+        let mut args = vec!["fit".to_string(), "--log".into(), fixture(log)];
+        let rest = [
+            "--profile",
+            "kaist",
+            "--vehicle-template",
+            template,
+            "-o",
+            &out,
+        ];
+        args.extend(rest.iter().chain(more).map(|a| a.to_string()));
+        args
+    };
+    let none = common::scratch("fitbad", "none.csv").display().to_string();
     let cases: Vec<(Vec<String>, &str)> = vec![
+        (fit("kaist_missing_cur.csv", "dji-m100", &[]), "cur"),
+        (fit("kaist_small.csv", "aec-quadrotor", &[]), "[power]"),
         (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_missing_cur.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "dji-m100".into(),
-                "-o".into(),
-                out.display().to_string(),
-            ],
-            "cur",
-        ),
-        (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_small.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "aec-quadrotor".into(),
-                "-o".into(),
-                out.display().to_string(),
-            ],
-            "[power]",
-        ),
-        (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_small.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "dji-m100".into(),
-                "-o".into(),
-                out.display().to_string(),
-                "--free".into(),
-                "k,drag".into(),
-            ],
+            fit("kaist_small.csv", "dji-m100", &["--free", "k,drag"]),
             "drag",
         ),
         (
-            vec![
-                "validate".into(),
-                "--log".into(),
-                common::scratch("fitbad", "none.csv").display().to_string(),
-                "--vehicle".into(),
-                "dji-m100".into(),
-            ],
+            ["validate", "--log", &none, "--vehicle", "dji-m100"]
+                .map(String::from)
+                .to_vec(),
             "none.csv",
         ),
     ];

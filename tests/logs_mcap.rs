@@ -4,7 +4,6 @@
 mod common;
 use common::ros2::{battery_state, message_header, pose_stamped, ros2_channel};
 
-use std::collections::BTreeMap;
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
@@ -52,28 +51,16 @@ fn twist_cdr(sec: i32, frame: &str) -> Vec<u8> {
 fn ros2_file(path: &Path) {
     let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
     let mut w = mcap::Writer::new(f).unwrap();
-    let s_pose = w
-        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"...")
-        .unwrap();
-    let s_bat = w
-        .add_schema("sensor_msgs/msg/BatteryState", "ros2msg", b"...")
-        .unwrap();
-    let s_tw = w
-        .add_schema("geometry_msgs/msg/TwistStamped", "ros2msg", b"...")
-        .unwrap();
-    let s_other = w
-        .add_schema("std_msgs/msg/String", "ros2msg", b"string data")
-        .unwrap();
-    let meta = BTreeMap::new();
-    let c_pose = w
-        .add_channel(s_pose, "/vehicle/pose", "cdr", &meta)
-        .unwrap();
-    let c_pose2 = w.add_channel(s_pose, "/mocap/pose", "cdr", &meta).unwrap();
-    let c_bat = w.add_channel(s_bat, "/battery", "cdr", &meta).unwrap();
-    let c_tw = w
-        .add_channel(s_tw, "/vehicle/velocity", "cdr", &meta)
-        .unwrap();
-    let c_other = w.add_channel(s_other, "/status", "cdr", &meta).unwrap();
+    let pose = "geometry_msgs/msg/PoseStamped";
+    let c_pose = ros2_channel(&mut w, pose, "/vehicle/pose");
+    let c_pose2 = ros2_channel(&mut w, pose, "/mocap/pose");
+    let c_bat = ros2_channel(&mut w, "sensor_msgs/msg/BatteryState", "/battery");
+    let c_tw = ros2_channel(
+        &mut w,
+        "geometry_msgs/msg/TwistStamped",
+        "/vehicle/velocity",
+    );
+    let c_other = ros2_channel(&mut w, "std_msgs/msg/String", "/status");
     for k in 0..10u32 {
         let ns = 1_000_000_000 + u64::from(k) * 100_000_000;
         let hdr = |ch: u16| message_header(ch, k, ns);

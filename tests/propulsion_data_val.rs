@@ -42,6 +42,11 @@ fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, &x| a.max(x.abs()))
 }
 
+/// The largest and the RMS relative error of `e`, in percent, for the report.
+fn spread(e: &[f64]) -> String {
+    format!("max {:.1}% rms {:.1}%", max_abs(e) * 100.0, rms(e) * 100.0)
+}
+
 /// UIUC static tables of the Master Airscrew propellers (the maker of the seed's MA1470T):
 /// C_T, C_P fitted on even rows, odd rows predicted. The speed-dependent (Reynolds) model must
 /// beat the seed's constant-coefficient model on every table (the data supports a speed
@@ -130,16 +135,14 @@ fn data_val_mit_kde2814_14in_propeller_even_odd() {
         .map(|r| p.torque_nm(r[3], 1.225) / r[1] - 1.0)
         .collect();
     eprintln!(
-        "MIT 14in: C_T {:.4} C_P {:.4}, train RMSE {:.3} N / {:.4} N m; odd rows (n={}) thrust max {:.1}% rms {:.1}%, torque max {:.1}% rms {:.1}%",
+        "MIT 14in: C_T {:.4} C_P {:.4}, train RMSE {:.3} N / {:.4} N m; odd rows (n={}) thrust {}, torque {}",
         fit.ct,
         fit.cp,
         fit.rmse_thrust,
         fit.rmse_power,
         test.len(),
-        max_abs(&et) * 100.0,
-        rms(&et) * 100.0,
-        max_abs(&eq) * 100.0,
-        rms(&eq) * 100.0
+        spread(&et),
+        spread(&eq)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&et) < 0.08 && max_abs(&eq) < 0.08);
@@ -178,13 +181,12 @@ fn data_val_mit_kde2814_motor_even_odd() {
         .map(|r| fit.supply_current_a(volts, r[3], r[1]) / r[4] - 1.0)
         .collect();
     eprintln!(
-        "KDE2814 motor: R_m {:.3} ohm, {:?}, train RMSE {:.3} A; odd rows (n={}) max {:.1}% rms {:.1}%",
+        "KDE2814 motor: R_m {:.3} ohm, {:?}, train RMSE {:.3} A; odd rows (n={}) {}",
         fit.resistance_ohm,
         fit.loss,
         fit.rmse_current_a,
         test.len(),
-        max_abs(&e) * 100.0,
-        rms(&e) * 100.0
+        spread(&e)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&e) < 0.10);
@@ -246,15 +248,13 @@ fn data_val_kde2814_current_from_thrust() {
         .map(|r| predict(r[2], 0.069, 0.5) / r[4] - 1.0)
         .collect();
     eprintln!(
-        "KDE2814XF-775 + 14in: fitted R_m {:.3} ohm I0 {:.2} A (train RMSE {:.3} A); current from thrust on odd rows (n={}): max {:.1}% rms {:.1}%; catalogue-only max {:.1}% rms {:.1}%",
+        "KDE2814XF-775 + 14in: fitted R_m {:.3} ohm I0 {:.2} A (train RMSE {:.3} A); current from thrust on odd rows (n={}): {}; catalogue-only {}",
         motor.resistance_ohm,
         i0_fit,
         motor.rmse_current_a,
         test.len(),
-        max_abs(&e_fit) * 100.0,
-        rms(&e_fit) * 100.0,
-        max_abs(&e_cat) * 100.0,
-        rms(&e_cat) * 100.0
+        spread(&e_fit),
+        spread(&e_cat)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&e_fit) <= 0.10);
