@@ -78,6 +78,19 @@ fn ros2_file(path: &Path) {
     w.finish().unwrap();
 }
 
+/// An MCAP at `path` of the one ROS 2 topic `topic` of `message_type`: each of `messages` is
+/// its log time (ns) and its CDR bytes, in sequence from 0.
+fn one_topic_file(path: &Path, message_type: &str, topic: &str, messages: &[(u64, &[u8])]) {
+    let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut w = mcap::Writer::new(f).unwrap();
+    let c = ros2_channel(&mut w, message_type, topic);
+    for (k, (ns, data)) in (0u32..).zip(messages) {
+        w.write_to_known_channel(&message_header(c, k, *ns), data)
+            .unwrap();
+    }
+    w.finish().unwrap();
+}
+
 /// The log of the MCAP at `path` read from the named `topics` only.
 fn read_topics(path: &Path, topics: &[&str]) -> Result<aloft_logs::Log, LogError> {
     let o = McapOptions {
@@ -152,12 +165,8 @@ fn named_topics_select_decode_and_fail_clearly() {
 #[test]
 fn body_frame_twist_is_not_taken_as_enu() {
     let p = tmp("twist-body.mcap");
-    let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
-    let mut w = mcap::Writer::new(f).unwrap();
-    let c = ros2_channel(&mut w, "geometry_msgs/msg/TwistStamped", "/v");
-    w.write_to_known_channel(&message_header(c, 0, 1), &twist_cdr(1, "base_link"))
-        .unwrap();
-    w.finish().unwrap();
+    let twist = twist_cdr(1, "base_link");
+    one_topic_file(&p, "geometry_msgs/msg/TwistStamped", "/v", &[(1, &twist)]);
     let log = read_log(&p, None, &McapOptions::default()).unwrap();
     assert_eq!(log.samples.len(), 1);
     assert_eq!(log.samples[0].vel_enu_mps, None);
@@ -166,17 +175,14 @@ fn body_frame_twist_is_not_taken_as_enu() {
 #[test]
 fn corrupt_cdr_payload_names_topic_and_message() {
     let p = tmp("cdr-bad.mcap");
-    let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
-    let mut w = mcap::Writer::new(f).unwrap();
-    let c = ros2_channel(&mut w, "geometry_msgs/msg/PoseStamped", "/pose");
-    for (k, data) in [pose_cdr(1, 0.0), pose_cdr(1, 0.0)[..30].to_vec()]
-        .iter()
-        .enumerate()
-    {
-        w.write_to_known_channel(&message_header(c, k as u32, k as u64), data)
-            .unwrap();
-    }
-    w.finish().unwrap();
+    let pose = pose_cdr(1, 0.0);
+    let cut = &pose[..30];
+    one_topic_file(
+        &p,
+        "geometry_msgs/msg/PoseStamped",
+        "/pose",
+        &[(0, &pose), (1, cut)],
+    );
     let e = read_log(&p, None, &McapOptions::default()).unwrap_err();
     match &e {
         LogError::Cdr { topic, index, .. } => {

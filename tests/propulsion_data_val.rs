@@ -34,6 +34,22 @@ fn split_even_odd<T: Clone>(v: &[T]) -> (Vec<T>, Vec<T>) {
     (even, odd)
 }
 
+/// Column `k` of `rows`.
+fn col(rows: &[Vec<f64>], k: usize) -> Vec<f64> {
+    rows.iter().map(|x| x[k]).collect()
+}
+
+/// The rows of the MIT run of the KDE2814XF-775 with the 14 in propeller.
+fn mit_14in_rows() -> Vec<Vec<f64>> {
+    numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"))
+}
+
+/// [`mit_14in_rows`] where the motor turns (column 3 > 0), split into even and odd rows.
+fn mit_14in_turning() -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let rows: Vec<_> = mit_14in_rows().into_iter().filter(|r| r[3] > 0.0).collect();
+    split_even_odd(&rows)
+}
+
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
@@ -75,7 +91,6 @@ fn data_val_uiuc_master_airscrew_static_even_odd() {
     for f in files {
         let rows = numeric_rows(&f);
         let (even, odd) = split_even_odd(&rows);
-        let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
         let (rpm, ct, cp) = (col(&even, 0), col(&even, 1), col(&even, 2));
         let err = |fit: &aloft_propulsion::fit::propeller::PropellerFit| {
             let et: Vec<f64> = odd.iter().map(|r| fit.ct_at(r[0]) / r[1] - 1.0).collect();
@@ -111,9 +126,7 @@ fn data_val_uiuc_master_airscrew_static_even_odd() {
 /// odd rows include the other direction's hysteresis (~3 % at equal ESC signal).
 #[test]
 fn data_val_mit_kde2814_14in_propeller_even_odd() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = split_even_odd(&mit_14in_rows());
     let d = 14.0 * 0.0254;
     let fit = fit_thrust_stand(
         &col(&even, 3),
@@ -161,10 +174,7 @@ fn data_val_mit_kde2814_14in_propeller_even_odd() {
 /// rows by up to 21 %. The speed or torque column of those runs is likely mis-scaled.)
 #[test]
 fn data_val_mit_kde2814_motor_even_odd() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let rows: Vec<_> = rows.into_iter().filter(|r| r[3] > 0.0).collect();
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = mit_14in_turning();
     let volts = 11.1;
     let fit = fit_motor(
         &vec![volts; even.len()],
@@ -203,10 +213,7 @@ fn data_val_mit_kde2814_motor_even_odd() {
 /// reported too; it under-predicts, as it ignores ESC and wiring losses.
 #[test]
 fn data_val_kde2814_current_from_thrust() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let rows: Vec<_> = rows.into_iter().filter(|r| r[3] > 0.0).collect();
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = mit_14in_turning();
     let (d, rho, volts, kv) = (14.0 * 0.0254, 1.225, 11.1, 775.0);
     let prop = fit_thrust_stand(
         &col(&even, 3),

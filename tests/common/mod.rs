@@ -133,12 +133,17 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
 /// Writes a wind-field CSV to `path` (`x_m,y_m,z_m,u_mps,v_mps,w_mps`): the same `wind` (`u,v,w`
 /// in m/s) at each corner of the box `[half_width_m, top_m]`, ±`half_width_m` east and north of
 /// home from the ground to `top_m`.
-pub fn write_wind_grid(path: &Path, box_m: [f64; 2], wind: &str) {
+pub fn write_wind_grid(path: impl AsRef<Path>, box_m: [f64; 2], wind: &str) {
     write_wind_grid_with_columns(path, "x_m,y_m,z_m,u_mps,v_mps,w_mps", box_m, wind);
 }
 
 /// [`write_wind_grid`] with other `columns`: each row is `x,y,z,` and `values`.
-pub fn write_wind_grid_with_columns(path: &Path, columns: &str, box_m: [f64; 2], values: &str) {
+pub fn write_wind_grid_with_columns(
+    path: impl AsRef<Path>,
+    columns: &str,
+    box_m: [f64; 2],
+    values: &str,
+) {
     let [half_width_m, top_m] = box_m;
     let mut text = format!("{columns}\n");
     for x in [-half_width_m, half_width_m] {
