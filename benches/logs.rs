@@ -10,7 +10,8 @@ use std::hint::black_box;
 use std::io::Cursor;
 use std::path::Path;
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 
 use aloft_logs::synth;
 use aloft_logs::{
@@ -85,69 +86,59 @@ fn ros2_mcap(poses: u32) -> Vec<u8> {
     w.into_inner().into_inner()
 }
 
+/// The bench group `name`, of 10 samples (each reads a whole log).
+fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10);
+    g
+}
+
+/// In `g`, the bench `name` of `read` over `data` (a whole log in memory), in bytes of input per
+/// second.
+fn bench_bytes<R>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    data: &[u8],
+    read: impl Fn(&[u8]) -> R,
+) {
+    g.throughput(Throughput::Bytes(data.len() as u64));
+    g.bench_function(name, |b| b.iter(|| black_box(read(black_box(data)))));
+}
+
 fn csv_read(c: &mut Criterion) {
     let data = kaist_csv(150_000);
-    let mut g = c.benchmark_group("logs/csv_read");
-    g.throughput(Throughput::Bytes(data.len() as u64));
-    g.sample_size(10);
-    g.bench_function("kaist_150k_rows", |b| {
-        b.iter(|| {
-            let r = CsvSamples::from_reader(
-                black_box(&data[..]),
-                Path::new("bench.csv"),
-                &ColumnMap::kaist(),
-            )
-            .unwrap();
-            let mut n = 0usize;
-            for s in r {
-                n += usize::from(s.unwrap().voltage_v.is_some());
-            }
-            black_box(n)
-        })
+    let mut g = group(c, "logs/csv_read");
+    bench_bytes(&mut g, "kaist_150k_rows", &data, |data| {
+        let map = ColumnMap::kaist();
+        let r = CsvSamples::from_reader(data, Path::new("bench.csv"), &map).unwrap();
+        r.filter(|s| s.as_ref().unwrap().voltage_v.is_some())
+            .count()
     });
     g.finish();
 }
 
 fn mcap_read(c: &mut Criterion) {
     let data = ros2_mcap(200_000);
-    let mut g = c.benchmark_group("logs/mcap_read");
-    g.throughput(Throughput::Bytes(data.len() as u64));
-    g.sample_size(10);
-    g.bench_function("ros2_cdr_pose_battery", |b| {
-        b.iter(|| {
-            let r = McapSamples::from_reader(
-                Cursor::new(black_box(&data[..])),
-                Path::new("bench.mcap"),
-                McapOptions::default(),
-            );
-            let mut n = 0usize;
-            for s in r {
-                n += usize::from(s.unwrap().pos_enu_m.is_some());
-            }
-            black_box(n)
-        })
+    let mut g = group(c, "logs/mcap_read");
+    bench_bytes(&mut g, "ros2_cdr_pose_battery", &data, |data| {
+        let path = Path::new("bench.mcap");
+        let r = McapSamples::from_reader(Cursor::new(data), path, McapOptions::default());
+        r.filter(|s| s.as_ref().unwrap().pos_enu_m.is_some())
+            .count()
     });
     g.finish();
 }
 
 fn binary_read(c: &mut Criterion) {
-    let mut g = c.benchmark_group("logs/read");
-    g.sample_size(10);
+    let mut g = group(c, "logs/read");
+    let options = BinaryOptions::default();
     let ulog = synth::ulog_flight(3_000);
-    g.throughput(Throughput::Bytes(ulog.len() as u64));
-    g.bench_function("ulog", |b| {
-        b.iter(|| {
-            let r = read_ulog(black_box(&ulog[..]), &BinaryOptions::default()).unwrap();
-            black_box(r.summary.energy_wh())
-        })
+    bench_bytes(&mut g, "ulog", &ulog, |data| {
+        read_ulog(data, &options).unwrap().summary.energy_wh()
     });
     let df = synth::dataflash_flight(3_000);
-    g.throughput(Throughput::Bytes(df.len() as u64));
-    g.bench_function("dataflash", |b| {
-        b.iter(|| {
-            let r = read_dataflash(black_box(&df[..]), &BinaryOptions::default()).unwrap();
-            black_box(r.summary.energy_wh())
-        })
+    bench_bytes(&mut g, "dataflash", &df, |data| {
+        read_dataflash(data, &options).unwrap().summary.energy_wh()
     });
     g.finish();
 }
