@@ -1,5 +1,7 @@
 //! Helpers shared by the integration tests: running the `aloft` binary, the shared real-data
-//! folder and the repository's fixtures. Each test file takes what it needs with `mod common;`.
+//! folder and the repository's fixtures, files and checks several tests make, mission segments as
+//! TOML ([`mission_toml`]) and ROS 2 messages ([`ros2`]; both also taken by the benches with
+//! `#[path]`). Each test file takes what it needs with `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
 
 pub mod mission_toml;
