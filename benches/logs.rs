@@ -6,18 +6,21 @@
 //! logs with the topic mix of a real flight (kept topics and a high-rate IMU topic that is
 //! skipped); guards the same 100 MB/s, so a 1 GB log reads in about 10 s.
 
-use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::io::Cursor;
 use std::path::Path;
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 
-use aloft_logs::cdr::CdrWriter;
 use aloft_logs::synth;
 use aloft_logs::{
     read_dataflash, read_ulog, BinaryOptions, ColumnMap, CsvSamples, McapOptions, McapSamples,
 };
+
+#[path = "../tests/common/ros2.rs"]
+mod ros2;
+use ros2::{battery_state, message_header, pose_stamped, ros2_channel};
 
 /// A KAIST-layout CSV of `rows` rows at 10 Hz with varying, realistic values (about 170 bytes a row).
 fn kaist_csv(rows: usize) -> Vec<u8> {
@@ -57,128 +60,85 @@ fn kaist_csv(rows: usize) -> Vec<u8> {
 /// BatteryState at 10 Hz.
 fn ros2_mcap(poses: u32) -> Vec<u8> {
     let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
-    let sp = w
-        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"")
-        .unwrap();
-    let sb = w
-        .add_schema("sensor_msgs/msg/BatteryState", "ros2msg", b"")
-        .unwrap();
-    let cp = w.add_channel(sp, "/pose", "cdr", &BTreeMap::new()).unwrap();
-    let cb = w
-        .add_channel(sb, "/battery", "cdr", &BTreeMap::new())
-        .unwrap();
+    let cp = ros2_channel(&mut w, "geometry_msgs/msg/PoseStamped", "/pose");
+    let cb = ros2_channel(&mut w, "sensor_msgs/msg/BatteryState", "/battery");
     for k in 0..poses {
         let ns = 1_700_000_000_000_000_000 + u64::from(k) * 10_000_000;
         let t = f64::from(k) * 0.01;
-        let mut m = CdrWriter::new();
-        m.header(
-            (ns / 1_000_000_000) as i32,
+        let sec = (ns / 1_000_000_000) as i32;
+        let pose = pose_stamped(
+            sec,
             (ns % 1_000_000_000) as u32,
             "map",
-        )
-        .f64(t.sin())
-        .f64(t.cos())
-        .f64(10.0 + 0.1 * t)
-        .f64(0.0)
-        .f64(0.0)
-        .f64((0.5 * t).sin())
-        .f64((0.5 * t).cos());
-        let h = |c: u16| mcap::records::MessageHeader {
-            channel_id: c,
-            sequence: k,
-            log_time: ns,
-            publish_time: ns,
-        };
-        w.write_to_known_channel(&h(cp), &m.finish()).unwrap();
+            [t.sin(), t.cos(), 10.0 + 0.1 * t],
+            [0.0, 0.0, (0.5 * t).sin(), (0.5 * t).cos()],
+        );
+        w.write_to_known_channel(&message_header(cp, k, ns), &pose)
+            .unwrap();
         if k % 10 == 0 {
-            let mut b = CdrWriter::new();
-            b.header((ns / 1_000_000_000) as i32, 0, "")
-                .f32(16.0 - 0.0001 * t as f32)
-                .f32(25.0)
-                .f32(-20.0)
-                .f32(3.0)
-                .f32(5.0)
-                .f32(5.0)
-                .f32(0.6)
-                .u8(2)
-                .u8(1)
-                .u8(3)
-                .u8(1)
-                .u32(4);
-            for _ in 0..4 {
-                b.f32(4.0);
-            }
-            b.u32(0).string("").string("");
-            w.write_to_known_channel(&h(cb), &b.finish()).unwrap();
+            let numbers = [16.0 - 0.0001 * t as f32, 25.0, -20.0, 3.0, 5.0, 5.0, 0.6];
+            let battery = battery_state(sec, numbers, &[4.0; 4]);
+            w.write_to_known_channel(&message_header(cb, k, ns), &battery)
+                .unwrap();
         }
     }
     w.finish().unwrap();
     w.into_inner().into_inner()
 }
 
+/// The bench group `name`, of 10 samples (each reads a whole log).
+fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10);
+    g
+}
+
+/// In `g`, the bench `name` of `read` over `data` (a whole log in memory), in bytes of input per
+/// second.
+fn bench_bytes<R>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    data: &[u8],
+    read: impl Fn(&[u8]) -> R,
+) {
+    g.throughput(Throughput::Bytes(data.len() as u64));
+    g.bench_function(name, |b| b.iter(|| black_box(read(black_box(data)))));
+}
+
 fn csv_read(c: &mut Criterion) {
     let data = kaist_csv(150_000);
-    let mut g = c.benchmark_group("logs/csv_read");
-    g.throughput(Throughput::Bytes(data.len() as u64));
-    g.sample_size(10);
-    g.bench_function("kaist_150k_rows", |b| {
-        b.iter(|| {
-            let r = CsvSamples::from_reader(
-                black_box(&data[..]),
-                Path::new("bench.csv"),
-                &ColumnMap::kaist(),
-            )
-            .unwrap();
-            let mut n = 0usize;
-            for s in r {
-                n += usize::from(s.unwrap().voltage_v.is_some());
-            }
-            black_box(n)
-        })
+    let mut g = group(c, "logs/csv_read");
+    bench_bytes(&mut g, "kaist_150k_rows", &data, |data| {
+        let map = ColumnMap::kaist();
+        let r = CsvSamples::from_reader(data, Path::new("bench.csv"), &map).unwrap();
+        r.filter(|s| s.as_ref().unwrap().voltage_v.is_some())
+            .count()
     });
     g.finish();
 }
 
 fn mcap_read(c: &mut Criterion) {
     let data = ros2_mcap(200_000);
-    let mut g = c.benchmark_group("logs/mcap_read");
-    g.throughput(Throughput::Bytes(data.len() as u64));
-    g.sample_size(10);
-    g.bench_function("ros2_cdr_pose_battery", |b| {
-        b.iter(|| {
-            let r = McapSamples::from_reader(
-                Cursor::new(black_box(&data[..])),
-                Path::new("bench.mcap"),
-                McapOptions::default(),
-            );
-            let mut n = 0usize;
-            for s in r {
-                n += usize::from(s.unwrap().pos_enu_m.is_some());
-            }
-            black_box(n)
-        })
+    let mut g = group(c, "logs/mcap_read");
+    bench_bytes(&mut g, "ros2_cdr_pose_battery", &data, |data| {
+        let path = Path::new("bench.mcap");
+        let r = McapSamples::from_reader(Cursor::new(data), path, McapOptions::default());
+        r.filter(|s| s.as_ref().unwrap().pos_enu_m.is_some())
+            .count()
     });
     g.finish();
 }
 
 fn binary_read(c: &mut Criterion) {
-    let mut g = c.benchmark_group("logs/read");
-    g.sample_size(10);
+    let mut g = group(c, "logs/read");
+    let options = BinaryOptions::default();
     let ulog = synth::ulog_flight(3_000);
-    g.throughput(Throughput::Bytes(ulog.len() as u64));
-    g.bench_function("ulog", |b| {
-        b.iter(|| {
-            let r = read_ulog(black_box(&ulog[..]), &BinaryOptions::default()).unwrap();
-            black_box(r.summary.energy_wh())
-        })
+    bench_bytes(&mut g, "ulog", &ulog, |data| {
+        read_ulog(data, &options).unwrap().summary.energy_wh()
     });
     let df = synth::dataflash_flight(3_000);
-    g.throughput(Throughput::Bytes(df.len() as u64));
-    g.bench_function("dataflash", |b| {
-        b.iter(|| {
-            let r = read_dataflash(black_box(&df[..]), &BinaryOptions::default()).unwrap();
-            black_box(r.summary.energy_wh())
-        })
+    bench_bytes(&mut g, "dataflash", &df, |data| {
+        read_dataflash(data, &options).unwrap().summary.energy_wh()
     });
     g.finish();
 }

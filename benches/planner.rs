@@ -21,32 +21,27 @@ use aloft_planner::{
     endurance, plan, AoaModel, BatterySpec, EnduranceQuery, MissionSpec, Pack, PlanOptions, Wind,
 };
 
+#[path = "../tests/common/mission_toml.rs"]
+mod mission_toml;
+use mission_toml::{landing, leg, orbit, return_home, take_off, OrbitFor};
+
 /// One hour: take-off, a leg, a long orbit, a leg back, landing (3600 s in total within a second).
-const ONE_HOUR: &str = r#"
-[[segment]]
-kind = "take-off"
-altitude_m = 40.0
-climb_rate_mps = 3.0
-[[segment]]
-kind = "leg"
-east_m = 600.0
-north_m = 0.0
-ground_speed_mps = 8.0
-[[segment]]
-kind = "orbit"
-centre_east_m = 600.0
-centre_north_m = 300.0
-radius_m = 300.0
-ground_speed_mps = 8.0
-direction = "clockwise"
-duration_s = 3397.0
-[[segment]]
-kind = "return"
-ground_speed_mps = 8.0
-[[segment]]
-kind = "landing"
-rate_mps = 2.0
-"#;
+fn one_hour() -> String {
+    [
+        take_off(40.0, 3.0),
+        leg(600.0, 0.0, 8.0),
+        orbit(
+            [600.0, 300.0],
+            300.0,
+            8.0,
+            "clockwise",
+            OrbitFor::Seconds(3397.0),
+        ),
+        return_home(8.0),
+        landing(2.0),
+    ]
+    .concat()
+}
 
 fn bench_mission(c: &mut Criterion) {
     let f = VehicleFile::builtin("dji-m100").expect("built-in");
@@ -65,7 +60,7 @@ fn bench_mission(c: &mut Criterion) {
         ..BatterySpec::default()
     })
     .expect("pack");
-    let mission = MissionSpec::from_toml_str(ONE_HOUR)
+    let mission = MissionSpec::from_toml_str(&one_hour())
         .expect("mission")
         .compile(aircraft.airframe(), battery.mass_kg(), None)
         .expect("compiles");

@@ -5,42 +5,19 @@
 //! * `propulsion/step_response`: a 0.5 s fixed-step RK4 simulation of eq (2) at 0.1 ms steps
 //!   (5000 steps, metrics only) for the MN1806 + 6x2 rotor. Target: <= 200 us.
 
-use aloft_propulsion::battery::{Battery, InternalResistance};
-use aloft_propulsion::motor::motor_with_no_load_current;
+use aloft::vehicle::VehicleFile;
 use aloft_propulsion::transient::{kt_from_kv, motor_inertia_kgm2, prop_inertia_kgm2};
-use aloft_propulsion::{Esc, EscProtocol, Propeller, PropulsionSystem, RotorTransient};
+use aloft_propulsion::{EscProtocol, PropulsionSystem, RotorTransient};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
+/// The AEC quadrotor's propulsion chain, as `fixtures/vehicles/aec-quadrotor.toml` (the
+/// built-in vehicle, provenance there) gives it.
 fn aec() -> PropulsionSystem {
-    // Values of fixtures/vehicles/aec-quadrotor.toml (provenance there).
-    PropulsionSystem::new(
-        Propeller::new(14.0 * 0.0254, 0.10026, 0.03914)
-            .unwrap()
-            .with_installed_loss(0.11)
-            .unwrap(),
-        motor_with_no_load_current(515.0, 0.07, 1.5, 55.0).unwrap(),
-        Esc::ideal(),
-        Battery::new(
-            5,
-            4,
-            8.0,
-            0.9,
-            4.1,
-            3.7,
-            InternalResistance::Constant {
-                resistance_ohm: 0.0699,
-            },
-            f64::INFINITY,
-        )
-        .unwrap(),
-        4,
-        4,
-        7.48427,
-        9.80665,
-        1.225,
-    )
-    .unwrap()
+    VehicleFile::builtin("aec-quadrotor")
+        .expect("built-in")
+        .propulsion_system()
+        .expect("propulsion chain")
 }
 
 fn mn1806() -> RotorTransient {

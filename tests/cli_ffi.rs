@@ -75,15 +75,7 @@ fn mission_answers_are_the_same_bytes() {
     let m100 = CVehicle::builtin("dji-m100");
     let example = std::fs::read_to_string("fixtures/missions/example.toml").unwrap();
     let grid = std::env::temp_dir().join("aloft-cli-ffi-grid.csv");
-    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps\n");
-    for x in [-1000.0, 1000.0] {
-        for y in [-1000.0, 1000.0] {
-            for z in [0.0, 200.0] {
-                text.push_str(&format!("{x},{y},{z},2,-1,0\n"));
-            }
-        }
-    }
-    std::fs::write(&grid, text).unwrap();
+    common::write_wind_grid(&grid, [1000.0, 200.0], "2,-1,0");
     let grid = grid.display().to_string();
     let cases: Vec<(Vec<&str>, Option<&str>, String)> = vec![
         (vec![], None, "{}".into()),
@@ -182,42 +174,45 @@ fn endurance_and_power_answers_are_the_same_bytes() {
         let ffi = take(|out| unsafe { aloft_endurance_json(m100.0, options_c.as_ptr(), out) });
         assert_eq!(cli(&args), ffi, "aloft {args:?} against options {options}");
     }
-    let state = CString::new(
+    same_power_answer(
+        &m100,
+        &[
+            "--airspeed",
+            "7.5",
+            "--roll",
+            "2",
+            "--pitch",
+            "-9",
+            "--climb-rate",
+            "0.5",
+        ],
         r#"{"airspeed_mps": 7.5, "roll_deg": 2, "pitch_deg": -9, "climb_rate_mps": 0.5}"#,
-    )
-    .unwrap();
+    );
+    // The take-off mass's pack and payload, as the CLI's flags.
+    let ffi = same_power_answer(
+        &m100,
+        &[
+            "--airspeed",
+            "4",
+            "--battery",
+            "2xTB47D",
+            "--payload-kg",
+            "0.2",
+        ],
+        r#"{"airspeed_mps": 4, "battery": "2xTB47D", "payload_kg": 0.2}"#,
+    );
+    assert!(ffi.contains("\"takeoff_mass_kg\": 3.315"), "{ffi}");
+}
+
+/// `aloft power flags --format json` and `aloft_vehicle_power_json` of `state` give the same
+/// bytes; returns them.
+fn same_power_answer(m100: &CVehicle, flags: &[&str], state: &str) -> String {
+    let state = CString::new(state).unwrap();
     // SAFETY: a live vehicle, a NUL-terminated state document, an out pointer.
     let ffi = take(|out| unsafe { aloft_vehicle_power_json(m100.0, state.as_ptr(), out) });
-    let args = [
-        "power",
-        "--airspeed",
-        "7.5",
-        "--roll",
-        "2",
-        "--pitch",
-        "-9",
-        "--climb-rate",
-        "0.5",
-        "--format",
-        "json",
-    ];
-    assert_eq!(cli(&args), ffi);
-    // The take-off mass's pack and payload, as the CLI's flags.
-    let state =
-        CString::new(r#"{"airspeed_mps": 4, "battery": "2xTB47D", "payload_kg": 0.2}"#).unwrap();
-    // SAFETY: as above.
-    let ffi = take(|out| unsafe { aloft_vehicle_power_json(m100.0, state.as_ptr(), out) });
-    let args = [
-        "power",
-        "--airspeed",
-        "4",
-        "--battery",
-        "2xTB47D",
-        "--payload-kg",
-        "0.2",
-        "--format",
-        "json",
-    ];
-    assert_eq!(cli(&args), ffi);
-    assert!(ffi.contains("\"takeoff_mass_kg\": 3.315"), "{ffi}");
+    let mut args = vec!["power"];
+    args.extend(flags);
+    args.extend(["--format", "json"]);
+    assert_eq!(cli(&args), ffi, "aloft {args:?} against state {state:?}");
+    ffi
 }

@@ -7,17 +7,16 @@ use common::{aloft, ok_json, refused, stderr, stdout};
 use std::io::Write;
 use std::process::{Command, Stdio};
 
+/// `aloft power` at 6 m/s and 8 deg nose down, the state these tests fly, with `flags`.
+fn forward_flight<'a>(flags: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["power", "--airspeed", "6", "--pitch", "-8"];
+    args.extend(flags);
+    args
+}
+
 #[test]
 fn power_json_has_the_contract_keys_and_matches_the_library() {
-    let v = ok_json(&[
-        "power",
-        "--airspeed",
-        "6",
-        "--pitch",
-        "-8",
-        "--format",
-        "json",
-    ]);
+    let v = ok_json(&forward_flight(&["--format", "json"]));
     for key in [
         "thrust_n",
         "induced_velocity_mps",
@@ -62,17 +61,12 @@ fn power_json_has_the_contract_keys_and_matches_the_library() {
 
 #[test]
 fn power_without_terms_removes_them() {
-    let v = ok_json(&[
-        "power",
-        "--airspeed",
-        "6",
-        "--pitch",
-        "-8",
+    let v = ok_json(&forward_flight(&[
         "--without",
         "profile,parasitic",
         "--format",
         "json",
-    ]);
+    ]));
     assert_eq!(v["profile_w"].as_f64(), Some(0.0));
     assert_eq!(v["parasitic_w"].as_f64(), Some(0.0));
     let sum = v["induced_w"].as_f64().unwrap() + v["climb_w"].as_f64().unwrap();
@@ -81,36 +75,15 @@ fn power_without_terms_removes_them() {
 
 #[test]
 fn geometric_aoa_needs_a_direction_and_differs_from_the_paper() {
-    let err = refused(&[
-        "power",
-        "--airspeed",
-        "6",
-        "--pitch",
-        "-8",
-        "--aoa",
-        "geometric",
-    ]);
+    let err = refused(&forward_flight(&["--aoa", "geometric"]));
     assert!(err.contains("--air-direction-deg"), "{err}");
-    let paper = aloft(&[
-        "power",
-        "--airspeed",
-        "6",
-        "--pitch",
-        "-8",
-        "--format",
-        "json",
-    ]);
-    let geo = aloft(&[
-        "power",
-        "--airspeed",
-        "6",
-        "--pitch",
-        "-8",
+    let paper = aloft(&forward_flight(&["--format", "json"]));
+    let geo = aloft(&forward_flight(&[
         "--air-direction-deg",
         "0",
         "--format",
         "json",
-    ]);
+    ]));
     let p: serde_json::Value = serde_json::from_str(&stdout(&paper)).unwrap();
     let g: serde_json::Value = serde_json::from_str(&stdout(&geo)).unwrap();
     // Nose-down forward flight: the exact geometry puts air through the disk (Vn > 0), which the
@@ -160,45 +133,45 @@ fn bad_input_exits_2_naming_the_value() {
     }
 }
 
+/// The JSON answer of `aloft power --vehicle FILE flags`, FILE the vehicle file `text` with each
+/// (from, to) of `edits` replaced.
+fn power_of_edited(text: &str, edits: &[(&str, &str)], flags: &[&str]) -> serde_json::Value {
+    let mut text = text.to_string();
+    for (from, to) in edits {
+        text = text.replace(from, to);
+    }
+    let file = common::scratch("cli", "edited.toml");
+    std::fs::write(&file, text).unwrap();
+    let file = file.display().to_string();
+    let mut args = vec!["power", "--vehicle", &file];
+    args.extend(flags);
+    args.extend(["--format", "json"]);
+    ok_json(&args)
+}
+
 #[test]
 fn vehicle_files_load_and_bad_files_are_named() {
-    let dir = std::env::temp_dir().join(format!("aloft-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     // A power model alone flies its [power] table's mass (+ payload).
-    let good = dir.join("heavy.toml");
-    let text = include_str!("../fixtures/vehicles/dji-m100-paper.toml")
-        .replace("mass_kg = 3.29", "mass_kg = 4.0");
-    std::fs::write(&good, text).unwrap();
-    let v = ok_json(&[
-        "power",
-        "--vehicle",
-        good.to_str().unwrap(),
-        "--payload-kg",
-        "0.5",
-        "--format",
-        "json",
-    ]);
+    let v = power_of_edited(
+        include_str!("../fixtures/vehicles/dji-m100-paper.toml"),
+        &[("mass_kg = 3.29", "mass_kg = 4.0")],
+        &["--payload-kg", "0.5"],
+    );
     assert!((v["thrust_n"].as_f64().unwrap() - 4.5 * 9.8066).abs() < 1e-9);
     assert!(v.get("battery").is_none(), "{v}");
     // A vehicle with an airframe flies airframe + pack + payload, whatever its [power] mass.
-    let framed = dir.join("framed.toml");
-    let text = include_str!("../fixtures/vehicles/dji-m100.toml")
-        .replace("mass_kg = 1.755", "mass_kg = 2.0")
-        .replace("mass_kg = 2.355", "mass_kg = 9.0");
-    std::fs::write(&framed, text).unwrap();
-    let v = ok_json(&[
-        "power",
-        "--vehicle",
-        framed.to_str().unwrap(),
-        "--battery",
-        "tb48d",
-        "--format",
-        "json",
-    ]);
+    let v = power_of_edited(
+        include_str!("../fixtures/vehicles/dji-m100.toml"),
+        &[
+            ("mass_kg = 1.755", "mass_kg = 2.0"),
+            ("mass_kg = 2.355", "mass_kg = 9.0"),
+        ],
+        &["--battery", "tb48d"],
+    );
     assert!((v["thrust_n"].as_f64().unwrap() - (2.0 + 0.676) * 9.8066).abs() < 1e-9);
     assert_eq!(v["battery"].as_str(), Some("TB48D"));
 
-    let bad = dir.join("bad.toml");
+    let bad = common::scratch("cli", "bad.toml");
     std::fs::write(&bad, "name = \"x\"\n[power]\nmass_lb = 3\n").unwrap();
     let err = refused(&["power", "--vehicle", bad.to_str().unwrap()]);
     assert!(err.contains("mass_lb") && err.contains("bad.toml"), "{err}");
@@ -255,9 +228,7 @@ fn paper_val_m100_paper_flies_the_seed_mass_from_the_cli() {
 
 #[test]
 fn batch_mode_streams_csv_and_reports_bad_rows() {
-    let dir = std::env::temp_dir().join(format!("aloft-batch-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("states.csv");
+    let input = common::scratch("batch", "states.csv");
     std::fs::write(
         &input,
         "airspeed_mps,roll_deg,pitch_deg,climb_rate_mps\n0,0,0,0\n6,0,-8,\n8,2,-10,1.5\n",
@@ -296,19 +267,21 @@ fn batch_mode_streams_csv_and_reports_bad_rows() {
         .collect();
     assert_eq!(batch_vals, point_vals);
 
-    let missing = dir.join("missing.csv");
+    let missing = common::scratch("batch", "missing.csv");
     std::fs::write(&missing, "airspeed_mps,pitch_deg\n1,2\n").unwrap();
     let err = refused(&["power", "--input", missing.to_str().unwrap()]);
     assert!(err.contains("roll_deg"), "{err}");
-    let err = refused(&["power", "--input", dir.join("nope.csv").to_str().unwrap()]);
+    let err = refused(&[
+        "power",
+        "--input",
+        common::scratch("batch", "nope.csv").to_str().unwrap(),
+    ]);
     assert!(err.contains("nope.csv"), "{err}");
 }
 
 #[test]
 fn broken_pipe_exits_quietly() {
-    let dir = std::env::temp_dir().join(format!("aloft-pipe-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("many.csv");
+    let input = common::scratch("pipe", "many.csv");
     let mut f = std::fs::File::create(&input).unwrap();
     writeln!(f, "airspeed_mps,roll_deg,pitch_deg").unwrap();
     for i in 0..200_000 {
@@ -343,12 +316,7 @@ fn broken_pipe_exits_quietly() {
 #[test]
 fn vehicles_lists_the_builtins() {
     let v = ok_json(&["vehicles", "--format", "json"]);
-    let names: Vec<&str> = v
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e["name"].as_str().unwrap())
-        .collect();
+    let names = common::strs_of(&v, "name");
     assert_eq!(
         names,
         [
@@ -432,9 +400,7 @@ fn rotor_mn1806_settles_within_the_issue_band() {
 
 #[test]
 fn propulsion_sweep_writes_csv_and_svg() {
-    let dir = std::env::temp_dir().join(format!("aloft-sweep-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let svg = dir.join("fig13.svg");
+    let svg = common::scratch("sweep", "fig13.svg");
     let o = aloft(&[
         "propulsion",
         "--sweep-takeoff-mass",
@@ -460,63 +426,34 @@ fn propulsion_sweep_writes_csv_and_svg() {
 
 #[test]
 fn fit_and_validate_reject_bad_input() {
-    let dir = std::env::temp_dir().join(format!("aloft-fitbad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("out.toml");
+    let out = common::scratch("fitbad", "out.toml").display().to_string();
     let fixture = |name: &str| format!("{}/fixtures/logs/{name}", env!("CARGO_MANIFEST_DIR"));
+    // `aloft fit` of the fixture `log` (KAIST layout) on the vehicle `template`, and `more`.
+    let fit = |log: &str, template: &str, more: &[&str]| -> Vec<String> {
+        let mut args = vec!["fit".to_string(), "--log".into(), fixture(log)];
+        let rest = [
+            "--profile",
+            "kaist",
+            "--vehicle-template",
+            template,
+            "-o",
+            &out,
+        ];
+        args.extend(rest.iter().chain(more).map(|a| a.to_string()));
+        args
+    };
+    let none = common::scratch("fitbad", "none.csv").display().to_string();
     let cases: Vec<(Vec<String>, &str)> = vec![
+        (fit("kaist_missing_cur.csv", "dji-m100", &[]), "cur"),
+        (fit("kaist_small.csv", "aec-quadrotor", &[]), "[power]"),
         (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_missing_cur.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "dji-m100".into(),
-                "-o".into(),
-                out.display().to_string(),
-            ],
-            "cur",
-        ),
-        (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_small.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "aec-quadrotor".into(),
-                "-o".into(),
-                out.display().to_string(),
-            ],
-            "[power]",
-        ),
-        (
-            vec![
-                "fit".into(),
-                "--log".into(),
-                fixture("kaist_small.csv"),
-                "--profile".into(),
-                "kaist".into(),
-                "--vehicle-template".into(),
-                "dji-m100".into(),
-                "-o".into(),
-                out.display().to_string(),
-                "--free".into(),
-                "k,drag".into(),
-            ],
+            fit("kaist_small.csv", "dji-m100", &["--free", "k,drag"]),
             "drag",
         ),
         (
-            vec![
-                "validate".into(),
-                "--log".into(),
-                dir.join("none.csv").display().to_string(),
-                "--vehicle".into(),
-                "dji-m100".into(),
-            ],
+            ["validate", "--log", &none, "--vehicle", "dji-m100"]
+                .map(String::from)
+                .to_vec(),
             "none.csv",
         ),
     ];

@@ -6,11 +6,20 @@ use common::{cli, uniform_wind as wind};
 
 use aloft::engine::{endurance, plan_mission, EnduranceOptions, Mission, MissionOptions, Vehicle};
 
+/// For the defaults and then each case's flags and options, `aloft command --format json flags`
+/// prints the engine's `answer` to the options and a newline.
+fn same_json<O: Default>(command: &str, cases: Vec<(Vec<&str>, O)>, answer: impl Fn(&O) -> String) {
+    for (args, options) in [(vec![], O::default())].into_iter().chain(cases) {
+        let mut full = vec![command, "--format", "json"];
+        full.extend(&args);
+        assert_eq!(format!("{}\n", answer(&options)), cli(&full), "{args:?}");
+    }
+}
+
 #[test]
 fn mission_summary_is_the_cli_json() {
     let m100 = Vehicle::builtin("dji-m100").unwrap();
     let cases: Vec<(Vec<&str>, MissionOptions)> = vec![
-        (vec![], MissionOptions::default()),
         (
             vec![
                 "--payload-kg",
@@ -43,17 +52,10 @@ fn mission_summary_is_the_cli_json() {
             },
         ),
     ];
-    for (args, options) in cases {
-        let mut full = vec!["mission", "--format", "json"];
-        full.extend(&args);
-        let expected = cli(&full);
-        let plan = plan_mission(&m100, &Mission::demo(), &options).unwrap();
-        assert_eq!(
-            format!("{}\n", plan.to_json().unwrap()),
-            expected,
-            "{args:?}"
-        );
-    }
+    same_json("mission", cases, |options| {
+        let plan = plan_mission(&m100, &Mission::demo(), options).unwrap();
+        plan.to_json().unwrap()
+    });
 }
 
 #[test]
@@ -76,45 +78,34 @@ fn infeasible_case_has_the_optional_keys() {
 #[test]
 fn endurance_summary_is_the_cli_json() {
     let m100 = Vehicle::builtin("dji-m100").unwrap();
-    let cases: Vec<(Vec<&str>, EnduranceOptions)> = vec![
-        (vec![], EnduranceOptions::default()),
-        (
-            vec![
-                "--wind-speed",
-                "6",
-                "--wind-from",
-                "30",
-                "--course",
-                "45",
-                "--payload-kg",
-                "0.5",
-                "--reserve-percent",
-                "20",
-                "--orbit-radius",
-                "30",
-                "--orbit-speed",
-                "5",
-            ],
-            EnduranceOptions {
-                wind: wind(6.0, 30.0),
-                course_deg: 45.0,
-                payload_kg: 0.5,
-                reserve_percent: 20.0,
-                orbit_radius_m: Some(30.0),
-                orbit_speed_mps: Some(5.0),
-                ..EnduranceOptions::default()
-            },
-        ),
-    ];
-    for (args, options) in cases {
-        let mut full = vec!["endurance", "--format", "json"];
-        full.extend(&args);
-        let expected = cli(&full);
-        let got = endurance(&m100, &options).unwrap();
-        assert_eq!(
-            format!("{}\n", got.to_json().unwrap()),
-            expected,
-            "{args:?}"
-        );
-    }
+    let cases: Vec<(Vec<&str>, EnduranceOptions)> = vec![(
+        vec![
+            "--wind-speed",
+            "6",
+            "--wind-from",
+            "30",
+            "--course",
+            "45",
+            "--payload-kg",
+            "0.5",
+            "--reserve-percent",
+            "20",
+            "--orbit-radius",
+            "30",
+            "--orbit-speed",
+            "5",
+        ],
+        EnduranceOptions {
+            wind: wind(6.0, 30.0),
+            course_deg: 45.0,
+            payload_kg: 0.5,
+            reserve_percent: 20.0,
+            orbit_radius_m: Some(30.0),
+            orbit_speed_mps: Some(5.0),
+            ..EnduranceOptions::default()
+        },
+    )];
+    same_json("endurance", cases, |options| {
+        endurance(&m100, options).unwrap().to_json().unwrap()
+    });
 }

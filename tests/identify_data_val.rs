@@ -7,6 +7,8 @@
 mod common;
 use common::ok_stdout as aloft;
 
+use std::path::Path;
+
 /// The `<prefix>*<suffix>` files of the data folder `folder`, as command-line words.
 fn files(folder: &str, prefix: &str, suffix: &str) -> Vec<String> {
     common::strings(&common::files_like(folder, prefix, suffix))
@@ -20,29 +22,38 @@ fn args(words: &[&str], logs: &[String], rest: &[&str]) -> Vec<String> {
     v
 }
 
+/// The vehicle fixture `name`, as a command-line word.
+fn template(name: &str) -> String {
+    format!("{}/fixtures/vehicles/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The JSON of `aloft words --log logs --vehicle-template T -o out --format json`, T the vehicle
+/// fixture `template`.
+fn fit_json(words: &[&str], logs: &[String], template: &str, out: &Path) -> serde_json::Value {
+    let template = self::template(template);
+    let rest = [
+        "--vehicle-template",
+        &template,
+        "-o",
+        out.to_str().unwrap(),
+        "--format",
+        "json",
+    ];
+    serde_json::from_str(&aloft(&args(words, logs, &rest))).unwrap()
+}
+
 /// Fit on 08-03, validate on 08-06 with a 120 s calibration window; the JSON of `aloft validate`.
 fn kaist_validation() -> serde_json::Value {
     // One file per call: the tests run in parallel threads of one process.
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
     let tmp = std::env::temp_dir().join(format!("aloft-kaist-{}-{call}.toml", std::process::id()));
-    let template = format!(
-        "{}/fixtures/vehicles/kaist-template.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let fit = aloft(&args(
+    let fit = fit_json(
         &["fit", "--profile", "kaist"],
         &files("kaist_energy_drone", "2018-08-03", ".csv"),
-        &[
-            "--vehicle-template",
-            &template,
-            "-o",
-            tmp.to_str().unwrap(),
-            "--format",
-            "json",
-        ],
-    ));
-    let fit: serde_json::Value = serde_json::from_str(&fit).unwrap();
+        "kaist-template.toml",
+        &tmp,
+    );
     for l in fit["logs"].as_array().unwrap() {
         // The lag found: the data README says power lags motion by seconds.
         let lag = l["lag_s"].as_f64().unwrap();
@@ -98,12 +109,7 @@ fn data_val_kaist_energy_within_5_percent_on_every_validation_flight() {
         }
     }
     // Table I layout: the full model and each term dropped.
-    let rows: Vec<&str> = v["table_i"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r["dropped_term"].as_str().unwrap())
-        .collect();
+    let rows = common::strs_of(&v["table_i"], "dropped_term");
     assert_eq!(rows, ["none", "parasitic", "profile", "induced", "climb"]);
 }
 
@@ -151,10 +157,7 @@ fn data_val_kaist_calibrated_energy_within_2_percent() {
 #[test]
 fn data_val_px4_fit_and_validate_report() {
     let tmp = std::env::temp_dir().join(format!("aloft-px4-{}.toml", std::process::id()));
-    let template = format!(
-        "{}/fixtures/vehicles/px4-template.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let template = template("px4-template.toml");
     let logs = files("px4_flugdrohne/csv", "", "_vehicle_local_position_0.csv");
     assert_eq!(logs.len(), 5);
     aloft(&args(
@@ -186,29 +189,18 @@ fn data_val_px4_fit_and_validate_report() {
 /// a short hover-and-climb flight cannot identify is kept, not fitted.
 #[test]
 fn data_val_px4_fit_with_defaults_gives_a_physical_vehicle_on_every_short_flight() {
-    let template = format!(
-        "{}/fixtures/vehicles/px4-template.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
     for (k, log) in files("px4_flugdrohne/csv", "", "_vehicle_local_position_0.csv")
         .iter()
         .enumerate()
     {
         let out =
             std::env::temp_dir().join(format!("aloft-px4-one-{}-{k}.toml", std::process::id()));
-        let json = aloft(&args(
+        let v = fit_json(
             &["fit", "--profile", "px4"],
             std::slice::from_ref(log),
-            &[
-                "--vehicle-template",
-                &template,
-                "-o",
-                out.to_str().unwrap(),
-                "--format",
-                "json",
-            ],
-        ));
-        let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+            "px4-template.toml",
+            &out,
+        );
         let eta = v["power"]["vehicle"]["efficiency"].as_f64().unwrap();
         assert!(eta > 0.0 && eta <= 1.0, "{log}: efficiency {eta}");
         let fitted: Vec<&str> = v["fitted_parameters"]
@@ -233,7 +225,7 @@ fn data_val_px4_fit_with_defaults_gives_a_physical_vehicle_on_every_short_flight
             "mu2_n_s2_per_m2",
             "mu3_n_s3_per_m3",
         ] {
-            assert!(named(n), "{log}: {n} neither fitted nor kept: {json}");
+            assert!(named(n), "{log}: {n} neither fitted nor kept: {v}");
         }
         // The fitted vehicle loads and validates on its own flight.
         let report = aloft(&args(

@@ -6,7 +6,6 @@ mod common;
 use common::aloft;
 
 use std::io::Write as _;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -45,8 +44,10 @@ fn aloft_limited(
     }
 }
 
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("aloft-contract-{}-{name}", std::process::id()))
+/// A scratch file `name` of this test process, as a command-line word.
+fn tmp(name: &str) -> String {
+    let path = std::env::temp_dir().join(format!("aloft-contract-{}-{name}", std::process::id()));
+    path.display().to_string()
 }
 
 /// Exit 2, exactly one stderr line, that line contains every needle, and no panic.
@@ -70,7 +71,7 @@ const TAKE_OFF: &str =
     "[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n";
 const LANDING: &str = "[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n";
 
-fn mission_with(middle: &str, name: &str) -> PathBuf {
+fn mission_with(middle: &str, name: &str) -> String {
     let p = tmp(name);
     std::fs::write(&p, format!("{TAKE_OFF}{middle}{LANDING}")).unwrap();
     p
@@ -162,7 +163,7 @@ fn huge_finite_inputs_are_refused_not_overflowed() {
     ] {
         let p = tmp(&format!("huge-{key}.toml"));
         std::fs::write(&p, text.replacen(from, to, 1)).unwrap();
-        assert_refused(&["endurance", "--vehicle", p.to_str().unwrap()], &[key]);
+        assert_refused(&["endurance", "--vehicle", &p], &[key]);
     }
     let aec = std::fs::read_to_string("fixtures/vehicles/aec-quadrotor.toml").unwrap();
     let p = tmp("huge-aec.toml");
@@ -171,7 +172,7 @@ fn huge_finite_inputs_are_refused_not_overflowed() {
         aec.replacen("kv_rpm_per_v = 515.0", "kv_rpm_per_v = 1e300", 1),
     )
     .unwrap();
-    assert_refused(&["propulsion", "--vehicle", p.to_str().unwrap()], &["Kv"]);
+    assert_refused(&["propulsion", "--vehicle", &p], &["Kv"]);
     assert_refused(
         &[
             "propulsion",
@@ -196,12 +197,7 @@ fn a_tiny_ground_speed_or_a_huge_hold_is_refused_at_once() {
     );
     let plot = tmp("slow.svg");
     let (code, err, took) = aloft_limited(
-        &[
-            "mission",
-            slow.to_str().unwrap(),
-            "--plot",
-            plot.to_str().unwrap(),
-        ],
+        &["mission", &slow, "--plot", &plot],
         2_000_000,
         Duration::from_secs(20),
     );
@@ -215,10 +211,7 @@ fn a_tiny_ground_speed_or_a_huge_hold_is_refused_at_once() {
         "[[segment]]\nkind = \"hover\"\nduration_s = 1e9\n",
         "hold.toml",
     );
-    assert_refused(
-        &["mission", hold.to_str().unwrap()],
-        &["duration_s", "1000000000"],
-    );
+    assert_refused(&["mission", &hold], &["duration_s", "1000000000"]);
 }
 
 #[test]
@@ -255,17 +248,17 @@ fn output_files_do_not_make_memory_grow_with_the_flight() {
     let (code, err, _) = aloft_limited(
         &[
             "mission",
-            mission.to_str().unwrap(),
+            &mission,
             "--vehicle",
-            vehicle.to_str().unwrap(),
+            &vehicle,
             "--time-step",
             "0.001",
             "--timeseries",
-            csv.to_str().unwrap(),
+            &csv,
             "--mcap",
-            mcap.to_str().unwrap(),
+            &mcap,
             "--plot",
-            svg.to_str().unwrap(),
+            &svg,
         ],
         170_000,
         Duration::from_secs(300),
@@ -289,7 +282,7 @@ fn a_fifo_given_as_input_is_refused_without_blocking() {
     if !made.is_ok_and(|s| s.success()) {
         return; // no mkfifo here: nothing to test
     }
-    let f = fifo.to_str().unwrap();
+    let f = fifo.as_str();
     let cases: Vec<Vec<&str>> = vec![
         vec!["mission", f],
         vec!["mission", "--vehicle", f],
@@ -319,7 +312,7 @@ fn coordinates_and_orbits_out_of_range_are_named() {
     ] {
         let p = tmp(&format!("coord-{key}.toml"));
         std::fs::write(&p, leg(lat, lon)).unwrap();
-        assert_refused(&["mission", p.to_str().unwrap()], &[key]);
+        assert_refused(&["mission", &p], &[key]);
     }
     // A circle too tight for the speed is flown slower (at the speed the tilt allows), but one
     // of a nanometre cannot be turned at any speed worth the name: refused, naming the radius.
@@ -337,24 +330,15 @@ fn a_repeated_csv_column_is_refused() {
         "airspeed_mps,roll_deg,pitch_deg,roll_deg\n5,0,-5,1\n",
     )
     .unwrap();
-    assert_refused(
-        &["power", "--input", states.to_str().unwrap()],
-        &["roll_deg", "twice"],
-    );
+    assert_refused(&["power", "--input", &states], &["roll_deg", "twice"]);
     let grid = tmp("dup-grid.csv");
-    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps,u_mps\n");
-    for x in [-500, 500] {
-        for y in [-500, 500] {
-            for z in [0, 100] {
-                text.push_str(&format!("{x},{y},{z},1,0,0,2\n"));
-            }
-        }
-    }
-    std::fs::write(&grid, text).unwrap();
-    assert_refused(
-        &["mission", "--wind-field", grid.to_str().unwrap()],
-        &["u_mps", "twice"],
+    common::write_wind_grid_with_columns(
+        &grid,
+        "x_m,y_m,z_m,u_mps,v_mps,w_mps,u_mps",
+        [500.0, 100.0],
+        "1,0,0,2",
     );
+    assert_refused(&["mission", "--wind-field", &grid], &["u_mps", "twice"]);
 }
 
 #[test]
@@ -372,11 +356,7 @@ fn a_mission_of_too_many_segments_is_refused_in_bounded_memory() {
     }
     f.write_all(LANDING.as_bytes()).unwrap();
     drop(f);
-    let (code, err, _) = aloft_limited(
-        &["mission", p.to_str().unwrap()],
-        1_500_000,
-        Duration::from_secs(60),
-    );
+    let (code, err, _) = aloft_limited(&["mission", &p], 1_500_000, Duration::from_secs(60));
     assert_eq!(code, Some(2), "{err}");
     assert!(
         err.contains("60002 segments") && err.contains("50000"),

@@ -6,7 +6,6 @@ mod common;
 use common::{ok_json, refused};
 
 use std::path::Path;
-use std::process::Command;
 
 fn shared(name: &str) -> String {
     common::data_dir()
@@ -97,11 +96,7 @@ fn data_val_converted_ulog_and_dataflash_open_in_the_python_mcap_reader() {
             "json",
         ]);
         assert_eq!(j["samples"], samples);
-        let has_mcap = Command::new("python3")
-            .args(["-c", "import mcap"])
-            .status()
-            .is_ok_and(|s| s.success());
-        if !has_mcap {
+        if !common::python_has("mcap") {
             assert!(
                 std::env::var_os("CI").is_none(),
                 "CI is set but python3 has no mcap"
@@ -112,16 +107,8 @@ fn data_val_converted_ulog_and_dataflash_open_in_the_python_mcap_reader() {
             continue;
         }
         let script = "import sys\nfrom mcap.reader import make_reader\nn = 0\nwith open(sys.argv[1], 'rb') as f:\n    for schema, channel, message in make_reader(f).iter_messages():\n        n += 1\nprint(n)\n";
-        let py = Command::new("python3")
-            .args(["-c", script, out.to_str().unwrap()])
-            .output()
-            .unwrap();
-        assert!(
-            py.status.success(),
-            "{}",
-            String::from_utf8_lossy(&py.stderr)
-        );
-        let n: u64 = String::from_utf8_lossy(&py.stdout).trim().parse().unwrap();
+        let py = common::python_stdout(script, &[out.to_str().unwrap()]);
+        let n: u64 = py.trim().parse().unwrap();
         let written: u64 = j["topics"]
             .as_array()
             .unwrap()

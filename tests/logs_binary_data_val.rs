@@ -8,7 +8,6 @@ use common::data_dir;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
-use std::process::Command;
 
 use aloft_logs::dataflash::DataflashRecords;
 use aloft_logs::{read_dataflash, read_ulog, BinaryLog, BinaryOptions};
@@ -208,27 +207,14 @@ print(len(rows), e / 3600.0)
 
 #[test]
 fn data_val_energy_matches_pyulog_and_pymavlink_when_present() {
-    let ok = Command::new("python3")
-        .args(["-c", "import pyulog, pymavlink"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
+    if !common::python_has("pyulog, pymavlink") {
         eprintln!("NOTICE: skipping the pyulog/pymavlink check: python3 with pyulog and pymavlink is not available (the figures they gave are in FIGURES)");
         return;
     }
     for (name, _, energy) in FIGURES {
         let Some(_) = energy else { continue };
         let p = path(name);
-        let out = Command::new("python3")
-            .args(["-c", INDEPENDENT, p.to_str().unwrap()])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let text = String::from_utf8(out.stdout).unwrap();
+        let text = common::python_stdout(INDEPENDENT, &[p.to_str().unwrap()]);
         let mut it = text.split_whitespace();
         let valid: u64 = it.next().unwrap().parse().unwrap();
         let e: f64 = it.next().unwrap().parse().unwrap();

@@ -167,28 +167,25 @@ fn bad_inputs_exit_2_with_the_file_named() {
     }
 }
 
+/// `aloft convert` of the fixture log `csv` with the custom profile to `out`.
+fn convert_custom(csv: &str, out: &Path) -> Vec<String> {
+    let out = out.display().to_string();
+    let profile = fixture("custom.toml");
+    ["convert", &fixture(csv), "--profile", &profile, "-o", &out]
+        .map(String::from)
+        .to_vec()
+}
+
 #[test]
 fn convert_writes_mcap_that_reads_back() {
     let out = tmp("conv.mcap");
-    let j = ok_json(&[
-        "convert",
-        &fixture("custom.csv"),
-        "--profile",
-        &fixture("custom.toml"),
-        "-o",
-        out.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
+    let mut args = convert_custom("custom.csv", &out);
+    args.extend(["--format".into(), "json".into()]);
+    let j = ok_json(&args);
     assert_eq!(j["samples"], 10);
     let j = ok_json(&["log", "info", out.to_str().unwrap(), "--format", "json"]);
     assert_eq!(j["format"], "mcap");
-    let topics: Vec<&str> = j["topics"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|t| t["topic"].as_str().unwrap())
-        .collect();
+    let topics = common::strs_of(&j["topics"], "topic");
     assert_eq!(
         topics,
         vec!["/aloft/state", "/aloft/pose", "/aloft/battery"]
@@ -201,14 +198,7 @@ fn convert_writes_mcap_that_reads_back() {
 #[test]
 fn failed_convert_leaves_no_output_file() {
     let out = tmp("bad.mcap");
-    let err = refused(&[
-        "convert",
-        &fixture("custom_bad_number.csv"),
-        "--profile",
-        &fixture("custom.toml"),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let err = refused(&convert_custom("custom_bad_number.csv", &out));
     assert!(err.contains("row 6"), "{err}");
     assert!(!out.exists());
 }

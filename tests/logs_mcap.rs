@@ -1,10 +1,11 @@
 //! MCAP reading (ROS 2 CDR and JSON), writing, round trips, bad files, and the independent check
 //! of what aloft writes with the Python `mcap` package (`tests/python/check_mcap.py`).
 
-use std::collections::BTreeMap;
+mod common;
+use common::ros2::{battery_state, message_header, pose_stamped, ros2_channel};
+
 use std::io::Cursor;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use aloft_logs::cdr::CdrWriter;
 use aloft_logs::{
@@ -26,34 +27,15 @@ fn fixture(name: &str) -> PathBuf {
 // quaternion <-> Euler conversions cost a few ulps: 1e-9.
 const TOL: f64 = 1e-9;
 
+/// A pose at (x, 2, 3) m in `map`, level and facing east.
 fn pose_cdr(sec: i32, x: f64) -> Vec<u8> {
-    let mut w = CdrWriter::new();
-    w.header(sec, 0, "map").f64(x).f64(2.0).f64(3.0);
-    for q in [0.0, 0.0, 0.0, 1.0] {
-        w.f64(q);
-    }
-    w.finish()
+    pose_stamped(sec, 0, "map", [x, 2.0, 3.0], [0.0, 0.0, 0.0, 1.0])
 }
 
+/// A pack at `v` volts drawing `i` amperes (negative: discharging), 80 % full.
 fn battery_cdr(sec: i32, v: f32, i: f32) -> Vec<u8> {
-    let mut w = CdrWriter::new();
-    w.header(sec, 0, "")
-        .f32(v)
-        .f32(f32::NAN)
-        .f32(i)
-        .f32(f32::NAN)
-        .f32(f32::NAN)
-        .f32(5.0)
-        .f32(0.8)
-        .u8(2)
-        .u8(1)
-        .u8(3)
-        .u8(1)
-        .u32(0)
-        .u32(0)
-        .string("")
-        .string("");
-    w.finish()
+    let nan = f32::NAN;
+    battery_state(sec, [v, nan, i, nan, nan, 5.0, 0.8], &[])
 }
 
 fn twist_cdr(sec: i32, frame: &str) -> Vec<u8> {
@@ -69,36 +51,19 @@ fn twist_cdr(sec: i32, frame: &str) -> Vec<u8> {
 fn ros2_file(path: &Path) {
     let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
     let mut w = mcap::Writer::new(f).unwrap();
-    let s_pose = w
-        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"...")
-        .unwrap();
-    let s_bat = w
-        .add_schema("sensor_msgs/msg/BatteryState", "ros2msg", b"...")
-        .unwrap();
-    let s_tw = w
-        .add_schema("geometry_msgs/msg/TwistStamped", "ros2msg", b"...")
-        .unwrap();
-    let s_other = w
-        .add_schema("std_msgs/msg/String", "ros2msg", b"string data")
-        .unwrap();
-    let meta = BTreeMap::new();
-    let c_pose = w
-        .add_channel(s_pose, "/vehicle/pose", "cdr", &meta)
-        .unwrap();
-    let c_pose2 = w.add_channel(s_pose, "/mocap/pose", "cdr", &meta).unwrap();
-    let c_bat = w.add_channel(s_bat, "/battery", "cdr", &meta).unwrap();
-    let c_tw = w
-        .add_channel(s_tw, "/vehicle/velocity", "cdr", &meta)
-        .unwrap();
-    let c_other = w.add_channel(s_other, "/status", "cdr", &meta).unwrap();
+    let pose = "geometry_msgs/msg/PoseStamped";
+    let c_pose = ros2_channel(&mut w, pose, "/vehicle/pose");
+    let c_pose2 = ros2_channel(&mut w, pose, "/mocap/pose");
+    let c_bat = ros2_channel(&mut w, "sensor_msgs/msg/BatteryState", "/battery");
+    let c_tw = ros2_channel(
+        &mut w,
+        "geometry_msgs/msg/TwistStamped",
+        "/vehicle/velocity",
+    );
+    let c_other = ros2_channel(&mut w, "std_msgs/msg/String", "/status");
     for k in 0..10u32 {
         let ns = 1_000_000_000 + u64::from(k) * 100_000_000;
-        let hdr = |ch: u16| mcap::records::MessageHeader {
-            channel_id: ch,
-            sequence: k,
-            log_time: ns,
-            publish_time: ns,
-        };
+        let hdr = |ch: u16| message_header(ch, k, ns);
         w.write_to_known_channel(&hdr(c_pose), &pose_cdr(1, f64::from(k)))
             .unwrap();
         w.write_to_known_channel(&hdr(c_pose2), &pose_cdr(1, 100.0))
@@ -111,6 +76,28 @@ fn ros2_file(path: &Path) {
             .unwrap();
     }
     w.finish().unwrap();
+}
+
+/// An MCAP at `path` of the one ROS 2 topic `topic` of `message_type`: each of `messages` is
+/// its log time (ns) and its CDR bytes, in sequence from 0.
+fn one_topic_file(path: &Path, message_type: &str, topic: &str, messages: &[(u64, &[u8])]) {
+    let f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut w = mcap::Writer::new(f).unwrap();
+    let c = ros2_channel(&mut w, message_type, topic);
+    for (k, (ns, data)) in (0u32..).zip(messages) {
+        w.write_to_known_channel(&message_header(c, k, *ns), data)
+            .unwrap();
+    }
+    w.finish().unwrap();
+}
+
+/// The log of the MCAP at `path` read from the named `topics` only.
+fn read_topics(path: &Path, topics: &[&str]) -> Result<aloft_logs::Log, LogError> {
+    let o = McapOptions {
+        topics: topics.iter().map(|t| t.to_string()).collect(),
+        ..McapOptions::default()
+    };
+    read_log(path, None, &o)
 }
 
 #[test]
@@ -154,11 +141,7 @@ fn ros2_cdr_topics_are_chosen_by_type_without_mixing_sources() {
 fn named_topics_select_decode_and_fail_clearly() {
     let p = tmp("ros2-named.mcap");
     ros2_file(&p);
-    let o = McapOptions {
-        topics: vec!["/mocap/pose".into()],
-        ..McapOptions::default()
-    };
-    let log = read_log(&p, None, &o).unwrap();
+    let log = read_topics(&p, &["/mocap/pose"]).unwrap();
     assert_eq!(log.samples.len(), 10);
     assert!(log
         .samples
@@ -167,22 +150,14 @@ fn named_topics_select_decode_and_fail_clearly() {
     let e = log.power_series().unwrap_err();
     assert!(matches!(e, LogError::NoPowerData { .. }), "{e}");
 
-    let o = McapOptions {
-        topics: vec!["/nope".into()],
-        ..McapOptions::default()
-    };
-    let e = read_log(&p, None, &o).unwrap_err();
+    let e = read_topics(&p, &["/nope"]).unwrap_err();
     assert!(matches!(e, LogError::TopicNotFound { .. }), "{e}");
     assert!(
         e.to_string().contains("/vehicle/pose"),
         "lists what exists: {e}"
     );
 
-    let o = McapOptions {
-        topics: vec!["/status".into()],
-        ..McapOptions::default()
-    };
-    let e = read_log(&p, None, &o).unwrap_err();
+    let e = read_topics(&p, &["/status"]).unwrap_err();
     assert!(matches!(e, LogError::UnsupportedTopic { .. }), "{e}");
     assert!(e.to_string().contains("std_msgs/msg/String"), "{e}");
 }
@@ -190,21 +165,8 @@ fn named_topics_select_decode_and_fail_clearly() {
 #[test]
 fn body_frame_twist_is_not_taken_as_enu() {
     let p = tmp("twist-body.mcap");
-    let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
-    let mut w = mcap::Writer::new(f).unwrap();
-    let s = w
-        .add_schema("geometry_msgs/msg/TwistStamped", "ros2msg", b"")
-        .unwrap();
-    let c = w.add_channel(s, "/v", "cdr", &BTreeMap::new()).unwrap();
-    let hdr = mcap::records::MessageHeader {
-        channel_id: c,
-        sequence: 0,
-        log_time: 1,
-        publish_time: 1,
-    };
-    w.write_to_known_channel(&hdr, &twist_cdr(1, "base_link"))
-        .unwrap();
-    w.finish().unwrap();
+    let twist = twist_cdr(1, "base_link");
+    one_topic_file(&p, "geometry_msgs/msg/TwistStamped", "/v", &[(1, &twist)]);
     let log = read_log(&p, None, &McapOptions::default()).unwrap();
     assert_eq!(log.samples.len(), 1);
     assert_eq!(log.samples[0].vel_enu_mps, None);
@@ -213,25 +175,14 @@ fn body_frame_twist_is_not_taken_as_enu() {
 #[test]
 fn corrupt_cdr_payload_names_topic_and_message() {
     let p = tmp("cdr-bad.mcap");
-    let f = std::io::BufWriter::new(std::fs::File::create(&p).unwrap());
-    let mut w = mcap::Writer::new(f).unwrap();
-    let s = w
-        .add_schema("geometry_msgs/msg/PoseStamped", "ros2msg", b"")
-        .unwrap();
-    let c = w.add_channel(s, "/pose", "cdr", &BTreeMap::new()).unwrap();
-    for (k, data) in [pose_cdr(1, 0.0), pose_cdr(1, 0.0)[..30].to_vec()]
-        .iter()
-        .enumerate()
-    {
-        let hdr = mcap::records::MessageHeader {
-            channel_id: c,
-            sequence: k as u32,
-            log_time: k as u64,
-            publish_time: k as u64,
-        };
-        w.write_to_known_channel(&hdr, data).unwrap();
-    }
-    w.finish().unwrap();
+    let pose = pose_cdr(1, 0.0);
+    let cut = &pose[..30];
+    one_topic_file(
+        &p,
+        "geometry_msgs/msg/PoseStamped",
+        "/pose",
+        &[(0, &pose), (1, cut)],
+    );
     let e = read_log(&p, None, &McapOptions::default()).unwrap_err();
     match &e {
         LogError::Cdr { topic, index, .. } => {
@@ -350,11 +301,7 @@ fn converted_log_reads_back_equal() {
         assert!((s.current_a.unwrap() - cur[i]).abs() < TOL);
     }
     // The pose topic alone: attitude through the ROS quaternion and back.
-    let o = McapOptions {
-        topics: vec!["/aloft/pose".into()],
-        ..McapOptions::default()
-    };
-    let poses = read_log(&out, None, &o).unwrap();
+    let poses = read_topics(&out, &["/aloft/pose"]).unwrap();
     assert_eq!(poses.samples.len(), 20);
     for (s, b) in log.samples.iter().zip(&poses.samples) {
         let (a, b) = (s.attitude.unwrap(), b.attitude.unwrap());
@@ -363,11 +310,7 @@ fn converted_log_reads_back_equal() {
         assert!((a.yaw_rad - b.yaw_rad).abs() < TOL);
     }
     // Pose and battery by name: aloft's pose topic joins its instant too.
-    let o = McapOptions {
-        topics: vec!["/aloft/pose".into(), "/aloft/battery".into()],
-        ..McapOptions::default()
-    };
-    let named = read_log(&out, None, &o).unwrap();
+    let named = read_topics(&out, &["/aloft/pose", "/aloft/battery"]).unwrap();
     assert_eq!(named.samples.len(), 20);
     assert!(named
         .samples
@@ -376,40 +319,6 @@ fn converted_log_reads_back_equal() {
     // Same relative times; the absolute start (1 s of boot time) is kept as log_time.
     assert!((back.samples.last().unwrap().time_s - 1.9).abs() < 1e-6);
     assert!((back.start_time_s - 1.0).abs() < 1e-6);
-}
-
-fn python_has_mcap() -> bool {
-    Command::new("python3")
-        .args(["-c", "import mcap"])
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// Run the Python check; skipped (with a notice) only outside CI when `mcap` is not installed.
-fn python_check(file: &Path, expect: &serde_json::Value) -> bool {
-    if !python_has_mcap() {
-        if std::env::var_os("CI").is_some() {
-            panic!("CI is set but `python3 -c 'import mcap'` fails: install it (python3 -m pip install mcap)");
-        }
-        eprintln!("NOTICE: skipping the Python MCAP check: python3 with the `mcap` package is not available (set CI to make this an error)");
-        return false;
-    }
-    let exp = file.with_extension("expect.json");
-    std::fs::write(&exp, serde_json::to_vec_pretty(expect).unwrap()).unwrap();
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(file)
-        .arg(&exp)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "check_mcap.py failed:\n{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    true
 }
 
 #[test]
@@ -432,7 +341,7 @@ fn python_mcap_reads_a_converted_log() {
             {"topic": "/aloft/state", "index": 0, "path": "time_s", "value": 0.0, "tol": 0.0},
         ]
     });
-    python_check(&out, &expect);
+    common::check_mcap_with_python(&out, &expect);
 }
 
 fn mission() -> (Vec<MissionSample>, Vec<PathPoint>) {
@@ -514,7 +423,7 @@ fn mission_mcap_has_all_topics_and_reads_back() {
             {"topic": "/aloft/battery", "index": 49, "path": "state_of_charge", "value": 1.0 - 0.01 * 24.5, "tol": 1e-12},
         ]
     });
-    python_check(&out, &expect);
+    common::check_mcap_with_python(&out, &expect);
 }
 
 /// Issue 23: `log info` of `mission --mcap` output counted a state and a battery message of one

@@ -16,6 +16,12 @@ fn read(name: &str, profile: Option<&Profile>) -> Result<aloft_logs::Log, LogErr
     read_log(&fixture(name), profile, &McapOptions::default())
 }
 
+/// The fixture log `name` read through the fixture profile file `profile`.
+fn read_with(name: &str, profile: &str) -> Result<aloft_logs::Log, LogError> {
+    let profile = Profile::resolve(fixture(profile).to_str().unwrap()).unwrap();
+    read(name, Some(&profile))
+}
+
 // Inputs are short decimals; conversions are one or two products, so 1e-9 bounds the rounding.
 const TOL: f64 = 1e-9;
 
@@ -66,8 +72,7 @@ fn kaist_layout_is_recognised_and_converted() {
 
 #[test]
 fn user_map_converts_units_and_quaternion() {
-    let profile = Profile::resolve(fixture("custom.toml").to_str().unwrap()).unwrap();
-    let log = read("custom.csv", Some(&profile)).unwrap();
+    let log = read_with("custom.csv", "custom.toml").unwrap();
     assert_eq!(log.samples.len(), 10);
     let s = &log.samples[3];
     assert!((s.time_s - 0.15).abs() < TOL);
@@ -126,8 +131,7 @@ fn header_only_log_is_empty() {
 
 #[test]
 fn wrong_voltage_unit_is_caught_on_the_first_row() {
-    let profile = Profile::resolve(fixture("custom_wrong_units.toml").to_str().unwrap()).unwrap();
-    let e = read("custom.csv", Some(&profile)).unwrap_err();
+    let e = read_with("custom.csv", "custom_wrong_units.toml").unwrap_err();
     match e {
         LogError::Implausible {
             row,
@@ -145,8 +149,7 @@ fn wrong_voltage_unit_is_caught_on_the_first_row() {
 
 #[test]
 fn text_in_a_number_column_names_row_and_column() {
-    let profile = Profile::resolve(fixture("custom.toml").to_str().unwrap()).unwrap();
-    let e = read("custom_bad_number.csv", Some(&profile)).unwrap_err();
+    let e = read_with("custom_bad_number.csv", "custom.toml").unwrap_err();
     match e {
         LogError::ParseValue {
             row, column, text, ..

@@ -3,32 +3,29 @@
 
 use aloft::engine::{plan_mission, Mission, MissionOptions, Plan, Vehicle};
 
+mod common;
+use common::assert_warned;
+use common::mission_toml::{landing, take_off};
+
 fn plan(text: &str) -> Plan {
     let m100 = Vehicle::builtin("dji-m100").unwrap();
     let mission = Mission::from_text(text, "test").unwrap();
     plan_mission(&m100, &mission, &MissionOptions::default()).unwrap()
 }
 
-const LOITER: &str = r#"
-name = "loiter"
-default_speed_mps = 8.0
-[[segment]]
-kind = "take-off"
-altitude_m = 30.0
-climb_rate_mps = 2.0
-[[segment]]
-kind = "leg"
-east_m = 1000.0
-north_m = 0.0
-item = 2
-[[segment]]
-kind = "loiter-until-reserve"
-item = 3
-"#;
+/// Out 1 km at the default 8 m/s (item 2), then a loiter until the reserve (item 3).
+fn loiter() -> String {
+    let out = "[[segment]]\nkind = \"leg\"\neast_m = 1000.0\nnorth_m = 0.0\nitem = 2\n";
+    let until_reserve = "[[segment]]\nkind = \"loiter-until-reserve\"\nitem = 3\n";
+    format!(
+        "name = \"loiter\"\ndefault_speed_mps = 8.0\n{}{out}{until_reserve}",
+        take_off(30.0, 2.0)
+    )
+}
 
 /// The same route with a hover of `hover_s` and the way home written out by hand.
 fn loiter_by_hand(hover_s: f64) -> String {
-    let route = LOITER.replace("kind = \"loiter-until-reserve\"\nitem = 3\n", "");
+    let route = loiter().replace("kind = \"loiter-until-reserve\"\nitem = 3\n", "");
     format!(
         "{route}kind = \"hover\"\nduration_s = {hover_s}\n[[segment]]\nkind = \"return\"\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n"
     )
@@ -36,7 +33,7 @@ fn loiter_by_hand(hover_s: f64) -> String {
 
 #[test]
 fn the_loiter_is_the_last_second_that_lands_with_the_reserve() {
-    let p = plan(LOITER);
+    let p = plan(&loiter());
     let s = p.summary();
     let l = s.loiter.as_ref().expect("a loiter answer");
     assert_eq!(l.item, Some(3));
@@ -132,13 +129,7 @@ fn a_survey_that_ends_in_the_air_is_priced_with_its_way_home_and_split_like_any_
     let open = format!("allow_end_in_air = true\n{}", &closed[..end]);
     let (a, b) = (plan(&open), plan(&closed));
     let (a, b) = (a.summary(), b.summary());
-    assert!(
-        a.warnings
-            .iter()
-            .any(|w| w.contains("ends in the air after item 49")),
-        "{:?}",
-        a.warnings
-    );
+    assert_warned(&a.warnings, "ends in the air after item 49");
     assert_eq!(a.segments.len(), b.segments.len());
     assert!(a.batteries_required.is_some() && a.batteries_required == b.batteries_required);
     for (x, y) in a.sorties.iter().zip(&b.sorties) {
@@ -163,32 +154,18 @@ fn a_mission_one_pack_flies_needs_one_battery_and_lists_no_sorties() {
 
 #[test]
 fn a_leg_too_long_for_one_pack_cannot_be_split_and_says_so() {
-    let text = r#"
-        default_speed_mps = 10.0
-        [[segment]]
-        kind = "take-off"
-        altitude_m = 30.0
-        climb_rate_mps = 2.0
-        [[segment]]
-        kind = "leg"
-        east_m = 40000.0
-        north_m = 0.0
-        item = 2
-        [[segment]]
-        kind = "return"
-        [[segment]]
-        kind = "landing"
-        rate_mps = 1.0
-    "#;
-    let s = plan(text);
+    let far = "[[segment]]\nkind = \"leg\"\neast_m = 40000.0\nnorth_m = 0.0\nitem = 2\n";
+    let text = format!(
+        "default_speed_mps = 10.0\n{}{far}[[segment]]\nkind = \"return\"\n{}",
+        take_off(30.0, 2.0),
+        landing(1.0)
+    );
+    let s = plan(&text);
     let s = s.summary();
     assert!(!s.feasible);
     assert_eq!(s.batteries_required, None);
-    assert!(
-        s.warnings
-            .iter()
-            .any(|w| w.contains("item 2 (leg) cannot be flown from home and back")),
-        "{:?}",
-        s.warnings
+    assert_warned(
+        &s.warnings,
+        "item 2 (leg) cannot be flown from home and back",
     );
 }

@@ -12,7 +12,7 @@
 //! Heights are sums of exact file values: 1e-9 m.
 
 mod common;
-use common::data_dir;
+use common::{assert_warned, data_dir};
 
 use std::path::PathBuf;
 
@@ -80,6 +80,12 @@ fn check_route(m: &Mission, points: &[Ll], extra_m: f64, climb_m: f64, descent_m
 }
 
 // ---- Raw file values ----
+
+/// The `.plan` `name` as aloft loads it, and its raw values: home and items as [`plan_items`].
+fn plan_file(name: &str) -> (Mission, Ll, Vec<Value>) {
+    let (home, items) = plan_items(name);
+    (load(name), home, items)
+}
 
 /// A `.plan`: its home `[lat, lon]` and its items flattened (surveys' stored items in order).
 fn plan_items(name: &str) -> (Ll, Vec<Value>) {
@@ -157,13 +163,7 @@ fn check_flight(plan: &Plan, m: &Mission, items: &[u32]) {
         let kinds: Vec<(&str, Option<u32>)> =
             added.iter().map(|x| (x.kind.as_str(), x.item)).collect();
         assert_eq!(kinds, [("return", None), ("landing", None)]);
-        assert!(
-            s.warnings
-                .iter()
-                .any(|w| w.contains("priced with the way home an autopilot flies")),
-            "{:?}",
-            s.warnings
-        );
+        assert_warned(&s.warnings, "priced with the way home an autopilot flies");
     }
     assert_eq!(&s.route, m.route());
     assert!(s.energy_wh > 0.0 && s.duration_s > 0.0);
@@ -189,9 +189,7 @@ fn counts(total: usize, flown: usize, commands: usize, free: usize) -> Option<It
 /// interleaved with 15 camera triggers (and a camera mode item first), RTL.
 #[test]
 fn data_val_neilvaltec_survey_plan() {
-    let name = "neilvaltec_test.plan";
-    let (home, items) = plan_items(name);
-    let m = load(name);
+    let (m, home, items) = plan_file("neilvaltec_test.plan");
     assert_eq!(m.route().source_format, SourceFormat::QgcPlan);
     let wps: Vec<(u32, Ll)> = (1u32..)
         .zip(&items)
@@ -241,9 +239,7 @@ fn data_val_neilvaltec_survey_plan() {
 /// PX4 test field: TAKEOFF 20 m at home, 5 waypoints at 20 m, RTL in frame 2.
 #[test]
 fn data_val_kasperg3_uas_test_plan() {
-    let name = "kasperg3_uas_test_plan.plan";
-    let (home, items) = plan_items(name);
-    let m = load(name);
+    let (m, home, items) = plan_file("kasperg3_uas_test_plan.plan");
     let mut points = vec![home];
     points.extend(items.iter().filter(|i| command(i) == 16).map(latlon));
     points.push(home);
@@ -259,9 +255,7 @@ fn data_val_kasperg3_uas_test_plan() {
 /// home and the route ends in the air (no return).
 #[test]
 fn data_val_kasperg3_mission_ends_in_the_air() {
-    let name = "kasperg3_mission.plan";
-    let (home, items) = plan_items(name);
-    let m = load(name);
+    let (m, home, items) = plan_file("kasperg3_mission.plan");
     let mut points = vec![home];
     points.extend(items.iter().map(latlon));
     assert_eq!(points.len(), 15);
@@ -306,9 +300,7 @@ fn data_val_kasperg3_mission_ends_in_the_air() {
 /// take-off from the landing point; the payload is released at the landing.
 #[test]
 fn data_val_px4_triangle_gripper_delivery() {
-    let name = "px4_triangle_gripper_package_delivery.plan";
-    let (home, items) = plan_items(name);
-    let m = load(name);
+    let (m, home, items) = plan_file("px4_triangle_gripper_package_delivery.plan");
     let points = [
         home,
         latlon(&items[0]),
@@ -339,9 +331,7 @@ fn data_val_px4_triangle_gripper_delivery() {
 /// the M100: clamped), LAND at a point.
 #[test]
 fn data_val_droneicarus_hand_made_plan() {
-    let name = "droneicarus_test7-Mission_avec_parametre.plan";
-    let (home, items) = plan_items(name);
-    let m = load(name);
+    let (m, home, items) = plan_file("droneicarus_test7-Mission_avec_parametre.plan");
     let takeoff = items[0]["params"][6].as_f64().unwrap();
     let points = [
         home,

@@ -3,7 +3,7 @@
 //! maximum take-off mass with a note, and the CLI's table, JSON, CSV, chart and refusals.
 
 mod common;
-use common::{aloft, ok_stdout as stdout_of};
+use common::{aloft, ok_json, ok_stdout as stdout_of};
 
 use aloft::engine::{
     endurance, payload_sweep, EnduranceOptions, PayloadCurve, PayloadSweep, Vehicle,
@@ -234,14 +234,13 @@ fn expected_rows(payloads: &[f64]) -> usize {
 
 #[test]
 fn cli_json_has_the_keys_one_row_per_pack_and_payload_and_equals_the_engine() {
-    let out = stdout_of(&[
+    let v = ok_json(&[
         "endurance",
         "--payload-sweep",
         "0:1.5:0.25",
         "--format",
         "json",
     ]);
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     for k in [
         "vehicle",
         "wind",
@@ -256,17 +255,8 @@ fn cli_json_has_the_keys_one_row_per_pack_and_payload_and_equals_the_engine() {
     let payloads: Vec<f64> = (0..=6).map(|i| f64::from(i) * 0.25).collect();
     assert_eq!(rows.len(), expected_rows(&payloads));
     for r in rows {
-        for k in [
-            "battery",
-            "payload_kg",
-            "takeoff_mass_kg",
-            "hover_power_w",
-            "hover_endurance_s",
-            "max_endurance_speed_mps",
-            "max_endurance_s",
-            "max_range_speed_mps",
-            "max_range_m",
-        ] {
+        let own = ["battery", "payload_kg", "takeoff_mass_kg"];
+        for k in own.iter().chain(&common::ENDURANCE_KEYS) {
             assert!(r.get(k).is_some(), "row key {k}: {r}");
         }
     }
@@ -349,44 +339,30 @@ fn cli_plot_draws_a_curve_per_pack() {
 #[test]
 fn cli_refuses_bad_sweeps_with_one_line_and_exit_2() {
     let flag = "--payload-sweep";
-    assert_refused(
-        &["endurance", flag, "1:0:0.1"],
-        &[flag, "1:0:0.1", "below START"],
-    );
-    assert_refused(
-        &["endurance", flag, "0:1:0"],
-        &[flag, "0:1:0", "not positive"],
-    );
-    assert_refused(
-        &["endurance", flag, "a:b:c"],
-        &[flag, "a:b:c", "not a number"],
-    );
-    assert_refused(
-        &["endurance", flag, "0:1:nan"],
-        &[flag, "0:1:nan", "not a finite"],
-    );
-    assert_refused(
-        &["endurance", flag, "0:1e9:1e-9"],
-        &[flag, "0:1e9:1e-9", "more than the 1000"],
-    );
+    // A bad START:STOP:STEP is named, with what is wrong with it.
+    for (sweep, why) in [
+        ("1:0:0.1", "below START"),
+        ("0:1:0", "not positive"),
+        ("a:b:c", "not a number"),
+        ("0:1:nan", "not a finite"),
+        ("0:1e9:1e-9", "more than the 1000"),
+        ("50:60:1", "3.600 kg maximum take-off mass"),
+    ] {
+        assert_refused(&["endurance", flag, sweep], &[flag, sweep, why]);
+    }
     assert_refused(&["endurance", flag, "-1:1:0.5"], &[flag, "negative"]);
     assert_refused(&["endurance", flag, "0:1"], &[flag, "START:STOP:STEP"]);
-    assert_refused(
-        &["endurance", flag, "0:1:0.5", "--payload-kg", "1"],
-        &[flag, "--payload-kg"],
-    );
-    assert_refused(
-        &["endurance", flag, "0:1:0.5", "--sweep-speed", "1"],
-        &[flag, "--sweep-speed"],
-    );
-    assert_refused(
-        &["endurance", flag, "0:1:0.5", "--samples", "10"],
-        &[flag, "--samples"],
-    );
-    assert_refused(
-        &["endurance", flag, "50:60:1"],
-        &[flag, "50:60:1", "3.600 kg maximum take-off mass"],
-    );
+    // An option that does not go with a sweep is named beside it.
+    for (option, value) in [
+        ("--payload-kg", "1"),
+        ("--sweep-speed", "1"),
+        ("--samples", "10"),
+    ] {
+        assert_refused(
+            &["endurance", flag, "0:1:0.5", option, value],
+            &[flag, option],
+        );
+    }
     assert_refused(
         &["endurance", "--plot", "x.svg"],
         &["--payload-sweep", "--sweep-speed"],

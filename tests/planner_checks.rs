@@ -8,6 +8,9 @@ use aloft_planner::{
 };
 use proptest::prelude::*;
 
+mod common;
+use common::mission_toml::{hover, landing, leg, orbit, return_home, take_off, OrbitFor};
+
 const DEMO: &str = include_str!("../fixtures/missions/demo-survey.toml");
 
 fn m100() -> (Aircraft, Pack) {
@@ -54,18 +57,10 @@ fn halving_the_time_step_changes_mission_energy_by_less_than_0_1_percent() {
     assert!(rel < 1e-3, "{rel}");
 }
 
-const HOVER_LONG: &str = r#"
-[[segment]]
-kind = "take-off"
-altitude_m = 20.0
-climb_rate_mps = 2.0
-[[segment]]
-kind = "hover"
-duration_s = 5000.0
-[[segment]]
-kind = "landing"
-rate_mps = 1.0
-"#;
+/// Up to 20 m, a hover longer than the pack lasts, down.
+fn hover_long() -> String {
+    [take_off(20.0, 2.0), hover(5000.0), landing(1.0)].concat()
+}
 
 /// With no internal resistance every joule drawn from the cells reaches the load, so after the
 /// take-off the hover lasts exactly (usable energy - take-off energy) / hover power.
@@ -73,7 +68,7 @@ rate_mps = 1.0
 fn still_air_hover_endurance_is_usable_energy_over_hover_power_without_resistance() {
     let (a, b) = m100();
     let b = b.with_resistance(0.0).unwrap();
-    let m = MissionSpec::from_toml_str(HOVER_LONG)
+    let m = MissionSpec::from_toml_str(&hover_long())
         .unwrap()
         .compile(a.airframe(), b.mass_kg(), None)
         .unwrap();
@@ -112,30 +107,22 @@ fn still_air_hover_endurance_is_usable_energy_over_hover_power_without_resistanc
 /// `aloft endurance`), so any wind that raises the mean airspeed, or splits it into a slow and a
 /// fast leg of unequal duration, costs more. Below that speed a crosswind can lower the cost at a
 /// fixed ground speed (see the next test).
-const OUT_AND_BACK: &str = r#"
-[[segment]]
-kind = "take-off"
-altitude_m = 30.0
-climb_rate_mps = 2.0
-[[segment]]
-kind = "leg"
-east_m = 800.0
-north_m = 0.0
-ground_speed_mps = 10.0
-[[segment]]
-kind = "return"
-ground_speed_mps = 10.0
-[[segment]]
-kind = "landing"
-rate_mps = 1.0
-"#;
+fn out_and_back() -> String {
+    [
+        take_off(30.0, 2.0),
+        leg(800.0, 0.0, 10.0),
+        return_home(10.0),
+        landing(1.0),
+    ]
+    .concat()
+}
 
 #[test]
 fn an_out_and_back_costs_more_in_wind_than_in_still_air() {
-    let calm = run(OUT_AND_BACK, &Wind::calm(), &PlanOptions::default()).unwrap();
+    let calm = run(&out_and_back(), &Wind::calm(), &PlanOptions::default()).unwrap();
     for from in [0.0, 90.0, 270.0, 45.0] {
         let windy = run(
-            OUT_AND_BACK,
+            &out_and_back(),
             &Wind::constant(5.0, from).unwrap(),
             &PlanOptions::default(),
         )
@@ -155,7 +142,7 @@ fn below_the_minimum_power_speed_a_crosswind_lowers_the_cost_at_fixed_ground_spe
     // 6 m/s over the ground with a 5 m/s crosswind: 7.8 m/s through the air, closer to the 8.8 m/s
     // minimum of the power curve, for the same time aloft. Physics, not an error: the check above
     // holds only above the minimum-power speed.
-    let slow = OUT_AND_BACK.replace("ground_speed_mps = 10.0", "ground_speed_mps = 6.0");
+    let slow = out_and_back().replace("ground_speed_mps = 10.0", "ground_speed_mps = 6.0");
     let calm = run(&slow, &Wind::calm(), &PlanOptions::default()).unwrap();
     let cross = run(
         &slow,
@@ -188,31 +175,23 @@ fn best_range_speed_rises_with_headwind_and_falls_with_tailwind() {
     assert!(v(-8.0) > head);
 }
 
-const ORBIT: &str = r#"
-[[segment]]
-kind = "take-off"
-altitude_m = 30.0
-climb_rate_mps = 2.0
-[[segment]]
-kind = "leg"
-east_m = 25.0
-north_m = 0.0
-ground_speed_mps = 3.0
-[[segment]]
-kind = "orbit"
-centre_east_m = 0.0
-centre_north_m = 0.0
-radius_m = 25.0
-ground_speed_mps = 8.0
-direction = "counter-clockwise"
-laps = 3.0
-[[segment]]
-kind = "return"
-ground_speed_mps = 3.0
-[[segment]]
-kind = "landing"
-rate_mps = 1.0
-"#;
+/// Out to a circle of 25 m about home at 3 m/s, three laps of it at 8 m/s, back.
+fn orbit_mission() -> String {
+    [
+        take_off(30.0, 2.0),
+        leg(25.0, 0.0, 3.0),
+        orbit(
+            [0.0, 0.0],
+            25.0,
+            8.0,
+            "counter-clockwise",
+            OrbitFor::Laps(3.0),
+        ),
+        return_home(3.0),
+        landing(1.0),
+    ]
+    .concat()
+}
 
 #[test]
 fn a_still_air_orbit_has_constant_power_above_straight_flight_and_the_right_bank() {
@@ -220,7 +199,7 @@ fn a_still_air_orbit_has_constant_power_above_straight_flight_and_the_right_bank
         record_samples: true,
         ..PlanOptions::default()
     };
-    let r = run(ORBIT, &Wind::calm(), &opts).unwrap();
+    let r = run(&orbit_mission(), &Wind::calm(), &opts).unwrap();
     let cruise: Vec<_> = r
         .samples
         .iter()
@@ -293,26 +272,14 @@ proptest! {
         east in 20.0f64..600.0, north in -300.0f64..300.0, speed in 1.0f64..9.0,
         wind in 0.0f64..6.0, from in 0.0f64..360.0, alt in 5.0f64..80.0,
     ) {
-        let text = format!(r#"
-[[segment]]
-kind = "take-off"
-altitude_m = {alt}
-climb_rate_mps = 2.0
-[[segment]]
-kind = "leg"
-east_m = {east}
-north_m = {north}
-ground_speed_mps = {speed}
-[[segment]]
-kind = "hover"
-duration_s = 10.0
-[[segment]]
-kind = "return"
-ground_speed_mps = {speed}
-[[segment]]
-kind = "landing"
-rate_mps = 1.5
-"#);
+        let text = [
+            take_off(alt, 2.0),
+            leg(east, north, speed),
+            hover(10.0),
+            return_home(speed),
+            landing(1.5),
+        ]
+        .concat();
         let r = run(&text, &Wind::constant(wind, from).unwrap(), &PlanOptions::default()).unwrap();
         let sum: f64 = r.segments.iter().map(|s| s.energy_wh).sum();
         prop_assert!((sum - r.energy_wh).abs() <= 1e-9 * r.energy_wh);
@@ -382,7 +349,7 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
     // 10 m holds; the leg east climbing to 40 m cannot make headway from where the wind passes
     // what it can fly against. The answer says where (segment 2) and why, and the flight stops
     // there: infeasible, not an error.
-    let climbing = OUT_AND_BACK
+    let climbing = out_and_back()
         .replace("altitude_m = 30.0", "altitude_m = 10.0")
         .replace("north_m = 0.0\n", "north_m = 0.0\naltitude_m = 40.0\n");
     let shear = aloft_planner::WindProfile::PowerLaw {
@@ -429,7 +396,7 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
         }
     }
     let w = Wind::grid(WindGrid::from_rows(&rows).unwrap());
-    let e = run(OUT_AND_BACK, &w, &PlanOptions::default()).unwrap_err();
+    let e = run(&out_and_back(), &w, &PlanOptions::default()).unwrap_err();
     assert!(matches!(e, PlannerError::OutsideWindGrid { .. }), "{e}");
     assert!(e.to_string().contains("does not cover"), "{e}");
 }
@@ -437,7 +404,7 @@ fn a_wind_beyond_the_vehicle_is_infeasible_and_an_uncovering_grid_is_an_error() 
 #[test]
 fn an_infeasible_mission_says_where_the_battery_runs_out_and_has_a_point_of_no_return() {
     // The same out-and-back, 7 km out.
-    let far = OUT_AND_BACK.replace("east_m = 800.0", "east_m = 7000.0");
+    let far = out_and_back().replace("east_m = 800.0", "east_m = 7000.0");
     let r = run(
         &far,
         &Wind::constant(4.0, 90.0).unwrap(),

@@ -1,12 +1,33 @@
 //! End-to-end checks of `aloft mission` and `aloft endurance`: outputs, JSON keys, exit codes.
 
 mod common;
+use common::mission_toml::{hover, landing, orbit, take_off, OrbitFor};
 use common::run as aloft;
 
-use std::process::Command;
+use std::path::PathBuf;
 
-fn tmp(name: &str) -> std::path::PathBuf {
+fn tmp(name: &str) -> PathBuf {
     common::scratch("planner-cli", name)
+}
+
+/// A mission file `name` of `segments` in this test's scratch folder.
+fn mission_file(name: &str, segments: &[String]) -> PathBuf {
+    let path = tmp(name);
+    std::fs::write(&path, segments.concat()).unwrap();
+    path
+}
+
+/// Flies the demo writing an output file for each (flag, file name) of `outputs` in this test's
+/// scratch folder; it must succeed. The files' paths, in order.
+fn demo_writing<const N: usize>(outputs: [(&str, &str); N]) -> [PathBuf; N] {
+    let files = outputs.map(|(_, name)| tmp(name));
+    let mut args = vec!["mission".to_string()];
+    for ((flag, _), file) in outputs.iter().zip(&files) {
+        args.push(flag.to_string());
+        args.push(file.display().to_string());
+    }
+    common::ok_stdout(&args);
+    files
 }
 
 #[test]
@@ -27,9 +48,7 @@ fn the_demo_runs_feasible_and_reads_as_a_report() {
 
 #[test]
 fn mission_json_has_the_contract_keys_and_omits_a_missing_point_of_no_return() {
-    let (code, out, err) = aloft(&["mission", "--format", "json"]);
-    assert_eq!(code, 0, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let v = common::ok_json(&["mission", "--format", "json"]);
     for k in [
         "feasible",
         "duration_s",
@@ -62,12 +81,10 @@ fn mission_json_has_the_contract_keys_and_omits_a_missing_point_of_no_return() {
 
 #[test]
 fn an_infeasible_mission_exits_1_and_says_where() {
-    let path = tmp("long-hover.toml");
-    std::fs::write(
-        &path,
-        "[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n[[segment]]\nkind = \"hover\"\nduration_s = 3600.0\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
-    )
-    .unwrap();
+    let path = mission_file(
+        "long-hover.toml",
+        &[take_off(20.0, 2.0), hover(3600.0), landing(1.0)],
+    );
     let (code, out, _) = aloft(&["mission", path.to_str().unwrap()]);
     assert_eq!(code, 1, "{out}");
     assert!(
@@ -86,12 +103,11 @@ fn an_infeasible_mission_exits_1_and_says_where() {
 
 #[test]
 fn bad_input_exits_2_with_a_clear_message() {
-    let path = tmp("bad-radius.toml");
-    std::fs::write(
-        &path,
-        "[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n[[segment]]\nkind = \"orbit\"\ncentre_east_m = 0.0\ncentre_north_m = 0.0\nradius_m = -25.0\nground_speed_mps = 4.0\ndirection = \"clockwise\"\nlaps = 1.0\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
-    )
-    .unwrap();
+    let negative = orbit([0.0, 0.0], -25.0, 4.0, "clockwise", OrbitFor::Laps(1.0));
+    let path = mission_file(
+        "bad-radius.toml",
+        &[take_off(20.0, 2.0), negative, landing(1.0)],
+    );
     let (code, _, err) = aloft(&["mission", path.to_str().unwrap()]);
     assert_eq!(code, 2);
     assert!(err.contains("radius_m") && err.contains("-25"), "{err}");
@@ -102,15 +118,7 @@ fn bad_input_exits_2_with_a_clear_message() {
     assert!(err.contains("no segments"), "{err}");
     // A wind grid that does not reach the demo's survey area.
     let grid = tmp("small-grid.csv");
-    let mut text = String::from("x_m,y_m,z_m,u_mps,v_mps,w_mps\n");
-    for x in [-10.0, 10.0] {
-        for y in [-10.0, 10.0] {
-            for z in [0.0, 50.0] {
-                text.push_str(&format!("{x},{y},{z},3,0,0\n"));
-            }
-        }
-    }
-    std::fs::write(&grid, text).unwrap();
+    common::write_wind_grid(&grid, [10.0, 50.0], "3,0,0");
     let (code, _, err) = aloft(&["mission", "--wind-field", grid.to_str().unwrap()]);
     assert_eq!(code, 2);
     assert!(err.contains("does not cover"), "{err}");
@@ -121,16 +129,7 @@ fn bad_input_exits_2_with_a_clear_message() {
 
 #[test]
 fn timeseries_and_plot_are_written() {
-    let csv = tmp("demo.csv");
-    let svg = tmp("demo.svg");
-    let (code, _, err) = aloft(&[
-        "mission",
-        "--timeseries",
-        csv.to_str().unwrap(),
-        "--plot",
-        svg.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let [csv, svg] = demo_writing([("--timeseries", "demo.csv"), ("--plot", "demo.svg")]);
     let text = std::fs::read_to_string(&csv).unwrap();
     let header = text.lines().next().unwrap();
     for k in [
@@ -154,7 +153,7 @@ fn timeseries_and_plot_are_written() {
 
 #[test]
 fn endurance_json_has_the_contract_keys() {
-    let (code, out, err) = aloft(&[
+    let v = common::ok_json(&[
         "endurance",
         "--format",
         "json",
@@ -169,18 +168,8 @@ fn endurance_json_has_the_contract_keys() {
         "--orbit-speed",
         "5",
     ]);
-    assert_eq!(code, 0, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    for k in [
-        "hover_power_w",
-        "hover_endurance_s",
-        "max_endurance_speed_mps",
-        "max_endurance_s",
-        "max_range_speed_mps",
-        "max_range_m",
-        "orbit_endurance_s",
-    ] {
-        assert!(v[k].as_f64().is_some_and(|x| x > 0.0), "{k}: {out}");
+    for k in common::ENDURANCE_KEYS.iter().chain(&["orbit_endurance_s"]) {
+        assert!(v[*k].as_f64().is_some_and(|x| x > 0.0), "{k}: {v}");
     }
     let (code, out, _) = aloft(&["endurance", "--sweep-speed", "1", "--format", "csv"]);
     assert_eq!(code, 0);
@@ -190,16 +179,10 @@ fn endurance_json_has_the_contract_keys() {
 
 #[test]
 fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
-    let mcap = tmp("demo.mcap");
-    let csv = tmp("demo-for-mcap.csv");
-    let (code, _, err) = aloft(&[
-        "mission",
-        "--mcap",
-        mcap.to_str().unwrap(),
-        "--timeseries",
-        csv.to_str().unwrap(),
+    let [mcap, csv] = demo_writing([
+        ("--mcap", "demo.mcap"),
+        ("--timeseries", "demo-for-mcap.csv"),
     ]);
-    assert_eq!(code, 0, "{err}");
     let bytes = std::fs::read(&mcap).unwrap();
     // MCAP magic at both ends (MCAP spec: 0x89 "MCAP0" CR LF).
     let magic = b"\x89MCAP0\r\n";
@@ -221,16 +204,6 @@ fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
     let col = |k: &str| header.iter().position(|h| *h == k).unwrap();
     let n = rows.len();
     assert!(n > 4000);
-    let python_mcap = Command::new("python3")
-        .args(["-c", "import mcap"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !python_mcap {
-        eprintln!(
-            "python3 with the mcap package not found: the independent reader check is skipped"
-        );
-        return;
-    }
     let k = n / 2;
     let expect = serde_json::json!({
         "topics": {
@@ -252,21 +225,7 @@ fn mission_mcap_is_written_with_samples_power_battery_and_the_path() {
             {"topic": "/aloft/path", "index": 0, "path": "poses.0.position.x", "value": 0.0, "tol": 1e-9},
         ],
     });
-    let expect_path = tmp("demo-mcap-expect.json");
-    std::fs::write(&expect_path, expect.to_string()).unwrap();
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/python/check_mcap.py");
-    let out = Command::new("python3")
-        .arg(script)
-        .arg(&mcap)
-        .arg(&expect_path)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "check_mcap.py: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::check_mcap_with_python(&mcap, &expect);
 }
 
 /// `--corners`: the demo's survey flown through its corners (the default) is shorter than with

@@ -34,12 +34,33 @@ fn split_even_odd<T: Clone>(v: &[T]) -> (Vec<T>, Vec<T>) {
     (even, odd)
 }
 
+/// Column `k` of `rows`.
+fn col(rows: &[Vec<f64>], k: usize) -> Vec<f64> {
+    rows.iter().map(|x| x[k]).collect()
+}
+
+/// The rows of the MIT run of the KDE2814XF-775 with the 14 in propeller.
+fn mit_14in_rows() -> Vec<Vec<f64>> {
+    numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"))
+}
+
+/// [`mit_14in_rows`] where the motor turns (column 3 > 0), split into even and odd rows.
+fn mit_14in_turning() -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+    let rows: Vec<_> = mit_14in_rows().into_iter().filter(|r| r[3] > 0.0).collect();
+    split_even_odd(&rows)
+}
+
 fn rms(v: &[f64]) -> f64 {
     (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
 }
 
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, &x| a.max(x.abs()))
+}
+
+/// The largest and the RMS relative error of `e`, in percent, for the report.
+fn spread(e: &[f64]) -> String {
+    format!("max {:.1}% rms {:.1}%", max_abs(e) * 100.0, rms(e) * 100.0)
 }
 
 /// UIUC static tables of the Master Airscrew propellers (the maker of the seed's MA1470T):
@@ -70,7 +91,6 @@ fn data_val_uiuc_master_airscrew_static_even_odd() {
     for f in files {
         let rows = numeric_rows(&f);
         let (even, odd) = split_even_odd(&rows);
-        let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
         let (rpm, ct, cp) = (col(&even, 0), col(&even, 1), col(&even, 2));
         let err = |fit: &aloft_propulsion::fit::propeller::PropellerFit| {
             let et: Vec<f64> = odd.iter().map(|r| fit.ct_at(r[0]) / r[1] - 1.0).collect();
@@ -106,9 +126,7 @@ fn data_val_uiuc_master_airscrew_static_even_odd() {
 /// odd rows include the other direction's hysteresis (~3 % at equal ESC signal).
 #[test]
 fn data_val_mit_kde2814_14in_propeller_even_odd() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = split_even_odd(&mit_14in_rows());
     let d = 14.0 * 0.0254;
     let fit = fit_thrust_stand(
         &col(&even, 3),
@@ -130,16 +148,14 @@ fn data_val_mit_kde2814_14in_propeller_even_odd() {
         .map(|r| p.torque_nm(r[3], 1.225) / r[1] - 1.0)
         .collect();
     eprintln!(
-        "MIT 14in: C_T {:.4} C_P {:.4}, train RMSE {:.3} N / {:.4} N m; odd rows (n={}) thrust max {:.1}% rms {:.1}%, torque max {:.1}% rms {:.1}%",
+        "MIT 14in: C_T {:.4} C_P {:.4}, train RMSE {:.3} N / {:.4} N m; odd rows (n={}) thrust {}, torque {}",
         fit.ct,
         fit.cp,
         fit.rmse_thrust,
         fit.rmse_power,
         test.len(),
-        max_abs(&et) * 100.0,
-        rms(&et) * 100.0,
-        max_abs(&eq) * 100.0,
-        rms(&eq) * 100.0
+        spread(&et),
+        spread(&eq)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&et) < 0.08 && max_abs(&eq) < 0.08);
@@ -158,10 +174,7 @@ fn data_val_mit_kde2814_14in_propeller_even_odd() {
 /// rows by up to 21 %. The speed or torque column of those runs is likely mis-scaled.)
 #[test]
 fn data_val_mit_kde2814_motor_even_odd() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let rows: Vec<_> = rows.into_iter().filter(|r| r[3] > 0.0).collect();
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = mit_14in_turning();
     let volts = 11.1;
     let fit = fit_motor(
         &vec![volts; even.len()],
@@ -178,13 +191,12 @@ fn data_val_mit_kde2814_motor_even_odd() {
         .map(|r| fit.supply_current_a(volts, r[3], r[1]) / r[4] - 1.0)
         .collect();
     eprintln!(
-        "KDE2814 motor: R_m {:.3} ohm, {:?}, train RMSE {:.3} A; odd rows (n={}) max {:.1}% rms {:.1}%",
+        "KDE2814 motor: R_m {:.3} ohm, {:?}, train RMSE {:.3} A; odd rows (n={}) {}",
         fit.resistance_ohm,
         fit.loss,
         fit.rmse_current_a,
         test.len(),
-        max_abs(&e) * 100.0,
-        rms(&e) * 100.0
+        spread(&e)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&e) < 0.10);
@@ -201,10 +213,7 @@ fn data_val_mit_kde2814_motor_even_odd() {
 /// reported too; it under-predicts, as it ignores ESC and wiring losses.
 #[test]
 fn data_val_kde2814_current_from_thrust() {
-    let rows = numeric_rows(&data_dir().join("mit_multicopter_motor/motor_14inch_prop.txt"));
-    let rows: Vec<_> = rows.into_iter().filter(|r| r[3] > 0.0).collect();
-    let (even, odd) = split_even_odd(&rows);
-    let col = |r: &[Vec<f64>], k: usize| r.iter().map(|x| x[k]).collect::<Vec<f64>>();
+    let (even, odd) = mit_14in_turning();
     let (d, rho, volts, kv) = (14.0 * 0.0254, 1.225, 11.1, 775.0);
     let prop = fit_thrust_stand(
         &col(&even, 3),
@@ -246,15 +255,13 @@ fn data_val_kde2814_current_from_thrust() {
         .map(|r| predict(r[2], 0.069, 0.5) / r[4] - 1.0)
         .collect();
     eprintln!(
-        "KDE2814XF-775 + 14in: fitted R_m {:.3} ohm I0 {:.2} A (train RMSE {:.3} A); current from thrust on odd rows (n={}): max {:.1}% rms {:.1}%; catalogue-only max {:.1}% rms {:.1}%",
+        "KDE2814XF-775 + 14in: fitted R_m {:.3} ohm I0 {:.2} A (train RMSE {:.3} A); current from thrust on odd rows (n={}): {}; catalogue-only {}",
         motor.resistance_ohm,
         i0_fit,
         motor.rmse_current_a,
         test.len(),
-        max_abs(&e_fit) * 100.0,
-        rms(&e_fit) * 100.0,
-        max_abs(&e_cat) * 100.0,
-        rms(&e_cat) * 100.0
+        spread(&e_fit),
+        spread(&e_cat)
     );
     assert!(test.len() >= 8);
     assert!(max_abs(&e_fit) <= 0.10);

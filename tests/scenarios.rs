@@ -4,9 +4,12 @@
 
 use aloft::engine::{
     endurance, endurance_scenarios, plan_mission, plan_scenarios, EnduranceOptions, Mission,
-    MissionOptions, ScenarioOptions, Vehicle,
+    MissionOptions, Percentiles, ScenarioOptions, Uncertainty, Vehicle,
 };
 use proptest::prelude::*;
+
+mod common;
+use common::mission_toml::{landing, leg, return_home, take_off};
 
 fn m100() -> Vehicle {
     Vehicle::builtin("dji-m100").unwrap()
@@ -294,31 +297,31 @@ fn endurance_scenarios_give_ordered_percentiles_around_the_answer() {
 
 /// A short mission for the property tests: take-off, one leg, home, landing.
 fn short_mission() -> Mission {
-    Mission::from_toml(
-        r#"
-        name = "short"
-        [wind]
-        speed_mps = 4.0
-        from_deg = 270.0
-        [[segment]]
-        kind = "take-off"
-        altitude_m = 20.0
-        climb_rate_mps = 3.0
-        [[segment]]
-        kind = "leg"
-        east_m = 300.0
-        north_m = 0.0
-        ground_speed_mps = 10.0
-        [[segment]]
-        kind = "return"
-        ground_speed_mps = 10.0
-        [[segment]]
-        kind = "landing"
-        rate_mps = 2.0
-        "#,
-        "test",
-    )
-    .unwrap()
+    let text = [
+        "name = \"short\"\n[wind]\nspeed_mps = 4.0\nfrom_deg = 270.0\n".to_string(),
+        take_off(20.0, 3.0),
+        leg(300.0, 0.0, 10.0),
+        return_home(10.0),
+        landing(2.0),
+    ]
+    .concat();
+    Mission::from_toml(&text, "test").unwrap()
+}
+
+/// The p95 - p5 width of the `band` of the short mission's answer (at a 0.5 s step) in the
+/// scenarios of `sc` drawn with `seed`.
+fn band_width(
+    seed: u64,
+    sc: ScenarioOptions,
+    band: impl Fn(&Uncertainty) -> Option<Percentiles>,
+) -> f64 {
+    let o = MissionOptions {
+        time_step_s: Some(0.5),
+        ..MissionOptions::default()
+    };
+    let sc = ScenarioOptions { seed, ..sc };
+    let b = band(&plan_scenarios(&m100(), &short_mission(), &o, &sc).unwrap()).unwrap();
+    b.p95 - b.p5
 }
 
 proptest! {
@@ -362,11 +365,9 @@ proptest! {
         // The same draws scaled further from 1: every scenario's energy moves away from the
         // plan's in proportion (the flight is the same, its power times the factor), so the
         // p95 - p5 width grows, and it is zero without a spread.
-        let o = MissionOptions { time_step_s: Some(0.5), ..MissionOptions::default() };
         let at = |power_sd_percent| {
-            let sc = ScenarioOptions { samples: 20, seed, power_sd_percent, ..no_spread(0) };
-            let e = plan_scenarios(&m100(), &short_mission(), &o, &sc).unwrap().energy_wh.unwrap();
-            e.p95 - e.p5
+            let sc = ScenarioOptions { power_sd_percent, ..no_spread(20) };
+            band_width(seed, sc, |u| u.energy_wh)
         };
         let (zero, narrow, wide) = (at(0.0), at(sd), at(sd + more));
         prop_assert!(zero == 0.0);
@@ -379,11 +380,9 @@ proptest! {
         sd in 0.5f64..8.0,
         more in 0.5f64..8.0,
     ) {
-        let o = MissionOptions { time_step_s: Some(0.5), ..MissionOptions::default() };
         let at = |capacity_sd_percent| {
-            let sc = ScenarioOptions { samples: 20, seed, capacity_sd_percent, ..no_spread(0) };
-            let s = plan_scenarios(&m100(), &short_mission(), &o, &sc).unwrap().end_soc.unwrap();
-            s.p95 - s.p5
+            let sc = ScenarioOptions { capacity_sd_percent, ..no_spread(20) };
+            band_width(seed, sc, |u| u.end_soc)
         };
         prop_assert!(at(sd + more) > at(sd));
     }

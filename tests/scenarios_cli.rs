@@ -2,11 +2,11 @@
 //! chart, the endurance percentiles, and bad values exiting 2 with the flag named.
 
 mod common;
-use common::run as aloft;
+use common::{ok_json, ok_stdout, run as aloft};
 
 #[test]
 fn mission_json_carries_the_uncertainty_keys() {
-    let (code, out, err) = aloft(&[
+    let out = ok_stdout(&[
         "mission",
         "--samples",
         "30",
@@ -17,7 +17,6 @@ fn mission_json_carries_the_uncertainty_keys() {
         "--format",
         "json",
     ]);
-    assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let u = &v["uncertainty"];
     assert_eq!(u["samples"], 30);
@@ -87,7 +86,7 @@ fn the_table_says_it_in_a_line_and_the_chart_is_drawn() {
 
 #[test]
 fn endurance_gives_percentiles_of_hover_endurance_and_range() {
-    let (code, out, err) = aloft(&[
+    let v = ok_json(&[
         "endurance",
         "--samples",
         "50",
@@ -100,8 +99,6 @@ fn endurance_gives_percentiles_of_hover_endurance_and_range() {
         "--format",
         "json",
     ]);
-    assert_eq!(code, 0, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let u = &v["uncertainty"];
     for key in ["hover_endurance_s", "max_endurance_s", "max_range_m"] {
         let (a, b, c) = (

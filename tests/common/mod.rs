@@ -1,6 +1,11 @@
 //! Helpers shared by the integration tests: running the `aloft` binary, the shared real-data
-//! folder and the repository's fixtures. Each test file takes what it needs with `mod common;`.
+//! folder and the repository's fixtures, files and checks several tests make, mission segments as
+//! TOML ([`mission_toml`]) and ROS 2 messages ([`ros2`]; both also taken by the benches with
+//! `#[path]`). Each test file takes what it needs with `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
+
+pub mod mission_toml;
+pub mod ros2;
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -127,6 +132,99 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     err
 }
 
+/// Writes a wind-field CSV to `path` (`x_m,y_m,z_m,u_mps,v_mps,w_mps`): the same `wind` (`u,v,w`
+/// in m/s) at each corner of the box `[half_width_m, top_m]`, ±`half_width_m` east and north of
+/// home from the ground to `top_m`.
+pub fn write_wind_grid(path: impl AsRef<Path>, box_m: [f64; 2], wind: &str) {
+    write_wind_grid_with_columns(path, "x_m,y_m,z_m,u_mps,v_mps,w_mps", box_m, wind);
+}
+
+/// [`write_wind_grid`] with other `columns`: each row is `x,y,z,` and `values`.
+pub fn write_wind_grid_with_columns(
+    path: impl AsRef<Path>,
+    columns: &str,
+    box_m: [f64; 2],
+    values: &str,
+) {
+    let [half_width_m, top_m] = box_m;
+    let mut text = format!("{columns}\n");
+    for x in [-half_width_m, half_width_m] {
+        for y in [-half_width_m, half_width_m] {
+            for z in [0.0, top_m] {
+                text.push_str(&format!("{x},{y},{z},{values}\n"));
+            }
+        }
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// Whether `python3` can import `modules` (as an `import` statement names them: `a, b`).
+pub fn python_has(modules: &str) -> bool {
+    Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// The standard output of `python3 -c script args`, which must succeed.
+pub fn python_stdout(script: &str, args: &[&str]) -> String {
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .args(args)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "python3 {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).expect("UTF-8")
+}
+
+/// Checks the MCAP `file` with the independent reader, the Python `mcap` package
+/// (`tests/python/check_mcap.py`), against `expect` (topics with counts and schemas, values at
+/// paths with tolerances), which is written beside it. Skipped (with a notice) only outside CI
+/// when `mcap` is not installed; returns whether it ran.
+pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
+    if !python_has("mcap") {
+        if std::env::var_os("CI").is_some() {
+            panic!("CI is set but `python3 -c 'import mcap'` fails: install it (python3 -m pip install mcap)");
+        }
+        eprintln!("NOTICE: skipping the Python MCAP check: python3 with the `mcap` package is not available (set CI to make this an error)");
+        return false;
+    }
+    let exp = file.with_extension("expect.json");
+    std::fs::write(&exp, serde_json::to_vec_pretty(expect).unwrap()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
+    let out = Command::new("python3")
+        .arg(script)
+        .arg(file)
+        .arg(&exp)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "check_mcap.py failed:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    true
+}
+
+/// The `key` string of each element of the JSON array `array`.
+pub fn strs_of<'a>(array: &'a serde_json::Value, key: &str) -> Vec<&'a str> {
+    let items = array.as_array().expect("a JSON array");
+    items.iter().map(|x| x[key].as_str().unwrap()).collect()
+}
+
+/// Asserts that one of `warnings` contains `needle`.
+pub fn assert_warned(warnings: &[String], needle: &str) {
+    assert!(
+        warnings.iter().any(|w| w.contains(needle)),
+        "no warning with {needle:?}: {warnings:?}"
+    );
+}
+
 /// A uniform wind of `speed_mps` from `from_deg`, without gusts.
 pub fn uniform_wind(speed_mps: f64, from_deg: f64) -> Option<aloft::engine::WindSpec> {
     Some(aloft::engine::WindSpec {
@@ -152,4 +250,15 @@ pub const HOVER_KEYS: [&str; 9] = [
     "power_drawn_w",
     "battery_heat_w",
     "flight_time_min",
+];
+
+/// The numbers of an endurance answer (`aloft endurance --format json`) that every vehicle and
+/// payload has, and that a payload sweep gives for each row.
+pub const ENDURANCE_KEYS: [&str; 6] = [
+    "hover_power_w",
+    "hover_endurance_s",
+    "max_endurance_speed_mps",
+    "max_endurance_s",
+    "max_range_speed_mps",
+    "max_range_m",
 ];
