@@ -3,8 +3,8 @@
 //!
 //! `cargo run --example mission`
 
+use aloft::engine::WindSpec;
 use aloft::engine::{plan_mission, Mission, MissionOptions, MissionSummary, Vehicle};
-use aloft::engine::{WindProfileKind, WindSpec};
 
 /// A 600 m out-and-back at 40 m.
 const OUT_AND_BACK: &str = r#"
@@ -36,16 +36,7 @@ pub fn run(
 
     let options = MissionOptions {
         payload_kg: Some(0.4),
-        wind: Some(WindSpec {
-            speed_mps: 5.0,
-            from_deg: 270.0,
-            profile: WindProfileKind::Uniform,
-            reference_height_m: None,
-            exponent: None,
-            roughness_m: None,
-            gust_std_mps: None,
-            gust_seed: None,
-        }),
+        wind: Some(WindSpec::uniform(5.0, 270.0)),
         ..MissionOptions::default()
     };
     let custom = plan_mission(&m100, &Mission::from_toml(OUT_AND_BACK, "code")?, &options)?;

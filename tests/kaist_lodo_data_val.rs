@@ -314,3 +314,14 @@ fn data_val_kaist_lodo_live_remaining_within_3_percent_median_8_worst() {
     assert_eq!(errors.len(), 44);
     assert!(m <= 3.0 && worst <= 8.0, "median {m}, worst {worst}");
 }
+
+/// Issue 25 target: the p5-p95 band of `remaining_wh` holds the measured rest at least 80 % of
+/// the time, over every update of the held-out flights.
+#[test]
+fn data_val_kaist_lodo_live_band_holds_the_truth_80_percent() {
+    let r = lodo();
+    let coverage = r.iter().map(|j| j.live_coverage).sum::<f64>() / r.len() as f64;
+    let lowest = r.iter().map(|j| j.live_coverage).fold(1.0, f64::min);
+    println!("live p5-p95 coverage: mean over flights {coverage:.2}, lowest {lowest:.2}");
+    assert!(coverage >= 0.8, "{coverage}");
+}

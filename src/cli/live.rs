@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::{Args, ValueEnum};
 
 use aloft::engine::flags::LiveFlags;
-use aloft::engine::{replay_live, Error, LiveCheck, LiveUpdate, Vehicle};
+use aloft::engine::{replay_live, Error, LiveCheck, LiveCheckpoint, LiveUpdate, Vehicle};
 
 use super::Outcome;
 
@@ -94,21 +94,21 @@ fn render_check(out: &mut impl Write, c: &LiveCheck) -> Result<()> {
         c.duration_s,
         100.0 * c.band_coverage
     )?;
-    writeln!(
-        out,
-        "{:>6} {:>8} {:>10} {:>12} {:>8}",
-        "at", "time s", "error %", "naive err %", "in band"
-    )?;
+    writeln!(out, "{CHECK_HEADER}")?;
     for p in &c.checkpoints {
-        writeln!(
-            out,
-            "{:>6} {:>8.1} {:>+10.2} {:>+12.2} {:>8}",
-            p.at,
-            p.time_s,
-            p.error_percent,
-            p.naive_error_percent,
-            if p.in_band { "yes" } else { "no" }
-        )?;
+        writeln!(out, "{}", checkpoint_row(p))?;
     }
     Ok(())
+}
+
+/// The column heads of the checkpoints.
+const CHECK_HEADER: &str = "    at   time s    error %  naive err %  in band";
+
+/// One checkpoint as a line of text.
+fn checkpoint_row(p: &LiveCheckpoint) -> String {
+    let in_band = if p.in_band { "yes" } else { "no" };
+    format!(
+        "{:>6} {:>8.1} {:>+10.2} {:>+12.2} {in_band:>8}",
+        p.at, p.time_s, p.error_percent, p.naive_error_percent
+    )
 }

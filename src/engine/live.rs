@@ -69,17 +69,6 @@ pub struct LiveReplayRequest {
     pub every_s: f64,
 }
 
-impl Default for LiveReplayRequest {
-    fn default() -> Self {
-        Self {
-            logs: FlightLogs::default(),
-            battery: None,
-            payload_kg: 0.0,
-            every_s: 1.0,
-        }
-    }
-}
-
 /// One update: a line of `aloft live --format json`.
 #[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -68,7 +68,7 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::{
     Aircraft, Gusts, MissionReport, MissionSpec, NoSamples, Pack, PlannerError, Shortfall, Wind,
-    WindProfileKind, WindSpec,
+    WindSpec,
 };
 
 use super::finite::finite;
@@ -466,16 +466,7 @@ fn scaled_models<'a>(
 
 /// Still air, as a wind table: what scenarios draw around when the request names no wind.
 fn calm_spec() -> WindSpec {
-    WindSpec {
-        speed_mps: 0.0,
-        from_deg: 0.0,
-        profile: WindProfileKind::Uniform,
-        reference_height_m: None,
-        exponent: None,
-        roughness_m: None,
-        gust_std_mps: None,
-        gust_seed: None,
-    }
+    WindSpec::uniform(0.0, 0.0)
 }
 
 /// A steady wind drawn around `spec` (gusts left out: they are added by the caller).

@@ -227,16 +227,7 @@ pub fn assert_warned(warnings: &[String], needle: &str) {
 
 /// A uniform wind of `speed_mps` from `from_deg`, without gusts.
 pub fn uniform_wind(speed_mps: f64, from_deg: f64) -> Option<aloft::engine::WindSpec> {
-    Some(aloft::engine::WindSpec {
-        speed_mps,
-        from_deg,
-        profile: aloft::engine::WindProfileKind::Uniform,
-        reference_height_m: None,
-        exponent: None,
-        roughness_m: None,
-        gust_std_mps: None,
-        gust_seed: None,
-    })
+    Some(aloft::engine::WindSpec::uniform(speed_mps, from_deg))
 }
 
 /// The keys of a propulsion hover answer (`aloft propulsion --format json`), all numbers.

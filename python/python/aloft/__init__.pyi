@@ -1,7 +1,9 @@
 """Type stubs of aloft: keyword arguments are the CLI's flags in snake_case."""
 
 import os
-from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, TypedDict, Union
+
+from typing_extensions import Unpack
 
 import numpy as np
 import numpy.typing as npt
@@ -19,83 +21,75 @@ WindProfile = Literal["uniform", "power-law", "log"]
 class AloftError(ValueError):
     """A request aloft refuses; the message is the one `aloft` prints."""
 
+class VehicleKeywords(TypedDict, total=False):
+    """The vehicle flown and what it carries."""
+
+    vehicle: str
+    battery: Optional[str]
+    payload_kg: Optional[float]
+
+class WindKeywords(TypedDict, total=False):
+    """A steady wind and its profile with height."""
+
+    wind_speed: Optional[float]
+    wind_from: Optional[float]
+    wind_profile: Optional[WindProfile]
+    wind_reference_height: Optional[float]
+    wind_exponent: Optional[float]
+    wind_roughness: Optional[float]
+
+class MissionKeywords(VehicleKeywords, WindKeywords, total=False):
+    """How a mission is flown (`aloft mission`'s flags)."""
+
+    wind_field: Optional[PathLike]
+    gust_std: Optional[float]
+    gust_seed: Optional[int]
+    reserve_percent: Optional[float]
+    start_percent: Optional[float]
+    time_step: Optional[float]
+    speed: Optional[float]
+    rtl_altitude_m: Optional[float]
+    corners: Optional[Literal["pass", "stop"]]
+    aoa: Optional[Aoa]
+    no_ground_effect: bool
+
+class ScenarioKeywords(MissionKeywords, total=False):
+    """A mission with Monte-Carlo scenarios around it (`--samples` and the spreads)."""
+
+    samples: Optional[int]
+    seed: Optional[int]
+    wind_speed_sd: Optional[float]
+    wind_from_sd: Optional[float]
+    payload_sd_kg: Optional[float]
+    capacity_sd_percent: Optional[float]
+    power_sd_percent: Optional[float]
+    threads: Optional[int]
+
+class EnduranceKeywords(VehicleKeywords, WindKeywords, total=False):
+    """`aloft endurance`'s flags."""
+
+    course: Optional[float]
+    reserve_percent: Optional[float]
+    orbit_radius: Optional[float]
+    orbit_speed: Optional[float]
+    aoa: Optional[Aoa]
+    sweep_speed: Optional[float]
+    payload_sweep: Optional[Union[str, Tuple[float, float, float], Sequence[float]]]
+
+class FlightLogKeywords(TypedDict, total=False):
+    """How flight logs are read and power aligned with motion (`aloft fit` and `validate`)."""
+
+    profile: Optional[str]
+    aoa: Optional[Aoa]
+    lag: Optional[float]
+    max_lag: Optional[float]
+    battery_instance: Optional[int]
+
 def mission(
-    path: Optional[PathLike] = None,
-    *,
-    vehicle: str = ...,
-    battery: Optional[str] = None,
-    payload_kg: Optional[float] = None,
-    wind_speed: Optional[float] = None,
-    wind_from: Optional[float] = None,
-    wind_profile: Optional[WindProfile] = None,
-    wind_reference_height: Optional[float] = None,
-    wind_exponent: Optional[float] = None,
-    wind_roughness: Optional[float] = None,
-    wind_field: Optional[PathLike] = None,
-    gust_std: Optional[float] = None,
-    gust_seed: Optional[int] = None,
-    reserve_percent: Optional[float] = None,
-    start_percent: Optional[float] = None,
-    time_step: Optional[float] = None,
-    speed: Optional[float] = None,
-    rtl_altitude_m: Optional[float] = None,
-    corners: Optional[Literal["pass", "stop"]] = None,
-    aoa: Optional[Aoa] = None,
-    no_ground_effect: bool = False,
-    samples: Optional[int] = None,
-    seed: Optional[int] = None,
-    wind_speed_sd: Optional[float] = None,
-    wind_from_sd: Optional[float] = None,
-    payload_sd_kg: Optional[float] = None,
-    capacity_sd_percent: Optional[float] = None,
-    power_sd_percent: Optional[float] = None,
-    threads: Optional[int] = None,
-    **options: Any,
+    path: Optional[PathLike] = None, **options: Unpack[ScenarioKeywords]
 ) -> Dict[str, Any]: ...
-def timeseries(
-    path: Optional[PathLike] = None,
-    *,
-    vehicle: str = ...,
-    battery: Optional[str] = None,
-    payload_kg: Optional[float] = None,
-    wind_speed: Optional[float] = None,
-    wind_from: Optional[float] = None,
-    wind_profile: Optional[WindProfile] = None,
-    wind_reference_height: Optional[float] = None,
-    wind_exponent: Optional[float] = None,
-    wind_roughness: Optional[float] = None,
-    wind_field: Optional[PathLike] = None,
-    gust_std: Optional[float] = None,
-    gust_seed: Optional[int] = None,
-    reserve_percent: Optional[float] = None,
-    start_percent: Optional[float] = None,
-    time_step: Optional[float] = None,
-    speed: Optional[float] = None,
-    rtl_altitude_m: Optional[float] = None,
-    corners: Optional[Literal["pass", "stop"]] = None,
-    aoa: Optional[Aoa] = None,
-    no_ground_effect: bool = False,
-    **options: Any,
-) -> Any: ...
-def endurance(
-    *,
-    vehicle: str = ...,
-    battery: Optional[str] = None,
-    payload_kg: Optional[float] = None,
-    wind_speed: Optional[float] = None,
-    wind_from: Optional[float] = None,
-    wind_profile: Optional[WindProfile] = None,
-    wind_reference_height: Optional[float] = None,
-    wind_exponent: Optional[float] = None,
-    wind_roughness: Optional[float] = None,
-    course: Optional[float] = None,
-    reserve_percent: Optional[float] = None,
-    orbit_radius: Optional[float] = None,
-    orbit_speed: Optional[float] = None,
-    aoa: Optional[Aoa] = None,
-    sweep_speed: Optional[float] = None,
-    payload_sweep: Optional[Union[str, Tuple[float, float, float], Sequence[float]]] = None,
-) -> Dict[str, Any]: ...
+def timeseries(path: Optional[PathLike] = None, **options: Unpack[MissionKeywords]) -> Any: ...
+def endurance(**options: Unpack[EnduranceKeywords]) -> Dict[str, Any]: ...
 def log_info(
     path: PathLike,
     *,
@@ -113,11 +107,7 @@ def fit(
     free: Optional[Union[str, Sequence[str]]] = None,
     no_drag: bool = False,
     output: Optional[PathLike] = None,
-    profile: Optional[str] = None,
-    aoa: Optional[Aoa] = None,
-    lag: Optional[float] = None,
-    max_lag: Optional[float] = None,
-    battery_instance: Optional[int] = None,
+    **logs_options: Unpack[FlightLogKeywords],
 ) -> Dict[str, Any]: ...
 def validate(
     logs: Union[PathLike, Sequence[PathLike]],
@@ -126,11 +116,7 @@ def validate(
     calibrate_first: Optional[float] = None,
     battery: Optional[str] = None,
     payload_kg: Optional[float] = None,
-    profile: Optional[str] = None,
-    aoa: Optional[Aoa] = None,
-    lag: Optional[float] = None,
-    max_lag: Optional[float] = None,
-    battery_instance: Optional[int] = None,
+    **logs_options: Unpack[FlightLogKeywords],
 ) -> Dict[str, Any]: ...
 def power(
     airspeed: ArrayLike,

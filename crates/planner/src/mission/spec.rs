@@ -241,6 +241,21 @@ pub struct WindSpec {
 }
 
 impl WindSpec {
+    /// A steady wind of `speed_mps` from `from_deg` (clockwise from north), the same at every
+    /// height, without gusts.
+    pub fn uniform(speed_mps: f64, from_deg: f64) -> Self {
+        Self {
+            speed_mps,
+            from_deg,
+            profile: WindProfileKind::Uniform,
+            reference_height_m: None,
+            exponent: None,
+            roughness_m: None,
+            gust_std_mps: None,
+            gust_seed: None,
+        }
+    }
+
     /// The wind this table describes.
     ///
     /// # Errors
