@@ -311,7 +311,6 @@ pub fn force_samples(log: &Log) -> Vec<aloft_power::ForceSample> {
 }
 
 /// NRMSE of one model variant in one airspeed band.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BandNrmse {
     /// Airspeed band, m/s, as `"low-high"` (the last open: `"9-"`).
@@ -319,6 +318,7 @@ pub struct BandNrmse {
     /// Samples in the band.
     pub samples: usize,
     /// NRMSE (normalised by the band's mean measured power), percent; omitted when empty.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nrmse_percent: Option<f64>,
 }
 
@@ -363,7 +363,6 @@ pub struct Calibration {
 }
 
 /// Validation of the model on one flight.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlightValidation {
     /// The log file.
@@ -387,6 +386,7 @@ pub struct FlightValidation {
     /// Table I rows: full model and each term dropped, per airspeed band.
     pub table_i: Vec<AblationRow>,
     /// With a calibration window: the re-estimated efficiency and the errors after it.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub calibration: Option<Calibration>,
 }
 

@@ -70,7 +70,6 @@ pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
 pub const DEFAULT_VEHICLE: &str = "dji-m100";
 
 /// A parsed vehicle file.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VehicleFile {
@@ -80,12 +79,16 @@ pub struct VehicleFile {
     #[serde(default)]
     pub description: String,
     /// The published figures the vehicle was built from and where they were published.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<VehicleSource>,
     /// Four-term power model parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub power: Option<aloft_power::VehicleParams>,
     /// Propulsion chain: propeller, motor, ESC, battery packs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub propulsion: Option<aloft_propulsion::PropulsionSpec>,
     /// Airframe mass without battery and the flight envelope (missions and endurance queries).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub airframe: Option<aloft_planner::AirframeSpec>,
     /// Battery packs for missions (`[[battery]]` tables).
     #[serde(default, rename = "battery", skip_serializing_if = "Vec::is_empty")]

@@ -75,7 +75,6 @@ pub fn fit_parameter(name: &str) -> Result<FitParameter, Error> {
 }
 
 /// One log of a fit: its alignment and pack.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogFitReport {
     /// The file.
@@ -83,17 +82,18 @@ pub struct LogFitReport {
     /// Lag of power behind motion applied, s.
     pub lag_s: f64,
     /// Correlation of power with tilt at that lag (absent when the lag was given).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lag_correlation: Option<f64>,
     /// Aligned samples.
     pub samples: usize,
     /// Motion samples left out.
     pub skipped: usize,
     /// Pack internal resistance from voltage and current, when logged.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pack: Option<PackResistanceFit>,
 }
 
 /// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitAnswer {
     /// Per log.
@@ -101,13 +101,16 @@ pub struct FitAnswer {
     /// The power-model fit.
     pub power: PowerFit,
     /// Drag from the force balance, when fitted.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub drag: Option<DragFit>,
     /// Body-axis quadratic drag (`mu2_x`, `mu2_y`) from the force balance, when the logs
     /// separate the two axes.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub drag_body_axes: Option<BodyAxisDragFit>,
     /// Relative standard deviation of the efficiency between the fitted logs (each log's
     /// measured energy against the fitted model's), when there are two logs or more: written to
     /// the vehicle file as `efficiency_relative_sd`, the prior of in-flight re-calibration.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub efficiency_relative_sd: Option<f64>,
     /// The constants fitted: the power fit's lumped constants and the force balance's drag
     /// coefficients.

@@ -70,7 +70,6 @@ pub struct LiveReplayRequest {
 }
 
 /// One update: a line of `aloft live --format json`.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LiveUpdate {
     /// Time since the start of the stream, s.
@@ -80,6 +79,7 @@ pub struct LiveUpdate {
     /// Measured electrical energy so far, Wh.
     pub energy_used_wh: f64,
     /// Measured electrical power now, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub power_w: Option<f64>,
     /// Whether the source measures power (without it the prediction is the model's alone).
     pub power_available: bool,
@@ -88,11 +88,14 @@ pub struct LiveUpdate {
     /// Energy to finish the route and land, Wh.
     pub remaining_wh: Percentiles,
     /// The naive rate: mean measured power so far times the route's remaining time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub naive_remaining_wh: Option<f64>,
     /// Validation mode: the energy the log measured from now to the end, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_remaining_wh: Option<f64>,
     /// What to do: `continue`, `return now` or `land now`; absent where the pack's capacity or
     /// state is not known (a vehicle with a power table only).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub advice: Option<&'static str>,
 }
 

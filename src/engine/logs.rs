@@ -69,7 +69,6 @@ impl LogReadOptions {
 }
 
 /// One channel of a log: how many samples and at what rate.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogChannel {
     /// The channel.
@@ -77,11 +76,11 @@ pub struct LogChannel {
     /// Samples that carry it.
     pub samples: u64,
     /// Mean rate, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rate_hz: Option<f64>,
 }
 
 /// One MCAP topic.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogTopic {
     /// Topic name.
@@ -95,16 +94,17 @@ pub struct LogTopic {
     /// Messages decoded.
     pub decoded: u64,
     /// Mean rate, Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rate_hz: Option<f64>,
     /// Channels it fed.
     pub used_for: Vec<Channel>,
 }
 
 /// The regularity of a log's time base (the first ten gaps and backward steps).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogTime {
     /// The typical sample period, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal_period_s: Option<f64>,
     /// Gaps longer than three periods.
     pub gap_count: u64,
@@ -131,7 +131,6 @@ impl From<&TimeReport> for LogTime {
 }
 
 /// The lag of power behind ground speed, by cross-correlation.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct LagInfo {
     /// Lag, s.
@@ -144,11 +143,11 @@ pub struct LagInfo {
     pub at_window_edge: bool,
     /// Log time up to which the samples were used, s, when the log was longer than the search
     /// keeps (about 2 million samples of each series); absent when the whole log was used.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub used_until_s: Option<f64>,
 }
 
 /// What a PX4 ULog or ArduPilot DataFlash log holds besides its samples.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BinaryLogInfo {
     /// Records decoded, by topic or record type (the kinds aloft reads).
@@ -168,12 +167,16 @@ pub struct BinaryLogInfo {
     /// Time from the first to the last valid battery record, s.
     pub battery_span_s: f64,
     /// Battery cells (parameters).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub battery_cells: Option<u32>,
     /// Battery capacity (parameters), A h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub battery_capacity_ah: Option<f64>,
     /// Mean air density (PX4 `vehicle_air_data`), kg/m^3.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub air_density_kg_m3: Option<f64>,
     /// Time not landed (PX4 `vehicle_land_detected`), s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub in_air_s: Option<f64>,
     /// Bytes skipped over corrupt data.
     pub bytes_skipped: u64,
@@ -203,7 +206,6 @@ impl BinaryLogInfo {
 }
 
 /// What a log holds: the JSON of `aloft log info --format json`.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LogInfo {
     /// The file.
@@ -211,26 +213,33 @@ pub struct LogInfo {
     /// Its format.
     pub format: LogFormat,
     /// The CSV profile used.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub profile: Option<String>,
     /// Samples read.
     pub samples: u64,
     /// Time from the first to the last sample, s.
     pub duration_s: f64,
     /// Time of the first sample in the log's own clock, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_time_s: Option<f64>,
     /// Channels found.
     pub channels: Vec<LogChannel>,
     /// CSV columns.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub columns: Option<Vec<String>>,
     /// MCAP topics.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub topics: Option<Vec<LogTopic>>,
     /// Whether the log has electrical power (voltage and current, or a power channel).
     pub power_available: bool,
     /// Energy used (trapezoid of V x I), Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub energy_wh: Option<f64>,
     /// Mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_power_w: Option<f64>,
     /// Largest power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_power_w: Option<f64>,
     /// Regularity of the time base.
     pub time: LogTime,
@@ -240,8 +249,10 @@ pub struct LogInfo {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dropped: Vec<DroppedValue>,
     /// With a lag search (`--max-lag`): the lag of power behind ground speed.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lag: Option<LagInfo>,
     /// ULog and DataFlash: records, battery records, parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub log: Option<BinaryLogInfo>,
     /// What went wrong or was left out while reading (corrupt or truncated data with its byte
     /// offset, records left out, no battery data).

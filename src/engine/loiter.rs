@@ -24,10 +24,10 @@ const FIRST_GUESS_S: f64 = 1800.0;
 const LONGEST_S: f64 = 100_000.0;
 
 /// The loiter of a route that ends in one (in the answer as `loiter`).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LoiterSummary {
     /// The loiter's mission item number (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub item: Option<u32>,
     /// The loiter's segment in the answer's `segments` (a hover), from 1.
     pub segment: usize,

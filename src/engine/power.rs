@@ -62,12 +62,12 @@ pub struct PowerGradientDeg {
 
 /// The answer of [`power_point`]: every term, and the gradient when asked (the JSON of
 /// `aloft power --format json`).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PowerAnswer {
     /// The take-off mass the model flew, kg (airframe + pack + payload).
     pub takeoff_mass_kg: f64,
     /// The pack in that mass (absent for a vehicle without an airframe).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub battery: Option<String>,
     /// The payload in that mass, kg.
     pub payload_kg: f64,
@@ -75,6 +75,7 @@ pub struct PowerAnswer {
     #[serde(flatten)]
     pub power: PowerBreakdown,
     /// The gradient, when asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub electrical_gradient: Option<PowerGradientDeg>,
     /// What was evaluated, in words (not part of the JSON).
     #[serde(skip)]

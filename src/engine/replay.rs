@@ -80,7 +80,6 @@ impl Default for ReplayRequest {
 /// The span compared is split into airborne time, flown through the power model, and ground time
 /// (before, between and after flights), priced at the measured idle power; the energies of the
 /// two parts add up to the totals.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReplayAnswer {
     /// The log.
@@ -88,6 +87,7 @@ pub struct ReplayAnswer {
     /// Vehicle name.
     pub vehicle: String,
     /// The pack flown (its mass is part of `mass_kg`); absent for a `[power]`-only vehicle.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub battery: Option<String>,
     /// Mass flown, kg.
     pub mass_kg: f64,
@@ -98,16 +98,20 @@ pub struct ReplayAnswer {
     /// `velocity` or `log`.
     pub acceleration: &'static str,
     /// Lag of power behind motion applied, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub lag_s: Option<f64>,
     /// Predicted energy over the span, Wh: airborne from the trajectory, ground at idle.
     pub predicted_energy_wh: f64,
     /// Predicted mean power, W.
     pub predicted_mean_power_w: f64,
     /// Measured energy over the span, Wh (absent without power in the log).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_energy_wh: Option<f64>,
     /// Measured mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_mean_power_w: Option<f64>,
     /// `(predicted - measured) / measured`, percent.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub energy_error_percent: Option<f64>,
     /// Flights (airborne spans) in the span.
     pub flights: usize,
@@ -120,6 +124,7 @@ pub struct ReplayAnswer {
     pub ground_source: &'static str,
     /// Mean measured power on the ground over the record, W, over the ground time's own span
     /// (not shifted by the lag); absent without power or ground time.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub idle_power_w: Option<f64>,
     /// Predicted energy of the airborne time, Wh (from the trajectory alone).
     pub predicted_airborne_energy_wh: f64,
@@ -127,10 +132,13 @@ pub struct ReplayAnswer {
     /// power (the record's where the power does not cover it), 0 without power.
     pub predicted_ground_energy_wh: f64,
     /// Measured energy of the airborne time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_airborne_energy_wh: Option<f64>,
     /// Measured energy of the ground time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub measured_ground_energy_wh: Option<f64>,
     /// `(predicted - measured) / measured` of the airborne time, percent.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub airborne_energy_error_percent: Option<f64>,
     /// The airborne spans, s from the start of the log.
     pub airborne_spans: Vec<aloft_logs::Span>,

@@ -42,14 +42,16 @@ pub(super) fn nearest_rank(sorted: &[f64], p: usize) -> f64 {
 
 /// Percentiles of the time of the point of no return, s: each absent when it falls among the
 /// scenarios without a point of no return.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct PointOfNoReturnPercentiles {
     /// 5th percentile: 95 % of the scenarios can still turn back until then.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p5: Option<f64>,
     /// Median.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p50: Option<f64>,
     /// 95th percentile.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p95: Option<f64>,
 }
 

@@ -892,7 +892,6 @@ fn run_indexed<R: Send, S: Send>(
 
 /// The answer of [`endurance_scenarios`]: the `uncertainty` object of `aloft endurance --samples
 /// N --format json`.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EnduranceUncertainty {
     /// Scenarios drawn.
@@ -905,12 +904,16 @@ pub struct EnduranceUncertainty {
     /// The spreads drawn with.
     pub spreads: Spreads,
     /// Hover endurance, s (over the scenarios that can be flown; absent when none can).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub hover_endurance_s: Option<Percentiles>,
     /// Endurance at the best-endurance speed, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_endurance_s: Option<Percentiles>,
     /// Range along the course at the best-range speed, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_range_m: Option<Percentiles>,
     /// Orbit endurance, s (with an orbit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orbit_endurance_s: Option<Percentiles>,
 }
 

@@ -35,12 +35,13 @@ use super::flight::{first_speed, Flight};
 pub const MAX_SORTIES: usize = 200;
 
 /// One sortie of a route flown on several packs (in the answer's `sorties`).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SortieSummary {
     /// The first mission item of the route it flies (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub first_item: Option<u32>,
     /// The last mission item of the route it flies (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub last_item: Option<u32>,
     /// The first segment of the mission it flies, from 1.
     pub first_segment: usize,

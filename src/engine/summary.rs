@@ -13,7 +13,6 @@ use super::sorties::SortieSummary;
 use crate::error::Error;
 
 /// One segment of a [`MissionSummary`] (keys as `aloft mission --format json`).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SegmentSummary {
     /// Segment number, from 1.
@@ -21,6 +20,7 @@ pub struct SegmentSummary {
     /// Segment kind (`take-off`, `leg`, `orbit`, ...).
     pub kind: String,
     /// The operator's mission item number, when the mission came from a planner file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub item: Option<u32>,
     /// Duration, s.
     pub duration_s: f64,
@@ -36,18 +36,20 @@ pub struct SegmentSummary {
     pub end_soc: f64,
     /// Time flown beyond the plan because the vehicle flew at the edge of its envelope, s
     /// (absent when the segment was flown as planned).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_lost_s: Option<f64>,
     /// The lowest speed along the path at cruise where the envelope slowed the vehicle, m/s
     /// (over the ground; vertical for a climb or descent). Absent when the segment was flown as
     /// planned, or only its speed changes at the ends were slowed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_ground_speed_mps: Option<f64>,
     /// The limit the vehicle flew at where it was slowest: `tilt`, `thrust`, `airspeed`,
     /// `climb` or `descent` (absent when flown as planned).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit: Option<Limit>,
 }
 
 /// Where the point of no return lies (flattened into the [`MissionSummary`]).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PointOfNoReturnSummary {
     /// East of home, m.
@@ -59,6 +61,7 @@ pub struct PointOfNoReturnSummary {
     /// Segment it lies in, from 1.
     pub point_of_no_return_segment: usize,
     /// The operator's mission item of that segment, when the mission came from a planner file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_item: Option<u32>,
 }
 

@@ -27,7 +27,6 @@ pub struct ValidateRequest {
 }
 
 /// Mean over flights of one Table I cell.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MeanBand {
     /// Airspeed band, m/s.
@@ -35,6 +34,7 @@ pub struct MeanBand {
     /// Flights with samples in the band.
     pub flights: usize,
     /// Mean NRMSE, percent (absent when no flight has samples there).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nrmse_percent: Option<f64>,
 }
 

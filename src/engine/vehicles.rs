@@ -429,7 +429,6 @@ fn check_payload(payload_kg: f64) -> Result<(), Error> {
 }
 
 /// One built-in vehicle as `aloft vehicles` lists it.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct VehicleEntry {
     /// Name on the command line.
@@ -444,6 +443,7 @@ pub struct VehicleEntry {
     /// Its battery options (`--battery`), the default first.
     pub batteries: Vec<String>,
     /// The published figures it was built from and where they were published.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub source: Option<VehicleSource>,
 }
 

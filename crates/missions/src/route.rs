@@ -24,7 +24,6 @@ use crate::geo::{distance_m, LatLon};
 use crate::{ItemCounts, SourceFormat};
 
 /// The planned route of a mission (the `route` of `aloft mission --format json`).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct RouteFigures {
     /// The mission file's format: `qgc_plan`, `qgc_wpl`, `aloft_toml`, `aloft_json`.
@@ -38,6 +37,7 @@ pub struct RouteFigures {
     /// Timed holds and delays, s.
     pub hold_s: f64,
     /// The items of a planner file by role (absent for aloft's own files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub items: Option<ItemCounts>,
     /// What the reader adjusted or could not model.
     #[serde(default)]

@@ -8,7 +8,6 @@ use crate::error::{positive, within, PlannerError};
 
 /// The `[airframe]` table: mass without battery and payload, and the limits a mission must stay
 /// inside. Units are in the key names; unknown keys are rejected.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AirframeSpec {
@@ -18,6 +17,7 @@ pub struct AirframeSpec {
     pub max_takeoff_mass_kg: f64,
     /// Largest total thrust, N (default: the thrust of level flight at the largest take-off mass
     /// and the largest tilt, `m_max g / cos(tilt_max)`, a lower bound of the true value).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_thrust_n: Option<f64>,
     /// Largest tilt of the thrust axis from the vertical, deg.
     pub max_tilt_deg: f64,
@@ -26,6 +26,7 @@ pub struct AirframeSpec {
     pub max_speed_mps: f64,
     /// Largest horizontal airspeed, m/s (default: none; the tilt limit bounds the airspeed). A
     /// planned state beyond it is flown slower ([`crate::envelope`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_airspeed_mps: Option<f64>,
     /// Largest climb rate, m/s.
     pub max_climb_rate_mps: f64,
@@ -41,12 +42,15 @@ pub struct AirframeSpec {
     pub rotor_height_m: f64,
     /// Acceptance radius of a waypoint, m: how far before it a pass-through corner may start
     /// (default 2 m, the PX4 and ArduPilot defaults; a mission leg may give its own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub acceptance_radius_m: Option<f64>,
     /// Planning speed of the autopilot, m/s: the ground speed of mission legs that give none
     /// (default: the mission file's; `--speed` overrides both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cruise_speed_mps: Option<f64>,
     /// Return-to-launch height of the autopilot, m: a return below it climbs to it first
     /// (default: the mission's, else none; `--rtl-altitude-m` overrides both).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rtl_altitude_m: Option<f64>,
 }
 

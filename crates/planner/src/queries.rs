@@ -188,7 +188,6 @@ pub fn endurance_at_power_s(battery: &Pack, power_w: f64, start_soc: f64, stop_s
 }
 
 /// The answers of `aloft endurance`.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EnduranceReport {
     /// Hover power in the given wind, W.
@@ -210,8 +209,10 @@ pub struct EnduranceReport {
     /// Range along the course, m.
     pub max_range_m: f64,
     /// Mean power on the orbit, W (when an orbit was asked for).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub orbit_power_w: Option<f64>,
     /// Endurance on the orbit, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub orbit_endurance_s: Option<f64>,
 }
 
@@ -371,18 +372,19 @@ pub fn endurance(
 }
 
 /// One row of the power curve.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SweepRow {
     /// Airspeed, m/s.
     pub airspeed_mps: f64,
     /// Ground speed along the course, m/s (absent when no headway).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ground_speed_mps: Option<f64>,
     /// Electrical power in level flight, W.
     pub power_w: f64,
     /// Endurance at that power, s.
     pub endurance_s: f64,
     /// Range along the course, m (absent when no headway).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub range_m: Option<f64>,
 }
 

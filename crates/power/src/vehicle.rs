@@ -71,7 +71,6 @@ pub enum DiskArea {
 ///
 /// Units are in the key names. Unknown keys are rejected. Turn it into a validated [`Vehicle`]
 /// with [`Vehicle::new`].
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VehicleParams {
@@ -106,12 +105,15 @@ pub struct VehicleParams {
     /// along the body's forward axis, N s^2/m^2. With [`Self::mu2_y_n_s2_per_m2`] the drag
     /// force is `D_b = (mu1 + mu2_b v + mu3 v^2) v_b` per horizontal body axis `b`, the frontal
     /// area differing by axis; see [`crate::drag`]. Absent: the scalar law of eq (6).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mu2_x_n_s2_per_m2: Option<f64>,
     /// Body-axis drag: the quadratic coefficient `mu2` along the body's right axis, N s^2/m^2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mu2_y_n_s2_per_m2: Option<f64>,
     /// Relative standard deviation of the efficiency between flights (optional, a fraction:
     /// 0.02 is 2 %), written by `aloft fit` from the spread of the fitted flights: the prior
     /// uncertainty an in-flight re-calibration weighs its estimate against.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub efficiency_relative_sd: Option<f64>,
 }
 

@@ -51,7 +51,6 @@ fn full_usable() -> f64 {
 }
 
 /// One battery pack (see the module docs for the keys and which model reads each).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "BatteryTable")]
 pub struct BatterySpec {
@@ -68,36 +67,51 @@ pub struct BatterySpec {
     /// Rated capacity, mA h.
     pub capacity_mah: f64,
     /// Rated (nominal) pack voltage, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal_v: Option<f64>,
     /// Rated energy, W h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub energy_wh: Option<f64>,
     /// Pack mass, kg.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mass_kg: Option<f64>,
     /// Constant pack internal resistance, ohm (0 allowed for missions: an ideal source).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub internal_resistance_ohm: Option<f64>,
     /// `r_1` of eq (17), ohm.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub r1_ohm: Option<f64>,
     /// `r_2` of eq (17), ohm A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub r2_ohm_a: Option<f64>,
     /// `r_3` of eq (17), ohm A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub r3_ohm_a: Option<f64>,
     /// Lower end of eq (17)'s valid current range, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub eq17_min_current_a: Option<f64>,
     /// Upper end of eq (17)'s valid current range, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub eq17_max_current_a: Option<f64>,
     /// Cut-off voltage per cell under load, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cutoff_cell_v: Option<f64>,
     /// Fraction of the rated capacity that may be drawn, in `(0, 1]`.
     pub usable_fraction: f64,
     /// Effective-capacity coefficient `C_e` of eq (31).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub effective_capacity_fraction: Option<f64>,
     /// Full-charge cell voltage of eq (30), V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub full_charge_cell_v: Option<f64>,
     /// Open-circuit curve: state-of-charge points in `[0, 1]`, increasing.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ocv_soc: Option<Vec<f64>>,
     /// Open-circuit curve: cell voltage at each `ocv_soc` point, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub ocv_cell_v: Option<Vec<f64>>,
     /// Rated continuous current, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_current_a: Option<f64>,
 }
 

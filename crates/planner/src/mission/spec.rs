@@ -11,19 +11,23 @@ use crate::error::PlannerError;
 use crate::wind::{Gusts, Profile as WindProfile, Wind};
 
 /// Home point: local east/north metres, or latitude and longitude.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HomeSpec {
     /// East, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub east_m: Option<f64>,
     /// North, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub north_m: Option<f64>,
     /// Latitude, deg (WGS-84).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub latitude_deg: Option<f64>,
     /// Longitude, deg (WGS-84).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub longitude_deg: Option<f64>,
     /// Ground altitude above mean sea level, m (informational; heights are above home).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub altitude_amsl_m: Option<f64>,
 }
 
@@ -38,7 +42,6 @@ pub enum OrbitDirection {
 }
 
 /// One `[[segment]]` of a mission file, tagged by `kind`.
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum SegmentSpec {
@@ -49,53 +52,72 @@ pub enum SegmentSpec {
         /// Climb rate, m/s.
         climb_rate_mps: f64,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Straight leg to a waypoint.
     Leg {
         /// Waypoint east, m.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         east_m: Option<f64>,
         /// Waypoint north, m.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         north_m: Option<f64>,
         /// Waypoint latitude, deg.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         latitude_deg: Option<f64>,
         /// Waypoint longitude, deg.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         longitude_deg: Option<f64>,
         /// Waypoint height, m (default: the present one).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         altitude_m: Option<f64>,
         /// Horizontal ground speed, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         ground_speed_mps: Option<f64>,
         /// Payload after the waypoint, kg (a pick-up or delivery).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
         /// Acceptance radius of the waypoint, m: how far from it a pass-through corner may start
         /// (default: the airframe's).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         acceptance_radius_m: Option<f64>,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Circles about a centre.
     Orbit {
         /// Centre east, m.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         centre_east_m: Option<f64>,
         /// Centre north, m.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         centre_north_m: Option<f64>,
         /// Centre latitude, deg.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         centre_latitude_deg: Option<f64>,
         /// Centre longitude, deg.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         centre_longitude_deg: Option<f64>,
         /// Height, m (default: the present one).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         altitude_m: Option<f64>,
         /// Radius, m.
         radius_m: f64,
         /// Ground speed on the circle, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         ground_speed_mps: Option<f64>,
         /// Direction seen from above.
         direction: OrbitDirection,
         /// Number of laps (give this or `duration_s`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         laps: Option<f64>,
         /// Time on the circle, s.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         duration_s: Option<f64>,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Hover in place.
@@ -103,19 +125,24 @@ pub enum SegmentSpec {
         /// Duration, s.
         duration_s: f64,
         /// Payload after the hover, kg (a winch delivery).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Straight back over home at the present height (or at `altitude_m`, reached first), as an
     /// autopilot's return-to-launch; a landing follows.
     Return {
         /// Horizontal ground speed, m/s (default: the mission's `default_speed_mps`).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         ground_speed_mps: Option<f64>,
         /// Height to return at, m (default: the present height, or the mission's
         /// `rtl_altitude_m` when that is higher).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         altitude_m: Option<f64>,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Vertical descent to a lower height.
@@ -125,6 +152,7 @@ pub enum SegmentSpec {
         /// Descent rate, m/s.
         rate_mps: f64,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Vertical descent to the ground.
@@ -132,8 +160,10 @@ pub enum SegmentSpec {
         /// Descent rate, m/s.
         rate_mps: f64,
         /// Payload after landing, kg.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         payload_after_kg: Option<f64>,
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
     /// Hover here until the pack must fly home with the reserve: an open-ended loiter (an
@@ -141,6 +171,7 @@ pub enum SegmentSpec {
     /// vehicle can stay.
     LoiterUntilReserve {
         /// The operator's mission item number (from a planner file), named in the reports.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
     },
 }
@@ -217,7 +248,6 @@ pub enum WindProfileKind {
 }
 
 /// The optional `[wind]` table of a mission file (the command line overrides it).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WindSpec {
@@ -229,14 +259,19 @@ pub struct WindSpec {
     #[serde(default)]
     pub profile: WindProfileKind,
     /// Reference height of a profile, m (default 10).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_height_m: Option<f64>,
     /// Power-law exponent (default 1/7).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub exponent: Option<f64>,
     /// Roughness length of the log profile, m (default 0.03, open grass).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roughness_m: Option<f64>,
     /// Gust standard deviation per horizontal axis, m/s (default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust_std_mps: Option<f64>,
     /// Gust seed (default 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust_seed: Option<u64>,
 }
 
@@ -284,7 +319,6 @@ impl WindSpec {
 /// A mission: what every mission source produces (see [Mission sources](super#mission-sources))
 /// and [`MissionSpec::compile`] flies. Its serde form is the mission file; its [`Default`] is the
 /// empty file (every optional key at its default, no segments).
-#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MissionSpec {
@@ -298,16 +332,20 @@ pub struct MissionSpec {
     #[serde(default)]
     pub payload_kg: f64,
     /// Reserve of the usable capacity required at landing, percent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reserve_percent: Option<f64>,
     /// Sampling step, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_step_s: Option<f64>,
     /// Home point.
     #[serde(default)]
     pub home: HomeSpec,
     /// Wind (optional; the command line overrides it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wind: Option<WindSpec>,
     /// Ground speed of the legs, orbits and returns that give none, m/s (a planner file's
     /// planning speed; the command line or the vehicle may set it instead).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub default_speed_mps: Option<f64>,
     /// Fly a speed beyond the vehicle's maximum at the maximum, with a warning, instead of
     /// refusing the mission (planner files, written for another vehicle; default false).
@@ -315,9 +353,11 @@ pub struct MissionSpec {
     pub clamp_speeds: bool,
     /// How the vehicle flies through a waypoint without a hold: `pass` (the default: through a
     /// corner at a speed its turn allows, as autopilots do) or `stop` (stop, turn, go on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub corners: Option<CornerMode>,
     /// Lowest height of a return to home, m: a `return` below it climbs to it first (an
     /// autopilot's RTL altitude; default none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rtl_altitude_m: Option<f64>,
     /// Accept a mission that ends in the air (a planner file without a landing or a return): its
     /// reserve is judged where it ends (default false: a mission lands).
@@ -330,6 +370,7 @@ pub struct MissionSpec {
     /// (the rest of a flight in progress, as `aloft live` plans it; not a key of the file).
     /// `None`, the default: on the ground at home, so the first segment is a take-off.
     #[serde(skip)]
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_in_air_m: Option<[f64; 3]>,
 }
 
