@@ -41,7 +41,9 @@ pub mod request;
 pub mod source;
 pub mod tlog;
 
-pub use aloft_logs::telemetry::{Event, Reply, Telemetry, TelemetrySource};
+pub use aloft_logs::telemetry::{
+    BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,
+};
 pub use decode::Decoder;
 pub use error::{LinkError, Result};
 /// The `mavlink` crate aloft-link is built on (its ArduPilot dialect's message types appear in

@@ -95,6 +95,8 @@ pub struct TlogFrame {
     pub timestamp_us: u64,
     /// Byte offset of the frame's timestamp in the input.
     pub offset: u64,
+    /// Bytes of the frame in the input, its timestamp included.
+    pub len: usize,
     /// MAVLink 1 or 2.
     pub version: MavlinkVersion,
     /// Sender's system and component ids, sequence number.
@@ -261,6 +263,7 @@ impl<R: Read> TlogReader<R> {
                 TlogFrame {
                     timestamp_us,
                     offset: self.offset(),
+                    len: total,
                     version,
                     header,
                     message,
