@@ -5,6 +5,8 @@
 //! component that sent that HEARTBEAT (the autopilot), so a companion computer or camera of the
 //! same system, other vehicles and ground stations are ignored. Mission transfers are the
 //! exception: a ground station's upload to the vehicle is read too ([`crate::mission`]).
+//! Messages before the vehicle's first HEARTBEAT cannot be told apart and are dropped (the
+//! first second of a log at most).
 //!
 //! | message | event |
 //! |---|---|

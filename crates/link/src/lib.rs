@@ -12,8 +12,8 @@
 //! - [`Decoder`] ([`decode`]): messages of the vehicle into [`Telemetry`] events; the mission
 //!   assembled from the mission protocol ([`mission`]).
 //! - [`TlogSource`] and [`LinkSource`] ([`source`]): the two as
-//!   [`TelemetrySource`](aloft_logs::telemetry::TelemetrySource)s; a live link reads on a thread,
-//!   reports silence as [`Event::LinkLost`](aloft_logs::telemetry::Event::LinkLost), answers with
+//!   [`TelemetrySource`]s; a live link reads on a thread,
+//!   reports silence as [`Event::LinkLost`], answers with
 //!   [`LinkSource::reply`], and downloads the mission when none passed ([`request`]).
 //!
 //! ```no_run
