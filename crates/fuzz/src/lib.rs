@@ -23,7 +23,8 @@
 //! dropped, repeated or swapped, CSV columns repeated, `key = value` lines inserted; for MCAP,
 //! the record, string and chunk length fields overwritten; for ULog and DataFlash, record sizes,
 //! ids, `FMT` lengths and timestamps set to extreme values, the floats of data records to NaN,
-//! infinities and extremes, and format characters to other ones ([`log_fields`]). Inputs that end in a new kind of
+//! infinities and extremes, and format characters to other ones ([`log_fields`]); for MAVLink
+//! telemetry logs, frame timestamps, lengths, flags and ids, CRCs and payload floats. Inputs that end in a new kind of
 //! answer or message join the corpus (a coarse stand-in for coverage feedback). The generator is
 //! seeded ([`Rng`]), so a run is reproduced by its seed.
 

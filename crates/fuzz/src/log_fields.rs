@@ -108,6 +108,36 @@ pub fn dataflash_fields(d: &[u8]) -> LogFields {
     f
 }
 
+/// The fields of a MAVLink telemetry log, for each frame aloft-link's reader finds: the
+/// timestamp (`u64`), the payload length, the sender's system id and the message id (one byte in
+/// MAVLink 1; in MAVLink 2 also the incompatibility flags and the message id's three bytes),
+/// the CRC, and the payload's floats (every 4 bytes; MAVLink lays out the widest fields first).
+pub fn tlog_fields(d: &[u8]) -> LogFields {
+    let mut f = LogFields::default();
+    for frame in aloft_link::TlogReader::new(d, "fields").flatten() {
+        if f.full() {
+            break;
+        }
+        let at = usize::try_from(frame.offset).unwrap_or(usize::MAX);
+        let magic = at + 8;
+        let v2 = d.get(magic) == Some(&0xFD);
+        let header = if v2 { 10 } else { 6 };
+        f.ints.extend([(at, 8), (magic + 1, 1)]);
+        if v2 {
+            f.ints
+                .extend([(magic + 2, 1), (magic + 5, 1), (magic + 7, 3)]);
+        } else {
+            f.ints.extend([(magic + 3, 1), (magic + 5, 1)]);
+        }
+        let payload_len = usize::from(d.get(magic + 1).copied().unwrap_or(0));
+        let payload = magic + header;
+        f.ints.push((payload + payload_len, 2));
+        f.floats
+            .extend((payload..(payload + payload_len).saturating_sub(3)).step_by(4));
+    }
+    f
+}
+
 /// Float values that break decoders and models, as `f32` bits: zeros of both signs, NaN, the
 /// infinities, the largest and smallest magnitudes.
 pub const EXTREME_F32: [f32; 12] = [
@@ -147,6 +177,16 @@ mod tests {
         );
         assert_eq!(f.floats, [49, 53]);
         assert_eq!(d[53..57], 10.0f32.to_le_bytes());
+    }
+
+    #[test]
+    fn tlog_timestamps_lengths_ids_crc_and_floats_are_found() {
+        let d = crate::seeds::tlog_made_in_code();
+        let f = tlog_fields(&d);
+        // The first frame: a MAVLink 1 HEARTBEAT (9 bytes of payload) at 0.
+        assert_eq!(f.ints[..5], [(0, 8), (9, 1), (11, 1), (13, 1), (23, 2)]);
+        assert_eq!(f.floats[..2], [14, 18]);
+        assert!(f.ints.len() > 50);
     }
 
     #[test]

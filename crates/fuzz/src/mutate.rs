@@ -4,7 +4,9 @@
 //! DataFlash (record sizes, ids, `FMT` lengths and timestamps set to extreme values, floats of
 //! data records to NaN, infinities and extremes, format characters to other ones).
 
-use crate::log_fields::{dataflash_fields, ulog_fields, LogFields, EXTREME_F32, FORMAT_CHARS};
+use crate::log_fields::{
+    dataflash_fields, tlog_fields, ulog_fields, LogFields, EXTREME_F32, FORMAT_CHARS,
+};
 use crate::rng::Rng;
 
 /// What kind of bytes a target reads, which decides the structure-aware mutations.
@@ -18,6 +20,8 @@ pub enum Format {
     Ulog,
     /// ArduPilot DataFlash: `FMT` lengths and formats, record types, timestamps, floats.
     Dataflash,
+    /// MAVLink telemetry log (`.tlog`): frame timestamps, lengths, flags, ids, payload floats.
+    Tlog,
 }
 
 /// Numbers that break parsers and models: zeros of both signs, subnormals, overflow to infinity,
@@ -243,7 +247,7 @@ impl Mutator {
     fn mutate_once(&self, rng: &mut Rng, data: &mut Vec<u8>, other: &[u8]) {
         let structured = match self.format {
             Format::Text => 9,
-            Format::Mcap | Format::Ulog | Format::Dataflash => 3,
+            Format::Mcap | Format::Ulog | Format::Dataflash | Format::Tlog => 3,
         };
         let k = rng.below(7 + structured);
         match k {
@@ -271,6 +275,10 @@ impl Mutator {
                 }
                 Format::Dataflash => {
                     let fields = dataflash_fields(data);
+                    log_field_mutation(rng, data, &fields, k - 7);
+                }
+                Format::Tlog => {
+                    let fields = tlog_fields(data);
                     log_field_mutation(rng, data, &fields, k - 7);
                 }
             },

@@ -494,6 +494,232 @@ pub fn dataflash() -> Vec<Vec<u8>> {
     out
 }
 
+/// How much of each shared telemetry log is a seed, bytes: its first frames (a few hundred,
+/// the first seconds: heartbeats, parameters, the first positions), small enough that a million
+/// inputs run in minutes.
+pub const TLOG_HEAD: usize = 16 << 10;
+
+/// A telemetry log made in code, frames of MAVLink 1 and 2 every 50 ms from 2024-05-01: a ground
+/// station's and the vehicle's HEARTBEAT, HOME_POSITION before the fix, GLOBAL_POSITION_INT
+/// without and with a fix, ATTITUDE, SYS_STATUS, BATTERY_STATUS, VFR_HUD, WIND,
+/// EXTENDED_SYS_STATE, an upload of a 3-item mission by the ground station (MISSION_COUNT,
+/// MISSION_ITEM_INT, MISSION_ITEM, MISSION_ACK), MISSION_CURRENT, SYSTEM_TIME going back (a
+/// restart).
+pub fn tlog_made_in_code() -> Vec<u8> {
+    use aloft_link::mavlink::dialects::ardupilotmega as m;
+    use aloft_link::mavlink::MavHeader;
+    let gcs = MavHeader {
+        system_id: 255,
+        component_id: 190,
+        sequence: 0,
+    };
+    let vehicle = MavHeader {
+        system_id: 1,
+        component_id: 1,
+        sequence: 0,
+    };
+    let heartbeat = |gcs_type: bool| {
+        m::MavMessage::HEARTBEAT(m::HEARTBEAT_DATA {
+            custom_mode: if gcs_type { 0 } else { 3 },
+            mavtype: if gcs_type {
+                m::MavType::MAV_TYPE_GCS
+            } else {
+                m::MavType::MAV_TYPE_QUADROTOR
+            },
+            autopilot: if gcs_type {
+                m::MavAutopilot::MAV_AUTOPILOT_INVALID
+            } else {
+                m::MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA
+            },
+            base_mode: m::MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
+            system_status: m::MavState::MAV_STATE_ACTIVE,
+            mavlink_version: 3,
+        })
+    };
+    let position = |ms: u32, lat: i32| {
+        m::MavMessage::GLOBAL_POSITION_INT(m::GLOBAL_POSITION_INT_DATA {
+            time_boot_ms: ms,
+            lat,
+            lon: if lat == 0 { 0 } else { 85_456_000 },
+            alt: 490_000,
+            relative_alt: 2_000,
+            vx: 150,
+            vy: -40,
+            vz: -20,
+            hdg: 9_000,
+        })
+    };
+    let item = |seq: u16| {
+        m::MavMessage::MISSION_ITEM_INT(m::MISSION_ITEM_INT_DATA {
+            param4: f32::NAN,
+            x: 473_977_000 + i32::from(seq) * 500,
+            y: 85_456_000,
+            z: 25.0,
+            seq,
+            command: m::MavCmd::MAV_CMD_NAV_WAYPOINT,
+            target_system: 1,
+            target_component: 1,
+            frame: m::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+            ..m::MISSION_ITEM_INT_DATA::default()
+        })
+    };
+    #[allow(deprecated)] // MISSION_ITEM: deprecated by MAVLink, still in logs
+    let float_item = m::MavMessage::MISSION_ITEM(m::MISSION_ITEM_DATA {
+        x: 47.399,
+        y: 8.5456,
+        z: 0.0,
+        seq: 2,
+        command: m::MavCmd::MAV_CMD_NAV_LAND,
+        target_system: 1,
+        target_component: 1,
+        frame: m::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        ..m::MISSION_ITEM_DATA::default()
+    });
+    let mut voltages = [u16::MAX; 10];
+    voltages[0] = 16_100;
+    let frames: Vec<(MavHeader, bool, m::MavMessage)> = vec![
+        (vehicle, false, heartbeat(false)),
+        (gcs, true, heartbeat(true)),
+        (
+            vehicle,
+            true,
+            m::MavMessage::HOME_POSITION(m::HOME_POSITION_DATA {
+                latitude: 473_977_000,
+                longitude: 85_456_000,
+                altitude: 488_000,
+                ..m::HOME_POSITION_DATA::default()
+            }),
+        ),
+        (vehicle, false, position(1_000, 0)),
+        (vehicle, true, position(1_100, 473_977_000)),
+        (
+            vehicle,
+            false,
+            m::MavMessage::ATTITUDE(m::ATTITUDE_DATA {
+                time_boot_ms: 1_150,
+                roll: 0.05,
+                pitch: -0.1,
+                yaw: 1.5,
+                ..m::ATTITUDE_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            false,
+            m::MavMessage::SYS_STATUS(m::SYS_STATUS_DATA {
+                voltage_battery: 16_100,
+                current_battery: 2_250,
+                battery_remaining: 87,
+                ..m::SYS_STATUS_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            true,
+            m::MavMessage::BATTERY_STATUS(m::BATTERY_STATUS_DATA {
+                current_consumed: 420,
+                voltages,
+                current_battery: 2_250,
+                battery_remaining: 87,
+                ..m::BATTERY_STATUS_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            false,
+            m::MavMessage::VFR_HUD(m::VFR_HUD_DATA {
+                airspeed: 6.0,
+                groundspeed: 5.5,
+                ..m::VFR_HUD_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            true,
+            m::MavMessage::WIND(m::WIND_DATA {
+                direction: 270.0,
+                speed: 3.0,
+                speed_z: 0.1,
+            }),
+        ),
+        (
+            vehicle,
+            true,
+            m::MavMessage::EXTENDED_SYS_STATE(m::EXTENDED_SYS_STATE_DATA {
+                landed_state: m::MavLandedState::MAV_LANDED_STATE_IN_AIR,
+                ..m::EXTENDED_SYS_STATE_DATA::default()
+            }),
+        ),
+        (
+            gcs,
+            true,
+            m::MavMessage::MISSION_COUNT(m::MISSION_COUNT_DATA {
+                count: 3,
+                target_system: 1,
+                target_component: 1,
+                ..m::MISSION_COUNT_DATA::default()
+            }),
+        ),
+        (gcs, true, item(0)),
+        (gcs, false, item(1)),
+        (gcs, false, float_item),
+        (
+            vehicle,
+            true,
+            m::MavMessage::MISSION_ACK(m::MISSION_ACK_DATA {
+                target_system: 255,
+                target_component: 190,
+                ..m::MISSION_ACK_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            false,
+            m::MavMessage::MISSION_CURRENT(m::MISSION_CURRENT_DATA {
+                seq: 1,
+                ..m::MISSION_CURRENT_DATA::default()
+            }),
+        ),
+        (
+            vehicle,
+            true,
+            m::MavMessage::SYSTEM_TIME(m::SYSTEM_TIME_DATA {
+                time_unix_usec: 0,
+                time_boot_ms: 9_000,
+            }),
+        ),
+        (
+            vehicle,
+            true,
+            m::MavMessage::SYSTEM_TIME(m::SYSTEM_TIME_DATA {
+                time_unix_usec: 0,
+                time_boot_ms: 500,
+            }),
+        ),
+        (vehicle, false, position(600, 473_978_000)),
+    ];
+    let mut out = Vec::new();
+    for (k, (header, v2, msg)) in frames.iter().enumerate() {
+        let t_us = 1_714_521_600_000_000u64 + 50_000 * k as u64;
+        out.extend(t_us.to_be_bytes());
+        let written = if *v2 {
+            aloft_link::mavlink::write_v2_msg(&mut out, *header, msg)
+        } else {
+            aloft_link::mavlink::write_v1_msg(&mut out, *header, msg)
+        };
+        // Writing to a Vec cannot fail.
+        let _ = written;
+    }
+    out
+}
+
+/// The telemetry log made in code, and the first [`TLOG_HEAD`] bytes of the shared `.tlog`s.
+pub fn tlog() -> Vec<Vec<u8>> {
+    let mut out = vec![tlog_made_in_code()];
+    out.extend(shared("telemetry", &[".tlog"], TLOG_HEAD));
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -516,6 +742,7 @@ mod tests {
         assert!(ulog().len() >= 3 + 3 * shared);
         assert!(dataflash().len() >= 2 + 4 * shared);
         assert!(ulog().iter().all(|s| s.len() <= DATA_LOG_HEAD));
+        assert!(tlog().len() > 5 * shared);
     }
 
     /// The seeds made in code are read whole, so the fuzzing starts from the accepted path.
@@ -537,6 +764,11 @@ mod tests {
                 .warnings
                 .is_empty());
         }
+        // Every frame of the telemetry log made in code reads back.
+        let t = tlog_made_in_code();
+        let mut r = aloft_link::TlogReader::new(&t[..], "seed");
+        assert_eq!(r.by_ref().count(), 20);
+        assert_eq!(r.stats().bytes_skipped, 0);
         let defs = aloft_logs::read_ulog(&ulog()[2][..], &o).unwrap();
         assert!(defs.log.samples.is_empty());
         let w = &defs.summary.warnings;

@@ -137,6 +137,15 @@ pub const TARGETS: &[Target] = &[
         seeds: seeds::dataflash,
         run: dataflash,
     },
+    Target {
+        name: "tlog",
+        about: "aloft_link::TlogSource of the bytes (frames, the vehicle's events: times never \
+                back, values finite); the frames' bytes and the skipped ones add up on every \
+                4th input",
+        format: Format::Tlog,
+        seeds: seeds::tlog,
+        run: tlog,
+    },
 ];
 
 /// A target by name.
@@ -535,4 +544,113 @@ fn dataflash(data: &[u8]) -> Outcome {
     binary_log(data, "log.bin", |d| {
         aloft_logs::read_dataflash(d, &aloft_logs::BinaryOptions::default())
     })
+}
+
+/// The numbers aloft computed in an event (mission parameters are passed as sent, NaN meaning
+/// "not set" in MAVLink, so they are not among them), and the event's kind.
+fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
+    use aloft_link::Event;
+    match e {
+        Event::Sample(s) => {
+            let mut v: Vec<f64> = [s.pos_enu_m, s.vel_enu_mps, s.acc_enu_mps2, s.wind_enu_mps]
+                .into_iter()
+                .flatten()
+                .flatten()
+                .collect();
+            v.extend(
+                [s.voltage_v, s.current_a, s.power_w, s.charge_ah]
+                    .into_iter()
+                    .flatten(),
+            );
+            if let Some(a) = s.attitude {
+                v.extend([a.roll_rad, a.pitch_rad, a.yaw_rad]);
+            }
+            v.push(s.time_s);
+            ("sample", v)
+        }
+        Event::Origin(o) => ("origin", vec![o.lat_rad, o.lon_rad, o.alt_m]),
+        Event::Home(h) => ("home", h.to_vec()),
+        Event::Heartbeat(_) => ("heartbeat", Vec::new()),
+        Event::Battery(b) => (
+            "battery",
+            [b.soc, b.consumed_ah].into_iter().flatten().collect(),
+        ),
+        Event::Speeds {
+            airspeed_mps,
+            groundspeed_mps,
+        } => ("speeds", vec![*airspeed_mps, *groundspeed_mps]),
+        Event::MissionCurrent(_) => ("mission-current", Vec::new()),
+        Event::Mission(m) => ("mission", vec![m.len() as f64]),
+        Event::Reboot => ("reboot", Vec::new()),
+        Event::LinkLost { silent_s } => ("link-lost", vec![*silent_s]),
+    }
+}
+
+/// A telemetry log: every event of [`aloft_link::TlogSource`], with its invariants checked (time
+/// finite and never going back, computed values finite, all bytes read), and the answer the
+/// counts of events by kind; on every 4th input the frames of [`aloft_link::TlogReader`] and the
+/// skipped bytes add up to the input.
+fn tlog(data: &[u8]) -> Outcome {
+    let mut o = Outcome::default();
+    let mut source = aloft_link::TlogSource::new(data, "fuzz.tlog");
+    let mut kinds: std::collections::BTreeMap<&'static str, u64> = Default::default();
+    let (mut last_s, mut largest) = (0.0f64, 0.0f64);
+    loop {
+        let t = match source.next_telemetry() {
+            Ok(Some(t)) => t,
+            Ok(None) => break,
+            Err(e) => {
+                o.broken.push(Problem {
+                    check: "tlog-read",
+                    detail: format!("a read error on bytes in memory: {e}"),
+                });
+                break;
+            }
+        };
+        if !(t.time_s.is_finite() && t.time_s >= last_s) {
+            o.broken.push(Problem {
+                check: "tlog-time",
+                detail: format!("time {} after {last_s}", t.time_s),
+            });
+        }
+        last_s = last_s.max(t.time_s);
+        let (kind, numbers) = event_numbers(&t.event);
+        *kinds.entry(kind).or_default() += 1;
+        if let Some(v) = numbers.iter().find(|v| !v.is_finite()) {
+            o.broken.push(Problem {
+                check: "tlog-non-finite",
+                detail: format!("{v} in {:?}", t.event),
+            });
+        }
+        largest = numbers.iter().fold(largest, |m, v| m.max(v.abs()));
+    }
+    let stats = *source.stats();
+    if stats.bytes != data.len() as u64 || stats.bytes_skipped > stats.bytes {
+        o.broken.push(Problem {
+            check: "tlog-bytes",
+            detail: format!("{} bytes in, {stats:?}", data.len()),
+        });
+    }
+    if fnv1a(data) % 4 == 0 {
+        let mut reader = aloft_link::TlogReader::new(data, "fuzz.tlog");
+        let framed: u64 = reader.by_ref().flatten().map(|f| f.len as u64).sum();
+        if framed + reader.stats().bytes_skipped != data.len() as u64 {
+            o.broken.push(Problem {
+                check: "tlog-framing",
+                detail: format!("{framed} framed + {:?} != {}", reader.stats(), data.len()),
+            });
+        }
+    }
+    o.accepted = stats.frames > 0;
+    let mut answer = serde_json::Map::new();
+    answer.insert("frames".into(), stats.frames.into());
+    answer.insert("bad_frames".into(), stats.bad_frames().into());
+    answer.insert("bytes_skipped".into(), stats.bytes_skipped.into());
+    answer.insert("last_time_s".into(), json_f64(last_s));
+    answer.insert("largest".into(), json_f64(largest));
+    for (k, n) in kinds {
+        answer.insert(k.into(), n.into());
+    }
+    o.json("tlog", &answer);
+    o
 }

@@ -24,7 +24,7 @@ static ALLOC: aloft_fuzz::CountingAlloc = aloft_fuzz::CountingAlloc;
 /// the 8 s cap (the count, not the time, ends the run).
 fn short_inputs(target: &str) -> u64 {
     match target {
-        "qgc-plan" | "ulog" => 2_000,
+        "qgc-plan" | "ulog" | "tlog" => 2_000,
         "dataflash" => 1_000,
         _ => 4_000,
     }

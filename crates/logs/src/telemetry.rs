@@ -19,6 +19,8 @@ pub struct Telemetry {
 }
 
 /// What a flight reports.
+// Most events are samples: boxing the large variant would allocate once per message.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum Event {
     /// The state at an instant: the channels the message carried, the others `None`
@@ -50,6 +52,13 @@ pub enum Event {
     /// The vehicle restarted (its boot time went back): what was learned of the flight so far no
     /// longer holds.
     Reboot,
+    /// Live links only: nothing from the vehicle for `silent_s` seconds (the link's timeout). Sent
+    /// again after every further timeout while the silence lasts; the stream goes on, as the link
+    /// may come back.
+    LinkLost {
+        /// Time since the vehicle's last message (or since the link opened), s.
+        silent_s: f64,
+    },
 }
 
 /// The vehicle's HEARTBEAT.

@@ -1,0 +1,436 @@
+use super::*;
+use mavlink::dialects::ardupilotmega::{
+    MavBatteryFunction, MavFrame, MavState, EXTENDED_SYS_STATE_DATA, MISSION_COUNT_DATA,
+    MISSION_CURRENT_DATA, SYSTEM_TIME_DATA, VFR_HUD_DATA,
+};
+
+/// Unit conversions are exact or within a few ulps of f32 -> f64 conversion; 1e-9 covers them.
+const TOL: f64 = 1e-9;
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol
+}
+
+fn h(system_id: u32, component_id: u8) -> MavHeader {
+    MavHeader {
+        system_id,
+        component_id,
+        sequence: 0,
+    }
+}
+
+const VEHICLE: (u32, u8) = (1, 1);
+
+fn hb(autopilot: MavAutopilot, mavtype: MavType, armed: bool, custom_mode: u32) -> MavMessage {
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode,
+        mavtype,
+        autopilot,
+        base_mode: if armed {
+            MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED | MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        } else {
+            MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED
+        },
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
+}
+
+fn copter_hb(armed: bool, mode: u32) -> MavMessage {
+    hb(
+        MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
+        MavType::MAV_TYPE_QUADROTOR,
+        armed,
+        mode,
+    )
+}
+
+/// A decoder that knows the vehicle (1, 1).
+fn decoder() -> Decoder {
+    let mut d = Decoder::new();
+    let mut out = Vec::new();
+    d.push(0.0, &h(1, 1), &copter_hb(false, 0), &mut out);
+    d
+}
+
+fn events(d: &mut Decoder, t: f64, header: MavHeader, msg: MavMessage) -> Vec<Telemetry> {
+    let mut out = Vec::new();
+    d.push(t, &header, &msg, &mut out);
+    out
+}
+
+fn samples(ev: &[Telemetry]) -> Vec<Sample> {
+    ev.iter()
+        .filter_map(|t| match &t.event {
+            Event::Sample(s) => Some(*s),
+            _ => None,
+        })
+        .collect()
+}
+
+fn gpi(time_boot_ms: u32, lat: i32, lon: i32, alt: i32, relative_alt: i32) -> MavMessage {
+    MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
+        time_boot_ms,
+        lat,
+        lon,
+        alt,
+        relative_alt,
+        vx: 100,
+        vy: -200,
+        vz: 50,
+        hdg: 0,
+    })
+}
+
+#[test]
+fn the_vehicle_is_the_first_autopilot_heartbeat_not_a_gcs_or_companion() {
+    let mut d = Decoder::new();
+    let gcs = hb(
+        MavAutopilot::MAV_AUTOPILOT_INVALID,
+        MavType::MAV_TYPE_GCS,
+        false,
+        0,
+    );
+    assert!(events(&mut d, 0.0, h(255, 190), gcs).is_empty());
+    let companion = hb(
+        MavAutopilot::MAV_AUTOPILOT_INVALID,
+        MavType::MAV_TYPE_ONBOARD_CONTROLLER,
+        false,
+        0,
+    );
+    assert!(events(&mut d, 0.1, h(1, 240), companion).is_empty());
+    assert_eq!(d.vehicle(), None);
+    let ev = events(&mut d, 0.2, h(1, 1), copter_hb(true, 3));
+    assert_eq!(d.vehicle(), Some(VEHICLE));
+    assert_eq!(
+        ev[0].event,
+        Event::Heartbeat(Heartbeat {
+            armed: true,
+            mode: "AUTO".into(),
+            vehicle_type: 2,
+        })
+    );
+    // A second autopilot, and another component of the vehicle's system, are not the vehicle.
+    assert!(events(&mut d, 0.3, h(2, 1), copter_hb(false, 5)).is_empty());
+    let time = MavMessage::SYSTEM_TIME(SYSTEM_TIME_DATA {
+        time_unix_usec: 0,
+        time_boot_ms: 0,
+    });
+    assert!(events(&mut d, 0.4, h(1, 240), time).is_empty());
+    assert_eq!(d.vehicle_messages(), 1);
+}
+
+#[test]
+fn sys_status_volts_amps_and_soc_with_their_not_sent_values() {
+    let mut d = decoder();
+    let status = |mv: u16, ca: i16, pct: i8| {
+        MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+            voltage_battery: mv,
+            current_battery: ca,
+            battery_remaining: pct,
+            ..SYS_STATUS_DATA::default()
+        })
+    };
+    let ev = events(&mut d, 1.0, h(1, 1), status(12_450, 5_500, 99));
+    let s = samples(&ev);
+    assert!(close(s[0].voltage_v.unwrap(), 12.45, TOL));
+    assert!(close(s[0].current_a.unwrap(), 55.0, TOL));
+    assert_eq!(
+        ev[1].event,
+        Event::Battery(BatteryState {
+            soc: Some(0.99),
+            consumed_ah: None
+        })
+    );
+    // Phoenix's log: no power module (0 V, -1, -1): nothing.
+    assert!(events(&mut d, 2.0, h(1, 1), status(0, -1, -1)).is_empty());
+    let ev = events(&mut d, 3.0, h(1, 1), status(u16::MAX, 100, -1));
+    assert_eq!(samples(&ev)[0].voltage_v, None);
+    assert_eq!(ev.len(), 1);
+}
+
+#[test]
+fn battery_status_sums_cells_and_reads_consumed_charge() {
+    let mut d = decoder();
+    let mut voltages = [u16::MAX; 10];
+    voltages[..3].copy_from_slice(&[4_100, 4_050, 4_000]);
+    let msg = MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
+        current_consumed: 2_060,
+        voltages,
+        current_battery: 1_234,
+        id: 0,
+        battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
+        battery_remaining: 20,
+        ..BATTERY_STATUS_DATA::default()
+    });
+    let ev = events(&mut d, 1.0, h(1, 1), msg.clone());
+    let s = samples(&ev)[0];
+    assert!(close(s.voltage_v.unwrap(), 12.15, TOL));
+    assert!(close(s.current_a.unwrap(), 12.34, TOL));
+    let Event::Battery(b) = &ev[1].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(b.consumed_ah.unwrap(), 2.06, TOL));
+    assert!(close(b.soc.unwrap(), 0.2, TOL));
+    // A second battery is not the flight pack.
+    let MavMessage::BATTERY_STATUS(mut second) = msg else {
+        unreachable!()
+    };
+    second.id = 1;
+    assert!(events(&mut d, 2.0, h(1, 1), MavMessage::BATTERY_STATUS(second)).is_empty());
+}
+
+#[test]
+fn the_first_fix_is_the_origin_and_positions_are_enu_from_it() {
+    let mut d = decoder();
+    // No fix yet: velocity only, no origin.
+    let ev = events(&mut d, 1.0, h(1, 1), gpi(1_000, 0, 0, 0, 0));
+    assert_eq!(ev.len(), 1);
+    let s = samples(&ev)[0];
+    assert_eq!(s.pos_enu_m, None);
+    // vx north 1 m/s, vy east -2 m/s, vz down 0.5 m/s.
+    let v = s.vel_enu_mps.unwrap();
+    assert!(close(v[0], -2.0, TOL) && close(v[1], 1.0, TOL) && close(v[2], -0.5, TOL));
+    let ev = events(
+        &mut d,
+        2.0,
+        h(1, 1),
+        gpi(2_000, 473_977_000, 85_456_000, 488_000, 1_500),
+    );
+    let Event::Origin(o) = ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(o.lat_rad.to_degrees(), 47.3977, TOL));
+    assert!(close(o.alt_m, 488.0, TOL));
+    assert_eq!(samples(&ev)[0].pos_enu_m, Some([0.0, 0.0, 0.0]));
+    // 1e-4 deg north (11.1 m) and 10 m higher above home.
+    let ev = events(
+        &mut d,
+        3.0,
+        h(1, 1),
+        gpi(3_000, 473_978_000, 85_456_000, 498_000, 11_500),
+    );
+    assert_eq!(ev.len(), 1, "the origin is sent once");
+    let p = samples(&ev)[0].pos_enu_m.unwrap();
+    // 1e-4 deg of latitude at 47.398 deg is 11.11786 m by the series for the length of a degree
+    // of latitude (111132.954 - 559.822 cos 2phi + 1.175 cos 4phi m); 1 mm covers the series'
+    // truncation and the tangent plane.
+    assert!(close(p[0], 0.0, 1e-6) && close(p[1], 11.11786, 1e-3) && close(p[2], 10.0, TOL));
+}
+
+#[test]
+fn home_before_the_first_fix_is_sent_after_the_origin_and_home_moves_shift_up() {
+    let mut d = decoder();
+    let home = |altitude: i32| {
+        MavMessage::HOME_POSITION(HOME_POSITION_DATA {
+            latitude: 473_977_000,
+            longitude: 85_456_000,
+            altitude,
+            ..HOME_POSITION_DATA::default()
+        })
+    };
+    assert!(events(&mut d, 0.5, h(1, 1), home(488_000)).is_empty());
+    // The first fix 2 m above home.
+    let ev = events(
+        &mut d,
+        1.0,
+        h(1, 1),
+        gpi(1_000, 473_977_000, 85_456_000, 490_000, 2_000),
+    );
+    assert!(matches!(ev[0].event, Event::Origin(_)));
+    let Event::Home(home_enu) = ev[1].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(home_enu[0], 0.0, TOL) && close(home_enu[2], -2.0, TOL));
+    // Home moved 1 m up (armed elsewhere): relative_alt drops by 1 m, up stays.
+    let ev = events(&mut d, 2.0, h(1, 1), home(489_000));
+    let Event::Home(home_enu) = ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(home_enu[2], -1.0, TOL));
+    let ev = events(
+        &mut d,
+        3.0,
+        h(1, 1),
+        gpi(3_000, 473_977_000, 85_456_000, 490_000, 1_000),
+    );
+    assert!(close(samples(&ev)[0].pos_enu_m.unwrap()[2], 0.0, TOL));
+}
+
+#[test]
+fn attitude_wind_speeds_and_landed() {
+    let mut d = decoder();
+    let att = MavMessage::ATTITUDE(ATTITUDE_DATA {
+        time_boot_ms: 10,
+        roll: 0.1,
+        pitch: -0.2,
+        yaw: 3.5,
+        ..ATTITUDE_DATA::default()
+    });
+    let a = samples(&events(&mut d, 1.0, h(1, 1), att))[0]
+        .attitude
+        .unwrap();
+    // f32 inputs: 1e-6 rad.
+    assert!(close(a.roll_rad, 0.1, 1e-6) && close(a.pitch_rad, -0.2, 1e-6));
+    assert!(close(a.yaw_rad, 3.5 - 2.0 * PI, 1e-6));
+    let wind = |direction, speed, speed_z| {
+        MavMessage::WIND(WIND_DATA {
+            direction,
+            speed,
+            speed_z,
+        })
+    };
+    // From the north at 5 m/s: the air moves south.
+    let w = samples(&events(&mut d, 2.0, h(1, 1), wind(0.0, 5.0, 0.0)))[0]
+        .wind_enu_mps
+        .unwrap();
+    assert!(close(w[0], 0.0, 1e-6) && close(w[1], -5.0, 1e-6) && close(w[2], 0.0, TOL));
+    // From the east, sinking air (NED z positive down).
+    let w = samples(&events(&mut d, 3.0, h(1, 1), wind(90.0, 4.0, 1.0)))[0]
+        .wind_enu_mps
+        .unwrap();
+    assert!(close(w[0], -4.0, 1e-6) && close(w[1], 0.0, 1e-6) && close(w[2], -1.0, TOL));
+    assert!(events(&mut d, 3.5, h(1, 1), wind(f32::NAN, 4.0, 0.0)).is_empty());
+    let hud = MavMessage::VFR_HUD(VFR_HUD_DATA {
+        airspeed: 7.5,
+        groundspeed: 6.25,
+        ..VFR_HUD_DATA::default()
+    });
+    assert_eq!(
+        events(&mut d, 4.0, h(1, 1), hud)[0].event,
+        Event::Speeds {
+            airspeed_mps: 7.5,
+            groundspeed_mps: 6.25
+        }
+    );
+    let landed = |state| {
+        MavMessage::EXTENDED_SYS_STATE(EXTENDED_SYS_STATE_DATA {
+            landed_state: state,
+            ..EXTENDED_SYS_STATE_DATA::default()
+        })
+    };
+    let on_ground = landed(MavLandedState::MAV_LANDED_STATE_ON_GROUND);
+    assert_eq!(
+        samples(&events(&mut d, 5.0, h(1, 1), on_ground))[0].landed,
+        Some(true)
+    );
+    let taking_off = landed(MavLandedState::MAV_LANDED_STATE_TAKEOFF);
+    assert_eq!(
+        samples(&events(&mut d, 6.0, h(1, 1), taking_off))[0].landed,
+        Some(false)
+    );
+    let undefined = landed(MavLandedState::MAV_LANDED_STATE_UNDEFINED);
+    assert!(events(&mut d, 7.0, h(1, 1), undefined).is_empty());
+}
+
+#[test]
+fn time_never_goes_back() {
+    let mut d = decoder();
+    let current = |seq| {
+        MavMessage::MISSION_CURRENT(MISSION_CURRENT_DATA {
+            seq,
+            ..MISSION_CURRENT_DATA::default()
+        })
+    };
+    let times: Vec<f64> = [5.0, 4.0, f64::NAN, 6.0, -1.0]
+        .iter()
+        .flat_map(|&t| events(&mut d, t, h(1, 1), current(1)))
+        .map(|t| t.time_s)
+        .collect();
+    assert_eq!(times, [5.0, 5.0, 5.0, 6.0, 6.0]);
+}
+
+#[test]
+fn a_reboot_starts_the_flight_over_and_repeats_the_mission() {
+    let mut d = decoder();
+    let item = |seq| {
+        MavMessage::MISSION_ITEM_INT(MISSION_ITEM_INT_DATA {
+            seq,
+            frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+            x: 473_977_000,
+            y: 85_456_000,
+            z: 20.0,
+            target_system: 255,
+            ..MISSION_ITEM_INT_DATA::default()
+        })
+    };
+    let count = MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+        count: 2,
+        target_system: 255,
+        ..MISSION_COUNT_DATA::default()
+    });
+    events(&mut d, 1.0, h(1, 1), count);
+    events(&mut d, 1.1, h(1, 1), item(0));
+    let ev = events(&mut d, 1.2, h(1, 1), item(1));
+    let Event::Mission(m) = &ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(m[1].params[4], 47.3977, TOL) && close(m[1].params[6], 20.0, TOL));
+    events(
+        &mut d,
+        2.0,
+        h(1, 1),
+        gpi(60_000, 473_977_000, 85_456_000, 0, 0),
+    );
+    // Back by 2 s: messages out of order, not a restart.
+    assert_eq!(
+        events(
+            &mut d,
+            3.0,
+            h(1, 1),
+            gpi(58_000, 473_977_000, 85_456_000, 0, 0)
+        )
+        .len(),
+        1
+    );
+    let ev = events(
+        &mut d,
+        4.0,
+        h(1, 1),
+        gpi(1_500, 473_978_000, 85_456_000, 0, 0),
+    );
+    assert_eq!(ev[0].event, Event::Reboot);
+    assert!(matches!(&ev[1].event, Event::Mission(m) if m.len() == 2));
+    let Event::Origin(o) = ev[2].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(o.lat_rad.to_degrees(), 47.3978, TOL));
+}
+
+#[test]
+fn an_upload_by_the_ground_station_is_the_mission_and_fences_are_not() {
+    let mut d = decoder();
+    let count = |mission_type| {
+        MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+            count: 1,
+            target_system: 1,
+            target_component: 1,
+            mission_type,
+            opaque_id: 0,
+        })
+    };
+    let item = |mission_type| {
+        MavMessage::MISSION_ITEM_INT(MISSION_ITEM_INT_DATA {
+            seq: 0,
+            frame: MavFrame::MAV_FRAME_LOCAL_NED,
+            x: 12_345,
+            y: -20_000,
+            z: -3.0,
+            target_system: 1,
+            mission_type,
+            ..MISSION_ITEM_INT_DATA::default()
+        })
+    };
+    let fence = MavMissionType::MAV_MISSION_TYPE_FENCE;
+    assert!(events(&mut d, 1.0, h(255, 190), count(fence)).is_empty());
+    assert!(events(&mut d, 1.1, h(255, 190), item(fence)).is_empty());
+    let mission = MavMissionType::MAV_MISSION_TYPE_MISSION;
+    assert!(events(&mut d, 1.2, h(255, 190), count(mission)).is_empty());
+    let ev = events(&mut d, 1.3, h(255, 190), item(mission));
+    let Event::Mission(m) = &ev[0].event else {
+        panic!("{ev:?}")
+    };
+    // Local frame: metres x 1e4.
+    assert!(close(m[0].params[4], 1.2345, TOL) && close(m[0].params[5], -2.0, TOL));
+    assert_eq!(d.mission().map(<[MissionItem]>::len), Some(1));
+}

@@ -1,0 +1,55 @@
+//! # aloft-link
+//!
+//! MAVLink for `aloft live`: telemetry logs (`.tlog`) and live links (UDP, TCP, serial) turned
+//! into aloft's telemetry events ([`aloft_logs::telemetry`]): SI units, positions and velocities
+//! in east-north-up (ENU) from the stream's first fix, attitude as aerospace Euler angles relative
+//! to north-east-down, seconds from the stream's start.
+//!
+//! Layers, each usable alone:
+//! - [`TlogReader`] ([`tlog`]): the frames of a `.tlog` from any reader (sans-I/O: a `&[u8]`
+//!   works), with bounded memory, CRC-checked by the `mavlink` crate's ArduPilot dialect, damage
+//!   skipped and counted ([`TlogStats`]).
+//! - [`Decoder`] ([`decode`]): messages of the vehicle into [`Telemetry`] events; the mission
+//!   assembled from the mission protocol ([`mission`]).
+//! - [`TlogSource`] and [`LinkSource`] ([`source`]): the two as
+//!   [`TelemetrySource`]s; a live link reads on a thread,
+//!   reports silence as [`Event::LinkLost`], answers with
+//!   [`LinkSource::reply`], and downloads the mission when none passed ([`request`]).
+//!
+//! ```no_run
+//! use std::path::Path;
+//! use aloft_link::TlogSource;
+//! let mut source = TlogSource::open(Path::new("flight.tlog"))?;
+//! while let Some(t) = source.next_telemetry()? {
+//!     println!("{:.2} {:?}", t.time_s, t.event);
+//! }
+//! eprintln!("{}", aloft_link::describe_stats(source.stats()));
+//! # Ok::<(), aloft_link::LinkError>(())
+//! ```
+//!
+//! The library never prints or exits; every failure is a [`LinkError`] naming the file and byte
+//! offset, or the link.
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod decode;
+pub mod error;
+pub mod mission;
+mod modes;
+pub mod request;
+pub mod source;
+pub mod tlog;
+
+pub use aloft_logs::telemetry::{
+    BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,
+};
+pub use decode::Decoder;
+pub use error::{LinkError, Result};
+/// The `mavlink` crate aloft-link is built on (its ArduPilot dialect's message types appear in
+/// [`TlogFrame`] and [`Decoder::push`]).
+pub use mavlink;
+pub use mission::MAX_MISSION_ITEMS;
+pub use modes::mode_name;
+pub use source::{describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
+pub use tlog::{TlogFrame, TlogReader, TlogStats};

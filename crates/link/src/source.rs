@@ -1,0 +1,624 @@
+//! Telemetry sources for `aloft live`: a telemetry log ([`TlogSource`]) and a live MAVLink link
+//! ([`LinkSource`]), both [`TelemetrySource`]s.
+//!
+//! # Live links
+//!
+//! [`LinkSource::connect`] opens `udpin:HOST:PORT` (listen; replies go to the last sender),
+//! `udpout:HOST:PORT`, `tcpout:HOST:PORT` or `serial:PATH:BAUD` with the `mavlink` crate,
+//! accepting MAVLink 1 and 2. A thread reads the link into a bounded channel (1,024 messages; a
+//! consumer that falls behind holds the reader back rather than losing messages in the middle of
+//! the queue), so [`LinkSource::next_telemetry`] waits at most the link timeout:
+//!
+//! - while the vehicle is silent for [`LinkOptions::timeout`], `next` returns
+//!   [`Event::LinkLost`] (again after every further timeout), and the stream goes on: the link
+//!   may come back;
+//! - a link that ends (TCP closed, serial port gone) is an error, which ends the stream.
+//!
+//! Event times are seconds since the link opened, at each message's arrival.
+//!
+//! aloft speaks on the link as a ground station with [`LinkOptions::system_id`] and
+//! [`LinkOptions::component_id`] (default 255/190), in the MAVLink version the vehicle speaks
+//! (MAVLink 2 until the vehicle is heard):
+//! - a HEARTBEAT (MAV_TYPE_GCS) every second, so that routers and autopilots that answer the
+//!   last sender send to aloft ([`LinkOptions::heartbeat`]);
+//! - [`LinkSource::reply`]: NAMED_VALUE_FLOAT (`time_boot_ms` since the link opened, a name of at
+//!   most 10 bytes) and STATUSTEXT (WARNING or INFO, at most 50 bytes, cut at a character);
+//! - the mission download of [`crate::request`] when no mission passed on the link
+//!   ([`LinkOptions::request_mission`]).
+//!
+//! On `udpin`, nothing can be sent before the first datagram arrives (there is no peer yet):
+//! such sends are dropped silently.
+
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{ErrorKind, Read};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use aloft_logs::telemetry::{Event, Reply, Telemetry, TelemetrySource};
+use mavlink::dialects::ardupilotmega::{
+    MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
+    NAMED_VALUE_FLOAT_DATA, STATUSTEXT_DATA,
+};
+use mavlink::error::MessageReadError;
+use mavlink::{
+    Connectable, Connection, ConnectionAddress, MAVLinkMessageRaw, MAVLinkV1MessageRaw,
+    MAVLinkV2MessageRaw, MavConnection, MavHeader, MavlinkVersion, Message,
+};
+
+use crate::decode::Decoder;
+use crate::error::LinkError;
+use crate::request::MissionRequest;
+use crate::tlog::{TlogReader, TlogStats};
+
+/// A telemetry log read as a stream of events: times from the first frame's timestamp.
+pub struct TlogSource<R = File> {
+    reader: TlogReader<R>,
+    decoder: Decoder,
+    queue: VecDeque<Telemetry>,
+    first_us: Option<u64>,
+    finished: bool,
+}
+
+impl TlogSource<File> {
+    /// Opens a `.tlog` file.
+    pub fn open(path: &Path) -> Result<Self, LinkError> {
+        let file = File::open(path).map_err(|cause| LinkError::Open {
+            path: path.to_path_buf(),
+            cause,
+        })?;
+        Ok(Self::new(file, path.display().to_string()))
+    }
+}
+
+impl<R: Read> TlogSource<R> {
+    /// The events of the telemetry log `source`; `name` is what errors name.
+    pub fn new(source: R, name: impl Into<String>) -> Self {
+        Self {
+            reader: TlogReader::new(source, name),
+            decoder: Decoder::new(),
+            queue: VecDeque::new(),
+            first_us: None,
+            finished: false,
+        }
+    }
+
+    /// The next event, `None` at the end of the log.
+    pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
+        loop {
+            if let Some(t) = self.queue.pop_front() {
+                return Ok(Some(t));
+            }
+            if self.finished {
+                return Ok(None);
+            }
+            match self.reader.next_frame()? {
+                Some(frame) => {
+                    let first = *self.first_us.get_or_insert(frame.timestamp_us);
+                    // Before the first frame (out of order): clamped to 0 by the decoder.
+                    let time_s = (frame.timestamp_us as f64 - first as f64) * 1e-6;
+                    self.decoder
+                        .push(time_s, &frame.header, &frame.message, &mut self.queue);
+                }
+                None => {
+                    self.finished = true;
+                    self.decoder.finish(&mut self.queue);
+                }
+            }
+        }
+    }
+
+    /// What the reader has read and passed over so far.
+    pub fn stats(&self) -> &TlogStats {
+        self.reader.stats()
+    }
+
+    /// The decoder (the vehicle, the origin, the mission so far).
+    pub fn decoder(&self) -> &Decoder {
+        &self.decoder
+    }
+
+    /// The first frame's timestamp, µs since the Unix epoch (time 0 of the events).
+    pub fn start_us(&self) -> Option<u64> {
+        self.first_us
+    }
+}
+
+/// `N bad frames (c wrong CRC, u unknown, d undecodable, t bad time, x cut short), B bytes
+/// skipped`, or empty when nothing was passed over.
+pub fn describe_stats(s: &TlogStats) -> String {
+    if s.bytes_skipped == 0 && s.bad_frames() == 0 {
+        return String::new();
+    }
+    format!(
+        "{} bad frames ({} wrong CRC, {} unknown, {} undecodable, {} bad time, {} cut short), \
+         {} bytes skipped",
+        s.bad_frames(),
+        s.bad_crc,
+        s.unknown,
+        s.undecoded,
+        s.bad_time,
+        s.truncated,
+        s.bytes_skipped
+    )
+}
+
+impl<R: Read> TelemetrySource for TlogSource<R> {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        self.next_telemetry().map_err(|e| e.to_string())
+    }
+
+    fn skipped(&self) -> String {
+        describe_stats(self.reader.stats())
+    }
+}
+
+/// How aloft takes part in a live link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LinkOptions {
+    /// aloft's system id on the link (a ground station's: 255 by default).
+    pub system_id: u8,
+    /// aloft's component id (190, MAV_COMP_ID_MISSIONPLANNER, by default).
+    pub component_id: u8,
+    /// Silence of the vehicle after which [`Event::LinkLost`] is returned (5 s by default).
+    pub timeout: Duration,
+    /// Send a ground-station HEARTBEAT every second (default true).
+    pub heartbeat: bool,
+    /// Ask the vehicle for its mission when none passed on the link (default true).
+    pub request_mission: bool,
+}
+
+impl Default for LinkOptions {
+    fn default() -> Self {
+        Self {
+            system_id: 255,
+            component_id: 190,
+            timeout: Duration::from_secs(5),
+            heartbeat: true,
+            request_mission: true,
+        }
+    }
+}
+
+/// What a live link has passed over so far.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LinkStats {
+    /// Messages received and decoded (any system).
+    pub messages: u64,
+    /// Messages of the vehicle.
+    pub vehicle_messages: u64,
+    /// Frames with a valid CRC whose payload the dialect refused.
+    pub undecoded: u64,
+    /// Messages sent by aloft.
+    pub sent: u64,
+}
+
+/// The link's reading thread's output.
+enum Incoming {
+    Message {
+        header: MavHeader,
+        version: MavlinkVersion,
+        message: Box<MavMessage>,
+        at: Instant,
+    },
+    Closed(std::io::Error),
+}
+
+/// Messages the reading thread may hold before it waits for the consumer.
+const CHANNEL: usize = 1_024;
+/// Read timeout of UDP sockets: how often the reading thread looks whether it should stop.
+const READ_TIMEOUT: Duration = Duration::from_millis(100);
+/// Longest wait for a message in [`LinkSource::next_telemetry`] before heartbeats and the mission request
+/// get their turn.
+const TICK: Duration = Duration::from_millis(250);
+/// Period of aloft's HEARTBEAT.
+const HEARTBEAT_PERIOD: Duration = Duration::from_secs(1);
+
+type Link = Connection<MavMessage>;
+
+/// A live MAVLink link as a stream of events (see the module docs).
+pub struct LinkSource {
+    url: String,
+    options: LinkOptions,
+    link: Arc<Link>,
+    incoming: Receiver<Incoming>,
+    stop: Arc<AtomicBool>,
+    undecoded: Arc<AtomicU64>,
+    decoder: Decoder,
+    queue: VecDeque<Telemetry>,
+    start: Instant,
+    last_vehicle: Option<Instant>,
+    last_lost: Option<Instant>,
+    last_heartbeat: Option<Instant>,
+    vehicle_version: MavlinkVersion,
+    sequence: u8,
+    request: MissionRequest,
+    stats: LinkStats,
+    closed: bool,
+}
+
+impl LinkSource {
+    /// Opens the link `url` (`udpin:HOST:PORT`, `udpout:HOST:PORT`, `tcpout:HOST:PORT`,
+    /// `serial:PATH:BAUD`) and starts reading it.
+    pub fn connect(url: &str, options: LinkOptions) -> Result<Self, LinkError> {
+        let address = parse_url(url)?;
+        let mut link = address
+            .connect::<MavMessage>()
+            .map_err(|cause| LinkError::Connect {
+                url: url.to_owned(),
+                cause,
+            })?;
+        link.set_allow_recv_any_version(true);
+        let link = Arc::new(link);
+        let (tx, incoming) = sync_channel(CHANNEL);
+        let stop = Arc::new(AtomicBool::new(false));
+        let undecoded = Arc::new(AtomicU64::new(0));
+        {
+            let (link, stop, undecoded) = (link.clone(), stop.clone(), undecoded.clone());
+            std::thread::Builder::new()
+                .name("aloft-link-reader".into())
+                .spawn(move || read_link(&link, &tx, &stop, &undecoded))
+                .map_err(|cause| LinkError::Connect {
+                    url: url.to_owned(),
+                    cause,
+                })?;
+        }
+        Ok(Self {
+            url: url.to_owned(),
+            options,
+            link,
+            incoming,
+            stop,
+            undecoded,
+            decoder: Decoder::new(),
+            queue: VecDeque::new(),
+            start: Instant::now(),
+            last_vehicle: None,
+            last_lost: None,
+            last_heartbeat: None,
+            vehicle_version: MavlinkVersion::V2,
+            sequence: 0,
+            request: MissionRequest::new(
+                (options.system_id, options.component_id),
+                options.request_mission,
+            ),
+            stats: LinkStats::default(),
+            closed: false,
+        })
+    }
+
+    /// The next event: a message's, [`Event::LinkLost`] after [`LinkOptions::timeout`] of the
+    /// vehicle's silence, `None` once the link has ended (after its error was returned).
+    pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
+        loop {
+            if let Some(t) = self.queue.pop_front() {
+                return Ok(Some(t));
+            }
+            if self.closed {
+                return Ok(None);
+            }
+            let now = Instant::now();
+            self.tick(now)?;
+            let silent_since = self.last_vehicle.unwrap_or(self.start);
+            let lost_at =
+                self.last_lost.map_or(silent_since, |l| l.max(silent_since)) + self.options.timeout;
+            if now >= lost_at {
+                self.last_lost = Some(now);
+                return Ok(Some(Telemetry {
+                    time_s: self.time_s(now),
+                    event: Event::LinkLost {
+                        silent_s: now.duration_since(silent_since).as_secs_f64(),
+                    },
+                }));
+            }
+            let wait = lost_at.duration_since(now).min(TICK);
+            match self.incoming.recv_timeout(wait) {
+                Ok(Incoming::Message {
+                    header,
+                    version,
+                    message,
+                    at,
+                }) => self.received(&header, version, &message, at)?,
+                Ok(Incoming::Closed(cause)) => return Err(self.close(cause)),
+                Err(RecvTimeoutError::Timeout) => {}
+                Err(RecvTimeoutError::Disconnected) => {
+                    let cause = std::io::Error::other("the reading thread ended");
+                    return Err(self.close(cause));
+                }
+            }
+        }
+    }
+
+    /// Sends a reply to the ground station (NAMED_VALUE_FLOAT or STATUSTEXT) from aloft's ids.
+    pub fn reply(&mut self, reply: &Reply) -> Result<(), LinkError> {
+        let (message, name) = match reply {
+            Reply::Value { name, value } => (
+                named_value(self.boot_ms(), name, *value),
+                "NAMED_VALUE_FLOAT",
+            ),
+            Reply::Text { text, warning } => (status_text(text, *warning), "STATUSTEXT"),
+        };
+        self.send(&message, name)
+    }
+
+    /// What has been received, passed over and sent so far.
+    pub fn stats(&self) -> LinkStats {
+        LinkStats {
+            undecoded: self.undecoded.load(Ordering::Relaxed),
+            ..self.stats
+        }
+    }
+
+    /// The decoder (the vehicle, the origin, the mission so far).
+    pub fn decoder(&self) -> &Decoder {
+        &self.decoder
+    }
+
+    /// The address the link was opened with.
+    pub fn url(&self) -> &str {
+        &self.url
+    }
+
+    fn time_s(&self, at: Instant) -> f64 {
+        at.saturating_duration_since(self.start).as_secs_f64()
+    }
+
+    /// Milliseconds since the link opened, as a boot time.
+    fn boot_ms(&self) -> u32 {
+        u32::try_from(self.start.elapsed().as_millis()).unwrap_or(u32::MAX)
+    }
+
+    fn received(
+        &mut self,
+        header: &MavHeader,
+        version: MavlinkVersion,
+        message: &MavMessage,
+        at: Instant,
+    ) -> Result<(), LinkError> {
+        self.stats.messages += 1;
+        let time_s = self.time_s(at);
+        if !self.decoder.push(time_s, header, message, &mut self.queue) {
+            return Ok(());
+        }
+        self.stats.vehicle_messages += 1;
+        self.last_vehicle = Some(at);
+        self.vehicle_version = version;
+        if let Some(answer) = self.request.on_vehicle_message(at, header, message) {
+            self.send(&answer, answer.message_name())?;
+        }
+        Ok(())
+    }
+
+    /// Heartbeat and mission request, when due.
+    fn tick(&mut self, now: Instant) -> Result<(), LinkError> {
+        let due = self
+            .last_heartbeat
+            .is_none_or(|t| now.duration_since(t) >= HEARTBEAT_PERIOD);
+        if self.options.heartbeat && due {
+            self.last_heartbeat = Some(now);
+            self.send(&gcs_heartbeat(), "HEARTBEAT")?;
+        }
+        if !self.request.is_done() {
+            let known = self.decoder.mission().is_some();
+            if let Some(msg) = self.request.tick(now, self.decoder.vehicle(), known) {
+                self.send(&msg, msg.message_name())?;
+            }
+        }
+        Ok(())
+    }
+
+    fn send(&mut self, message: &MavMessage, name: &'static str) -> Result<(), LinkError> {
+        let header = MavHeader {
+            system_id: u32::from(self.options.system_id),
+            component_id: self.options.component_id,
+            sequence: self.sequence,
+        };
+        self.sequence = self.sequence.wrapping_add(1);
+        let raw = match self.vehicle_version {
+            MavlinkVersion::V1 => {
+                let mut raw = MAVLinkV1MessageRaw::new();
+                raw.serialize_message(header, message);
+                MAVLinkMessageRaw::V1(raw)
+            }
+            MavlinkVersion::V2 => {
+                let mut raw = MAVLinkV2MessageRaw::new();
+                raw.serialize_message(header, message);
+                MAVLinkMessageRaw::V2(raw)
+            }
+        };
+        match self.link.send_raw(&raw) {
+            Ok(_) => {
+                self.stats.sent += 1;
+                Ok(())
+            }
+            // No peer yet on `udpin`, or a full socket buffer: the message is dropped.
+            Err(mavlink::error::MessageWriteError::Io(e)) if e.kind() == ErrorKind::WouldBlock => {
+                Ok(())
+            }
+            Err(e) => Err(LinkError::Send {
+                url: self.url.clone(),
+                message: name,
+                cause: std::io::Error::other(e.to_string()),
+            }),
+        }
+    }
+
+    fn close(&mut self, cause: std::io::Error) -> LinkError {
+        self.closed = true;
+        LinkError::Closed {
+            url: self.url.clone(),
+            cause,
+        }
+    }
+}
+
+impl Drop for LinkSource {
+    fn drop(&mut self) {
+        // The reading thread ends at its next read timeout (UDP, TCP) or message (serial).
+        self.stop.store(true, Ordering::Relaxed);
+    }
+}
+
+impl TelemetrySource for LinkSource {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        self.next_telemetry().map_err(|e| e.to_string())
+    }
+
+    fn skipped(&self) -> String {
+        let undecoded = self.undecoded.load(Ordering::Relaxed);
+        if undecoded == 0 {
+            String::new()
+        } else {
+            format!("{undecoded} undecodable messages")
+        }
+    }
+}
+
+/// The link address, checked to be one of the supported forms; UDP sockets get a read timeout
+/// so that the reading thread can stop.
+fn parse_url(url: &str) -> Result<ConnectionAddress, LinkError> {
+    let bad = || LinkError::Address {
+        url: url.to_owned(),
+    };
+    let (scheme, rest) = url.split_once(':').ok_or_else(bad)?;
+    let (host, port) = rest.rsplit_once(':').ok_or_else(bad)?;
+    let supported = matches!(scheme, "udpin" | "udpout" | "tcpout" | "serial");
+    if !supported || host.is_empty() || port.is_empty() {
+        return Err(bad());
+    }
+    let numeric = port.parse::<u32>().is_ok();
+    if !numeric {
+        return Err(bad());
+    }
+    match ConnectionAddress::parse_address(url).map_err(|_| bad())? {
+        ConnectionAddress::Udp(c) => Ok(ConnectionAddress::Udp(c.read_timeout(READ_TIMEOUT))),
+        other => Ok(other),
+    }
+}
+
+/// Reads the link until it ends or the source is dropped.
+fn read_link(link: &Link, tx: &SyncSender<Incoming>, stop: &AtomicBool, undecoded: &AtomicU64) {
+    while !stop.load(Ordering::Relaxed) {
+        match link.recv_raw() {
+            Ok(raw) => {
+                let version = raw.version();
+                match MavMessage::parse(version, raw.message_id(), raw.payload()) {
+                    Ok(message) => {
+                        let header = MavHeader {
+                            system_id: raw.system_id(),
+                            component_id: raw.component_id(),
+                            sequence: raw.sequence(),
+                        };
+                        let incoming = Incoming::Message {
+                            header,
+                            version,
+                            message: Box::new(message),
+                            at: Instant::now(),
+                        };
+                        if tx.send(incoming).is_err() {
+                            return;
+                        }
+                    }
+                    Err(_) => {
+                        undecoded.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+            }
+            Err(MessageReadError::Io(e))
+                if matches!(
+                    e.kind(),
+                    ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
+                ) => {}
+            Err(MessageReadError::Io(e)) => {
+                let _ = tx.send(Incoming::Closed(e));
+                return;
+            }
+            Err(MessageReadError::Parse(_)) => {
+                undecoded.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    }
+}
+
+fn gcs_heartbeat() -> MavMessage {
+    MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: MavType::MAV_TYPE_GCS,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+        base_mode: MavModeFlag::empty(),
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
+}
+
+/// NAMED_VALUE_FLOAT: the name's first 10 bytes.
+fn named_value(time_boot_ms: u32, name: &str, value: f64) -> MavMessage {
+    MavMessage::NAMED_VALUE_FLOAT(NAMED_VALUE_FLOAT_DATA {
+        time_boot_ms,
+        value: value as f32,
+        name: truncated(name, 10).into(),
+    })
+}
+
+/// STATUSTEXT at WARNING or INFO severity: the text's first 50 bytes, cut at a character.
+fn status_text(text: &str, warning: bool) -> MavMessage {
+    let severity = if warning {
+        MavSeverity::MAV_SEVERITY_WARNING
+    } else {
+        MavSeverity::MAV_SEVERITY_INFO
+    };
+    MavMessage::STATUSTEXT(STATUSTEXT_DATA {
+        severity,
+        text: truncated(text, 50).into(),
+        id: 0,
+        chunk_seq: 0,
+    })
+}
+
+/// The longest prefix of `s` of at most `max` bytes that ends at a character boundary.
+fn truncated(s: &str, max: usize) -> &str {
+    let mut end = s.len().min(max);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn addresses_outside_the_four_forms_are_refused() {
+        for url in [
+            "udp:127.0.0.1:14550",
+            "tcpin:127.0.0.1:5760",
+            "file:/tmp/x.tlog",
+            "udpin:14550",
+            "udpin:127.0.0.1:",
+            "serial:/dev/ttyUSB0:fast",
+            "udpin:127.0.0.1:14550x",
+            "",
+        ] {
+            let e = parse_url(url).err().unwrap();
+            assert!(e.to_string().starts_with(url), "{e}");
+        }
+        assert!(parse_url("udpin:127.0.0.1:14550").is_ok());
+        assert!(parse_url("serial:/dev/ttyUSB0:57600").is_ok());
+    }
+
+    #[test]
+    fn texts_are_cut_at_characters() {
+        assert_eq!(truncated("energy_remaining", 10), "energy_rem");
+        assert_eq!(truncated("ééééééé", 5), "éé");
+        let long = "x".repeat(80);
+        let MavMessage::STATUSTEXT(t) = status_text(&long, true) else {
+            panic!("not a STATUSTEXT")
+        };
+        assert_eq!(t.text.to_str().unwrap().len(), 50);
+        assert_eq!(t.severity, MavSeverity::MAV_SEVERITY_WARNING);
+    }
+}

@@ -1,0 +1,265 @@
+//! A live link on the loopback interface: `LinkSource` listens on `udpin:127.0.0.1:PORT`; a
+//! simulated vehicle on another UDP socket of 127.0.0.1 sends MAVLink 1 telemetry, answers the
+//! mission download, and receives aloft's replies; then falls silent.
+
+use std::net::UdpSocket;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{channel, Sender};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use aloft_link::mavlink::dialects::ardupilotmega::{
+    MavAutopilot, MavFrame, MavMessage, MavModeFlag, MavSeverity, MavState, MavType,
+    GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA, MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA,
+    SYS_STATUS_DATA,
+};
+use aloft_link::mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
+use aloft_link::{Event, LinkOptions, LinkSource, Reply, Telemetry};
+
+const VEHICLE: MavHeader = MavHeader {
+    system_id: 1,
+    component_id: 1,
+    sequence: 0,
+};
+
+/// What the vehicle received from aloft.
+type Received = (MavlinkVersion, MavHeader, MavMessage);
+
+fn frame(msg: &MavMessage) -> Vec<u8> {
+    let mut out = Vec::new();
+    aloft_link::mavlink::write_v1_msg(&mut out, VEHICLE, msg).expect("serialise");
+    out
+}
+
+fn telemetry() -> Vec<MavMessage> {
+    vec![
+        MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            custom_mode: 3,
+            mavtype: MavType::MAV_TYPE_QUADROTOR,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
+            base_mode: MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
+            system_status: MavState::MAV_STATE_ACTIVE,
+            mavlink_version: 3,
+        }),
+        MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
+            time_boot_ms: 10_000,
+            lat: 473_977_000,
+            lon: 85_456_000,
+            alt: 500_000,
+            relative_alt: 12_000,
+            ..GLOBAL_POSITION_INT_DATA::default()
+        }),
+        MavMessage::SYS_STATUS(SYS_STATUS_DATA {
+            voltage_battery: 15_200,
+            current_battery: 1_250,
+            battery_remaining: 80,
+            ..SYS_STATUS_DATA::default()
+        }),
+    ]
+}
+
+/// The mission protocol's answers of the vehicle: MISSION_COUNT 2, then each item asked for.
+fn answer(msg: &MavMessage) -> Option<MavMessage> {
+    match msg {
+        MavMessage::MISSION_REQUEST_LIST(_) => {
+            Some(MavMessage::MISSION_COUNT(MISSION_COUNT_DATA {
+                count: 2,
+                target_system: 255,
+                target_component: 190,
+                ..MISSION_COUNT_DATA::default()
+            }))
+        }
+        MavMessage::MISSION_REQUEST_INT(r) => {
+            Some(MavMessage::MISSION_ITEM_INT(MISSION_ITEM_INT_DATA {
+                seq: r.seq,
+                frame: MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+                x: 473_977_000 + i32::from(r.seq) * 1_000,
+                y: 85_456_000,
+                z: 30.0,
+                target_system: 255,
+                target_component: 190,
+                ..MISSION_ITEM_INT_DATA::default()
+            }))
+        }
+        _ => None,
+    }
+}
+
+/// The vehicle: telemetry every 100 ms while `talking`, answers to aloft's requests, everything
+/// received forwarded to the test.
+fn vehicle(port: u16, talking: Arc<AtomicBool>, done: Arc<AtomicBool>, tx: Sender<Received>) {
+    let socket = UdpSocket::bind("127.0.0.1:0").expect("bind");
+    socket.connect(("127.0.0.1", port)).expect("connect");
+    socket
+        .set_read_timeout(Some(Duration::from_millis(20)))
+        .expect("timeout");
+    let mut last_sent: Option<Instant> = None;
+    let mut buf = [0u8; 2048];
+    while !done.load(Ordering::Relaxed) {
+        let due = last_sent.is_none_or(|t| t.elapsed() >= Duration::from_millis(100));
+        if talking.load(Ordering::Relaxed) && due {
+            last_sent = Some(Instant::now());
+            for m in telemetry() {
+                let _ = socket.send(&frame(&m));
+            }
+        }
+        let Ok(n) = socket.recv(&mut buf) else {
+            continue;
+        };
+        let mut reader = MavlinkReader::new(&buf[..n]);
+        while let Ok(raw) = reader.read_any_raw_message::<MavMessage>() {
+            let header = MavHeader {
+                system_id: raw.system_id(),
+                component_id: raw.component_id(),
+                sequence: raw.sequence(),
+            };
+            let Ok(msg) = <MavMessage as aloft_link::mavlink::Message>::parse(
+                raw.version(),
+                raw.message_id(),
+                raw.payload(),
+            ) else {
+                continue;
+            };
+            if let Some(a) = answer(&msg) {
+                let _ = socket.send(&frame(&a));
+            }
+            let _ = tx.send((raw.version(), header, msg));
+        }
+    }
+}
+
+/// Events of the link until `stop` says so or 15 s pass.
+fn events_until(link: &mut LinkSource, mut stop: impl FnMut(&Telemetry) -> bool) -> Vec<Telemetry> {
+    let deadline = Instant::now() + Duration::from_secs(15);
+    let mut out = Vec::new();
+    while Instant::now() < deadline {
+        let t = link.next_telemetry().expect("link up").expect("link open");
+        let end = stop(&t);
+        out.push(t);
+        if end {
+            return out;
+        }
+    }
+    panic!("no such event in 15 s: {:?}", out.last());
+}
+
+#[test]
+fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
+    let port = {
+        let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
+        probe.local_addr().expect("address").port()
+    };
+    let options = LinkOptions {
+        timeout: Duration::from_millis(600),
+        ..LinkOptions::default()
+    };
+    let mut link = LinkSource::connect(&format!("udpin:127.0.0.1:{port}"), options).expect("udpin");
+    let talking = Arc::new(AtomicBool::new(true));
+    let done = Arc::new(AtomicBool::new(false));
+    let (tx, rx) = channel();
+    let sim = {
+        let (talking, done) = (talking.clone(), done.clone());
+        std::thread::spawn(move || vehicle(port, talking, done, tx))
+    };
+
+    // Telemetry: heartbeat, origin and position, battery.
+    let mut seen = (false, false, false);
+    events_until(&mut link, |t| {
+        match &t.event {
+            Event::Heartbeat(h) => seen.0 = h.armed && h.mode == "AUTO",
+            Event::Origin(o) => seen.1 = (o.lat_rad.to_degrees() - 47.3977).abs() < 1e-9,
+            Event::Sample(s) => seen.2 |= s.voltage_v.is_some_and(|v| (v - 15.2).abs() < 1e-12),
+            _ => {}
+        }
+        seen == (true, true, true)
+    });
+    assert_eq!(link.decoder().vehicle(), Some((1, 1)));
+
+    // Replies, to the vehicle (the last sender on udpin).
+    link.reply(&Reply::Value {
+        name: "energy_remaining_wh",
+        value: 42.5,
+    })
+    .expect("send");
+    link.reply(&Reply::Text {
+        text: "aloft: return now, 12 % margin left at home".into(),
+        warning: true,
+    })
+    .expect("send");
+
+    // The mission, downloaded by aloft START_AFTER the vehicle's first message.
+    let ev = events_until(&mut link, |t| matches!(t.event, Event::Mission(_)));
+    let Some(Event::Mission(m)) = ev.last().map(|t| &t.event) else {
+        unreachable!()
+    };
+    assert_eq!(m.len(), 2);
+    assert!((m[1].params[4] - 47.3978).abs() < 1e-9);
+
+    // Silence: LinkLost after the timeout, again after another one.
+    talking.store(false, Ordering::Relaxed);
+    let lost = events_until(&mut link, |t| matches!(t.event, Event::LinkLost { .. }));
+    let Some(Event::LinkLost { silent_s }) = lost.last().map(|t| t.event.clone()) else {
+        unreachable!()
+    };
+    assert!((0.6..1.5).contains(&silent_s), "{silent_s}");
+    let again = link.next_telemetry().expect("link up").expect("open");
+    assert!(matches!(again.event, Event::LinkLost { silent_s } if silent_s >= 1.2));
+    done.store(true, Ordering::Relaxed);
+    sim.join().expect("vehicle thread");
+
+    // What the vehicle received: from 255/190, in MAVLink 1 (the vehicle's version).
+    let received: Vec<Received> = rx.try_iter().collect();
+    assert!(received
+        .iter()
+        .all(|(v, h, _)| *v == MavlinkVersion::V1 && (h.system_id, h.component_id) == (255, 190)));
+    let value = received.iter().find_map(|(_, _, m)| match m {
+        MavMessage::NAMED_VALUE_FLOAT(v) => Some(v.clone()),
+        _ => None,
+    });
+    let value = value.expect("NAMED_VALUE_FLOAT");
+    assert_eq!(value.name.to_str().unwrap(), "energy_rem");
+    assert_eq!(value.value.to_bits(), 42.5f32.to_bits());
+    let text = received.iter().find_map(|(_, _, m)| match m {
+        MavMessage::STATUSTEXT(t) => Some(t.clone()),
+        _ => None,
+    });
+    let text = text.expect("STATUSTEXT");
+    assert_eq!(text.severity, MavSeverity::MAV_SEVERITY_WARNING);
+    assert_eq!(
+        text.text.to_str().unwrap(),
+        "aloft: return now, 12 % margin left at home"
+    );
+    let names: Vec<&str> = received
+        .iter()
+        .map(|(_, _, m)| aloft_link::mavlink::Message::message_name(m))
+        .filter(|n| n.starts_with("MISSION"))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "MISSION_REQUEST_LIST",
+            "MISSION_REQUEST_INT",
+            "MISSION_REQUEST_INT",
+            "MISSION_ACK"
+        ]
+    );
+    assert!(received.iter().any(
+        |(_, _, m)| matches!(m, MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS)
+    ));
+    let stats = link.stats();
+    assert!(
+        stats.vehicle_messages > 10 && stats.undecoded == 0,
+        "{stats:?}"
+    );
+}
+
+#[test]
+fn a_tcp_link_that_cannot_connect_is_an_error_naming_it() {
+    // Port 1 on loopback: nothing listens there.
+    let e = LinkSource::connect("tcpout:127.0.0.1:1", LinkOptions::default()).err();
+    let e = e.expect("refused").to_string();
+    assert!(
+        e.starts_with("tcpout:127.0.0.1:1: cannot open the link"),
+        "{e}"
+    );
+}
