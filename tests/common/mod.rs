@@ -4,8 +4,11 @@
 //! `#[path]`). Each test file takes what it needs with `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
 
+mod data;
 pub mod mission_toml;
 pub mod ros2;
+
+pub use data::data_dir;
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -80,20 +83,6 @@ pub fn scratch(tag: &str, name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("aloft-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
-}
-
-/// The shared real-data folder: `ALOFT_DATA_DIR`, or `../shared/data` beside the repository.
-pub fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need the shared data \
-         (set ALOFT_DATA_DIR or place it at ../shared/data)",
-        dir.display()
-    );
-    dir
 }
 
 /// The files of the data folder `sub` whose names pass `filter`, sorted.

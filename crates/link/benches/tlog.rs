@@ -116,32 +116,35 @@ fn frames_of(bytes: &[u8]) -> u64 {
 
 fn bench_log(c: &mut Criterion, name: &str, bytes: &[u8]) {
     let frames = frames_of(bytes);
-    let mut g = c.benchmark_group("link/tlog/frames");
+    per_frame(c, "link/tlog/frames", name, frames, || {
+        let mut r = TlogReader::new(black_box(bytes), "bench");
+        let n = r.by_ref().flatten().count();
+        black_box((n as u64, r.stats().bytes_skipped as f64))
+    });
+    per_frame(c, "link/tlog/events", name, frames, || {
+        let mut s = TlogSource::new(black_box(bytes), "bench");
+        let mut events = 0u64;
+        let mut last_s = 0.0;
+        while let Ok(Some(t)) = s.next_telemetry() {
+            events += 1;
+            last_s = t.time_s;
+        }
+        black_box((events, last_s))
+    });
+}
+
+/// One bench of `group`, its throughput in frames.
+fn per_frame(
+    c: &mut Criterion,
+    group: &str,
+    name: &str,
+    frames: u64,
+    mut run: impl FnMut() -> (u64, f64),
+) {
+    let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(frames));
     g.sample_size(20);
-    g.bench_function(name, |b| {
-        b.iter(|| {
-            let mut r = TlogReader::new(black_box(bytes), "bench");
-            let n = r.by_ref().flatten().count();
-            black_box((n, r.stats().bytes_skipped))
-        })
-    });
-    g.finish();
-    let mut g = c.benchmark_group("link/tlog/events");
-    g.throughput(Throughput::Elements(frames));
-    g.sample_size(20);
-    g.bench_function(name, |b| {
-        b.iter(|| {
-            let mut s = TlogSource::new(black_box(bytes), "bench");
-            let mut events = 0u64;
-            let mut last_s = 0.0;
-            while let Ok(Some(t)) = s.next_telemetry() {
-                events += 1;
-                last_s = t.time_s;
-            }
-            black_box((events, last_s))
-        })
-    });
+    g.bench_function(name, |b| b.iter(&mut run));
     g.finish();
 }
 

@@ -294,6 +294,23 @@ impl Decoder {
         let voltage_v = (s.voltage_battery != 0 && s.voltage_battery != u16::MAX)
             .then(|| f64::from(s.voltage_battery) / 1000.0);
         let current_a = (s.current_battery != -1).then(|| f64::from(s.current_battery) / 100.0);
+        self.battery_sample(voltage_v, current_a, out);
+        if let Some(soc) = soc(s.battery_remaining) {
+            let battery = BatteryState {
+                soc: Some(soc),
+                consumed_ah: None,
+            };
+            self.emit(out, Event::Battery(battery));
+        }
+    }
+
+    /// A sample of the pack's voltage and current, where the message carried either.
+    fn battery_sample(
+        &self,
+        voltage_v: Option<f64>,
+        current_a: Option<f64>,
+        out: &mut impl Extend<Telemetry>,
+    ) {
         if voltage_v.is_some() || current_a.is_some() {
             let sample = Sample {
                 voltage_v,
@@ -301,13 +318,6 @@ impl Decoder {
                 ..self.sample()
             };
             self.emit(out, Event::Sample(sample));
-        }
-        if let Some(soc) = soc(s.battery_remaining) {
-            let battery = BatteryState {
-                soc: Some(soc),
-                consumed_ah: None,
-            };
-            self.emit(out, Event::Battery(battery));
         }
     }
 
@@ -325,14 +335,7 @@ impl Decoder {
             .sum();
         let voltage_v = (cells_mv > 0).then(|| f64::from(cells_mv) / 1000.0);
         let current_a = (b.current_battery != -1).then(|| f64::from(b.current_battery) / 100.0);
-        if voltage_v.is_some() || current_a.is_some() {
-            let sample = Sample {
-                voltage_v,
-                current_a,
-                ..self.sample()
-            };
-            self.emit(out, Event::Sample(sample));
-        }
+        self.battery_sample(voltage_v, current_a, out);
         let battery = BatteryState {
             soc: soc(b.battery_remaining),
             consumed_ah: (b.current_consumed >= 0).then(|| f64::from(b.current_consumed) / 1000.0),

@@ -7,20 +7,9 @@ use std::path::{Path, PathBuf};
 use aloft_link::mavlink::Message;
 use aloft_link::{Telemetry, TlogFrame, TlogReader, TlogSource, TlogStats};
 
-/// The shared real-data folder: `ALOFT_DATA_DIR`, or `../shared/data` beside the workspace (as
-/// the root's `tests/common` finds it).
-pub fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data"));
-    assert!(
-        dir.is_dir(),
-        "ALOFT_DATA_DIR={} is not a directory: the data_val tests need the shared data \
-         (set ALOFT_DATA_DIR or place it at ../shared/data)",
-        dir.display()
-    );
-    dir
-}
+#[path = "../../../../tests/common/data.rs"]
+mod data;
+pub use data::data_dir;
 
 /// A shared telemetry log by its file stem.
 pub fn tlog(stem: &str) -> PathBuf {
