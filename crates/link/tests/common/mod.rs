@@ -2,7 +2,7 @@
 #![allow(dead_code)] // not every test file uses every helper
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use aloft_link::mavlink::Message;
 use aloft_link::{Telemetry, TlogFrame, TlogReader, TlogSource, TlogStats};
