@@ -506,78 +506,104 @@ pub const TLOG_HEAD: usize = 16 << 10;
 /// MISSION_ITEM_INT, MISSION_ITEM, MISSION_ACK), MISSION_CURRENT, SYSTEM_TIME going back (a
 /// restart).
 pub fn tlog_made_in_code() -> Vec<u8> {
+    let gcs = mav_header(255, 190);
+    let vehicle = mav_header(1, 1);
+    let mut frames = state_frames(gcs, vehicle);
+    frames.extend(mission_frames(gcs, vehicle));
+    let mut out = Vec::new();
+    for (k, (header, v2, msg)) in frames.iter().enumerate() {
+        let t_us = 1_714_521_600_000_000u64 + 50_000 * k as u64;
+        out.extend(t_us.to_be_bytes());
+        let written = if *v2 {
+            aloft_link::mavlink::write_v2_msg(&mut out, *header, msg)
+        } else {
+            aloft_link::mavlink::write_v1_msg(&mut out, *header, msg)
+        };
+        // Writing to a Vec cannot fail.
+        let _ = written;
+    }
+    out
+}
+
+/// One frame of the log made in code: header, MAVLink 2, message.
+type Frame = (
+    aloft_link::mavlink::MavHeader,
+    bool,
+    aloft_link::mavlink::dialects::ardupilotmega::MavMessage,
+);
+
+/// A sender's header.
+fn mav_header(system_id: u32, component_id: u8) -> aloft_link::mavlink::MavHeader {
+    aloft_link::mavlink::MavHeader {
+        system_id,
+        component_id,
+        sequence: 0,
+    }
+}
+
+/// A HEARTBEAT of the ground station or the vehicle.
+fn heartbeat(gcs_type: bool) -> aloft_link::mavlink::dialects::ardupilotmega::MavMessage {
     use aloft_link::mavlink::dialects::ardupilotmega as m;
-    use aloft_link::mavlink::MavHeader;
-    let gcs = MavHeader {
-        system_id: 255,
-        component_id: 190,
-        sequence: 0,
-    };
-    let vehicle = MavHeader {
-        system_id: 1,
-        component_id: 1,
-        sequence: 0,
-    };
-    let heartbeat = |gcs_type: bool| {
-        m::MavMessage::HEARTBEAT(m::HEARTBEAT_DATA {
-            custom_mode: if gcs_type { 0 } else { 3 },
-            mavtype: if gcs_type {
-                m::MavType::MAV_TYPE_GCS
-            } else {
-                m::MavType::MAV_TYPE_QUADROTOR
-            },
-            autopilot: if gcs_type {
-                m::MavAutopilot::MAV_AUTOPILOT_INVALID
-            } else {
-                m::MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA
-            },
-            base_mode: m::MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
-            system_status: m::MavState::MAV_STATE_ACTIVE,
-            mavlink_version: 3,
-        })
-    };
-    let position = |ms: u32, lat: i32| {
-        m::MavMessage::GLOBAL_POSITION_INT(m::GLOBAL_POSITION_INT_DATA {
-            time_boot_ms: ms,
-            lat,
-            lon: if lat == 0 { 0 } else { 85_456_000 },
-            alt: 490_000,
-            relative_alt: 2_000,
-            vx: 150,
-            vy: -40,
-            vz: -20,
-            hdg: 9_000,
-        })
-    };
-    let item = |seq: u16| {
-        m::MavMessage::MISSION_ITEM_INT(m::MISSION_ITEM_INT_DATA {
-            param4: f32::NAN,
-            x: 473_977_000 + i32::from(seq) * 500,
-            y: 85_456_000,
-            z: 25.0,
-            seq,
-            command: m::MavCmd::MAV_CMD_NAV_WAYPOINT,
-            target_system: 1,
-            target_component: 1,
-            frame: m::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
-            ..m::MISSION_ITEM_INT_DATA::default()
-        })
-    };
-    #[allow(deprecated)] // MISSION_ITEM: deprecated by MAVLink, still in logs
-    let float_item = m::MavMessage::MISSION_ITEM(m::MISSION_ITEM_DATA {
-        x: 47.399,
-        y: 8.5456,
-        z: 0.0,
-        seq: 2,
-        command: m::MavCmd::MAV_CMD_NAV_LAND,
+    m::MavMessage::HEARTBEAT(m::HEARTBEAT_DATA {
+        custom_mode: if gcs_type { 0 } else { 3 },
+        mavtype: if gcs_type {
+            m::MavType::MAV_TYPE_GCS
+        } else {
+            m::MavType::MAV_TYPE_QUADROTOR
+        },
+        autopilot: if gcs_type {
+            m::MavAutopilot::MAV_AUTOPILOT_INVALID
+        } else {
+            m::MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA
+        },
+        base_mode: m::MavModeFlag::MAV_MODE_FLAG_SAFETY_ARMED,
+        system_status: m::MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    })
+}
+
+/// A GLOBAL_POSITION_INT at `ms` (latitude 0: no fix).
+fn position(ms: u32, lat: i32) -> aloft_link::mavlink::dialects::ardupilotmega::MavMessage {
+    use aloft_link::mavlink::dialects::ardupilotmega as m;
+    m::MavMessage::GLOBAL_POSITION_INT(m::GLOBAL_POSITION_INT_DATA {
+        time_boot_ms: ms,
+        lat,
+        lon: if lat == 0 { 0 } else { 85_456_000 },
+        alt: 490_000,
+        relative_alt: 2_000,
+        vx: 150,
+        vy: -40,
+        vz: -20,
+        hdg: 9_000,
+    })
+}
+
+/// A MISSION_ITEM_INT of the 3-item mission.
+fn mission_item(seq: u16) -> aloft_link::mavlink::dialects::ardupilotmega::MavMessage {
+    use aloft_link::mavlink::dialects::ardupilotmega as m;
+    m::MavMessage::MISSION_ITEM_INT(m::MISSION_ITEM_INT_DATA {
+        param4: f32::NAN,
+        x: 473_977_000 + i32::from(seq) * 500,
+        y: 85_456_000,
+        z: 25.0,
+        seq,
+        command: m::MavCmd::MAV_CMD_NAV_WAYPOINT,
         target_system: 1,
         target_component: 1,
         frame: m::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
-        ..m::MISSION_ITEM_DATA::default()
-    });
+        ..m::MISSION_ITEM_INT_DATA::default()
+    })
+}
+
+/// The vehicle's state messages of the log made in code, and the two heartbeats.
+fn state_frames(
+    gcs: aloft_link::mavlink::MavHeader,
+    vehicle: aloft_link::mavlink::MavHeader,
+) -> Vec<Frame> {
+    use aloft_link::mavlink::dialects::ardupilotmega as m;
     let mut voltages = [u16::MAX; 10];
     voltages[0] = 16_100;
-    let frames: Vec<(MavHeader, bool, m::MavMessage)> = vec![
+    vec![
         (vehicle, false, heartbeat(false)),
         (gcs, true, heartbeat(true)),
         (
@@ -650,6 +676,29 @@ pub fn tlog_made_in_code() -> Vec<u8> {
                 ..m::EXTENDED_SYS_STATE_DATA::default()
             }),
         ),
+    ]
+}
+
+/// The mission upload, MISSION_CURRENT, the restart and the last fix of the log made in code.
+fn mission_frames(
+    gcs: aloft_link::mavlink::MavHeader,
+    vehicle: aloft_link::mavlink::MavHeader,
+) -> Vec<Frame> {
+    use aloft_link::mavlink::dialects::ardupilotmega as m;
+    #[allow(deprecated)] // MISSION_ITEM: deprecated by MAVLink, still in logs
+    let float_item = m::MavMessage::MISSION_ITEM(m::MISSION_ITEM_DATA {
+        x: 47.399,
+        y: 8.5456,
+        z: 0.0,
+        seq: 2,
+        command: m::MavCmd::MAV_CMD_NAV_LAND,
+        target_system: 1,
+        target_component: 1,
+        frame: m::MavFrame::MAV_FRAME_GLOBAL_RELATIVE_ALT,
+        ..m::MISSION_ITEM_DATA::default()
+    });
+    let item = mission_item;
+    vec![
         (
             gcs,
             true,
@@ -697,20 +746,7 @@ pub fn tlog_made_in_code() -> Vec<u8> {
             }),
         ),
         (vehicle, false, position(600, 473_978_000)),
-    ];
-    let mut out = Vec::new();
-    for (k, (header, v2, msg)) in frames.iter().enumerate() {
-        let t_us = 1_714_521_600_000_000u64 + 50_000 * k as u64;
-        out.extend(t_us.to_be_bytes());
-        let written = if *v2 {
-            aloft_link::mavlink::write_v2_msg(&mut out, *header, msg)
-        } else {
-            aloft_link::mavlink::write_v1_msg(&mut out, *header, msg)
-        };
-        // Writing to a Vec cannot fail.
-        let _ = written;
-    }
-    out
+    ]
 }
 
 /// The telemetry log made in code, and the first [`TLOG_HEAD`] bytes of the shared `.tlog`s.
