@@ -46,16 +46,6 @@ const MIN_WINDOW_S: f64 = 10.0;
 /// Length of the blocks whose ratios measure how the ratio drifts along a flight, s.
 const DRIFT_BLOCK_S: f64 = 60.0;
 
-/// The route ahead of a live flight.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LiveRoute {
-    /// The rest of the mission, then home and the landing.
-    #[default]
-    Mission,
-    /// The rest of the logged path (a replay only): the validation mode.
-    Log,
-}
-
 /// A replayed flight followed as if live, with the rest of the log as the route ahead.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LiveReplayRequest {
@@ -232,7 +222,12 @@ impl Series {
                 &self.predicted_w[..=k],
                 prior_sd,
             );
-            let estimate_sd = posterior_sd(prior_sd, shrunk.window_relative_sd);
+            // The shrunk estimate's variance is the window's times its weight: `w s_d^2 =
+            // s_p^2 s_d^2 / (s_p^2 + s_d^2)`; without a finite window spread, the prior's.
+            let estimate_sd = match shrunk.window_relative_sd {
+                sd if sd.is_finite() => shrunk.window_weight.sqrt() * sd,
+                _ => prior_sd.unwrap_or(0.0),
+            };
             let drift_sd = self.drift_sd(k, self.t[last] - self.t[k]);
             (shrunk.ratio, estimate_sd.hypot(drift_sd))
         } else {
@@ -284,20 +279,6 @@ impl Series {
         let mean = logs.iter().sum::<f64>() / n;
         let var = logs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
         (var / (rest_s / DRIFT_BLOCK_S).max(1.0)).sqrt()
-    }
-}
-
-/// Relative standard deviation of the shrunk ratio: the prior's and the window's variances
-/// combined (`s_p^2 s_d^2 / (s_p^2 + s_d^2)`), the window's alone without a prior.
-fn posterior_sd(prior_sd: Option<f64>, window_sd: f64) -> f64 {
-    match prior_sd {
-        Some(sp) if window_sd.is_finite() && sp > 0.0 => {
-            let (vp, vd) = (sp * sp, window_sd * window_sd);
-            (vp * vd / (vp + vd)).sqrt()
-        }
-        Some(sp) if !window_sd.is_finite() => sp,
-        _ if window_sd.is_finite() => window_sd,
-        _ => 0.0,
     }
 }
 

@@ -66,30 +66,24 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
 }
 
 /// Read a mission as a MAVLink link or log carries it (MISSION_ITEM_INT, DataFlash `CMD`): the
-/// rows of a `.waypoints` file, ArduPilot's semantics (item 0 is home when it is a home row).
-/// Messages name an item by its sequence number.
+/// rows of a `.waypoints` file, ArduPilot's semantics (item 0 is home when it is a home row). A
+/// NaN parameter is MAVLink's "not set", as in a `.plan`. Messages name an item by its sequence
+/// number.
 ///
 /// # Errors
-/// A parameter that is not finite (naming the item), and the errors of [`read_waypoints`].
+/// The errors of the items' semantics, as [`read_waypoints`] (an infinite coordinate, say).
 pub fn read_items(items: &[aloft_logs::telemetry::MissionItem]) -> Result<Imported, ImportError> {
-    let mut rows = Vec::with_capacity(items.len());
-    for item in items {
-        if let Some(k) = item.params.iter().position(|p| !p.is_finite()) {
-            return Err(ImportError::BadField {
-                line: item.seq as usize,
-                field: FIELDS[4 + k],
-                found: format!("{}", item.params[k]),
-            });
-        }
-        rows.push(RawItem {
+    let rows = items
+        .iter()
+        .map(|item| RawItem {
             at: Place::Item(item.seq),
             number: item.seq,
             command: item.command,
             frame: item.frame,
             params: item.params,
             jump_id: None,
-        });
-    }
+        })
+        .collect();
     from_rows(rows, SourceFormat::MavlinkItems, "MAVLink mission")
 }
 
@@ -285,5 +279,44 @@ mod tests {
         let i = read_waypoints(&t).unwrap();
         assert_eq!(i.spec.segments[0].item(), Some(7));
         assert!(i.warnings[0].starts_with("row 7: INDEX 7 where 1 was expected"));
+    }
+
+    /// A mission from a link's items flies as the `.waypoints` file of the same rows.
+    #[test]
+    fn items_from_a_link_read_as_their_waypoints_file() {
+        let item = |seq: u32, frame: u32, command: u32, lat: f64, lon: f64, alt: f64| {
+            aloft_logs::telemetry::MissionItem {
+                seq,
+                frame,
+                command,
+                params: [0.0, 0.0, 0.0, 0.0, lat, lon, alt],
+            }
+        };
+        let items = [
+            item(0, 0, 16, -35.0, 149.0, 100.0),
+            item(1, 3, 22, 0.0, 0.0, 20.0),
+            item(2, 3, 16, -35.001, 149.0, 20.0),
+            item(3, 3, 21, 0.0, 0.0, 0.0),
+        ];
+        let text = format!(
+            "QGC WPL 110\n{HOME}\n{TAKEOFF}\n2\t0\t3\t16\t0\t0\t0\t0\t-35.001\t149.0\t20\t1\n\
+             3\t0\t3\t21\t0\t0\t0\t0\t0\t0\t0\t1\n"
+        );
+        let (from_link, from_file) = (read_items(&items).unwrap(), read_waypoints(&text).unwrap());
+        assert_eq!(from_link.spec.segments, from_file.spec.segments);
+        assert_eq!(from_link.spec.home, from_file.spec.home);
+        assert_eq!(from_link.spec.description, "MAVLink mission, 3 items");
+        assert_eq!(from_link.format, SourceFormat::MavlinkItems);
+        // NaN is MAVLink's "not set" (a waypoint's yaw); an infinite latitude names the item.
+        let mut unset = items;
+        unset[2].params[3] = f64::NAN;
+        assert_eq!(
+            read_items(&unset).unwrap().spec.segments,
+            from_file.spec.segments
+        );
+        let mut bad = items;
+        bad[2].params[4] = f64::INFINITY;
+        let e = read_items(&bad).unwrap_err().to_string();
+        assert!(e.starts_with("item 2"), "{e}");
     }
 }
