@@ -397,7 +397,11 @@ impl LinkSource {
         let due = self
             .last_heartbeat
             .is_none_or(|t| now.duration_since(t) >= HEARTBEAT_PERIOD);
-        if self.options.heartbeat && due {
+        // On `udpin` the only peer is whoever sent last: wait until the vehicle has been heard
+        // (and its MAVLink version with it), else a heartbeat can leave in the wrong version in
+        // the moment between its first datagram and its decoding.
+        let peer_known = !self.url.starts_with("udpin:") || self.last_vehicle.is_some();
+        if self.options.heartbeat && due && peer_known {
             self.last_heartbeat = Some(now);
             self.send(&gcs_heartbeat(), "HEARTBEAT")?;
         }
