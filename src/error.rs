@@ -113,6 +113,9 @@ pub enum Error {
         /// The log reader's error.
         source: Box<aloft_logs::LogError>,
     },
+    /// A telemetry source (a link, a telemetry log) failed: the message names it.
+    #[error("{0}")]
+    Link(String),
     /// A log file that cannot be opened, read or written (the message names the file).
     #[error(transparent)]
     LogFile(Box<aloft_logs::LogError>),

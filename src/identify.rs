@@ -20,6 +20,7 @@
 //! norm (the paper's level-flight inputs), climb rate its vertical component, the angle of attack
 //! the exact geometry with the air direction `course - yaw` from the nose.
 
+use aloft_logs::sample::Attitude;
 use aloft_logs::{Log, Sample};
 use aloft_power::{
     fit::FitSample, metrics, AoaInput, FlightState, ModelOptions, PowerModel, Term, Terms,
@@ -87,9 +88,16 @@ fn interpolate(times: &[f64], values: &[f64], t: f64) -> Option<f64> {
 }
 
 fn motion(s: &Sample) -> Option<(FlightState, f64)> {
-    let vel = s.vel_enu_mps?;
     let att = s.attitude?;
-    let wind = s.wind_enu_mps.unwrap_or([0.0; 3]);
+    let state = motion_state(s.vel_enu_mps?, &att, s.wind_enu_mps.unwrap_or([0.0; 3]))?;
+    let tilt_cos = att.roll_rad.cos() * att.pitch_rad.cos();
+    Some((state, tilt_cos.clamp(-1.0, 1.0).acos()))
+}
+
+/// The model's flight state from a ground velocity, attitude and wind (ENU, m/s): the air
+/// velocity's horizontal speed and course against the heading, its vertical speed the climb.
+/// `None` for a vehicle tilted 90 deg or more, or a speed that is not finite.
+pub(crate) fn motion_state(vel: [f64; 3], att: &Attitude, wind: [f64; 3]) -> Option<FlightState> {
     let air = [vel[0] - wind[0], vel[1] - wind[1], vel[2] - wind[2]];
     let speed = air[0].hypot(air[1]);
     // Course over the air, clockwise from north (ENU: x east, y north).
@@ -104,8 +112,7 @@ fn motion(s: &Sample) -> Option<(FlightState, f64)> {
         },
     };
     let tilt_cos = att.roll_rad.cos() * att.pitch_rad.cos();
-    (tilt_cos > 1e-6 && state.airspeed_mps.is_finite())
-        .then_some((state, tilt_cos.clamp(-1.0, 1.0).acos()))
+    (tilt_cos > 1e-6 && state.airspeed_mps.is_finite()).then_some(state)
 }
 
 /// Pair power with motion in `log` (see the module docs): the power series, the motion series,

@@ -1,23 +1,26 @@
-//! `aloft live`: a flight followed as it flies, an answer every `--every` seconds: JSON lines, or
-//! a line of text per update; the validation replay ends with how the predictions did.
+//! `aloft live`: a flight followed as it flies, an answer every `--every` seconds: JSON lines, a
+//! status panel refreshed in place on a terminal, or a line of text per update otherwise; the
+//! validation replay (`--route log`) ends with how the predictions did.
 
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 
-use aloft::engine::flags::LiveFlags;
-use aloft::engine::{replay_live, Error, LiveCheck, LiveCheckpoint, LiveUpdate, Vehicle};
+use aloft::engine::flags::{LiveFlags, LiveTask};
+use aloft::engine::{
+    follow_live, replay_live, Error, LiveCheck, LiveCheckpoint, LiveSummary, LiveUpdate, Vehicle,
+};
 
 use super::Outcome;
 
 /// Output of `aloft live`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum LiveFormat {
-    /// A line of text per update, then the check.
+    /// A status panel refreshed in place on a terminal, a line of text per update otherwise.
     #[default]
     Table,
-    /// JSON lines: one object per update, then `{"check": ...}`.
+    /// JSON lines: one object per update, then `{"summary": ...}` (or `{"check": ...}`).
     Json,
 }
 
@@ -33,55 +36,212 @@ pub struct LiveArgs {
 
 pub fn run(args: LiveArgs) -> Result<Outcome> {
     let vehicle = Vehicle::load(&args.flags.vehicle)?;
-    let request = args.flags.request();
+    let task = args.flags.request()?;
     let stdout = std::io::stdout();
+    let panel = args.format == LiveFormat::Table
+        && stdout.is_terminal()
+        && matches!(task, LiveTask::Follow { .. });
     let mut out = stdout.lock();
-    let format = args.format;
-    let mut header = format == LiveFormat::Table;
+    let mut view = View {
+        format: args.format,
+        panel,
+        drawn: 0,
+        header: true,
+    };
     let mut emit = |u: &LiveUpdate| -> Result<(), Error> {
-        let written = match format {
-            LiveFormat::Json => serde_json::to_string(u)
-                .map_err(std::io::Error::from)
-                .and_then(|line| writeln!(out, "{line}")),
-            LiveFormat::Table if std::mem::take(&mut header) => {
-                writeln!(out, "{HEADER}").and_then(|()| writeln!(out, "{}", row(u)))
-            }
-            LiveFormat::Table => writeln!(out, "{}", row(u)),
-        };
-        written.map_err(|source| Error::Io {
+        view.write(&mut out, u).map_err(|source| Error::Io {
             origin: "standard output".to_string(),
             source,
         })
     };
-    let check = replay_live(&vehicle, &request, &mut emit)?;
-    match format {
-        LiveFormat::Json => {
-            let line = serde_json::json!({ "check": check });
-            writeln!(out, "{line}")?;
+    match task {
+        LiveTask::Validate(request) => {
+            let check = replay_live(&vehicle, &request, &mut emit)?;
+            match args.format {
+                LiveFormat::Json => writeln!(out, "{}", serde_json::json!({ "check": check }))?,
+                LiveFormat::Table => render_check(&mut out, &check)?,
+            }
         }
-        LiveFormat::Table => render_check(&mut out, &check)?,
+        LiveTask::Follow { source, request } => {
+            let mut source = source.open()?;
+            let summary = follow_live(&vehicle, &request, &mut source, &mut emit)?;
+            match args.format {
+                LiveFormat::Json => {
+                    writeln!(out, "{}", serde_json::json!({ "summary": summary }))?
+                }
+                LiveFormat::Table => render_summary(&mut out, &summary)?,
+            }
+        }
     }
     Ok(Outcome::Ok)
 }
 
-/// The column heads of the lines of text.
+/// How updates are shown.
+struct View {
+    format: LiveFormat,
+    /// A panel redrawn in place (a terminal).
+    panel: bool,
+    /// Lines of the panel on screen.
+    drawn: usize,
+    header: bool,
+}
+
+impl View {
+    fn write(&mut self, out: &mut impl Write, u: &LiveUpdate) -> std::io::Result<()> {
+        match self.format {
+            LiveFormat::Json => {
+                let line = serde_json::to_string(u).map_err(std::io::Error::from)?;
+                writeln!(out, "{line}")
+            }
+            LiveFormat::Table if self.panel => {
+                let lines = panel(u);
+                if self.drawn > 0 {
+                    // Up to the panel's first line, and clear to the end of the screen.
+                    write!(out, "\x1b[{}F\x1b[J", self.drawn)?;
+                }
+                self.drawn = lines.len();
+                for l in lines {
+                    writeln!(out, "{l}")?;
+                }
+                out.flush()
+            }
+            LiveFormat::Table => {
+                let validation = u.measured_remaining_wh.is_some();
+                if std::mem::take(&mut self.header) {
+                    let head = if validation { HEADER } else { FOLLOW_HEADER };
+                    writeln!(out, "{head}")?;
+                }
+                match validation {
+                    true => writeln!(out, "{}", row(u)),
+                    false => writeln!(out, "{}", follow_row(u)),
+                }
+            }
+        }
+    }
+}
+
+/// A value with `digits` decimals, or `-`.
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "-".to_string(), |v| format!("{v:.digits$}"))
+}
+
+/// `p5 / p50 / p95` of a band, scaled, or `-`.
+fn band(b: Option<aloft::engine::Percentiles>, scale: f64, digits: usize) -> String {
+    b.map_or_else(
+        || "-".to_string(),
+        |b| {
+            format!(
+                "{:.digits$} / {:.digits$} / {:.digits$}",
+                scale * b.p5,
+                scale * b.p50,
+                scale * b.p95
+            )
+        },
+    )
+}
+
+/// The status panel of one update.
+fn panel(u: &LiveUpdate) -> Vec<String> {
+    let state = match (u.link_lost, u.in_air) {
+        (true, _) => "LINK LOST (last estimate)",
+        (false, true) => "in the air",
+        (false, false) => "on the ground",
+    };
+    let item = u.mission_item.map_or_else(String::new, |i| format!(" · item {i}"));
+    let mode = u.mode.as_deref().unwrap_or("-");
+    let wind = match (u.wind_mps, u.wind_from_deg) {
+        (Some(s), Some(d)) => format!("{s:.1} m/s from {d:.0} deg"),
+        _ => "-".to_string(),
+    };
+    let pnr = match u.point_of_no_return_s {
+        Some(s) if s < 0.0 => format!("passed {:.0} s ago", -s),
+        Some(s) => format!("in {s:.0} s"),
+        None => "none (home is always in reach)".to_string(),
+    };
+    let mut lines = vec![
+        format!("aloft live · t {:.1} s · {mode}{item} · {state}", u.time_s),
+        format!(
+            "battery   {} %   used {:.2} Wh   power {} W   eta {:.4}",
+            opt(u.soc.map(|s| 100.0 * s), 1),
+            u.energy_used_wh,
+            opt(u.power_w, 0),
+            u.efficiency
+        ),
+        format!("wind      {wind}"),
+        format!(
+            "ahead     {} Wh (p5 / p50 / p95); naive {} Wh",
+            band(u.remaining_wh, 1.0, 2),
+            opt(u.naive_remaining_wh, 2)
+        ),
+        format!("landing   {} % state of charge", band(u.landing_soc, 100.0, 1)),
+        format!("no return {pnr}"),
+        format!("advice    {}", u.advice.unwrap_or("-")),
+    ];
+    if let Some(note) = &u.note {
+        lines.push(format!("note      {note}"));
+    }
+    lines
+}
+
+/// The column heads of the lines of a followed flight.
+const FOLLOW_HEADER: &str = "  time s  mode        item  air   soc %  used Wh  power W     eta  wind m/s  from  remaining Wh p5 / p50 / p95  landing % p5 / p50   pnr s  advice";
+
+/// One update of a followed flight as a line of text.
+fn follow_row(u: &LiveUpdate) -> String {
+    let landing = u.landing_soc.map_or_else(
+        || "-".to_string(),
+        |l| format!("{:.1} / {:.1}", 100.0 * l.p5, 100.0 * l.p50),
+    );
+    format!(
+        "{:>8.1}  {:<10} {:>5}  {:<4} {:>6} {:>8.2} {:>8} {:>7.4} {:>9} {:>5} {:>29} {:>18} {:>7}  {}{}",
+        u.time_s,
+        u.mode.as_deref().unwrap_or("-"),
+        u.mission_item.map_or_else(|| "-".to_string(), |i| i.to_string()),
+        if u.in_air { "yes" } else { "no" },
+        opt(u.soc.map(|s| 100.0 * s), 1),
+        u.energy_used_wh,
+        opt(u.power_w, 0),
+        u.efficiency,
+        opt(u.wind_mps, 1),
+        opt(u.wind_from_deg, 0),
+        band(u.remaining_wh, 1.0, 2),
+        landing,
+        opt(u.point_of_no_return_s, 0),
+        u.advice.unwrap_or("-"),
+        if u.link_lost { " (link lost)" } else { "" }
+    )
+}
+
+/// The column heads of the lines of the validation replay.
 const HEADER: &str =
     "  time s   used Wh  power W     eta   remaining Wh p5 / p50 / p95  naive Wh  truth Wh";
 
-/// One update as a line of text.
+/// One update of the validation replay as a line of text.
 fn row(u: &LiveUpdate) -> String {
-    let opt = |x: Option<f64>| x.map_or_else(|| "-".to_string(), |v| format!("{v:.2}"));
-    let r = &u.remaining_wh;
     format!(
         "{:>8.1} {:>9.2} {:>8} {:>7.4} {:>29} {:>9} {:>9}",
         u.time_s,
         u.energy_used_wh,
-        opt(u.power_w),
+        opt(u.power_w, 2),
         u.efficiency,
-        format!("{:.2} / {:.2} / {:.2}", r.p5, r.p50, r.p95),
-        opt(u.naive_remaining_wh),
-        opt(u.measured_remaining_wh)
+        band(u.remaining_wh, 1.0, 2),
+        opt(u.naive_remaining_wh, 2),
+        opt(u.measured_remaining_wh, 2)
     )
+}
+
+/// How a followed stream ended.
+fn render_summary(out: &mut impl Write, s: &LiveSummary) -> Result<()> {
+    let skipped = match s.skipped.as_str() {
+        "" => String::new(),
+        text => format!("; skipped {text}"),
+    };
+    writeln!(
+        out,
+        "\n{} updates over {:.0} s; {} mission(s) received, {} restart(s) of the vehicle{skipped}",
+        s.updates, s.duration_s, s.missions, s.reboots
+    )?;
+    Ok(())
 }
 
 /// How the predictions did against the measured rest.

@@ -19,7 +19,8 @@ use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
 use super::fit::{fit_parameter, FitRequest};
-use super::live::LiveReplayRequest;
+use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
+use super::mission_file::Mission;
 use super::logs::{FlightLogs, LogReadOptions};
 use super::mission_options::{GustSpec, MissionOptions};
 use super::payload_sweep::PayloadSweep;
@@ -605,8 +606,12 @@ pub struct MissionScenarioFlags {
 }
 
 /// The route ahead of `aloft live` (`--route`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum RouteFlag {
+    /// From where the vehicle is through the rest of the mission (`--mission`, else the one on
+    /// the link) to home and the landing; without a mission, home and the landing.
+    #[default]
+    Mission,
     /// The rest of the logged path (a replay): the prediction at each time is checked against
     /// the energy the log measured from then to the end.
     Log,
@@ -614,16 +619,31 @@ pub enum RouteFlag {
 
 /// The options of `aloft live`.
 #[derive(Debug, Clone, Args)]
+#[command(group(clap::ArgGroup::new("live_source").required(true).args(["replay", "tlog", "connect"])))]
 pub struct LiveFlags {
     /// Follow a flight log (CSV, MCAP, PX4 ULog or ArduPilot DataFlash) as if live.
     #[arg(long, value_name = "LOG")]
-    pub replay: PathBuf,
-    /// Log layout: kaist, px4 or a column-map TOML (default: detected).
-    #[arg(long)]
+    pub replay: Option<PathBuf>,
+    /// Log layout of `--replay`: kaist, px4 or a column-map TOML (default: detected).
+    #[arg(long, requires = "replay")]
     pub profile: Option<String>,
-    /// The route ahead: `log`, the rest of the logged path (the validation mode).
-    #[arg(long, value_enum)]
+    /// Follow a telemetry log (Mission Planner / QGroundControl `.tlog`).
+    #[arg(long, value_name = "FILE")]
+    pub tlog: Option<PathBuf>,
+    /// Follow a live MAVLink link: `udpin:0.0.0.0:14550`, `udpout:HOST:PORT`,
+    /// `tcpout:HOST:PORT` or `serial:/dev/ttyUSB0:57600`.
+    #[arg(long, value_name = "URL")]
+    pub connect: Option<String>,
+    /// Pace of `--tlog` and `--replay`: X times their own time, or `max` (default: 1 for a tlog,
+    /// max for a replay).
+    #[arg(long, value_name = "X|max", conflicts_with = "connect", value_parser = playback_speed)]
+    pub speed: Option<PlaybackSpeed>,
+    /// The route ahead.
+    #[arg(long, value_enum, default_value_t = RouteFlag::Mission)]
     pub route: RouteFlag,
+    /// The mission flown (any format aloft reads), where the link does not carry it.
+    #[arg(long, value_name = "FILE", conflicts_with = "route")]
+    pub mission: Option<PathBuf>,
     /// Vehicle with a power model: built-in name or TOML file (e.g. from `aloft fit`).
     #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
     pub vehicle: String,
@@ -636,20 +656,127 @@ pub struct LiveFlags {
     /// An update every S seconds of flight time.
     #[arg(value_parser = finite(), long, default_value_t = 1.0, value_name = "S")]
     pub every: f64,
+    /// Reserve required at landing, percent of the usable capacity (default: the mission's,
+    /// else 20).
+    #[arg(value_parser = finite(), long, value_name = "PERCENT")]
+    pub reserve_percent: Option<f64>,
+    /// Monte-Carlo scenarios of the route ahead per update.
+    #[arg(long, default_value_t = super::LIVE_SCENARIOS, value_parser = clap::value_parser!(u32).range(1..=10_000), value_name = "N")]
+    pub scenarios: u32,
+    /// aloft's MAVLink system id on the link (a ground station's).
+    #[arg(long, default_value_t = 255, value_name = "ID")]
+    pub system_id: u8,
+    /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER).
+    #[arg(long, default_value_t = 190, value_name = "ID")]
+    pub component_id: u8,
+    /// Silence of the vehicle after which the link is said lost, s.
+    #[arg(value_parser = finite(), long, default_value_t = 5.0, value_name = "S")]
+    pub link_timeout: f64,
+}
+
+/// The pace of a replayed source (`--speed`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PlaybackSpeed {
+    /// As fast as it goes.
+    Max,
+    /// Times its own time.
+    Times(f64),
+}
+
+/// `max` or a positive, finite number.
+fn playback_speed(text: &str) -> Result<PlaybackSpeed, String> {
+    if text.eq_ignore_ascii_case("max") {
+        return Ok(PlaybackSpeed::Max);
+    }
+    match text.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(PlaybackSpeed::Times(x)),
+        _ => Err("expected `max` or a positive number (times the log's own time)".to_string()),
+    }
+}
+
+/// What `aloft live` is asked: the validation replay, or a source followed.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LiveTask {
+    /// `--route log`.
+    Validate(LiveReplayRequest),
+    /// A source followed on the mission's route.
+    Follow {
+        /// Where the flight comes from.
+        source: LiveSource,
+        /// How it is answered.
+        request: Box<LiveRequest>,
+    },
 }
 
 impl LiveFlags {
-    /// The engine's request of these flags.
-    pub fn request(&self) -> LiveReplayRequest {
-        LiveReplayRequest {
-            logs: FlightLogs {
-                logs: vec![self.replay.clone()],
-                profile: self.profile.clone(),
-                ..FlightLogs::default()
-            },
-            battery: self.battery.clone(),
-            payload_kg: self.payload_kg,
-            every_s: self.every,
+    /// The engine's task of these flags.
+    ///
+    /// # Errors
+    /// `--route log` without `--replay`, a `--speed` that is neither `max` nor a positive
+    /// number, a link timeout that is not positive, and a `--mission` that cannot be read.
+    pub fn request(&self) -> Result<LiveTask, Error> {
+        let logs = |path: &PathBuf| FlightLogs {
+            logs: vec![path.clone()],
+            profile: self.profile.clone(),
+            ..FlightLogs::default()
+        };
+        if self.route == RouteFlag::Log {
+            let path = self.replay.as_ref().ok_or(Error::MissingValue {
+                flag: "--replay",
+                hint: "--route log checks the predictions against the rest of a logged path, which only a replayed log has",
+            })?;
+            return Ok(LiveTask::Validate(LiveReplayRequest {
+                logs: logs(path),
+                battery: self.battery.clone(),
+                payload_kg: self.payload_kg,
+                every_s: self.every,
+            }));
         }
+        let speed = match self.speed {
+            None if self.tlog.is_some() => Some(1.0),
+            None | Some(PlaybackSpeed::Max) => None,
+            Some(PlaybackSpeed::Times(x)) => Some(x),
+        };
+        if !(self.link_timeout.is_finite() && self.link_timeout > 0.0) {
+            return Err(Error::InvalidInput {
+                name: "link-timeout",
+                value: self.link_timeout,
+                unit: "s",
+                expected: "a positive number of seconds",
+            });
+        }
+        let source = match (&self.replay, &self.tlog, &self.connect) {
+            (Some(path), _, _) => LiveSource::Replay {
+                logs: logs(path),
+                speed,
+            },
+            (_, Some(path), _) => LiveSource::Tlog {
+                path: path.clone(),
+                speed,
+            },
+            (_, _, url) => LiveSource::Connect {
+                url: url.clone().unwrap_or_default(),
+                system_id: self.system_id,
+                component_id: self.component_id,
+                timeout_s: self.link_timeout,
+            },
+        };
+        let mission = self
+            .mission
+            .as_deref()
+            .map(|p| Mission::load(Some(p)))
+            .transpose()?;
+        Ok(LiveTask::Follow {
+            source,
+            request: Box::new(LiveRequest {
+                battery: self.battery.clone(),
+                payload_kg: self.payload_kg,
+                every_s: self.every,
+                mission,
+                reserve_percent: self.reserve_percent,
+                speed_mps: None,
+                scenarios: self.scenarios,
+            }),
+        })
     }
 }

@@ -586,6 +586,26 @@ impl Default for FlightLogs {
 }
 
 impl FlightLogs {
+    /// Read the first log as it is (no alignment): a replay's events.
+    pub(crate) fn read_first(&self) -> Result<aloft_logs::Log, Error> {
+        let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;
+        let open = OpenOptions {
+            binary: BinaryOptions {
+                battery_instance: self.battery_instance,
+                ..BinaryOptions::default()
+            },
+            ..OpenOptions::default()
+        };
+        let path = self.logs.first().ok_or_else(|| Error::InvalidInput {
+            name: "replay",
+            value: 0.0,
+            unit: "logs",
+            expected: "one flight log",
+        })?;
+        let mut reader = open_log_with(path, profile.as_ref(), &open)?;
+        Ok(reader.read_rest(&path.display().to_string())?)
+    }
+
     /// Read every log, align power with motion, and set the angle-of-attack model.
     pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
         let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;

@@ -52,7 +52,7 @@ impl Mission {
     }
 
     /// An aloft mission spec from `format`, with its route figures.
-    fn of_spec(spec: MissionSpec, origin: &str, format: SourceFormat) -> Self {
+    pub(crate) fn of_spec(spec: MissionSpec, origin: &str, format: SourceFormat) -> Self {
         Self {
             route: route_figures(&spec, format, Vec::new()),
             spec,

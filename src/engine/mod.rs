@@ -87,7 +87,10 @@ pub use files::read_text_file;
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use flown::PlanningSpeed;
 pub use keywords::{keywords, parse_keywords, FlagGroup, Keyword};
-pub use live::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest, LiveUpdate};
+pub use live::{
+    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveReplayRequest, LiveRequest,
+    LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
+};
 pub use logs::{
     convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
     LogReadOptions, LogTime, LogTopic, TopicCount,

@@ -479,6 +479,10 @@ impl TelemetrySource for LinkSource {
             format!("{undecoded} undecodable messages")
         }
     }
+
+    fn reply(&mut self, reply: &Reply) -> Result<(), String> {
+        LinkSource::reply(self, reply).map_err(|e| e.to_string())
+    }
 }
 
 /// The link address, checked to be one of the supported forms; UDP sockets get a read timeout

@@ -182,10 +182,38 @@ pub fn geodetic_to_enu(origin: &GeoOrigin, lat_rad: f64, lon_rad: f64, alt_m: f6
     ]
 }
 
+/// The geodetic point of a local ENU position relative to `origin`: the inverse of
+/// [`geodetic_to_enu`] (latitude and longitude in rad, altitude in m).
+pub fn enu_to_geodetic(origin: &GeoOrigin, enu_m: [f64; 3]) -> (f64, f64, f64) {
+    let s = origin.lat_rad.sin();
+    let w = (1.0 - WGS84_E2 * s * s).sqrt();
+    let n = WGS84_A_M / w;
+    let m = WGS84_A_M * (1.0 - WGS84_E2) / (w * w * w);
+    (
+        origin.lat_rad + enu_m[1] / (m + origin.alt_m),
+        origin.lon_rad + enu_m[0] / ((n + origin.alt_m) * origin.lat_rad.cos()),
+        origin.alt_m + enu_m[2],
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::FRAC_PI_2;
+
+    #[test]
+    fn enu_to_geodetic_inverts_geodetic_to_enu() {
+        let origin = GeoOrigin {
+            lat_rad: 36.37_f64.to_radians(),
+            lon_rad: 127.36_f64.to_radians(),
+            alt_m: 60.0,
+        };
+        let (lat, lon, alt) = enu_to_geodetic(&origin, [812.5, -301.25, 42.0]);
+        let back = geodetic_to_enu(&origin, lat, lon, alt);
+        for (a, b) in back.iter().zip([812.5, -301.25, 42.0]) {
+            assert!((a - b).abs() < 1e-9, "{back:?}");
+        }
+    }
 
     // Angles are recovered to 1e-9 rad: well above the f64 rounding of a few trig calls.
     const TOL: f64 = 1e-9;

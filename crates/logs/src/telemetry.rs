@@ -7,7 +7,7 @@
 //! the same events (a sample per record, `Heartbeat` from its arming and mode records where it
 //! has them).
 
-use crate::sample::{GeoOrigin, Sample};
+use crate::sample::{GeoOrigin, Log, Sample};
 
 /// One event of a flight, at a time.
 #[derive(Debug, Clone, PartialEq)]
@@ -107,6 +107,30 @@ pub trait TelemetrySource {
     fn skipped(&self) -> String {
         String::new()
     }
+
+    /// Send `reply` back to the vehicle's link (a ground station on it shows it); a source that
+    /// is not a link ignores it (the default).
+    ///
+    /// # Errors
+    /// The link's, as a message naming it.
+    fn reply(&mut self, reply: &Reply) -> Result<(), String> {
+        let _ = reply;
+        Ok(())
+    }
+}
+
+impl<T: TelemetrySource + ?Sized> TelemetrySource for Box<T> {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        (**self).next_event()
+    }
+
+    fn skipped(&self) -> String {
+        (**self).skipped()
+    }
+
+    fn reply(&mut self, reply: &Reply) -> Result<(), String> {
+        (**self).reply(reply)
+    }
 }
 
 /// What `aloft live` sends back on a link, so a ground station shows it without a plugin.
@@ -126,4 +150,85 @@ pub enum Reply {
         /// WARNING severity (else INFO).
         warning: bool,
     },
+}
+
+/// A source played at a pace: event `t` is returned no earlier than `t / speed` seconds of wall
+/// time after the first (a telemetry log "in its own time", `--speed 1`, or faster). The waits
+/// are sleeps; nothing is buffered.
+pub struct Paced<S> {
+    source: S,
+    speed: f64,
+    start: Option<(std::time::Instant, f64)>,
+}
+
+impl<S: TelemetrySource> Paced<S> {
+    /// `source` at `speed` times its own time (positive and finite; the caller checks it).
+    pub fn new(source: S, speed: f64) -> Self {
+        Self {
+            source,
+            speed,
+            start: None,
+        }
+    }
+}
+
+impl<S: TelemetrySource> TelemetrySource for Paced<S> {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        let Some(t) = self.source.next_event()? else {
+            return Ok(None);
+        };
+        let (wall0, t0) = *self
+            .start
+            .get_or_insert_with(|| (std::time::Instant::now(), t.time_s));
+        let due = ((t.time_s - t0) / self.speed).clamp(0.0, 1e9);
+        let elapsed = wall0.elapsed().as_secs_f64();
+        if due > elapsed {
+            std::thread::sleep(std::time::Duration::from_secs_f64(due - elapsed));
+        }
+        Ok(Some(t))
+    }
+
+    fn skipped(&self) -> String {
+        self.source.skipped()
+    }
+
+    fn reply(&mut self, reply: &Reply) -> Result<(), String> {
+        self.source.reply(reply)
+    }
+}
+
+/// A flight log replayed as events: its origin (where its positions were geodetic), then a
+/// sample event per record, in file order (`aloft live --replay`).
+pub struct LogEvents {
+    origin: Option<GeoOrigin>,
+    samples: std::vec::IntoIter<Sample>,
+}
+
+impl LogEvents {
+    /// The events of `log`.
+    pub fn new(log: Log) -> Self {
+        Self {
+            origin: log.origin,
+            samples: log.samples.into_iter(),
+        }
+    }
+}
+
+impl TelemetrySource for LogEvents {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        let event = match self.origin.take() {
+            Some(o) => Telemetry {
+                time_s: self.samples.as_slice().first().map_or(0.0, |s| s.time_s),
+                event: Event::Origin(o),
+            },
+            None => match self.samples.next() {
+                Some(s) => Telemetry {
+                    time_s: s.time_s,
+                    event: Event::Sample(s),
+                },
+                None => return Ok(None),
+            },
+        };
+        Ok(Some(event))
+    }
 }

@@ -65,6 +65,9 @@ impl MissionSpec {
         compiler.clamp_speeds = self.clamp_speeds;
         compiler.clamp_to_mps = clamp_to_mps;
         compiler.corners = self.corners.unwrap_or_default();
+        if let Some(start_m) = self.start_in_air_m {
+            compiler.start_in_air(start_m)?;
+        }
         for (index, segment) in self.segments.iter().enumerate() {
             compiler.segment(index, segment)?;
         }
@@ -180,6 +183,22 @@ impl<'a> Compiler<'a> {
         };
         compiler.check_take_off_mass(start_payload_kg)?;
         Ok(compiler)
+    }
+
+    /// Start in the air at rest, `start_m` (east, north, up) from home: the rest of a flight in
+    /// progress.
+    fn start_in_air(&mut self, start_m: [f64; 3]) -> Result<(), PlannerError> {
+        for (name, value) in [("start_east_m", start_m[0]), ("start_north_m", start_m[1])] {
+            crate::error::parameter(name, value, "m", value.is_finite(), "a finite number")?;
+        }
+        crate::error::positive("start_up_m", start_m[2], "m")?;
+        self.pos_m = [
+            self.home_m[0] + start_m[0],
+            self.home_m[1] + start_m[1],
+            self.home_m[2] + start_m[2],
+        ];
+        self.airborne = true;
+        Ok(())
     }
 
     /// Compile segment `index` (from 0): the one place each kind is sent to its method.

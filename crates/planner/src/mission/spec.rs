@@ -366,6 +366,12 @@ pub struct MissionSpec {
     /// Segments, in order.
     #[serde(default, rename = "segment")]
     pub segments: Vec<SegmentSpec>,
+    /// Where the flight starts when it starts in the air, at rest: east, north, up from home, m
+    /// (the rest of a flight in progress, as `aloft live` plans it; not a key of the file).
+    /// `None`, the default: on the ground at home, so the first segment is a take-off.
+    #[serde(skip)]
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start_in_air_m: Option<[f64; 3]>,
 }
 
 /// How the vehicle flies through a waypoint that has no hold.

@@ -1,24 +1,15 @@
-//! `aloft live`: following a flight as it flies and answering, at every update, what the rest of
-//! it costs and whether it can be flown.
+//! The validation route of `aloft live` (`--route log`): a flight log replayed as if live, with
+//! the rest of the logged path as the route ahead, so the prediction made at each time can be
+//! checked against the energy the log measured from then to the end.
 //!
-//! This module holds the answer of one update ([`LiveUpdate`], one JSON line) and the validation
-//! route (`--route log`): a flight log replayed as if live, with the rest of the logged path as
-//! the route ahead, so the prediction made at each time can be checked against the energy the
-//! log measured from then to the end.
+//! At an update at time `t`:
 //!
-//! At an update at time `t` of a replayed flight:
-//!
-//! 1. the efficiency is re-estimated from the samples so far: the energy ratio
-//!    `r_d = E_measured / E_predicted` over `[t_0, t]` shrunk toward the fitted model by the
-//!    uncertainty of each ([`crate::recalibration`]; power seed eqs 7 and 14), `r = exp(w ln r_d)`;
+//! 1. the efficiency is re-estimated from the samples so far ([`super::estimate`]: the energy
+//!    ratio shrunk toward the fitted model, its spread from the estimate and the drift);
 //! 2. the energy ahead is the model's power along the rest of the path times the ratio:
 //!    `E_ahead = r * integral_t^end P_predicted dt` (the p50);
-//! 3. its spread is that of the ratio of the rest, on the log scale the sum of two variances:
-//!    the estimate's, `s^2 = s_p^2 s_d^2 / (s_p^2 + s_d^2)` (the fit's spread `s_p` between
-//!    flights, or the scenarios' 3 % model error for a vehicle without one, combined with the
-//!    window's standard error `s_d`), and the drift of the ratio along the flight, the variance
-//!    of the log ratios of the 60 s blocks so far over the number of blocks ahead. p5 and p95 are
-//!    `E_ahead exp(-+1.645 s_total)` (the limit of a Monte-Carlo draw of the ratio);
+//! 3. p5 and p95 are `E_ahead exp(-+1.645 s)` with `s` the ratio's spread on the log scale (the
+//!    limit of a Monte-Carlo draw of the ratio);
 //! 4. beside it, the naive rate: the mean measured power so far times the time left,
 //!    `P_mean(t_0..t) (t_end - t)` (the rate behind PX4's remaining-time estimate).
 //!
@@ -28,23 +19,18 @@
 
 use serde::Serialize;
 
-use super::finite::finite;
-use super::logs::FlightLogs;
-use super::scenario_stats::Percentiles;
-use super::scenarios::DEFAULT_POWER_SD_PERCENT;
-use super::vehicles::Vehicle;
+use super::super::finite::finite;
+use super::super::logs::FlightLogs;
+use super::super::scenario_stats::Percentiles;
+use super::super::scenarios::DEFAULT_POWER_SD_PERCENT;
+use super::super::vehicles::Vehicle;
+use super::estimate::RatioEstimator;
+use super::LiveUpdate;
 use crate::error::Error;
 use crate::identify::{predict, AlignedFlight};
 
 /// The standard normal quantile of 95 %: p5 and p95 lie 1.645 standard deviations from p50.
 const Z_95: f64 = 1.644_853_626_951_472_2;
-
-/// Shortest window the efficiency is re-estimated from, s: before it an update answers with the
-/// fitted model alone.
-const MIN_WINDOW_S: f64 = 10.0;
-
-/// Length of the blocks whose ratios measure how the ratio drifts along a flight, s.
-const DRIFT_BLOCK_S: f64 = 60.0;
 
 /// A replayed flight followed as if live, with the rest of the log as the route ahead.
 #[derive(Debug, Clone, PartialEq)]
@@ -57,36 +43,6 @@ pub struct LiveReplayRequest {
     pub payload_kg: f64,
     /// An update every this many seconds of flight time.
     pub every_s: f64,
-}
-
-/// One update: a line of `aloft live --format json`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct LiveUpdate {
-    /// Time since the start of the stream, s.
-    pub time_s: f64,
-    /// In the air.
-    pub in_air: bool,
-    /// Measured electrical energy so far, Wh.
-    pub energy_used_wh: f64,
-    /// Measured electrical power now, W.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub power_w: Option<f64>,
-    /// Whether the source measures power (without it the prediction is the model's alone).
-    pub power_available: bool,
-    /// The efficiency the rest is predicted with (re-estimated in flight).
-    pub efficiency: f64,
-    /// Energy to finish the route and land, Wh.
-    pub remaining_wh: Percentiles,
-    /// The naive rate: mean measured power so far times the route's remaining time, Wh.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub naive_remaining_wh: Option<f64>,
-    /// Validation mode: the energy the log measured from now to the end, Wh.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub measured_remaining_wh: Option<f64>,
-    /// What to do: `continue`, `return now` or `land now`; absent where the pack's capacity or
-    /// state is not known (a vehicle with a power table only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub advice: Option<&'static str>,
 }
 
 /// The end of a validation replay: how the predictions did against the measured rest.
@@ -133,33 +89,30 @@ pub fn replay_live(
     request: &LiveReplayRequest,
     emit: &mut dyn FnMut(&LiveUpdate) -> Result<(), Error>,
 ) -> Result<LiveCheck, Error> {
-    if !(request.every_s.is_finite() && request.every_s > 0.0) {
-        return Err(Error::InvalidInput {
-            name: "every",
-            value: request.every_s,
-            unit: "s",
-            expected: "a positive number of seconds",
-        });
-    }
+    super::check_every(request.every_s)?;
     let (model, _) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
     let mut flights = request.logs.load()?;
     let (flight, _) = flights.swap_remove(0);
     let predicted = predict(&model, &flight)?;
     let series = Series::new(&flight, predicted);
     // Without a spread from a fit, the model error the scenarios assume.
-    let prior_sd = Some(
-        model
-            .vehicle()
-            .params()
-            .efficiency_relative_sd
-            .unwrap_or(DEFAULT_POWER_SD_PERCENT / 100.0),
-    );
+    let prior_sd = model
+        .vehicle()
+        .params()
+        .efficiency_relative_sd
+        .unwrap_or(DEFAULT_POWER_SD_PERCENT / 100.0);
     let eta0 = model.vehicle().efficiency();
+    let mut estimator = RatioEstimator::new(prior_sd);
     let mut judge = Judge::new(series.duration_s());
-    let mut t = series.t[0];
+    let (mut t, mut next) = (series.t[0], 0);
     let end = series.t[series.t.len() - 1];
     while t < end {
-        let update = series.update_at(t, eta0, prior_sd);
+        // The samples up to `t` so far.
+        while next < series.t.len() && series.t[next] <= t {
+            estimator.push(series.t[next], series.measured_w[next], series.predicted_w[next]);
+            next += 1;
+        }
+        let update = series.update_at(next.max(1) - 1, &estimator, eta0);
         let update = finite(update, "live", || flight.source.clone())?;
         judge.add(&update, t - series.t[0]);
         emit(&update)?;
@@ -207,78 +160,44 @@ impl Series {
         self.t[self.t.len() - 1] - self.t[0]
     }
 
-    /// The answer at time `t`: the samples up to it are "so far", the rest "ahead".
-    fn update_at(&self, t: f64, eta0: f64, prior_sd: Option<f64>) -> LiveUpdate {
-        let k = self.t.partition_point(|&x| x <= t).max(1) - 1;
+    /// The answer at sample `k`: the samples up to it (in `estimator`) are "so far", the rest
+    /// "ahead".
+    fn update_at(&self, k: usize, estimator: &RatioEstimator, eta0: f64) -> LiveUpdate {
         let last = self.t.len() - 1;
-        let (so_far_m, so_far_p) = (self.measured_j[k], self.predicted_j[k]);
-        let ahead_p = self.predicted_j[last] - so_far_p;
+        let so_far_m = self.measured_j[k];
+        let ahead_p = self.predicted_j[last] - self.predicted_j[k];
         let ahead_m = self.measured_j[last] - so_far_m;
         let elapsed = self.t[k] - self.t[0];
-        let (ratio, sd) = if elapsed >= MIN_WINDOW_S && so_far_p > 0.0 && k >= 2 {
-            let shrunk = crate::recalibration::shrink(
-                so_far_m / so_far_p,
-                &self.measured_w[..=k],
-                &self.predicted_w[..=k],
-                prior_sd,
-            );
-            // The shrunk estimate's variance is the window's times its weight: `w s_d^2 =
-            // s_p^2 s_d^2 / (s_p^2 + s_d^2)`; without a finite window spread, the prior's.
-            let estimate_sd = match shrunk.window_relative_sd {
-                sd if sd.is_finite() => shrunk.window_weight.sqrt() * sd,
-                _ => prior_sd.unwrap_or(0.0),
-            };
-            let drift_sd = self.drift_sd(k, self.t[last] - self.t[k]);
-            (shrunk.ratio, estimate_sd.hypot(drift_sd))
-        } else {
-            (1.0, prior_sd.unwrap_or(0.0))
-        };
-        let p50 = ratio * ahead_p / 3600.0;
-        let spread = (Z_95 * sd).exp();
         let time_left = self.t[last] - self.t[k];
+        let r = estimator.ratio(time_left);
+        let p50 = r.ratio * ahead_p / 3600.0;
+        let spread = (Z_95 * r.log_sd).exp();
         LiveUpdate {
             time_s: self.t[k],
             in_air: true,
+            mode: None,
+            mission_item: None,
+            position: None,
+            soc: None,
             energy_used_wh: so_far_m / 3600.0,
             power_w: Some(self.measured_w[k]),
             power_available: true,
-            efficiency: eta0 / ratio,
-            remaining_wh: Percentiles {
+            efficiency: eta0 / r.ratio,
+            wind_mps: None,
+            wind_from_deg: None,
+            remaining_wh: Some(Percentiles {
                 p5: p50 / spread,
                 p50,
                 p95: p50 * spread,
-            },
+            }),
+            landing_soc: None,
+            point_of_no_return_s: None,
+            advice: None,
             naive_remaining_wh: (elapsed > 0.0).then(|| so_far_m / elapsed * time_left / 3600.0),
             measured_remaining_wh: Some(ahead_m / 3600.0),
-            advice: None,
+            link_lost: false,
+            note: None,
         }
-    }
-}
-
-impl Series {
-    /// How far the ratio of the rest may drift from the flight's so far: the spread of the log
-    /// ratios of the [`DRIFT_BLOCK_S`] blocks so far, over the square root of the blocks the rest
-    /// holds (at least one); 0 with fewer than three blocks so far.
-    fn drift_sd(&self, k: usize, rest_s: f64) -> f64 {
-        let mut logs = Vec::new();
-        let mut from = 0;
-        for j in 1..=k {
-            if self.t[j] - self.t[from] >= DRIFT_BLOCK_S {
-                let m = self.measured_j[j] - self.measured_j[from];
-                let p = self.predicted_j[j] - self.predicted_j[from];
-                if m > 0.0 && p > 0.0 {
-                    logs.push((m / p).ln());
-                }
-                from = j;
-            }
-        }
-        if logs.len() < 3 {
-            return 0.0;
-        }
-        let n = logs.len() as f64;
-        let mean = logs.iter().sum::<f64>() / n;
-        let var = logs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
-        (var / (rest_s / DRIFT_BLOCK_S).max(1.0)).sqrt()
     }
 }
 
@@ -315,7 +234,10 @@ impl Judge {
         let Some(truth) = u.measured_remaining_wh.filter(|m| *m > 0.0) else {
             return;
         };
-        let inside = (u.remaining_wh.p5..=u.remaining_wh.p95).contains(&truth);
+        let Some(band) = u.remaining_wh else {
+            return;
+        };
+        let inside = (band.p5..=band.p95).contains(&truth);
         self.judged += 1;
         self.in_band += usize::from(inside);
         while self.pending.first().is_some_and(|(_, at)| elapsed_s >= *at) {
@@ -324,7 +246,7 @@ impl Judge {
             self.checkpoints.push(LiveCheckpoint {
                 at,
                 time_s: u.time_s,
-                error_percent: percent(u.remaining_wh.p50),
+                error_percent: percent(band.p50),
                 naive_error_percent: u.naive_remaining_wh.map_or(f64::NAN, percent),
                 in_band: inside,
             });

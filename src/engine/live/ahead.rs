@@ -1,0 +1,285 @@
+//! The rest of a flight followed live: the route ahead from the vehicle's present state, flown by
+//! the planner in Monte-Carlo scenarios, and the advice.
+//!
+//! The route ahead, from where the vehicle is (at rest, in the air; on the ground: the whole
+//! mission from home):
+//! - flight mode `RTL`, `SMART_RTL` or `AUTO_RTL`: straight back to home and the landing;
+//! - `LAND` or `PRECLAND`: the landing where it is;
+//! - `AUTO` (ArduPilot) or `MISSION` (PX4) with a mission (`--mission`, or the one learned from
+//!   the link): the mission from the item being flown (MISSION_CURRENT) to its end, then home and
+//!   the landing if it does not end on the ground;
+//! - any other mode (flown by hand or guided), or without a mission: home and the landing, what
+//!   it costs to come back now.
+//!
+//! It is flown from the present state of charge, by the vehicle at the re-estimated efficiency,
+//! in the present wind, in [`LIVE_SCENARIOS`] scenarios that draw the model error from the
+//! estimate's own spread and the wind from its source's ([`WIND_SD`]). The advice: `continue`
+//! while 95 % of the scenarios land with the reserve (the p5 reserve at landing holds), `return
+//! now` where they do not but 95 % of a direct return's do, `land now` where neither holds.
+
+use aloft_missions::SourceFormat;
+use aloft_planner::{geodesy::LocalFrame, HomeSpec, MissionSpec, SegmentSpec, WindSpec};
+
+use super::super::mission_file::Mission;
+use super::super::mission_options::MissionOptions;
+use super::super::scenario_stats::Percentiles;
+use super::super::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
+use super::super::vehicles::Vehicle;
+use super::estimate::Ratio;
+use super::tracker::{Tracker, WindSource};
+use crate::error::Error;
+
+/// Scenarios per update (the figure: one update with them within 100 ms on 2 cores).
+pub const LIVE_SCENARIOS: u32 = 200;
+
+/// Time step the rest is flown at, s (coarser than a plan's 0.1 s: the rest is re-planned every
+/// update, and its energy changes by less than 0.1 % between the two on the demo mission).
+pub(crate) const LIVE_TIME_STEP_S: f64 = 0.5;
+
+/// Spread of the wind, one standard deviation: speed (m/s) and direction (deg), by source. The
+/// autopilot's estimate (ArduPilot's EKF) is steadier than one from the tilt, which also holds
+/// the accelerations and the attitude's trim offsets.
+const WIND_SD: [(WindSource, f64, f64); 2] = [
+    (WindSource::Autopilot, 1.0, 15.0),
+    (WindSource::Attitude, 2.0, 30.0),
+];
+
+/// Share of the scenarios that must land with the reserve for a route to be flown.
+const P_HOLDS: f64 = 0.95;
+
+/// Ground speed of a return where neither the mission nor the vehicle gives one, m/s (PX4's
+/// `MPC_XY_CRUISE`; ArduPilot's `WPNAV_SPEED` is 10 m/s).
+const RETURN_SPEED_MPS: f64 = 5.0;
+
+/// Landing rate of the landing appended to a route and of `LAND`, m/s (ArduPilot's `LAND_SPEED`).
+const LANDING_RATE_MPS: f64 = 0.5;
+
+/// What the rest costs and what to do.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct AheadAnswer {
+    pub remaining_wh: Option<Percentiles>,
+    pub landing_soc: Option<Percentiles>,
+    pub duration_s: Option<Percentiles>,
+    /// The rest's point of no return (p5 of the scenarios), s from now: `None` where the route
+    /// can turn back everywhere.
+    pub point_of_no_return_s: Option<f64>,
+    /// Whether a direct return has a point of no return at all (`false`: it is past).
+    pub advice: &'static str,
+}
+
+/// The route ahead's inputs that do not change within a flight.
+pub(crate) struct Ahead<'a> {
+    pub vehicle: &'a Vehicle,
+    pub battery: Option<String>,
+    pub payload_kg: f64,
+    pub reserve_percent: Option<f64>,
+    pub speed_mps: Option<f64>,
+    pub scenarios: u32,
+}
+
+impl Ahead<'_> {
+    /// Fly the rest of the flight `t` describes, on `mission` where one is known.
+    ///
+    /// # Errors
+    /// What makes the route itself wrong (a mission the vehicle cannot fly at all is not an
+    /// error: its scenarios are infeasible).
+    pub(crate) fn answer(
+        &self,
+        t: &Tracker,
+        mission: Option<&Mission>,
+        soc: f64,
+        ratio: Ratio,
+    ) -> Result<Option<AheadAnswer>, Error> {
+        let vehicle = self.vehicle_at(ratio)?;
+        let Some((rest, is_return)) = rest_spec(t, mission) else {
+            return Ok(None);
+        };
+        let rest_u = self.fly(&vehicle, rest, t, soc, ratio)?;
+        let holds = |u: &Uncertainty| u.p_feasible >= P_HOLDS;
+        let advice = if holds(&rest_u) {
+            "continue"
+        } else if !is_return && t.in_air() {
+            let back = self.fly(&vehicle, return_spec(t, mission), t, soc, ratio)?;
+            if holds(&back) {
+                "return now"
+            } else {
+                "land now"
+            }
+        } else {
+            "land now"
+        };
+        Ok(Some(AheadAnswer {
+            remaining_wh: rest_u.energy_wh,
+            landing_soc: rest_u.end_soc,
+            duration_s: rest_u.duration_s,
+            point_of_no_return_s: rest_u.point_of_no_return_s.p5,
+            advice,
+        }))
+    }
+
+    /// The vehicle at the re-estimated efficiency `eta_0 / r` (at most 1).
+    fn vehicle_at(&self, ratio: Ratio) -> Result<Vehicle, Error> {
+        match self.vehicle.efficiency() {
+            Some(eta0) if (ratio.ratio - 1.0).abs() > 1e-12 => {
+                self.vehicle.with_efficiency((eta0 / ratio.ratio).clamp(0.01, 1.0))
+            }
+            _ => Ok(self.vehicle.clone()),
+        }
+    }
+
+    /// The scenarios of `spec` from the present state.
+    fn fly(
+        &self,
+        vehicle: &Vehicle,
+        spec: MissionSpec,
+        t: &Tracker,
+        soc: f64,
+        ratio: Ratio,
+    ) -> Result<Uncertainty, Error> {
+        let mission = Mission::of_spec(spec, "ahead", SourceFormat::AloftToml);
+        let (wind, wind_sd, from_sd) = match t.wind {
+            Some((w, source)) => {
+                let (_, speed_sd, from_sd) = WIND_SD
+                    .iter()
+                    .copied()
+                    .find(|(s, _, _)| *s == source)
+                    .unwrap_or(WIND_SD[1]);
+                let from_deg = (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0);
+                (WindSpec::uniform(w[0].hypot(w[1]), from_deg), speed_sd, from_sd)
+            }
+            None => (WindSpec::uniform(0.0, 0.0), WIND_SD[1].1, WIND_SD[1].2),
+        };
+        let options = MissionOptions {
+            battery: self.battery.clone(),
+            payload_kg: Some(self.payload_kg),
+            wind: Some(wind),
+            reserve_percent: self.reserve_percent,
+            start_percent: (100.0 * soc).clamp(0.1, 100.0),
+            time_step_s: Some(LIVE_TIME_STEP_S),
+            speed_mps: self.speed_mps,
+            ..MissionOptions::default()
+        };
+        let sc = ScenarioOptions {
+            samples: self.scenarios,
+            wind_speed_sd_mps: wind_sd,
+            wind_from_sd_deg: from_sd,
+            power_sd_percent: (100.0 * ratio.log_sd).clamp(0.0, 50.0),
+            ..ScenarioOptions::default()
+        };
+        plan_scenarios(vehicle, &mission, &options, &sc)
+    }
+}
+
+/// The route ahead (see the module docs) and whether it is a return already; `None` on the
+/// ground without a mission (nothing to fly).
+fn rest_spec(t: &Tracker, mission: Option<&Mission>) -> Option<(MissionSpec, bool)> {
+    let mode = t.heartbeat.as_ref().map_or("", |h| h.mode.as_str());
+    if !t.in_air() {
+        return mission.map(|m| (m.spec().clone(), false));
+    }
+    Some(match mode {
+        "RTL" | "SMART_RTL" | "AUTO_RTL" => (return_spec(t, mission), true),
+        "LAND" | "PRECLAND" => {
+            let mut spec = start_here(t, mission);
+            spec.segments.push(landing());
+            (spec, true)
+        }
+        "AUTO" | "MISSION" if mission.is_some() => (mission_rest(t, mission?), false),
+        _ => (return_spec(t, mission), true),
+    })
+}
+
+/// The mission from the item being flown, ending on the ground.
+fn mission_rest(t: &Tracker, m: &Mission) -> MissionSpec {
+    let mut spec = start_here(t, Some(m));
+    let current = t.mission_current.unwrap_or(0);
+    let from = m
+        .spec()
+        .segments
+        .iter()
+        .position(|s| s.item().is_some_and(|i| i >= current))
+        .unwrap_or(m.spec().segments.len());
+    spec.segments = m.spec().segments[from..]
+        .iter()
+        // In the air already: a take-off item is the climb done.
+        .filter(|s| !matches!(s, SegmentSpec::TakeOff { .. }))
+        .cloned()
+        .collect();
+    // A descent under way below its height is done too (the landing after it is not).
+    let up = spec.start_in_air_m.map_or(0.0, |p| p[2]);
+    if let Some(SegmentSpec::Descent { altitude_m, .. }) = spec.segments.first() {
+        if *altitude_m >= up {
+            spec.segments.remove(0);
+        }
+    }
+    match spec.segments.last() {
+        Some(SegmentSpec::Landing { .. } | SegmentSpec::LoiterUntilReserve { .. }) => {}
+        Some(SegmentSpec::Return { .. }) => spec.segments.push(landing()),
+        _ => spec.segments.extend([back_home(), landing()]),
+    }
+    spec
+}
+
+/// Straight back to home from where the vehicle is, and the landing.
+fn return_spec(t: &Tracker, mission: Option<&Mission>) -> MissionSpec {
+    let mut spec = start_here(t, mission);
+    if t.in_air() {
+        spec.segments = vec![back_home(), landing()];
+    }
+    spec
+}
+
+/// The mission's settings (or none), starting in the air where the vehicle is, no segments.
+fn start_here(t: &Tracker, mission: Option<&Mission>) -> MissionSpec {
+    let mut spec = match mission {
+        Some(m) => MissionSpec {
+            segments: Vec::new(),
+            ..m.spec().clone()
+        },
+        None => MissionSpec {
+            name: "return".to_string(),
+            home: HomeSpec::default(),
+            ..MissionSpec::default()
+        },
+    };
+    spec.allow_end_in_air = false;
+    // A return needs a speed: the mission's, else the vehicle's cruise speed, else this.
+    spec.default_speed_mps.get_or_insert(RETURN_SPEED_MPS);
+    if t.in_air() {
+        spec.start_in_air_m = Some(position_from_home(t, &spec.home));
+    }
+    spec
+}
+
+/// The vehicle's position from `home`, m (east, north, up; up at least 0.5 m): through the
+/// geodetic origin of the stream where home is geodetic, else from the stream's home.
+fn position_from_home(t: &Tracker, home: &HomeSpec) -> [f64; 3] {
+    let pos = t.pos_enu.unwrap_or([0.0; 3]);
+    let up = t.height_m().unwrap_or(pos[2]).max(0.5);
+    match (t.origin, home.latitude_deg, home.longitude_deg) {
+        (Some(o), Some(lat), Some(lon)) => {
+            let o_en = LocalFrame::new(lat, lon).to_local_m(o.lat_rad.to_degrees(), o.lon_rad.to_degrees());
+            [o_en[0] + pos[0], o_en[1] + pos[1], up]
+        }
+        _ => {
+            let h = t.home_enu.unwrap_or([0.0; 3]);
+            [pos[0] - h[0], pos[1] - h[1], up]
+        }
+    }
+}
+
+fn back_home() -> SegmentSpec {
+    SegmentSpec::Return {
+        ground_speed_mps: None,
+        altitude_m: None,
+        item: None,
+    }
+}
+
+fn landing() -> SegmentSpec {
+    SegmentSpec::Landing {
+        rate_mps: LANDING_RATE_MPS,
+        payload_after_kg: None,
+        item: None,
+    }
+}

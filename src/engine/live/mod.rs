@@ -1,0 +1,476 @@
+//! `aloft live`: following a flight as it flies and answering, at every update, what the rest of
+//! it costs and whether it can be flown.
+//!
+//! Two ways in:
+//! - [`follow_live`]: any [`TelemetrySource`] (a MAVLink link or telemetry log through the
+//!   `aloft-link` crate, a flight log replayed as events): the events folded into the flight's
+//!   state, the efficiency re-estimated from measured against predicted power
+//!   ([`estimate`](self::estimate)), the wind from the autopilot or the tilt, and the rest of the
+//!   route flown from the present state in Monte-Carlo scenarios, with the advice
+//!   ([`ahead`](self::ahead)); on a link, the answer sent back ([`replies`]).
+//! - [`replay_live`]: the validation route (`--route log`), a flight log replayed with the rest of
+//!   the logged path as the route ahead, so each prediction is checked against the energy the
+//!   log measured from then to the end.
+
+use serde::Serialize;
+
+use aloft_logs::frame::enu_to_geodetic;
+use aloft_logs::telemetry::{Reply, TelemetrySource};
+
+use super::finite::finite;
+use super::mission_file::Mission;
+use super::scenario_stats::Percentiles;
+use super::scenarios::DEFAULT_POWER_SD_PERCENT;
+use super::vehicles::Vehicle;
+use crate::error::Error;
+
+mod ahead;
+mod estimate;
+mod replay;
+mod sources;
+mod tracker;
+
+pub use ahead::LIVE_SCENARIOS;
+pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
+pub use sources::LiveSource;
+
+use ahead::{Ahead, AheadAnswer};
+use tracker::Tracker;
+
+/// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
+/// battery, no mission) are `null`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LiveUpdate {
+    /// Time since the start of the stream, s.
+    pub time_s: f64,
+    /// In the air.
+    pub in_air: bool,
+    /// Flight mode, by the autopilot's name.
+    pub mode: Option<String>,
+    /// The mission item being flown (MISSION_CURRENT).
+    pub mission_item: Option<u32>,
+    /// Where the vehicle is.
+    pub position: Option<Position>,
+    /// State of charge now, 0-1 (the autopilot's, else from the charge or energy drawn).
+    pub soc: Option<f64>,
+    /// Electrical energy used so far, Wh (measured; the model's without power data).
+    pub energy_used_wh: f64,
+    /// Measured electrical power now, W.
+    pub power_w: Option<f64>,
+    /// Whether the source measures power (without it the prediction is the model's alone).
+    pub power_available: bool,
+    /// The efficiency the rest is predicted with (re-estimated in flight).
+    pub efficiency: f64,
+    /// Wind speed, m/s (horizontal).
+    pub wind_mps: Option<f64>,
+    /// Direction the wind blows from, deg clockwise from north.
+    pub wind_from_deg: Option<f64>,
+    /// Energy to finish the route and land, Wh.
+    pub remaining_wh: Option<Percentiles>,
+    /// State of charge at landing, 0-1.
+    pub landing_soc: Option<Percentiles>,
+    /// The point of no return, s from now (negative once passed); `null` where the route can
+    /// turn back everywhere.
+    pub point_of_no_return_s: Option<f64>,
+    /// What to do: `continue`, `return now` or `land now`.
+    pub advice: Option<&'static str>,
+    /// The naive rate: mean measured power so far times the route's remaining time, Wh.
+    pub naive_remaining_wh: Option<f64>,
+    /// Validation mode: the energy the log measured from now to the end, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured_remaining_wh: Option<f64>,
+    /// The link has gone quiet: the figures are the last estimate's.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub link_lost: bool,
+    /// Why the route ahead has no answer (the planner's message).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// Where the vehicle is: from home (else the stream's first fix), and geodetic where the source
+/// has a fix.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Position {
+    /// East of home, m.
+    pub east_m: f64,
+    /// North of home, m.
+    pub north_m: f64,
+    /// Height above home, m.
+    pub up_m: f64,
+    /// Latitude, deg (WGS-84).
+    pub latitude_deg: Option<f64>,
+    /// Longitude, deg (WGS-84).
+    pub longitude_deg: Option<f64>,
+}
+
+/// A flight followed live.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LiveRequest {
+    /// Pack flown (default: the vehicle's).
+    pub battery: Option<String>,
+    /// Payload, kg.
+    pub payload_kg: f64,
+    /// An update every this many seconds of the stream's time.
+    pub every_s: f64,
+    /// The mission, where it is not learned from the link (`--mission FILE`).
+    pub mission: Option<Mission>,
+    /// Reserve required at landing, percent of the usable capacity (default: the mission's,
+    /// else 20).
+    pub reserve_percent: Option<f64>,
+    /// Planning speed of the legs that give none, m/s.
+    pub speed_mps: Option<f64>,
+    /// Scenarios per update (default [`LIVE_SCENARIOS`]).
+    pub scenarios: u32,
+}
+
+impl LiveRequest {
+    /// A request with the defaults: the vehicle's pack, no payload, an update a second.
+    pub fn new() -> Self {
+        Self {
+            battery: None,
+            payload_kg: 0.0,
+            every_s: 1.0,
+            mission: None,
+            reserve_percent: None,
+            speed_mps: None,
+            scenarios: LIVE_SCENARIOS,
+        }
+    }
+}
+
+impl Default for LiveRequest {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// How a followed stream ended.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LiveSummary {
+    /// Updates made.
+    pub updates: usize,
+    /// Span of the stream, s.
+    pub duration_s: f64,
+    /// Restarts of the vehicle seen.
+    pub reboots: u32,
+    /// Missions received (uploads and downloads).
+    pub missions: u32,
+    /// What the source passed over (damaged frames, bytes skipped).
+    pub skipped: String,
+}
+
+/// Follow `source` to its end: an update every `every_s` seconds of its time to `emit`, and on a
+/// link the answer sent back through [`TelemetrySource::reply`] ([`replies`]).
+///
+/// Steps per event: fold it into the flight's state; at an update, the state of charge, the
+/// efficiency's estimate, then the route ahead and the advice, then the replies.
+///
+/// # Errors
+/// A vehicle without a power model, an update interval that is not positive, a `--mission` the
+/// vehicle cannot plan at all, a source that fails (a file that cannot be read), and `emit`'s
+/// own error.
+pub fn follow_live(
+    vehicle: &Vehicle,
+    request: &LiveRequest,
+    source: &mut dyn TelemetrySource,
+    emit: &mut dyn FnMut(&LiveUpdate) -> Result<(), Error>,
+) -> Result<LiveSummary, Error> {
+    check_every(request.every_s)?;
+    let mut follower = Follower::new(vehicle, request)?;
+    let mut updates = 0;
+    let (mut first_s, mut next_s) = (None, f64::NEG_INFINITY);
+    let mut last: Option<LiveUpdate> = None;
+    while let Some(event) = source.next_event().map_err(Error::Link)? {
+        follower.tracker.apply(&event);
+        let now = follower.tracker.now_s;
+        first_s.get_or_insert(now);
+        let lost = follower.tracker.link_lost;
+        if now < next_s && !lost {
+            continue;
+        }
+        next_s = now + request.every_s;
+        let update = match (lost, &last) {
+            // The last estimate, said to be old.
+            (true, Some(prev)) => LiveUpdate {
+                time_s: now,
+                link_lost: true,
+                ..prev.clone()
+            },
+            _ => follower.update()?,
+        };
+        let update = finite(update, "live", || "the live update".to_string())?;
+        for reply in replies(last.as_ref(), &update) {
+            source.reply(&reply).map_err(Error::Link)?;
+        }
+        emit(&update)?;
+        updates += 1;
+        last = Some(update);
+    }
+    Ok(LiveSummary {
+        updates,
+        duration_s: follower.tracker.now_s - first_s.unwrap_or(0.0),
+        reboots: follower.tracker.reboots,
+        missions: follower.tracker.mission.as_ref().map_or(0, |(_, n)| *n),
+        skipped: source.skipped(),
+    })
+}
+
+/// An update interval must be positive and finite.
+pub(crate) fn check_every(every_s: f64) -> Result<(), Error> {
+    if every_s.is_finite() && every_s > 0.0 {
+        return Ok(());
+    }
+    Err(Error::InvalidInput {
+        name: "every",
+        value: every_s,
+        unit: "s",
+        expected: "a positive number of seconds",
+    })
+}
+
+/// What `aloft live` sends back on a link after `update` (the one before it `previous`): the
+/// reserve at landing (p50 and p5, percent), the seconds to the point of no return and the
+/// remaining energy as NAMED_VALUE_FLOAT, and a STATUSTEXT when the advice changes (at warning
+/// severity unless it is `continue`).
+pub fn replies(previous: Option<&LiveUpdate>, update: &LiveUpdate) -> Vec<Reply> {
+    let mut out = Vec::new();
+    if let Some(l) = update.landing_soc {
+        out.push(Reply::Value {
+            name: "rsv_p50",
+            value: 100.0 * l.p50,
+        });
+        out.push(Reply::Value {
+            name: "rsv_p5",
+            value: 100.0 * l.p5,
+        });
+    }
+    if let Some(pnr) = update.point_of_no_return_s {
+        out.push(Reply::Value {
+            name: "pnr_s",
+            value: pnr,
+        });
+    }
+    if let Some(r) = update.remaining_wh {
+        out.push(Reply::Value {
+            name: "rem_wh",
+            value: r.p50,
+        });
+    }
+    let before = previous.and_then(|p| p.advice);
+    if let Some(advice) = update.advice.filter(|a| Some(*a) != before) {
+        let landing = update
+            .landing_soc
+            .map_or_else(String::new, |l| format!(", lands at {:.0}% (p5)", 100.0 * l.p5));
+        out.push(Reply::Text {
+            text: format!("aloft: {advice}{landing}"),
+            warning: advice != "continue",
+        });
+    }
+    out
+}
+
+/// The state of a followed flight and what answers it.
+struct Follower<'a> {
+    tracker: Tracker,
+    ahead: Ahead<'a>,
+    pack_ah: f64,
+    pack_wh: f64,
+    eta0: f64,
+    given_mission: Option<&'a Mission>,
+    /// The mission learned from the source, with the upload it came from.
+    learned: Option<(Mission, u32)>,
+    /// The last point of no return, s of the stream, to say how long ago it passed.
+    point_of_no_return_at: Option<f64>,
+    /// The answer on the ground, while nothing it depends on changes.
+    on_ground: Option<(GroundKey, AheadAnswer)>,
+    /// The rest's duration at the last update (p50), s: the horizon of the ratio's drift.
+    rest_s: f64,
+}
+
+/// The rest's duration before the first answer, s.
+const DEFAULT_REST_S: f64 = 300.0;
+
+/// What an answer on the ground depends on: the mission's upload, the state of charge (0.5 %
+/// steps), the wind (0.5 m/s steps).
+type GroundKey = (u32, i64, [i64; 2]);
+
+impl<'a> Follower<'a> {
+    fn new(vehicle: &'a Vehicle, request: &'a LiveRequest) -> Result<Self, Error> {
+        let (model, mass) =
+            vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
+        let pack = vehicle.battery(request.battery.as_deref())?;
+        let drag = vehicle
+            .aircraft()
+            .ok()
+            .map(|a| (*a.drag(), mass.total_kg * a.gravity_mps2()));
+        let prior_sd = model
+            .vehicle()
+            .params()
+            .efficiency_relative_sd
+            .unwrap_or(DEFAULT_POWER_SD_PERCENT / 100.0);
+        let eta0 = model.vehicle().efficiency();
+        Ok(Self {
+            tracker: Tracker::new(model, drag, prior_sd),
+            ahead: Ahead {
+                vehicle,
+                battery: request.battery.clone(),
+                payload_kg: request.payload_kg,
+                reserve_percent: request.reserve_percent,
+                speed_mps: request.speed_mps,
+                scenarios: request.scenarios,
+            },
+            pack_ah: pack.capacity_ah(),
+            pack_wh: pack.rated_energy_wh(),
+            eta0,
+            given_mission: request.mission.as_ref(),
+            learned: None,
+            point_of_no_return_at: None,
+            on_ground: None,
+            rest_s: DEFAULT_REST_S,
+        })
+    }
+
+    /// The state of charge now: the autopilot's, else from the charge drawn, else from the
+    /// energy used (a full pack at the start).
+    fn soc(&self) -> f64 {
+        let b = &self.tracker.battery;
+        b.soc
+            .or_else(|| b.consumed_ah.map(|ah| 1.0 - ah / self.pack_ah))
+            .unwrap_or_else(|| 1.0 - self.tracker.energy_used_wh() / self.pack_wh)
+            .clamp(0.0, 1.0)
+    }
+
+    /// The mission flown: `--mission`, else the last one the source sent (read once per upload).
+    fn mission(&mut self) -> Result<Option<&Mission>, Error> {
+        if let Some(m) = self.given_mission {
+            return Ok(Some(m));
+        }
+        if let Some((items, upload)) = &self.tracker.mission {
+            if self.learned.as_ref().is_none_or(|(_, u)| u != upload) {
+                let m = Mission::from_items(items, "the mission on the link")?;
+                self.learned = Some((m, *upload));
+            }
+        }
+        Ok(self.learned.as_ref().map(|(m, _)| m))
+    }
+
+    fn update(&mut self) -> Result<LiveUpdate, Error> {
+        let soc = self.soc();
+        let t = &self.tracker;
+        let rest_s = self.rest_s;
+        let ratio = match t.power_available() {
+            true => t.estimator.ratio(rest_s),
+            false => estimate::Ratio {
+                ratio: 1.0,
+                log_sd: t.estimator.ratio(rest_s).log_sd,
+            },
+        };
+        let in_air = t.in_air();
+        let wind = t.wind.map(|(w, _)| w);
+        let key: GroundKey = (
+            t.mission.as_ref().map_or(0, |(_, n)| *n),
+            (soc * 200.0).round() as i64,
+            wind.map_or([0, 0], |w| [(w[0] * 2.0).round() as i64, (w[1] * 2.0).round() as i64]),
+        );
+        let cached = match (&self.on_ground, in_air) {
+            (Some((k, a)), false) if *k == key => Some(a.clone()),
+            _ => None,
+        };
+        let (answer, note) = match cached {
+            Some(a) => (Some(a), None),
+            None => {
+                // A learned mission aloft cannot read is said in the note, not an error.
+                let given = self.given_mission.is_some();
+                let mission = match self.mission() {
+                    Ok(m) => m.cloned(),
+                    Err(e) if !given => {
+                        return Ok(self.answer_update(soc, ratio, None, Some(e.to_string())))
+                    }
+                    Err(e) => return Err(e),
+                };
+                match self.ahead.answer(&self.tracker, mission.as_ref(), soc, ratio) {
+                    Ok(a) => (a, None),
+                    Err(e) => (None, Some(aloft_core::one_line(&e.to_string()))),
+                }
+            }
+        };
+        if let (Some(a), false) = (&answer, in_air) {
+            self.on_ground = Some((key, a.clone()));
+        }
+        if let Some(d) = answer.as_ref().and_then(|a| a.duration_s) {
+            self.rest_s = d.p50;
+        }
+        let note = match (note, self.eta0 / ratio.ratio > 1.0) {
+            (None, true) => Some(
+                "the measured power is below the model's at any efficiency up to 1: the vehicle \
+                 file does not describe this vehicle (the rest is flown at efficiency 1)"
+                    .to_string(),
+            ),
+            (note, _) => note,
+        };
+        Ok(self.answer_update(soc, ratio, answer, note))
+    }
+
+    /// The update from the state and the route ahead's answer.
+    fn answer_update(
+        &mut self,
+        soc: f64,
+        ratio: estimate::Ratio,
+        answer: Option<AheadAnswer>,
+        note: Option<String>,
+    ) -> LiveUpdate {
+        let t = &self.tracker;
+        let now = t.now_s;
+        let pnr = answer.as_ref().and_then(|a| a.point_of_no_return_s);
+        let point_of_no_return_s = match pnr {
+            Some(p) if p > 0.0 => {
+                self.point_of_no_return_at = Some(now + p);
+                Some(p)
+            }
+            // Passed: how long ago, where it was seen ahead before.
+            Some(_) => Some(self.point_of_no_return_at.map_or(0.0, |at| (at - now).min(0.0))),
+            None => None,
+        };
+        let naive = (t.power_available() && t.air_s >= estimate::MIN_WINDOW_S)
+            .then_some(())
+            .and_then(|()| answer.as_ref()?.duration_s)
+            .map(|d| t.air_measured_j / t.air_s * d.p50 / 3600.0);
+        let wind = t.wind.map(|(w, _)| w);
+        LiveUpdate {
+            time_s: now,
+            in_air: t.in_air(),
+            mode: t.heartbeat.as_ref().map(|h| h.mode.clone()),
+            mission_item: t.mission_current,
+            position: position(t),
+            soc: Some(soc),
+            energy_used_wh: t.energy_used_wh(),
+            power_w: t.power_w,
+            power_available: t.power_available(),
+            efficiency: self.eta0 / ratio.ratio,
+            wind_mps: wind.map(|w| w[0].hypot(w[1])),
+            wind_from_deg: wind.map(|w| (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0)),
+            remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
+            landing_soc: answer.as_ref().and_then(|a| a.landing_soc),
+            point_of_no_return_s,
+            advice: answer.as_ref().map(|a| a.advice),
+            naive_remaining_wh: naive,
+            measured_remaining_wh: None,
+            link_lost: false,
+            note,
+        }
+    }
+}
+
+/// The vehicle's position from home, geodetic where the stream has an origin.
+fn position(t: &Tracker) -> Option<Position> {
+    let p = t.pos_enu?;
+    let h = t.home_enu.unwrap_or([0.0; 3]);
+    let geo = t.origin.map(|o| enu_to_geodetic(&o, p));
+    Some(Position {
+        east_m: p[0] - h[0],
+        north_m: p[1] - h[1],
+        up_m: p[2] - h[2],
+        latitude_deg: geo.map(|g| g.0.to_degrees()),
+        longitude_deg: geo.map(|g| g.1.to_degrees()),
+    })
+}

@@ -1,0 +1,306 @@
+//! The state of a flight followed live: every [`Telemetry`] event folded into what the last
+//! messages said (position, velocity, attitude, power, battery, mode, mission), the energy so far
+//! and the efficiency estimate. Memory is bounded whatever the flight's length.
+
+use aloft_core::Trapezoid;
+use aloft_logs::frame::euler_to_mat_ned_frd;
+use aloft_logs::sample::{Attitude, GeoOrigin, Sample};
+use aloft_logs::telemetry::{BatteryState, Event, Heartbeat, MissionItem, Telemetry};
+use aloft_power::{CubicDrag, PowerModel};
+
+use super::estimate::RatioEstimator;
+
+/// Oldest motion (velocity, attitude) a power sample is paired with, s.
+const MOTION_FRESH_S: f64 = 2.0;
+
+/// Time constant of the wind estimated from the attitude, s (a low-pass over a few turns of a
+/// survey: the tilt of one instant also holds the acceleration).
+const WIND_TIME_CONSTANT_S: f64 = 20.0;
+
+/// Height above home, or ground speed, above which an armed vehicle with no landed state is
+/// taken to be in the air, m and m/s.
+const AIRBORNE_M: f64 = 1.0;
+
+/// Where the wind comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum WindSource {
+    /// The autopilot's own estimate (ArduPilot's WIND).
+    Autopilot,
+    /// Estimated here from the ground velocity and the tilt (the model's force balance).
+    Attitude,
+}
+
+/// What the last messages said, and what was learned of the flight so far.
+#[derive(Debug, Clone)]
+pub(crate) struct Tracker {
+    model: PowerModel,
+    /// Drag law and weight for the wind from the tilt (a vehicle with an airframe).
+    drag: Option<(CubicDrag, f64)>,
+    prior_sd: f64,
+    pub now_s: f64,
+    pub origin: Option<GeoOrigin>,
+    pub home_enu: Option<[f64; 3]>,
+    pub pos_enu: Option<[f64; 3]>,
+    vel: Option<([f64; 3], f64)>,
+    att: Option<(Attitude, f64)>,
+    pub power_w: Option<f64>,
+    landed: Option<bool>,
+    pub heartbeat: Option<Heartbeat>,
+    pub battery: BatteryState,
+    /// The mission as the vehicle holds it, and how many times one arrived (a re-upload).
+    pub mission: Option<(Vec<MissionItem>, u32)>,
+    pub mission_current: Option<u32>,
+    pub wind: Option<([f64; 2], WindSource)>,
+    wind_time_s: f64,
+    /// Measured energy since the start, J; the model's for a source without power.
+    measured_j: Trapezoid,
+    model_j: Trapezoid,
+    pub estimator: RatioEstimator,
+    /// Time in the air so far, s, and the measured energy over it, J.
+    pub air_s: f64,
+    pub air_measured_j: f64,
+    last_in_air_s: Option<f64>,
+    pub link_lost: bool,
+    pub reboots: u32,
+}
+
+impl Tracker {
+    /// A tracker predicting with `model` (at the flown mass); `drag` and the weight (N) estimate
+    /// the wind from the tilt; `prior_sd` is the fitted model's relative spread.
+    pub(crate) fn new(model: PowerModel, drag: Option<(CubicDrag, f64)>, prior_sd: f64) -> Self {
+        Self {
+            model,
+            drag,
+            prior_sd,
+            now_s: 0.0,
+            origin: None,
+            home_enu: None,
+            pos_enu: None,
+            vel: None,
+            att: None,
+            power_w: None,
+            landed: None,
+            heartbeat: None,
+            battery: BatteryState::default(),
+            mission: None,
+            mission_current: None,
+            wind: None,
+            wind_time_s: 0.0,
+            measured_j: Trapezoid::new(),
+            model_j: Trapezoid::new(),
+            estimator: RatioEstimator::new(prior_sd),
+            air_s: 0.0,
+            air_measured_j: 0.0,
+            last_in_air_s: None,
+            link_lost: false,
+            reboots: 0,
+        }
+    }
+
+    /// Fold one event in.
+    pub(crate) fn apply(&mut self, t: &Telemetry) {
+        let time_s = t.time_s.max(self.now_s);
+        if !matches!(t.event, Event::LinkLost { .. }) {
+            self.link_lost = false;
+        }
+        self.count_air_time(time_s);
+        self.now_s = time_s;
+        match &t.event {
+            Event::Sample(s) => self.sample(time_s, s),
+            Event::Origin(o) => self.origin = Some(*o),
+            Event::Home(h) => self.home_enu = Some(*h),
+            Event::Heartbeat(h) => self.heartbeat = Some(h.clone()),
+            Event::Battery(b) => {
+                self.battery.soc = b.soc.or(self.battery.soc);
+                self.battery.consumed_ah = b.consumed_ah.or(self.battery.consumed_ah);
+            }
+            Event::Speeds { .. } => {}
+            Event::MissionCurrent(seq) => self.mission_current = Some(*seq),
+            Event::Mission(items) => {
+                let uploads = self.mission.as_ref().map_or(0, |(_, n)| *n) + 1;
+                self.mission = Some((items.clone(), uploads));
+            }
+            Event::Reboot => self.reboot(),
+            Event::LinkLost { .. } => self.link_lost = true,
+        }
+    }
+
+    /// A restart of the vehicle: what was learned of the flight no longer holds (the mission
+    /// is sent again by the source).
+    fn reboot(&mut self) {
+        let fresh = Self::new(self.model.clone(), self.drag, self.prior_sd);
+        let reboots = self.reboots + 1;
+        let now_s = self.now_s;
+        *self = Self {
+            now_s,
+            reboots,
+            ..fresh
+        };
+    }
+
+    fn count_air_time(&mut self, time_s: f64) {
+        if let Some(since) = self.last_in_air_s {
+            self.air_s += (time_s - since).max(0.0);
+        }
+        self.last_in_air_s = self.in_air().then_some(time_s);
+    }
+
+    fn sample(&mut self, time_s: f64, s: &Sample) {
+        if let Some(p) = s.pos_enu_m {
+            self.pos_enu = Some(p);
+        }
+        if let Some(v) = s.vel_enu_mps {
+            self.vel = Some((v, time_s));
+            self.wind_from_tilt(time_s);
+        }
+        if let Some(a) = s.attitude {
+            self.att = Some((a, time_s));
+            if self.power_w.is_none() && self.in_air() {
+                if let Some(p) = self.predicted_w(time_s) {
+                    self.model_j.push(time_s, p);
+                }
+            }
+        }
+        if let Some(w) = s.wind_enu_mps {
+            self.wind = Some(([w[0], w[1]], WindSource::Autopilot));
+        }
+        if let Some(l) = s.landed {
+            self.landed = Some(l);
+        }
+        if let Some(p) = s.electrical_power_w().filter(|p| p.is_finite() && *p >= 0.0) {
+            self.power(time_s, p);
+        }
+    }
+
+    fn power(&mut self, time_s: f64, measured_w: f64) {
+        if self.measured_j.last().is_some_and(|(t, _)| time_s <= t) {
+            return;
+        }
+        if let Some((t0, p0)) = self.measured_j.last().filter(|_| self.in_air()) {
+            self.air_measured_j += 0.5 * (p0 + measured_w) * (time_s - t0);
+        }
+        self.measured_j.push(time_s, measured_w);
+        self.power_w = Some(measured_w);
+        if self.in_air() {
+            if let Some(predicted) = self.predicted_w(time_s) {
+                self.estimator.push(time_s, measured_w, predicted);
+            }
+        }
+    }
+
+    /// The model's electrical power at the last motion, W, if it is recent.
+    fn predicted_w(&self, time_s: f64) -> Option<f64> {
+        let (vel, tv) = self.vel?;
+        let (att, ta) = self.att?;
+        if time_s - tv > MOTION_FRESH_S || time_s - ta > MOTION_FRESH_S {
+            return None;
+        }
+        let wind = self.wind.map_or([0.0; 2], |(w, _)| w);
+        let state = crate::identify::motion_state(vel, &att, [wind[0], wind[1], 0.0])?;
+        self.model
+            .evaluate(&state)
+            .ok()
+            .map(|p| p.electrical_w)
+            .filter(|p| p.is_finite())
+    }
+
+    /// Without the autopilot's wind: the air velocity from the tilt (the horizontal thrust
+    /// balances the drag, `f_D(v_air) = m g tan(tilt)`, along the tilt), the wind the ground
+    /// velocity less it, low-passed over [`WIND_TIME_CONSTANT_S`].
+    fn wind_from_tilt(&mut self, time_s: f64) {
+        if matches!(self.wind, Some((_, WindSource::Autopilot))) || !self.in_air() {
+            return;
+        }
+        let (Some((drag, weight_n)), Some((vel, _)), Some((att, ta))) =
+            (self.drag, self.vel, self.att)
+        else {
+            return;
+        };
+        if time_s - ta > MOTION_FRESH_S {
+            return;
+        }
+        let Some(air) = air_velocity_from_tilt(&att, &drag, weight_n) else {
+            return;
+        };
+        let w = [vel[0] - air[0], vel[1] - air[1]];
+        let dt = (time_s - self.wind_time_s).max(0.0);
+        self.wind_time_s = time_s;
+        self.wind = Some(match self.wind {
+            Some((old, WindSource::Attitude)) => {
+                let a = 1.0 - (-dt / WIND_TIME_CONSTANT_S).exp();
+                ([old[0] + a * (w[0] - old[0]), old[1] + a * (w[1] - old[1])], WindSource::Attitude)
+            }
+            _ => (w, WindSource::Attitude),
+        });
+    }
+
+    /// In the air: the landed state where the autopilot sends it, else armed (or no heartbeat)
+    /// and above [`AIRBORNE_M`] over home or moving faster than it.
+    pub(crate) fn in_air(&self) -> bool {
+        let armed = self.heartbeat.as_ref().is_none_or(|h| h.armed);
+        if !armed {
+            return false;
+        }
+        if let Some(landed) = self.landed {
+            return !landed;
+        }
+        let up = self.height_m().unwrap_or(0.0);
+        let speed = self.vel.map_or(0.0, |(v, _)| v[0].hypot(v[1]));
+        up > AIRBORNE_M || speed > AIRBORNE_M
+    }
+
+    /// Height above home (else above the stream's origin), m.
+    pub(crate) fn height_m(&self) -> Option<f64> {
+        let p = self.pos_enu?;
+        Some(p[2] - self.home_enu.map_or(0.0, |h| h[2]))
+    }
+
+    /// Whether the source measures power.
+    pub(crate) fn power_available(&self) -> bool {
+        self.measured_j.last().is_some()
+    }
+
+    /// Energy used so far, Wh: measured, else the model's at the re-estimated efficiency.
+    pub(crate) fn energy_used_wh(&self) -> f64 {
+        match self.power_available() {
+            true => self.measured_j.integral() / 3600.0,
+            false => self.model_j.integral() / 3600.0,
+        }
+    }
+}
+
+/// The velocity of the air relative to the vehicle's ground track, ENU m/s (horizontal), from
+/// its attitude: the horizontal component of the thrust balances the drag in steady flight, so
+/// the air comes along the tilt at the speed where `f_D(v) = W tan(tilt)`. `None` beyond the
+/// drag law's range (50 m/s) or where the vehicle is upside down.
+pub(crate) fn air_velocity_from_tilt(
+    att: &Attitude,
+    drag: &CubicDrag,
+    weight_n: f64,
+) -> Option<[f64; 2]> {
+    let r = euler_to_mat_ned_frd(att);
+    // The thrust, up the body: minus body z in NED.
+    let (north, east, down) = (-r[0][2], -r[1][2], -r[2][2]);
+    if down >= -1e-3 {
+        return None;
+    }
+    let horizontal = north.hypot(east);
+    let force_n = weight_n * horizontal / -down;
+    if horizontal < 1e-9 {
+        return Some([0.0, 0.0]);
+    }
+    let (mut lo, mut hi) = (0.0, 50.0);
+    if drag.force_n(hi) < force_n {
+        return None;
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if drag.force_n(mid) < force_n {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let v = 0.5 * (lo + hi);
+    Some([v * east / horizontal, v * north / horizontal])
+}
