@@ -62,7 +62,10 @@ fn data_val_live_tlog_learns_the_real_auto_mission_and_follows_its_items() {
         .filter(|u| u["mission_item"] == 4)
         .find_map(|u| rest(u))
         .unwrap();
-    assert!(near_end < first, "{near_end} Wh at item 4, {first} Wh at the start");
+    assert!(
+        near_end < first,
+        "{near_end} Wh at item 4, {first} Wh at the start"
+    );
     for u in &air {
         assert!(u["position"]["latitude_deg"].as_f64().is_some(), "{u}");
     }
@@ -77,14 +80,21 @@ fn data_val_live_tlog_follows_a_mission_with_battery_data() {
     assert!(summary["missions"].as_u64().unwrap() >= 1, "{summary}");
     let air = in_air(&updates);
     assert!(air.len() > 30, "{}", air.len());
-    let used: Vec<f64> = air.iter().map(|u| u["energy_used_wh"].as_f64().unwrap()).collect();
+    let used: Vec<f64> = air
+        .iter()
+        .map(|u| u["energy_used_wh"].as_f64().unwrap())
+        .collect();
     assert!(used.windows(2).all(|w| w[1] >= w[0]), "{used:?}");
     let soc: Vec<f64> = air.iter().map(|u| u["soc"].as_f64().unwrap()).collect();
     assert!(soc[soc.len() - 1] < soc[0] - 0.3, "{soc:?}");
     for u in &air {
         assert_eq!(u["power_available"], true);
         let r = &u["remaining_wh"];
-        let (p5, p50, p95) = (r["p5"].as_f64().unwrap(), r["p50"].as_f64().unwrap(), r["p95"].as_f64().unwrap());
+        let (p5, p50, p95) = (
+            r["p5"].as_f64().unwrap(),
+            r["p50"].as_f64().unwrap(),
+            r["p95"].as_f64().unwrap(),
+        );
         assert!(p5 <= p50 && p50 <= p95 && p5 > 0.0, "{u}");
         assert!(u["landing_soc"]["p50"].as_f64().unwrap() < u["soc"].as_f64().unwrap());
         assert_eq!(u["advice"], "continue", "{u}");
@@ -93,7 +103,10 @@ fn data_val_live_tlog_follows_a_mission_with_battery_data() {
     let eta = air[air.len() - 1]["efficiency"].as_f64().unwrap();
     assert!((eta - 0.9503).abs() > 0.02, "{eta}");
     // The item follows the mission forward.
-    let items: Vec<u64> = air.iter().filter_map(|u| u["mission_item"].as_u64()).collect();
+    let items: Vec<u64> = air
+        .iter()
+        .filter_map(|u| u["mission_item"].as_u64())
+        .collect();
     assert!(items.windows(2).all(|w| w[1] >= w[0]), "{items:?}");
     assert!(items[items.len() - 1] >= 5, "{items:?}");
 }
@@ -112,7 +125,9 @@ fn data_val_live_tlog_advises_to_turn_back_when_the_reserve_will_not_hold() {
         .collect();
     assert_eq!(advice[0], "continue", "{advice:?}");
     assert!(
-        advice.iter().any(|a| *a == "return now" || *a == "land now"),
+        advice
+            .iter()
+            .any(|a| *a == "return now" || *a == "land now"),
         "{advice:?}"
     );
 }
@@ -122,23 +137,34 @@ fn data_val_live_tlog_advises_to_turn_back_when_the_reserve_will_not_hold() {
 #[test]
 fn data_val_live_tlog_survives_a_damaged_real_log_with_a_restart() {
     let (updates, summary) = follow("dronekit_flight_replay.tlog", &["--every", "10"]);
-    assert!(summary["skipped"].as_str().unwrap().contains("wrong CRC"), "{summary}");
+    assert!(
+        summary["skipped"].as_str().unwrap().contains("wrong CRC"),
+        "{summary}"
+    );
     assert!(summary["reboots"].as_u64().unwrap() >= 1, "{summary}");
     let last = &updates[updates.len() - 1];
-    assert!((last["soc"].as_f64().unwrap() - 0.20).abs() < 0.02, "{last}");
+    assert!(
+        (last["soc"].as_f64().unwrap() - 0.20).abs() < 0.02,
+        "{last}"
+    );
     assert!(last["energy_used_wh"].as_f64().unwrap() > 15.0, "{last}");
 }
 
 /// Bad input: one line on stderr naming the value, exit 2.
 #[test]
 fn live_bad_input_is_one_line_and_exit_2() {
-    let tlog = data_dir().join("telemetry").join("ayoub_auto_mission_sitl.tlog");
+    let tlog = data_dir()
+        .join("telemetry")
+        .join("ayoub_auto_mission_sitl.tlog");
     let tlog = tlog.to_str().unwrap();
     let cases: [(&[&str], &str); 6] = [
         (&["live", "--tlog", tlog, "--speed", "0"], "--speed"),
         (&["live", "--tlog", tlog, "--speed", "fast"], "--speed"),
         (&["live", "--tlog", tlog, "--route", "log"], "--replay"),
-        (&["live", "--tlog", "/nonexistent/x.tlog"], "/nonexistent/x.tlog"),
+        (
+            &["live", "--tlog", "/nonexistent/x.tlog"],
+            "/nonexistent/x.tlog",
+        ),
         (&["live", "--connect", "udp:1.2.3.4"], "udp:1.2.3.4"),
         (&["live", "--tlog", tlog, "--every", "0"], "every"),
     ];

@@ -66,9 +66,7 @@ pub fn run(args: LiveArgs) -> Result<Outcome> {
             let mut source = source.open()?;
             let summary = follow_live(&vehicle, &request, &mut source, &mut emit)?;
             match args.format {
-                LiveFormat::Json => {
-                    writeln!(out, "{}", serde_json::json!({ "summary": summary }))?
-                }
+                LiveFormat::Json => writeln!(out, "{}", serde_json::json!({ "summary": summary }))?,
                 LiveFormat::Table => render_summary(&mut out, &summary)?,
             }
         }
@@ -147,7 +145,9 @@ fn panel(u: &LiveUpdate) -> Vec<String> {
         (false, true) => "in the air",
         (false, false) => "on the ground",
     };
-    let item = u.mission_item.map_or_else(String::new, |i| format!(" · item {i}"));
+    let item = u
+        .mission_item
+        .map_or_else(String::new, |i| format!(" · item {i}"));
     let mode = u.mode.as_deref().unwrap_or("-");
     let wind = match (u.wind_mps, u.wind_from_deg) {
         (Some(s), Some(d)) => format!("{s:.1} m/s from {d:.0} deg"),
@@ -173,7 +173,10 @@ fn panel(u: &LiveUpdate) -> Vec<String> {
             band(u.remaining_wh, 1.0, 2),
             opt(u.naive_remaining_wh, 2)
         ),
-        format!("landing   {} % state of charge", band(u.landing_soc, 100.0, 1)),
+        format!(
+            "landing   {} % state of charge",
+            band(u.landing_soc, 100.0, 1)
+        ),
         format!("no return {pnr}"),
         format!("advice    {}", u.advice.unwrap_or("-")),
     ];

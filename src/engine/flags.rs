@@ -20,8 +20,8 @@ use aloft_power::{AoaModel, Term};
 
 use super::fit::{fit_parameter, FitRequest};
 use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
-use super::mission_file::Mission;
 use super::logs::{FlightLogs, LogReadOptions};
+use super::mission_file::Mission;
 use super::mission_options::{GustSpec, MissionOptions};
 use super::payload_sweep::PayloadSweep;
 use super::power::PowerQuery;

@@ -89,7 +89,7 @@ pub use flown::PlanningSpeed;
 pub use keywords::{keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::{
     follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveReplayRequest, LiveRequest,
-    LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
+    LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
 };
 pub use logs::{
     convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,

@@ -120,9 +120,9 @@ impl Ahead<'_> {
     /// The vehicle at the re-estimated efficiency `eta_0 / r` (at most 1).
     fn vehicle_at(&self, ratio: Ratio) -> Result<Vehicle, Error> {
         match self.vehicle.efficiency() {
-            Some(eta0) if (ratio.ratio - 1.0).abs() > 1e-12 => {
-                self.vehicle.with_efficiency((eta0 / ratio.ratio).clamp(0.01, 1.0))
-            }
+            Some(eta0) if (ratio.ratio - 1.0).abs() > 1e-12 => self
+                .vehicle
+                .with_efficiency((eta0 / ratio.ratio).clamp(0.01, 1.0)),
             _ => Ok(self.vehicle.clone()),
         }
     }
@@ -145,7 +145,11 @@ impl Ahead<'_> {
                     .find(|(s, _, _)| *s == source)
                     .unwrap_or(WIND_SD[1]);
                 let from_deg = (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0);
-                (WindSpec::uniform(w[0].hypot(w[1]), from_deg), speed_sd, from_sd)
+                (
+                    WindSpec::uniform(w[0].hypot(w[1]), from_deg),
+                    speed_sd,
+                    from_sd,
+                )
             }
             None => (WindSpec::uniform(0.0, 0.0), WIND_SD[1].1, WIND_SD[1].2),
         };
@@ -258,7 +262,8 @@ fn position_from_home(t: &Tracker, home: &HomeSpec) -> [f64; 3] {
     let up = t.height_m().unwrap_or(pos[2]).max(0.5);
     match (t.origin, home.latitude_deg, home.longitude_deg) {
         (Some(o), Some(lat), Some(lon)) => {
-            let o_en = LocalFrame::new(lat, lon).to_local_m(o.lat_rad.to_degrees(), o.lon_rad.to_degrees());
+            let o_en = LocalFrame::new(lat, lon)
+                .to_local_m(o.lat_rad.to_degrees(), o.lon_rad.to_degrees());
             [o_en[0] + pos[0], o_en[1] + pos[1], up]
         }
         _ => {

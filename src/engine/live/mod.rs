@@ -176,12 +176,12 @@ pub fn follow_live(
     emit: &mut dyn FnMut(&LiveUpdate) -> Result<(), Error>,
 ) -> Result<LiveSummary, Error> {
     check_every(request.every_s)?;
-    let mut follower = Follower::new(vehicle, request)?;
+    let mut follower = LiveSession::new(vehicle, request)?;
     let mut updates = 0;
     let (mut first_s, mut next_s) = (None, f64::NEG_INFINITY);
     let mut last: Option<LiveUpdate> = None;
     while let Some(event) = source.next_event().map_err(Error::Link)? {
-        follower.tracker.apply(&event);
+        follower.apply(&event);
         let now = follower.tracker.now_s;
         first_s.get_or_insert(now);
         let lost = follower.tracker.link_lost;
@@ -258,9 +258,9 @@ pub fn replies(previous: Option<&LiveUpdate>, update: &LiveUpdate) -> Vec<Reply>
     }
     let before = previous.and_then(|p| p.advice);
     if let Some(advice) = update.advice.filter(|a| Some(*a) != before) {
-        let landing = update
-            .landing_soc
-            .map_or_else(String::new, |l| format!(", lands at {:.0}% (p5)", 100.0 * l.p5));
+        let landing = update.landing_soc.map_or_else(String::new, |l| {
+            format!(", lands at {:.0}% (p5)", 100.0 * l.p5)
+        });
         out.push(Reply::Text {
             text: format!("aloft: {advice}{landing}"),
             warning: advice != "continue",
@@ -269,8 +269,10 @@ pub fn replies(previous: Option<&LiveUpdate>, update: &LiveUpdate) -> Vec<Reply>
     out
 }
 
-/// The state of a followed flight and what answers it.
-struct Follower<'a> {
+/// A flight followed event by event: [`follow_live`]'s state, for a caller that feeds the events
+/// itself ([`LiveSession::apply`]) and asks for an answer when it wants one
+/// ([`LiveSession::update`]).
+pub struct LiveSession<'a> {
     tracker: Tracker,
     ahead: Ahead<'a>,
     pack_ah: f64,
@@ -294,8 +296,12 @@ const DEFAULT_REST_S: f64 = 300.0;
 /// steps), the wind (0.5 m/s steps).
 type GroundKey = (u32, i64, [i64; 2]);
 
-impl<'a> Follower<'a> {
-    fn new(vehicle: &'a Vehicle, request: &'a LiveRequest) -> Result<Self, Error> {
+impl<'a> LiveSession<'a> {
+    /// A session for `vehicle` as `request` asks (its `every_s` is the caller's to keep).
+    ///
+    /// # Errors
+    /// A vehicle without a power model or without a pack (by name, or a default).
+    pub fn new(vehicle: &'a Vehicle, request: &'a LiveRequest) -> Result<Self, Error> {
         let (model, mass) =
             vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
         let pack = vehicle.battery(request.battery.as_deref())?;
@@ -354,7 +360,18 @@ impl<'a> Follower<'a> {
         Ok(self.learned.as_ref().map(|(m, _)| m))
     }
 
-    fn update(&mut self) -> Result<LiveUpdate, Error> {
+    /// Fold one event in.
+    pub fn apply(&mut self, event: &aloft_logs::telemetry::Telemetry) {
+        self.tracker.apply(event);
+    }
+
+    /// The answer now: the state of charge, the efficiency's estimate, the route ahead in
+    /// scenarios and the advice.
+    ///
+    /// # Errors
+    /// A `--mission` the vehicle cannot plan at all (a mission learned from the link that aloft
+    /// cannot read, or a route the planner refuses, is said in the update's `note`).
+    pub fn update(&mut self) -> Result<LiveUpdate, Error> {
         let soc = self.soc();
         let t = &self.tracker;
         let rest_s = self.rest_s;
@@ -370,7 +387,9 @@ impl<'a> Follower<'a> {
         let key: GroundKey = (
             t.mission.as_ref().map_or(0, |(_, n)| *n),
             (soc * 200.0).round() as i64,
-            wind.map_or([0, 0], |w| [(w[0] * 2.0).round() as i64, (w[1] * 2.0).round() as i64]),
+            wind.map_or([0, 0], |w| {
+                [(w[0] * 2.0).round() as i64, (w[1] * 2.0).round() as i64]
+            }),
         );
         let cached = match (&self.on_ground, in_air) {
             (Some((k, a)), false) if *k == key => Some(a.clone()),
@@ -388,7 +407,10 @@ impl<'a> Follower<'a> {
                     }
                     Err(e) => return Err(e),
                 };
-                match self.ahead.answer(&self.tracker, mission.as_ref(), soc, ratio) {
+                match self
+                    .ahead
+                    .answer(&self.tracker, mission.as_ref(), soc, ratio)
+                {
                     Ok(a) => (a, None),
                     Err(e) => (None, Some(aloft_core::one_line(&e.to_string()))),
                 }
@@ -428,7 +450,10 @@ impl<'a> Follower<'a> {
                 Some(p)
             }
             // Passed: how long ago, where it was seen ahead before.
-            Some(_) => Some(self.point_of_no_return_at.map_or(0.0, |at| (at - now).min(0.0))),
+            Some(_) => Some(
+                self.point_of_no_return_at
+                    .map_or(0.0, |at| (at - now).min(0.0)),
+            ),
             None => None,
         };
         let naive = (t.power_available() && t.air_s >= estimate::MIN_WINDOW_S)

@@ -109,7 +109,11 @@ pub fn replay_live(
     while t < end {
         // The samples up to `t` so far.
         while next < series.t.len() && series.t[next] <= t {
-            estimator.push(series.t[next], series.measured_w[next], series.predicted_w[next]);
+            estimator.push(
+                series.t[next],
+                series.measured_w[next],
+                series.predicted_w[next],
+            );
             next += 1;
         }
         let update = series.update_at(next.max(1) - 1, &estimator, eta0);

@@ -49,8 +49,7 @@ impl LiveSource {
     pub fn open(&self) -> Result<Box<dyn TelemetrySource>, Error> {
         match self {
             LiveSource::Replay { logs, speed } => {
-                let source: Box<dyn TelemetrySource> =
-                    Box::new(LogEvents::new(logs.read_first()?));
+                let source: Box<dyn TelemetrySource> = Box::new(LogEvents::new(logs.read_first()?));
                 Ok(paced(source, *speed))
             }
             LiveSource::Tlog { path, speed } => Ok(paced(open_tlog(path)?, *speed)),

@@ -167,7 +167,10 @@ impl Tracker {
         if let Some(l) = s.landed {
             self.landed = Some(l);
         }
-        if let Some(p) = s.electrical_power_w().filter(|p| p.is_finite() && *p >= 0.0) {
+        if let Some(p) = s
+            .electrical_power_w()
+            .filter(|p| p.is_finite() && *p >= 0.0)
+        {
             self.power(time_s, p);
         }
     }
@@ -228,7 +231,10 @@ impl Tracker {
         self.wind = Some(match self.wind {
             Some((old, WindSource::Attitude)) => {
                 let a = 1.0 - (-dt / WIND_TIME_CONSTANT_S).exp();
-                ([old[0] + a * (w[0] - old[0]), old[1] + a * (w[1] - old[1])], WindSource::Attitude)
+                (
+                    [old[0] + a * (w[0] - old[0]), old[1] + a * (w[1] - old[1])],
+                    WindSource::Attitude,
+                )
             }
             _ => (w, WindSource::Attitude),
         });
