@@ -189,15 +189,16 @@ mod tests {
         for k in 0..n {
             let t = k as f64 * 0.1;
             let p = 200.0 + 20.0 * (t / 50.0).sin();
-            e.push(t, 1.1 * p, p);
+            // Measurement noise that averages out over the flight.
+            e.push(t, 1.1 * p + 5.0 * (1.7 * t).sin(), p);
         }
         assert!(e.t.len() < MAX_POINTS, "{} points", e.t.len());
         assert_eq!(e.level, 2);
         let (m, p) = e.energies_j();
-        assert!((m / p - 1.1).abs() < 1e-12, "{}", m / p);
+        assert!((m / p - 1.1).abs() < 1e-4, "{}", m / p);
         let r = e.ratio(600.0);
-        // Shrunk a little toward 1 by the 3 % prior; the window is 4915 s of smooth samples.
-        assert!(r.ratio > 1.09 && r.ratio <= 1.1, "{r:?}");
+        // Shrunk toward 1 by the 3 % prior, by very little: the window is 4915 s long.
+        assert!(r.ratio > 1.09 && r.ratio < 1.1, "{r:?}");
         assert!(r.log_sd > 0.0 && r.log_sd < 0.03, "{r:?}");
     }
 }
