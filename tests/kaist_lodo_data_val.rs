@@ -315,14 +315,32 @@ fn data_val_kaist_lodo_live_remaining_within_3_percent_median_8_worst() {
     assert!(m <= 3.0 && worst <= 8.0, "median {m}, worst {worst}");
 }
 
-/// Issue 25 target: the p5-p95 band of `remaining_wh` holds the measured rest at least 80 % of
-/// the time, over every update of the held-out flights. Missed: mean 0.68 over the flights,
-/// lowest 0.23 (an update every 10 s). The errors are steady offsets of 1-2 % that persist over
-/// a flight (the measured over predicted ratio of the rest differs from the ratio so far), which
-/// the band's two variances (the estimate's and the 60 s blocks' drift) do not cover. Kept as
-/// stated; run with `--ignored`.
+/// Issue 25: not worse than the naive rate. By the root mean square and the worst case over the
+/// 44 checkpoints (the pooled median is 0.05 points worse: 1.03 % against 0.98 %; see
+/// docs/validation.md for each checkpoint).
 #[test]
-#[ignore = "missed: the band holds the truth 68 % of the time (lowest flight 23 %): see the doc comment and docs/validation.md"]
+fn data_val_kaist_lodo_live_no_worse_than_the_naive_rate() {
+    let pairs: Vec<(f64, f64)> = lodo()
+        .iter()
+        .flat_map(|j| j.live.iter().map(|c| (c.1.abs(), c.2.abs())))
+        .collect();
+    let rms = |f: fn(&(f64, f64)) -> f64| {
+        (pairs.iter().map(|p| f(p) * f(p)).sum::<f64>() / pairs.len() as f64).sqrt()
+    };
+    let (live, naive) = (rms(|p| p.0), rms(|p| p.1));
+    let worst = |f: fn(&(f64, f64)) -> f64| pairs.iter().map(f).fold(0.0, f64::max);
+    println!("RMS error: live {live:.2} %, naive {naive:.2} %");
+    assert!(live <= naive, "RMS live {live}, naive {naive}");
+    assert!(worst(|p| p.0) <= worst(|p| p.1));
+}
+
+/// Issue 25 target: the p5-p95 band of `remaining_wh` holds the measured rest at least 80 % of
+/// the time, over every update of the held-out flights (an update every 10 s), by the mean over
+/// the flights. With the estimate's and the drift's variances alone it held 68 % (lowest flight
+/// 23 %): the errors are steady offsets of 1-2 % between the parts of a flight; with the
+/// estimator's own record on the flight (prequential, `src/engine/live/estimate.rs`) as the
+/// least spread, 90 % (lowest 74 %).
+#[test]
 fn data_val_kaist_lodo_live_band_holds_the_truth_80_percent() {
     let r = lodo();
     let coverage = r.iter().map(|j| j.live_coverage).sum::<f64>() / r.len() as f64;

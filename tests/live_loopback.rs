@@ -20,6 +20,11 @@ use common::data_dir;
 /// Play speed, times the log's own time.
 const SPEED: f64 = 40.0;
 
+/// A MAVLink text, or what is wrong with it.
+fn text(s: Result<&str, std::str::Utf8Error>) -> String {
+    s.map_or_else(|e| e.to_string(), str::to_string)
+}
+
 /// What the vehicle received from aloft: (NAMED_VALUE_FLOAT names, STATUSTEXT texts with their
 /// severity).
 fn received(socket: &UdpSocket, names: &mut Vec<String>, texts: &mut Vec<(String, String)>) {
@@ -28,23 +33,9 @@ fn received(socket: &UdpSocket, names: &mut Vec<String>, texts: &mut Vec<(String
         let mut reader = MavlinkReader::new(&buf[..n]);
         while let Ok(raw) = reader.read_any_raw_message::<MavMessage>() {
             match MavMessage::parse(raw.version(), raw.message_id(), raw.payload()) {
-                Ok(MavMessage::NAMED_VALUE_FLOAT(v)) => {
-                    let name: String = v
-                        .name
-                        .iter()
-                        .take_while(|b| **b != 0)
-                        .map(|b| *b as char)
-                        .collect();
-                    names.push(name);
-                }
+                Ok(MavMessage::NAMED_VALUE_FLOAT(v)) => names.push(text(v.name.to_str())),
                 Ok(MavMessage::STATUSTEXT(t)) => {
-                    let text: String = t
-                        .text
-                        .iter()
-                        .take_while(|b| **b != 0)
-                        .map(|b| *b as char)
-                        .collect();
-                    texts.push((text, format!("{:?}", t.severity)));
+                    texts.push((text(t.text.to_str()), format!("{:?}", t.severity)));
                 }
                 _ => {}
             }

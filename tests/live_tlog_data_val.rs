@@ -30,16 +30,23 @@ fn in_air(updates: &[Value]) -> Vec<&Value> {
     updates.iter().filter(|u| u["in_air"] == true).collect()
 }
 
+/// A mission flown: an update every `every` s, the mission learned from the link, more than
+/// `min_air` updates in the air; all the updates and those in the air.
+fn follow_mission(file: &str, every: u32, min_air: usize) -> (Vec<Value>, Vec<Value>) {
+    let (updates, summary) = follow(file, &["--every", &every.to_string()]);
+    assert!(summary["missions"].as_u64().unwrap() >= 1, "{summary}");
+    let air: Vec<Value> = in_air(&updates).into_iter().cloned().collect();
+    assert!(air.len() > min_air, "{} updates in the air", air.len());
+    (updates, air)
+}
+
 /// The real AUTO mission without a power module: the mission (11 items on the link, 5 after the
 /// protocol's home and jumps as `aloft_link` reads it) is learned from MISSION_ITEM_INT,
 /// `mission_item` follows MISSION_CURRENT through each of the six runs, and the rest is predicted
 /// from the model alone.
 #[test]
 fn data_val_live_tlog_learns_the_real_auto_mission_and_follows_its_items() {
-    let (updates, summary) = follow("phoenix_mission1_real.tlog", &["--every", "2"]);
-    assert!(summary["missions"].as_u64().unwrap() >= 1, "{summary}");
-    let air = in_air(&updates);
-    assert!(air.len() > 100, "{} updates in the air", air.len());
+    let (updates, air) = follow_mission("phoenix_mission1_real.tlog", 2, 100);
     assert!(updates.iter().all(|u| u["power_available"] == false));
     // In AUTO, in the air: the item only goes forward within a run, and every run reaches the
     // last waypoints (items 3 and 4).
@@ -56,11 +63,11 @@ fn data_val_live_tlog_learns_the_real_auto_mission_and_follows_its_items() {
     assert!(backwards <= 6, "{backwards} steps back in {items:?}");
     // The rest shrinks along a run: on its first leg more than near its end.
     let rest = |u: &Value| u["remaining_wh"]["p50"].as_f64();
-    let first = air.iter().find_map(|u| rest(u)).unwrap();
+    let first = air.iter().find_map(rest).unwrap();
     let near_end = air
         .iter()
         .filter(|u| u["mission_item"] == 4)
-        .find_map(|u| rest(u))
+        .find_map(rest)
         .unwrap();
     assert!(
         near_end < first,
@@ -76,10 +83,7 @@ fn data_val_live_tlog_learns_the_real_auto_mission_and_follows_its_items() {
 /// band, a landing state of charge and advice.
 #[test]
 fn data_val_live_tlog_follows_a_mission_with_battery_data() {
-    let (updates, summary) = follow("ayoub_auto_mission_sitl.tlog", &["--every", "5"]);
-    assert!(summary["missions"].as_u64().unwrap() >= 1, "{summary}");
-    let air = in_air(&updates);
-    assert!(air.len() > 30, "{}", air.len());
+    let (_, air) = follow_mission("ayoub_auto_mission_sitl.tlog", 5, 30);
     let used: Vec<f64> = air
         .iter()
         .map(|u| u["energy_used_wh"].as_f64().unwrap())
@@ -174,5 +178,31 @@ fn live_bad_input_is_one_line_and_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
         assert!(err.contains(names), "{args:?}: {err}");
+    }
+}
+
+/// `--mcap FILE` records every update, as its JSON line, on `/aloft/live` (read back with the
+/// `mcap` crate, not aloft's reader).
+#[test]
+fn data_val_live_tlog_records_its_updates_in_mcap() {
+    let file = common::scratch("live-mcap", "ayoub.mcap");
+    let (updates, _) = follow(
+        "ayoub_auto_mission_sitl.tlog",
+        &["--every", "20", "--mcap", file.to_str().unwrap()],
+    );
+    let bytes = std::fs::read(&file).unwrap();
+    let mut seen = Vec::new();
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        assert_eq!(m.channel.topic, "/aloft/live");
+        assert_eq!(m.channel.message_encoding, "json");
+        let v: Value = serde_json::from_slice(&m.data).unwrap();
+        seen.push(v);
+    }
+    assert_eq!(seen.len(), updates.len());
+    for (recorded, printed) in seen.iter().zip(&updates) {
+        assert_eq!(recorded["time_s"], printed["time_s"]);
+        assert_eq!(recorded["remaining_wh"], printed["remaining_wh"]);
+        assert_eq!(recorded["advice"], printed["advice"]);
     }
 }

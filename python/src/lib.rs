@@ -27,14 +27,14 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use aloft::engine::flags::{
-    EnduranceFlags, FitFlags, LogInfoFlags, MissionFlags, MissionScenarioFlags, PowerModelFlags,
-    ValidateFlags,
+    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionFlags,
+    MissionScenarioFlags, PowerModelFlags, ValidateFlags,
 };
 use aloft::engine::{
-    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, list_vehicles, log_info,
-    payload_sweep, plan_mission, plan_scenarios, power_curve, power_model, power_point,
-    power_values, validate_logs, EnduranceWithUncertainty, Mission, MissionWithUncertainty,
-    PowerQuery, Vehicle, POWER_KEYS,
+    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, follow_live, list_vehicles,
+    log_info, payload_sweep, plan_mission, plan_scenarios, power_curve, power_model, power_point,
+    power_values, replay_live, validate_logs, EnduranceWithUncertainty, Mission,
+    MissionWithUncertainty, PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -309,6 +309,48 @@ fn validate_json(
     .map_err(engine_error)
 }
 
+/// `aloft live --replay LOG --format json` as one JSON text: `{"updates": [...], "check" or
+/// "summary": {...}}`. This package is built without the `live` feature: `tlog` and `connect`
+/// are refused with a message saying so.
+#[pyfunction]
+#[pyo3(signature = (replay, vehicle, options=None))]
+fn live_json(
+    py: Python<'_>,
+    replay: PathBuf,
+    vehicle: String,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let positional = [
+        ("replay", options::path(&replay)),
+        ("vehicle", options::text(&vehicle)),
+    ];
+    let flags: LiveFlags = options::parse("live", &positional, options)?;
+    py.detach(|| {
+        let v = Vehicle::load(&flags.vehicle)?;
+        let mut updates = Vec::new();
+        let mut keep = |u: &aloft::engine::LiveUpdate| -> Result<(), aloft::Error> {
+            updates.push(u.clone());
+            Ok(())
+        };
+        let end = match flags.request()? {
+            LiveTask::Validate(request) => {
+                serde_json::json!({ "check": replay_live(&v, &request, &mut keep)? })
+            }
+            LiveTask::Follow { source, request } => {
+                let mut source = source.open()?;
+                let summary = follow_live(&v, &request, &mut source, &mut keep)?;
+                serde_json::json!({ "summary": summary })
+            }
+        };
+        let mut answer = serde_json::json!({ "updates": updates });
+        if let (Some(a), serde_json::Value::Object(e)) = (answer.as_object_mut(), end) {
+            a.extend(e);
+        }
+        json_of(&answer)
+    })
+    .map_err(engine_error)
+}
+
 /// States per block of the batch kernel.
 const BLOCK: usize = 4096;
 
@@ -497,6 +539,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(log_info_json, m)?)?;
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(validate_json, m)?)?;
+    m.add_function(wrap_pyfunction!(live_json, m)?)?;
     m.add_function(wrap_pyfunction!(power, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())

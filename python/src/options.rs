@@ -88,6 +88,11 @@ pub fn paths(ps: &[PathBuf]) -> Keyword {
     Keyword::Many(ps.iter().map(|p| p.as_os_str().to_os_string()).collect())
 }
 
+/// One path given positionally (the log of `live`).
+pub fn path(p: &std::path::Path) -> Keyword {
+    Keyword::One(p.as_os_str().to_os_string())
+}
+
 /// A text given positionally.
 pub fn text(s: &str) -> Keyword {
     Keyword::One(OsString::from(s))

@@ -180,3 +180,26 @@ def test_monte_carlo_mission_equals_cli(cli):
     got = aloft.mission(samples=64, seed=3, payload_sd_kg=0.2, wind_speed_sd=1.0, threads=1)
     assert got == json.loads(out)
     assert got["uncertainty"]["samples"] == 64
+
+
+def test_live_replay_equals_cli(cli, data):
+    """``aloft.live`` is ``aloft live --replay LOG --format json``: the same updates and check
+    (the validation replay) or summary (the route ahead from the log's events)."""
+    log = data / "flight_logs" / "sitl_ac47_00000002.BIN"
+    for route, end in (("log", "check"), ("mission", "summary")):
+        rc, out, err = cli.run("live", "--replay", str(log), "--route", route, "--vehicle",
+                               "dji-m100", "--every", "5", "--format", "json")
+        assert rc == 0, err
+        lines = [json.loads(line) for line in out.splitlines()]
+        got = aloft.live(log, "dji-m100", route=route, every=5)
+        assert got["updates"] == lines[:-1]
+        assert got[end] == lines[-1][end]
+        assert len(got["updates"]) >= 2
+
+
+def test_live_refuses_bad_options_and_links(data):
+    log = data / "flight_logs" / "sitl_ac47_00000002.BIN"
+    with pytest.raises(aloft.AloftError, match="every"):
+        aloft.live(log, "dji-m100", every=0)
+    with pytest.raises(aloft.AloftError, match="live"):
+        aloft.live(log, "dji-m100", speed="fast")

@@ -9,7 +9,8 @@ use clap::{Args, ValueEnum};
 
 use aloft::engine::flags::{LiveFlags, LiveTask};
 use aloft::engine::{
-    follow_live, replay_live, Error, LiveCheck, LiveCheckpoint, LiveSummary, LiveUpdate, Vehicle,
+    follow_live, replay_live, Error, LiveCheck, LiveCheckpoint, LiveRecorder, LiveSummary,
+    LiveUpdate, Vehicle,
 };
 
 use super::Outcome;
@@ -32,6 +33,9 @@ pub struct LiveArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = LiveFormat::Table)]
     format: LiveFormat,
+    /// Also record every update in this MCAP file for Foxglove (topic `/aloft/live`).
+    #[arg(long, value_name = "FILE")]
+    mcap: Option<std::path::PathBuf>,
 }
 
 pub fn run(args: LiveArgs) -> Result<Outcome> {
@@ -48,7 +52,11 @@ pub fn run(args: LiveArgs) -> Result<Outcome> {
         drawn: 0,
         header: true,
     };
+    let mut recorder = args.mcap.as_deref().map(LiveRecorder::create).transpose()?;
     let mut emit = |u: &LiveUpdate| -> Result<(), Error> {
+        if let Some(r) = &mut recorder {
+            r.record(u)?;
+        }
         view.write(&mut out, u).map_err(|source| Error::Io {
             origin: "standard output".to_string(),
             source,
@@ -70,6 +78,9 @@ pub fn run(args: LiveArgs) -> Result<Outcome> {
                 LiveFormat::Table => render_summary(&mut out, &summary)?,
             }
         }
+    }
+    if let Some(r) = recorder {
+        r.finish()?;
     }
     Ok(Outcome::Ok)
 }
@@ -274,4 +285,57 @@ fn checkpoint_row(p: &LiveCheckpoint) -> String {
         "{:>6} {:>8.1} {:>+10.2} {:>+12.2} {in_band:>8}",
         p.at, p.time_s, p.error_percent, p.naive_error_percent
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The panel says the state, the battery, the band and the advice, and that the link is lost.
+    #[test]
+    fn the_panel_shows_the_answer_and_a_lost_link() {
+        let mut u = sample();
+        let lines = panel(&u);
+        assert_eq!(lines.len(), 7);
+        assert_eq!(
+            lines[0],
+            "aloft live · t 12.5 s · AUTO · item 3 · in the air"
+        );
+        assert!(lines[1].contains("60.0 %") && lines[1].contains("used 10.00 Wh"));
+        assert_eq!(lines[2], "wind      4.0 m/s from 270 deg");
+        assert!(lines[3].contains("4.50 / 5.00 / 5.50 Wh"));
+        assert_eq!(lines[5], "no return in 42 s");
+        assert_eq!(lines[6], "advice    continue");
+        u.link_lost = true;
+        u.point_of_no_return_s = Some(-10.0);
+        let lines = panel(&u);
+        assert!(lines[0].ends_with("LINK LOST (last estimate)"));
+        assert_eq!(lines[5], "no return passed 10 s ago");
+    }
+
+    fn sample() -> LiveUpdate {
+        let band = |p5: f64, p50: f64, p95: f64| aloft::engine::Percentiles { p5, p50, p95 };
+        LiveUpdate {
+            time_s: 12.5,
+            in_air: true,
+            mode: Some("AUTO".to_string()),
+            mission_item: Some(3),
+            position: None,
+            soc: Some(0.6),
+            energy_used_wh: 10.0,
+            power_w: Some(300.0),
+            power_available: true,
+            efficiency: 0.8,
+            wind_mps: Some(4.0),
+            wind_from_deg: Some(270.0),
+            remaining_wh: Some(band(4.5, 5.0, 5.5)),
+            landing_soc: Some(band(0.3, 0.32, 0.34)),
+            point_of_no_return_s: Some(42.0),
+            advice: Some("continue"),
+            naive_remaining_wh: None,
+            measured_remaining_wh: None,
+            link_lost: false,
+            note: None,
+        }
+    }
 }

@@ -88,8 +88,8 @@ pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFi
 pub use flown::PlanningSpeed;
 pub use keywords::{keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::{
-    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveReplayRequest, LiveRequest,
-    LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
+    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveRecorder, LiveReplayRequest,
+    LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
 };
 pub use logs::{
     convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,

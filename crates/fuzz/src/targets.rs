@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use aloft::engine::{
     calibrate_spec, convert_log, endurance, hover, log_info, plan_mission, power_csv, power_model,
-    power_point, EnduranceOptions, HoverRequest, LogReadOptions, Mission, MissionOptions,
-    PowerQuery, SpecSheet, Vehicle,
+    power_point, EnduranceOptions, HoverRequest, LiveRequest, LiveSession, LogReadOptions, Mission,
+    MissionOptions, PowerQuery, SpecSheet, Vehicle,
 };
 use aloft::power::{ModelOptions, PowerModel};
 use aloft_planner::Aircraft;
@@ -589,9 +589,15 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
 /// A telemetry log: every event of [`aloft_link::TlogSource`], with its invariants checked (time
 /// finite and never going back, computed values finite, all bytes read), and the answer the
 /// counts of events by kind; on every 4th input the frames of [`aloft_link::TlogReader`] and the
-/// skipped bytes add up to the input.
+/// skipped bytes add up to the input. Every event is folded into an `aloft live` session, and on
+/// every 8th input the session answers (4 scenarios): an answer or an error, its numbers finite.
 fn tlog(data: &[u8]) -> Outcome {
     let mut o = Outcome::default();
+    let request = LiveRequest {
+        scenarios: 4,
+        ..LiveRequest::new()
+    };
+    let mut session = LiveSession::new(m100(), &request).ok();
     let mut source = aloft_link::TlogSource::new(data, "fuzz.tlog");
     let mut kinds: std::collections::BTreeMap<&'static str, u64> = Default::default();
     let (mut last_s, mut largest) = (0.0f64, 0.0f64);
@@ -614,6 +620,9 @@ fn tlog(data: &[u8]) -> Outcome {
             });
         }
         last_s = last_s.max(t.time_s);
+        if let Some(s) = &mut session {
+            s.apply(&t);
+        }
         let (kind, numbers) = event_numbers(&t.event);
         *kinds.entry(kind).or_default() += 1;
         if let Some(v) = numbers.iter().find(|v| !v.is_finite()) {
@@ -643,6 +652,34 @@ fn tlog(data: &[u8]) -> Outcome {
     }
     o.accepted = stats.frames > 0;
     let mut answer = serde_json::Map::new();
+    if let Some(s) = session.as_mut().filter(|_| fnv1a(data) % 8 == 1) {
+        match s.update() {
+            Ok(u) => {
+                let band = |b: Option<aloft::engine::Percentiles>| {
+                    b.map_or_else(Vec::new, |b| vec![b.p5, b.p50, b.p95])
+                };
+                let mut numbers = vec![u.energy_used_wh, u.efficiency, u.time_s];
+                numbers.extend(band(u.remaining_wh));
+                numbers.extend(band(u.landing_soc));
+                numbers.extend(
+                    u.soc
+                        .iter()
+                        .chain(&u.point_of_no_return_s)
+                        .chain(&u.power_w),
+                );
+                if numbers.iter().any(|x| !x.is_finite()) {
+                    o.broken.push(Problem {
+                        check: "live-non-finite",
+                        detail: format!("{u:?}"),
+                    });
+                }
+                answer.insert("live_advice".into(), u.advice.unwrap_or("-").into());
+            }
+            Err(e) => {
+                answer.insert("live_error".into(), e.to_string().into());
+            }
+        }
+    }
     answer.insert("frames".into(), stats.frames.into());
     answer.insert("bad_frames".into(), stats.bad_frames().into());
     answer.insert("bytes_skipped".into(), stats.bytes_skipped.into());

@@ -10,6 +10,7 @@
 //! | `/aloft/battery` | `aloft.BatteryState` | `voltage_v`, `current_a`, `power_w`, `charge_ah`, `state_of_charge`, `energy_used_wh` |
 //! | `/aloft/power` | `aloft.PowerTerms` | `induced_w`, `parasitic_w`, `profile_w`, `acceleration_w`, `climb_w`, `electrical_w` |
 //! | `/aloft/path` | `foxglove.PosesInFrame` | the planned path, once |
+//! | `/aloft/live` | `aloft.LiveUpdate` | an update of `aloft live`, its JSON line as it is |
 //!
 //! One sample of a log (or instant of a mission) is written as consecutive messages at one time,
 //! `/aloft/state` first (every sample has one), and [`crate::mcap_read`] joins them back into one
@@ -41,6 +42,8 @@ pub const TOPIC_BATTERY: &str = "/aloft/battery";
 pub const TOPIC_POWER: &str = "/aloft/power";
 /// Topic of the planned path.
 pub const TOPIC_PATH: &str = "/aloft/path";
+/// Topic of `aloft live`'s updates ([`McapWriter::write_object`]).
+pub const TOPIC_LIVE: &str = "/aloft/live";
 
 /// The four terms of the power model and the electrical total, W.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
@@ -167,6 +170,12 @@ fn schema_for(name: &str) -> Value {
                 "acceleration_enu_mps2": schema_vec3(), "wind_enu_mps": schema_vec3(),
                 "roll_rad": {"type": "number"}, "pitch_rad": {"type": "number"}, "yaw_rad": {"type": "number"},
                 "roll_deg": {"type": "number"}, "pitch_deg": {"type": "number"}, "yaw_deg": {"type": "number"}},
+            "required": ["timestamp", "time_s"]}),
+        "aloft.LiveUpdate" => json!({
+            "title": "aloft.LiveUpdate",
+            "description": "An update of aloft live: the JSON line of --format json (time_s, soc, energy_used_wh, power_w, efficiency, wind, remaining_wh and landing_soc as {p5, p50, p95}, point_of_no_return_s, advice, ...)",
+            "type": "object",
+            "properties": {"timestamp": schema_time(), "time_s": {"type": "number"}},
             "required": ["timestamp", "time_s"]}),
         "aloft.BatteryState" => numbers(
             "aloft.BatteryState",
@@ -450,6 +459,21 @@ impl<W: Write + Seek> McapWriter<W> {
             self.put(TOPIC_BATTERY, "aloft.BatteryState", ns, m)?;
         }
         Ok(())
+    }
+
+    /// Write one JSON object at `time_s` on `topic` with the schema `schema` (`aloft.LiveUpdate`
+    /// for [`TOPIC_LIVE`]); `index` names it in errors. Its numbers must be finite (the caller's
+    /// JSON has no NaN: `serde_json` writes them as `null`).
+    pub fn write_object(
+        &mut self,
+        topic: &'static str,
+        schema: &'static str,
+        time_s: f64,
+        index: usize,
+        msg: Map<String, Value>,
+    ) -> Result<()> {
+        let ns = self.time_ns(time_s, index)?;
+        self.put(topic, schema, ns, msg)
     }
 
     /// Write the planned path as one `foxglove.PosesInFrame` message at `time_s`.

@@ -80,6 +80,25 @@ impl CubicDrag {
         v * (self.mu1 + v * (self.mu2 + v * self.mu3))
     }
 
+    /// The airspeed at which the drag is `force_n`, m/s: the inverse of eq (6) on
+    /// `[0, max_mps]` by bisection to the last bit (the first crossing where the law is not
+    /// monotonic); `None` where the law stays below `force_n` up to `max_mps`, or for a force that
+    /// is negative or not finite.
+    pub fn airspeed_for_force(&self, force_n: f64, max_mps: f64) -> Option<f64> {
+        if !(force_n.is_finite() && force_n >= 0.0) || self.force_n(max_mps) < force_n {
+            return None;
+        }
+        let (mut lo, mut hi) = (0.0, max_mps);
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            match self.force_n(mid) < force_n {
+                true => lo = mid,
+                false => hi = mid,
+            }
+        }
+        Some(0.5 * (lo + hi))
+    }
+
     /// Parasitic power `P_par = f_D v`, eq (11), W.
     #[inline]
     pub fn parasitic_power_w(&self, airspeed_mps: f64) -> f64 {
@@ -168,6 +187,18 @@ impl CubicDrag {
 // of zero airspeed, bit-identical results of the same arithmetic).
 #[allow(clippy::float_cmp)]
 mod tests {
+    #[test]
+    fn airspeed_for_force_inverts_eq_6() {
+        // The power seed's M100 constants (Fig. 3): mu2 < 0, still increasing over 0-30 m/s.
+        let d = CubicDrag::new(0.1816, -0.02326, 0.004045).unwrap();
+        for v in [0.0, 0.5, 3.0, 12.0, 25.0] {
+            let back = d.airspeed_for_force(d.force_n(v), 50.0).unwrap();
+            assert!((back - v).abs() < 1e-9, "{v} -> {back}");
+        }
+        assert_eq!(d.airspeed_for_force(d.force_n(60.0), 50.0), None);
+        assert_eq!(d.airspeed_for_force(f64::NAN, 50.0), None);
+    }
+
     use super::*;
 
     fn m100() -> CubicDrag {

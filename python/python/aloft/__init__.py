@@ -34,6 +34,7 @@ __all__ = [
     "__version__",
     "endurance",
     "fit",
+    "live",
     "log_info",
     "mission",
     "power",
@@ -195,6 +196,24 @@ def validate(
             ``battery_instance``.
     """
     return json.loads(_native.validate_json(_paths(logs), vehicle, options))
+
+
+def live(replay: PathLike, vehicle: str, **options: Any) -> Dict[str, Any]:
+    """Follow a flight log as if live: ``aloft live --replay LOG --format json``.
+
+    Returns ``{"updates": [...], "check": {...}}`` for ``route="log"`` (the validation replay:
+    each prediction against the energy the log measured from then to the end), else
+    ``{"updates": [...], "summary": {...}}``. Each update is the command's JSON line.
+
+    Args:
+        replay: The flight log (CSV with ``profile``, MCAP, ULog, DataFlash).
+        vehicle: Built-in name or TOML path of a vehicle with a ``[power]`` table.
+        **options: ``route`` (``"mission"``, the default, or ``"log"``), ``mission`` (a mission
+            file), ``profile``, ``every`` (s), ``battery``, ``payload_kg``,
+            ``reserve_percent``, ``scenarios``, ``speed``. Telemetry logs and MAVLink links
+            (``tlog``, ``connect``) need the command line: this package is built without them.
+    """
+    return json.loads(_native.live_json(str(replay), vehicle, options))
 
 
 def _paths(logs: Union[PathLike, Sequence[PathLike]]) -> List[str]:

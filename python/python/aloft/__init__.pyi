@@ -118,6 +118,20 @@ def validate(
     payload_kg: Optional[float] = None,
     **logs_options: Unpack[FlightLogKeywords],
 ) -> Dict[str, Any]: ...
+def live(
+    replay: PathLike,
+    vehicle: str,
+    *,
+    route: Optional[str] = None,
+    mission: Optional[PathLike] = None,
+    profile: Optional[str] = None,
+    every: Optional[float] = None,
+    battery: Optional[str] = None,
+    payload_kg: Optional[float] = None,
+    reserve_percent: Optional[float] = None,
+    scenarios: Optional[int] = None,
+    speed: Optional[str] = None,
+) -> Dict[str, Any]: ...
 def power(
     airspeed: ArrayLike,
     roll: ArrayLike,

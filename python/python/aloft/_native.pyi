@@ -24,6 +24,9 @@ def fit_json(
 def validate_json(
     logs: List[str], vehicle: str, options: Optional[Mapping[str, Any]] = None
 ) -> str: ...
+def live_json(
+    replay: str, vehicle: str, options: Optional[Mapping[str, Any]] = None
+) -> str: ...
 def power(
     airspeed: npt.NDArray[np.float64],
     roll: npt.NDArray[np.float64],

@@ -20,17 +20,18 @@ use aloft_logs::telemetry::{Reply, TelemetrySource};
 use super::finite::finite;
 use super::mission_file::Mission;
 use super::scenario_stats::Percentiles;
-use super::scenarios::DEFAULT_POWER_SD_PERCENT;
 use super::vehicles::Vehicle;
 use crate::error::Error;
 
 mod ahead;
 mod estimate;
+mod record;
 mod replay;
 mod sources;
 mod tracker;
 
 pub use ahead::LIVE_SCENARIOS;
+pub use record::LiveRecorder;
 pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
 pub use sources::LiveSource;
 
@@ -309,11 +310,7 @@ impl<'a> LiveSession<'a> {
             .aircraft()
             .ok()
             .map(|a| (*a.drag(), mass.total_kg * a.gravity_mps2()));
-        let prior_sd = model
-            .vehicle()
-            .params()
-            .efficiency_relative_sd
-            .unwrap_or(DEFAULT_POWER_SD_PERCENT / 100.0);
+        let prior_sd = estimate::prior_sd(&model);
         let eta0 = model.vehicle().efficiency();
         Ok(Self {
             tracker: Tracker::new(model, drag, prior_sd),
@@ -498,4 +495,73 @@ fn position(t: &Tracker) -> Option<Position> {
         latitude_deg: geo.map(|g| g.0.to_degrees()),
         longitude_deg: geo.map(|g| g.1.to_degrees()),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn update(advice: &'static str, landing_p5: f64) -> LiveUpdate {
+        let band = |p50: f64| Percentiles {
+            p5: p50 * 0.9,
+            p50,
+            p95: p50 * 1.1,
+        };
+        LiveUpdate {
+            time_s: 100.0,
+            in_air: true,
+            mode: Some("AUTO".to_string()),
+            mission_item: Some(3),
+            position: None,
+            soc: Some(0.6),
+            energy_used_wh: 10.0,
+            power_w: Some(300.0),
+            power_available: true,
+            efficiency: 0.8,
+            wind_mps: None,
+            wind_from_deg: None,
+            remaining_wh: Some(band(5.0)),
+            landing_soc: Some(Percentiles {
+                p5: landing_p5,
+                p50: landing_p5 + 0.02,
+                p95: landing_p5 + 0.04,
+            }),
+            point_of_no_return_s: Some(42.0),
+            advice: Some(advice),
+            naive_remaining_wh: None,
+            measured_remaining_wh: None,
+            link_lost: false,
+            note: None,
+        }
+    }
+
+    /// Every update sends the four values; a STATUSTEXT only when the advice changes, at warning
+    /// severity unless it is `continue`.
+    #[test]
+    fn replies_send_the_values_and_the_advice_when_it_changes() {
+        let first = update("continue", 0.30);
+        let r = replies(None, &first);
+        let values: Vec<(&str, f64)> = r
+            .iter()
+            .filter_map(|r| match r {
+                Reply::Value { name, value } => Some((*name, *value)),
+                Reply::Text { .. } => None,
+            })
+            .collect();
+        assert_eq!(values.len(), 4);
+        assert_eq!(values[0].0, "rsv_p50");
+        assert!((values[0].1 - 32.0).abs() < 1e-9);
+        assert_eq!(values[1].0, "rsv_p5");
+        assert_eq!(values[2], ("pnr_s", 42.0));
+        assert_eq!(values[3], ("rem_wh", 5.0));
+        assert!(
+            matches!(&r[4], Reply::Text { text, warning: false } if text == "aloft: continue, lands at 30% (p5)")
+        );
+        // The same advice again: values only.
+        assert_eq!(replies(Some(&first), &update("continue", 0.25)).len(), 4);
+        let turn = replies(Some(&first), &update("return now", 0.12));
+        assert!(
+            matches!(&turn[4], Reply::Text { text, warning: true } if text.starts_with("aloft: return now"))
+        );
+    }
 }

@@ -22,7 +22,6 @@ use serde::Serialize;
 use super::super::finite::finite;
 use super::super::logs::FlightLogs;
 use super::super::scenario_stats::Percentiles;
-use super::super::scenarios::DEFAULT_POWER_SD_PERCENT;
 use super::super::vehicles::Vehicle;
 use super::estimate::RatioEstimator;
 use super::LiveUpdate;
@@ -95,12 +94,7 @@ pub fn replay_live(
     let (flight, _) = flights.swap_remove(0);
     let predicted = predict(&model, &flight)?;
     let series = Series::new(&flight, predicted);
-    // Without a spread from a fit, the model error the scenarios assume.
-    let prior_sd = model
-        .vehicle()
-        .params()
-        .efficiency_relative_sd
-        .unwrap_or(DEFAULT_POWER_SD_PERCENT / 100.0);
+    let prior_sd = super::estimate::prior_sd(&model);
     let eta0 = model.vehicle().efficiency();
     let mut estimator = RatioEstimator::new(prior_sd);
     let mut judge = Judge::new(series.duration_s());

@@ -17,6 +17,9 @@ const MOTION_FRESH_S: f64 = 2.0;
 /// survey: the tilt of one instant also holds the acceleration).
 const WIND_TIME_CONSTANT_S: f64 = 20.0;
 
+/// Highest airspeed the wind from the tilt is solved for, m/s.
+const MAX_AIRSPEED_MPS: f64 = 50.0;
+
 /// Height above home, or ground speed, above which an armed vehicle with no landed state is
 /// taken to be in the air, m and m/s.
 const AIRBORNE_M: f64 = 1.0;
@@ -295,18 +298,48 @@ pub(crate) fn air_velocity_from_tilt(
     if horizontal < 1e-9 {
         return Some([0.0, 0.0]);
     }
-    let (mut lo, mut hi) = (0.0, 50.0);
-    if drag.force_n(hi) < force_n {
-        return None;
-    }
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if drag.force_n(mid) < force_n {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let v = 0.5 * (lo + hi);
+    let v = drag.airspeed_for_force(force_n, MAX_AIRSPEED_MPS)?;
     Some([v * east / horizontal, v * north / horizontal])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Closed form: a vehicle tilted nose down by `atan(f_D(v) / W)`, heading `psi`, flies
+    /// through the air at `v` along its heading (the horizontal thrust balances the drag); yawed
+    /// and rolled instead of pitched, the same along its right side.
+    #[test]
+    fn the_air_velocity_from_the_tilt_balances_the_drag() {
+        let drag = CubicDrag::new(0.1816, -0.02326, 0.004045).unwrap();
+        let weight_n = 2.355 * 9.80665;
+        for (v, psi_deg) in [(5.0_f64, 0.0_f64), (8.0, 90.0), (3.0, 225.0)] {
+            let tilt = (drag.force_n(v) / weight_n).atan();
+            let psi = psi_deg.to_radians();
+            let att = Attitude {
+                roll_rad: 0.0,
+                pitch_rad: -tilt,
+                yaw_rad: psi,
+            };
+            let air = air_velocity_from_tilt(&att, &drag, weight_n).unwrap();
+            // ENU: east = v sin(psi), north = v cos(psi).
+            assert!((air[0] - v * psi.sin()).abs() < 1e-9, "{air:?}");
+            assert!((air[1] - v * psi.cos()).abs() < 1e-9, "{air:?}");
+            // Rolled right by the same tilt, heading north: the air comes from the right (east).
+            let rolled = Attitude {
+                roll_rad: tilt,
+                pitch_rad: 0.0,
+                yaw_rad: 0.0,
+            };
+            let air = air_velocity_from_tilt(&rolled, &drag, weight_n).unwrap();
+            assert!((air[0] - v).abs() < 1e-9 && air[1].abs() < 1e-9, "{air:?}");
+        }
+        // Upside down: no answer.
+        let flipped = Attitude {
+            roll_rad: 3.0,
+            pitch_rad: 0.0,
+            yaw_rad: 0.0,
+        };
+        assert_eq!(air_velocity_from_tilt(&flipped, &drag, weight_n), None);
+    }
 }
