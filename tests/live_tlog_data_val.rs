@@ -12,12 +12,24 @@ use serde_json::Value;
 fn follow(file: &str, extra: &[&str]) -> (Vec<Value>, Value) {
     let path = data_dir().join("telemetry").join(file);
     let mut args = vec!["live", "--tlog", path.to_str().unwrap(), "--speed", "max"];
-    args.extend_from_slice(&["--vehicle", "dji-m100", "--format", "json"]);
+    // 50 scenarios an update (200 by default): the debug build of the tests is slow.
+    args.extend_from_slice(&[
+        "--vehicle",
+        "dji-m100",
+        "--format",
+        "json",
+        "--scenarios",
+        "50",
+    ]);
     args.extend_from_slice(extra);
     let out = aloft(&args);
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let mut lines: Vec<Value> = String::from_utf8(out.stdout)
-        .unwrap()
+    let text = String::from_utf8(out.stdout).unwrap();
+    // What is not known is left out: never null, NaN or inf.
+    for bad in ["null", "NaN", "inf"] {
+        assert!(!text.contains(bad), "{bad} in {file}");
+    }
+    let mut lines: Vec<Value> = text
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
@@ -205,4 +217,42 @@ fn data_val_live_tlog_records_its_updates_in_mcap() {
         assert_eq!(recorded["remaining_wh"], printed["remaining_wh"]);
         assert_eq!(recorded["advice"], printed["advice"]);
     }
+}
+
+/// `--mission FILE` replaces the mission on the link: the demo survey (no item numbers) is
+/// flown whole from where the vehicle is, in AUTO; a file that is not there is bad input.
+#[test]
+fn data_val_live_tlog_flies_a_given_mission() {
+    let demo = format!(
+        "{}/fixtures/missions/demo-survey.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (learned, _) = follow("ayoub_auto_mission_sitl.tlog", &["--every", "30"]);
+    let (given, _) = follow(
+        "ayoub_auto_mission_sitl.tlog",
+        &["--every", "30", "--mission", &demo],
+    );
+    let first_auto = |u: &[Value]| {
+        u.iter()
+            .find(|u| u["in_air"] == true && u["mode"] == "AUTO")
+            .map(|u| u["remaining_wh"]["p50"].as_f64().unwrap())
+            .unwrap()
+    };
+    // The demo flies 32.4 Wh from the ground; the simulator's own mission about 11 Wh.
+    let (l, g) = (first_auto(&learned), first_auto(&given));
+    assert!(g > 20.0 && l < 15.0, "given {g} Wh, learned {l} Wh");
+    let tlog = data_dir().join("telemetry/ayoub_auto_mission_sitl.tlog");
+    let out = aloft(&[
+        "live",
+        "--tlog",
+        tlog.to_str().unwrap(),
+        "--mission",
+        "/nonexistent/m.plan",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("/nonexistent/m.plan"),
+        "{}",
+        stderr(&out)
+    );
 }

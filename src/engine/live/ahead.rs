@@ -7,7 +7,8 @@
 //! - `LAND` or `PRECLAND`: the landing where it is;
 //! - `AUTO` (ArduPilot) or `MISSION` (PX4) with a mission (`--mission`, or the one learned from
 //!   the link): the mission from the item being flown (MISSION_CURRENT) to its end, then home and
-//!   the landing if it does not end on the ground;
+//!   the landing if it does not end on the ground (a mission file without item numbers, aloft's
+//!   TOML or JSON, is flown whole from where the vehicle is);
 //! - any other mode (flown by hand or guided), or without a mission: home and the landing, what
 //!   it costs to come back now.
 //!
@@ -197,13 +198,18 @@ fn rest_spec(t: &Tracker, mission: Option<&Mission>) -> Option<(MissionSpec, boo
 fn mission_rest(t: &Tracker, m: &Mission) -> MissionSpec {
     let mut spec = start_here(t, Some(m));
     let current = t.mission_current.unwrap_or(0);
-    let from = m
-        .spec()
-        .segments
-        .iter()
-        .position(|s| s.item().is_some_and(|i| i >= current))
-        .unwrap_or(m.spec().segments.len());
-    spec.segments = m.spec().segments[from..]
+    let segments = &m.spec().segments;
+    // A mission without item numbers (an aloft TOML or JSON file) cannot be indexed by
+    // MISSION_CURRENT: it is flown whole from where the vehicle is.
+    let numbered = segments.iter().any(|s| s.item().is_some());
+    let from = match numbered {
+        true => segments
+            .iter()
+            .position(|s| s.item().is_some_and(|i| i >= current))
+            .unwrap_or(segments.len()),
+        false => 0,
+    };
+    spec.segments = segments[from..]
         .iter()
         // In the air already: a take-off item is the climb done.
         .filter(|s| !matches!(s, SegmentSpec::TakeOff { .. }))

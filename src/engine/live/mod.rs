@@ -39,7 +39,7 @@ use ahead::{Ahead, AheadAnswer};
 use tracker::Tracker;
 
 /// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
-/// battery, no mission) are `null`.
+/// battery, no mission) are left out, as everywhere in aloft's JSON.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LiveUpdate {
     /// Time since the start of the stream, s.
@@ -47,35 +47,47 @@ pub struct LiveUpdate {
     /// In the air.
     pub in_air: bool,
     /// Flight mode, by the autopilot's name.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mode: Option<String>,
     /// The mission item being flown (MISSION_CURRENT).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mission_item: Option<u32>,
     /// Where the vehicle is.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub position: Option<Position>,
     /// State of charge now, 0-1 (the autopilot's, else from the charge or energy drawn).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub soc: Option<f64>,
     /// Electrical energy used so far, Wh (measured; the model's without power data).
     pub energy_used_wh: f64,
     /// Measured electrical power now, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub power_w: Option<f64>,
     /// Whether the source measures power (without it the prediction is the model's alone).
     pub power_available: bool,
     /// The efficiency the rest is predicted with (re-estimated in flight).
     pub efficiency: f64,
     /// Wind speed, m/s (horizontal).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub wind_mps: Option<f64>,
     /// Direction the wind blows from, deg clockwise from north.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub wind_from_deg: Option<f64>,
     /// Energy to finish the route and land, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub remaining_wh: Option<Percentiles>,
     /// State of charge at landing, 0-1.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub landing_soc: Option<Percentiles>,
-    /// The point of no return, s from now (negative once passed); `null` where the route can
+    /// The point of no return, s from now (negative once passed); left out where the route can
     /// turn back everywhere.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_s: Option<f64>,
     /// What to do: `continue`, `return now` or `land now`.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub advice: Option<&'static str>,
     /// The naive rate: mean measured power so far times the route's remaining time, Wh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub naive_remaining_wh: Option<f64>,
     /// Validation mode: the energy the log measured from now to the end, Wh.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -99,8 +111,10 @@ pub struct Position {
     /// Height above home, m.
     pub up_m: f64,
     /// Latitude, deg (WGS-84).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub latitude_deg: Option<f64>,
     /// Longitude, deg (WGS-84).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub longitude_deg: Option<f64>,
 }
 
