@@ -256,3 +256,27 @@ fn data_val_live_tlog_flies_a_given_mission() {
         stderr(&out)
     );
 }
+
+/// `--speed X` plays the log at X times its own time: never faster (the 271 s of the simulator
+/// mission at 500 times take at least 0.54 s of wall time).
+#[test]
+fn data_val_live_tlog_plays_at_its_speed() {
+    let tlog = data_dir().join("telemetry/ayoub_auto_mission_sitl.tlog");
+    let start = std::time::Instant::now();
+    let out = aloft(&[
+        "live",
+        "--tlog",
+        tlog.to_str().unwrap(),
+        "--speed",
+        "500",
+        "--every",
+        "60",
+        "--scenarios",
+        "10",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let elapsed = start.elapsed().as_secs_f64();
+    assert!(elapsed >= 271.0 / 500.0, "{elapsed} s");
+}
