@@ -606,6 +606,29 @@ impl FlightLogs {
         Ok(reader.read_rest(&path.display().to_string())?)
     }
 
+    /// The first log as events: its samples, and a DataFlash log's mode, arming and mission
+    /// ([`aloft_logs::flight_events`]) read in a second pass over the file.
+    pub(crate) fn events_of_first(&self) -> Result<aloft_logs::telemetry::LogEvents, Error> {
+        let log = self.read_first()?;
+        let path = &self.logs[0];
+        let io = |source| Error::Io {
+            origin: path.display().to_string(),
+            source,
+        };
+        let mut head = [0u8; 3];
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let dataflash = std::io::Read::read_exact(&mut file, &mut head).is_ok()
+            && aloft_logs::dataflash::is_dataflash(&head);
+        let events = match dataflash {
+            true => {
+                let file = std::io::BufReader::new(std::fs::File::open(path).map_err(io)?);
+                aloft_logs::flight_events::dataflash_events(file, log.start_time_s)
+            }
+            false => Vec::new(),
+        };
+        Ok(aloft_logs::telemetry::LogEvents::with_events(log, events))
+    }
+
     /// Read every log, align power with motion, and set the angle-of-attack model.
     pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
         let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;

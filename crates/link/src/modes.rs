@@ -1,74 +1,9 @@
 //! Flight mode names from HEARTBEAT `custom_mode`: ArduCopter's mode numbers, PX4's main and sub
-//! modes (bytes 2 and 3 of `custom_mode`), else `custom N`.
+//! modes (bytes 2 and 3 of `custom_mode`), else `custom N`; the tables are aloft-logs'
+//! ([`aloft_logs::modes`]).
 
+use aloft_logs::modes::{arducopter_mode, px4_mode};
 use mavlink::dialects::ardupilotmega::{MavAutopilot, MavType};
-
-/// ArduCopter's modes by number (`ArduCopter/mode.h`, `enum class Number`; the same as the
-/// ardupilotmega dialect's `COPTER_MODE`).
-const ARDUCOPTER: [(u32, &str); 26] = [
-    (0, "STABILIZE"),
-    (1, "ACRO"),
-    (2, "ALT_HOLD"),
-    (3, "AUTO"),
-    (4, "GUIDED"),
-    (5, "LOITER"),
-    (6, "RTL"),
-    (7, "CIRCLE"),
-    (9, "LAND"),
-    (11, "DRIFT"),
-    (13, "SPORT"),
-    (14, "FLIP"),
-    (15, "AUTOTUNE"),
-    (16, "POSHOLD"),
-    (17, "BRAKE"),
-    (18, "THROW"),
-    (19, "AVOID_ADSB"),
-    (20, "GUIDED_NOGPS"),
-    (21, "SMART_RTL"),
-    (22, "FLOWHOLD"),
-    (23, "FOLLOW"),
-    (24, "ZIGZAG"),
-    (25, "SYSTEMID"),
-    (26, "AUTOROTATE"),
-    (27, "AUTO_RTL"),
-    (28, "TURTLE"),
-];
-
-/// PX4's main modes (`px4_custom_mode.h`, `PX4_CUSTOM_MAIN_MODE_*`).
-const PX4_MAIN: [(u32, &str); 10] = [
-    (1, "MANUAL"),
-    (2, "ALTCTL"),
-    (3, "POSCTL"),
-    (4, "AUTO"),
-    (5, "ACRO"),
-    (6, "OFFBOARD"),
-    (7, "STABILIZED"),
-    (8, "RATTITUDE"),
-    (9, "SIMPLE"),
-    (10, "TERMINATION"),
-];
-
-/// PX4's AUTO sub-modes (`PX4_CUSTOM_SUB_MODE_AUTO_*`), by the names QGroundControl and
-/// pymavlink show.
-const PX4_AUTO: [(u32, &str); 9] = [
-    (1, "READY"),
-    (2, "TAKEOFF"),
-    (3, "LOITER"),
-    (4, "MISSION"),
-    (5, "RTL"),
-    (6, "LAND"),
-    (8, "FOLLOWME"),
-    (9, "PRECLAND"),
-    (10, "VTOL_TAKEOFF"),
-];
-
-const PX4_MAIN_AUTO: u32 = 4;
-const PX4_MAIN_POSCTL: u32 = 3;
-const PX4_POSCTL_ORBIT: u32 = 1;
-
-fn lookup(table: &[(u32, &'static str)], n: u32) -> Option<&'static str> {
-    table.iter().find(|(k, _)| *k == n).map(|(_, name)| *name)
-}
 
 /// Whether ArduPilot on this vehicle type runs ArduCopter (rotorcraft that are not VTOL planes).
 fn is_copter(vehicle_type: MavType) -> bool {
@@ -91,22 +26,12 @@ fn is_copter(vehicle_type: MavType) -> bool {
 pub fn mode_name(autopilot: MavAutopilot, vehicle_type: MavType, custom_mode: u32) -> String {
     let known = match autopilot {
         MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA if is_copter(vehicle_type) => {
-            lookup(&ARDUCOPTER, custom_mode)
+            arducopter_mode(custom_mode)
         }
-        MavAutopilot::MAV_AUTOPILOT_PX4 => px4(custom_mode),
+        MavAutopilot::MAV_AUTOPILOT_PX4 => px4_mode(custom_mode),
         _ => None,
     };
     known.map_or_else(|| format!("custom {custom_mode}"), str::to_owned)
-}
-
-fn px4(custom_mode: u32) -> Option<&'static str> {
-    let main = (custom_mode >> 16) & 0xFF;
-    let sub = (custom_mode >> 24) & 0xFF;
-    match main {
-        PX4_MAIN_AUTO => lookup(&PX4_AUTO, sub),
-        PX4_MAIN_POSCTL if sub == PX4_POSCTL_ORBIT => Some("ORBIT"),
-        _ => lookup(&PX4_MAIN, main),
-    }
 }
 
 #[cfg(test)]

@@ -731,6 +731,8 @@ pub struct Record {
     pub name: String,
     /// Numeric columns (scaled), by name; string columns are left out.
     pub values: Vec<(String, f64)>,
+    /// Boot time, s (as the samples': `TimeUS`, else `TimeMS`, else GPS `T`).
+    pub time_s: Option<f64>,
 }
 
 impl<R: Read> DataflashRecords<R> {
@@ -767,6 +769,7 @@ impl<R: Read> Iterator for DataflashRecords<R> {
             offset,
             name: f.name.clone(),
             values,
+            time_s: boot_time_s(&f, &self.payload),
         })
     }
 }

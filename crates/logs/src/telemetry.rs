@@ -198,37 +198,51 @@ impl<S: TelemetrySource> TelemetrySource for Paced<S> {
 }
 
 /// A flight log replayed as events: its origin (where its positions were geodetic), then a
-/// sample event per record, in file order (`aloft live --replay`).
+/// sample event per record and the log's other events (a DataFlash log's mode, arming and
+/// mission: [`crate::flight_events`]) in time order (`aloft live --replay`).
 pub struct LogEvents {
     origin: Option<GeoOrigin>,
-    samples: std::vec::IntoIter<Sample>,
+    samples: std::iter::Peekable<std::vec::IntoIter<Sample>>,
+    events: std::iter::Peekable<std::vec::IntoIter<Telemetry>>,
 }
 
 impl LogEvents {
-    /// The events of `log`.
+    /// The events of `log` alone.
     pub fn new(log: Log) -> Self {
+        Self::with_events(log, Vec::new())
+    }
+
+    /// The events of `log` and `events` (in time order, times as the samples'), merged by time.
+    pub fn with_events(log: Log, events: Vec<Telemetry>) -> Self {
         Self {
             origin: log.origin,
-            samples: log.samples.into_iter(),
+            samples: log.samples.into_iter().peekable(),
+            events: events.into_iter().peekable(),
         }
     }
 }
 
 impl TelemetrySource for LogEvents {
     fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
-        let event = match self.origin.take() {
-            Some(o) => Telemetry {
-                time_s: self.samples.as_slice().first().map_or(0.0, |s| s.time_s),
+        if let Some(o) = self.origin.take() {
+            let first = self.samples.peek().map_or(0.0, |s| s.time_s);
+            return Ok(Some(Telemetry {
+                time_s: first,
                 event: Event::Origin(o),
-            },
-            None => match self.samples.next() {
-                Some(s) => Telemetry {
-                    time_s: s.time_s,
-                    event: Event::Sample(s),
-                },
-                None => return Ok(None),
-            },
+            }));
+        }
+        let sample_first = match (self.samples.peek(), self.events.peek()) {
+            (Some(s), Some(e)) => s.time_s <= e.time_s,
+            (Some(_), None) => true,
+            (None, Some(_)) => false,
+            (None, None) => return Ok(None),
         };
-        Ok(Some(event))
+        Ok(match sample_first {
+            true => self.samples.next().map(|s| Telemetry {
+                time_s: s.time_s,
+                event: Event::Sample(s),
+            }),
+            false => self.events.next(),
+        })
     }
 }

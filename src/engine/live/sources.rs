@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use aloft_logs::telemetry::{LogEvents, Paced, TelemetrySource};
+use aloft_logs::telemetry::{Paced, TelemetrySource};
 
 use super::super::logs::FlightLogs;
 use crate::error::Error;
@@ -12,7 +12,8 @@ use crate::error::Error;
 #[derive(Debug, Clone, PartialEq)]
 pub enum LiveSource {
     /// A flight log (CSV with a profile, MCAP, ULog, DataFlash), as if live, at `speed` times its
-    /// own time (`None`: as fast as it goes).
+    /// own time (`None`: as fast as it goes): its samples, and a DataFlash log's mode, arming and
+    /// mission.
     Replay {
         /// The log and how to read it.
         logs: FlightLogs,
@@ -49,7 +50,7 @@ impl LiveSource {
     pub fn open(&self) -> Result<Box<dyn TelemetrySource>, Error> {
         match self {
             LiveSource::Replay { logs, speed } => {
-                let source: Box<dyn TelemetrySource> = Box::new(LogEvents::new(logs.read_first()?));
+                let source: Box<dyn TelemetrySource> = Box::new(logs.events_of_first()?);
                 Ok(paced(source, *speed))
             }
             LiveSource::Tlog { path, speed } => Ok(paced(open_tlog(path)?, *speed)),

@@ -17,6 +17,36 @@ const MOTION_FRESH_S: f64 = 2.0;
 /// survey: the tilt of one instant also holds the acceleration).
 const WIND_TIME_CONSTANT_S: f64 = 20.0;
 
+/// Longest gap between power samples that is integrated over, s: across a longer one (a log
+/// that stops, a vehicle switched off between flights) the energy is not known and not counted.
+const MAX_GAP_S: f64 = 5.0;
+
+/// An energy by the trapezoid rule over power samples, not across gaps longer than
+/// [`MAX_GAP_S`].
+#[derive(Debug, Clone, Default)]
+struct Energy {
+    banked_j: f64,
+    run: Trapezoid,
+}
+
+impl Energy {
+    fn push(&mut self, time_s: f64, power_w: f64) {
+        if self.run.last().is_some_and(|(t, _)| time_s - t > MAX_GAP_S) {
+            self.banked_j += self.run.integral();
+            self.run = Trapezoid::new();
+        }
+        self.run.push(time_s, power_w);
+    }
+
+    fn last(&self) -> Option<(f64, f64)> {
+        self.run.last()
+    }
+
+    fn integral(&self) -> f64 {
+        self.banked_j + self.run.integral()
+    }
+}
+
 /// Highest airspeed the wind from the tilt is solved for, m/s.
 const MAX_AIRSPEED_MPS: f64 = 50.0;
 
@@ -56,8 +86,8 @@ pub(crate) struct Tracker {
     pub wind: Option<([f64; 2], WindSource)>,
     wind_time_s: f64,
     /// Measured energy since the start, J; the model's for a source without power.
-    measured_j: Trapezoid,
-    model_j: Trapezoid,
+    measured_j: Energy,
+    model_j: Energy,
     pub estimator: RatioEstimator,
     /// Time in the air so far, s, and the measured energy over it, J.
     pub air_s: f64,
@@ -89,8 +119,8 @@ impl Tracker {
             mission_current: None,
             wind: None,
             wind_time_s: 0.0,
-            measured_j: Trapezoid::new(),
-            model_j: Trapezoid::new(),
+            measured_j: Energy::default(),
+            model_j: Energy::default(),
             estimator: RatioEstimator::new(prior_sd),
             air_s: 0.0,
             air_measured_j: 0.0,
@@ -142,7 +172,8 @@ impl Tracker {
     }
 
     fn count_air_time(&mut self, time_s: f64) {
-        if let Some(since) = self.last_in_air_s {
+        // Not across a gap in the stream (as the energy).
+        if let Some(since) = self.last_in_air_s.filter(|t| time_s - t <= MAX_GAP_S) {
             self.air_s += (time_s - since).max(0.0);
         }
         self.last_in_air_s = self.in_air().then_some(time_s);
@@ -182,7 +213,11 @@ impl Tracker {
         if self.measured_j.last().is_some_and(|(t, _)| time_s <= t) {
             return;
         }
-        if let Some((t0, p0)) = self.measured_j.last().filter(|_| self.in_air()) {
+        let bridged = self
+            .measured_j
+            .last()
+            .filter(|(t0, _)| time_s - t0 <= MAX_GAP_S);
+        if let Some((t0, p0)) = bridged.filter(|_| self.in_air()) {
             self.air_measured_j += 0.5 * (p0 + measured_w) * (time_s - t0);
         }
         self.measured_j.push(time_s, measured_w);
