@@ -280,3 +280,17 @@ fn data_val_live_tlog_plays_at_its_speed() {
     let elapsed = start.elapsed().as_secs_f64();
     assert!(elapsed >= 271.0 / 500.0, "{elapsed} s");
 }
+
+/// On the ground, a mission that will not keep the reserve: `do not take off`.
+#[test]
+fn data_val_live_tlog_advises_not_to_take_off() {
+    let (updates, _) = follow(
+        "ayoub_auto_mission_sitl.tlog",
+        &["--every", "30", "--reserve-percent", "95"],
+    );
+    let on_ground = updates
+        .iter()
+        .find(|u| u["in_air"] == false && u["advice"].is_string())
+        .unwrap();
+    assert_eq!(on_ground["advice"], "do not take off", "{on_ground}");
+}

@@ -16,7 +16,8 @@
 //! in the present wind, in [`LIVE_SCENARIOS`] scenarios that draw the model error from the
 //! estimate's own spread and the wind from its source's ([`WIND_SD`]). The advice: `continue`
 //! while 95 % of the scenarios land with the reserve (the p5 reserve at landing holds), `return
-//! now` where they do not but 95 % of a direct return's do, `land now` where neither holds.
+//! now` where they do not but 95 % of a direct return's do, `land now` where neither holds; on
+//! the ground, `do not take off` where the mission from the ground does not hold it.
 
 use aloft_missions::SourceFormat;
 use aloft_planner::{geodesy::LocalFrame, HomeSpec, MissionSpec, SegmentSpec, WindSpec};
@@ -99,7 +100,10 @@ impl Ahead<'_> {
         let holds = |u: &Uncertainty| u.p_feasible >= P_HOLDS;
         let advice = if holds(&rest_u) {
             "continue"
-        } else if !is_return && t.in_air() {
+        } else if !t.in_air() {
+            // Before take-off (or after landing): the whole mission from the ground.
+            "do not take off"
+        } else if !is_return {
             let back = self.fly(&vehicle, return_spec(t, mission), t, soc, ratio)?;
             if holds(&back) {
                 "return now"

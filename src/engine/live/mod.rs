@@ -83,7 +83,8 @@ pub struct LiveUpdate {
     /// turn back everywhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_s: Option<f64>,
-    /// What to do: `continue`, `return now` or `land now`.
+    /// What to do: `continue`, `return now` or `land now`; on the ground, `continue` or `do not
+    /// take off`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub advice: Option<&'static str>,
     /// The naive rate: mean measured power so far times the route's remaining time, Wh.
