@@ -26,15 +26,13 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use aloft::engine::answers;
 use aloft::engine::flags::{
-    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionFlags,
-    MissionScenarioFlags, PowerModelFlags, ValidateFlags,
+    EnduranceFlags, FitFlags, LiveFlags, LogInfoFlags, MissionFlags, MissionScenarioFlags,
+    PowerModelFlags, ValidateFlags,
 };
 use aloft::engine::{
-    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, follow_live, list_vehicles,
-    log_info, payload_sweep, plan_mission, plan_scenarios, power_curve, power_model, power_point,
-    power_values, replay_live, validate_logs, EnduranceWithUncertainty, Mission,
-    MissionWithUncertainty, PowerQuery, Vehicle, POWER_KEYS,
+    plan_mission, power_model, power_point, power_values, Mission, PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -71,14 +69,6 @@ pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
     aloft_error(cli_message(&e))
 }
 
-/// Pretty JSON of an engine answer, as the CLI's `--format json` writes it.
-fn json_of(value: &impl serde::Serialize) -> Result<String, aloft::Error> {
-    serde_json::to_string_pretty(value).map_err(|e| aloft::Error::OptionsFormat {
-        what: "answer",
-        message: e.to_string(),
-    })
-}
-
 /// `aloft mission --format json` as text.
 #[pyfunction]
 #[pyo3(signature = (path=None, options=None))]
@@ -88,23 +78,8 @@ fn mission_json(
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
     let flags: MissionScenarioFlags = options::parse("mission", &[], options)?;
-    let opts = flags.mission.options();
-    let scenarios = flags.scenarios.options(false);
-    py.detach(|| {
-        let v = Vehicle::load(&flags.mission.vehicle)?;
-        let m = Mission::load(path.as_deref())?;
-        let plan = plan_mission(&v, &m, &opts)?;
-        match scenarios {
-            None => plan.to_json(),
-            // As `aloft mission --samples N --format json`: the answer with its uncertainty.
-            Some(sc) => MissionWithUncertainty {
-                summary: plan.summary(),
-                uncertainty: &plan_scenarios(&v, &m, &opts, &sc)?,
-            }
-            .to_json(),
-        }
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::mission_answer(path.as_deref(), &flags))
+        .map_err(engine_error)
 }
 
 /// The columns of `aloft mission --timeseries`: names and arrays (`segment` as int64).
@@ -202,35 +177,14 @@ impl Table {
 #[pyo3(signature = (options=None))]
 fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<String> {
     let flags: EnduranceFlags = options::parse("endurance", &[], options)?;
-    let opts = flags.options();
-    let scenarios = flags.scenarios.options(false);
-    py.detach(|| {
-        let v = Vehicle::load(&flags.vehicle)?;
-        if let Some(sweep) = &flags.payload_sweep {
-            return json_of(&payload_sweep(&v, &opts, sweep)?);
-        }
-        if let Some(step) = flags.sweep_speed {
-            return json_of(&power_curve(&v, &opts, step)?);
-        }
-        let summary = endurance(&v, &opts)?;
-        match scenarios {
-            None => summary.to_json(),
-            // As `aloft endurance --samples N --format json`: the answer with its uncertainty.
-            Some(sc) => json_of(&EnduranceWithUncertainty {
-                summary: &summary,
-                uncertainty: &endurance_scenarios(&v, &opts, &sc)?,
-            }),
-        }
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::endurance_answer(&flags))
+        .map_err(engine_error)
 }
 
 /// `aloft vehicles --format json` as text: the built-in vehicles with their packs and sources.
 #[pyfunction]
 fn vehicles_json() -> PyResult<String> {
-    list_vehicles()
-        .and_then(|v| json_of(&v))
-        .map_err(engine_error)
+    answers::vehicles_answer().map_err(engine_error)
 }
 
 /// `aloft vehicles calibrate SPEC -o OUTPUT --format json` as text: the vehicle file of a spec
@@ -238,12 +192,8 @@ fn vehicles_json() -> PyResult<String> {
 #[pyfunction]
 #[pyo3(signature = (spec, output))]
 fn calibrate_vehicle_json(py: Python<'_>, spec: PathBuf, output: PathBuf) -> PyResult<String> {
-    py.detach(|| {
-        let c = calibrate_spec_file(&spec)?;
-        c.write_vehicle_file(&output)?;
-        json_of(&c)
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::calibrate_vehicle_answer(&spec, &output))
+        .map_err(engine_error)
 }
 
 /// `aloft log info --format json` as text.
@@ -262,8 +212,7 @@ fn log_info_json(
         "the search window of the lag estimate, s; 'lag' is the lag itself in fit and validate",
     )?;
     let flags: LogInfoFlags = options::parse("log_info", &[], options)?;
-    let read = flags.read.options();
-    py.detach(|| json_of(&log_info(&path, &read, flags.max_lag)?))
+    py.detach(|| answers::log_info_answer(&path, &flags))
         .map_err(engine_error)
 }
 
@@ -281,11 +230,8 @@ fn fit_json(
         ("vehicle_template", options::text(&vehicle_template)),
     ];
     let flags: FitFlags = options::parse("fit", &positional, options)?;
-    py.detach(|| {
-        let template = Vehicle::load(&flags.vehicle_template)?;
-        json_of(&fit_logs(&template, &flags.request()?)?)
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::fit_answer(&flags))
+        .map_err(engine_error)
 }
 
 /// `aloft validate --format json` as text.
@@ -302,11 +248,8 @@ fn validate_json(
         ("vehicle", options::text(&vehicle)),
     ];
     let flags: ValidateFlags = options::parse("validate", &positional, options)?;
-    py.detach(|| {
-        let v = Vehicle::load(&flags.vehicle)?;
-        json_of(&validate_logs(&v, &flags.request(false))?.report)
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::validate_answer(&flags))
+        .map_err(engine_error)
 }
 
 /// `aloft live --replay LOG --format json` as one JSON text: `{"updates": [...], "check" or
@@ -325,30 +268,8 @@ fn live_json(
         ("vehicle", options::text(&vehicle)),
     ];
     let flags: LiveFlags = options::parse("live", &positional, options)?;
-    py.detach(|| {
-        let v = Vehicle::load(&flags.vehicle)?;
-        let mut updates = Vec::new();
-        let mut keep = |u: &aloft::engine::LiveUpdate| -> Result<(), aloft::Error> {
-            updates.push(u.clone());
-            Ok(())
-        };
-        let end = match flags.request()? {
-            LiveTask::Validate(request) => {
-                serde_json::json!({ "check": replay_live(&v, &request, &mut keep)? })
-            }
-            LiveTask::Follow { source, request } => {
-                let mut source = source.open()?;
-                let summary = follow_live(&v, &request, &mut source, &mut keep)?;
-                serde_json::json!({ "summary": summary })
-            }
-        };
-        let mut answer = serde_json::json!({ "updates": updates });
-        if let (Some(a), serde_json::Value::Object(e)) = (answer.as_object_mut(), end) {
-            a.extend(e);
-        }
-        json_of(&answer)
-    })
-    .map_err(engine_error)
+    py.detach(|| answers::live_answer(&flags))
+        .map_err(engine_error)
 }
 
 /// States per block of the batch kernel.

@@ -41,6 +41,7 @@
 //! # Ok::<(), aloft::Error>(())
 //! ```
 
+pub mod answers;
 mod calibrate;
 mod endurance;
 mod estimator;

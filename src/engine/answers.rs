@@ -1,0 +1,145 @@
+//! The command line's `--format json` answers as text, one request of flags in: what the JSON
+//! front ends give (the Python package; the page's API of `aloft serve` to come), so that none
+//! of them composes a pipeline of its own and each answers exactly as `aloft ... --format json`
+//! (the Python tests hold every answer equal to the command line's).
+//!
+//! Each function is the steps of its command: the vehicle, the request of the flags, the engine
+//! call, the JSON text (pretty, as the command line prints it, without its final line break).
+
+use std::path::Path;
+
+use super::flags::{
+    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags,
+    ValidateFlags,
+};
+use super::{
+    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, follow_live, list_vehicles,
+    log_info, payload_sweep, plan_mission, plan_scenarios, power_curve, replay_live, validate_logs,
+    EnduranceWithUncertainty, LiveUpdate, Mission, MissionWithUncertainty, Vehicle,
+};
+use crate::error::Error;
+
+/// A value as the command line's JSON text.
+pub fn json_text(value: &impl serde::Serialize) -> Result<String, Error> {
+    serde_json::to_string_pretty(value).map_err(|e| Error::OptionsFormat {
+        what: "answer",
+        message: e.to_string(),
+    })
+}
+
+/// `aloft mission [PATH] --format json` (`None`: the built-in demo), with its uncertainty when
+/// the flags ask for scenarios.
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_answer(path: Option<&Path>, flags: &MissionScenarioFlags) -> Result<String, Error> {
+    let opts = flags.mission.options();
+    let v = Vehicle::load(&flags.mission.vehicle)?;
+    let m = Mission::load(path)?;
+    let plan = plan_mission(&v, &m, &opts)?;
+    match flags.scenarios.options(false) {
+        None => plan.to_json(),
+        Some(sc) => MissionWithUncertainty {
+            summary: plan.summary(),
+            uncertainty: &plan_scenarios(&v, &m, &opts, &sc)?,
+        }
+        .to_json(),
+    }
+}
+
+/// `aloft endurance --format json`: the power curve with `--sweep-speed`, endurance against
+/// payload with `--payload-sweep`, with its uncertainty when the flags ask for scenarios.
+///
+/// # Errors
+/// As [`endurance`] and the sweeps.
+pub fn endurance_answer(flags: &EnduranceFlags) -> Result<String, Error> {
+    let opts = flags.options();
+    let v = Vehicle::load(&flags.vehicle)?;
+    if let Some(sweep) = &flags.payload_sweep {
+        return json_text(&payload_sweep(&v, &opts, sweep)?);
+    }
+    if let Some(step) = flags.sweep_speed {
+        return json_text(&power_curve(&v, &opts, step)?);
+    }
+    let summary = endurance(&v, &opts)?;
+    match flags.scenarios.options(false) {
+        None => summary.to_json(),
+        Some(sc) => json_text(&EnduranceWithUncertainty {
+            summary: &summary,
+            uncertainty: &endurance_scenarios(&v, &opts, &sc)?,
+        }),
+    }
+}
+
+/// `aloft vehicles --format json`: the built-in vehicles with their packs and sources.
+///
+/// # Errors
+/// A built-in vehicle file that does not read (a defect, tested against).
+pub fn vehicles_answer() -> Result<String, Error> {
+    json_text(&list_vehicles()?)
+}
+
+/// `aloft vehicles calibrate SPEC -o OUTPUT --format json`: the vehicle file of a spec sheet,
+/// written to `output`.
+///
+/// # Errors
+/// As [`calibrate_spec_file`], and an `output` that cannot be written.
+pub fn calibrate_vehicle_answer(spec: &Path, output: &Path) -> Result<String, Error> {
+    let c = calibrate_spec_file(spec)?;
+    c.write_vehicle_file(output)?;
+    json_text(&c)
+}
+
+/// `aloft log info PATH --format json`.
+///
+/// # Errors
+/// As [`log_info`].
+pub fn log_info_answer(path: &Path, flags: &LogInfoFlags) -> Result<String, Error> {
+    json_text(&log_info(path, &flags.read.options(), flags.max_lag)?)
+}
+
+/// `aloft fit --format json` (the vehicle file written only when the flags give `-o`).
+///
+/// # Errors
+/// As [`fit_logs`].
+pub fn fit_answer(flags: &FitFlags) -> Result<String, Error> {
+    let template = Vehicle::load(&flags.vehicle_template)?;
+    json_text(&fit_logs(&template, &flags.request()?)?)
+}
+
+/// `aloft validate --format json`.
+///
+/// # Errors
+/// As [`validate_logs`].
+pub fn validate_answer(flags: &ValidateFlags) -> Result<String, Error> {
+    let v = Vehicle::load(&flags.vehicle)?;
+    json_text(&validate_logs(&v, &flags.request(false))?.report)
+}
+
+/// `aloft live --format json` as one JSON text: `{"updates": [...], "check": ...}` for the
+/// validation replay (`--route log`), else `{"updates": [...], "summary": ...}`.
+///
+/// # Errors
+/// As [`replay_live`] and [`follow_live`].
+pub fn live_answer(flags: &LiveFlags) -> Result<String, Error> {
+    let v = Vehicle::load(&flags.vehicle)?;
+    let mut updates: Vec<LiveUpdate> = Vec::new();
+    let mut keep = |u: &LiveUpdate| -> Result<(), Error> {
+        updates.push(u.clone());
+        Ok(())
+    };
+    let end = match flags.request()? {
+        LiveTask::Validate(request) => {
+            serde_json::json!({ "check": replay_live(&v, &request, &mut keep)? })
+        }
+        LiveTask::Follow { source, request } => {
+            let mut source = source.open()?;
+            serde_json::json!({ "summary": follow_live(&v, &request, &mut source, &mut keep)? })
+        }
+    };
+    let mut answer = serde_json::json!({ "updates": updates });
+    if let (Some(a), serde_json::Value::Object(e)) = (answer.as_object_mut(), end) {
+        a.extend(e);
+    }
+    json_text(&answer)
+}
