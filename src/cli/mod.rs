@@ -19,6 +19,8 @@ mod propulsion;
 mod replay;
 mod rotor;
 mod scenarios;
+#[cfg(feature = "serve")]
+mod serve;
 mod validate;
 mod vehicles;
 
@@ -61,6 +63,10 @@ enum Command {
     Mission(Box<mission_args::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
     Endurance(endurance::EnduranceArgs),
+    /// A local web server whose JSON API is the command line (`/api/mission`, `/api/endurance`,
+    /// `/api/vehicles`).
+    #[cfg(feature = "serve")]
+    Serve(serve::ServeArgs),
 }
 
 /// Output format of a result.
@@ -101,6 +107,8 @@ pub fn main() -> ExitCode {
         Command::Live(args) => live::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
+        #[cfg(feature = "serve")]
+        Command::Serve(args) => serve::run(args),
     };
     match result {
         Ok(Outcome::Ok) => ExitCode::SUCCESS,
@@ -139,6 +147,12 @@ fn usage_line(rendered: &str) -> String {
         .filter(|l| !l.is_empty())
         .collect::<Vec<_>>()
         .join(" ")
+}
+
+/// An engine error as the command line says it (without its `aloft: error: ` prefix).
+#[cfg(feature = "serve")]
+fn engine_message(e: aloft::Error) -> String {
+    message(&anyhow::Error::from(e))
 }
 
 /// The error and its causes on one line, each cause once: engine errors already say their

@@ -33,15 +33,22 @@ pub fn json_text(value: &impl serde::Serialize) -> Result<String, Error> {
 /// # Errors
 /// As [`plan_mission`] and [`plan_scenarios`].
 pub fn mission_answer(path: Option<&Path>, flags: &MissionScenarioFlags) -> Result<String, Error> {
+    mission_answer_for(&Mission::load(path)?, flags)
+}
+
+/// [`mission_answer`] of a mission already read (a file's text sent to the page's API).
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Result<String, Error> {
     let opts = flags.mission.options();
     let v = Vehicle::load(&flags.mission.vehicle)?;
-    let m = Mission::load(path)?;
-    let plan = plan_mission(&v, &m, &opts)?;
+    let plan = plan_mission(&v, m, &opts)?;
     match flags.scenarios.options(false) {
         None => plan.to_json(),
         Some(sc) => MissionWithUncertainty {
             summary: plan.summary(),
-            uncertainty: &plan_scenarios(&v, &m, &opts, &sc)?,
+            uncertainty: &plan_scenarios(&v, m, &opts, &sc)?,
         }
         .to_json(),
     }
