@@ -320,11 +320,9 @@ mod tests {
             in_air: true,
             mode: Some("AUTO".to_string()),
             mission_item: Some(3),
-            position: None,
             soc: Some(0.6),
             energy_used_wh: 10.0,
             power_w: Some(300.0),
-            power_available: true,
             efficiency: 0.8,
             wind_mps: Some(4.0),
             wind_from_deg: Some(270.0),
@@ -332,10 +330,7 @@ mod tests {
             landing_soc: Some(band(0.3, 0.32, 0.34)),
             point_of_no_return_s: Some(42.0),
             advice: Some("continue"),
-            naive_remaining_wh: None,
-            measured_remaining_wh: None,
-            link_lost: false,
-            note: None,
+            ..LiveUpdate::default()
         }
     }
 }

@@ -139,24 +139,26 @@ fn answer(result: Result<String, aloft::Error>) -> Response {
 
 /// The query's options (all but `file`) as the command's flag group, or the message of a 400.
 fn flags<T: FlagGroup>(function: &str, query: &[(String, String)]) -> Result<T, String> {
-    let mut given: Vec<(String, Keyword)> = Vec::new();
+    // Each key's values, in order: one is a value (or a switch), several are a list.
+    let mut values: Vec<(&String, Vec<&str>)> = Vec::new();
     for (k, v) in query.iter().filter(|(k, _)| k != "file") {
-        let value = match v.as_str() {
-            "true" => Keyword::Switch(true),
-            "false" => Keyword::Switch(false),
-            text => Keyword::One(text.into()),
-        };
-        match given.iter_mut().find(|(g, _)| g == k) {
-            Some((_, Keyword::One(first))) => {
-                let first = std::mem::take(first);
-                let many = vec![first, v.into()];
-                given.retain(|(g, _)| g != k);
-                given.push((k.clone(), Keyword::Many(many)));
-            }
-            Some((_, Keyword::Many(all))) => all.push(v.into()),
-            _ => given.push((k.clone(), value)),
+        match values.iter_mut().find(|(g, _)| *g == k) {
+            Some((_, vs)) => vs.push(v),
+            None => values.push((k, vec![v])),
         }
     }
+    let given: Vec<(String, Keyword)> = values
+        .into_iter()
+        .map(|(k, vs)| {
+            let value = match vs.as_slice() {
+                ["true"] => Keyword::Switch(true),
+                ["false"] => Keyword::Switch(false),
+                [one] => Keyword::One((*one).into()),
+                many => Keyword::Many(many.iter().map(|v| (*v).into()).collect()),
+            };
+            (k.clone(), value)
+        })
+        .collect();
     parse_keywords::<T>(function, &[], &given).map_err(super::engine_message)
 }
 
@@ -169,11 +171,7 @@ fn file_name(query: &[(String, String)], default: &str) -> String {
 }
 
 async fn vehicles() -> Response {
-    answer(
-        tokio::task::spawn_blocking(answers::vehicles_answer)
-            .await
-            .unwrap_or_else(join_error),
-    )
+    blocking(answers::vehicles_answer).await
 }
 
 async fn endurance(Query(query): Query<Vec<(String, String)>>) -> Response {
@@ -182,11 +180,7 @@ async fn endurance(Query(query): Query<Vec<(String, String)>>) -> Response {
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };
     let run = move || answers::endurance_answer(&flags);
-    answer(
-        tokio::task::spawn_blocking(run)
-            .await
-            .unwrap_or_else(join_error),
-    )
+    blocking(run).await
 }
 
 async fn mission(Query(query): Query<Vec<(String, String)>>, body: Bytes) -> Response {
@@ -208,8 +202,15 @@ async fn mission(Query(query): Query<Vec<(String, String)>>, body: Bytes) -> Res
         };
         answers::mission_answer_for(&mission, &flags)
     };
+    blocking(run).await
+}
+
+/// The engine's work of a request on the blocking pool, and its answer.
+async fn blocking(
+    work: impl FnOnce() -> Result<String, aloft::Error> + Send + 'static,
+) -> Response {
     answer(
-        tokio::task::spawn_blocking(run)
+        tokio::task::spawn_blocking(work)
             .await
             .unwrap_or_else(join_error),
     )

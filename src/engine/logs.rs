@@ -586,8 +586,8 @@ impl Default for FlightLogs {
 }
 
 impl FlightLogs {
-    /// Read the first log as it is (no alignment): a replay's events.
-    pub(crate) fn read_first(&self) -> Result<aloft_logs::Log, Error> {
+    /// The profile and reading options every log is opened with.
+    fn open_options(&self) -> Result<(Option<Profile>, OpenOptions), Error> {
         let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;
         let open = OpenOptions {
             binary: BinaryOptions {
@@ -596,6 +596,14 @@ impl FlightLogs {
             },
             ..OpenOptions::default()
         };
+        Ok((profile, open))
+    }
+
+    /// The first log as events, read as it is (no alignment): its samples, and a DataFlash
+    /// log's mode, arming and mission ([`aloft_logs::flight_events`]) from a second pass over
+    /// the file.
+    pub(crate) fn events_of_first(&self) -> Result<aloft_logs::telemetry::LogEvents, Error> {
+        let (profile, open) = self.open_options()?;
         let path = self.logs.first().ok_or_else(|| Error::InvalidInput {
             name: "replay",
             value: 0.0,
@@ -603,46 +611,28 @@ impl FlightLogs {
             expected: "one flight log",
         })?;
         let mut reader = open_log_with(path, profile.as_ref(), &open)?;
-        Ok(reader.read_rest(&path.display().to_string())?)
-    }
-
-    /// The first log as events: its samples, and a DataFlash log's mode, arming and mission
-    /// ([`aloft_logs::flight_events`]) read in a second pass over the file.
-    pub(crate) fn events_of_first(&self) -> Result<aloft_logs::telemetry::LogEvents, Error> {
-        let log = self.read_first()?;
-        let path = &self.logs[0];
-        let io = |source| Error::Io {
-            origin: path.display().to_string(),
-            source,
-        };
-        let mut head = [0u8; 3];
-        let mut file = std::fs::File::open(path).map_err(io)?;
-        let dataflash = std::io::Read::read_exact(&mut file, &mut head).is_ok()
-            && aloft_logs::dataflash::is_dataflash(&head);
-        let events = match dataflash {
-            true => {
-                let file = std::io::BufReader::new(std::fs::File::open(path).map_err(io)?);
+        let log = reader.read_rest(&path.display().to_string())?;
+        let events = match reader.format() {
+            LogFormat::ArduPilotDataflash => {
+                let file = std::fs::File::open(path).map_err(|source| Error::Io {
+                    origin: path.display().to_string(),
+                    source,
+                })?;
+                let file = std::io::BufReader::new(file);
                 aloft_logs::flight_events::dataflash_events(file, log.start_time_s)
             }
-            false => Vec::new(),
+            _ => Vec::new(),
         };
         Ok(aloft_logs::telemetry::LogEvents::with_events(log, events))
     }
 
     /// Read every log, align power with motion, and set the angle-of-attack model.
     pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
-        let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;
+        let (profile, open) = self.open_options()?;
         let align = AlignOptions {
             max_lag_s: self.max_lag_s,
             lag_s: self.lag_s,
             ..AlignOptions::default()
-        };
-        let open = OpenOptions {
-            binary: BinaryOptions {
-                battery_instance: self.battery_instance,
-                ..BinaryOptions::default()
-            },
-            ..OpenOptions::default()
         };
         let mut out = Vec::new();
         for path in &self.logs {

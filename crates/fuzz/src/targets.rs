@@ -590,7 +590,7 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
 /// finite and never going back, computed values finite, all bytes read), and the answer the
 /// counts of events by kind; on every 4th input the frames of [`aloft_link::TlogReader`] and the
 /// skipped bytes add up to the input. Every event is folded into an `aloft live` session, and on
-/// every 8th input the session answers (4 scenarios): an answer or an error, its numbers finite.
+/// every 8th input the session answers (4 scenarios): its numbers finite.
 fn tlog(data: &[u8]) -> Outcome {
     let mut o = Outcome::default();
     let request = LiveRequest {
@@ -653,32 +653,26 @@ fn tlog(data: &[u8]) -> Outcome {
     o.accepted = stats.frames > 0;
     let mut answer = serde_json::Map::new();
     if let Some(s) = session.as_mut().filter(|_| fnv1a(data) % 8 == 1) {
-        match s.update() {
-            Ok(u) => {
-                let band = |b: Option<aloft::engine::Percentiles>| {
-                    b.map_or_else(Vec::new, |b| vec![b.p5, b.p50, b.p95])
-                };
-                let mut numbers = vec![u.energy_used_wh, u.efficiency, u.time_s];
-                numbers.extend(band(u.remaining_wh));
-                numbers.extend(band(u.landing_soc));
-                numbers.extend(
-                    u.soc
-                        .iter()
-                        .chain(&u.point_of_no_return_s)
-                        .chain(&u.power_w),
-                );
-                if numbers.iter().any(|x| !x.is_finite()) {
-                    o.broken.push(Problem {
-                        check: "live-non-finite",
-                        detail: format!("{u:?}"),
-                    });
-                }
-                answer.insert("live_advice".into(), u.advice.unwrap_or("-").into());
-            }
-            Err(e) => {
-                answer.insert("live_error".into(), e.to_string().into());
-            }
+        let u = s.update();
+        let band = |b: Option<aloft::engine::Percentiles>| {
+            b.map_or_else(Vec::new, |b| vec![b.p5, b.p50, b.p95])
+        };
+        let mut numbers = vec![u.energy_used_wh, u.efficiency, u.time_s];
+        numbers.extend(band(u.remaining_wh));
+        numbers.extend(band(u.landing_soc));
+        numbers.extend(
+            u.soc
+                .iter()
+                .chain(&u.point_of_no_return_s)
+                .chain(&u.power_w),
+        );
+        if numbers.iter().any(|x| !x.is_finite()) {
+            o.broken.push(Problem {
+                check: "live-non-finite",
+                detail: format!("{u:?}"),
+            });
         }
+        answer.insert("live_advice".into(), u.advice.unwrap_or("-").into());
     }
     answer.insert("frames".into(), stats.frames.into());
     answer.insert("bad_frames".into(), stats.bad_frames().into());

@@ -14,7 +14,7 @@
 //!
 //! It is flown from the present state of charge, by the vehicle at the re-estimated efficiency,
 //! in the present wind, in [`LIVE_SCENARIOS`] scenarios that draw the model error from the
-//! estimate's own spread and the wind from its source's ([`WIND_SD`]). The advice: `continue`
+//! estimate's own spread and the wind from its source's ([`wind_sd`]). The advice: `continue`
 //! while 95 % of the scenarios land with the reserve (the p5 reserve at landing holds), `return
 //! now` where they do not but 95 % of a direct return's do, `land now` where neither holds; on
 //! the ground, `do not take off` where the mission from the ground does not hold it.
@@ -28,7 +28,7 @@ use super::super::scenario_stats::Percentiles;
 use super::super::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
 use super::super::vehicles::Vehicle;
 use super::estimate::Ratio;
-use super::tracker::{Tracker, WindSource};
+use super::tracker::{wind_from_deg, Tracker, WindSource};
 use crate::error::Error;
 
 /// Scenarios per update (the figure: one update with them within 100 ms on 2 cores).
@@ -40,11 +40,13 @@ pub(crate) const LIVE_TIME_STEP_S: f64 = 0.5;
 
 /// Spread of the wind, one standard deviation: speed (m/s) and direction (deg), by source. The
 /// autopilot's estimate (ArduPilot's EKF) is steadier than one from the tilt, which also holds
-/// the accelerations and the attitude's trim offsets.
-const WIND_SD: [(WindSource, f64, f64); 2] = [
-    (WindSource::Autopilot, 1.0, 15.0),
-    (WindSource::Attitude, 2.0, 30.0),
-];
+/// the accelerations and the attitude's trim offsets; without either, the tilt's.
+fn wind_sd(source: Option<WindSource>) -> (f64, f64) {
+    match source {
+        Some(WindSource::Autopilot) => (1.0, 15.0),
+        Some(WindSource::Attitude) | None => (2.0, 30.0),
+    }
+}
 
 /// Share of the scenarios that must land with the reserve for a route to be flown.
 const P_HOLDS: f64 = 0.95;
@@ -142,21 +144,10 @@ impl Ahead<'_> {
         ratio: Ratio,
     ) -> Result<Uncertainty, Error> {
         let mission = Mission::of_spec(spec, "ahead", SourceFormat::AloftToml);
-        let (wind, wind_sd, from_sd) = match t.wind {
-            Some((w, source)) => {
-                let (_, speed_sd, from_sd) = WIND_SD
-                    .iter()
-                    .copied()
-                    .find(|(s, _, _)| *s == source)
-                    .unwrap_or(WIND_SD[1]);
-                let from_deg = (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0);
-                (
-                    WindSpec::uniform(w[0].hypot(w[1]), from_deg),
-                    speed_sd,
-                    from_sd,
-                )
-            }
-            None => (WindSpec::uniform(0.0, 0.0), WIND_SD[1].1, WIND_SD[1].2),
+        let (speed_sd, from_sd) = wind_sd(t.wind.map(|(_, source)| source));
+        let wind = match t.wind {
+            Some((w, _)) => WindSpec::uniform(w[0].hypot(w[1]), wind_from_deg(w)),
+            None => WindSpec::uniform(0.0, 0.0),
         };
         let options = MissionOptions {
             battery: self.battery.clone(),
@@ -170,7 +161,7 @@ impl Ahead<'_> {
         };
         let sc = ScenarioOptions {
             samples: self.scenarios,
-            wind_speed_sd_mps: wind_sd,
+            wind_speed_sd_mps: speed_sd,
             wind_from_sd_deg: from_sd,
             power_sd_percent: (100.0 * ratio.log_sd).clamp(0.0, 50.0),
             ..ScenarioOptions::default()

@@ -159,59 +159,13 @@ impl RatioEstimator {
         };
         Ratio {
             ratio: shrunk.ratio,
-            log_sd: estimate_sd
-                .hypot(self.drift_sd(rest_s))
-                .max(self.prequential_sd()),
+            log_sd: {
+                let blocks = self.blocks();
+                estimate_sd
+                    .hypot(drift_sd(&blocks, rest_s))
+                    .max(prequential_sd(&blocks))
+            },
         }
-    }
-
-    /// How far the ratio of the rest may drift from the flight's so far: the spread of the log
-    /// ratios of the [`DRIFT_BLOCK_S`] blocks so far, over the square root of the blocks the rest
-    /// holds (at least one); 0 with fewer than three blocks so far.
-    fn drift_sd(&self, rest_s: f64) -> f64 {
-        let logs: Vec<f64> = self
-            .blocks()
-            .iter()
-            .filter(|(m, p)| *m > 0.0 && *p > 0.0)
-            .map(|(m, p)| (m / p).ln())
-            .collect();
-        if logs.len() < 3 {
-            return 0.0;
-        }
-        let n = logs.len() as f64;
-        let mean = logs.iter().sum::<f64>() / n;
-        let var = logs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
-        // Blocks that drift together count as fewer: `tau` blocks per independent one, from
-        // their autocorrelation (as the window's effective sample size).
-        let tau = n / crate::recalibration::effective_sample_size(&logs);
-        (var / (rest_s / DRIFT_BLOCK_S / tau).max(1.0)).sqrt()
-    }
-
-    /// How far this estimator's own past predictions were off: at the end of every
-    /// [`DRIFT_BLOCK_S`] block so far, the ratio up to there against the ratio from there to
-    /// now, `e_j = ln(r_(j..now) / r_(0..j))`; the root mean square of the `e_j` (0 with fewer
-    /// than two). A forecaster's spread checked on its own record: it holds the ratio's drift
-    /// along this flight whatever its shape.
-    fn prequential_sd(&self) -> f64 {
-        let blocks = self.blocks();
-        let (m_all, p_all) = blocks
-            .iter()
-            .fold((0.0, 0.0), |(a, b), (m, p)| (a + m, b + p));
-        let (mut m, mut p) = (0.0, 0.0);
-        let mut sq = Vec::new();
-        for (bm, bp) in &blocks[..blocks.len().saturating_sub(1)] {
-            m += bm;
-            p += bp;
-            let (later_m, later_p) = (m_all - m, p_all - p);
-            if m > 0.0 && p > 0.0 && later_m > 0.0 && later_p > 0.0 {
-                let e = ((later_m / later_p) / (m / p)).ln();
-                sq.push(e * e);
-            }
-        }
-        if sq.len() < 2 {
-            return 0.0;
-        }
-        (sq.iter().sum::<f64>() / sq.len() as f64).sqrt()
     }
 
     /// Sums of measured and predicted power over the [`DRIFT_BLOCK_S`] blocks so far (the last
@@ -232,6 +186,53 @@ impl RatioEstimator {
         }
         out
     }
+}
+
+/// How far the ratio of the rest may drift from the flight's so far: the spread of the log
+/// ratios of the [`DRIFT_BLOCK_S`] blocks so far, over the square root of the blocks the rest
+/// holds (at least one); 0 with fewer than three blocks so far.
+fn drift_sd(blocks: &[(f64, f64)], rest_s: f64) -> f64 {
+    let logs: Vec<f64> = blocks
+        .iter()
+        .filter(|(m, p)| *m > 0.0 && *p > 0.0)
+        .map(|(m, p)| (m / p).ln())
+        .collect();
+    if logs.len() < 3 {
+        return 0.0;
+    }
+    let n = logs.len() as f64;
+    let mean = logs.iter().sum::<f64>() / n;
+    let var = logs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+    // Blocks that drift together count as fewer: `tau` blocks per independent one, from
+    // their autocorrelation (as the window's effective sample size).
+    let tau = n / crate::recalibration::effective_sample_size(&logs);
+    (var / (rest_s / DRIFT_BLOCK_S / tau).max(1.0)).sqrt()
+}
+
+/// How far this estimator's own past predictions were off: at the end of every
+/// [`DRIFT_BLOCK_S`] block so far, the ratio up to there against the ratio from there to
+/// now, `e_j = ln(r_(j..now) / r_(0..j))`; the root mean square of the `e_j` (0 with fewer
+/// than two). A forecaster's spread checked on its own record: it holds the ratio's drift
+/// along this flight whatever its shape.
+fn prequential_sd(blocks: &[(f64, f64)]) -> f64 {
+    let (m_all, p_all) = blocks
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (m, p)| (a + m, b + p));
+    let (mut m, mut p) = (0.0, 0.0);
+    let mut sq = Vec::new();
+    for (bm, bp) in &blocks[..blocks.len().saturating_sub(1)] {
+        m += bm;
+        p += bp;
+        let (later_m, later_p) = (m_all - m, p_all - p);
+        if m > 0.0 && p > 0.0 && later_m > 0.0 && later_p > 0.0 {
+            let e = ((later_m / later_p) / (m / p)).ln();
+            sq.push(e * e);
+        }
+    }
+    if sq.len() < 2 {
+        return 0.0;
+    }
+    (sq.iter().sum::<f64>() / sq.len() as f64).sqrt()
 }
 
 #[cfg(test)]

@@ -40,7 +40,7 @@ use tracker::Tracker;
 
 /// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
 /// battery, no mission) are left out, as everywhere in aloft's JSON.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct LiveUpdate {
     /// Time since the start of the stream, s.
     pub time_s: f64,
@@ -212,7 +212,7 @@ pub fn follow_live(
                 link_lost: true,
                 ..prev.clone()
             },
-            _ => follower.update()?,
+            _ => follower.update(),
         };
         let update = finite(update, "live", || "the live update".to_string())?;
         for reply in replies(last.as_ref(), &update) {
@@ -295,8 +295,9 @@ pub struct LiveSession<'a> {
     pack_wh: f64,
     eta0: f64,
     given_mission: Option<&'a Mission>,
-    /// The mission learned from the source, with the upload it came from.
-    learned: Option<(Mission, u32)>,
+    /// The mission learned from the source (or why it cannot be read), by the upload it came
+    /// from.
+    learned: Option<(u32, Result<Mission, String>)>,
     /// The last point of no return, s of the stream, to say how long ago it passed.
     point_of_no_return_at: Option<f64>,
     /// The answer on the ground, while nothing it depends on changes.
@@ -358,18 +359,16 @@ impl<'a> LiveSession<'a> {
             .clamp(0.0, 1.0)
     }
 
-    /// The mission flown: `--mission`, else the last one the source sent (read once per upload).
-    fn mission(&mut self) -> Result<Option<&Mission>, Error> {
-        if let Some(m) = self.given_mission {
-            return Ok(Some(m));
-        }
+    /// Read the mission the source sent, once per upload (a mission aloft cannot read is kept as
+    /// its message).
+    fn learn_mission(&mut self) {
         if let Some((items, upload)) = &self.tracker.mission {
-            if self.learned.as_ref().is_none_or(|(_, u)| u != upload) {
-                let m = Mission::from_items(items, "the mission on the link")?;
-                self.learned = Some((m, *upload));
+            if self.learned.as_ref().is_none_or(|(u, _)| u != upload) {
+                let m = Mission::from_items(items, "the mission on the link")
+                    .map_err(|e| e.to_string());
+                self.learned = Some((*upload, m));
             }
         }
-        Ok(self.learned.as_ref().map(|(m, _)| m))
     }
 
     /// Fold one event in.
@@ -378,22 +377,14 @@ impl<'a> LiveSession<'a> {
     }
 
     /// The answer now: the state of charge, the efficiency's estimate, the route ahead in
-    /// scenarios and the advice.
-    ///
-    /// # Errors
-    /// A `--mission` the vehicle cannot plan at all (a mission learned from the link that aloft
-    /// cannot read, or a route the planner refuses, is said in the update's `note`).
-    pub fn update(&mut self) -> Result<LiveUpdate, Error> {
+    /// scenarios and the advice. A mission learned from the link that aloft cannot read, or a
+    /// route the planner refuses, is said in the update's `note`.
+    pub fn update(&mut self) -> LiveUpdate {
         let soc = self.soc();
         let t = &self.tracker;
         let rest_s = self.rest_s;
-        let ratio = match t.power_available() {
-            true => t.estimator.ratio(rest_s),
-            false => estimate::Ratio {
-                ratio: 1.0,
-                log_sd: t.estimator.ratio(rest_s).log_sd,
-            },
-        };
+        // Without power the estimator has no samples: the fitted model and its spread.
+        let ratio = t.estimator.ratio(rest_s);
         let in_air = t.in_air();
         let wind = t.wind.map(|(w, _)| w);
         let key: GroundKey = (
@@ -410,19 +401,19 @@ impl<'a> LiveSession<'a> {
         let (answer, note) = match cached {
             Some(a) => (Some(a), None),
             None => {
-                // A learned mission aloft cannot read is said in the note, not an error.
-                let given = self.given_mission.is_some();
-                let mission = match self.mission() {
-                    Ok(m) => m.cloned(),
-                    Err(e) if !given => {
-                        return Ok(self.answer_update(soc, ratio, None, Some(e.to_string())))
+                // The mission flown: `--mission`, else the last one the source sent; one aloft
+                // cannot read is said in the note, not an error.
+                self.learn_mission();
+                let mission = match (self.given_mission, &self.learned) {
+                    (Some(m), _) => Some(m),
+                    (None, Some((_, Ok(m)))) => Some(m),
+                    (None, Some((_, Err(e)))) => {
+                        let note = Some(e.clone());
+                        return self.answer_update(soc, ratio, None, note);
                     }
-                    Err(e) => return Err(e),
+                    (None, None) => None,
                 };
-                match self
-                    .ahead
-                    .answer(&self.tracker, mission.as_ref(), soc, ratio)
-                {
+                match self.ahead.answer(&self.tracker, mission, soc, ratio) {
                     Ok(a) => (a, None),
                     Err(e) => (None, Some(aloft_core::one_line(&e.to_string()))),
                 }
@@ -442,7 +433,7 @@ impl<'a> LiveSession<'a> {
             ),
             (note, _) => note,
         };
-        Ok(self.answer_update(soc, ratio, answer, note))
+        self.answer_update(soc, ratio, answer, note)
     }
 
     /// The update from the state and the route ahead's answer.
@@ -485,7 +476,7 @@ impl<'a> LiveSession<'a> {
             power_available: t.power_available(),
             efficiency: self.eta0 / ratio.ratio,
             wind_mps: wind.map(|w| w[0].hypot(w[1])),
-            wind_from_deg: wind.map(|w| (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0)),
+            wind_from_deg: wind.map(tracker::wind_from_deg),
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
             landing_soc: answer.as_ref().and_then(|a| a.landing_soc),
             point_of_no_return_s,
@@ -517,25 +508,12 @@ mod tests {
     use super::*;
 
     fn update(advice: &'static str, landing_p5: f64) -> LiveUpdate {
-        let band = |p50: f64| Percentiles {
-            p5: p50 * 0.9,
-            p50,
-            p95: p50 * 1.1,
-        };
         LiveUpdate {
-            time_s: 100.0,
-            in_air: true,
-            mode: Some("AUTO".to_string()),
-            mission_item: Some(3),
-            position: None,
-            soc: Some(0.6),
-            energy_used_wh: 10.0,
-            power_w: Some(300.0),
-            power_available: true,
-            efficiency: 0.8,
-            wind_mps: None,
-            wind_from_deg: None,
-            remaining_wh: Some(band(5.0)),
+            remaining_wh: Some(Percentiles {
+                p5: 4.5,
+                p50: 5.0,
+                p95: 5.5,
+            }),
             landing_soc: Some(Percentiles {
                 p5: landing_p5,
                 p50: landing_p5 + 0.02,
@@ -543,10 +521,7 @@ mod tests {
             }),
             point_of_no_return_s: Some(42.0),
             advice: Some(advice),
-            naive_remaining_wh: None,
-            measured_remaining_wh: None,
-            link_lost: false,
-            note: None,
+            ..LiveUpdate::default()
         }
     }
 

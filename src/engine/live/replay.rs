@@ -173,28 +173,18 @@ impl Series {
         LiveUpdate {
             time_s: self.t[k],
             in_air: true,
-            mode: None,
-            mission_item: None,
-            position: None,
-            soc: None,
             energy_used_wh: so_far_m / 3600.0,
             power_w: Some(self.measured_w[k]),
             power_available: true,
             efficiency: eta0 / r.ratio,
-            wind_mps: None,
-            wind_from_deg: None,
             remaining_wh: Some(Percentiles {
                 p5: p50 / spread,
                 p50,
                 p95: p50 * spread,
             }),
-            landing_soc: None,
-            point_of_no_return_s: None,
-            advice: None,
             naive_remaining_wh: (elapsed > 0.0).then(|| so_far_m / elapsed * time_left / 3600.0),
             measured_remaining_wh: Some(ahead_m / 3600.0),
-            link_lost: false,
-            note: None,
+            ..LiveUpdate::default()
         }
     }
 }

@@ -313,6 +313,11 @@ impl Tracker {
     }
 }
 
+/// Where a wind (the air's velocity, ENU m/s) blows from, deg clockwise from north.
+pub(crate) fn wind_from_deg(w: [f64; 2]) -> f64 {
+    (-w[0]).atan2(-w[1]).to_degrees().rem_euclid(360.0)
+}
+
 /// The velocity of the air relative to the vehicle's ground track, ENU m/s (horizontal), from
 /// its attitude: the horizontal component of the thrust balances the drag in steady flight, so
 /// the air comes along the tilt at the speed where `f_D(v) = W tan(tilt)`. `None` beyond the
