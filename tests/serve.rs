@@ -78,6 +78,18 @@ impl Drop for Server {
     }
 }
 
+/// `text` as a query value (percent-encoded but for unreserved characters and `/`).
+fn encoded(text: &str) -> String {
+    text.bytes()
+        .map(|b| match b {
+            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' | b'/' => {
+                (b as char).to_string()
+            }
+            _ => format!("%{b:02X}"),
+        })
+        .collect()
+}
+
 /// The command line's JSON text (its stdout without the final line break).
 fn cli(args: &[&str]) -> String {
     let out = aloft(args);
@@ -194,4 +206,265 @@ fn the_api_refuses_bad_requests_and_keeps_serving() {
         b"",
     );
     assert_eq!(code, 200);
+}
+
+/// Every shared flight log, sent as the body of `POST /api/log/info` and named as the command
+/// line is given it: the command line's answer, or its message with 422 where it refuses the
+/// file.
+#[test]
+fn every_shared_log_answers_as_the_command_line() {
+    let server = Server::start(&[]);
+    let mut logs = Vec::new();
+    for sub in [
+        "flight_logs",
+        "mcap_foreign",
+        "px4_flugdrohne/ulg",
+        "kaist_energy_drone",
+        "telemetry",
+    ] {
+        logs.extend(common::files(sub, |n| n != "README.md"));
+    }
+    assert!(logs.len() >= 25, "{}", logs.len());
+    let mut answered = 0;
+    for log in &logs {
+        let path = log.display().to_string();
+        let out = aloft(&["log", "info", &path, "--format", "json"]);
+        let bytes = std::fs::read(log).unwrap();
+        let (code, body) = server.request(
+            "POST",
+            &format!("/api/log/info?file={}", encoded(&path)),
+            None,
+            &bytes,
+        );
+        if out.status.code() == Some(0) {
+            assert_eq!(code, 200, "{path}: {body}");
+            assert_eq!(body, common::stdout(&out).trim_end(), "{path}");
+            answered += 1;
+        } else {
+            assert_eq!(code, 422, "{path}: {body}");
+            let message = common::stderr(&out);
+            let message = message.trim_end().strip_prefix("aloft: error: ").unwrap();
+            let got: serde_json::Value = serde_json::from_str(&body).unwrap();
+            assert_eq!(got["error"], message, "{path}");
+        }
+    }
+    // The flight logs all read; the telemetry logs are for `aloft live`.
+    assert!(answered >= 20, "{answered}");
+    // With an option, and one the command does not take.
+    let log = &common::files("kaist_energy_drone", |n| n.ends_with(".csv"))[0];
+    let path = log.display().to_string();
+    let bytes = std::fs::read(log).unwrap();
+    let (code, body) = server.request(
+        "POST",
+        &format!("/api/log/info?file={path}&max_lag=5"),
+        None,
+        &bytes,
+    );
+    assert_eq!(code, 200, "{body}");
+    assert_eq!(
+        body,
+        cli(&["log", "info", &path, "--max-lag", "5", "--format", "json"])
+    );
+    let (code, body) = server.request("POST", "/api/log/info?bogus=1", None, &bytes);
+    assert_eq!(code, 400, "{body}");
+}
+
+/// An upload past the limit to `/api/log/info` (streamed to its file, not held) gets 413.
+#[test]
+fn a_log_past_the_upload_limit_is_refused() {
+    let server = Server::start(&["--max-upload-mb", "1"]);
+    let big = vec![0u8; 3 << 20];
+    let (code, body) = server.request("POST", "/api/log/info?file=big.bin", None, &big);
+    assert_eq!(code, 413, "{body}");
+    assert!(body.contains("1 MiB"), "{body}");
+    assert_eq!(server.get("/api/vehicles").0, 200);
+}
+
+/// The page's map: each leg of a QGroundControl plan flown with stops ends on its item's
+/// latitude and longitude as the file gives them (within 1e-7 deg, 1 cm); the segments are the
+/// mission answer's; the state of charge runs from the start to the answer's end; the band of
+/// the scenarios is ordered.
+#[test]
+fn the_map_holds_the_route_of_the_file() {
+    let server = Server::start(&[]);
+    let path = data_dir().join("missions/kasperg3_mission.plan");
+    let bytes = std::fs::read(&path).unwrap();
+    let query = "file=k.plan&corners=stop&samples=40";
+    let (code, body) = server.request("POST", &format!("/api/map?{query}"), None, &bytes);
+    assert_eq!(code, 200, "{body}");
+    let map: serde_json::Value = serde_json::from_str(&body).unwrap();
+    let (code, body) = server.request("POST", &format!("/api/mission?{query}"), None, &bytes);
+    assert_eq!(code, 200, "{body}");
+    let answer: serde_json::Value = serde_json::from_str(&body).unwrap();
+    // The items' positions, from the file itself.
+    let plan: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+    let items = plan["mission"]["items"].as_array().unwrap();
+    let home = &plan["mission"]["plannedHomePosition"];
+    assert_eq!(map["home"]["latitude_deg"], home[0]);
+    assert_eq!(map["home"]["longitude_deg"], home[1]);
+    let mut legs = 0;
+    for s in map["segments"].as_array().unwrap() {
+        if s["kind"] != "leg" {
+            continue;
+        }
+        let item = s["item"].as_u64().unwrap() as usize;
+        let p = &items[item - 1]["params"];
+        let end = s["points_deg"].as_array().unwrap().last().unwrap();
+        for (got, want) in [(&end[0], &p[4]), (&end[1], &p[5])] {
+            let (g, w) = (got.as_f64().unwrap(), want.as_f64().unwrap());
+            assert!((g - w).abs() < 1e-7, "item {item}: {g} against {w}");
+        }
+        legs += 1;
+    }
+    assert!(legs >= 10, "{legs}");
+    // One path per segment of the answer, in its order.
+    let indices = |v: &serde_json::Value| -> Vec<u64> {
+        v["segments"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s["index"].as_u64().unwrap())
+            .collect()
+    };
+    assert_eq!(indices(&map), indices(&answer));
+    let soc = map["battery"]["soc"].as_array().unwrap();
+    assert_eq!(soc[0], answer["start_soc"]);
+    assert_eq!(soc[soc.len() - 1], answer["end_soc"]);
+    let band = &map["band"];
+    let col = |k: &str| -> Vec<f64> {
+        band[k]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    let (p5, p50, p95) = (col("p5"), col("p50"), col("p95"));
+    assert!(p5.len() > 100);
+    assert!((0..p5.len()).all(|k| p5[k] <= p50[k] && p50[k] <= p95[k]));
+    // The demo has no geographic home: metres only.
+    let (code, body) = server.request("POST", "/api/map", None, b"");
+    assert_eq!(code, 200, "{body}");
+    let demo: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert!(demo.get("home").is_none() && demo.get("band").is_none());
+    assert!(demo["segments"][1].get("points_deg").is_none());
+}
+
+/// The files given on the command line: listed, a mission's text served, a log's `log info`
+/// answered as the command line's; a file that is neither is bad input (exit 2, named).
+#[test]
+fn the_files_given_are_served() {
+    let demo = common::fixture("missions", "demo-survey.toml");
+    let log = data_dir().join("flight_logs/pyulog_sample_log_small.ulg");
+    let (demo, log) = (demo.display().to_string(), log.display().to_string());
+    let server = Server::start(&[&demo, &log]);
+    let (code, body) = server.get("/api/config");
+    assert_eq!(code, 200);
+    let config: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(config["files"][0]["kind"], "mission");
+    assert_eq!(config["files"][0]["name"], demo.as_str());
+    assert_eq!(config["files"][1]["kind"], "log");
+    assert_eq!(config["live"], false);
+    assert!(config.get("tiles").is_none());
+    assert_eq!(
+        server.get("/api/files/0"),
+        (200, std::fs::read_to_string(&demo).unwrap())
+    );
+    assert_eq!(
+        server.get("/api/files/1/info"),
+        (200, cli(&["log", "info", &log, "--format", "json"]))
+    );
+    assert_eq!(server.get("/api/files/1").0, 404);
+    assert_eq!(server.get("/api/files/7").0, 404);
+    // The page and its files; anything else is 404.
+    let (code, page) = server.get("/");
+    assert_eq!(code, 200);
+    assert!(page.contains("id=\"map\"") && page.contains("id=\"segments\""));
+    assert_eq!(server.get("/vendor/leaflet/leaflet.js").0, 200);
+    assert_eq!(server.get("/no/such/file.js").0, 404);
+    // Bad input at start: exit 2, one line naming the file or the value.
+    let bad = common::scratch("serve", "bad.plan");
+    std::fs::write(&bad, "{ not a plan").unwrap();
+    let (code, _, err) = common::run(&["serve", "--listen", "127.0.0.1:0", bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("bad.plan") && err.lines().count() == 1,
+        "{err}"
+    );
+    let (code, _, err) = common::run(&["serve", "--listen", "127.0.0.1:0", "/no/such/file.csv"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("/no/such/file.csv"), "{err}");
+    let (code, _, err) = common::run(&[
+        "serve",
+        "--tiles",
+        "https://t.example/a.png",
+        "--attribution",
+        "x",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--tiles"), "{err}");
+    let (code, _, err) = common::run(&["serve", "--tiles", "https://t.example/{z}/{x}/{y}.png"]);
+    assert_eq!(code, 2, "{err}");
+    // With a tile layer, the page is told it.
+    let server = Server::start(&[
+        "--tiles",
+        "https://tiles.example/{z}/{x}/{y}.png",
+        "--attribution",
+        "(c) Example",
+    ]);
+    let config: serde_json::Value = serde_json::from_str(&server.get("/api/config").1).unwrap();
+    assert_eq!(config["tiles"], "https://tiles.example/{z}/{x}/{y}.png");
+    assert_eq!(config["attribution"], "(c) Example");
+}
+
+/// `aloft serve --tlog`: the updates streamed to the page are `aloft live`'s lines (each one
+/// received equals the command line's line of the same time), and the stream ends with the
+/// flight's summary.
+#[test]
+fn the_live_feed_streams_the_updates_of_aloft_live() {
+    let tlog = data_dir().join("telemetry/kudrone_guided_sitl.tlog");
+    let tlog = tlog.display().to_string();
+    let server = Server::start(&["--tlog", &tlog, "--speed", "40"]);
+    let config: serde_json::Value = serde_json::from_str(&server.get("/api/config").1).unwrap();
+    assert_eq!(config["live"], true);
+    let mut s = TcpStream::connect(&server.address).expect("connect");
+    let head = format!(
+        "GET /api/live HTTP/1.1\r\nHost: {}\r\nConnection: close\r\n\r\n",
+        server.address
+    );
+    s.write_all(head.as_bytes()).unwrap();
+    let mut events: Vec<(String, String)> = Vec::new();
+    let mut kind = String::new();
+    for line in BufReader::new(s).lines() {
+        let line = line.unwrap();
+        if let Some(k) = line.strip_prefix("event: ") {
+            kind = k.to_string();
+        } else if let Some(d) = line.strip_prefix("data: ") {
+            events.push((kind.clone(), d.to_string()));
+            if kind == "end" {
+                break;
+            }
+        }
+    }
+    let expected = cli(&[
+        "live", "--tlog", &tlog, "--speed", "max", "--format", "json",
+    ]);
+    let lines: Vec<&str> = expected.lines().collect();
+    let updates: Vec<&String> = events
+        .iter()
+        .filter(|(k, _)| k == "update")
+        .map(|(_, d)| d)
+        .collect();
+    assert!(updates.len() >= 20, "{} updates", updates.len());
+    for u in &updates {
+        assert!(lines.contains(&u.as_str()), "not a line of aloft live: {u}");
+    }
+    let (kind, end) = events.last().unwrap();
+    assert_eq!(kind, "end");
+    let end: serde_json::Value = serde_json::from_str(end).unwrap();
+    let cli_end: serde_json::Value = serde_json::from_str(lines[lines.len() - 1]).unwrap();
+    assert_eq!(end["summary"], cli_end["summary"]);
+    // Without a flight: 404.
+    let plain = Server::start(&[]);
+    assert_eq!(plain.get("/api/live").0, 404);
 }

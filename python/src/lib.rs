@@ -82,6 +82,19 @@ fn mission_json(
         .map_err(engine_error)
 }
 
+/// The map of a mission (`aloft serve`'s `/api/map`) as compact JSON text.
+#[pyfunction]
+#[pyo3(signature = (path=None, options=None))]
+fn mission_map_json(
+    py: Python<'_>,
+    path: Option<PathBuf>,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<String> {
+    let flags: MissionScenarioFlags = options::parse("mission", &[], options)?;
+    py.detach(|| answers::mission_map_answer(path.as_deref(), &flags))
+        .map_err(engine_error)
+}
+
 /// The columns of `aloft mission --timeseries`: names and arrays (`segment` as int64).
 #[pyfunction]
 #[pyo3(signature = (path=None, options=None))]
@@ -453,6 +466,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEMO_MISSION", aloft::engine::DEMO_MISSION)?;
     m.add("DEFAULT_VEHICLE", aloft::engine::DEFAULT_VEHICLE)?;
     m.add_function(wrap_pyfunction!(mission_json, m)?)?;
+    m.add_function(wrap_pyfunction!(mission_map_json, m)?)?;
     m.add_function(wrap_pyfunction!(timeseries_columns, m)?)?;
     m.add_function(wrap_pyfunction!(endurance_json, m)?)?;
     m.add_function(wrap_pyfunction!(vehicles_json, m)?)?;

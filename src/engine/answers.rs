@@ -14,8 +14,9 @@ use super::flags::{
 };
 use super::{
     calibrate_spec_file, endurance, endurance_scenarios, fit_logs, follow_live, list_vehicles,
-    log_info, payload_sweep, plan_mission, plan_scenarios, power_curve, replay_live, validate_logs,
-    EnduranceWithUncertainty, LiveUpdate, Mission, MissionWithUncertainty, Vehicle,
+    log_info, mission_map, payload_sweep, plan_mission, plan_mission_with, plan_scenarios,
+    power_curve, replay_live, validate_logs, EnduranceWithUncertainty, LiveUpdate, Mission,
+    MissionOutputs, MissionWithUncertainty, Vehicle,
 };
 use crate::error::Error;
 
@@ -52,6 +53,44 @@ pub fn mission_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Result<S
         }
         .to_json(),
     }
+}
+
+/// The page's map of the mission file at `path` (`None`: the built-in demo): see
+/// [`mission_map_answer_for`].
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_map_answer(
+    path: Option<&Path>,
+    flags: &MissionScenarioFlags,
+) -> Result<String, Error> {
+    mission_map_answer_for(&Mission::load(path)?, flags)
+}
+
+/// The page's map of a mission already read ([`MissionMap`](super::MissionMap)): the route
+/// per segment, the point of no return, the state of charge over time and, when the flags ask
+/// for scenarios, its band, as compact JSON. Planned with the same flags as [`mission_answer_for`], so the two
+/// answers describe one flight.
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_map_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Result<String, Error> {
+    let opts = flags.mission.options();
+    let v = Vehicle::load(&flags.mission.vehicle)?;
+    let outputs = MissionOutputs {
+        plot: true,
+        ..MissionOutputs::default()
+    };
+    let plan = plan_mission_with(&v, m, &opts, &outputs)?;
+    let fan = match flags.scenarios.options(true) {
+        None => None,
+        Some(sc) => plan_scenarios(&v, m, &opts, &sc)?.soc_fan,
+    };
+    // Compact: the page's, not a reader's (a long route is thousands of points).
+    serde_json::to_string(&mission_map(&plan, m, fan)).map_err(|e| Error::OptionsFormat {
+        what: "answer",
+        message: e.to_string(),
+    })
 }
 
 /// `aloft endurance --format json`: the power curve with `--sweep-speed`, endurance against

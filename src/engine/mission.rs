@@ -101,6 +101,11 @@ impl Plan {
         self.compiled.home_m()
     }
 
+    /// The mission as compiled and flown (the options applied, the way home added).
+    pub fn compiled(&self) -> &aloft_planner::Mission {
+        &self.compiled
+    }
+
     /// The samples kept for a chart ([`MissionOutputs::plot`]): all of a short flight, an evenly
     /// decimated selection of a long one (at most [`PLOT_SAMPLES`](super::PLOT_SAMPLES)).
     pub fn plot_samples(&self) -> &[Sample] {

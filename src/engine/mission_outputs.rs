@@ -7,14 +7,11 @@ use std::io::BufWriter;
 use std::path::PathBuf;
 
 use aloft_logs::{Attitude, BatteryPoint, McapWriter, MissionSample, PathPoint, PowerTerms};
-use aloft_planner::trajectory::Shape;
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
 use super::finite::first_non_finite;
+use super::mission_map::segment_paths;
 use crate::error::Error;
-
-/// Points drawn per arc of the planned path, so the path shows the circle.
-const ARC_POINTS: usize = 36;
 
 /// Most samples kept for a chart: a flight with more is decimated (every 2nd, 4th, ... sample),
 /// keeping between half this number and this number.
@@ -294,17 +291,8 @@ pub(crate) fn path_points(mission: &aloft_planner::Mission) -> Vec<PathPoint> {
         yaw_rad: None,
     };
     let mut points = vec![point(mission.home_m())];
-    for p in mission.pieces() {
-        let end = p.end_m();
-        let last = points[points.len() - 1].pos_enu_m;
-        if matches!(p.shape, Shape::Arc { .. }) {
-            let d = p.duration_s();
-            for k in 1..=ARC_POINTS {
-                points.push(point(p.at(d * k as f64 / ARC_POINTS as f64).pos_m));
-            }
-        } else if (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
-            points.push(point(end));
-        }
+    for (_, path) in segment_paths(mission) {
+        points.extend(path.into_iter().skip(1).map(point));
     }
     points
 }

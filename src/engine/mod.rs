@@ -57,6 +57,7 @@ mod logs;
 mod loiter;
 mod mission;
 mod mission_file;
+mod mission_map;
 mod mission_options;
 mod mission_outputs;
 mod payload_sweep;
@@ -101,6 +102,9 @@ pub use mission::{
     plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
 };
 pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
+pub use mission_map::{
+    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocBand, SocLine, MAP_CHART_POINTS,
+};
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
 pub use payload_sweep::{

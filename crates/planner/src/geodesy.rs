@@ -51,6 +51,14 @@ impl LocalFrame {
             (latitude_deg.to_radians() - self.lat0_rad) * self.m_per_rad_north,
         ]
     }
+
+    /// Latitude and longitude of the point `east_m`, `north_m` from the frame's origin, deg: the
+    /// inverse of [`LocalFrame::to_local_m`] (longitude wrapped into `[-180, 180)`).
+    pub fn to_lat_lon_deg(&self, east_m: f64, north_m: f64) -> [f64; 2] {
+        let lat = (self.lat0_rad + north_m / self.m_per_rad_north).to_degrees();
+        let lon = (self.lon0_rad + east_m / self.m_per_rad_east).to_degrees();
+        [lat, (lon + 180.0).rem_euclid(360.0) - 180.0]
+    }
 }
 
 #[cfg(test)]
@@ -66,5 +74,22 @@ mod tests {
         // 1' of longitude at 45 deg: N cos(lat) / 60 in rad = 1314.0 m.
         let [e, _] = f.to_local_m(45.0, 7.0 + 1.0 / 60.0);
         assert!((e - 1314.0).abs() < 1.0, "{e}");
+    }
+
+    #[test]
+    fn lat_lon_of_a_local_point_is_the_inverse_of_the_frame() {
+        let f = LocalFrame::new(47.397_742, 8.545_594);
+        for (lat, lon) in [(47.40, 8.55), (47.39, 8.54), (47.397_742, 8.545_594)] {
+            let [e, n] = f.to_local_m(lat, lon);
+            let [la, lo] = f.to_lat_lon_deg(e, n);
+            assert!(
+                (la - lat).abs() < 1e-12 && (lo - lon).abs() < 1e-12,
+                "{la} {lo}"
+            );
+        }
+        // Across the antimeridian: 1 km east of 179.999 deg is in the western hemisphere.
+        let f = LocalFrame::new(0.0, 179.999);
+        let [_, lo] = f.to_lat_lon_deg(1000.0, 0.0);
+        assert!(lo < -179.99 && lo > -180.0, "{lo}");
     }
 }

@@ -37,6 +37,7 @@ __all__ = [
     "live",
     "log_info",
     "mission",
+    "mission_map",
     "power",
     "timeseries",
     "validate",
@@ -88,6 +89,26 @@ def mission(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
             the vehicle cannot fly, a bad option), with its message.
     """
     return json.loads(_native.mission_json(_path(path), options))
+
+
+def mission_map(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
+    """The map of a mission, as the page of ``aloft serve`` draws it (its ``/api/map``).
+
+    Args:
+        path: As :func:`mission`.
+        **options: As :func:`mission` (with ``samples``, the band of the state of charge).
+
+    Returns:
+        ``segments`` (per segment: ``index``, ``kind``, ``item``, ``points_m`` east-north-up
+        from home and, for a mission with a geographic home, ``points_deg``), ``home``,
+        ``point_of_no_return``, ``battery`` (``time_s``, ``soc``: the state of charge over time)
+        and with ``samples`` its ``band`` (``p5``, ``p50``, ``p95``). The segments are those of
+        :func:`mission` with the same options.
+
+    Raises:
+        AloftError: As :func:`mission`.
+    """
+    return json.loads(_native.mission_map_json(_path(path), options))
 
 
 def timeseries(path: Optional[PathLike] = None, **options: Any) -> Any:

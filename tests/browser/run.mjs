@@ -1,0 +1,526 @@
+// Real-browser tests of the `aloft serve` page: Debian chromium driven by playwright-core.
+//
+//   cd tests/browser && npm install && node run.mjs
+//
+// Environment: ALOFT_BIN (default ../../target/debug/aloft), ALOFT_DATA_DIR (default
+// ../../../shared/data, i.e. `shared/data` next to the repository), CHROMIUM (default
+// /usr/bin/chromium), UPDATE_SCREENSHOT=1 to rewrite docs/img/serve.png.
+// Prints one `ok - ...` / `not ok - ...` line per check and exits 0 only when all pass.
+
+import { spawn, execFileSync } from 'node:child_process';
+import { readFileSync, readdirSync, mkdirSync, existsSync } from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const repo = path.resolve(here, '../..');
+const BIN = path.resolve(process.env.ALOFT_BIN || path.join(repo, 'target/debug/aloft'));
+const DATA = path.resolve(process.env.ALOFT_DATA_DIR || path.resolve(here, '../../../shared/data'));
+const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
+const SHOTS = path.join(repo, 'target/browser');
+const DEMO = path.join(repo, 'fixtures/missions/demo-survey.toml');
+const LOG = path.join(DATA, 'flight_logs/px4_esc_status_log.ulg');
+const DROP_MISSION = path.join(DATA, 'missions/kasperg3_mission.plan');
+const TLOG = path.join(DATA, 'telemetry/ayoub_auto_mission_sitl.tlog');
+const MISSION_EXT = /\.(plan|waypoints|toml|json|txt)$/i;
+const started = Date.now();
+
+// ------------------------------------------------------------------ reporting
+
+let passed = 0;
+let failed = 0;
+function ok(name) {
+  passed += 1;
+  console.log(`ok - ${name}`);
+}
+function notOk(name, why) {
+  failed += 1;
+  console.log(`not ok - ${name}`);
+  for (const line of String(why).split('\n')) console.log(`#   ${line}`);
+}
+async function check(name, fn) {
+  try {
+    const r = await fn();
+    if (r === false) notOk(name, 'failed');
+    else ok(name);
+  } catch (e) {
+    notOk(name, e && e.stack ? e.stack.split('\n').slice(0, 4).join('\n') : e);
+  }
+}
+function assert(cond, message) {
+  if (!cond) throw new Error(message);
+}
+
+// ------------------------------------------------------------------ servers
+
+const servers = new Set();
+function killAll() {
+  for (const child of servers) {
+    try {
+      child.kill('SIGTERM');
+    } catch (e) {
+      /* already gone */
+    }
+  }
+  servers.clear();
+}
+process.on('exit', killAll);
+for (const sig of ['SIGINT', 'SIGTERM']) {
+  process.on(sig, () => {
+    killAll();
+    process.exit(130);
+  });
+}
+
+function serve(args) {
+  return new Promise((resolve, reject) => {
+    const child = spawn(BIN, ['serve', ...args, '--listen', '127.0.0.1:0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+    servers.add(child);
+    let out = '';
+    let err = '';
+    const timer = setTimeout(() => {
+      reject(new Error(`aloft serve did not print its URL in 15 s: ${out} ${err}`));
+    }, 15000);
+    child.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/http:\/\/127\.0\.0\.1:\d+\//);
+      if (m) {
+        clearTimeout(timer);
+        resolve({ url: m[0], child, stop: () => stop(child) });
+      }
+    });
+    child.stderr.on('data', (d) => {
+      err += d;
+    });
+    child.on('exit', (code) => {
+      servers.delete(child);
+      clearTimeout(timer);
+      reject(new Error(`aloft serve exited (${code}): ${err.trim()}`));
+    });
+    child.on('error', (e) => {
+      clearTimeout(timer);
+      reject(e);
+    });
+  });
+}
+
+function stop(child) {
+  servers.delete(child);
+  try {
+    child.kill('SIGTERM');
+  } catch (e) {
+    /* gone */
+  }
+}
+
+// ------------------------------------------------------------------ the CLI
+
+// `aloft mission [FILE] ARGS --format json`: {status, json, message}; exit 1 is still an answer.
+// With `cwd`, FILE is given relative to it (as a browser names an upload: by its base name).
+function cliMission(file, args = [], cwd = undefined) {
+  const argv = ['mission', ...(file ? [file] : []), ...args, '--format', 'json'];
+  try {
+    const stdout = execFileSync(BIN, argv, { cwd, encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'], maxBuffer: 1 << 28 });
+    return { status: 0, json: JSON.parse(stdout) };
+  } catch (e) {
+    if (e.status === 1 && e.stdout) return { status: 1, json: JSON.parse(e.stdout) };
+    const stderr = String(e.stderr || '');
+    const line = stderr.split('\n').find((l) => l.startsWith('aloft: error: ')) || stderr.trim().split('\n').pop() || '';
+    return { status: e.status, message: line.replace(/^aloft: error: /, '').trim() };
+  }
+}
+
+function cliLogInfo(file) {
+  return JSON.parse(execFileSync(BIN, ['log', 'info', file, '--format', 'json'], { encoding: 'utf8', stdio: ['ignore', 'pipe', 'pipe'] }));
+}
+
+const expectedRows = (json) =>
+  json.segments.map((s) => ({
+    index: String(s.index),
+    item: s.item === undefined || s.item === null ? null : String(s.item),
+    kind: s.kind,
+    energy: String(s.energy_wh),
+    soc: String(s.end_soc),
+  }));
+
+async function pageRows(page) {
+  return page.$$eval('#segments tbody tr', (trs) =>
+    trs.map((tr) => ({
+      index: tr.getAttribute('data-index'),
+      item: tr.getAttribute('data-item'),
+      kind: tr.getAttribute('data-kind'),
+      energy: tr.getAttribute('data-energy-wh'),
+      soc: tr.getAttribute('data-end-soc'),
+    })),
+  );
+}
+
+function compareRows(actual, expected) {
+  assert(actual.length === expected.length, `${actual.length} rows in the page, ${expected.length} segments from the CLI`);
+  for (let i = 0; i < expected.length; i++) {
+    for (const k of Object.keys(expected[i])) {
+      assert(actual[i][k] === expected[i][k], `row ${i} ${k}: page ${actual[i][k]} vs CLI ${expected[i][k]}`);
+    }
+  }
+}
+
+// ------------------------------------------------------------------ the page
+
+const pageProblems = [];
+const HTTP_4XX = /^Failed to load resource: the server responded with a status of 4\d\d /;
+let expectRefusal = 0;
+let expectedRefusals = 0;
+// Run `fn` while a 4xx answer (and Chromium's console line about it) is expected.
+async function refusing(fn) {
+  expectRefusal += 1;
+  try {
+    return await fn();
+  } finally {
+    await new Promise((r) => setTimeout(r, 50));
+    expectRefusal -= 1;
+  }
+}
+let browser;
+
+async function openPage(url, viewport = { width: 1400, height: 900 }) {
+  const context = await browser.newContext({ viewport });
+  const page = await context.newPage();
+  page.on('pageerror', (e) => pageProblems.push(`pageerror at ${url}: ${e.message}`));
+  page.on('console', (m) => {
+    if (m.type() !== 'error') return;
+    // Chromium itself logs every 4xx answer to fetch() as a console error; those are expected
+    // (and only those) while a check provokes a refusal.
+    if (expectRefusal > 0 && HTTP_4XX.test(m.text())) expectedRefusals += 1;
+    else pageProblems.push(`console error at ${url}: ${m.text()}`);
+  });
+  await page.goto(url);
+  await waitReady(page, 0);
+  return page;
+}
+
+// Wait until the page completed more than `before` re-plans and nothing is in flight.
+async function waitReady(page, before, timeout = 20000) {
+  await page.waitForFunction(
+    (b) => Number(document.body.dataset.plans) > b && document.body.dataset.state !== 'loading',
+    before,
+    { timeout },
+  );
+}
+
+const plans = (page) => page.evaluate(() => Number(document.body.dataset.plans));
+
+async function shot(page, name) {
+  mkdirSync(SHOTS, { recursive: true });
+  await page.screenshot({ path: path.join(SHOTS, `${name}.png`) });
+}
+
+async function mapAnswer(base, file, text) {
+  const url = new URL('api/map', base);
+  if (file) url.searchParams.set('file', file);
+  const r = await fetch(url, { method: 'POST', body: text });
+  return r.json();
+}
+
+// Drop files (name + bytes) on the page with a real DataTransfer.
+async function dropFiles(page, files) {
+  const payload = files.map((f) => ({ name: f.name, b64: Buffer.from(f.bytes).toString('base64') }));
+  const dt = await page.evaluateHandle((items) => {
+    const transfer = new DataTransfer();
+    for (const it of items) {
+      const bin = atob(it.b64);
+      const bytes = new Uint8Array(bin.length);
+      for (let i = 0; i < bin.length; i++) bytes[i] = bin.charCodeAt(i);
+      transfer.items.add(new File([bytes], it.name));
+    }
+    return transfer;
+  }, payload);
+  await page.dispatchEvent('#map', 'dragenter', { dataTransfer: dt });
+  await page.dispatchEvent('#map', 'dragover', { dataTransfer: dt });
+  await page.dispatchEvent('#map', 'drop', { dataTransfer: dt });
+}
+
+async function setOptions(page, values) {
+  await page.evaluate((vals) => {
+    for (const [id, v] of Object.entries(vals)) {
+      const input = document.getElementById(id);
+      input.value = v;
+      input.dispatchEvent(new Event('input', { bubbles: true }));
+    }
+  }, values);
+}
+
+// ------------------------------------------------------------------ the checks
+
+async function main() {
+  assert(existsSync(BIN), `no aloft binary at ${BIN} (set ALOFT_BIN)`);
+  assert(existsSync(DATA), `no shared data at ${DATA} (set ALOFT_DATA_DIR)`);
+  const missions = readdirSync(path.join(DATA, 'missions'))
+    .filter((f) => f !== 'README.md' && MISSION_EXT.test(f))
+    .sort()
+    .map((f) => path.join(DATA, 'missions', f));
+  browser = await chromium.launch({
+    executablePath: CHROMIUM,
+    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+  });
+
+  // --- 1, 2: every shared mission and the demo against the CLI. `aloft serve` refuses to start
+  // with a mission it cannot fly, so the accepted ones are given on its command line (picked in
+  // #mission-select) and the refused ones are opened with the #file input.
+  const accepted = missions.filter((m) => cliMission(m).status <= 1);
+  const refused = missions.filter((m) => !accepted.includes(m));
+  const main = await serve([DEMO, ...accepted, LOG]);
+  try {
+    const page = await openPage(main.url);
+    const config = await page.evaluate(() => fetch('/api/config').then((r) => r.json()));
+    const given = config.files.filter((f) => f.kind === 'mission');
+    await check(`the page lists the demo and the ${given.length} given missions`, async () => {
+      const values = await page.$$eval('#mission-select option', (os) => os.map((o) => o.value));
+      assert(values.length === given.length + 1, `${values.length} options`);
+      assert(given.length === accepted.length + 1, `${given.length} missions in /api/config`);
+    });
+    await check('a given log shows its info in #log', async () => {
+      const cli = cliLogInfo(LOG);
+      await page.waitForSelector('#log .log-card', { timeout: 10000 });
+      const card = await page.$eval('#log .log-card', (c) => ({ format: c.dataset.format, samples: c.dataset.samples, text: c.textContent }));
+      assert(card.format === cli.format && card.samples === String(cli.samples), JSON.stringify(card));
+    });
+    const entries = [{ key: 'demo', file: null, label: 'built-in demo' }]
+      .concat(given.map((f) => ({ key: `file:${f.index}`, file: f.name, label: path.basename(f.name) })))
+      .concat(refused.map((f) => ({ upload: f, file: f, label: `${path.basename(f)} (opened)` })));
+    for (const entry of entries) {
+      const cli = entry.upload
+        ? cliMission(path.basename(entry.file), [], path.dirname(entry.file))
+        : cliMission(entry.file);
+      const open = async () => {
+        const before = await plans(page);
+        if (entry.upload) await page.setInputFiles('#file', entry.upload);
+        else await page.selectOption('#mission-select', entry.key);
+        await waitReady(page, before);
+      };
+      if (cli.status > 1) await refusing(open);
+      else await open();
+      if (cli.status === 0 || cli.status === 1) {
+        await check(`${entry.label}: table equals aloft mission (${cli.json.segments.length} segments, ${cli.json.feasible ? 'feasible' : 'infeasible'})`, async () => {
+          compareRows(await pageRows(page), expectedRows(cli.json));
+          const s = await page.$eval('#summary', (e) => ({ f: e.dataset.feasible, e: e.dataset.energyWh }));
+          assert(s.f === String(cli.json.feasible) && s.e === String(cli.json.energy_wh), `summary ${JSON.stringify(s)}`);
+          assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
+        });
+        await check(`${entry.label}: the map holds the route`, async () => {
+          const text = entry.file ? readFileSync(entry.file) : '';
+          const answer = await mapAnswer(main.url, entry.upload ? path.basename(entry.file) : entry.file, text);
+          const withPoints = answer.segments.filter((s) => s.points_m.length > 0).length;
+          const n = await page.$$eval('#map path.seg', (ps) => ps.length);
+          assert(n === answer.segments.length && n === withPoints, `${n} paths, ${answer.segments.length} map segments`);
+          const indexed = await page.$$eval('#map path.seg', (ps) => ps.map((p) => p.dataset.index).join(','));
+          assert(indexed === answer.segments.map((s) => String(s.index)).join(','), `data-index ${indexed}`);
+          const box = await page.$eval('#map svg', (s) => {
+            const r = s.getBoundingClientRect();
+            return [r.width, r.height];
+          });
+          assert(box[0] > 0 && box[1] > 0, `map svg ${box}`);
+          if (answer.point_of_no_return) assert(await page.$('#map path.pnr'), 'no point-of-no-return marker');
+        });
+      } else {
+        await check(`${entry.label}: refused (exit ${cli.status}) and #error shows the CLI's message`, async () => {
+          const shown = await page.$eval('#error', (e) => (e.hidden ? null : e.textContent));
+          assert(shown === cli.message, `page: ${shown}\nCLI: ${cli.message}`);
+          assert((await page.$$('#segments tbody tr')).length === 0, 'stale rows');
+          assert((await page.evaluate(() => document.body.dataset.state)) === 'error', 'state is not error');
+        });
+      }
+    }
+    await check('hovering a table row highlights its leg', async () => {
+      const before = await plans(page);
+      await page.selectOption('#mission-select', 'demo');
+      await waitReady(page, before);
+      await page.hover('#segments tbody tr:nth-child(3)');
+      const index = await page.$eval('#segments tbody tr:nth-child(3)', (tr) => tr.dataset.index);
+      const lit = await page.$eval(`#map path.seg[data-index="${index}"]`, (p) => p.classList.contains('highlight'));
+      assert(lit, 'the path is not highlighted');
+    });
+    await shot(page, 'demo');
+
+    // --- 3: the wind re-plans
+    await check('wind 8 m/s from 270 re-plans and the table equals aloft mission --wind-speed 8 --wind-from 270', async () => {
+      const before = await plans(page);
+      await setOptions(page, { 'wind-speed': '8', 'wind-from': '270' });
+      await waitReady(page, before);
+      const cli = cliMission(null, ['--wind-speed', '8', '--wind-from', '270']);
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const still = cliMission(null);
+      assert(String(cli.json.energy_wh) !== String(still.json.energy_wh), 'the wind changed nothing');
+    });
+
+    // --- 5: samples draw the band
+    await check('samples 50 draw the p5-p95 band and the dashed p50', async () => {
+      const before = await plans(page);
+      await setOptions(page, { samples: '50' });
+      await waitReady(page, before, 60000);
+      assert(await page.$('#chart svg polygon.band'), 'no band polygon');
+      assert(await page.$('#chart svg polyline.p50'), 'no p50 line');
+    });
+    await shot(page, 'demo-wind-samples');
+    await check('a refused option shows the server message and the page stays alive', async () => {
+      const before = await plans(page);
+      await refusing(async () => {
+        await setOptions(page, { samples: '', payload: '-3' });
+        await waitReady(page, before);
+      });
+      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
+      assert(shown.length > 0, 'no error shown');
+      const b2 = await plans(page);
+      await setOptions(page, { payload: '' });
+      await waitReady(page, b2);
+      assert(await page.$eval('#error', (e) => e.hidden), 'the error stayed');
+      assert((await page.$$('#segments tbody tr')).length > 0, 'no rows after recovery');
+    });
+    await check('a reserve of 80 % (wind 8 m/s from 270) splits the demo into sorties: their ends and the point of no return are marked', async () => {
+      const before = await plans(page);
+      await setOptions(page, { reserve: '80' });
+      await waitReady(page, before);
+      const cli = cliMission(null, ['--wind-speed', '8', '--wind-from', '270', '--reserve-percent', '80']);
+      assert(cli.json.sorties && cli.json.sorties.length >= 2, 'the CLI gives no sorties');
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const ends = await page.$$('#map path.sortie-end');
+      assert(ends.length === cli.json.sorties.length, `${ends.length} sortie ends, ${cli.json.sorties.length} sorties`);
+      assert(await page.$('#map path.pnr'), 'no point-of-no-return marker');
+      assert(await page.$('#map-legend'), 'no colour legend');
+      await shot(page, 'sorties');
+      const b2 = await plans(page);
+      await setOptions(page, { reserve: '' });
+      await waitReady(page, b2);
+    });
+    await check('the payload sweep is drawn', async () => {
+      assert(await page.$('#sweep svg polyline.sweep-hover'), 'no hover line');
+      assert(await page.$('#sweep svg polyline.sweep-max'), 'no max endurance line');
+      mkdirSync(SHOTS, { recursive: true });
+      await page.locator('#sweep').screenshot({ path: path.join(SHOTS, 'sweep.png') });
+    });
+
+    // --- 4: dropped files
+    await check(`a dropped ${path.basename(DROP_MISSION)} loads and its table equals aloft mission`, async () => {
+      await setOptions(page, { 'wind-speed': '', 'wind-from': '' });
+      await page.waitForFunction(() => document.body.dataset.state !== 'loading');
+      const before = await plans(page);
+      await dropFiles(page, [{ name: path.basename(DROP_MISSION), bytes: readFileSync(DROP_MISSION) }]);
+      await waitReady(page, before);
+      const cli = cliMission(DROP_MISSION);
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const selected = await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent);
+      assert(selected.includes(path.basename(DROP_MISSION)), `selected ${selected}`);
+    });
+    await check(`a dropped log (${path.basename(LOG)}) shows its format and samples in #log`, async () => {
+      const cli = cliLogInfo(LOG);
+      const name = `dropped-${path.basename(LOG)}`;
+      await dropFiles(page, [{ name, bytes: readFileSync(LOG) }]);
+      const sel = `#log .log-card[data-file="${name}"]`;
+      await page.waitForSelector(sel, { timeout: 10000 });
+      const card = await page.$eval(sel, (c) => ({ format: c.dataset.format, samples: c.dataset.samples, text: c.textContent }));
+      assert(card.format === cli.format, `format ${card.format} vs ${cli.format}`);
+      assert(card.samples === String(cli.samples), `samples ${card.samples} vs ${cli.samples}`);
+      assert(card.text.includes(cli.format) && card.text.includes(String(cli.samples)), 'not visible');
+      await page.locator('#log').screenshot({ path: path.join(SHOTS, 'log.png') });
+    });
+    await check('a dropped file the server cannot read shows its error', async () => {
+      await refusing(async () => {
+        await dropFiles(page, [{ name: 'garbage.bin', bytes: Buffer.from('not a flight log at all\n') }]);
+        await page.waitForSelector('#error:not([hidden])', { timeout: 10000 });
+      });
+    });
+    await check('a mission chosen with the #file input loads', async () => {
+      const file = missions.find((m) => m.endsWith('.waypoints') && cliMission(m).status === 0);
+      const before = await plans(page);
+      await page.setInputFiles('#file', file);
+      await waitReady(page, before);
+      compareRows(await pageRows(page), expectedRows(cliMission(file).json));
+    });
+    await page.context().close();
+  } finally {
+    main.stop();
+  }
+
+  // --- geographic map with a tile layer (tiles served by aloft itself: works offline)
+  const geo = await serve([DROP_MISSION, '--tiles', '/vendor/leaflet/images/layers.png?{z}/{x}/{y}', '--attribution', 'test tiles']);
+  try {
+    const page = await openPage(geo.url);
+    await check('with --tiles a mission with a home is drawn on a geographic map with tiles', async () => {
+      const answer = await mapAnswer(geo.url, DROP_MISSION, readFileSync(DROP_MISSION));
+      assert(answer.home, 'no home');
+      const n = await page.$$eval('#map path.seg', (ps) => ps.length);
+      assert(n === answer.segments.length, `${n} paths vs ${answer.segments.length}`);
+      await page.waitForSelector('#map .leaflet-tile-pane img', { timeout: 10000 });
+      const attribution = await page.$eval('#map .leaflet-control-attribution', (e) => e.textContent);
+      assert(attribution.includes('test tiles'), attribution);
+      assert(await page.$('#map path.home'), 'no home marker');
+      await shot(page, 'geo');
+    });
+    await check('switching to the demo (no home) falls back to the plain metric map', async () => {
+      const before = await plans(page);
+      await page.selectOption('#mission-select', 'demo');
+      await waitReady(page, before);
+      assert(!(await page.$('#map .leaflet-tile-pane img')), 'tiles still shown');
+      assert((await page.$$('#map path.seg')).length > 0, 'no route');
+    });
+    await page.context().close();
+  } finally {
+    geo.stop();
+  }
+
+  // --- 6: live telemetry
+  const live = await serve(['--tlog', TLOG, '--speed', 'max']);
+  try {
+    const page = await openPage(live.url);
+    await check(`live: #live shows updates from ${path.basename(TLOG)} and the vehicle marker`, async () => {
+      await page.waitForFunction(() => document.querySelector('#live') && !document.querySelector('#live').hidden && document.querySelector('#live').dataset.mode, null, { timeout: 20000 });
+      await page.waitForSelector('#map path.vehicle', { timeout: 10000 });
+      const p = await page.$eval('#live', (e) => ({ mode: e.dataset.mode, advice: e.dataset.advice, text: e.textContent }));
+      assert(p.mode.length > 0 && p.text.includes(p.mode), JSON.stringify(p));
+      assert(p.text.includes('Wh'), 'no energy shown');
+    });
+    await shot(page, 'live');
+    await page.context().close();
+  } finally {
+    live.stop();
+  }
+
+  // --- 8: the documentation screenshot (always to target/browser, docs/img with UPDATE_SCREENSHOT=1)
+  const doc = await serve([]);
+  try {
+    const page = await openPage(doc.url, { width: 1400, height: 900 });
+    await check('screenshot: the demo with wind 6 m/s from 270 and 100 samples', async () => {
+      const before = await plans(page);
+      await setOptions(page, { 'wind-speed': '6', 'wind-from': '270', samples: '100' });
+      await waitReady(page, before, 60000);
+      assert(await page.$('#chart svg polygon.band'), 'no band');
+      await page.hover('#segments tbody tr:nth-child(6)');
+      await page.mouse.move(5, 300);
+      await page.waitForTimeout(300);
+      await shot(page, 'serve');
+      if (process.env.UPDATE_SCREENSHOT === '1') {
+        await page.screenshot({ path: path.join(repo, 'docs/img/serve.png') });
+      }
+    });
+    await page.context().close();
+  } finally {
+    doc.stop();
+  }
+
+  // --- 7: no page errors anywhere
+  await check(`no page error and no console error in any test (${expectedRefusals} expected 4xx answers logged by Chromium while refusals were tested)`, async () => {
+    assert(pageProblems.length === 0, pageProblems.join('\n'));
+  });
+}
+
+try {
+  await main();
+} catch (e) {
+  notOk('the run', e && e.stack ? e.stack : e);
+} finally {
+  if (browser) await browser.close().catch(() => {});
+  killAll();
+}
+const seconds = ((Date.now() - started) / 1000).toFixed(1);
+console.log(`# ${passed} passed, ${failed} failed in ${seconds} s`);
+process.exit(failed === 0 && passed > 0 ? 0 : 1);
