@@ -12,6 +12,8 @@
 //!   the `aloft` under test first on `PATH`. Lines of the form `NAME=value` in a block set a
 //!   variable for the commands after them in that document.
 //! - The exit code is 0 unless the command says otherwise in a comment: `# exit 1`.
+//! - A server (`aloft serve`) says `# until stopped`: it runs until what the document shows has
+//!   been printed (at most [`SERVER_WAIT`]) and must still be running then; it is then stopped.
 //! - Output: in a block whose commands start with `$ `, the lines after a command (up to the next
 //!   `$ ` line or the block's end) are what it prints, abridged: each must appear in its stdout
 //!   and stderr, in that order; a line `...` stands for lines left out, and `...` within a line
@@ -22,8 +24,11 @@
 //!   `fit` writes the vehicle a `validate` reads). A page under `docs/` without commands is
 //!   skipped.
 
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
 
 /// One command of a document, with what the document says of it.
 #[derive(Debug)]
@@ -207,6 +212,16 @@ fn run_document(path: &str) -> Vec<String> {
             .filter(|(before, _)| *before <= k)
             .map(|(_, v)| v.as_str())
             .collect();
+        let at = format!("{path}:{}: `{}`", cmd.line, cmd.text.replace('\n', " "));
+        if cmd.text.contains(UNTIL_STOPPED) {
+            let script = format!("{}\nexec {}", env.join("\n"), cmd.text);
+            let mut server = Command::new("sh");
+            server.arg("-c").arg(&script).current_dir(&work).env("PATH", &path_var);
+            if let Err(e) = run_server(server, &cmd.shown) {
+                failures.push(format!("{at}: {e}"));
+            }
+            continue;
+        }
         let script = format!("{}\n{}", env.join("\n"), cmd.text);
         let out = Command::new("sh")
             .arg("-c")
@@ -221,7 +236,6 @@ fn run_document(path: &str) -> Vec<String> {
             String::from_utf8_lossy(&out.stdout),
             String::from_utf8_lossy(&out.stderr)
         );
-        let at = format!("{path}:{}: `{}`", cmd.line, cmd.text.replace('\n', " "));
         if code != cmd.exit {
             failures.push(format!(
                 "{at}: exit {code}, documented {}\n{printed}",
@@ -234,6 +248,56 @@ fn run_document(path: &str) -> Vec<String> {
         }
     }
     failures
+}
+
+/// The comment of a command that runs until stopped (a server).
+const UNTIL_STOPPED: &str = "# until stopped";
+
+/// Longest a documented server may take to print what the document shows.
+const SERVER_WAIT: Duration = Duration::from_secs(30);
+
+/// Run a server until its stdout holds the `shown` lines (or [`SERVER_WAIT`] passes), then stop
+/// it: an error when it exited first or did not print them.
+fn run_server(mut command: Command, shown: &[String]) -> Result<(), String> {
+    let mut child = command
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| e.to_string())?;
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let start = Instant::now();
+    let mut printed = String::new();
+    let result = loop {
+        if missing_line(shown, &printed).is_none() && !printed.is_empty() {
+            break match child.try_wait() {
+                Ok(None) => Ok(()),
+                _ => Err(format!("it exited instead of serving:\n{printed}")),
+            };
+        }
+        let left = SERVER_WAIT.saturating_sub(start.elapsed());
+        match rx.recv_timeout(left.min(Duration::from_millis(200))) {
+            Ok(line) => printed = format!("{printed}{line}\n"),
+            Err(_) if start.elapsed() >= SERVER_WAIT => {
+                break Err(format!("it did not print what is shown in {SERVER_WAIT:?}:\n{printed}"))
+            }
+            Err(_) => {
+                if let Ok(Some(status)) = child.try_wait() {
+                    break Err(format!("it exited ({status}) instead of serving:\n{printed}"));
+                }
+            }
+        }
+    };
+    let _ = child.kill();
+    let _ = child.wait();
+    result
 }
 
 /// The documents whose commands are run: the README and every page under `docs/`.

@@ -224,7 +224,7 @@ fn every_shared_log_answers_as_the_command_line() {
     ] {
         logs.extend(common::files(sub, |n| n != "README.md"));
     }
-    assert!(logs.len() >= 25, "{}", logs.len());
+    assert_eq!(logs.len(), 29);
     let mut answered = 0;
     for log in &logs {
         let path = log.display().to_string();
@@ -248,8 +248,8 @@ fn every_shared_log_answers_as_the_command_line() {
             assert_eq!(got["error"], message, "{path}");
         }
     }
-    // The flight logs all read; the telemetry logs are for `aloft live`.
-    assert!(answered >= 20, "{answered}");
+    // The flight logs all read; the 5 telemetry logs are for `aloft live`.
+    assert_eq!(answered, 24);
     // With an option, and one the command does not take.
     let log = &common::files("kaist_energy_drone", |n| n.ends_with(".csv"))[0];
     let path = log.display().to_string();

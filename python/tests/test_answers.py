@@ -47,6 +47,25 @@ def test_planner_file_and_infeasible_mission_equal_cli(cli, data):
     assert got["feasible"] is False
 
 
+def test_mission_map_describes_the_mission_the_cli_answers(cli, data):
+    """The map (aloft serve's /api/map) has a path per segment of the CLI's answer, in its order,
+    starting at home; its state of charge runs from the start to the answer's end; with samples,
+    the band is ordered."""
+    plan = data / "missions" / "kasperg3_mission.plan"
+    expected = cli.json("mission", str(plan), "--reserve-percent", "30")
+    got = aloft.mission_map(plan, reserve_percent=30, samples=20)
+    assert [s["index"] for s in got["segments"]] == [s["index"] for s in expected["segments"]]
+    assert got["segments"][0]["points_m"][0] == [0.0, 0.0, 0.0]
+    home = json.loads(plan.read_text())["mission"]["plannedHomePosition"]
+    assert got["home"] == {"latitude_deg": home[0], "longitude_deg": home[1]}
+    assert got["battery"]["soc"][0] == expected["start_soc"]
+    assert got["battery"]["soc"][-1] == expected["end_soc"]
+    band = got["band"]
+    assert all(a <= b <= c for a, b, c in zip(band["p5"], band["p50"], band["p95"]))
+    demo = aloft.mission_map()
+    assert "home" not in demo and "band" not in demo
+
+
 def test_windy_missions_fly_at_the_envelope_and_equal_cli(cli):
     # 12 m/s: the upwind lines are flown slower at the tilt limit (an answer with the time lost).
     slowed = aloft.mission(wind_speed=12, wind_from=250)
