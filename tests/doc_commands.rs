@@ -216,7 +216,11 @@ fn run_document(path: &str) -> Vec<String> {
         if cmd.text.contains(UNTIL_STOPPED) {
             let script = format!("{}\nexec {}", env.join("\n"), cmd.text);
             let mut server = Command::new("sh");
-            server.arg("-c").arg(&script).current_dir(&work).env("PATH", &path_var);
+            server
+                .arg("-c")
+                .arg(&script)
+                .current_dir(&work)
+                .env("PATH", &path_var);
             if let Err(e) = run_server(server, &cmd.shown) {
                 failures.push(format!("{at}: {e}"));
             }
@@ -286,11 +290,15 @@ fn run_server(mut command: Command, shown: &[String]) -> Result<(), String> {
         match rx.recv_timeout(left.min(Duration::from_millis(200))) {
             Ok(line) => printed = format!("{printed}{line}\n"),
             Err(_) if start.elapsed() >= SERVER_WAIT => {
-                break Err(format!("it did not print what is shown in {SERVER_WAIT:?}:\n{printed}"))
+                break Err(format!(
+                    "it did not print what is shown in {SERVER_WAIT:?}:\n{printed}"
+                ))
             }
             Err(_) => {
                 if let Ok(Some(status)) = child.try_wait() {
-                    break Err(format!("it exited ({status}) instead of serving:\n{printed}"));
+                    break Err(format!(
+                        "it exited ({status}) instead of serving:\n{printed}"
+                    ));
                 }
             }
         }
