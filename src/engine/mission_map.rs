@@ -4,21 +4,18 @@
 //! state of charge over time; and with scenarios its 5-95 % band.
 //!
 //! The route is the compiled mission's pieces (the path the planner flies, corners and the way
-//! home it adds included): a line by its ends, an arc by [`ARC_POINTS`] points, a hold by its
+//! home it adds included): a line by its ends, an arc by 36 points, a hold by its
 //! point. Latitude and longitude come from the local tangent plane at home
 //! ([`LocalFrame::to_lat_lon_deg`], the inverse of the frame the planner files were read in).
 
 use serde::Serialize;
 
 use aloft_planner::geodesy::LocalFrame;
-use aloft_planner::trajectory::Shape;
 
 use super::mission::Plan;
+use super::mission_outputs::segment_paths;
 use super::scenario_stats::SocFan;
 use super::Mission;
-
-/// Points drawn per arc of the planned path, so the path shows the circle.
-pub(super) const ARC_POINTS: usize = 36;
 
 /// Most points of the state-of-charge line: a longer flight's chart samples are thinned evenly.
 pub const MAP_CHART_POINTS: usize = 2_000;
@@ -171,30 +168,4 @@ fn soc_line(plan: &Plan) -> SocLine {
         }
     }
     line
-}
-
-/// The planned path, segment by segment (segment numbers from 0), each path starting where the
-/// one before ended: a line by its end, an arc by [`ARC_POINTS`] points, a hold by its point.
-pub(super) fn segment_paths(mission: &aloft_planner::Mission) -> Vec<(usize, Vec<[f64; 3]>)> {
-    let mut paths: Vec<(usize, Vec<[f64; 3]>)> = Vec::new();
-    let mut last = mission.home_m();
-    for p in mission.pieces() {
-        if paths.last().is_none_or(|(k, _)| *k != p.segment) {
-            paths.push((p.segment, vec![last]));
-        }
-        let Some((_, points)) = paths.last_mut() else {
-            continue;
-        };
-        if matches!(p.shape, Shape::Arc { .. }) {
-            let d = p.duration_s();
-            points.extend((1..=ARC_POINTS).map(|k| p.at(d * k as f64 / ARC_POINTS as f64).pos_m));
-        } else {
-            let end = p.end_m();
-            if (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
-                points.push(end);
-            }
-        }
-        last = points[points.len() - 1];
-    }
-    paths
 }

@@ -7,11 +7,14 @@ use std::io::BufWriter;
 use std::path::PathBuf;
 
 use aloft_logs::{Attitude, BatteryPoint, McapWriter, MissionSample, PathPoint, PowerTerms};
+use aloft_planner::trajectory::Shape;
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
 use super::finite::first_non_finite;
-use super::mission_map::segment_paths;
 use crate::error::Error;
+
+/// Points drawn per arc of the planned path, so the path shows the circle.
+const ARC_POINTS: usize = 36;
 
 /// Most samples kept for a chart: a flight with more is decimated (every 2nd, 4th, ... sample),
 /// keeping between half this number and this number.
@@ -295,6 +298,32 @@ pub(crate) fn path_points(mission: &aloft_planner::Mission) -> Vec<PathPoint> {
         points.extend(path.into_iter().skip(1).map(point));
     }
     points
+}
+
+/// The planned path, segment by segment (segment numbers from 0), each path starting where the
+/// one before ended: a line by its end, an arc by [`ARC_POINTS`] points, a hold by its point.
+pub(super) fn segment_paths(mission: &aloft_planner::Mission) -> Vec<(usize, Vec<[f64; 3]>)> {
+    let mut paths: Vec<(usize, Vec<[f64; 3]>)> = Vec::new();
+    let mut last = mission.home_m();
+    for p in mission.pieces() {
+        if paths.last().is_none_or(|(k, _)| *k != p.segment) {
+            paths.push((p.segment, vec![last]));
+        }
+        let Some((_, points)) = paths.last_mut() else {
+            continue;
+        };
+        if matches!(p.shape, Shape::Arc { .. }) {
+            let d = p.duration_s();
+            points.extend((1..=ARC_POINTS).map(|k| p.at(d * k as f64 / ARC_POINTS as f64).pos_m));
+        } else {
+            let end = p.end_m();
+            if (0..3).any(|c| (end[c] - last[c]).abs() > 1e-6) {
+                points.push(end);
+            }
+        }
+        last = points[points.len() - 1];
+    }
+    paths
 }
 
 #[cfg(test)]
