@@ -92,7 +92,7 @@ fn bench_page_replan(c: &mut Criterion) {
     use aloft::engine::answers::{mission_answer_for, mission_map_answer_for};
     use aloft::engine::flags::MissionScenarioFlags;
     use aloft::engine::{parse_keywords, Mission};
-    let flags: MissionScenarioFlags = parse_keywords("mission", &[], &[]).expect("defaults");
+    let flags: MissionScenarioFlags = parse_keywords("the bench", &[], &[]).expect("defaults");
     let survey = Mission::from_text(&survey_plan(335), "survey.plan").expect("the survey reads");
     let mut g = c.benchmark_group("serve/replan");
     g.sample_size(10);

@@ -185,6 +185,16 @@ fn the_api_refuses_bad_requests_and_keeps_serving() {
     let (code, body) = server.get("/api/endurance?bogus=1");
     assert_eq!(code, 400, "{body}");
     assert!(body.contains("unknown option 'bogus'"), "{body}");
+    let (code, body) = server.get("/api/endurance?payload_kg=abc");
+    assert_eq!(code, 400, "{body}");
+    let got: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(
+        got["error"],
+        "invalid value 'abc' for 'payload_kg' of GET /api/endurance: not a number"
+    );
+    let (code, body) = server.get("/api/files/abc");
+    assert_eq!(code, 404, "{body}");
+    assert!(body.starts_with("{\"error\""), "{body}");
     let (code, body) = server.request("POST", "/api/mission?file=x.toml", None, b"hello");
     assert_eq!(code, 422, "{body}");
     assert!(body.contains("x.toml"), "{body}");
@@ -467,4 +477,64 @@ fn the_live_feed_streams_the_updates_of_aloft_live() {
     // Without a flight: 404.
     let plain = Server::start(&[]);
     assert_eq!(plain.get("/api/live").0, 404);
+}
+
+/// No request takes the server down or gets a server error: wrong methods, options that are not
+/// numbers or not finite, bytes that are not text, names that climb out of the upload folder, a
+/// long query, and 200 truncations of a real plan file; the server answers each with a 4xx or an
+/// answer, and serves the next.
+#[test]
+fn no_request_takes_the_server_down() {
+    let server = Server::start(&["--max-upload-mb", "1"]);
+    let long = format!("/api/endurance?payload_kg={}", "9".repeat(100_000));
+    let requests: Vec<(&str, &str, Vec<u8>)> = vec![
+        ("GET", "/api/mission", vec![]),
+        ("POST", "/api/endurance", vec![]),
+        ("GET", "/api/endurance?wind_speed=nan&wind_from=0", vec![]),
+        ("GET", "/api/endurance?wind_speed=inf&wind_from=0", vec![]),
+        ("GET", "/api/endurance?payload_kg=-1", vec![]),
+        ("GET", "/api/endurance?payload_kg=1e400", vec![]),
+        ("GET", "/api/endurance?payload_sweep=0:1:0", vec![]),
+        ("GET", "/api/endurance?vehicle=/etc/passwd", vec![]),
+        (
+            "POST",
+            "/api/mission?file=%ff%fe",
+            vec![0xff, 0xfe, 0x00, 0x80],
+        ),
+        ("POST", "/api/map?corners=sideways", vec![]),
+        ("POST", "/api/mission?samples=0", vec![]),
+        (
+            "POST",
+            "/api/log/info?file=../../../../tmp/escape.bin",
+            b"x".to_vec(),
+        ),
+        ("POST", "/api/log/info?file=..", vec![0u8; 1000]),
+        ("POST", "/api/log/info", vec![]),
+        ("GET", "/%00", vec![]),
+        ("GET", "/api/files/99999999999999999999999", vec![]),
+        ("GET", "/api/live", vec![]),
+        ("GET", long.as_str(), vec![]),
+    ];
+    for (method, path, body) in &requests {
+        let (code, answer) = server.request(method, path, None, body);
+        assert!(
+            (200..500).contains(&code),
+            "{method} {}: {code} {answer}",
+            &path[..path.len().min(80)]
+        );
+    }
+    assert!(!std::path::Path::new("/tmp/escape.bin").exists());
+    let plan = std::fs::read(data_dir().join("missions/kasperg3_mission.plan")).unwrap();
+    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+    for _ in 0..200 {
+        // xorshift: a repeatable choice of where to cut.
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let cut = (state % plan.len() as u64) as usize;
+        let (code, answer) =
+            server.request("POST", "/api/mission?file=cut.plan", None, &plan[..cut]);
+        assert!(matches!(code, 200 | 422), "cut at {cut}: {code} {answer}");
+    }
+    assert_eq!(server.get("/api/vehicles").0, 200);
 }

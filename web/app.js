@@ -835,7 +835,7 @@
     if (u.remaining_wh) {
       row('Remaining', `${fmt(u.remaining_wh.p5, 1)} / ${fmt(u.remaining_wh.p50, 1)} / ${fmt(u.remaining_wh.p95, 1)} Wh (p5/p50/p95)`);
     }
-    if (u.advice) row('Advice', u.advice, /return|land|abort/i.test(u.advice) ? 'bad' : 'good');
+    if (u.advice) row('Advice', u.advice, u.advice === 'continue' ? 'good' : 'bad');
     panel.querySelector('.live-body').replaceChildren(el('dl', { class: 'summary' }, rows));
   }
 
@@ -859,6 +859,8 @@
     } else {
       state.liveMarker.setLatLng(at);
     }
+    // The map follows the vehicle: back into view when it leaves it.
+    if (!state.map.getBounds().contains(at)) state.map.panTo(at);
   }
 
   // ---------------------------------------------------------------- wiring

@@ -80,7 +80,7 @@ pub fn parse<T: FlagGroup>(
             }
         }
     }
-    parse_keywords::<T>(function, positional, &given).map_err(engine_error)
+    parse_keywords::<T>(&format!("aloft.{function}"), positional, &given).map_err(engine_error)
 }
 
 /// Paths given positionally (the logs of `fit` and `validate`).

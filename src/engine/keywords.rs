@@ -58,7 +58,7 @@ pub fn keywords<T: FlagGroup>(reserved: &[&str]) -> Vec<String> {
 
 /// Parse `keywords` (and the `positional` options, given by the function's own arguments) into
 /// `T`, as the command line parses its flags. `function` names the caller in messages
-/// (`mission` for `aloft.mission`).
+/// as its user wrote it (`aloft.mission` in Python, `POST /api/mission` for `aloft serve`).
 ///
 /// # Errors
 /// [`Error::Keyword`] naming the keyword: unknown (with the known ones), a value that is not
@@ -87,7 +87,7 @@ pub fn parse_keywords<T: FlagGroup>(
             .filter(|_| is_positional || !reserved.contains(&key.as_str()));
         let Some(arg) = arg else {
             return Err(keyword_error(format!(
-                "unknown option '{key}' for aloft.{function}; known options: {}",
+                "unknown option '{key}' for {function}; known options: {}",
                 keywords::<T>(&reserved).join(", ")
             )));
         };
@@ -97,7 +97,7 @@ pub fn parse_keywords<T: FlagGroup>(
         .clone()
         .try_get_matches_from(argv.clone())
         .map_err(|e| translate(&e, &cmd, &argv, function))?;
-    T::from_arg_matches(&matches).map_err(|e| keyword_error(format!("aloft.{function}: {e}")))
+    T::from_arg_matches(&matches).map_err(|e| keyword_error(format!("{function}: {e}")))
 }
 
 fn keyword_error(message: String) -> Error {
@@ -116,7 +116,7 @@ fn push_flag(
     let switch = matches!(arg.get_action(), ArgAction::SetTrue);
     let invalid = |why: &str| {
         keyword_error(format!(
-            "invalid value {} for '{key}' of aloft.{function}: {why}",
+            "invalid value {} for '{key}' of {function}: {why}",
             shown(value)
         ))
     };
@@ -203,22 +203,20 @@ fn translate(e: &clap::Error, cmd: &Command, argv: &[OsString], function: &str) 
                 .map(|v| format!("'{v}'"))
                 .collect::<Vec<_>>()
                 .join(", ");
-            format!(
-                "invalid value '{value}' for '{arg}' of aloft.{function}: expected one of {valid}"
-            )
+            format!("invalid value '{value}' for '{arg}' of {function}: expected one of {valid}")
         }
         ErrorKind::ValueValidation => {
             let why = std::error::Error::source(e)
                 .map(|s| aloft_core::one_line(&s.to_string()))
                 .unwrap_or_else(|| "out of range".to_string());
-            format!("invalid value '{value}' for '{arg}' of aloft.{function}: {why}")
+            format!("invalid value '{value}' for '{arg}' of {function}: {why}")
         }
         ErrorKind::ArgumentConflict => {
             let other = context_strings(e, ContextKind::PriorArg)
                 .first()
                 .map(|s| keyword_in(s))
                 .unwrap_or_default();
-            format!("the option '{arg}' of aloft.{function} cannot be used with '{other}'")
+            format!("the option '{arg}' of {function} cannot be used with '{other}'")
         }
         ErrorKind::MissingRequiredArgument => {
             let missing: Vec<String> = context_strings(e, ContextKind::InvalidArg)
@@ -228,7 +226,7 @@ fn translate(e: &clap::Error, cmd: &Command, argv: &[OsString], function: &str) 
             missing_partner(cmd, argv, function, &missing)
         }
         _ => format!(
-            "aloft.{function}: {}",
+            "{function}: {}",
             aloft_core::one_line(&e.to_string()).trim_start_matches("error: ")
         ),
     };
@@ -239,7 +237,7 @@ fn translate(e: &clap::Error, cmd: &Command, argv: &[OsString], function: &str) 
 /// that misses the same option is named; when several options need it, they are listed.
 fn missing_partner(cmd: &Command, argv: &[OsString], function: &str, missing: &[String]) -> String {
     let Some(first) = missing.first() else {
-        return format!("aloft.{function}: a required option is missing");
+        return format!("{function}: a required option is missing");
     };
     let misses_first = |flag: &OsString| {
         cmd.clone()
@@ -264,10 +262,10 @@ fn missing_partner(cmd: &Command, argv: &[OsString], function: &str, missing: &[
         String::new()
     };
     match needing.as_slice() {
-        [] => format!("aloft.{function} needs '{first}'{also}"),
-        [one] => format!("'{one}' of aloft.{function} needs '{first}'{also}"),
+        [] => format!("{function} needs '{first}'{also}"),
+        [one] => format!("'{one}' of {function} needs '{first}'{also}"),
         many => format!(
-            "the options {} of aloft.{function} need '{first}'",
+            "the options {} of {function} need '{first}'",
             many.iter()
                 .map(|k| format!("'{k}'"))
                 .collect::<Vec<_>>()

@@ -49,7 +49,7 @@ pub(super) async fn vehicles() -> Response {
 
 /// `GET /api/endurance?OPTIONS`.
 pub(super) async fn endurance(Query(query): QueryPairs) -> Response {
-    let flags: EnduranceFlags = match flags("endurance", &query) {
+    let flags: EnduranceFlags = match flags("GET /api/endurance", &query) {
         Ok(f) => f,
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };
@@ -58,21 +58,34 @@ pub(super) async fn endurance(Query(query): QueryPairs) -> Response {
 
 /// `POST /api/mission?file=NAME&OPTIONS`.
 pub(super) async fn mission(Query(query): QueryPairs, body: Bytes) -> Response {
-    planned(query, body, answers::mission_answer_for).await
+    planned(
+        "POST /api/mission",
+        query,
+        body,
+        answers::mission_answer_for,
+    )
+    .await
 }
 
 /// `POST /api/map?file=NAME&OPTIONS`: the page's map of the plan `/api/mission` answers.
 pub(super) async fn map(Query(query): QueryPairs, body: Bytes) -> Response {
-    planned(query, body, answers::mission_map_answer_for).await
+    planned(
+        "POST /api/map",
+        query,
+        body,
+        answers::mission_map_answer_for,
+    )
+    .await
 }
 
 /// A mission request: its options, its mission (the body, or the demo when empty), the answer.
 async fn planned(
+    request: &str,
     query: Vec<(String, String)>,
     body: Bytes,
     answer: fn(&Mission, &MissionScenarioFlags) -> Result<String, aloft::Error>,
 ) -> Response {
-    let flags: MissionScenarioFlags = match flags("mission", &query) {
+    let flags: MissionScenarioFlags = match flags(request, &query) {
         Ok(f) => f,
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };
@@ -93,8 +106,9 @@ fn mission_of(body: &[u8], origin: &str) -> Result<Mission, aloft::Error> {
     Mission::from_text(text, origin)
 }
 
-/// The query's options (all but `file`) as the command's flag group, or the message of a 400.
-pub(super) fn flags<T: FlagGroup>(function: &str, query: &[(String, String)]) -> Result<T, String> {
+/// The query's options (all but `file`) as the command's flag group, or the message of a 400
+/// (naming the option and the `request`).
+pub(super) fn flags<T: FlagGroup>(request: &str, query: &[(String, String)]) -> Result<T, String> {
     // Each key's values, in order: one is a value (or a switch), several are a list.
     let mut values: Vec<(&String, Vec<&str>)> = Vec::new();
     for (k, v) in query.iter().filter(|(k, _)| k != "file") {
@@ -115,7 +129,7 @@ pub(super) fn flags<T: FlagGroup>(function: &str, query: &[(String, String)]) ->
             (k.clone(), value)
         })
         .collect();
-    parse_keywords::<T>(function, &[], &given).map_err(super::super::engine_message)
+    parse_keywords::<T>(request, &[], &given).map_err(super::super::engine_message)
 }
 
 /// The upload's name (`file=`), else `default`.

@@ -70,19 +70,25 @@ fn read_one(path: &Path) -> Result<Given> {
         Ok(text) => Content::Mission(text),
         Err(e) if mission_like => return Err(e.into()),
         Err(_) => {
-            let flags: LogInfoFlags = flags("log_info", &[]).map_err(anyhow::Error::msg)?;
+            let flags: LogInfoFlags = flags("aloft serve", &[]).map_err(anyhow::Error::msg)?;
             Content::Log(answers::log_info_answer(path, &flags)?)
         }
     };
     Ok(Given { name, content })
 }
 
+/// The file given at `index` (a number in the URL; anything else is no file).
+fn given<'a>(shared: &'a Shared, index: &str) -> Option<&'a Content> {
+    let k: usize = index.parse().ok()?;
+    shared.files.get(k).map(|f| &f.content)
+}
+
 /// `GET /api/files/N`: a given mission's text.
 pub(super) async fn given_file(
     State(shared): State<Arc<Shared>>,
-    UrlPath(index): UrlPath<usize>,
+    UrlPath(index): UrlPath<String>,
 ) -> Response {
-    match shared.files.get(index).map(|f| &f.content) {
+    match given(&shared, &index) {
         Some(Content::Mission(text)) => (
             StatusCode::OK,
             [(header::CONTENT_TYPE, "text/plain; charset=utf-8")],
@@ -97,9 +103,9 @@ pub(super) async fn given_file(
 /// `GET /api/files/N/info`: a given log's `log info` answer.
 pub(super) async fn given_log_info(
     State(shared): State<Arc<Shared>>,
-    UrlPath(index): UrlPath<usize>,
+    UrlPath(index): UrlPath<String>,
 ) -> Response {
-    match shared.files.get(index).map(|f| &f.content) {
+    match given(&shared, &index) {
         Some(Content::Log(text)) => answer(Ok(text.clone())),
         Some(Content::Mission(_)) => {
             error(StatusCode::NOT_FOUND, &format!("file {index} is a mission"))
@@ -115,7 +121,7 @@ pub(super) async fn log_info(
     Query(query): QueryPairs,
     body: Body,
 ) -> Response {
-    let flags: LogInfoFlags = match flags("log_info", &query) {
+    let flags: LogInfoFlags = match flags("POST /api/log/info", &query) {
         Ok(f) => f,
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };

@@ -98,7 +98,7 @@ pub(super) fn start(args: &ServeArgs) -> Result<Option<Feed>> {
 
 /// `aloft live`'s flags of the keywords, a bad one as bad input.
 fn parse(given: &[(String, Keyword)]) -> Result<LiveFlags> {
-    aloft::engine::parse_keywords::<LiveFlags>("live", &[], given)
+    aloft::engine::parse_keywords::<LiveFlags>("aloft serve --live/--tlog", &[], given)
         .map_err(|e| anyhow::Error::msg(super::super::engine_message(e)))
 }
 
