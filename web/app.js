@@ -223,6 +223,14 @@
     let ok = false;
     try {
       if (!entry) throw new ApiError('no mission selected');
+      if (entry.key === 'none') {
+        // A live flight without a mission: the map shows the vehicle and its track only.
+        state.plan = null;
+        clearPlan();
+        clearError();
+        ok = true;
+        return;
+      }
       if (entry.text === null) entry.text = await fetchText(`/api/files/${entry.index}`);
       const q = options();
       if (entry.name) q.set('file', entry.name);
@@ -928,6 +936,8 @@
       return;
     }
     fillVehicles();
+    const liveOnly = state.config.live && !state.config.files.some((f) => f.kind === 'mission');
+    if (liveOnly) addMission({ key: 'none', label: 'none (the live flight)', name: null, text: '' });
     addMission({ key: 'demo', label: 'demo survey (built in)', name: null, text: '' });
     let first = null;
     for (const f of state.config.files) {
@@ -945,7 +955,7 @@
         .then((info) => renderLogInfo(info, f.name))
         .catch((e) => showError(`${basename(f.name)}: ${e.message}`)),
     );
-    await selectMission(first ? first.key : 'demo');
+    await selectMission(first ? first.key : liveOnly ? 'none' : 'demo');
     await Promise.all(logLoads);
     settle(!$('#error').textContent);
   }

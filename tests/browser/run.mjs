@@ -478,6 +478,11 @@ async function main() {
       const p = await page.$eval('#live', (e) => ({ mode: e.dataset.mode, advice: e.dataset.advice, text: e.textContent }));
       assert(p.mode.length > 0 && p.text.includes(p.mode), JSON.stringify(p));
       assert(p.text.includes('Wh'), 'no energy shown');
+      // Once the estimate is made: the energy left with its band, and one of aloft live's advices.
+      await page.waitForFunction(() => document.querySelector('#live').dataset.advice, null, { timeout: 90000 });
+      const q = await page.$eval('#live', (e) => ({ advice: e.dataset.advice, text: e.textContent }));
+      assert(['continue', 'return now', 'land now', 'do not take off'].includes(q.advice), `advice ${q.advice}`);
+      assert(q.text.includes('Remaining') && q.text.includes(q.advice), q.text);
     });
     await shot(page, 'live');
     await page.context().close();
