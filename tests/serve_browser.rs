@@ -6,10 +6,11 @@
 //! It needs `/usr/bin/chromium` and `npm ci` in `tests/browser` (`.ci/run` installs both). Without
 //! them the test says so and passes, unless `ALOFT_BROWSER_TESTS=require` (set by `.ci/run`),
 //! where it fails.
-#![cfg(feature = "serve")]
+#![cfg(all(feature = "serve", unix))]
 
 mod common;
 
+use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -33,7 +34,10 @@ fn the_page_works_in_a_real_browser() {
         );
         return;
     }
+    // In a process group of its own, so that a run stopped at the deadline takes its servers and
+    // its browser with it.
     let mut child = Command::new("node")
+        .process_group(0)
         .arg("run.mjs")
         .current_dir(&dir)
         .env("ALOFT_BIN", env!("CARGO_BIN_EXE_aloft"))
@@ -47,6 +51,8 @@ fn the_page_works_in_a_real_browser() {
             break status;
         }
         if start.elapsed() > DEADLINE {
+            let group = format!("-{}", child.id());
+            let _ = Command::new("kill").args(["-KILL", "--", &group]).status();
             let _ = child.kill();
             let _ = child.wait();
             panic!("the browser tests ran past {DEADLINE:?} and were stopped");
