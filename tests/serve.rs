@@ -511,6 +511,8 @@ fn no_request_takes_the_server_down() {
         ("POST", "/api/log/info?file=..", vec![0u8; 1000]),
         ("POST", "/api/log/info", vec![]),
         ("GET", "/%00", vec![]),
+        ("GET", "/../Cargo.toml", vec![]),
+        ("GET", "/vendor/../../Cargo.toml", vec![]),
         ("GET", "/api/files/99999999999999999999999", vec![]),
         ("GET", "/api/live", vec![]),
         ("GET", long.as_str(), vec![]),
@@ -524,6 +526,10 @@ fn no_request_takes_the_server_down() {
         );
     }
     assert!(!std::path::Path::new("/tmp/escape.bin").exists());
+    // No file outside the page's.
+    for path in ["/../Cargo.toml", "/vendor/../../Cargo.toml"] {
+        assert_eq!(server.get(path).0, 404, "{path}");
+    }
     let plan = std::fs::read(data_dir().join("missions/kasperg3_mission.plan")).unwrap();
     let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
     for _ in 0..200 {
