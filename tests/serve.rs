@@ -92,12 +92,16 @@ fn encoded(text: &str) -> String {
 
 /// The command line's JSON text (its stdout without the final line break).
 fn cli(args: &[&str]) -> String {
-    let out = aloft(args);
-    assert!(matches!(out.status.code(), Some(0 | 1)), "{args:?}");
-    String::from_utf8(out.stdout)
-        .unwrap()
-        .trim_end()
-        .to_string()
+    common::cli(args).trim_end().to_string()
+}
+
+/// A request the command line refuses (`out`, exit 2) is refused alike: 422 with its message.
+fn assert_refused_alike(out: &std::process::Output, (code, body): (u16, &str), what: &str) {
+    assert_eq!(code, 422, "{what}: {body}");
+    let message = common::stderr(out);
+    let message = message.trim_end().strip_prefix("aloft: error: ").unwrap();
+    let got: serde_json::Value = serde_json::from_str(body).unwrap();
+    assert_eq!(got["error"], message, "{what}");
 }
 
 #[test]
@@ -163,18 +167,8 @@ fn the_api_answers_as_the_command_line() {
                     "{name}"
                 );
             }
-            _ => {
-                // Refused by the command line: the same message, 422.
-                assert_eq!(code, 422, "{name}: {body}");
-                let message = String::from_utf8(out.stderr).unwrap();
-                let message = message
-                    .trim_end()
-                    .strip_prefix("aloft: error: ")
-                    .unwrap()
-                    .to_string();
-                let got: serde_json::Value = serde_json::from_str(&body).unwrap();
-                assert_eq!(got["error"], message, "{name}");
-            }
+            // Refused by the command line: the same message, 422.
+            _ => assert_refused_alike(&out, (code, &body), &name),
         }
     }
 }
@@ -251,11 +245,7 @@ fn every_shared_log_answers_as_the_command_line() {
             assert_eq!(body, common::stdout(&out).trim_end(), "{path}");
             answered += 1;
         } else {
-            assert_eq!(code, 422, "{path}: {body}");
-            let message = common::stderr(&out);
-            let message = message.trim_end().strip_prefix("aloft: error: ").unwrap();
-            let got: serde_json::Value = serde_json::from_str(&body).unwrap();
-            assert_eq!(got["error"], message, "{path}");
+            assert_refused_alike(&out, (code, &body), &path);
         }
     }
     // The flight logs all read; the 5 telemetry logs are for `aloft live`.

@@ -141,7 +141,18 @@ pub fn calibrate_vehicle_answer(spec: &Path, output: &Path) -> Result<String, Er
 /// # Errors
 /// As [`log_info`].
 pub fn log_info_answer(path: &Path, flags: &LogInfoFlags) -> Result<String, Error> {
-    json_text(&log_info(path, &flags.read.options(), flags.max_lag)?)
+    log_info_answer_as(path, &path.display().to_string(), flags)
+}
+
+/// [`log_info_answer`] of the log at `path` as `aloft log info NAME` answers it: the page's
+/// upload, kept in a temporary file, named as it was sent.
+///
+/// # Errors
+/// As [`log_info`].
+pub fn log_info_answer_as(path: &Path, name: &str, flags: &LogInfoFlags) -> Result<String, Error> {
+    let mut info = log_info(path, &flags.read.options(), flags.max_lag)?;
+    info.file = name.to_string();
+    json_text(&info)
 }
 
 /// `aloft fit --format json` (the vehicle file written only when the flags give `-o`).

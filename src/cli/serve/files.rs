@@ -130,19 +130,14 @@ pub(super) async fn log_info(
         Ok(u) => u,
         Err(response) => return response,
     };
-    let path = upload.path.clone();
-    let work = move || answers::log_info_answer(&path, &flags);
-    let result = tokio::task::spawn_blocking(work)
-        .await
-        .unwrap_or_else(super::join_error);
-    // The answer and its errors name the upload as it was given, not the temporary file.
-    let quoted = |s: &str| serde_json::Value::from(s).to_string();
-    let temporary = upload.path.display().to_string();
-    let response = match result {
-        Ok(text) => answer(Ok(text.replacen(&quoted(&temporary), &quoted(&name), 1))),
+    let (path, shown) = (upload.path.clone(), name.clone());
+    let work = move || answers::log_info_answer_as(&path, &shown, &flags);
+    let response = match super::on_blocking_pool(work).await {
+        Ok(text) => answer(Ok(text)),
+        // The readers' messages name the file they read: the temporary file, named as sent.
         Err(e) => error(
             StatusCode::UNPROCESSABLE_ENTITY,
-            &super::super::engine_message(e).replace(&temporary, &name),
+            &super::super::engine_message(e).replace(&upload.path.display().to_string(), &name),
         ),
     };
     drop(upload);

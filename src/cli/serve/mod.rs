@@ -201,11 +201,16 @@ fn answer(result: Result<String, aloft::Error>) -> Response {
 async fn blocking(
     work: impl FnOnce() -> Result<String, aloft::Error> + Send + 'static,
 ) -> Response {
-    answer(
-        tokio::task::spawn_blocking(work)
-            .await
-            .unwrap_or_else(join_error),
-    )
+    answer(on_blocking_pool(work).await)
+}
+
+/// The engine's work of a request on the blocking pool (the server's threads go on serving).
+async fn on_blocking_pool(
+    work: impl FnOnce() -> Result<String, aloft::Error> + Send + 'static,
+) -> Result<String, aloft::Error> {
+    tokio::task::spawn_blocking(work)
+        .await
+        .unwrap_or_else(join_error)
 }
 
 /// A request's work that panicked: never expected (the engine does not panic on any input), said
