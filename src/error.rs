@@ -35,14 +35,15 @@ pub enum Error {
         message: String,
     },
     /// A CSV input lacks a required column.
-    #[error("{origin}: missing column '{column}' (found: {found})")]
+    #[error("{origin}: missing column '{column}' (none of the {columns} columns of its first line is named so)")]
     ColumnMissing {
         /// The column asked for.
         column: &'static str,
         /// File or stream name.
         origin: String,
-        /// The header that was found, comma-separated.
-        found: String,
+        /// How many columns its first line has (their names are the file's text: not quoted, as
+        /// the file may be anything the caller could name).
+        columns: usize,
     },
     /// An answer that would carry a number that is not finite (an overflow the input checks did
     /// not foresee): refused rather than printed as `null` or `inf`.

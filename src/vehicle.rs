@@ -112,7 +112,7 @@ impl VehicleFile {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, Error> {
         let file: Self = toml::from_str(text).map_err(|e| Error::VehicleFormat {
             origin: origin.to_string(),
-            message: aloft_core::one_line(&e.to_string()),
+            message: aloft_core::file_message(&e.to_string()),
         })?;
         // Validate every table that is present, so a file that loads is usable.
         if let Some(p) = &file.power {

@@ -134,9 +134,9 @@ impl SpecSheet {
         toml::from_str(text).map_err(|e| Error::SpecSheet {
             origin: origin.to_string(),
             key: missing_key(text, &e)
-                .or_else(|| e.span().and_then(|s| key_at(text, s.start)))
+                .or_else(|| e.span().and_then(|s| place(text, s.start, e.message())))
                 .unwrap_or_else(|| "(file)".to_string()),
-            message: aloft_core::one_line(e.message()),
+            message: aloft_core::file_message(e.message()),
         })
     }
 }
@@ -166,6 +166,17 @@ fn missing_key(text: &str, e: &toml::de::Error) -> Option<String> {
         Some(t) if !t.is_empty() => format!("{t}.{field}"),
         _ => field.to_string(),
     })
+}
+
+/// Where an error at byte `offset` is: the dotted key of its line, or for a key the spec sheet
+/// does not have, its line number (the key is the file's text, not quoted: see
+/// [`aloft_core::file_message`]).
+fn place(text: &str, offset: usize, message: &str) -> Option<String> {
+    if message.starts_with("unknown field") {
+        let line = text.get(..offset)?.matches('\n').count() + 1;
+        return Some(format!("line {line}"));
+    }
+    key_at(text, offset)
 }
 
 /// The dotted key (`battery.mass_kg`) of the `key = value` line holding byte `offset` of a TOML

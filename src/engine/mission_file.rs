@@ -84,7 +84,7 @@ impl Mission {
     pub fn from_json(text: &str, origin: &str) -> Result<Self, Error> {
         let spec: MissionSpec = serde_json::from_str(text).map_err(|e| Error::MissionFormat {
             origin: origin.to_string(),
-            message: e.to_string(),
+            message: aloft_core::file_message(&e.to_string()),
         })?;
         Ok(Self::of_spec(spec, origin, SourceFormat::AloftJson))
     }

@@ -137,7 +137,7 @@ impl Columns {
             column(name).ok_or_else(|| Error::ColumnMissing {
                 column: name,
                 origin: origin.to_string(),
-                found: headers.iter().collect::<Vec<_>>().join(","),
+                columns: headers.len(),
             })
         };
         Ok(Self {

@@ -190,7 +190,7 @@ fn base_rotor(rotor: &str) -> Result<RotorSpec, Error> {
     };
     toml::from_str(&text).map_err(|e| Error::RotorFormat {
         origin,
-        message: aloft_core::one_line(&e.to_string()),
+        message: aloft_core::file_message(&e.to_string()),
     })
 }
 

@@ -142,7 +142,7 @@ fn read_wind_grid(path: &Path) -> Result<WindGrid, Error> {
             .ok_or_else(|| Error::ColumnMissing {
                 column: name,
                 origin: origin.clone(),
-                found: headers.iter().collect::<Vec<_>>().join(","),
+                columns: headers.len(),
             })?;
     }
     let mut rows = Vec::new();

@@ -106,9 +106,108 @@ pub fn one_line(message: &str) -> String {
     out
 }
 
+/// A parser's message about a file (TOML, JSON), on one line ([`one_line`]) and without the
+/// file's content: the text serde quotes from the input (an unknown key or variant, a string of the
+/// wrong type or value, a duplicate key) is left out, the place (line and column) and what was
+/// expected are kept.
+///
+/// A file named where a vehicle, a mission or a column map is expected may be any file the
+/// process can read (a password file, a process's environment): what the message says of it must
+/// not tell its content to whoever named it (a request to `aloft serve`, a script's caller).
+///
+/// ```
+/// let m = "TOML parse error at line 1, column 1\n  |\n1 | TOKEN=1\n  | ^\nunknown field `TOKEN`, expected `name`";
+/// assert_eq!(
+///     aloft_core::file_message(m),
+///     "TOML parse error at line 1, column 1: unknown field, expected `name`"
+/// );
+/// assert_eq!(
+///     aloft_core::file_message("invalid type: string \"s3cr\\\"et\", expected f64 at line 2 column 9"),
+///     "invalid type: string, expected f64 at line 2 column 9"
+/// );
+/// ```
+pub fn file_message(message: &str) -> String {
+    let mut text = one_line(message);
+    for (prefix, close) in [
+        ("unknown field ", '`'),
+        ("unknown variant ", '`'),
+        ("duplicate key ", '`'),
+        ("duplicate field ", '`'),
+        ("invalid type: string ", '"'),
+        ("invalid value: string ", '"'),
+        ("invalid type: character ", '`'),
+        ("invalid value: character ", '`'),
+    ] {
+        text = without_quoted(&text, prefix, close);
+    }
+    text
+}
+
+/// `text` with every quotation that follows `prefix` (opened and closed by `close`, a backslash
+/// escaping the next character) left out, the space before it with it.
+fn without_quoted(text: &str, prefix: &str, close: char) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(prefix) {
+        let after = &rest[at + prefix.len()..];
+        out.push_str(&rest[..at]);
+        out.push_str(prefix.trim_end());
+        let Some(body) = after.strip_prefix(close) else {
+            rest = after;
+            out.push(' ');
+            continue;
+        };
+        let mut escaped = false;
+        let mut end = body.len();
+        for (i, c) in body.char_indices() {
+            match c {
+                _ if escaped => escaped = false,
+                '\\' => escaped = true,
+                c if c == close => {
+                    end = i + c.len_utf8();
+                    break;
+                }
+                _ => {}
+            }
+        }
+        rest = &body[end..];
+    }
+    out.push_str(rest);
+    out
+}
+
 #[cfg(test)]
 mod one_line_tests {
-    use super::one_line;
+    use super::{file_message, one_line};
+
+    /// The content serde quotes is left out; the expected keys and the place stay.
+    #[test]
+    fn file_messages_quote_nothing_of_the_file() {
+        for (raw, want) in [
+            (
+                "unknown field `SECRET`, expected one of `name`, `power`",
+                "unknown field, expected one of `name`, `power`",
+            ),
+            (
+                "unknown variant `SECRET`, expected `pass` or `stop`",
+                "unknown variant, expected `pass` or `stop`",
+            ),
+            (
+                "invalid type: string \"SECRET\", expected f64",
+                "invalid type: string, expected f64",
+            ),
+            (
+                "invalid value: string \"a\\\"SECRET\", expected x",
+                "invalid value: string, expected x",
+            ),
+            ("duplicate key `SECRET` in table", "duplicate key in table"),
+            // Cut short: nothing after the opening quote survives.
+            ("unknown field `SECRET", "unknown field"),
+            ("missing field `mass_kg`", "missing field `mass_kg`"),
+        ] {
+            assert_eq!(file_message(raw), want);
+        }
+    }
 
     /// Regression (found by aloft-fuzz): a carriage return, vertical tab or form feed quoted
     /// from the input (a CSV header, an unknown TOML or JSON key, an MCAP topic) was printed as

@@ -224,14 +224,6 @@ impl CsvSamples<BufReader<File>> {
     }
 }
 
-fn header_list(h: &[String]) -> String {
-    let mut s = h.iter().take(40).cloned().collect::<Vec<_>>().join(",");
-    if h.len() > 40 {
-        s.push_str(",...");
-    }
-    s
-}
-
 impl<R: Read> CsvSamples<R> {
     /// Read from any reader; `path` names the source in errors.
     pub fn from_reader(reader: R, path: &Path, map: &ColumnMap) -> Result<Self> {
@@ -692,7 +684,7 @@ impl ColumnFinder<'_> {
                 path: self.path.to_path_buf(),
                 column: name.to_string(),
                 channel,
-                header: header_list(self.columns),
+                columns: self.columns.len(),
             }),
         }
     }

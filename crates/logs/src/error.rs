@@ -37,7 +37,7 @@ pub enum LogError {
     },
     /// A column named by the column map is not in the CSV header.
     #[error(
-        "{path}: column '{column}' for {channel} is missing from the header (columns: {header})"
+        "{path}: column '{column}' for {channel} is missing from the header (none of its {columns} columns is named so)"
     )]
     ColumnMissing {
         /// The file.
@@ -46,8 +46,9 @@ pub enum LogError {
         column: String,
         /// The channel the column was to feed (e.g. "voltage").
         channel: &'static str,
-        /// The header that was found, comma-separated (truncated when long).
-        header: String,
+        /// How many columns the header has (their names are the file's text, not quoted: the
+        /// file may be anything the caller could name).
+        columns: usize,
     },
     /// A CSV row could not be read (bad quoting, wrong number of fields, invalid UTF-8).
     #[error("{path}: row {row}: malformed CSV: {message}")]

@@ -46,11 +46,8 @@ pub enum ImportError {
         offset: usize,
     },
     /// Text that is none of the planner formats (QGroundControl `.plan`, `QGC WPL 110`).
-    #[error("not a QGroundControl .plan (JSON with a fileType key) nor a QGC WPL 110 .waypoints file: starts with {found:?}")]
-    UnknownFormat {
-        /// The first characters of the text.
-        found: String,
-    },
+    #[error("not a QGroundControl .plan (JSON with a fileType key) nor a QGC WPL 110 .waypoints file")]
+    UnknownFormat,
     /// A `.plan` that is not valid JSON.
     #[error("not valid JSON at line {line}, column {column}: {message}")]
     Json {
@@ -92,11 +89,8 @@ pub enum ImportError {
         expected: &'static str,
     },
     /// A `.waypoints` file whose first line is not `QGC WPL 110`.
-    #[error("line 1: header is {found:?}, expected \"QGC WPL 110\"")]
-    BadHeader {
-        /// The first line (shortened).
-        found: String,
-    },
+    #[error("line 1: the header is not \"QGC WPL 110\" (another version of the format?)")]
+    BadHeader,
     /// A `.waypoints` line that does not have 12 tab-separated fields.
     #[error("line {line}: {found} tab-separated fields, expected 12 (INDEX CURRENT FRAME COMMAND P1 P2 P3 P4 LAT LON ALT AUTOCONTINUE)")]
     FieldCount {

@@ -142,9 +142,7 @@ pub fn import(text: &str) -> Result<Imported, ImportError> {
         SourceFormat::QgcPlan => read_plan(text),
         SourceFormat::QgcWpl => read_waypoints(text),
         SourceFormat::AloftToml | SourceFormat::AloftJson | SourceFormat::MavlinkItems => {
-            Err(ImportError::UnknownFormat {
-                found: text.trim_start().chars().take(24).collect(),
-            })
+            Err(ImportError::UnknownFormat)
         }
     }
 }

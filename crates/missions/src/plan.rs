@@ -48,7 +48,7 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
         ImportError::Json {
             line: e.line(),
             column: e.column(),
-            message: e.to_string(),
+            message: aloft_core::file_message(&e.to_string()),
         }
     })?;
     let root = object(&root, Place::File, None, "(top level)")?;

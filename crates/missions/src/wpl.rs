@@ -52,9 +52,7 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
     let mut lines = text.lines().enumerate();
     let header = lines.next().map_or("", |(_, l)| l.trim());
     if header != "QGC WPL 110" {
-        return Err(ImportError::BadHeader {
-            found: header.chars().take(40).collect(),
-        });
+        return Err(ImportError::BadHeader);
     }
     let mut rows = Vec::new();
     for (k, line) in lines {

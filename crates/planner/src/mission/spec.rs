@@ -395,7 +395,7 @@ impl MissionSpec {
     /// names the line and the key.
     pub fn from_toml_str(text: &str) -> Result<Self, PlannerError> {
         toml::from_str(text).map_err(|e| PlannerError::MissionFormat {
-            message: aloft_core::one_line(&e.to_string()),
+            message: aloft_core::file_message(&e.to_string()),
         })
     }
 }
