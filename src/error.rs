@@ -34,6 +34,22 @@ pub enum Error {
         /// The parser's message (line, column and key).
         message: String,
     },
+    /// A request whose scenarios would fly more steps than its caller allows
+    /// ([`WorkBounds::max_steps`](crate::engine::WorkBounds::max_steps), `aloft serve`).
+    #[error("{samples} scenarios of about {steps_per_flight} steps each is more work than one request may ask for ({max_steps} steps): ask for at most {max_samples} samples, or a longer time step")]
+    TooMuchWork {
+        /// Scenarios asked for.
+        samples: u32,
+        /// Steps of one flight: its duration over the time step.
+        steps_per_flight: u64,
+        /// The bound on the steps of all the scenarios.
+        max_steps: u64,
+        /// The most scenarios within the bound.
+        max_samples: u64,
+    },
+    /// Work stopped because its caller no longer wants the answer (a client that went away).
+    #[error("the work was cancelled: its answer is no longer wanted")]
+    Cancelled,
     /// A CSV input lacks a required column.
     #[error("{origin}: missing column '{column}' (none of the {columns} columns of its first line is named so)")]
     ColumnMissing {

@@ -110,6 +110,10 @@ pub struct VehicleSource {
 impl VehicleFile {
     /// Parse vehicle TOML text; `origin` names the text in error messages (a path or a name).
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self, Error> {
+        aloft_core::check_value_count(text).map_err(|count| Error::VehicleFormat {
+            origin: origin.to_string(),
+            message: aloft_core::too_many_values(count),
+        })?;
         let file: Self = toml::from_str(text).map_err(|e| Error::VehicleFormat {
             origin: origin.to_string(),
             message: aloft_core::file_message(&e.to_string()),

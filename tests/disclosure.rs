@@ -43,11 +43,7 @@ fn secrets() -> Vec<(PathBuf, &'static str)> {
             "SECRETWPL",
             b"SECRETWPL 110\n0\t1\t0\t16\t0\t0\t0\t0\t1\t2\t3\t1\n".to_vec(),
         ),
-        (
-            "line.json",
-            "SECRETJSON",
-            b"[SECRETJSON]\n".to_vec(),
-        ),
+        ("line.json", "SECRETJSON", b"[SECRETJSON]\n".to_vec()),
         ("key.csv", "SECRETKEY", b"SECRETKEY=1\nother=2\n".to_vec()),
     ];
     shapes
@@ -132,5 +128,10 @@ fn no_message_quotes_a_file_that_is_not_what_was_expected() {
             );
         }
     }
-    assert!(leaks.is_empty(), "{} leaks:\n{}", leaks.len(), leaks.join("\n"));
+    assert!(
+        leaks.is_empty(),
+        "{} leaks:\n{}",
+        leaks.len(),
+        leaks.join("\n")
+    );
 }

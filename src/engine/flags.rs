@@ -25,7 +25,7 @@ use super::mission_file::Mission;
 use super::mission_options::{GustSpec, MissionOptions};
 use super::payload_sweep::PayloadSweep;
 use super::power::PowerQuery;
-use super::scenarios::{ScenarioOptions, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
+use super::scenarios::{ScenarioOptions, WorkBounds, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
 use super::validate::ValidateRequest;
 use super::EnduranceOptions;
 use crate::error::Error;
@@ -179,7 +179,7 @@ impl WindFlags {
 #[derive(Debug, Clone, Args)]
 pub struct MissionFlags {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
     pub vehicle: String,
     /// Battery pack by name (default: the vehicle's default pack). With --replay, the pack flown
     /// in the log: its mass is part of the mass flown (airframe + pack + payload).
@@ -292,6 +292,9 @@ pub struct ScenarioFlags {
     #[arg(long, requires = "samples", default_value_t = 0, value_name = "N",
         value_parser = clap::value_parser!(u16).range(0..=1024))]
     pub threads: u16,
+    /// What the request may spend (set by a caller that serves others; no flag).
+    #[arg(skip)]
+    pub bounds: WorkBounds,
 }
 
 impl ScenarioFlags {
@@ -308,6 +311,7 @@ impl ScenarioFlags {
             power_sd_percent: self.power_sd_percent,
             threads: usize::from(self.threads),
             soc_fan: fan,
+            bounds: self.bounds.clone(),
         })
     }
 }
@@ -317,7 +321,7 @@ impl ScenarioFlags {
 #[derive(Debug, Clone, Args)]
 pub struct EnduranceFlags {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
     pub vehicle: String,
     /// Battery pack by name (default: the vehicle's default pack).
     #[arg(long)]
@@ -443,7 +447,7 @@ pub struct FlightLogFlags {
     #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
     pub log: Vec<PathBuf>,
     /// Log layout: kaist, px4 or a column-map TOML (default: detected).
-    #[arg(long)]
+    #[arg(long, value_name = "PROFILE")]
     pub profile: Option<String>,
     /// Angle-of-attack model for the logged states: geometric (drag work is in the attitude;
     /// drag is fitted from the force balance) or paper (drag can be fitted from power).
@@ -557,7 +561,7 @@ impl ValidateFlags {
 #[derive(Debug, Clone, Args)]
 pub struct PowerModelFlags {
     /// Vehicle: a built-in name (see `aloft vehicles`) or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE)]
+    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
     pub vehicle: String,
     /// Battery pack by name (default: the vehicle's default pack); its mass is part of the
     /// take-off mass the model flies (airframe + pack + payload).
@@ -625,7 +629,7 @@ pub struct LiveFlags {
     #[arg(long, value_name = "LOG")]
     pub replay: Option<PathBuf>,
     /// Log layout of `--replay`: kaist, px4 or a column-map TOML (default: detected).
-    #[arg(long, requires = "replay")]
+    #[arg(long, requires = "replay", value_name = "PROFILE")]
     pub profile: Option<String>,
     /// Follow a telemetry log (Mission Planner / QGroundControl `.tlog`).
     #[arg(long, value_name = "FILE")]

@@ -56,6 +56,32 @@ pub fn keywords<T: FlagGroup>(reserved: &[&str]) -> Vec<String> {
     names
 }
 
+/// Words of an option's value name (`|` between them) that say it names a file (`--vehicle <NAME|FILE>`,
+/// `--wind-field <CSV>`, `--profile <PROFILE>`: a profile may be a column-map file).
+const FILE_VALUE_WORDS: [&str; 6] = ["FILE", "CSV", "TOML", "LOG", "MCAP", "PROFILE"];
+
+/// The keywords of the options of `T` whose value may name a file to read (or write): a caller
+/// that answers others (`aloft serve`) resolves or refuses each, so that no request names a
+/// file of the server's ([`super::flags`] gives every such option a value name that says so).
+pub fn file_keywords<T: FlagGroup>() -> Vec<String> {
+    let cmd = T::augment_args(Command::new("aloft"));
+    let mut names: Vec<String> = cmd
+        .get_arguments()
+        .filter(|a| !a.is_hide_set())
+        .filter(|a| {
+            a.get_value_names().is_some_and(|names| {
+                names.iter().any(|n| {
+                    n.split('|')
+                        .any(|word| FILE_VALUE_WORDS.contains(&word))
+                })
+            })
+        })
+        .filter_map(keyword_of)
+        .collect();
+    names.sort_unstable();
+    names
+}
+
 /// Parse `keywords` (and the `positional` options, given by the function's own arguments) into
 /// `T`, as the command line parses its flags. `function` names the caller in messages
 /// as its user wrote it (`aloft.mission` in Python, `POST /api/mission` for `aloft serve`).
@@ -302,4 +328,40 @@ fn needers(cmd: &Command, first: &str) -> Vec<String> {
         .collect();
     out.sort_unstable();
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::flags::{
+        EnduranceFlags, FitFlags, LiveFlags, LogInfoFlags, MissionScenarioFlags, PowerModelFlags,
+        ValidateFlags,
+    };
+    use super::*;
+
+    /// Every option that names a file is known as one: a server resolves or refuses each
+    /// (issue 32: `wind_field=/etc/passwd` was read and quoted). The lists are written out here,
+    /// from the options' help, so that a new file option without a value name that says so
+    /// fails this test rather than passing through.
+    #[test]
+    fn every_option_that_names_a_file_is_known_as_one() {
+        assert_eq!(
+            file_keywords::<MissionScenarioFlags>(),
+            ["vehicle", "wind_field"]
+        );
+        assert_eq!(file_keywords::<EnduranceFlags>(), ["vehicle"]);
+        assert_eq!(file_keywords::<PowerModelFlags>(), ["vehicle"]);
+        assert_eq!(file_keywords::<LogInfoFlags>(), ["profile"]);
+        assert_eq!(
+            file_keywords::<FitFlags>(),
+            ["log", "output", "profile", "vehicle_template"]
+        );
+        assert_eq!(
+            file_keywords::<ValidateFlags>(),
+            ["log", "profile", "vehicle"]
+        );
+        assert_eq!(
+            file_keywords::<LiveFlags>(),
+            ["mission", "profile", "replay", "tlog", "vehicle"]
+        );
+    }
 }

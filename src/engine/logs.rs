@@ -33,6 +33,15 @@ pub struct LogReadOptions {
     pub battery_instance: u8,
 }
 
+/// Check a CSV profile (`kaist`, `px4`, or a column-map TOML file) without reading a log.
+///
+/// # Errors
+/// An unknown profile name, a column map that cannot be read or is not one.
+pub fn check_profile(profile: &str) -> Result<(), Error> {
+    Profile::resolve(profile)?;
+    Ok(())
+}
+
 impl LogReadOptions {
     fn profile(&self) -> Result<Option<Profile>, Error> {
         Ok(self.profile.as_deref().map(Profile::resolve).transpose()?)

@@ -66,6 +66,7 @@ impl Mission {
     /// # Errors
     /// [`Error::MissionFormat`] with the parser's line, column and key.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self, Error> {
+        check_size(text, origin)?;
         let spec = MissionSpec::from_toml_str(text).map_err(|e| Error::MissionFormat {
             origin: origin.to_string(),
             message: match e {
@@ -82,6 +83,7 @@ impl Mission {
     /// # Errors
     /// [`Error::MissionFormat`] with the parser's line, column and key.
     pub fn from_json(text: &str, origin: &str) -> Result<Self, Error> {
+        check_size(text, origin)?;
         let spec: MissionSpec = serde_json::from_str(text).map_err(|e| Error::MissionFormat {
             origin: origin.to_string(),
             message: aloft_core::file_message(&e.to_string()),
@@ -96,6 +98,7 @@ impl Mission {
     /// # Errors
     /// [`Error::MissionImport`] naming the item (or row, or line) and the command or key.
     pub fn from_planner_file(text: &str, origin: &str) -> Result<Self, Error> {
+        check_size(text, origin)?;
         Self::of_imported(aloft_missions::import(text), origin)
     }
 
@@ -134,6 +137,7 @@ impl Mission {
     /// # Errors
     /// As [`Mission::from_planner_file`], [`Mission::from_json`] or [`Mission::from_toml`].
     pub fn from_text(text: &str, origin: &str) -> Result<Self, Error> {
+        check_size(text, origin)?;
         match aloft_missions::detect(text) {
             SourceFormat::QgcPlan | SourceFormat::QgcWpl | SourceFormat::MavlinkItems => {
                 Self::from_planner_file(text, origin)
@@ -178,4 +182,15 @@ impl Mission {
             &self.spec.name
         }
     }
+}
+
+/// A mission text within the values a parser may hold ([`aloft_core::MAX_TEXT_VALUES`]).
+///
+/// # Errors
+/// [`Error::MissionFormat`] naming the count.
+fn check_size(text: &str, origin: &str) -> Result<(), Error> {
+    aloft_core::check_value_count(text).map_err(|count| Error::MissionFormat {
+        origin: origin.to_string(),
+        message: aloft_core::too_many_values(count),
+    })
 }

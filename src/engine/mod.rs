@@ -85,16 +85,16 @@ pub use endurance::{
     PowerCurve,
 };
 pub use estimator::InFlightEstimator;
-pub use files::read_text_file;
+pub use files::{read_text_file, MAX_INPUT_BYTES};
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use flown::PlanningSpeed;
-pub use keywords::{keywords, parse_keywords, FlagGroup, Keyword};
+pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::{
     follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveRecorder, LiveReplayRequest,
     LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
 };
 pub use logs::{
-    convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
+    check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
     LogReadOptions, LogTime, LogTopic, TopicCount,
 };
 pub use loiter::LoiterSummary;
@@ -124,7 +124,7 @@ pub use scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
-    Uncertainty, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
+    Uncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
@@ -141,8 +141,8 @@ pub use aloft_core::one_line;
 pub use crate::error::{Error, SweepProblem};
 
 /// The vehicle every command uses when none is named.
-pub use crate::vehicle::DEFAULT_VEHICLE;
-pub use wind::describe_wind_spec;
+pub use crate::vehicle::{builtin_names, DEFAULT_VEHICLE};
+pub use wind::{describe_wind_spec, read_wind_field};
 
 /// Model types that appear in requests and answers, re-exported so callers of the engine (the
 /// command line among them) need no model crate.

@@ -52,8 +52,9 @@
 //!   charge: over the scenarios flown to the end of the route (feasible, or landing short of the
 //!   reserve: `completed_scenarios`). A scenario that ends early (its pack empty or below its
 //!   cut-off, or a path it cannot fly) has no such figures: its energy up to where it stopped is
-//!   not the mission's, and counting it would pull the percentiles down. The same scenarios make
-//!   the state-of-charge fan ([`Uncertainty::soc_fan`]). Nearest rank: the `p`-th percentile of
+//!   not the mission's, and counting it would pull the percentiles down. The state-of-charge fan
+//!   ([`Uncertainty::soc_fan`]) is of every scenario: one that ends early keeps its last state of
+//!   charge after its end, so the fan shows the packs that run out. Nearest rank: the `p`-th percentile of
 //!   `n` values is the `ceil(p n / 100)`-th smallest, always a value some scenario gave.
 //! - `point_of_no_return_s`: over all scenarios, a scenario without a point of no return (safe to
 //!   turn back everywhere) counting as later than any time, a scenario that cannot be flown at
@@ -63,6 +64,8 @@
 //!   that falls among the scenarios without one is omitted.
 
 use std::borrow::Cow;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -128,6 +131,64 @@ pub struct ScenarioOptions {
     /// [`Uncertainty::soc_fan`] (a chart's bands; not in the JSON; default false).
     #[serde(skip)]
     pub soc_fan: bool,
+    /// What the request may spend, and whether its caller still wants the answer (not in the
+    /// JSON; default: no bound, never cancelled).
+    #[serde(skip)]
+    pub bounds: WorkBounds,
+}
+
+/// What one request's scenarios may spend: a caller that answers others (`aloft serve`) bounds
+/// the work of each request and stops the work whose answer nobody waits for any more.
+#[derive(Debug, Clone, Default)]
+pub struct WorkBounds {
+    /// Most planner steps (samples of the flight's time grid) over all the scenarios of a
+    /// mission, checked before any is flown from the plan's duration and time step
+    /// ([`Error::TooMuchWork`]); `None`: no bound.
+    pub max_steps: Option<u64>,
+    /// Set by the caller when the answer is no longer wanted: the scenarios stop before their
+    /// next flight with [`Error::Cancelled`].
+    pub cancel: Option<Arc<AtomicBool>>,
+}
+
+impl WorkBounds {
+    /// Whether the caller has given up on the answer.
+    fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
+    /// `samples` flights of about `steps_per_flight` steps each, against [`Self::max_steps`].
+    ///
+    /// # Errors
+    /// [`Error::TooMuchWork`] beyond the bound.
+    fn check(&self, samples: u32, steps_per_flight: u64) -> Result<(), Error> {
+        let Some(max_steps) = self.max_steps else {
+            return Ok(());
+        };
+        let steps = steps_per_flight.max(1);
+        if u64::from(samples).saturating_mul(steps) <= max_steps {
+            return Ok(());
+        }
+        Err(Error::TooMuchWork {
+            samples,
+            steps_per_flight: steps,
+            max_steps,
+            max_samples: max_steps / steps,
+        })
+    }
+}
+
+/// The same bounds: the same step bound and the same cancellation flag (or none).
+impl PartialEq for WorkBounds {
+    fn eq(&self, other: &Self) -> bool {
+        let same_flag = match (&self.cancel, &other.cancel) {
+            (None, None) => true,
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            _ => false,
+        };
+        self.max_steps == other.max_steps && same_flag
+    }
 }
 
 impl Default for ScenarioOptions {
@@ -142,6 +203,7 @@ impl Default for ScenarioOptions {
             power_sd_percent: DEFAULT_POWER_SD_PERCENT,
             threads: 0,
             soc_fan: false,
+            bounds: WorkBounds::default(),
         }
     }
 }
@@ -677,6 +739,25 @@ impl<'a> MissionScenarios<'a> {
         })
     }
 
+    /// The duration of the plan's flight, s: as compiled, or as flown where the envelope slows it
+    /// beyond its planned time.
+    fn nominal_duration_s(&self) -> Result<f64, Error> {
+        let plan = Flight {
+            aircraft: self.aircraft,
+            pack: &self.pack,
+            wind: &self.winds.nominal,
+            options: self.options,
+        };
+        let compiled = plan
+            .compile(&self.spec, self.payload_kg)
+            .map_err(|e| mission_error(self.origin, self.vehicle, e))?;
+        let planned: f64 = compiled.pieces().iter().map(|p| p.duration_s()).sum();
+        let flown = plan
+            .fly_into(&compiled, &mut NoSamples)
+            .map_or(0.0, |r| r.duration_s);
+        Ok(planned.max(flown))
+    }
+
     /// Fly scenario `index`, its samples into `sink` (the state-of-charge fan) when given.
     fn fly(
         &self,
@@ -705,10 +786,7 @@ impl<'a> MissionScenarios<'a> {
                 Some(h) => {
                     let mut sink = FanSink::new(h);
                     let r = flight.fly_into(&c, &mut sink);
-                    let completed = r.as_ref().is_ok_and(|r| {
-                        matches!(r.shortfall, None | Some(Shortfall::Reserve { .. }))
-                    });
-                    sink.finish(completed);
+                    sink.finish();
                     r
                 }
                 None => flight.fly_into(&c, &mut NoSamples),
@@ -750,30 +828,19 @@ pub fn plan_scenarios(
     let setup = MissionScenarios::new(vehicle, mission, options, sc)?;
     let n = sc.samples as usize;
     let keep_segments = n.saturating_mul(setup.spec.segments.len().max(1)) <= MAX_SEGMENT_VALUES;
-    let fan_grid = match sc.soc_fan {
-        // The grid spans 1.5 times the plan's flight: a scenario's flight beyond it is cut.
-        true => {
-            let plan = Flight {
-                aircraft: setup.aircraft,
-                pack: &setup.pack,
-                wind: &setup.winds.nominal,
-                options: setup.options,
-            };
-            let compiled = plan
-                .compile(&setup.spec, setup.payload_kg)
-                .map_err(|e| mission_error(setup.origin, setup.vehicle, e))?;
-            let planned: f64 = compiled.pieces().iter().map(|p| p.duration_s()).sum();
-            // The plan as flown: the envelope may slow it beyond its planned time.
-            let flown = plan
-                .fly_into(&compiled, &mut NoSamples)
-                .map_or(0.0, |r| r.duration_s);
-            Some(1.5 * planned.max(flown).max(1.0))
-        }
+    let nominal_s = match sc.soc_fan || sc.bounds.max_steps.is_some() {
+        true => Some(setup.nominal_duration_s()?),
         false => None,
     };
+    if let Some(d) = nominal_s {
+        let steps = (d / setup.options.time_step_s).ceil();
+        sc.bounds.check(sc.samples, steps as u64)?;
+    }
+    // The fan's grid spans 1.5 times the plan's flight: a scenario's flight beyond it is cut.
+    let fan_grid = nominal_s.filter(|_| sc.soc_fan).map(|d| 1.5 * d.max(1.0));
     let (records, fans) = run_indexed(
         n,
-        sc.thread_count(n),
+        (sc.thread_count(n), &sc.bounds),
         || fan_grid.map(FanHistogram::new),
         |i, fan| setup.fly(sc, i, keep_segments, fan.as_mut()),
     )?;
@@ -832,11 +899,12 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
 }
 
 /// Run `fly` for every index below `n` on `threads` scoped threads (thread `t` takes indices `t,
-/// t + threads, ...`), each with its own state from `state`: the results in index order and the
-/// states. The first error by index is returned, whatever thread met it.
+/// t + threads, ...`), each with its own state from `state`, until `bounds` is cancelled: the
+/// results in index order and the states. The first error by index is returned, whatever thread
+/// met it ([`Error::Cancelled`] once cancelled).
 fn run_indexed<R: Send, S: Send>(
     n: usize,
-    threads: usize,
+    (threads, bounds): (usize, &WorkBounds),
     state: impl Fn() -> S + Sync,
     fly: impl Fn(usize, &mut S) -> Result<R, Error> + Sync,
 ) -> Result<(Vec<R>, Vec<S>), Error> {
@@ -845,6 +913,9 @@ fn run_indexed<R: Send, S: Send>(
         let mut st = state();
         let mut out = Vec::with_capacity(n / threads + 1);
         for i in (t..n).step_by(threads) {
+            if bounds.cancelled() {
+                return Err((i, Error::Cancelled));
+            }
             match fly(i, &mut st) {
                 Ok(r) => out.push((i, r)),
                 Err(e) => return Err((i, e)),
@@ -946,7 +1017,7 @@ pub fn endurance_scenarios(
     let base_wind = options.wind.clone().unwrap_or_else(calm_spec);
     let (reports, _) = run_indexed(
         n,
-        sc.thread_count(n),
+        (sc.thread_count(n), &sc.bounds),
         || (),
         |i, ()| {
             let d = Draws::of(sc.seed, i);

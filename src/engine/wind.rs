@@ -98,6 +98,15 @@ pub(crate) fn steady(w: &WindSpec) -> Result<Wind, Error> {
     })
 }
 
+/// Read the gridded wind field of a CSV file (columns `x_m,y_m,z_m,u_mps,v_mps,w_mps`), checked
+/// whole: its description, as a mission flown in it names it.
+///
+/// # Errors
+/// A file that cannot be read or is not a wind field, naming the file, row and column.
+pub fn read_wind_field(path: &Path) -> Result<String, Error> {
+    field(path).map(|(_, text)| text)
+}
+
 /// A gridded wind field from its CSV file, with its extent in words.
 fn field(path: &Path) -> Result<(Wind, String), Error> {
     let grid = read_wind_grid(path)?;

@@ -106,6 +106,44 @@ pub fn one_line(message: &str) -> String {
     out
 }
 
+/// The most values (separators and brackets: `,` `[` `{` `=` `:`) a TOML or JSON text that aloft
+/// reads whole may hold: one million, which a 32 MiB QGroundControl plan of the usual shape (about
+/// 3 % of its bytes) does not reach, nor a mission of the planner's 50,000 segments.
+///
+/// A parser holds a tree of the whole text before the file's own types see it (about 150 bytes a
+/// value for TOML, 50 for JSON); a text of nothing but values (`x = [1,1,1,...]`) would take
+/// gigabytes from a file of 32 MiB. Counted before parsing, the tree stays under about 150 MB.
+pub const MAX_TEXT_VALUES: usize = 1_000_000;
+
+/// `Err(count)` when `text` holds more than [`MAX_TEXT_VALUES`] values (counted as the bytes
+/// `,` `[` `{` `=` `:`, inside strings too: an over-count only ever refuses a text of millions of
+/// them).
+///
+/// ```
+/// assert!(aloft_core::check_value_count("a = [1, 2, 3]").is_ok());
+/// let many = format!("a = [{}1]", "1,".repeat(aloft_core::MAX_TEXT_VALUES));
+/// assert!(aloft_core::check_value_count(&many).is_err());
+/// ```
+pub fn check_value_count(text: &str) -> Result<(), usize> {
+    let count = text
+        .bytes()
+        .filter(|b| matches!(b, b',' | b'[' | b'{' | b'=' | b':'))
+        .count();
+    if count > MAX_TEXT_VALUES {
+        Err(count)
+    } else {
+        Ok(())
+    }
+}
+
+/// The message of a text refused by [`check_value_count`].
+pub fn too_many_values(count: usize) -> String {
+    format!(
+        "{count} values (separators and brackets), more than the {MAX_TEXT_VALUES} aloft parses \
+         from one file: not a mission, vehicle or map of any size aloft plans"
+    )
+}
+
 /// A parser's message about a file (TOML, JSON), on one line ([`one_line`]) and without the
 /// file's content: the text serde quotes from the input (an unknown key or variant, a string of the
 /// wrong type or value, a duplicate key) is left out, the place (line and column) and what was

@@ -46,7 +46,9 @@ pub enum ImportError {
         offset: usize,
     },
     /// Text that is none of the planner formats (QGroundControl `.plan`, `QGC WPL 110`).
-    #[error("not a QGroundControl .plan (JSON with a fileType key) nor a QGC WPL 110 .waypoints file")]
+    #[error(
+        "not a QGroundControl .plan (JSON with a fileType key) nor a QGC WPL 110 .waypoints file"
+    )]
     UnknownFormat,
     /// A `.plan` that is not valid JSON.
     #[error("not valid JSON at line {line}, column {column}: {message}")]

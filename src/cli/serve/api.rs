@@ -3,16 +3,18 @@
 
 use std::sync::Arc;
 
-use axum::body::Bytes;
+use axum::body::Body;
 use axum::extract::{Query, State};
-use axum::http::{header, StatusCode};
+use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
 
 use aloft::engine::answers;
 use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags};
-use aloft::engine::{parse_keywords, FlagGroup, Keyword, Mission};
+use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
 
-use super::{blocking, error, json_type, Shared};
+use super::body::{declared_too_large, read_whole, MISSION_LIMIT};
+use super::files::Names;
+use super::{engine_message, error, json_type, Shared};
 
 /// The query of a request: its keys and values in order.
 pub(super) type QueryPairs = Query<Vec<(String, String)>>;
@@ -34,63 +36,91 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
         c.insert("tiles".into(), url.as_str().into());
         c.insert("attribution".into(), attribution.as_str().into());
     }
-    (
-        StatusCode::OK,
-        [(header::CONTENT_TYPE, json_type())],
-        config.to_string(),
-    )
-        .into_response()
+    json(config.to_string())
 }
 
-/// `GET /api/vehicles`.
-pub(super) async fn vehicles() -> Response {
-    blocking(answers::vehicles_answer).await
+/// A JSON answer.
+fn json(text: String) -> Response {
+    (StatusCode::OK, [(header::CONTENT_TYPE, json_type())], text).into_response()
+}
+
+/// `GET /api/vehicles`: answered at start (it depends on nothing a request gives), off the
+/// engine's queue.
+pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> Response {
+    json(shared.vehicles.clone())
 }
 
 /// `GET /api/endurance?OPTIONS`.
-pub(super) async fn endurance(Query(query): QueryPairs) -> Response {
-    let flags: EnduranceFlags = match flags("GET /api/endurance", &query) {
+pub(super) async fn endurance(
+    State(shared): State<Arc<Shared>>,
+    Query(query): QueryPairs,
+) -> Response {
+    let mut flags: EnduranceFlags = match flags("GET /api/endurance", &query, &shared) {
         Ok(f) => f,
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };
-    blocking(move || answers::endurance_answer(&flags)).await
+    let work = shared.clone();
+    let job = move |cancel: &_| {
+        work.work.bound(&mut flags.scenarios, cancel);
+        answers::endurance_answer(&flags).map_err(engine_message)
+    };
+    shared.work.run(job).await
 }
 
 /// `POST /api/mission?file=NAME&OPTIONS`.
-pub(super) async fn mission(Query(query): QueryPairs, body: Bytes) -> Response {
-    planned(
-        "POST /api/mission",
-        query,
-        body,
-        answers::mission_answer_for,
-    )
-    .await
+pub(super) async fn mission(
+    State(shared): State<Arc<Shared>>,
+    headers: HeaderMap,
+    Query(query): QueryPairs,
+    body: Body,
+) -> Response {
+    let request = "POST /api/mission";
+    let answer = answers::mission_answer_for;
+    planned(request, (shared, headers), query, body, answer).await
 }
 
 /// `POST /api/map?file=NAME&OPTIONS`: the page's map of the plan `/api/mission` answers.
-pub(super) async fn map(Query(query): QueryPairs, body: Bytes) -> Response {
-    planned(
-        "POST /api/map",
-        query,
-        body,
-        answers::mission_map_answer_for,
-    )
-    .await
+pub(super) async fn map(
+    State(shared): State<Arc<Shared>>,
+    headers: HeaderMap,
+    Query(query): QueryPairs,
+    body: Body,
+) -> Response {
+    let request = "POST /api/map";
+    let answer = answers::mission_map_answer_for;
+    planned(request, (shared, headers), query, body, answer).await
 }
 
-/// A mission request: its options, its mission (the body, or the demo when empty), the answer.
+/// A mission request: its options, its mission (the body, or the demo when empty, within
+/// [`MISSION_LIMIT`]), the answer.
 async fn planned(
     request: &str,
+    (shared, headers): (Arc<Shared>, HeaderMap),
     query: Vec<(String, String)>,
-    body: Bytes,
+    body: Body,
     answer: fn(&Mission, &MissionScenarioFlags) -> Result<String, aloft::Error>,
 ) -> Response {
-    let flags: MissionScenarioFlags = match flags(request, &query) {
+    let limit_name = "the limit on mission files";
+    if let Some(refused) = declared_too_large(&headers, MISSION_LIMIT, limit_name) {
+        return refused;
+    }
+    let mut flags: MissionScenarioFlags = match flags(request, &query, &shared) {
         Ok(f) => f,
         Err(m) => return error(StatusCode::BAD_REQUEST, &m),
     };
+    let body = match read_whole(body, MISSION_LIMIT, limit_name).await {
+        Ok(b) => b,
+        Err(refused) => return refused,
+    };
     let origin = file_name(&query, "upload");
-    blocking(move || answer(&mission_of(&body, &origin)?, &flags)).await
+    let work = shared.clone();
+    let job = move |cancel: &_| {
+        work.work.bound(&mut flags.scenarios, cancel);
+        mission_of(&body, &origin)
+            .and_then(|m| answer(&m, &flags))
+            .map_err(engine_message)
+    };
+    shared.work.run(job).await
 }
 
 /// The mission of an upload: the built-in demo when empty, else the file's text in any of the
@@ -106,12 +136,23 @@ fn mission_of(body: &[u8], origin: &str) -> Result<Mission, aloft::Error> {
     Mission::from_text(text, origin)
 }
 
-/// The query's options (all but `file`) as the command's flag group, or the message of a 400
-/// (naming the option and the `request`).
-pub(super) fn flags<T: FlagGroup>(request: &str, query: &[(String, String)]) -> Result<T, String> {
+/// The query's options (all but `file`) as the command's flag group, the options that name a
+/// file resolved to the files given to the server ([`Names`]); or the message of a 400 (naming
+/// the option and the `request`).
+pub(super) fn flags<T: FlagGroup>(
+    request: &str,
+    query: &[(String, String)],
+    shared: &Shared,
+) -> Result<T, String> {
+    let file_options = file_keywords::<T>();
+    let names = Names(&shared.files);
     // Each key's values, in order: one is a value (or a switch), several are a list.
-    let mut values: Vec<(&String, Vec<&str>)> = Vec::new();
+    let mut values: Vec<(&String, Vec<String>)> = Vec::new();
     for (k, v) in query.iter().filter(|(k, _)| k != "file") {
+        let v = match file_options.contains(k) {
+            true => names.resolve(request, k, v)?,
+            false => v.clone(),
+        };
         match values.iter_mut().find(|(g, _)| *g == k) {
             Some((_, vs)) => vs.push(v),
             None => values.push((k, vec![v])),
@@ -121,15 +162,15 @@ pub(super) fn flags<T: FlagGroup>(request: &str, query: &[(String, String)]) -> 
         .into_iter()
         .map(|(k, vs)| {
             let value = match vs.as_slice() {
-                ["true"] => Keyword::Switch(true),
-                ["false"] => Keyword::Switch(false),
-                [one] => Keyword::One((*one).into()),
-                many => Keyword::Many(many.iter().map(|v| (*v).into()).collect()),
+                [one] if one == "true" => Keyword::Switch(true),
+                [one] if one == "false" => Keyword::Switch(false),
+                [one] => Keyword::One(one.into()),
+                many => Keyword::Many(many.iter().map(Into::into).collect()),
             };
             (k.clone(), value)
         })
         .collect();
-    parse_keywords::<T>(request, &[], &given).map_err(super::super::engine_message)
+    parse_keywords::<T>(request, &[], &given).map_err(engine_message)
 }
 
 /// The upload's name (`file=`), else `default`.

@@ -16,17 +16,27 @@
 //!
 //! OPTIONS are the command's flags in snake_case, as the Python package's keywords
 //! (`payload_kg=0.5`, `no_ground_effect=true`); `file` names the upload as the command line would
-//! be given it (its name in the answer). Every answer is the engine's
-//! ([`aloft::engine::answers`]), so it is the command line's text; an infeasible mission is an
-//! answer (200). Errors: 400 with `{"error": ...}` for options the command does not take, 422
-//! for a request the engine refuses (the command line's one-line message), 413 for an upload
-//! past `--max-upload-mb`, 403 for a `Host` that is not the listening address (a page elsewhere
-//! reaching the server through DNS rebinding), 404 for anything else.
+//! be given it (its name in the answer). An option that names a file (`vehicle`, `wind_field`,
+//! `profile`) names a built-in or a file given on the command line, never another file of the
+//! server ([`files`]). Every answer is the engine's ([`aloft::engine::answers`]), so it is the
+//! command line's text; an infeasible mission is an answer (200).
+//!
+//! Errors, each `{"error": "..."}`: 400 for options the command does not take or a file option
+//! naming no given file, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
+//! server's, a page of another origin), 404 for anything else, 408 for a body that stops
+//! arriving, 413 for a body past its limit ([`body`]), 422 for a request the engine refuses (the
+//! command line's one-line message, a request for more work than [`work`] allows among them),
+//! 503 with `Retry-After` when the server is busy ([`work`]). Connections are bounded in number
+//! and time ([`conn`]).
 
 mod api;
 mod assets;
+mod body;
+mod conn;
 mod files;
+mod guard;
 mod live;
+mod work;
 
 use std::io::Write;
 use std::net::SocketAddr;
@@ -34,29 +44,37 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::{Context, Result};
-use axum::extract::{DefaultBodyLimit, Request, State};
 use axum::http::{header, HeaderValue, StatusCode};
-use axum::middleware::{self, Next};
+use axum::middleware;
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::Router;
 use clap::Args;
 
-use aloft::engine::DEFAULT_VEHICLE;
+use aloft::engine::{answers, DEFAULT_VEHICLE};
 
 use super::Outcome;
 
 #[derive(Debug, Args)]
 pub struct ServeArgs {
-    /// Missions (`.plan`, `.waypoints`, `.toml`, `.json`) and flight logs to open on the page.
+    /// Files to open on the page and for requests to name: missions (`.plan`, `.waypoints`,
+    /// `.toml`, `.json`), flight logs, vehicle files (`vehicle=NAME`), wind fields
+    /// (`wind_field=FILE`) and column maps (`profile=FILE`). A request names no other file.
     #[arg(value_name = "FILE")]
     files: Vec<PathBuf>,
-    /// Address to listen on (loopback by default: the page is for this machine).
+    /// Address to listen on (loopback by default: the page is for this machine; `0.0.0.0:PORT`
+    /// serves every interface, see docs/reliability.md).
     #[arg(long, default_value = "127.0.0.1:8080", value_name = "HOST:PORT")]
     listen: SocketAddr,
-    /// Largest upload (a mission or a log), MiB.
+    /// Largest log upload, MiB (a mission's body is limited to 32 MiB, as the command line's
+    /// mission files).
     #[arg(long, default_value_t = 256, value_name = "MIB")]
     max_upload_mb: usize,
+    /// Most planner steps of one request's scenarios (samples x steps of the flight): a request
+    /// for more is refused (422) naming the most samples that fit.
+    #[arg(long, default_value_t = work::DEFAULT_MAX_REQUEST_STEPS, value_name = "STEPS",
+        value_parser = clap::value_parser!(u64).range(1..))]
+    max_request_steps: u64,
     /// A tile layer under the route, as a URL template with `{z}`, `{x}` and `{y}` (none by
     /// default: the route over a plain background, offline).
     #[arg(long, value_name = "URL", requires = "attribution")]
@@ -84,16 +102,22 @@ pub struct ServeArgs {
 
 /// What every request shares.
 struct Shared {
-    /// The `Host` values accepted: the listening address, and `localhost` on loopback.
-    hosts: Vec<String>,
+    /// The names the server answers to.
+    hosts: guard::Hosts,
     /// The files given on the command line.
     files: Vec<files::Given>,
     /// The tile layer: URL template and attribution.
     tiles: Option<(String, String)>,
     /// The followed flight's updates, with `--live` or `--tlog`.
     live: Option<live::Feed>,
-    /// Largest upload, bytes.
+    /// Largest log upload, bytes.
     max_upload: usize,
+    /// The server's private folder of uploads.
+    uploads: PathBuf,
+    /// The engine's work: permits and bounds.
+    work: work::Pool,
+    /// `aloft vehicles --format json`, answered once.
+    vehicles: String,
 }
 
 pub fn run(args: ServeArgs) -> Result<Outcome> {
@@ -103,30 +127,51 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         }
     }
     let given = files::read_given(&args.files)?;
+    let uploads = tempfile::Builder::new()
+        .prefix("aloft-serve-")
+        .tempdir()
+        .context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
         .build()
         .context("starting the server's runtime")?;
-    runtime.block_on(serve(args, given))?;
+    let served = runtime.block_on(serve(args, given, uploads.path().to_path_buf()));
+    // Work still running for clients that have gone is not waited for; the uploads' folder is
+    // removed whatever happened.
+    runtime.shutdown_background();
+    drop(uploads);
+    served?;
     Ok(Outcome::Ok)
 }
 
-async fn serve(args: ServeArgs, given: Vec<files::Given>) -> Result<()> {
+async fn serve(args: ServeArgs, given: Vec<files::Given>, uploads: PathBuf) -> Result<()> {
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;
     let local = listener.local_addr()?;
     let live = live::start(&args)?;
-    let max_upload = args.max_upload_mb.saturating_mul(1 << 20);
     let shared = Arc::new(Shared {
-        hosts: accepted_hosts(local),
+        hosts: guard::Hosts::new(local),
         files: given,
         tiles: args.tiles.zip(args.attribution),
         live,
-        max_upload,
+        max_upload: args.max_upload_mb.saturating_mul(1 << 20),
+        uploads,
+        work: work::Pool::new(args.max_request_steps),
+        vehicles: answers::vehicles_answer()?,
     });
-    let app = Router::new()
+    let app = router(shared);
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "aloft serve: http://{local}/ (Ctrl-C to stop)")?;
+    out.flush()?;
+    drop(out);
+    conn::serve(listener, app).await
+}
+
+/// The routes, behind the checks of [`guard`].
+fn router(shared: Arc<Shared>) -> Router {
+    Router::new()
         .route("/api/config", get(api::config))
         .route("/api/vehicles", get(api::vehicles))
         .route("/api/endurance", get(api::endurance))
@@ -137,46 +182,8 @@ async fn serve(args: ServeArgs, given: Vec<files::Given>) -> Result<()> {
         .route("/api/files/{index}/info", get(files::given_log_info))
         .route("/api/live", get(live::events))
         .fallback(get(assets::asset))
-        .layer(DefaultBodyLimit::max(max_upload))
-        .layer(middleware::from_fn_with_state(shared.clone(), check_host))
-        .with_state(shared);
-    let mut out = std::io::stdout().lock();
-    writeln!(out, "aloft serve: http://{local}/ (Ctrl-C to stop)")?;
-    out.flush()?;
-    drop(out);
-    axum::serve(listener, app).await.context("serving")?;
-    Ok(())
-}
-
-/// The `Host` values of a server at `local`: the address itself, and on loopback `localhost`
-/// and `127.0.0.1` / `[::1]` with its port.
-fn accepted_hosts(local: SocketAddr) -> Vec<String> {
-    let port = local.port();
-    let mut hosts = vec![local.to_string()];
-    if local.ip().is_loopback() {
-        hosts.extend([
-            format!("localhost:{port}"),
-            format!("127.0.0.1:{port}"),
-            format!("[::1]:{port}"),
-        ]);
-    }
-    hosts
-}
-
-/// Refuse a request whose `Host` is not the server's own (DNS rebinding).
-async fn check_host(State(shared): State<Arc<Shared>>, request: Request, next: Next) -> Response {
-    let host = request
-        .headers()
-        .get(header::HOST)
-        .and_then(|h| h.to_str().ok())
-        .unwrap_or("");
-    if !shared.hosts.iter().any(|h| h.eq_ignore_ascii_case(host)) {
-        return error(
-            StatusCode::FORBIDDEN,
-            &format!("Host '{host}' is not this server's ({})", shared.hosts[0]),
-        );
-    }
-    next.run(request).await
+        .layer(middleware::from_fn_with_state(shared.clone(), guard::check))
+        .with_state(shared)
 }
 
 /// A JSON error answer.
@@ -189,34 +196,15 @@ fn json_type() -> HeaderValue {
     HeaderValue::from_static("application/json")
 }
 
-/// An engine answer: its JSON text, or the command line's message with 422.
-fn answer(result: Result<String, aloft::Error>) -> Response {
+/// An answer: its JSON text, or the command line's message with 422.
+fn answer(result: Result<String, String>) -> Response {
     match result {
         Ok(text) => (StatusCode::OK, [(header::CONTENT_TYPE, json_type())], text).into_response(),
-        Err(e) => error(StatusCode::UNPROCESSABLE_ENTITY, &super::engine_message(e)),
+        Err(message) => error(StatusCode::UNPROCESSABLE_ENTITY, &message),
     }
 }
 
-/// The engine's work of a request on the blocking pool, and its answer.
-async fn blocking(
-    work: impl FnOnce() -> Result<String, aloft::Error> + Send + 'static,
-) -> Response {
-    answer(on_blocking_pool(work).await)
-}
-
-/// The engine's work of a request on the blocking pool (the server's threads go on serving).
-async fn on_blocking_pool(
-    work: impl FnOnce() -> Result<String, aloft::Error> + Send + 'static,
-) -> Result<String, aloft::Error> {
-    tokio::task::spawn_blocking(work)
-        .await
-        .unwrap_or_else(join_error)
-}
-
-/// A request's work that panicked: never expected (the engine does not panic on any input), said
-/// as an error rather than taking the server down.
-fn join_error(e: tokio::task::JoinError) -> Result<String, aloft::Error> {
-    Err(aloft::Error::Link(format!(
-        "the request's work failed: {e}"
-    )))
+/// The command line's one-line message of an engine error.
+fn engine_message(e: aloft::Error) -> String {
+    super::engine_message(e)
 }
