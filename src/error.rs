@@ -181,7 +181,7 @@ pub enum Error {
         origin: String,
     },
     /// A log whose time stamps span far longer than its samples could cover.
-    #[error("{origin}: the time stamps span {span_s:.3e} s for {samples} samples: a time stamp is off (see `aloft log info`)")]
+    #[error("{origin}: the time stamps span {} s for {samples} samples: a time stamp is off (see `aloft log info`)", aloft_core::Num::of(.span_s))]
     SparseTime {
         /// File.
         origin: String,
@@ -251,7 +251,7 @@ pub enum Error {
         source: Box<aloft_planner::PlannerError>,
     },
     /// A number outside its valid range in an option or a measured sample.
-    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
+    #[error("{name} = {}{} is invalid: expected {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
     InvalidInput {
         /// Option or field name, with its unit suffix.
         name: &'static str,
@@ -378,7 +378,7 @@ pub enum Error {
         source: aloft_power::PowerError,
     },
     /// The take-off mass exceeds the airframe's limit.
-    #[error("take-off mass {mass_kg:.3} kg (airframe + {battery} + payload) exceeds the vehicle's {max_kg:.3} kg limit")]
+    #[error("take-off mass {} kg (airframe + {battery} + payload) exceeds the vehicle's {} kg limit", aloft_core::Fixed(*.mass_kg, 3), aloft_core::Fixed(*.max_kg, 3))]
     TooHeavy {
         /// Take-off mass asked for, kg.
         mass_kg: f64,
@@ -397,7 +397,7 @@ pub enum Error {
     },
     /// No payload of a sweep can be carried with any of the packs swept: every take-off mass
     /// exceeds the airframe's limit.
-    #[error("every payload from {start_kg} kg exceeds the {max_takeoff_mass_kg:.3} kg maximum take-off mass with every pack swept (the most any of them leaves for payload is {max_payload_kg:.3} kg)")]
+    #[error("every payload from {start_kg} kg exceeds the {} kg maximum take-off mass with every pack swept (the most any of them leaves for payload is {} kg)", aloft_core::Fixed(*.max_takeoff_mass_kg, 3), aloft_core::Fixed(*.max_payload_kg, 3))]
     SweepTooHeavy {
         /// The sweep's first payload, kg.
         start_kg: f64,

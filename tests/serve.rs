@@ -6,89 +6,11 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{BufRead, BufReader, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
 
+use common::serve::{encoded, Server};
 use common::{aloft, data_dir};
-
-/// A server on a free loopback port, stopped when dropped.
-struct Server {
-    child: Child,
-    address: String,
-}
-
-impl Server {
-    fn start(extra: &[&str]) -> Self {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_aloft"))
-            .args(["serve", "--listen", "127.0.0.1:0"])
-            .args(extra)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("aloft serve starts");
-        let mut line = String::new();
-        BufReader::new(child.stdout.as_mut().unwrap())
-            .read_line(&mut line)
-            .expect("the URL line");
-        let address = line
-            .split("http://")
-            .nth(1)
-            .and_then(|r| r.split('/').next())
-            .unwrap_or_else(|| panic!("no URL in {line:?}"))
-            .to_string();
-        Self { child, address }
-    }
-
-    /// One request (HTTP/1.1, the connection closed after it): status and body.
-    fn request(&self, method: &str, path: &str, host: Option<&str>, body: &[u8]) -> (u16, String) {
-        let mut s = TcpStream::connect(&self.address).expect("connect");
-        let head = format!(
-            "{method} {path} HTTP/1.1\r\nHost: {}\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
-            host.unwrap_or(&self.address),
-            body.len()
-        );
-        s.write_all(head.as_bytes()).expect("request head");
-        // The server may answer (413) and close before the whole body is read.
-        let _ = s.write_all(body);
-        let mut raw = Vec::new();
-        let _ = s.read_to_end(&mut raw);
-        let text = String::from_utf8_lossy(&raw).into_owned();
-        let status: u16 = text
-            .split(' ')
-            .nth(1)
-            .and_then(|c| c.parse().ok())
-            .unwrap_or_else(|| panic!("no status in {text:?}"));
-        let body = text
-            .split_once("\r\n\r\n")
-            .map_or("", |(_, b)| b)
-            .to_string();
-        (status, body)
-    }
-
-    fn get(&self, path: &str) -> (u16, String) {
-        self.request("GET", path, None, b"")
-    }
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-/// `text` as a query value (percent-encoded but for unreserved characters and `/`).
-fn encoded(text: &str) -> String {
-    text.bytes()
-        .map(|b| match b {
-            b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'.' | b'_' | b'~' | b'/' => {
-                (b as char).to_string()
-            }
-            _ => format!("%{b:02X}"),
-        })
-        .collect()
-}
 
 /// The command line's JSON text (its stdout without the final line break).
 fn cli(args: &[&str]) -> String {
@@ -195,9 +117,9 @@ fn the_api_refuses_bad_requests_and_keeps_serving() {
     // A page elsewhere reaching the server by DNS rebinding.
     let (code, body) = server.request("GET", "/api/vehicles", Some("evil.example:80"), b"");
     assert_eq!(code, 403, "{body}");
-    // Past the limit: 413, and the server goes on.
+    // Past the limit (a log's, --max-upload-mb): 413, and the server goes on.
     let big = vec![b'#'; 2 << 20];
-    let (code, _) = server.request("POST", "/api/mission", None, &big);
+    let (code, _) = server.request("POST", "/api/log/info?file=big.bin", None, &big);
     assert_eq!(code, 413);
     let (code, _) = server.get("/api/vehicles");
     assert_eq!(code, 200);

@@ -380,7 +380,30 @@ pub(super) fn check_options(options: &MissionOptions) -> Result<(), Error> {
         _ => Ok(()),
     };
     positive("speed_mps", options.speed_mps, "m/s")?;
-    positive("rtl_altitude_m", options.rtl_altitude_m, "m")
+    positive("rtl_altitude_m", options.rtl_altitude_m, "m")?;
+    let start = options.start_percent;
+    if !(start.is_finite() && start > 0.0 && start <= 100.0) {
+        return Err(Error::InvalidInput {
+            name: "start_percent",
+            value: start,
+            unit: "%",
+            expected: "a state of charge above 0 and at most 100 %",
+        });
+    }
+    match options.payload_kg {
+        Some(p)
+            if !(p.is_finite()
+                && (0.0..=aloft_planner::mission::MAX_MISSION_VALUE).contains(&p)) =>
+        {
+            Err(Error::InvalidInput {
+                name: "payload_kg",
+                value: p,
+                unit: "kg",
+                expected: "from 0 to 1e7 kg",
+            })
+        }
+        _ => Ok(()),
+    }
 }
 
 /// The planner's options: the request's, else the mission file's, else the defaults (reserve

@@ -302,7 +302,11 @@ mod tests {
         // The grid stops at the longest flight (199 s), one grid step (1 s) beyond at most.
         assert!(*fan.time_s.last().unwrap() >= 199.0 && *fan.time_s.last().unwrap() < 201.0);
         // Within one bin (1e-3) of the value, by rounding.
-        assert!(fan.p5.iter().all(|p| (p - 0.3).abs() <= 1e-3), "{:?}", fan.p5);
+        assert!(
+            fan.p5.iter().all(|p| (p - 0.3).abs() <= 1e-3),
+            "{:?}",
+            fan.p5
+        );
         assert!((fan.p95[0] - 0.894).abs() <= 1e-3, "{}", fan.p95[0]);
         assert!(fan.p5.iter().zip(&fan.p95).all(|(a, b)| a <= b));
     }

@@ -7,6 +7,7 @@
 mod data;
 pub mod mission_toml;
 pub mod ros2;
+pub mod serve;
 
 pub use data::data_dir;
 

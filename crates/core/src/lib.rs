@@ -63,6 +63,48 @@ impl std::fmt::Display for Num {
     }
 }
 
+/// A number with `decimals` decimals as a message shows it (`{:.3}`), in scientific notation
+/// when it is too large for that to be readable (`1.000e308`, not 309 digits and three zeros).
+///
+/// ```
+/// use aloft_core::Fixed;
+/// assert_eq!(Fixed(2.3554, 3).to_string(), "2.355");
+/// assert_eq!(Fixed(1e308, 3).to_string(), "1.000e308");
+/// assert_eq!(Fixed(-1e20, 1).to_string(), "-1.0e20");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fixed(pub f64, pub usize);
+
+impl std::fmt::Display for Fixed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Self(value, decimals) = *self;
+        if value.is_finite() && value.abs() >= 1e15 {
+            write!(f, "{value:.decimals$e}")
+        } else {
+            write!(f, "{value:.decimals$}")
+        }
+    }
+}
+
+/// A unit after a number in a message: ` m/s`, or nothing for a number without one (so that
+/// `start_soc = 1.5 is invalid` has one space).
+///
+/// ```
+/// assert_eq!(format!("1{}", aloft_core::Unit("m/s")), "1 m/s");
+/// assert_eq!(format!("1{}", aloft_core::Unit("")), "1");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Unit<'a>(pub &'a str);
+
+impl std::fmt::Display for Unit<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.0 {
+            "" => Ok(()),
+            u => write!(f, " {u}"),
+        }
+    }
+}
+
 /// A parser's message on one line: TOML errors come with a snippet of the file (a line number
 /// gutter, the line, a caret under the spot) between their first line and the explanation; the
 /// snippet is dropped and the rest joined with `: `, so a message names the line, the column and

@@ -91,8 +91,12 @@ pub enum ImportError {
         expected: &'static str,
     },
     /// A `.waypoints` file whose first line is not `QGC WPL 110`.
-    #[error("line 1: the header is not \"QGC WPL 110\" (another version of the format?)")]
-    BadHeader,
+    #[error("line 1: the header is {}, expected \"QGC WPL 110\"", match .version { Some(v) => format!("version {v} of the format"), None => "not a version of the format".to_string() })]
+    BadHeader {
+        /// The version the header names, when it is a short number (nothing else of the line is
+        /// quoted: the file may be any file).
+        version: Option<String>,
+    },
     /// A `.waypoints` line that does not have 12 tab-separated fields.
     #[error("line {line}: {found} tab-separated fields, expected 12 (INDEX CURRENT FRAME COMMAND P1 P2 P3 P4 LAT LON ALT AUTOCONTINUE)")]
     FieldCount {
@@ -166,8 +170,8 @@ pub enum ImportError {
         /// The repeat count as written.
         repeat: f64,
     },
-    /// The route with its jumps unrolled is longer than [`crate::MAX_FLOWN_ITEMS`].
-    #[error("{at}: the route with its jumps unrolled passes {limit} flown items here (a loop repeated too often)")]
+    /// The jumps add more passes of items than [`crate::MAX_REPEATED_ITEMS`].
+    #[error("{at}: the jumps repeat more than {limit} items by here (a loop repeated too often)")]
     TooManyItems {
         /// Where the limit was passed.
         at: Place,

@@ -6,18 +6,19 @@
 //! jump nested in a repeated loop repeats only the first time round. The target is a `doJumpId`
 //! in a `.plan` and a row INDEX in a `.waypoints` file.
 //!
-//! The unrolled route is bounded: at most [`MAX_FLOWN_ITEMS`] items (jumps included) are passed;
-//! beyond it the file is refused at the item where the limit was passed. A repeat count of -1
-//! (for ever) is refused.
+//! The unrolled route is bounded: the jumps may add at most [`MAX_REPEATED_ITEMS`] passes of
+//! items (jumps included) to the file's own; beyond it the file is refused at the item where the
+//! limit was passed. A file without jumps is not bounded here (the planner bounds its segments).
+//! A repeat count of -1 (for ever) is refused.
 
 use crate::commands::DO_JUMP;
 use crate::error::ImportError;
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
 
-/// Most items the route may pass with its jumps unrolled: 20,000 (a survey of a 500 KB `.plan`
-/// has about 2,000); each becomes up to three segments, within the planner's 50,000.
-pub const MAX_FLOWN_ITEMS: usize = 20_000;
+/// Most passes of items the jumps may add to the route: 20,000 (a survey of a 500 KB `.plan`
+/// has about 2,000 items); each becomes up to three segments, and the planner takes 50,000.
+pub const MAX_REPEATED_ITEMS: usize = 20_000;
 
 /// How a DO_JUMP names its target.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,10 +57,10 @@ pub(crate) fn flying_order(
     let mut order = Vec::with_capacity(items.len());
     let mut pc = 0;
     while pc < items.len() {
-        if order.len() == MAX_FLOWN_ITEMS {
+        if order.len() == items.len() + MAX_REPEATED_ITEMS {
             return Err(ImportError::TooManyItems {
                 at: items[pc].at,
-                limit: MAX_FLOWN_ITEMS,
+                limit: MAX_REPEATED_ITEMS,
             });
         }
         order.push(pc);
@@ -89,7 +90,7 @@ fn resolve(
         });
     }
     // Beyond the limit any count is refused alike; keep the integer small.
-    let repeats = repeat.min(MAX_FLOWN_ITEMS as f64 + 1.0) as u64;
+    let repeats = repeat.min(MAX_REPEATED_ITEMS as f64 + 1.0) as u64;
     let whole = target.is_finite() && target.fract() == 0.0 && target.abs() < 1e9;
     let found = whole
         .then(|| match by {
@@ -164,6 +165,24 @@ mod tests {
         assert_eq!(numbers, [1, 2, 3, 2, 3, 4, 5, 1, 2, 3, 4, 5]);
     }
 
+    /// Regression (issue 32): a plan of 20,000 waypoints and no DO_JUMP was refused as "a loop
+    /// repeated too often": the bound is on what the jumps add.
+    #[test]
+    fn a_long_route_without_jumps_is_not_a_loop() {
+        let items: Vec<RawItem> = (1..=25_000).map(|n| item(n, 16, 0.0, 0.0)).collect();
+        let order = flying_order(&items, JumpsBy::RowIndex, &mut Notes::default()).unwrap();
+        assert_eq!(order.len(), 25_000);
+        // With a loop, the jumps may add 20,000 passes and no more.
+        let mut looped = items[..100].to_vec();
+        // 197 repeats: 101 x 198 = 19,998 passes, 19,897 of them added.
+        looped.push(item(101, DO_JUMP, 1.0, 197.0));
+        let order = flying_order(&looped, JumpsBy::RowIndex, &mut Notes::default()).unwrap();
+        assert_eq!(order.len(), 101 * 198);
+        // 199 repeats: 20,200 passes, 20,099 added.
+        looped[100] = item(101, DO_JUMP, 1.0, 199.0);
+        assert!(flying_order(&looped, JumpsBy::RowIndex, &mut Notes::default()).is_err());
+    }
+
     #[test]
     fn endless_and_huge_loops_and_missing_targets_are_refused_naming_the_item() {
         let endless = [item(1, 16, 0.0, 0.0), item(2, DO_JUMP, 1.0, -1.0)];
@@ -179,7 +198,7 @@ mod tests {
             matches!(
                 e,
                 ImportError::TooManyItems {
-                    limit: MAX_FLOWN_ITEMS,
+                    limit: MAX_REPEATED_ITEMS,
                     ..
                 }
             ),

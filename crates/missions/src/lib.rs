@@ -63,7 +63,7 @@ pub use detect::detect;
 pub use error::{ImportError, Place};
 pub use geo::{distance_m, great_circle_m, LatLon, MEAN_RADIUS_M};
 pub use items::MIN_HEIGHT_M;
-pub use jumps::MAX_FLOWN_ITEMS;
+pub use jumps::MAX_REPEATED_ITEMS;
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};

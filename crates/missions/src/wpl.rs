@@ -52,7 +52,14 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
     let mut lines = text.lines().enumerate();
     let header = lines.next().map_or("", |(_, l)| l.trim());
     if header != "QGC WPL 110" {
-        return Err(ImportError::BadHeader);
+        let version = header
+            .strip_prefix("QGC WPL")
+            .map(str::trim)
+            .filter(|v| {
+                (1..=8).contains(&v.len()) && v.bytes().all(|b| b.is_ascii_digit() || b == b'.')
+            })
+            .map(str::to_string);
+        return Err(ImportError::BadHeader { version });
     }
     let mut rows = Vec::new();
     for (k, line) in lines {
@@ -236,7 +243,7 @@ mod tests {
     fn the_header_fields_and_numbers_are_checked_naming_the_line_and_column() {
         assert_eq!(
             err("QGC WPL 120\n"),
-            "line 1: header is \"QGC WPL 120\", expected \"QGC WPL 110\""
+            "line 1: the header is version 120 of the format, expected \"QGC WPL 110\""
         );
         let short = format!("QGC WPL 110\n{HOME}\n1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\n");
         assert!(err(&short).starts_with("line 3: 11 tab-separated fields, expected 12"));

@@ -14,7 +14,7 @@ pub enum PlannerError {
     #[error(transparent)]
     Propulsion(#[from] aloft_propulsion::PropulsionError),
     /// A parameter outside its valid range.
-    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
+    #[error("{name} = {}{} is invalid: expected {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
     InvalidParameter {
         /// Parameter name (with its unit suffix).
         name: &'static str,
@@ -35,7 +35,7 @@ pub enum PlannerError {
     #[error("the mission has no segments: add at least a take-off and a landing")]
     EmptyMission,
     /// A mission segment that is invalid in itself.
-    #[error("segment {index} ({kind}{}): {name} = {} {unit} is invalid: {expected}", ItemNote(*.item), aloft_core::Num::of(.value))]
+    #[error("segment {index} ({kind}{}): {name} = {}{} is invalid: {expected}", ItemNote(*.item), aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
     InvalidSegment {
         /// Segment number, from 1.
         index: usize,
@@ -53,7 +53,7 @@ pub enum PlannerError {
         expected: &'static str,
     },
     /// A segment asks for something the vehicle cannot do (speed, climb rate, turn load).
-    #[error("segment {index} ({kind}{}): {name} = {value:.3} {unit} is beyond the vehicle's limit of {limit:.3} {unit}", ItemNote(*.item))]
+    #[error("segment {index} ({kind}{}): {name} = {}{} is beyond the vehicle's limit of {}{}", ItemNote(*.item), aloft_core::Fixed(*.value, 3), aloft_core::Unit(.unit), aloft_core::Fixed(*.limit, 3), aloft_core::Unit(.unit))]
     Unreachable {
         /// Segment number, from 1.
         index: usize,
@@ -83,7 +83,7 @@ pub enum PlannerError {
         reason: &'static str,
     },
     /// The gridded wind field does not cover a point of the route.
-    #[error("the wind grid does not cover the route at t = {time_s:.1} s: E {east_m:.1} m, N {north_m:.1} m, alt {up_m:.1} m (grid spans E {min_m:?}..{max_m:?} m as [E, N, Up])")]
+    #[error("the wind grid does not cover the route at t = {} s: E {} m, N {} m, alt {} m (grid spans E {min_m:?}..{max_m:?} m as [E, N, Up])", aloft_core::Fixed(*.time_s, 1), aloft_core::Fixed(*.east_m, 1), aloft_core::Fixed(*.north_m, 1), aloft_core::Fixed(*.up_m, 1))]
     OutsideWindGrid {
         /// Mission time, s.
         time_s: f64,
@@ -107,7 +107,7 @@ pub enum PlannerError {
         found: f64,
     },
     /// A battery description that is inconsistent.
-    #[error("battery '{name}': {key} = {} {unit} is invalid: {expected}", aloft_core::Num::of(.value))]
+    #[error("battery '{name}': {key} = {}{} is invalid: {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
     InvalidBattery {
         /// Pack name.
         name: String,
@@ -143,7 +143,7 @@ pub enum PlannerError {
         max_s: f64,
     },
     /// A flight that would take more steps than the limit (a tiny time step, a huge hold).
-    #[error("the flight takes more than {limit} samples at a time step of {time_step_s} s (stopped at t = {flown_s:.0} s of flight): raise the time step (--time-step) to at least {suggested_time_step_s:.3e} s")]
+    #[error("the flight takes more than {limit} samples at a time step of {time_step_s} s (stopped at t = {} s of flight): raise the time step (--time-step) to at least {} s", aloft_core::Fixed(*.flown_s, 0), aloft_core::Num::of(.suggested_time_step_s))]
     TooManySamples {
         /// The limit on samples (steps).
         limit: u64,
@@ -169,7 +169,7 @@ pub enum PlannerError {
         key: &'static str,
     },
     /// The speed search of a query found no airspeed that can be flown.
-    #[error("no airspeed between {min_mps:.1} and {max_mps:.1} m/s can make headway along the course in this wind")]
+    #[error("no airspeed between {} and {} m/s can make headway along the course in this wind", aloft_core::Fixed(*.min_mps, 1), aloft_core::Fixed(*.max_mps, 1))]
     NoHeadway {
         /// Lower end of the search, m/s.
         min_mps: f64,

@@ -42,7 +42,7 @@ pub enum PropulsionError {
         resistance_ohm: f64,
     },
     /// Any other parameter outside its valid range.
-    #[error("{name} = {} {unit} is invalid: expected {expected}", aloft_core::Num::of(.value))]
+    #[error("{name} = {}{} is invalid: expected {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
     InvalidParameter {
         /// Parameter name, with its unit suffix.
         name: &'static str,
@@ -64,7 +64,7 @@ pub enum PropulsionError {
         expected: &'static str,
     },
     /// The pack cannot deliver the requested power, whatever the current (eqs 29-30).
-    #[error("a pack cannot deliver {power_w:.1} W: its maximum is {max_power_w:.1} W (full-charge voltage and internal resistance, eqs 29-30)")]
+    #[error("a pack cannot deliver {} W: its maximum is {} W (full-charge voltage and internal resistance, eqs 29-30)", aloft_core::Fixed(*.power_w, 1), aloft_core::Fixed(*.max_power_w, 1))]
     PowerExceedsPack {
         /// Power asked of one pack, W.
         power_w: f64,
@@ -72,7 +72,7 @@ pub enum PropulsionError {
         max_power_w: f64,
     },
     /// The pack current needed exceeds the pack's rated continuous current.
-    #[error("pack current {current_a:.1} A exceeds the pack's rated {limit_a:.1} A")]
+    #[error("pack current {} A exceeds the pack's rated {} A", aloft_core::Fixed(*.current_a, 1), aloft_core::Fixed(*.limit_a, 1))]
     PackCurrentLimit {
         /// Current required, A.
         current_a: f64,
@@ -80,7 +80,7 @@ pub enum PropulsionError {
         limit_a: f64,
     },
     /// The thrust asked of a rotor needs more motor current than the motor's rating.
-    #[error("thrust {thrust_n:.2} N per rotor needs {current_a:.1} A of motor current, above the motor's {limit_a:.1} A limit")]
+    #[error("thrust {} N per rotor needs {} A of motor current, above the motor's {} A limit", aloft_core::Fixed(*.thrust_n, 2), aloft_core::Fixed(*.current_a, 1), aloft_core::Fixed(*.limit_a, 1))]
     CurrentLimitExceeded {
         /// Thrust asked of one rotor, N.
         thrust_n: f64,

@@ -21,7 +21,11 @@ use super::error;
 pub(super) const MISSION_LIMIT: usize = aloft::engine::MAX_INPUT_BYTES as usize;
 
 /// 413 when the body's declared length is over `limit` bytes (`what` names the limit).
-pub(super) fn declared_too_large(headers: &HeaderMap, limit: usize, what: &str) -> Option<Response> {
+pub(super) fn declared_too_large(
+    headers: &HeaderMap,
+    limit: usize,
+    what: &str,
+) -> Option<Response> {
     let declared = headers
         .get(header::CONTENT_LENGTH)?
         .to_str()

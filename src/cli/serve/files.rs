@@ -26,8 +26,7 @@ use tokio::io::AsyncWriteExt;
 use aloft::engine::answers;
 use aloft::engine::flags::LogInfoFlags;
 use aloft::engine::{
-    builtin_names, check_profile, parse_keywords, read_text_file, read_wind_field, Mission,
-    Vehicle,
+    builtin_names, check_profile, parse_keywords, read_text_file, read_wind_field, Mission, Vehicle,
 };
 
 use super::api::{file_name, flags, QueryPairs};
@@ -134,9 +133,8 @@ impl Names<'_> {
             _ => "",
         };
         let given = self.0.iter().filter(|g| g.kind() == kind);
-        let by_name = |g: &&Given| {
-            g.name == value || matches!(&g.content, Content::Vehicle(n) if n == value)
-        };
+        let by_name =
+            |g: &&Given| g.name == value || matches!(&g.content, Content::Vehicle(n) if n == value);
         if let Some(g) = given.clone().find(by_name) {
             return Ok(g.name.clone());
         }

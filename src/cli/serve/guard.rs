@@ -198,7 +198,12 @@ mod tests {
     #[test]
     fn loopback_answers_to_its_address_and_localhost_only() {
         let h = hosts("127.0.0.1:8080", Some("field-laptop"));
-        for ok in ["127.0.0.1:8080", "localhost:8080", "LOCALHOST:8080", "[::1]:8080"] {
+        for ok in [
+            "127.0.0.1:8080",
+            "localhost:8080",
+            "LOCALHOST:8080",
+            "[::1]:8080",
+        ] {
             assert!(h.accepts(ok, None), "{ok}");
         }
         for no in [

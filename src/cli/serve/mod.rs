@@ -127,10 +127,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         }
     }
     let given = files::read_given(&args.files)?;
-    let uploads = tempfile::Builder::new()
-        .prefix("aloft-serve-")
-        .tempdir()
-        .context("creating the uploads' folder")?;
+    let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -143,6 +140,19 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
     drop(uploads);
     served?;
     Ok(Outcome::Ok)
+}
+
+/// The server's private folder of uploads: a random name in the temporary directory, readable
+/// by this user only.
+fn uploads_folder() -> std::io::Result<tempfile::TempDir> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix("aloft-serve-");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o700));
+    }
+    builder.tempdir()
 }
 
 async fn serve(args: ServeArgs, given: Vec<files::Given>, uploads: PathBuf) -> Result<()> {

@@ -99,7 +99,9 @@ impl Drop for CancelOnDrop {
 fn busy(capacity: usize) -> Response {
     let mut response = error(
         StatusCode::SERVICE_UNAVAILABLE,
-        &format!("the server is busy with {capacity} requests (twice its cores): try again shortly"),
+        &format!(
+            "the server is busy with {capacity} requests (twice its cores): try again shortly"
+        ),
     );
     response
         .headers_mut()

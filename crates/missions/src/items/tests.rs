@@ -521,7 +521,7 @@ fn a_jump_loop_beyond_the_limit_is_refused_naming_the_row() {
     );
     let e = read_waypoints(&t).unwrap_err().to_string();
     assert!(
-        e.starts_with("row ") && e.contains("20000 flown items"),
+        e.starts_with("row ") && e.contains("repeat more than 20000 items"),
         "{e}"
     );
     let endless = t.replace("50000", "-1");
