@@ -65,7 +65,7 @@ pub struct LiveUpdate {
     pub power_w: Option<f64>,
     /// Whether the source measures power (without it the prediction is the model's alone).
     pub power_available: bool,
-    /// The efficiency the rest is predicted with (re-estimated in flight).
+    /// The efficiency the rest is predicted with (re-estimated in flight), in (0, 1].
     pub efficiency: f64,
     /// Wind speed, m/s (horizontal).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -426,11 +426,7 @@ impl<'a> LiveSession<'a> {
             self.rest_s = d.p50;
         }
         let note = match (note, self.eta0 / ratio.ratio > 1.0) {
-            (None, true) => Some(
-                "the measured power is below the model's at any efficiency up to 1: the vehicle \
-                 file does not describe this vehicle (the rest is flown at efficiency 1)"
-                    .to_string(),
-            ),
+            (None, true) => Some(estimate::EFFICIENCY_HELD_NOTE.to_string()),
             (note, _) => note,
         };
         self.answer_update(soc, ratio, answer, note)
@@ -474,7 +470,7 @@ impl<'a> LiveSession<'a> {
             energy_used_wh: t.energy_used_wh(),
             power_w: t.power_w,
             power_available: t.power_available(),
-            efficiency: self.eta0 / ratio.ratio,
+            efficiency: estimate::flown_efficiency(self.eta0, ratio.ratio),
             wind_mps: wind.map(|w| w[0].hypot(w[1])),
             wind_from_deg: wind.map(tracker::wind_from_deg),
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
