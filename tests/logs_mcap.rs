@@ -119,6 +119,8 @@ fn ros2_cdr_topics_are_chosen_by_type_without_mixing_sources() {
     assert_eq!(bat.len(), 10);
     // BatteryState current is negative when discharging: aloft's is positive.
     assert!((bat[0].current_a.unwrap() - 10.0).abs() < TOL);
+    // `percentage` is the reported state of charge (0.8 as f32: 1e-7 covers its rounding).
+    assert!((bat[0].soc.unwrap() - 0.8).abs() < 1e-7, "{:?}", bat[0].soc);
     let v = samples.iter().find_map(|s| s.vel_enu_mps).unwrap();
     assert_eq!(v, [1.0, -2.0, 0.5]);
     let topics = r.topics();
@@ -238,6 +240,31 @@ fn committed_truncated_fixture_reports_messages_read() {
     let e = read_log(&fixture("truncated.mcap"), None, &McapOptions::default()).unwrap_err();
     assert!(matches!(e, LogError::Mcap { .. }), "{e}");
     assert!(e.to_string().contains("truncated.mcap"), "{e}");
+}
+
+/// The state of charge an autopilot reports (`Sample::soc`) is written as `state_of_charge` of
+/// `/aloft/battery` and read back, where the sample has it and nowhere else.
+#[test]
+fn the_reported_state_of_charge_reads_back() {
+    let mut log = read_log(
+        &fixture("kaist_small.csv"),
+        Some(&Profile::Kaist),
+        &McapOptions::default(),
+    )
+    .unwrap();
+    for (k, s) in log.samples.iter_mut().enumerate() {
+        s.soc = (k % 2 == 0).then_some(0.69 - 0.001 * k as f64);
+    }
+    let out = tmp("kaist_small_soc.mcap");
+    write_log_mcap(&out, &log).unwrap();
+    let back = read_log(&out, None, &McapOptions::default()).unwrap();
+    assert_eq!(back.samples.len(), log.samples.len());
+    for (a, b) in log.samples.iter().zip(&back.samples) {
+        match (a.soc, b.soc) {
+            (Some(x), Some(y)) => assert!((x - y).abs() < TOL, "{x} {y}"),
+            (x, y) => assert_eq!(x, y),
+        }
+    }
 }
 
 fn log_round_trip_file() -> (aloft_logs::Log, PathBuf) {

@@ -558,7 +558,7 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
                 .flatten()
                 .collect();
             v.extend(
-                [s.voltage_v, s.current_a, s.power_w, s.charge_ah]
+                [s.voltage_v, s.current_a, s.power_w, s.charge_ah, s.soc]
                     .into_iter()
                     .flatten(),
             );

@@ -16,7 +16,9 @@
 //! - `BAT` of the chosen instance (`Instance` or `Inst`), else old `CURR`: `Volt`, `Curr`. Old
 //!   `CURR` integers have no multiplier in the file: their scale (centi-units in the logs seen)
 //!   is chosen so the first non-zero voltage is 3.3-4.4 V per cell for some 1-14 cells. A
-//!   record counts when `Volt` > 0 (a battery that reads 0 V has no sensor).
+//!   record counts when `Volt` > 0 (a battery that reads 0 V has no sensor). `BAT.RemPct`
+//!   (ArduPilot 4.1 and later; percent, 255 when unknown) is the reported state of charge
+//!   ([`Sample::soc`]); `CURR` has none.
 //! - The landed state ([`Sample::landed`]): `EV` events armed (10), disarmed (11) and land
 //!   complete (18) mean on the ground, not landed (28) in the air (the ids of ArduPilot's
 //!   `LogEvent`, kept stable across versions); an `ARM` record (armed or disarmed) means on the
@@ -635,6 +637,7 @@ impl DataflashDecoder {
         Some(Sample {
             voltage_v: Some(v),
             current_a: Some(i),
+            soc: f.num(p, "RemPct").and_then(reported_soc),
             ..Sample::default()
         })
     }
@@ -647,6 +650,14 @@ impl DataflashDecoder {
         s.battery_declared = self.has_bat || names("CURR");
         self.events_declared = names("EV") || names("ARM");
     }
+}
+
+/// The state of charge of a `BAT.RemPct` percentage, 0-1; `None` for 255 (ArduPilot's
+/// "unknown": no capacity or no current sensor) and what is not a number.
+fn reported_soc(percent: f64) -> Option<f64> {
+    // RemPct is a u8: half a unit tells 255 from its neighbours.
+    let unknown = (percent - f64::from(u8::MAX)).abs() < 0.5;
+    (percent.is_finite() && !unknown).then_some(percent / 100.0)
 }
 
 impl Decoder for DataflashDecoder {
@@ -870,6 +881,52 @@ mod tests {
                 _ => Some(true),
             };
             assert_eq!(x.landed, want, "sample {k}");
+        }
+    }
+
+    /// `BAT.RemPct` is the reported state of charge, percent; 255 (ArduPilot's "unknown") is
+    /// none, and a log whose `BAT` has no `RemPct` (before 4.1) reports none.
+    #[test]
+    fn bat_rem_pct_is_the_reported_state_of_charge() {
+        for (with_rem, pct, want) in [
+            (true, 69u8, Some(0.69)),
+            (true, 255, None),
+            (false, 69, None),
+        ] {
+            let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+            b.extend(dataflash_fmt(
+                1,
+                3 + 8 + 12,
+                "ATT",
+                "Qfff",
+                "TimeUS,Roll,Pitch,Yaw",
+            ));
+            let (format, cols) = match with_rem {
+                true => ("QffB", "TimeUS,Volt,Curr,RemPct"),
+                false => ("Qff", "TimeUS,Volt,Curr"),
+            };
+            let len = 3 + 8 + 8 + u8::from(with_rem);
+            b.extend(dataflash_fmt(2, len, "BAT", format, cols));
+            for k in 0..5u64 {
+                let t = 1_000_000 + k * 100_000;
+                // The battery first: the join emits a sample once its streams have a record.
+                let mut bat = dataflash_record(2, t, &[11.6, 0.5]);
+                if with_rem {
+                    bat.push(pct);
+                }
+                b.extend(bat);
+                b.extend(dataflash_record(1, t, &[0.0, 0.0, 0.0]));
+            }
+            let r = read_dataflash(&b[..], &BinaryOptions::default()).unwrap();
+            assert_eq!(r.log.samples.len(), 5);
+            for s in &r.log.samples {
+                // 1e-12: a percentage over 100.
+                let same = match (s.soc, want) {
+                    (Some(a), Some(b)) => (a - b).abs() < 1e-12,
+                    (a, b) => a == b,
+                };
+                assert!(same, "RemPct {pct} ({with_rem}): {:?}", s.soc);
+            }
         }
     }
 

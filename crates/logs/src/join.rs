@@ -37,7 +37,7 @@ pub enum Stream {
     Velocity,
     /// Wind.
     Wind,
-    /// Battery voltage and current.
+    /// Battery voltage and current, and the state of charge the autopilot reports.
     Battery,
     /// The landed state ([`Sample::landed`]), held from one record to the next. A record
     /// without a state declares that the log has the stream.
@@ -228,6 +228,7 @@ impl Joiner {
                 Stream::Battery => {
                     s.voltage_v = v.voltage_v;
                     s.current_a = v.current_a;
+                    s.soc = v.soc;
                 }
                 Stream::Base | Stream::Landed => {}
             }

@@ -209,6 +209,7 @@ fn merge(a: &mut Sample, b: &Sample) {
         current_a,
         power_w,
         charge_ah,
+        soc,
         wind_enu_mps,
         landed,
     } = *b;
@@ -220,6 +221,7 @@ fn merge(a: &mut Sample, b: &Sample) {
     a.current_a = a.current_a.or(current_a);
     a.power_w = a.power_w.or(power_w);
     a.charge_ah = a.charge_ah.or(charge_ah);
+    a.soc = a.soc.or(soc);
     a.wind_enu_mps = a.wind_enu_mps.or(wind_enu_mps);
     a.landed = a.landed.or(landed);
 }

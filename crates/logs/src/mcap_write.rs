@@ -395,7 +395,8 @@ impl<W: Write + Seek> McapWriter<W> {
         let battery = s.voltage_v.is_some()
             || s.current_a.is_some()
             || s.power_w.is_some()
-            || s.charge_ah.is_some();
+            || s.charge_ah.is_some()
+            || s.soc.is_some();
         self.state(index, &state)?;
         if battery {
             let ns = self.time_ns(s.time_s, index)?;
@@ -406,6 +407,7 @@ impl<W: Write + Seek> McapWriter<W> {
                 ("current_a", s.current_a),
                 ("power_w", s.electrical_power_w()),
                 ("charge_ah", s.charge_ah),
+                ("state_of_charge", s.soc),
             ] {
                 if let Some(v) = v {
                     m.insert(k.into(), json!(check("battery", index, v)?));

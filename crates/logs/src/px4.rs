@@ -188,6 +188,7 @@ pub fn lerp_sample(a: &Sample, b: &Sample, w: f64) -> Sample {
         current_a: lerp_opt(a.current_a, b.current_a, w),
         power_w: lerp_opt(a.power_w, b.power_w, w),
         charge_ah: lerp_opt(a.charge_ah, b.charge_ah, w),
+        soc: lerp_opt(a.soc, b.soc, w),
         wind_enu_mps: lerp_vec(a.wind_enu_mps, b.wind_enu_mps, w),
         // A state, not a quantity: the earlier record's holds until the later one.
         landed: if w < 1.0 { a.landed } else { b.landed },

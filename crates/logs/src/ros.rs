@@ -11,7 +11,9 @@
 //! kinematic acceleration `R f - g` from the specific force `f`. `sensor_msgs/BatteryState`
 //! defines current as negative while discharging; it is negated to aloft's positive-discharging
 //! convention unless [`RosDecodeOptions::battery_current_positive_discharging`] is set (some
-//! drivers publish the opposite sign). NaN fields (unmeasured) leave the channel empty.
+//! drivers publish the opposite sign); its `percentage` (0-1) is the reported state of charge
+//! ([`Sample::soc`]), as `state_of_charge` of `aloft.BatteryState`. NaN fields (unmeasured) leave
+//! the channel empty.
 
 use aloft_core::STANDARD_GRAVITY_MPS2;
 use serde_json::Value;
@@ -274,7 +276,7 @@ fn cdr_battery_state(r: &mut CdrReader<'_>, opts: RosDecodeOptions) -> Result<Sa
     let charge = r.f32()? as f64;
     let _capacity = r.f32()?;
     let _design = r.f32()?;
-    let _percentage = r.f32()?;
+    let percentage = r.f32()? as f64;
     let _status = r.u8()?;
     let _health = r.u8()?;
     let _technology = r.u8()?;
@@ -283,7 +285,15 @@ fn cdr_battery_state(r: &mut CdrReader<'_>, opts: RosDecodeOptions) -> Result<Sa
     r.skip_f32_sequence()?; // cell_temperature
     r.string()?; // location
     r.string()?; // serial_number
-    Ok(battery(voltage, current, charge, opts, true))
+    let mut s = battery(voltage, current, charge, opts, true);
+    s.soc = reported_soc(percentage);
+    Ok(s)
+}
+
+/// A reported state of charge (0-1), `None` where it is unknown: NaN (ROS `percentage`
+/// unmeasured), a negative value, an infinity.
+fn reported_soc(fraction: f64) -> Option<f64> {
+    (fraction.is_finite() && fraction >= 0.0).then_some(fraction)
 }
 
 /// The body of a `nav_msgs/Odometry` after its header.
@@ -404,13 +414,22 @@ pub fn decode_json(
 
 /// The fields of `aloft.BatteryState`, each optional: aloft's writer leaves out what the log did
 /// not have (a row with current but no voltage).
-const ALOFT_BATTERY_KEYS: [&str; 4] = ["voltage_v", "current_a", "power_w", "charge_ah"];
+const ALOFT_BATTERY_KEYS: [&str; 5] = [
+    "voltage_v",
+    "current_a",
+    "power_w",
+    "charge_ah",
+    "state_of_charge",
+];
 
 /// `aloft.BatteryState` (SI field names, every one optional, current positive while
-/// discharging) or `sensor_msgs/BatteryState` field names with the ROS sign.
+/// discharging; `state_of_charge` 0-1) or `sensor_msgs/BatteryState` field names with the ROS
+/// sign (`percentage` 0-1, NaN unmeasured).
 fn json_battery_state(v: &Value, opts: RosDecodeOptions) -> Result<Sample, String> {
     if !ALOFT_BATTERY_KEYS.iter().any(|k| v.get(k).is_some()) {
-        return json_battery_fields(v, ["voltage", "current", "charge"], opts, true);
+        let mut s = json_battery_fields(v, ["voltage", "current", "charge"], opts, true)?;
+        s.soc = reported_soc(optional_num(v, "percentage")?);
+        return Ok(s);
     }
     let mut s = battery(
         optional_num(v, "voltage_v")?,
@@ -420,6 +439,7 @@ fn json_battery_state(v: &Value, opts: RosDecodeOptions) -> Result<Sample, Strin
         false,
     );
     s.power_w = finite(optional_num(v, "power_w")?);
+    s.soc = reported_soc(optional_num(v, "state_of_charge")?);
     Ok(s)
 }
 

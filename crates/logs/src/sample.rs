@@ -38,6 +38,12 @@ pub struct Sample {
     pub power_w: Option<f64>,
     /// Remaining charge as logged, A h (KAIST `capacity`, PX4 derived from `discharged_mah`).
     pub charge_ah: Option<f64>,
+    /// State of charge as the autopilot reports it, a fraction of the pack (0-1): PX4
+    /// `battery_status.remaining`, ArduPilot `BAT.RemPct` / 100. `None` where the log does not
+    /// report it or reports it unknown (PX4 negative or NaN, ArduPilot 255). Carried as
+    /// reported otherwise (a value outside 0-1 is the reader's to judge: `aloft live` does not
+    /// believe it). Not a [`Channel`]: what a log measures is unchanged by it.
+    pub soc: Option<f64>,
     /// Wind velocity east, north, up (the velocity of the air), m/s.
     pub wind_enu_mps: Option<[f64; 3]>,
     /// On the ground, as the log itself records it: PX4 `vehicle_land_detected.landed`, ArduPilot

@@ -15,7 +15,9 @@
 //! - `vehicle_attitude` (instance 0): the quaternion (body FRD to NED) as Euler angles.
 //! - `wind` or `wind_estimate`: `windspeed_north`, `windspeed_east`.
 //! - `battery_status` of the chosen instance (multi_id): `voltage_v`, `current_a`; records with
-//!   `current_a` < 0 (unknown) or `voltage_v` <= 0 are dropped and counted.
+//!   `current_a` < 0 (unknown) or `voltage_v` <= 0 are dropped and counted. `remaining` (0-1,
+//!   negative or NaN when PX4 does not know it) is the reported state of charge
+//!   ([`Sample::soc`]) of the records kept.
 //! - `vehicle_air_data.rho` (mean air density) and `vehicle_land_detected.landed` (time in the
 //!   air, and [`Sample::landed`] of every sample, held from one record to the next), parameters `BAT1_N_CELLS` (or `BAT_N_CELLS`) and `BAT1_CAPACITY`.
 //!
@@ -149,6 +151,15 @@ struct Loc {
     prim: Prim,
 }
 
+/// One `battery_status` record's fields: voltage (V), current (A) and the state of charge PX4
+/// reports (`remaining`, 0-1; negative or NaN: unknown; `None` in a format without it).
+#[derive(Debug, Clone, Copy)]
+struct BatteryReading {
+    volt: f64,
+    amp: f64,
+    remaining: Option<f64>,
+}
+
 /// The topics aloft reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Topic {
@@ -193,7 +204,7 @@ impl Topic {
             ],
             Topic::Attitude => &["q[0]", "q[1]", "q[2]", "q[3]"],
             Topic::Wind => &["windspeed_north", "windspeed_east"],
-            Topic::Battery => &["voltage_v", "current_a"],
+            Topic::Battery => &["voltage_v", "current_a", "remaining"],
             Topic::AirData => &["rho"],
             Topic::LandDetected => &["landed"],
         }
@@ -608,7 +619,14 @@ impl UlogDecoder {
                     },
                 )
             }
-            Topic::Battery => return self.battery(multi_id, t, v[0]?, v[1]?, s),
+            Topic::Battery => {
+                let reading = BatteryReading {
+                    volt: v[0]?,
+                    amp: v[1]?,
+                    remaining: v[2],
+                };
+                return self.battery(multi_id, t, reading, s);
+            }
             Topic::AirData => {
                 let rho = v[0].filter(|r| r.is_finite() && *r > 0.0)?;
                 s.rho_sum += rho;
@@ -644,10 +662,14 @@ impl UlogDecoder {
         &mut self,
         multi_id: u8,
         t: f64,
-        volt: f64,
-        amp: f64,
+        reading: BatteryReading,
         s: &mut BinarySummary,
     ) -> Option<Event> {
+        let BatteryReading {
+            volt,
+            amp,
+            remaining,
+        } = reading;
         if !s.battery_instances.contains(&multi_id) {
             s.battery_instances.push(multi_id);
         }
@@ -670,6 +692,7 @@ impl UlogDecoder {
             sample: Sample {
                 voltage_v: Some(volt),
                 current_a: Some(amp),
+                soc: remaining.filter(|r| r.is_finite() && *r >= 0.0),
                 ..Sample::default()
             },
         })
@@ -763,4 +786,43 @@ pub fn ulog_samples<R: Read>(
         });
     }
     Ok(it)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::synth::{ulog_data, ulog_record, ulog_subscription, ULOG_HEADER};
+    use crate::{read_ulog, BinaryOptions};
+
+    /// `battery_status.remaining` is the reported state of charge of the samples it is joined
+    /// onto; PX4's "unknown" (negative, NaN) is none; a value above 1 is carried as reported.
+    #[test]
+    fn remaining_is_the_reported_state_of_charge() {
+        let mut b = ULOG_HEADER.to_vec();
+        b.extend(ulog_record(b'B', &[0u8; 40]));
+        b.extend(ulog_record(
+            b'F',
+            b"battery_status:uint64_t timestamp;float voltage_v;float current_a;float remaining;",
+        ));
+        b.extend(ulog_record(
+            b'F',
+            b"vehicle_local_position:uint64_t timestamp;float x;float y;float z;",
+        ));
+        b.extend(ulog_subscription(1, "battery_status"));
+        b.extend(ulog_subscription(2, "vehicle_local_position"));
+        let remaining = [0.69, 0.69, -1.0, f32::NAN, 1.5, 0.68];
+        for (k, r) in remaining.into_iter().enumerate() {
+            let t = 1_000_000 + k as u64 * 100_000;
+            // The battery first: the join emits a sample once its streams have a record.
+            b.extend(ulog_data(1, t, &[11.6, 0.0, r]));
+            b.extend(ulog_data(2, t, &[0.0, 0.0, -1.0]));
+        }
+        let log = read_ulog(&b[..], &BinaryOptions::default()).unwrap().log;
+        let soc: Vec<Option<f64>> = log.samples.iter().map(|s| s.soc).collect();
+        // f32 values: 1e-6 covers their rounding.
+        let near = |s: Option<f64>, want: f64| s.is_some_and(|s| (s - want).abs() < 1e-6);
+        assert_eq!(soc.len(), 6);
+        assert!(near(soc[0], 0.69) && near(soc[1], 0.69), "{soc:?}");
+        assert_eq!(soc[2..4], [None, None]);
+        assert!(near(soc[4], 1.5) && near(soc[5], 0.68), "{soc:?}");
+    }
 }

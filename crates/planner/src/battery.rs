@@ -88,6 +88,24 @@ impl Pack {
         t[k] + (t[k + 1] - t[k]) * f
     }
 
+    /// The state of charge at which the pack's open-circuit voltage is `ocv_v` (V): the inverse
+    /// of [`Self::ocv_v`] (the lowest such state of charge on a plateau), clamped to `[0, 1]`
+    /// (below the empty pack's voltage 0, above the full one's 1; NaN gives 0). What a pack's
+    /// rested voltage says of its charge; check the voltage against `ocv_v(0.0)` and
+    /// `ocv_v(1.0)` where a value outside them means another pack.
+    pub fn soc_at_ocv_v(&self, ocv_v: f64) -> f64 {
+        let t = &self.ocv_table_v;
+        let Some(k) = t.iter().position(|&v| v >= ocv_v) else {
+            return if ocv_v.is_nan() { 0.0 } else { 1.0 };
+        };
+        if k == 0 {
+            return 0.0;
+        }
+        // t[k - 1] < ocv_v <= t[k]: the interval rises.
+        let f = (ocv_v - t[k - 1]) / (t[k] - t[k - 1]);
+        ((k - 1) as f64 + f) / (OCV_TABLE_POINTS - 1) as f64
+    }
+
     /// Current and terminal voltage when the load draws `power_w` at state of charge `soc`;
     /// `None` when the pack cannot deliver that power (`V_oc^2 < 4 R P`).
     #[inline]
@@ -362,6 +380,23 @@ mod tests {
         }
         // mean rest voltage 3.858 V per cell: 6 x 3.858 x 4.5 = 104.2 W h
         assert!((b.rest_energy_wh(1.0, 0.0) - 6.0 * 3.85825 * 4.5).abs() < 1e-6);
+    }
+
+    /// The rested voltage's state of charge is the inverse of the open-circuit curve, and
+    /// clamped outside it.
+    #[test]
+    fn the_state_of_charge_at_a_rest_voltage_inverts_the_curve() {
+        let b = Pack::new(&tb47d()).unwrap();
+        for s in [0.0, 0.03, 0.335, 0.5, 0.77, 0.999, 1.0] {
+            // Linear interpolation of one table, inverted: rounding only.
+            assert!((b.soc_at_ocv_v(b.ocv_v(s)) - s).abs() < 1e-12, "{s}");
+        }
+        // 6 x 3.80 V is 40 % on the generic LiPo curve.
+        assert!((b.soc_at_ocv_v(22.8) - 0.40).abs() < 1e-12);
+        // Clamped to the ends: exact.
+        for (v, soc) in [(10.0, 0.0), (30.0, 1.0), (f64::NAN, 0.0)] {
+            assert!((b.soc_at_ocv_v(v) - soc).abs() < 1e-15, "{v}");
+        }
     }
 
     #[test]

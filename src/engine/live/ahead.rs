@@ -124,12 +124,13 @@ impl Ahead<'_> {
         }))
     }
 
-    /// The vehicle at the re-estimated efficiency `eta_0 / r` (at most 1).
+    /// The vehicle at the re-estimated efficiency `eta_0 / r` (at most 1:
+    /// [`super::estimate::flown_efficiency`]).
     fn vehicle_at(&self, ratio: Ratio) -> Result<Vehicle, Error> {
         match self.vehicle.efficiency() {
             Some(eta0) if (ratio.ratio - 1.0).abs() > 1e-12 => self
                 .vehicle
-                .with_efficiency((eta0 / ratio.ratio).clamp(0.01, 1.0)),
+                .with_efficiency(super::estimate::flown_efficiency(eta0, ratio.ratio)),
             _ => Ok(self.vehicle.clone()),
         }
     }

@@ -34,6 +34,27 @@ const DRIFT_BLOCK_S: f64 = 60.0;
 /// Most points kept (a power of two).
 pub(crate) const MAX_POINTS: usize = 16_384;
 
+/// Lowest efficiency a vehicle is flown at (a ratio of measured to predicted power above 100
+/// times the fitted efficiency is not a vehicle the file describes).
+const MIN_EFFICIENCY: f64 = 0.01;
+
+/// What an update says where the efficiency is held at 1.
+pub(crate) const EFFICIENCY_HELD_NOTE: &str = "the measured power is below the model's at any \
+    efficiency up to 1: the vehicle file does not describe this vehicle (the rest is flown at \
+    efficiency 1)";
+
+/// The efficiency the rest is flown at and reported: the fitted `eta0` over the re-estimated
+/// `ratio` of measured to predicted power, held in `[0.01, 1]` (above 1 the measured power is
+/// below the model's at any efficiency: the rest is flown at 1, as the update's note says); the
+/// fitted one where the ratio gives no number.
+pub(crate) fn flown_efficiency(eta0: f64, ratio: f64) -> f64 {
+    let eta = eta0 / ratio;
+    match eta.is_finite() {
+        true => eta.clamp(MIN_EFFICIENCY, 1.0),
+        false => eta0,
+    }
+}
+
 /// The fitted model's relative spread between flights (its vehicle file's
 /// `efficiency_relative_sd`), else the model error the scenarios assume.
 pub(crate) fn prior_sd(model: &aloft_power::PowerModel) -> f64 {
@@ -238,6 +259,22 @@ fn prequential_sd(blocks: &[(f64, f64)]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The efficiency flown and reported is in [0.01, 1] whatever the ratio, the fitted one
+    /// where the ratio gives no number.
+    #[test]
+    fn the_efficiency_flown_stays_in_its_range() {
+        // Exact: a clamp returns its bound, and one division.
+        let same = |a: f64, b: f64| (a - b).abs() < 1e-15;
+        // 0.74 / 0.6 = 1.23: the model above the measured power at any efficiency.
+        assert!(same(flown_efficiency(0.74, 0.6), 1.0));
+        assert!(same(flown_efficiency(0.74, 1.1), 0.74 / 1.1));
+        assert!(same(flown_efficiency(0.74, 1e6), MIN_EFFICIENCY));
+        for r in [0.0, f64::NAN, f64::INFINITY, -1.0] {
+            let eta = flown_efficiency(0.74, r);
+            assert!(eta > 0.0 && eta <= 1.0, "{r}: {eta}");
+        }
+    }
 
     /// A flight that draws 10 % more than predicted, with a slow swing: the ratio converges to
     /// 1.1 as the window grows, and merging the points when the buffer fills keeps the energies.

@@ -4,10 +4,11 @@
 //! Two ways in:
 //! - [`follow_live`]: any [`TelemetrySource`] (a MAVLink link or telemetry log through the
 //!   `aloft-link` crate, a flight log replayed as events): the events folded into the flight's
-//!   state, the efficiency re-estimated from measured against predicted power
-//!   ([`estimate`](self::estimate)), the wind from the autopilot or the tilt, and the rest of the
-//!   route flown from the present state in Monte-Carlo scenarios, with the advice
-//!   ([`ahead`](self::ahead)); on a link, the answer sent back ([`replies`]).
+//!   state, the state of charge from the vehicle's reports, else its rested voltage, else a full
+//!   pack ([`charge`](self::charge)), the efficiency re-estimated from measured against
+//!   predicted power ([`estimate`](self::estimate)), the wind from the autopilot or the tilt, and
+//!   the rest of the route flown from the present state in Monte-Carlo scenarios, with the
+//!   advice ([`ahead`](self::ahead)); on a link, the answer sent back ([`replies`]).
 //! - [`replay_live`]: the validation route (`--route log`), a flight log replayed with the rest of
 //!   the logged path as the route ahead, so each prediction is checked against the energy the
 //!   log measured from then to the end.
@@ -24,6 +25,7 @@ use super::vehicles::Vehicle;
 use crate::error::Error;
 
 mod ahead;
+mod charge;
 mod estimate;
 mod record;
 mod replay;
@@ -36,6 +38,7 @@ pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
 pub use sources::LiveSource;
 
 use ahead::{Ahead, AheadAnswer};
+use charge::{Charge, Drawn};
 use tracker::Tracker;
 
 /// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
@@ -55,7 +58,10 @@ pub struct LiveUpdate {
     /// Where the vehicle is.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub position: Option<Position>,
-    /// State of charge now, 0-1 (the autopilot's, else from the charge or energy drawn).
+    /// State of charge now, 0-1: the vehicle's report, else the rested voltage before take-off
+    /// on the pack's open-circuit curve, else a full pack at the start, less the charge drawn
+    /// since ([`charge`](self::charge); the `note` says where the report is not believed or a
+    /// full pack is assumed).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub soc: Option<f64>,
     /// Electrical energy used so far, Wh (measured; the model's without power data).
@@ -65,7 +71,7 @@ pub struct LiveUpdate {
     pub power_w: Option<f64>,
     /// Whether the source measures power (without it the prediction is the model's alone).
     pub power_available: bool,
-    /// The efficiency the rest is predicted with (re-estimated in flight).
+    /// The efficiency the rest is predicted with (re-estimated in flight), in (0, 1].
     pub efficiency: f64,
     /// Wind speed, m/s (horizontal).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -96,7 +102,9 @@ pub struct LiveUpdate {
     /// The link has gone quiet: the figures are the last estimate's.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub link_lost: bool,
-    /// Why the route ahead has no answer (the planner's message).
+    /// Why the route ahead has no answer (the planner's message), that the efficiency was held
+    /// at 1, where the state of charge comes from when it is not the vehicle's report; several
+    /// joined by `; `.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
 }
@@ -291,8 +299,8 @@ pub fn replies(previous: Option<&LiveUpdate>, update: &LiveUpdate) -> Vec<Reply>
 pub struct LiveSession<'a> {
     tracker: Tracker,
     ahead: Ahead<'a>,
-    pack_ah: f64,
-    pack_wh: f64,
+    /// The state of charge and where it comes from.
+    charge: Charge,
     eta0: f64,
     given_mission: Option<&'a Mission>,
     /// The mission learned from the source (or why it cannot be read), by the upload it came
@@ -338,8 +346,7 @@ impl<'a> LiveSession<'a> {
                 speed_mps: request.speed_mps,
                 scenarios: request.scenarios,
             },
-            pack_ah: pack.capacity_ah(),
-            pack_wh: pack.rated_energy_wh(),
+            charge: Charge::new(pack),
             eta0,
             given_mission: request.mission.as_ref(),
             learned: None,
@@ -349,14 +356,17 @@ impl<'a> LiveSession<'a> {
         })
     }
 
-    /// The state of charge now: the autopilot's, else from the charge drawn, else from the
-    /// energy used (a full pack at the start).
+    /// What was drawn from the pack so far: the autopilot's count and the energy used.
+    fn drawn(&self) -> Drawn {
+        Drawn {
+            consumed_ah: self.tracker.battery.consumed_ah,
+            energy_wh: self.tracker.energy_used_wh(),
+        }
+    }
+
+    /// The state of charge now ([`charge`](self::charge)).
     fn soc(&self) -> f64 {
-        let b = &self.tracker.battery;
-        b.soc
-            .or_else(|| b.consumed_ah.map(|ah| 1.0 - ah / self.pack_ah))
-            .unwrap_or_else(|| 1.0 - self.tracker.energy_used_wh() / self.pack_wh)
-            .clamp(0.0, 1.0)
+        self.charge.soc(self.drawn()).0
     }
 
     /// Read the mission the source sent, once per upload (a mission aloft cannot read is kept as
@@ -373,7 +383,33 @@ impl<'a> LiveSession<'a> {
 
     /// Fold one event in.
     pub fn apply(&mut self, event: &aloft_logs::telemetry::Telemetry) {
+        use aloft_logs::telemetry::Event;
         self.tracker.apply(event);
+        let in_air = self.tracker.in_air();
+        let drawn = self.drawn();
+        let c = &mut self.charge;
+        match &event.event {
+            // Another flight, maybe another pack: nothing reported holds.
+            Event::Reboot => *c = Charge::new(c.pack().clone()),
+            Event::Battery(b) => {
+                if let Some(soc) = b.soc {
+                    c.report(soc, in_air, drawn);
+                }
+            }
+            Event::Sample(s) => {
+                if let (Some(v), false) = (s.voltage_v, in_air) {
+                    let disarmed = self.tracker.heartbeat.as_ref().is_some_and(|h| !h.armed);
+                    c.voltage(self.tracker.now_s, v, s.current_a, disarmed, drawn);
+                }
+                if let Some(soc) = s.soc {
+                    c.report(soc, in_air, drawn);
+                }
+            }
+            _ => {}
+        }
+        if in_air {
+            c.in_air();
+        }
     }
 
     /// The answer now: the state of charge, the efficiency's estimate, the route ahead in
@@ -426,11 +462,7 @@ impl<'a> LiveSession<'a> {
             self.rest_s = d.p50;
         }
         let note = match (note, self.eta0 / ratio.ratio > 1.0) {
-            (None, true) => Some(
-                "the measured power is below the model's at any efficiency up to 1: the vehicle \
-                 file does not describe this vehicle (the rest is flown at efficiency 1)"
-                    .to_string(),
-            ),
+            (None, true) => Some(estimate::EFFICIENCY_HELD_NOTE.to_string()),
             (note, _) => note,
         };
         self.answer_update(soc, ratio, answer, note)
@@ -464,6 +496,10 @@ impl<'a> LiveSession<'a> {
             .and_then(|()| answer.as_ref()?.duration_s)
             .map(|d| t.air_measured_j / t.air_s * d.p50 / 3600.0);
         let wind = t.wind.map(|(w, _)| w);
+        let note = [note, self.charge.note()]
+            .into_iter()
+            .flatten()
+            .reduce(|a, b| format!("{a}; {b}"));
         LiveUpdate {
             time_s: now,
             in_air: t.in_air(),
@@ -474,7 +510,7 @@ impl<'a> LiveSession<'a> {
             energy_used_wh: t.energy_used_wh(),
             power_w: t.power_w,
             power_available: t.power_available(),
-            efficiency: self.eta0 / ratio.ratio,
+            efficiency: estimate::flown_efficiency(self.eta0, ratio.ratio),
             wind_mps: wind.map(|w| w[0].hypot(w[1])),
             wind_from_deg: wind.map(tracker::wind_from_deg),
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),

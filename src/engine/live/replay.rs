@@ -7,7 +7,9 @@
 //! 1. the efficiency is re-estimated from the samples so far ([`super::estimate`]: the energy
 //!    ratio shrunk toward the fitted model, its spread from the estimate and the drift);
 //! 2. the energy ahead is the model's power along the rest of the path times the ratio:
-//!    `E_ahead = r * integral_t^end P_predicted dt` (the p50);
+//!    `E_ahead = r * integral_t^end P_predicted dt` (the p50), the ratio at least the fitted
+//!    efficiency `eta_0` (the rest flown at an efficiency `eta_0 / r` of at most 1, as `aloft
+//!    live` flies it: [`super::estimate::flown_efficiency`]);
 //! 3. p5 and p95 are `E_ahead exp(-+1.645 s)` with `s` the ratio's spread on the log scale (the
 //!    limit of a Monte-Carlo draw of the ratio);
 //! 4. beside it, the naive rate: the mean measured power so far times the time left,
@@ -168,7 +170,9 @@ impl Series {
         let elapsed = self.t[k] - self.t[0];
         let time_left = self.t[last] - self.t[k];
         let r = estimator.ratio(time_left);
-        let p50 = r.ratio * ahead_p / 3600.0;
+        // As `aloft live` flies the rest: at an efficiency of at most 1.
+        let efficiency = super::estimate::flown_efficiency(eta0, r.ratio);
+        let p50 = eta0 / efficiency * ahead_p / 3600.0;
         let spread = (Z_95 * r.log_sd).exp();
         LiveUpdate {
             time_s: self.t[k],
@@ -176,7 +180,8 @@ impl Series {
             energy_used_wh: so_far_m / 3600.0,
             power_w: Some(self.measured_w[k]),
             power_available: true,
-            efficiency: eta0 / r.ratio,
+            efficiency,
+            note: (eta0 / r.ratio > 1.0).then(|| super::estimate::EFFICIENCY_HELD_NOTE.to_string()),
             remaining_wh: Some(Percentiles {
                 p5: p50 / spread,
                 p50,
