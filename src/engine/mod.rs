@@ -19,6 +19,11 @@
 //! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `fit.rs`, `validate.rs` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `estimator.rs` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
+//! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
+//! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `mission_map.rs` |
+//! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
+//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
+//! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
 //!
 //! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
 //! else the options' wind, else the mission file's, else still air; gusts on top), the reserve
