@@ -4,7 +4,7 @@
 
 use aloft::engine::{
     endurance, endurance_scenarios, plan_mission, plan_scenarios, EnduranceOptions, Mission,
-    MissionOptions, Percentiles, ScenarioOptions, Uncertainty, Vehicle,
+    MissionOptions, Percentiles, ScenarioOptions, Uncertainty, Vehicle, WorkBounds,
 };
 use proptest::prelude::*;
 
@@ -160,6 +160,7 @@ fn the_same_seed_gives_the_same_answer_on_one_two_or_three_threads() {
         power_sd_percent: 3.0,
         threads,
         soc_fan: true,
+        ..ScenarioOptions::default()
     };
     let one = plan_scenarios(&v, &Mission::demo(), &o, &sc(1)).unwrap();
     for t in [2, 3] {
@@ -183,6 +184,46 @@ fn the_same_seed_gives_the_same_answer_on_one_two_or_three_threads() {
     )
     .unwrap();
     assert_ne!(one.energy_wh, other_seed.energy_wh);
+}
+
+/// Work bounds (issue 32): the steps of a request's scenarios are its samples times the plan's
+/// duration over the time step, checked before any is flown; the most samples that fit are
+/// named; a cancelled request stops.
+#[test]
+fn a_bound_on_the_steps_refuses_the_scenarios_that_pass_it_and_a_cancelled_one_stops() {
+    let v = m100();
+    let o = MissionOptions::default();
+    let plan = plan_mission(&v, &Mission::demo(), &o).unwrap();
+    // The demo's steps at the default 0.1 s, from the plan's duration (an independent figure).
+    let steps = (plan.summary().duration_s / 0.1).ceil() as u64;
+    let bounded = |samples: u32, max_steps: u64| ScenarioOptions {
+        bounds: WorkBounds {
+            max_steps: Some(max_steps),
+            cancel: None,
+        },
+        ..no_spread(samples)
+    };
+    // Exactly at the bound: flown; one sample more: refused, naming the most that fit.
+    let within = plan_scenarios(&v, &Mission::demo(), &o, &bounded(10, 10 * steps)).unwrap();
+    assert_eq!(within.samples, 10);
+    let e = plan_scenarios(&v, &Mission::demo(), &o, &bounded(11, 10 * steps)).unwrap_err();
+    let message = e.to_string();
+    assert!(
+        matches!(e, aloft::Error::TooMuchWork { max_samples: 10, .. }),
+        "{message}"
+    );
+    assert!(message.contains("at most 10 samples"), "{message}");
+    // Cancelled before the first flight: nothing is flown.
+    let cancel = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let sc = ScenarioOptions {
+        bounds: WorkBounds {
+            max_steps: None,
+            cancel: Some(cancel),
+        },
+        ..no_spread(1000)
+    };
+    let e = plan_scenarios(&v, &Mission::demo(), &o, &sc).unwrap_err();
+    assert!(matches!(e, aloft::Error::Cancelled), "{e}");
 }
 
 #[test]
