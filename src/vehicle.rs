@@ -296,11 +296,18 @@ mod tests {
 
     #[test]
     fn unknown_keys_and_names_are_errors() {
+        // Named by its place (a file named as a vehicle may be any file: its text is not
+        // quoted), with the nearest known key.
         let text = "name = \"x\"\nwingspan_m = 3.0\n";
         let e = VehicleFile::from_toml_str(text, "test")
             .unwrap_err()
             .to_string();
-        assert!(e.contains("wingspan_m"), "{e}");
+        assert!(e.contains("line 2") && e.contains("unknown field"), "{e}");
+        assert!(!e.contains("wingspan_m"), "{e}");
+        let e = VehicleFile::from_toml_str("nmae = \"x\"\n", "test")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("did you mean `name`?"), "{e}");
         let e = VehicleFile::builtin("dji-m200").unwrap_err().to_string();
         assert!(e.contains("dji-m200") && e.contains("dji-m100"), "{e}");
     }

@@ -209,7 +209,13 @@ fn a_bound_on_the_steps_refuses_the_scenarios_that_pass_it_and_a_cancelled_one_s
     let e = plan_scenarios(&v, &Mission::demo(), &o, &bounded(11, 10 * steps)).unwrap_err();
     let message = e.to_string();
     assert!(
-        matches!(e, aloft::Error::TooMuchWork { max_samples: 10, .. }),
+        matches!(
+            e,
+            aloft::Error::TooMuchWork {
+                max_samples: 10,
+                ..
+            }
+        ),
         "{message}"
     );
     assert!(message.contains("at most 10 samples"), "{message}");

@@ -207,7 +207,7 @@ pub fn too_many_values(count: usize) -> String {
 /// );
 /// ```
 pub fn file_message(message: &str) -> String {
-    let mut text = one_line(message);
+    let mut text = with_nearest_key(&one_line(message));
     for (prefix, close) in [
         ("unknown field ", '`'),
         ("unknown variant ", '`'),
@@ -221,6 +221,54 @@ pub fn file_message(message: &str) -> String {
         text = without_quoted(&text, prefix, close);
     }
     text
+}
+
+/// "unknown field `X`, expected one of `a`, `b`": the known key nearest `X` (by edit distance,
+/// at most a third of the longer name's letters apart) named after "unknown field", so that the
+/// message still helps once `X` is left out.
+fn with_nearest_key(text: &str) -> String {
+    let Some((head, rest)) = text.split_once("unknown field `") else {
+        return text.to_string();
+    };
+    let Some((unknown, tail)) = rest.split_once('`') else {
+        return text.to_string();
+    };
+    let known = tail.split('`').skip(1).step_by(2);
+    let nearest = known
+        .map(|k| (edit_distance(unknown, k), k))
+        .filter(|(d, k)| 3 * d <= unknown.chars().count().max(k.chars().count()))
+        .min_by_key(|(d, _)| *d);
+    match nearest {
+        Some((_, k)) => format!("{head}unknown field `{unknown}` (did you mean `{k}`?){tail}"),
+        None => text.to_string(),
+    }
+}
+
+/// Edit distance between two names, by characters: insertions, deletions, substitutions and
+/// swaps of two neighbours (`nmae` is one from `name`).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
+    let width = b.len() + 1;
+    let mut d: Vec<usize> = vec![0; (a.len() + 1) * width];
+    for (i, row) in d.chunks_mut(width).enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d.iter_mut().take(width).enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut best = (d[(i - 1) * width + j] + 1)
+                .min(d[i * width + j - 1] + 1)
+                .min(d[(i - 1) * width + j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(d[(i - 2) * width + j - 2] + 1);
+            }
+            d[i * width + j] = best;
+        }
+    }
+    d[a.len() * width + b.len()]
 }
 
 /// `text` with every quotation that follows `prefix` (opened and closed by `close`, a backslash
@@ -284,6 +332,11 @@ mod one_line_tests {
             // Cut short: nothing after the opening quote survives.
             ("unknown field `SECRET", "unknown field"),
             ("missing field `mass_kg`", "missing field `mass_kg`"),
+            // The nearest known key is named in its place.
+            (
+                "unknown field `mass_lb`, expected one of `name`, `mass_kg`",
+                "unknown field (did you mean `mass_kg`?), expected one of `name`, `mass_kg`",
+            ),
         ] {
             assert_eq!(file_message(raw), want);
         }
