@@ -44,12 +44,12 @@ pub mod tlog;
 pub use aloft_logs::telemetry::{
     BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,
 };
-pub use decode::Decoder;
+pub use decode::{Decoder, FixStats};
 pub use error::{LinkError, Result};
 /// The `mavlink` crate aloft-link is built on (its ArduPilot dialect's message types appear in
 /// [`TlogFrame`] and [`Decoder::push`]).
 pub use mavlink;
 pub use mission::MAX_MISSION_ITEMS;
 pub use modes::mode_name;
-pub use source::{describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
+pub use source::{describe_fixes, describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
 pub use tlog::{TlogFrame, TlogReader, TlogStats};

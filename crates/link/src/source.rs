@@ -49,7 +49,7 @@ use mavlink::{
     MAVLinkV2MessageRaw, MavConnection, MavHeader, MavlinkVersion, Message,
 };
 
-use crate::decode::Decoder;
+use crate::decode::{Decoder, FixStats, MAX_SPEED_MPS};
 use crate::error::LinkError;
 use crate::request::MissionRequest;
 use crate::tlog::{TlogReader, TlogStats};
@@ -146,13 +146,49 @@ pub fn describe_stats(s: &TlogStats) -> String {
     )
 }
 
+/// `N positions not believed (o off the Earth, r out of reach), h homes, v velocities`: what
+/// the decoder dropped, or empty when nothing was.
+pub fn describe_fixes(f: &FixStats) -> String {
+    let mut parts = Vec::new();
+    if f.off_earth + f.out_of_reach > 0 {
+        parts.push(format!(
+            "{} positions not believed ({} off the Earth, {} out of reach)",
+            f.off_earth + f.out_of_reach,
+            f.off_earth,
+            f.out_of_reach
+        ));
+    }
+    if f.homes > 0 {
+        parts.push(format!("{} homes not believed", f.homes));
+    }
+    if f.velocities > 0 {
+        parts.push(format!(
+            "{} velocities over {MAX_SPEED_MPS} m/s",
+            f.velocities
+        ));
+    }
+    parts.join(", ")
+}
+
+/// The non-empty texts joined by `; `.
+fn joined(texts: [String; 2]) -> String {
+    texts
+        .into_iter()
+        .filter(|t| !t.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 impl<R: Read> TelemetrySource for TlogSource<R> {
     fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
         self.next_telemetry().map_err(|e| e.to_string())
     }
 
     fn skipped(&self) -> String {
-        describe_stats(self.reader.stats())
+        joined([
+            describe_stats(self.reader.stats()),
+            describe_fixes(&self.decoder.fixes()),
+        ])
     }
 }
 
@@ -473,11 +509,11 @@ impl TelemetrySource for LinkSource {
 
     fn skipped(&self) -> String {
         let undecoded = self.undecoded.load(Ordering::Relaxed);
-        if undecoded == 0 {
-            String::new()
-        } else {
-            format!("{undecoded} undecodable messages")
-        }
+        let frames = match undecoded {
+            0 => String::new(),
+            n => format!("{n} undecodable messages"),
+        };
+        joined([frames, describe_fixes(&self.decoder.fixes())])
     }
 
     fn reply(&mut self, reply: &Reply) -> Result<(), String> {
