@@ -23,7 +23,7 @@ use aloft_link::mavlink::dialects::ardupilotmega::{
     SYS_STATUS_DATA,
 };
 use aloft_link::mavlink::{write_v2_msg, MavHeader};
-use common::scratch;
+use common::{aloft, scratch, stderr};
 use serde_json::Value;
 
 /// The first timestamp of the logs, µs since the Unix epoch (2023-11-14).
@@ -143,6 +143,14 @@ fn hover(
 
 fn steady(t: f64) -> u64 {
     T0_US + (t * 1e6).round() as u64
+}
+
+fn at_home(_: f64) -> (i32, i32) {
+    (HOME.0, HOME.1)
+}
+
+fn home_at_home(_: f64) -> Option<(i32, i32)> {
+    Some((HOME.0, HOME.1))
 }
 
 /// `aloft live --tlog` of `path` with `extra` options, in JSON: the exit code, the updates, the
@@ -291,5 +299,89 @@ fn live_tlog_a_bad_first_fix_is_not_the_origin() {
             "{u}"
         );
         assert_eq!(u["advice"], "continue", "{u}");
+    }
+}
+
+/// A forward step of 1,000,000 s (11.6 days) in the middle of the log: a lost link, not time.
+/// Played as fast as it goes, the flight lasts its 40 s, not 11.6 days; played at 100 times its
+/// time it takes 0.4 s of pacing, not 2.8 hours.
+#[test]
+fn live_tlog_a_forward_clock_step_is_a_lost_link_not_time() {
+    let jump = |t: f64| steady(t) + if t >= 20.0 { 1_000_000_000_000 } else { 0 };
+    let path = hover(jump, at_home, home_at_home).write("forward.tlog");
+    let (code, updates, summary, err) = live(&path, &["--speed", "max", "--every", "1"], MINUTE);
+    assert_eq!(code, Some(0), "{err}");
+    let duration_s = summary["duration_s"].as_f64().unwrap();
+    // 40 s of frames; the first update comes with the first frame: 39.8 s from it to the last.
+    assert!((39.0..=40.0).contains(&duration_s), "{summary}");
+    let lost: Vec<&Value> = updates.iter().filter(|u| u["link_lost"] == true).collect();
+    assert_eq!(lost.len(), 1, "{updates:?}");
+    // The updates go on after it, one a second of the flight.
+    assert!(updates.len() >= 39, "{} updates", updates.len());
+    let start = Instant::now();
+    let (code, _, summary, err) = live(&path, &["--speed", "100", "--every", "5"], MINUTE);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(summary.is_object(), "{err}");
+    // 0.4 s of pacing; 30 s leaves the debug build's planning and a busy machine room.
+    assert!(
+        start.elapsed() < Duration::from_secs(30),
+        "{:?}",
+        start.elapsed()
+    );
+}
+
+/// A step back of 100 s in the middle of the log: said in a note, and the updates go on, one a
+/// second of the flight, instead of falling silent until the clock catches up.
+#[test]
+fn live_tlog_a_backward_clock_step_is_said_and_updates_go_on() {
+    let back = |t: f64| steady(t) - if t >= 20.0 { 100_000_000 } else { 0 };
+    let path = hover(back, at_home, home_at_home).write("backward.tlog");
+    let (code, updates, summary, err) = live(&path, &["--speed", "max", "--every", "1"], MINUTE);
+    assert_eq!(code, Some(0), "{err}");
+    // One update a second over the 40 s: 40 (39 from the first to the last frame, and the first).
+    assert!(
+        updates.len() >= 39,
+        "{} updates: {updates:?}",
+        updates.len()
+    );
+    let after: Vec<f64> = updates
+        .iter()
+        .map(|u| u["time_s"].as_f64().unwrap())
+        .filter(|t| *t > 20.0)
+        .collect();
+    assert!(after.len() >= 18, "{after:?}");
+    let notes: Vec<&str> = updates.iter().filter_map(|u| u["note"].as_str()).collect();
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.contains("clock") && n.contains("100 s")),
+        "{notes:?}"
+    );
+    assert!(
+        (39.0..=40.0).contains(&summary["duration_s"].as_f64().unwrap()),
+        "{summary}"
+    );
+}
+
+/// Nothing readable: timestamps all 0 (every frame whole and CRC-valid), no bytes, bytes that are
+/// not MAVLink. Bad input: exit 2, one line on stderr naming the file.
+#[test]
+fn live_tlog_with_nothing_readable_is_bad_input() {
+    let zero = hover(|_| 0, at_home, home_at_home).write("zero-time.tlog");
+    let empty = scratch("live-tlog-hostile", "empty.tlog");
+    std::fs::write(&empty, b"").unwrap();
+    let text = scratch("live-tlog-hostile", "text.tlog");
+    std::fs::write(&text, "time,lat,lon\n0,47.3977,8.5456\n".repeat(100)).unwrap();
+    for path in [zero, empty, text] {
+        let out = aloft(&["live", "--tlog", path.to_str().unwrap(), "--speed", "max"]);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{}: {err}", path.display());
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(path.to_str().unwrap()), "{err}");
+        assert!(
+            out.stdout.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
     }
 }

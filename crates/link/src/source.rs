@@ -54,12 +54,26 @@ use crate::error::LinkError;
 use crate::request::MissionRequest;
 use crate::tlog::{TlogReader, TlogStats};
 
-/// A telemetry log read as a stream of events: times from the first frame's timestamp.
+/// A step back of a telemetry log's timestamps longer than this is a step of its clock, said
+/// as [`Event::ClockBack`], s; shorter ones are frames out of order (a few ms in the shared
+/// logs), whose events take the time of the one before.
+pub const CLOCK_BACK_S: f64 = 1.0;
+
+/// A telemetry log read as a stream of events: times from the first frame's timestamp, less the
+/// clock's steps (see [`TlogSource::next_telemetry`]).
 pub struct TlogSource<R = File> {
     reader: TlogReader<R>,
     decoder: Decoder,
     queue: VecDeque<Telemetry>,
     first_us: Option<u64>,
+    /// The previous frame's timestamp, µs.
+    last_us: Option<u64>,
+    /// Seconds of clock steps taken out of the times so far (forward positive).
+    shift_s: f64,
+    /// The latest event time so far, s.
+    now_s: f64,
+    /// Forward steps longer than this are a lost link, s.
+    timeout_s: f64,
     finished: bool,
 }
 
@@ -75,18 +89,40 @@ impl TlogSource<File> {
 }
 
 impl<R: Read> TlogSource<R> {
-    /// The events of the telemetry log `source`; `name` is what errors name.
+    /// The events of the telemetry log `source`; `name` is what errors name. Forward steps of
+    /// its clock longer than [`LinkOptions::default`]'s timeout (5 s) are a lost link.
     pub fn new(source: R, name: impl Into<String>) -> Self {
         Self {
             reader: TlogReader::new(source, name),
             decoder: Decoder::new(),
             queue: VecDeque::new(),
             first_us: None,
+            last_us: None,
+            shift_s: 0.0,
+            now_s: 0.0,
+            timeout_s: LinkOptions::default().timeout.as_secs_f64(),
             finished: false,
         }
     }
 
+    /// The same with forward steps longer than `timeout` said as a lost link (`aloft live
+    /// --link-timeout`).
+    pub fn with_link_timeout(mut self, timeout: Duration) -> Self {
+        self.timeout_s = timeout.as_secs_f64();
+        self
+    }
+
     /// The next event, `None` at the end of the log.
+    ///
+    /// Times are seconds from the first frame's timestamp, with the clock's steps taken out: a
+    /// forward step longer than the link timeout is an [`Event::LinkLost`] of its length, and a
+    /// step back of more than [`CLOCK_BACK_S`] an [`Event::ClockBack`]; either way the frame
+    /// after the step takes the time of the frame before it, so a paced playback does not wait
+    /// through a jump and a flight's duration does not count it.
+    ///
+    /// # Errors
+    /// A read error, and [`LinkError::NothingReadable`] at the end of a log in which not one
+    /// frame could be read.
     pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
         loop {
             if let Some(t) = self.queue.pop_front() {
@@ -97,18 +133,51 @@ impl<R: Read> TlogSource<R> {
             }
             match self.reader.next_frame()? {
                 Some(frame) => {
-                    let first = *self.first_us.get_or_insert(frame.timestamp_us);
-                    // Before the first frame (out of order): clamped to 0 by the decoder.
-                    let time_s = (frame.timestamp_us as f64 - first as f64) * 1e-6;
+                    let time_s = self.clock(frame.timestamp_us);
                     self.decoder
                         .push(time_s, &frame.header, &frame.message, &mut self.queue);
                 }
                 None => {
                     self.finished = true;
                     self.decoder.finish(&mut self.queue);
+                    let stats = self.reader.stats();
+                    if stats.frames == 0 {
+                        return Err(LinkError::NothingReadable {
+                            name: self.reader.name().to_owned(),
+                            bytes: stats.bytes,
+                        });
+                    }
                 }
             }
         }
+    }
+
+    /// The stream time of a frame's timestamp, the clock's steps taken out (and said).
+    fn clock(&mut self, stamp_us: u64) -> f64 {
+        let first = *self.first_us.get_or_insert(stamp_us);
+        if let Some(last) = self.last_us {
+            let step_s = (stamp_us as f64 - last as f64) * 1e-6;
+            let event = if step_s > self.timeout_s {
+                self.decoder.gap(step_s);
+                Some(Event::LinkLost { silent_s: step_s })
+            } else if step_s < -CLOCK_BACK_S {
+                Some(Event::ClockBack { back_s: -step_s })
+            } else {
+                None
+            };
+            if let Some(event) = event {
+                self.shift_s += step_s;
+                self.queue.push_back(Telemetry {
+                    time_s: self.now_s,
+                    event,
+                });
+            }
+        }
+        self.last_us = Some(stamp_us);
+        // Before the first frame (out of order): clamped to 0 by the decoder.
+        let time_s = (stamp_us as f64 - first as f64) * 1e-6 - self.shift_s;
+        self.now_s = self.now_s.max(time_s);
+        time_s
     }
 
     /// What the reader has read and passed over so far.
@@ -652,6 +721,70 @@ mod tests {
         }
         assert!(parse_url("udpin:127.0.0.1:14550").is_ok());
         assert!(parse_url("serial:/dev/ttyUSB0:57600").is_ok());
+    }
+
+    /// A tlog of SYSTEM_TIME frames of the vehicle (after its HEARTBEAT) at these timestamps.
+    fn tlog(stamps_us: &[u64]) -> Vec<u8> {
+        let header = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 0,
+        };
+        let vehicle = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            autopilot: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
+            mavtype: MavType::MAV_TYPE_QUADROTOR,
+            ..HEARTBEAT_DATA::default()
+        });
+        let mut out = Vec::new();
+        for (k, &t) in stamps_us.iter().enumerate() {
+            out.extend(t.to_be_bytes());
+            let msg = match k {
+                0 => vehicle.clone(),
+                _ => MavMessage::MISSION_CURRENT(Default::default()),
+            };
+            mavlink::write_v2_msg(&mut out, header, &msg).unwrap();
+        }
+        out
+    }
+
+    fn events(bytes: &[u8], timeout_s: u64) -> Vec<Telemetry> {
+        let mut s = TlogSource::new(bytes, "t").with_link_timeout(Duration::from_secs(timeout_s));
+        std::iter::from_fn(|| s.next_telemetry().unwrap()).collect()
+    }
+
+    /// Forward by more than the timeout: a lost link of the step's length, and no time; back by
+    /// more than 1 s: said, and no time either; small steps either way are time as before.
+    #[test]
+    fn clock_steps_are_said_and_not_counted() {
+        const T0: u64 = 1_700_000_000_000_000;
+        let s = 1_000_000;
+        let stamps = [
+            T0,
+            T0 + s,
+            T0 + 1_000_001 * s,
+            T0 + 1_000_004 * s,
+            T0 + 1_000_003 * s,
+        ];
+        let ev = events(&tlog(&stamps), 5);
+        let times: Vec<f64> = ev.iter().map(|t| t.time_s).collect();
+        // Heartbeat 0; 1; the step (said at 1) and its frame at 1; 4 s later 4; 1 s back: clamped.
+        assert_eq!(times, [0.0, 1.0, 1.0, 1.0, 4.0, 4.0]);
+        assert_eq!(ev[2].event, Event::LinkLost { silent_s: 1e6 });
+        // The same 3 s step is time under a 2 s timeout; and 100 s back is said.
+        let ev = events(&tlog(&[T0, T0 + 3 * s, T0 - 97 * s, T0 - 96 * s]), 2);
+        let times: Vec<f64> = ev.iter().map(|t| t.time_s).collect();
+        assert_eq!(times, [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(ev[1].event, Event::LinkLost { silent_s: 3.0 });
+        assert_eq!(ev[3].event, Event::ClockBack { back_s: 100.0 });
+    }
+
+    #[test]
+    fn a_tlog_without_one_frame_is_an_error_naming_it() {
+        for bytes in [Vec::new(), tlog(&[0, 0, 0]), vec![0xFD; 300]] {
+            let mut s = TlogSource::new(&bytes[..], "x.tlog");
+            let e = s.next_telemetry().unwrap_err().to_string();
+            assert!(e.starts_with("x.tlog: not a telemetry log"), "{e}");
+        }
     }
 
     #[test]

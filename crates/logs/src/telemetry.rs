@@ -52,12 +52,19 @@ pub enum Event {
     /// The vehicle restarted (its boot time went back): what was learned of the flight so far no
     /// longer holds.
     Reboot,
-    /// Live links only: nothing from the vehicle for `silent_s` seconds (the link's timeout). Sent
-    /// again after every further timeout while the silence lasts; the stream goes on, as the link
-    /// may come back.
+    /// Nothing from the vehicle for `silent_s` seconds. On a live link, after the link's timeout,
+    /// and again after every further timeout while the silence lasts; the stream goes on, as the
+    /// link may come back. In a telemetry log, where its timestamps jump forward by more than the
+    /// timeout: the jump is not counted in the stream's times (nothing was received over it).
     LinkLost {
         /// Time since the vehicle's last message (or since the link opened), s.
         silent_s: f64,
+    },
+    /// A telemetry log's timestamps stepped back by `back_s` seconds (the ground station's clock
+    /// was set back): the stream's times go on from before the step.
+    ClockBack {
+        /// The step back, s.
+        back_s: f64,
     },
 }
 

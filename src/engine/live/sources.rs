@@ -26,6 +26,9 @@ pub enum LiveSource {
         path: PathBuf,
         /// Times its own time.
         speed: Option<f64>,
+        /// A forward step of the log's clock longer than this is a lost link (not waited
+        /// through, not counted as flight time), s.
+        timeout_s: f64,
     },
     /// A live MAVLink link.
     Connect {
@@ -53,7 +56,11 @@ impl LiveSource {
                 let source: Box<dyn TelemetrySource> = Box::new(logs.events_of_first()?);
                 Ok(paced(source, *speed))
             }
-            LiveSource::Tlog { path, speed } => Ok(paced(open_tlog(path)?, *speed)),
+            LiveSource::Tlog {
+                path,
+                speed,
+                timeout_s,
+            } => Ok(paced(open_tlog(path, *timeout_s)?, *speed)),
             LiveSource::Connect {
                 url,
                 system_id,
@@ -73,9 +80,20 @@ fn paced(source: Box<dyn TelemetrySource>, speed: Option<f64>) -> Box<dyn Teleme
 }
 
 #[cfg(feature = "live")]
-fn open_tlog(path: &std::path::Path) -> Result<Box<dyn TelemetrySource>, Error> {
+fn open_tlog(path: &std::path::Path, timeout_s: f64) -> Result<Box<dyn TelemetrySource>, Error> {
     let source = aloft_link::TlogSource::open(path).map_err(|e| Error::Link(e.to_string()))?;
-    Ok(Box::new(source))
+    Ok(Box::new(source.with_link_timeout(timeout(timeout_s)?)))
+}
+
+/// `--link-timeout` as a duration (one too long for a duration is refused, not a panic).
+#[cfg(feature = "live")]
+fn timeout(timeout_s: f64) -> Result<std::time::Duration, Error> {
+    std::time::Duration::try_from_secs_f64(timeout_s).map_err(|_| Error::InvalidInput {
+        name: "link-timeout",
+        value: timeout_s,
+        unit: "s",
+        expected: "a positive number of seconds, at most 1e9",
+    })
 }
 
 #[cfg(feature = "live")]
@@ -88,7 +106,7 @@ fn connect(
     let options = aloft_link::LinkOptions {
         system_id,
         component_id,
-        timeout: std::time::Duration::from_secs_f64(timeout_s),
+        timeout: timeout(timeout_s)?,
         ..aloft_link::LinkOptions::default()
     };
     let link =
@@ -97,7 +115,7 @@ fn connect(
 }
 
 #[cfg(not(feature = "live"))]
-fn open_tlog(path: &std::path::Path) -> Result<Box<dyn TelemetrySource>, Error> {
+fn open_tlog(path: &std::path::Path, _: f64) -> Result<Box<dyn TelemetrySource>, Error> {
     Err(Error::Link(format!(
         "{}: telemetry logs need aloft built with the `live` feature",
         path.display()
