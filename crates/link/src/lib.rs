@@ -40,6 +40,7 @@ mod modes;
 pub mod request;
 pub mod source;
 pub mod tlog;
+mod transport;
 
 pub use aloft_logs::telemetry::{
     BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,

@@ -3,9 +3,9 @@
 //!
 //! # Live links
 //!
-//! [`LinkSource::connect`] opens `udpin:HOST:PORT` (listen; replies go to the last sender),
-//! `udpout:HOST:PORT`, `tcpout:HOST:PORT` or `serial:PATH:BAUD` with the `mavlink` crate,
-//! accepting MAVLink 1 and 2. A thread reads the link into a bounded channel (1,024 messages; a
+//! [`LinkSource::connect`] opens `udpin:HOST:PORT` (listen on a UDP socket of aloft's own;
+//! replies go to the vehicle, see below), or `udpout:HOST:PORT`, `tcpout:HOST:PORT` or
+//! `serial:PATH:BAUD` with the `mavlink` crate, accepting MAVLink 1 and 2. A thread reads the link into a bounded channel (1,024 messages; a
 //! consumer that falls behind holds the reader back rather than losing messages in the middle of
 //! the queue), so [`LinkSource::next_telemetry`] waits at most the link timeout:
 //!
@@ -26,15 +26,18 @@
 //! - the mission download of [`crate::request`] when no mission passed on the link
 //!   ([`LinkOptions::request_mission`]).
 //!
-//! On `udpin`, nothing can be sent before the first datagram arrives (there is no peer yet):
-//! such sends are dropped silently.
+//! On `udpin` every message goes to the address the vehicle's last HEARTBEAT came from (the
+//! vehicle as the [`Decoder`] decides it), never to another sender on the port, whatever and
+//! however often it sends; nothing is sent before the vehicle's first HEARTBEAT (such sends are
+//! dropped silently). Each datagram's frames are read from that datagram alone.
 
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{ErrorKind, Read};
+use std::io::Read;
+use std::net::SocketAddr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -43,16 +46,15 @@ use mavlink::dialects::ardupilotmega::{
     MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
     NAMED_VALUE_FLOAT_DATA, STATUSTEXT_DATA,
 };
-use mavlink::error::MessageReadError;
 use mavlink::{
-    Connectable, Connection, ConnectionAddress, MAVLinkMessageRaw, MAVLinkV1MessageRaw,
-    MAVLinkV2MessageRaw, MavConnection, MavHeader, MavlinkVersion, Message,
+    MAVLinkMessageRaw, MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message,
 };
 
 use crate::decode::{Decoder, FixStats, MAX_SPEED_MPS};
 use crate::error::LinkError;
 use crate::request::MissionRequest;
 use crate::tlog::{TlogReader, TlogStats};
+use crate::transport::{parse_url, Incoming, Transport};
 
 /// A step back of a telemetry log's timestamps longer than this is a step of its clock, said
 /// as [`Event::ClockBack`], s; shorter ones are frames out of order (a few ms in the shared
@@ -301,34 +303,21 @@ pub struct LinkStats {
     pub sent: u64,
 }
 
-/// The link's reading thread's output.
-enum Incoming {
-    Message {
-        header: MavHeader,
-        version: MavlinkVersion,
-        message: Box<MavMessage>,
-        at: Instant,
-    },
-    Closed(std::io::Error),
-}
-
 /// Messages the reading thread may hold before it waits for the consumer.
 const CHANNEL: usize = 1_024;
-/// Read timeout of UDP sockets: how often the reading thread looks whether it should stop.
-const READ_TIMEOUT: Duration = Duration::from_millis(100);
 /// Longest wait for a message in [`LinkSource::next_telemetry`] before heartbeats and the mission request
 /// get their turn.
 const TICK: Duration = Duration::from_millis(250);
 /// Period of aloft's HEARTBEAT.
 const HEARTBEAT_PERIOD: Duration = Duration::from_secs(1);
 
-type Link = Connection<MavMessage>;
-
 /// A live MAVLink link as a stream of events (see the module docs).
 pub struct LinkSource {
     url: String,
     options: LinkOptions,
-    link: Arc<Link>,
+    link: Transport,
+    /// On `udpin`: the address of the vehicle's last HEARTBEAT, where aloft's messages go.
+    vehicle_address: Option<SocketAddr>,
     incoming: Receiver<Incoming>,
     stop: Arc<AtomicBool>,
     undecoded: Arc<AtomicU64>,
@@ -350,14 +339,10 @@ impl LinkSource {
     /// `serial:PATH:BAUD`) and starts reading it.
     pub fn connect(url: &str, options: LinkOptions) -> Result<Self, LinkError> {
         let address = parse_url(url)?;
-        let mut link = address
-            .connect::<MavMessage>()
-            .map_err(|cause| LinkError::Connect {
-                url: url.to_owned(),
-                cause,
-            })?;
-        link.set_allow_recv_any_version(true);
-        let link = Arc::new(link);
+        let link = Transport::open(address).map_err(|cause| LinkError::Connect {
+            url: url.to_owned(),
+            cause,
+        })?;
         let (tx, incoming) = sync_channel(CHANNEL);
         let stop = Arc::new(AtomicBool::new(false));
         let undecoded = Arc::new(AtomicU64::new(0));
@@ -365,7 +350,7 @@ impl LinkSource {
             let (link, stop, undecoded) = (link.clone(), stop.clone(), undecoded.clone());
             std::thread::Builder::new()
                 .name("aloft-link-reader".into())
-                .spawn(move || read_link(&link, &tx, &stop, &undecoded))
+                .spawn(move || link.read(&tx, &stop, &undecoded))
                 .map_err(|cause| LinkError::Connect {
                     url: url.to_owned(),
                     cause,
@@ -375,6 +360,7 @@ impl LinkSource {
             url: url.to_owned(),
             options,
             link,
+            vehicle_address: None,
             incoming,
             stop,
             undecoded,
@@ -426,7 +412,8 @@ impl LinkSource {
                     version,
                     message,
                     at,
-                }) => self.received(&header, version, &message, at)?,
+                    from,
+                }) => self.received(&header, version, &message, (at, from))?,
                 Ok(Incoming::Closed(cause)) => return Err(self.close(cause)),
                 Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => {
@@ -481,7 +468,7 @@ impl LinkSource {
         header: &MavHeader,
         version: MavlinkVersion,
         message: &MavMessage,
-        at: Instant,
+        (at, from): (Instant, Option<SocketAddr>),
     ) -> Result<(), LinkError> {
         self.stats.messages += 1;
         let time_s = self.time_s(at);
@@ -491,6 +478,10 @@ impl LinkSource {
         self.stats.vehicle_messages += 1;
         self.last_vehicle = Some(at);
         self.vehicle_version = version;
+        // On `udpin`, aloft answers where the vehicle's HEARTBEAT came from, whoever else sends.
+        if let (MavMessage::HEARTBEAT(_), Some(from)) = (message, from) {
+            self.vehicle_address = Some(from);
+        }
         if let Some(answer) = self.request.on_vehicle_message(at, header, message) {
             self.send(&answer, answer.message_name())?;
         }
@@ -502,10 +493,9 @@ impl LinkSource {
         let due = self
             .last_heartbeat
             .is_none_or(|t| now.duration_since(t) >= HEARTBEAT_PERIOD);
-        // On `udpin` the only peer is whoever sent last: wait until the vehicle has been heard
-        // (and its MAVLink version with it), else a heartbeat can leave in the wrong version in
-        // the moment between its first datagram and its decoding.
-        let peer_known = !self.url.starts_with("udpin:") || self.last_vehicle.is_some();
+        // On `udpin` there is no one to send to before the vehicle's HEARTBEAT.
+        let peer_known =
+            self.vehicle_address.is_some() || !matches!(self.link, Transport::UdpIn(_));
         if self.options.heartbeat && due && peer_known {
             self.last_heartbeat = Some(now);
             self.send(&gcs_heartbeat(), "HEARTBEAT")?;
@@ -538,19 +528,16 @@ impl LinkSource {
                 MAVLinkMessageRaw::V2(raw)
             }
         };
-        match self.link.send_raw(&raw) {
-            Ok(_) => {
-                self.stats.sent += 1;
+        // Not sent (no vehicle yet on `udpin`, a full socket buffer): the message is dropped.
+        match self.link.send(&raw, self.vehicle_address) {
+            Ok(sent) => {
+                self.stats.sent += u64::from(sent);
                 Ok(())
             }
-            // No peer yet on `udpin`, or a full socket buffer: the message is dropped.
-            Err(mavlink::error::MessageWriteError::Io(e)) if e.kind() == ErrorKind::WouldBlock => {
-                Ok(())
-            }
-            Err(e) => Err(LinkError::Send {
+            Err(cause) => Err(LinkError::Send {
                 url: self.url.clone(),
                 message: name,
-                cause: std::io::Error::other(e.to_string()),
+                cause,
             }),
         }
     }
@@ -587,72 +574,6 @@ impl TelemetrySource for LinkSource {
 
     fn reply(&mut self, reply: &Reply) -> Result<(), String> {
         LinkSource::reply(self, reply).map_err(|e| e.to_string())
-    }
-}
-
-/// The link address, checked to be one of the supported forms; UDP sockets get a read timeout
-/// so that the reading thread can stop.
-fn parse_url(url: &str) -> Result<ConnectionAddress, LinkError> {
-    let bad = || LinkError::Address {
-        url: url.to_owned(),
-    };
-    let (scheme, rest) = url.split_once(':').ok_or_else(bad)?;
-    let (host, port) = rest.rsplit_once(':').ok_or_else(bad)?;
-    let supported = matches!(scheme, "udpin" | "udpout" | "tcpout" | "serial");
-    if !supported || host.is_empty() || port.is_empty() {
-        return Err(bad());
-    }
-    let numeric = port.parse::<u32>().is_ok();
-    if !numeric {
-        return Err(bad());
-    }
-    match ConnectionAddress::parse_address(url).map_err(|_| bad())? {
-        ConnectionAddress::Udp(c) => Ok(ConnectionAddress::Udp(c.read_timeout(READ_TIMEOUT))),
-        other => Ok(other),
-    }
-}
-
-/// Reads the link until it ends or the source is dropped.
-fn read_link(link: &Link, tx: &SyncSender<Incoming>, stop: &AtomicBool, undecoded: &AtomicU64) {
-    while !stop.load(Ordering::Relaxed) {
-        match link.recv_raw() {
-            Ok(raw) => {
-                let version = raw.version();
-                match MavMessage::parse(version, raw.message_id(), raw.payload()) {
-                    Ok(message) => {
-                        let header = MavHeader {
-                            system_id: raw.system_id(),
-                            component_id: raw.component_id(),
-                            sequence: raw.sequence(),
-                        };
-                        let incoming = Incoming::Message {
-                            header,
-                            version,
-                            message: Box::new(message),
-                            at: Instant::now(),
-                        };
-                        if tx.send(incoming).is_err() {
-                            return;
-                        }
-                    }
-                    Err(_) => {
-                        undecoded.fetch_add(1, Ordering::Relaxed);
-                    }
-                }
-            }
-            Err(MessageReadError::Io(e))
-                if matches!(
-                    e.kind(),
-                    ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
-                ) => {}
-            Err(MessageReadError::Io(e)) => {
-                let _ = tx.send(Incoming::Closed(e));
-                return;
-            }
-            Err(MessageReadError::Parse(_)) => {
-                undecoded.fetch_add(1, Ordering::Relaxed);
-            }
-        }
     }
 }
 
