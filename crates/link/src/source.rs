@@ -332,6 +332,8 @@ pub struct LinkSource {
     request: MissionRequest,
     stats: LinkStats,
     closed: bool,
+    /// Set from outside (Ctrl-C): the stream ends at the next look, within [`TICK`].
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl LinkSource {
@@ -378,17 +380,30 @@ impl LinkSource {
             ),
             stats: LinkStats::default(),
             closed: false,
+            interrupt: None,
         })
     }
 
+    /// The same link, ending its stream (`None` from [`LinkSource::next_telemetry`], not an
+    /// error) within 250 ms of `interrupt` being set: how Ctrl-C ends `aloft live --connect`.
+    pub fn until(mut self, interrupt: Arc<AtomicBool>) -> Self {
+        self.interrupt = Some(interrupt);
+        self
+    }
+
     /// The next event: a message's, [`Event::LinkLost`] after [`LinkOptions::timeout`] of the
-    /// vehicle's silence, `None` once the link has ended (after its error was returned).
+    /// vehicle's silence, `None` once the link has ended (after its error was returned) or was
+    /// interrupted ([`LinkSource::until`]).
     pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
         loop {
             if let Some(t) = self.queue.pop_front() {
                 return Ok(Some(t));
             }
-            if self.closed {
+            let interrupted = self
+                .interrupt
+                .as_ref()
+                .is_some_and(|i| i.load(Ordering::Relaxed));
+            if self.closed || interrupted {
                 return Ok(None);
             }
             let now = Instant::now();
