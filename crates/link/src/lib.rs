@@ -14,7 +14,12 @@
 //! - [`TlogSource`] and [`LinkSource`] ([`source`]): the two as
 //!   [`TelemetrySource`]s; a live link reads on a thread,
 //!   reports silence as [`Event::LinkLost`], answers with
-//!   [`LinkSource::reply`], and downloads the mission when none passed ([`request`]).
+//!   [`LinkSource::reply`] (on `udpin`, to the vehicle's address only), and downloads the
+//!   mission when none passed ([`request`]); a telemetry log's clock steps are taken out of its
+//!   times and said ([`Event::LinkLost`], [`Event::ClockBack`]).
+//!
+//! Positions are believed only on the Earth and within a multirotor's reach of the last one
+//! ([`decode::fix`]).
 //!
 //! ```no_run
 //! use std::path::Path;

@@ -6,10 +6,10 @@
 //! vehicle by kilometres between two messages. Believed, such a fix puts the vehicle out of
 //! reach of home and turns the advice to `land now`. So a fix is taken in two steps:
 //!
-//! 1. **On the Earth** ([`Fix::new`]): latitude within +-90 deg, longitude within +-180 deg,
+//! 1. **On the Earth**: latitude within +-90 deg, longitude within +-180 deg,
 //!    altitude above sea level within [`MIN_ALT_AMSL_M`] to [`MAX_ALT_AMSL_M`], height above home
 //!    within +-[`MAX_RELATIVE_ALT_M`]; else the message is dropped at decode.
-//! 2. **Within reach** ([`reachable`]): no further from the last fix believed than
+//! 2. **Within reach**: no further from the last fix believed than
 //!    [`MAX_SPEED_MPS`] times the time between them plus [`FIX_SLACK_M`]; else it is a glitch,
 //!    dropped too. The first fix of a flight becomes the origin (and home, until the vehicle
 //!    sends one) only once the next fix agrees with it, so a bad first fix is replaced by the
