@@ -71,7 +71,12 @@ pub fn run(args: LiveArgs) -> Result<Outcome> {
             }
         }
         LiveTask::Follow { source, request } => {
-            let mut source = source.open()?;
+            // Ctrl-C (SIGINT) and SIGTERM end the stream: the summary is printed and the exit
+            // is 0, as at the end of a log.
+            let mut source = match interrupt() {
+                Some(stop) => source.open_until(stop)?,
+                None => source.open()?,
+            };
             let summary = follow_live(&vehicle, &request, &mut source, &mut emit)?;
             match args.format {
                 LiveFormat::Json => writeln!(out, "{}", serde_json::json!({ "summary": summary }))?,
@@ -83,6 +88,28 @@ pub fn run(args: LiveArgs) -> Result<Outcome> {
         r.finish()?;
     }
     Ok(Outcome::Ok)
+}
+
+/// A flag that SIGINT and SIGTERM set (a second one exits at once, with 130); `None` where the
+/// handler cannot be set (a build without the `live` feature, or one already set), so that the
+/// signal stops the process as it would otherwise.
+#[cfg(feature = "live")]
+fn interrupt() -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    let set = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::Relaxed) {
+            // 128 + SIGINT: the shell's code for a process stopped by Ctrl-C.
+            std::process::exit(130);
+        }
+    });
+    set.is_ok().then_some(stop)
+}
+
+#[cfg(not(feature = "live"))]
+fn interrupt() -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    None
 }
 
 /// How updates are shown.

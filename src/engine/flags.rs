@@ -673,7 +673,8 @@ pub struct LiveFlags {
     /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER).
     #[arg(long, default_value_t = 190, value_name = "ID")]
     pub component_id: u8,
-    /// Silence of the vehicle after which the link is said lost, s.
+    /// Silence of the vehicle after which the link is said lost, s (in a telemetry log: a
+    /// forward step of its clock longer than this, not waited through nor counted as time).
     #[arg(value_parser = finite(), long, default_value_t = 5.0, value_name = "S")]
     pub link_timeout: f64,
 }
@@ -741,12 +742,13 @@ impl LiveFlags {
             None | Some(PlaybackSpeed::Max) => None,
             Some(PlaybackSpeed::Times(x)) => Some(x),
         };
-        if !(self.link_timeout.is_finite() && self.link_timeout > 0.0) {
+        // At most 1e9 s (31 years): any longer is no timeout, and too long for a duration.
+        if !(self.link_timeout > 0.0 && self.link_timeout <= 1e9) {
             return Err(Error::InvalidInput {
                 name: "link-timeout",
                 value: self.link_timeout,
                 unit: "s",
-                expected: "a positive number of seconds",
+                expected: "a positive number of seconds, at most 1e9",
             });
         }
         let source = match (&self.replay, &self.tlog, &self.connect) {
@@ -757,6 +759,7 @@ impl LiveFlags {
             (_, Some(path), _) => LiveSource::Tlog {
                 path: path.clone(),
                 speed,
+                timeout_s: self.link_timeout,
             },
             (_, _, url) => LiveSource::Connect {
                 url: url.clone().unwrap_or_default(),

@@ -583,6 +583,7 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
         Event::Mission(m) => ("mission", vec![m.len() as f64]),
         Event::Reboot => ("reboot", Vec::new()),
         Event::LinkLost { silent_s } => ("link-lost", vec![*silent_s]),
+        Event::ClockBack { back_s } => ("clock-back", vec![*back_s]),
     }
 }
 
@@ -605,6 +606,8 @@ fn tlog(data: &[u8]) -> Outcome {
         let t = match source.next_telemetry() {
             Ok(Some(t)) => t,
             Ok(None) => break,
+            // Bytes without a single frame: bad input, said as such.
+            Err(aloft_link::LinkError::NothingReadable { .. }) => break,
             Err(e) => {
                 o.broken.push(Problem {
                     check: "tlog-read",

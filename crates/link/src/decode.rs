@@ -13,11 +13,11 @@
 //! | HEARTBEAT | [`Event::Heartbeat`]: armed (`base_mode` safety flag), mode by name ([`mode_name`]), MAV_TYPE |
 //! | SYS_STATUS | [`Event::Sample`]: `voltage_battery` mV -> V (unless 0 or UINT16_MAX), `current_battery` cA -> A (unless -1); [`Event::Battery`]: `battery_remaining` % -> soc (unless -1) |
 //! | BATTERY_STATUS (id 0) | [`Event::Sample`]: sum of the cell voltages, current; [`Event::Battery`]: soc, `current_consumed` mAh -> A h |
-//! | GLOBAL_POSITION_INT | [`Event::Origin`] at the first fix, then [`Event::Sample`]: position ENU from the origin (east and north on the WGS84 tangent plane, up from `relative_alt`, see below), velocity NED cm/s -> ENU m/s |
+//! | GLOBAL_POSITION_INT | [`Event::Origin`] at the first fix the next one confirms, then [`Event::Sample`]: position ENU from the origin (east and north on the WGS84 tangent plane, up from `relative_alt`, see below), velocity NED cm/s -> ENU m/s; fixes off the Earth or out of reach are dropped (see below) |
 //! | ATTITUDE | [`Event::Sample`]: roll, pitch, yaw (rad, yaw wrapped to (-pi, pi]) |
 //! | VFR_HUD | [`Event::Speeds`] |
 //! | WIND | [`Event::Sample`]: the velocity of the air, ENU: `direction` is where it comes from (deg), `speed` horizontal, `speed_z` down (ArduPilot's NED z) |
-//! | HOME_POSITION | [`Event::Home`], ENU from the origin (held until the first fix; up where `relative_alt` is 0) |
+//! | HOME_POSITION | [`Event::Home`], ENU from the origin (held until the origin; up where `relative_alt` is 0); dropped off the Earth or over 100 km from the vehicle |
 //! | EXTENDED_SYS_STATE | [`Event::Sample`]: landed (ON_GROUND) or not (IN_AIR, TAKEOFF, LANDING) |
 //! | MISSION_CURRENT | [`Event::MissionCurrent`] |
 //! | MISSION_COUNT, MISSION_ITEM(_INT), MISSION_ACK | [`Event::Mission`] ([`crate::mission`]) |
@@ -34,6 +34,15 @@
 //! order takes the time of the one before it). A value that is not finite is dropped (a sample
 //! without that channel), except mission parameters, which are passed as sent (MAVLink's NaN
 //! means "not set").
+//!
+//! Positions: a fix off the Earth (latitude beyond +-90 deg, longitude beyond +-180 deg, an
+//! altitude below -500 m or above 12 km, a height over 10 km from home's) or out of reach of the
+//! last one believed (faster than [`MAX_SPEED_MPS`], 150 m/s, over the time between them, with
+//! [`FIX_SLACK_M`] of slack) is not believed: the message is dropped and counted
+//! ([`Decoder::fixes`]), and the vehicle stays where it was. The first fix of a flight becomes
+//! the origin only once the next one is within its reach, so a bad first fix is never the origin
+//! (nor home, which is the origin until the vehicle sends one). A velocity faster than
+//! [`MAX_SPEED_MPS`] is dropped too. See [`fix`] for the bounds and why.
 //!
 //! After a [`Event::Reboot`] the decoder starts the flight over: the next fix sends a new
 //! [`Event::Origin`], and the mission the vehicle keeps in its storage is sent again.
@@ -54,12 +63,44 @@ use mavlink::MavHeader;
 use crate::mission::{MissionAssembler, Sender};
 use crate::modes::mode_name;
 
+pub mod fix;
+
+use fix::{on_earth, plausible_velocity, reachable, Fix, DEG_E7};
+pub use fix::{FIX_SLACK_M, MAX_HOME_DISTANCE_M, MAX_SPEED_MPS};
+
 /// How far the vehicle's boot time must go back to be a restart, ms (messages out of order by
 /// more than a second are rare; a restart takes its boot time back to a few seconds).
 pub const REBOOT_BACK_MS: u32 = 3_000;
 
-/// Degrees of a MAVLink `1e7 deg` integer.
-const DEG_E7: f64 = 1e-7;
+/// Positions the decoder did not believe (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FixStats {
+    /// GLOBAL_POSITION_INT off the Earth (latitude, longitude, altitude out of range).
+    pub off_earth: u64,
+    /// GLOBAL_POSITION_INT out of reach of the last fix believed.
+    pub out_of_reach: u64,
+    /// HOME_POSITION off the Earth or too far from the vehicle.
+    pub homes: u64,
+    /// Velocities faster than [`MAX_SPEED_MPS`].
+    pub velocities: u64,
+}
+
+impl FixStats {
+    /// Whether nothing was dropped.
+    pub fn is_empty(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// What the decoder makes of a fix on the Earth.
+enum Verdict {
+    /// Believed: the position ENU from the origin.
+    Believed([f64; 3]),
+    /// Waiting for the next fix to confirm it as the origin (no position yet).
+    Pending,
+    /// Out of reach of the last fix believed: dropped.
+    Glitch,
+}
 
 /// Turns messages into events (see the module docs). Memory is flat: a few numbers of state and
 /// the mission being assembled.
@@ -67,8 +108,11 @@ const DEG_E7: f64 = 1e-7;
 pub struct Decoder {
     vehicle: Option<Sender>,
     origin: Option<GeoOrigin>,
-    /// HOME_POSITION received before the first fix: latitude, longitude (rad).
+    /// HOME_POSITION received before the origin: latitude, longitude (rad).
     pending_home: Option<[f64; 2]>,
+    /// The last fix believed; before the origin, the fix waiting for the next to confirm it.
+    last_fix: Option<Fix>,
+    fixes: FixStats,
     /// `relative_alt` at the first fix, m.
     origin_relative_m: f64,
     /// Home's altitude at its last HOME_POSITION, m.
@@ -105,6 +149,22 @@ impl Decoder {
     /// Messages of the vehicle decoded so far.
     pub fn vehicle_messages(&self) -> u64 {
         self.vehicle_messages
+    }
+
+    /// Positions, homes and velocities not believed so far.
+    pub fn fixes(&self) -> FixStats {
+        self.fixes
+    }
+
+    /// The stream was silent for `silent_s` seconds that its times do not count (a telemetry
+    /// log's clock step, taken out of its times): the vehicle may have moved that much longer
+    /// since its last fix.
+    pub fn gap(&mut self, silent_s: f64) {
+        if let Some(f) = &mut self.last_fix {
+            if silent_s.is_finite() && silent_s > 0.0 {
+                f.time_s -= silent_s;
+            }
+        }
     }
 
     /// Decodes one message received at `time_s` (s from the stream's start), appending its
@@ -346,50 +406,107 @@ impl Decoder {
     }
 
     fn position(&mut self, p: &GLOBAL_POSITION_INT_DATA, out: &mut impl Extend<Telemetry>) {
-        let vel_ned = [p.vx, p.vy, p.vz].map(|v| f64::from(v) / 100.0);
-        let mut sample = Sample {
-            vel_enu_mps: Some(ned_to_enu(vel_ned)),
-            ..self.sample()
+        let vel_enu_mps = self.velocity(p);
+        let pos_enu_m = if p.lat != 0 || p.lon != 0 {
+            let Some(fix) = Fix::new(self.last_time_s, p) else {
+                self.fixes.off_earth += 1;
+                return;
+            };
+            match self.believe(fix, out) {
+                Verdict::Believed(enu) => Some(enu),
+                Verdict::Pending => None,
+                Verdict::Glitch => return,
+            }
+        } else {
+            None
         };
-        if p.lat != 0 || p.lon != 0 {
-            let lat_rad = (f64::from(p.lat) * DEG_E7).to_radians();
-            let lon_rad = (f64::from(p.lon) * DEG_E7).to_radians();
-            let relative_m = f64::from(p.relative_alt) / 1000.0;
-            let alt_m = f64::from(p.alt) / 1000.0;
-            let origin = self.origin_at(lat_rad, lon_rad, alt_m, relative_m, out);
-            let [east, north, _] = geodetic_to_enu(&origin, lat_rad, lon_rad, alt_m);
-            let up = relative_m - self.origin_relative_m + self.home_shift_m;
-            sample.pos_enu_m = Some([east, north, up]);
+        if vel_enu_mps.is_some() || pos_enu_m.is_some() {
+            let sample = Sample {
+                vel_enu_mps,
+                pos_enu_m,
+                ..self.sample()
+            };
+            self.emit(out, Event::Sample(sample));
         }
-        self.emit(out, Event::Sample(sample));
     }
 
-    /// The origin, set (and announced, with a home received before it) at the first fix.
-    fn origin_at(
-        &mut self,
-        lat_rad: f64,
-        lon_rad: f64,
-        alt_m: f64,
-        relative_m: f64,
-        out: &mut impl Extend<Telemetry>,
-    ) -> GeoOrigin {
-        if let Some(o) = self.origin {
-            return o;
+    /// The velocity of GLOBAL_POSITION_INT, ENU m/s, unless faster than [`MAX_SPEED_MPS`].
+    fn velocity(&mut self, p: &GLOBAL_POSITION_INT_DATA) -> Option<[f64; 3]> {
+        let vel_ned = [p.vx, p.vy, p.vz].map(|v| f64::from(v) / 100.0);
+        let vel = ned_to_enu(vel_ned);
+        if plausible_velocity(vel) {
+            return Some(vel);
         }
-        let origin = GeoOrigin {
-            lat_rad,
-            lon_rad,
-            alt_m,
-        };
+        self.fixes.velocities += 1;
+        None
+    }
+
+    /// Whether a fix on the Earth is believed: within reach of the last one believed; before the
+    /// origin, within reach of the fix before it, which then becomes the origin (else it waits
+    /// in its place for the next).
+    fn believe(&mut self, fix: Fix, out: &mut impl Extend<Telemetry>) -> Verdict {
+        let within = self
+            .last_fix
+            .as_ref()
+            .is_some_and(|last| reachable(last, &fix));
+        match (self.origin, self.last_fix) {
+            (Some(origin), Some(_)) if within => {
+                self.last_fix = Some(fix);
+                Verdict::Believed(self.enu(&origin, &fix))
+            }
+            (Some(_), _) => {
+                self.fixes.out_of_reach += 1;
+                Verdict::Glitch
+            }
+            (None, Some(first)) if within => {
+                let origin = self.set_origin(&first, out);
+                self.last_fix = Some(fix);
+                Verdict::Believed(self.enu(&origin, &fix))
+            }
+            (None, last) => {
+                // Two fixes that disagree: one of them is wrong, the next fix tells which.
+                if last.is_some() {
+                    self.fixes.out_of_reach += 1;
+                }
+                self.last_fix = Some(fix);
+                Verdict::Pending
+            }
+        }
+    }
+
+    /// A fix ENU from the origin: up from `relative_alt` (see the module docs).
+    fn enu(&self, origin: &GeoOrigin, fix: &Fix) -> [f64; 3] {
+        let [east, north, _] = geodetic_to_enu(origin, fix.lat_rad, fix.lon_rad, fix.alt_m);
+        let up = fix.relative_m - self.origin_relative_m + self.home_shift_m;
+        [east, north, up]
+    }
+
+    /// The origin at `first` (announced, with a home received before it).
+    fn set_origin(&mut self, first: &Fix, out: &mut impl Extend<Telemetry>) -> GeoOrigin {
+        let origin = first.origin();
         self.origin = Some(origin);
-        self.origin_relative_m = relative_m;
+        self.origin_relative_m = first.relative_m;
         // `relative_alt` is above the current home: home's moves count from here.
         self.home_shift_m = 0.0;
         self.emit(out, Event::Origin(origin));
         if let Some([lat, lon]) = self.pending_home.take() {
-            self.emit(out, Event::Home(self.home_enu(&origin, lat, lon)));
+            if self.home_near(first, lat, lon) {
+                self.emit(out, Event::Home(self.home_enu(&origin, lat, lon)));
+            } else {
+                self.home_alt_m = None;
+            }
         }
         origin
+    }
+
+    /// Whether a home (rad) is within [`MAX_HOME_DISTANCE_M`] of a fix; counted when not.
+    fn home_near(&mut self, fix: &Fix, lat_rad: f64, lon_rad: f64) -> bool {
+        let d = fix::ground_distance_m(fix.lat_rad, fix.lon_rad, lat_rad, lon_rad);
+        let near = d <= MAX_HOME_DISTANCE_M;
+        if !near {
+            self.fixes.homes += 1;
+        }
+        near
     }
 
     /// Home ENU: up where `relative_alt` is 0.
@@ -431,10 +548,24 @@ impl Decoder {
         self.emit(out, Event::Sample(s));
     }
 
+    /// HOME_POSITION, unless off the Earth or too far from the vehicle's last fix believed.
     fn home(&mut self, h: &HOME_POSITION_DATA, out: &mut impl Extend<Telemetry>) {
-        let lat = (f64::from(h.latitude) * DEG_E7).to_radians();
-        let lon = (f64::from(h.longitude) * DEG_E7).to_radians();
+        let (lat_deg, lon_deg) = (
+            f64::from(h.latitude) * DEG_E7,
+            f64::from(h.longitude) * DEG_E7,
+        );
         let alt_m = f64::from(h.altitude) / 1000.0;
+        if !on_earth(lat_deg, lon_deg, alt_m) {
+            self.fixes.homes += 1;
+            return;
+        }
+        let (lat, lon) = (lat_deg.to_radians(), lon_deg.to_radians());
+        let believed = self.origin.and(self.last_fix);
+        if let Some(fix) = believed {
+            if !self.home_near(&fix, lat, lon) {
+                return;
+            }
+        }
         if let Some(previous) = self.home_alt_m.replace(alt_m) {
             self.home_shift_m += alt_m - previous;
         }
@@ -455,6 +586,7 @@ impl Decoder {
         }
         self.emit(out, Event::Reboot);
         self.origin = None;
+        self.last_fix = None;
         self.pending_home = None;
         self.origin_relative_m = 0.0;
         self.home_alt_m = None;

@@ -27,6 +27,18 @@ pub enum LinkError {
         /// The operating system's error.
         cause: std::io::Error,
     },
+    /// A telemetry log in which not one frame could be read (no MAVLink frame after a timestamp
+    /// of the years 2000 to 2100 with a valid CRC and a payload the dialect decodes).
+    #[error(
+        "{name}: not a telemetry log: no MAVLink frame with a timestamp (µs since 1970, years \
+         2000 to 2100) and a valid CRC in its {bytes} bytes"
+    )]
+    NothingReadable {
+        /// The file (or the name the reader was given).
+        name: String,
+        /// Bytes read.
+        bytes: u64,
+    },
     /// A link address that is not one of the supported forms.
     #[error(
         "{url}: not a link address (udpin:HOST:PORT, udpout:HOST:PORT, tcpout:HOST:PORT or \

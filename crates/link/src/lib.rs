@@ -14,7 +14,12 @@
 //! - [`TlogSource`] and [`LinkSource`] ([`source`]): the two as
 //!   [`TelemetrySource`]s; a live link reads on a thread,
 //!   reports silence as [`Event::LinkLost`], answers with
-//!   [`LinkSource::reply`], and downloads the mission when none passed ([`request`]).
+//!   [`LinkSource::reply`] (on `udpin`, to the vehicle's address only), and downloads the
+//!   mission when none passed ([`request`]); a telemetry log's clock steps are taken out of its
+//!   times and said ([`Event::LinkLost`], [`Event::ClockBack`]).
+//!
+//! Positions are believed only on the Earth and within a multirotor's reach of the last one
+//! ([`decode::fix`]).
 //!
 //! ```no_run
 //! use std::path::Path;
@@ -40,16 +45,17 @@ mod modes;
 pub mod request;
 pub mod source;
 pub mod tlog;
+mod transport;
 
 pub use aloft_logs::telemetry::{
     BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,
 };
-pub use decode::Decoder;
+pub use decode::{Decoder, FixStats};
 pub use error::{LinkError, Result};
 /// The `mavlink` crate aloft-link is built on (its ArduPilot dialect's message types appear in
 /// [`TlogFrame`] and [`Decoder::push`]).
 pub use mavlink;
 pub use mission::MAX_MISSION_ITEMS;
 pub use modes::mode_name;
-pub use source::{describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
+pub use source::{describe_fixes, describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
 pub use tlog::{TlogFrame, TlogReader, TlogStats};

@@ -3,9 +3,9 @@
 //!
 //! # Live links
 //!
-//! [`LinkSource::connect`] opens `udpin:HOST:PORT` (listen; replies go to the last sender),
-//! `udpout:HOST:PORT`, `tcpout:HOST:PORT` or `serial:PATH:BAUD` with the `mavlink` crate,
-//! accepting MAVLink 1 and 2. A thread reads the link into a bounded channel (1,024 messages; a
+//! [`LinkSource::connect`] opens `udpin:HOST:PORT` (listen on a UDP socket of aloft's own;
+//! replies go to the vehicle, see below), or `udpout:HOST:PORT`, `tcpout:HOST:PORT` or
+//! `serial:PATH:BAUD` with the `mavlink` crate, accepting MAVLink 1 and 2. A thread reads the link into a bounded channel (1,024 messages; a
 //! consumer that falls behind holds the reader back rather than losing messages in the middle of
 //! the queue), so [`LinkSource::next_telemetry`] waits at most the link timeout:
 //!
@@ -26,15 +26,18 @@
 //! - the mission download of [`crate::request`] when no mission passed on the link
 //!   ([`LinkOptions::request_mission`]).
 //!
-//! On `udpin`, nothing can be sent before the first datagram arrives (there is no peer yet):
-//! such sends are dropped silently.
+//! On `udpin` every message goes to the address the vehicle's last HEARTBEAT came from (the
+//! vehicle as the [`Decoder`] decides it), never to another sender on the port, whatever and
+//! however often it sends; nothing is sent before the vehicle's first HEARTBEAT (such sends are
+//! dropped silently). Each datagram's frames are read from that datagram alone.
 
 use std::collections::VecDeque;
 use std::fs::File;
-use std::io::{ErrorKind, Read};
+use std::io::Read;
+use std::net::SocketAddr;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -43,23 +46,36 @@ use mavlink::dialects::ardupilotmega::{
     MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
     NAMED_VALUE_FLOAT_DATA, STATUSTEXT_DATA,
 };
-use mavlink::error::MessageReadError;
 use mavlink::{
-    Connectable, Connection, ConnectionAddress, MAVLinkMessageRaw, MAVLinkV1MessageRaw,
-    MAVLinkV2MessageRaw, MavConnection, MavHeader, MavlinkVersion, Message,
+    MAVLinkMessageRaw, MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message,
 };
 
-use crate::decode::Decoder;
+use crate::decode::{Decoder, FixStats, MAX_SPEED_MPS};
 use crate::error::LinkError;
 use crate::request::MissionRequest;
 use crate::tlog::{TlogReader, TlogStats};
+use crate::transport::{parse_url, Incoming, Transport};
 
-/// A telemetry log read as a stream of events: times from the first frame's timestamp.
+/// A step back of a telemetry log's timestamps longer than this is a step of its clock, said
+/// as [`Event::ClockBack`], s; shorter ones are frames out of order (a few ms in the shared
+/// logs), whose events take the time of the one before.
+pub const CLOCK_BACK_S: f64 = 1.0;
+
+/// A telemetry log read as a stream of events: times from the first frame's timestamp, less the
+/// clock's steps (see [`TlogSource::next_telemetry`]).
 pub struct TlogSource<R = File> {
     reader: TlogReader<R>,
     decoder: Decoder,
     queue: VecDeque<Telemetry>,
     first_us: Option<u64>,
+    /// The previous frame's timestamp, µs.
+    last_us: Option<u64>,
+    /// Seconds of clock steps taken out of the times so far (forward positive).
+    shift_s: f64,
+    /// The latest event time so far, s.
+    now_s: f64,
+    /// Forward steps longer than this are a lost link, s.
+    timeout_s: f64,
     finished: bool,
 }
 
@@ -75,18 +91,40 @@ impl TlogSource<File> {
 }
 
 impl<R: Read> TlogSource<R> {
-    /// The events of the telemetry log `source`; `name` is what errors name.
+    /// The events of the telemetry log `source`; `name` is what errors name. Forward steps of
+    /// its clock longer than [`LinkOptions::default`]'s timeout (5 s) are a lost link.
     pub fn new(source: R, name: impl Into<String>) -> Self {
         Self {
             reader: TlogReader::new(source, name),
             decoder: Decoder::new(),
             queue: VecDeque::new(),
             first_us: None,
+            last_us: None,
+            shift_s: 0.0,
+            now_s: 0.0,
+            timeout_s: LinkOptions::default().timeout.as_secs_f64(),
             finished: false,
         }
     }
 
+    /// The same with forward steps longer than `timeout` said as a lost link (`aloft live
+    /// --link-timeout`).
+    pub fn with_link_timeout(mut self, timeout: Duration) -> Self {
+        self.timeout_s = timeout.as_secs_f64();
+        self
+    }
+
     /// The next event, `None` at the end of the log.
+    ///
+    /// Times are seconds from the first frame's timestamp, with the clock's steps taken out: a
+    /// forward step longer than the link timeout is an [`Event::LinkLost`] of its length, and a
+    /// step back of more than [`CLOCK_BACK_S`] an [`Event::ClockBack`]; either way the frame
+    /// after the step takes the time of the frame before it, so a paced playback does not wait
+    /// through a jump and a flight's duration does not count it.
+    ///
+    /// # Errors
+    /// A read error, and [`LinkError::NothingReadable`] at the end of a log in which not one
+    /// frame could be read.
     pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
         loop {
             if let Some(t) = self.queue.pop_front() {
@@ -97,18 +135,51 @@ impl<R: Read> TlogSource<R> {
             }
             match self.reader.next_frame()? {
                 Some(frame) => {
-                    let first = *self.first_us.get_or_insert(frame.timestamp_us);
-                    // Before the first frame (out of order): clamped to 0 by the decoder.
-                    let time_s = (frame.timestamp_us as f64 - first as f64) * 1e-6;
+                    let time_s = self.clock(frame.timestamp_us);
                     self.decoder
                         .push(time_s, &frame.header, &frame.message, &mut self.queue);
                 }
                 None => {
                     self.finished = true;
                     self.decoder.finish(&mut self.queue);
+                    let stats = self.reader.stats();
+                    if stats.frames == 0 {
+                        return Err(LinkError::NothingReadable {
+                            name: self.reader.name().to_owned(),
+                            bytes: stats.bytes,
+                        });
+                    }
                 }
             }
         }
+    }
+
+    /// The stream time of a frame's timestamp, the clock's steps taken out (and said).
+    fn clock(&mut self, stamp_us: u64) -> f64 {
+        let first = *self.first_us.get_or_insert(stamp_us);
+        if let Some(last) = self.last_us {
+            let step_s = (stamp_us as f64 - last as f64) * 1e-6;
+            let event = if step_s > self.timeout_s {
+                self.decoder.gap(step_s);
+                Some(Event::LinkLost { silent_s: step_s })
+            } else if step_s < -CLOCK_BACK_S {
+                Some(Event::ClockBack { back_s: -step_s })
+            } else {
+                None
+            };
+            if let Some(event) = event {
+                self.shift_s += step_s;
+                self.queue.push_back(Telemetry {
+                    time_s: self.now_s,
+                    event,
+                });
+            }
+        }
+        self.last_us = Some(stamp_us);
+        // Before the first frame (out of order): clamped to 0 by the decoder.
+        let time_s = (stamp_us as f64 - first as f64) * 1e-6 - self.shift_s;
+        self.now_s = self.now_s.max(time_s);
+        time_s
     }
 
     /// What the reader has read and passed over so far.
@@ -146,13 +217,49 @@ pub fn describe_stats(s: &TlogStats) -> String {
     )
 }
 
+/// `N positions not believed (o off the Earth, r out of reach), h homes, v velocities`: what
+/// the decoder dropped, or empty when nothing was.
+pub fn describe_fixes(f: &FixStats) -> String {
+    let mut parts = Vec::new();
+    if f.off_earth + f.out_of_reach > 0 {
+        parts.push(format!(
+            "{} positions not believed ({} off the Earth, {} out of reach)",
+            f.off_earth + f.out_of_reach,
+            f.off_earth,
+            f.out_of_reach
+        ));
+    }
+    if f.homes > 0 {
+        parts.push(format!("{} homes not believed", f.homes));
+    }
+    if f.velocities > 0 {
+        parts.push(format!(
+            "{} velocities over {MAX_SPEED_MPS} m/s",
+            f.velocities
+        ));
+    }
+    parts.join(", ")
+}
+
+/// The non-empty texts joined by `; `.
+fn joined(texts: [String; 2]) -> String {
+    texts
+        .into_iter()
+        .filter(|t| !t.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 impl<R: Read> TelemetrySource for TlogSource<R> {
     fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
         self.next_telemetry().map_err(|e| e.to_string())
     }
 
     fn skipped(&self) -> String {
-        describe_stats(self.reader.stats())
+        joined([
+            describe_stats(self.reader.stats()),
+            describe_fixes(&self.decoder.fixes()),
+        ])
     }
 }
 
@@ -196,34 +303,21 @@ pub struct LinkStats {
     pub sent: u64,
 }
 
-/// The link's reading thread's output.
-enum Incoming {
-    Message {
-        header: MavHeader,
-        version: MavlinkVersion,
-        message: Box<MavMessage>,
-        at: Instant,
-    },
-    Closed(std::io::Error),
-}
-
 /// Messages the reading thread may hold before it waits for the consumer.
 const CHANNEL: usize = 1_024;
-/// Read timeout of UDP sockets: how often the reading thread looks whether it should stop.
-const READ_TIMEOUT: Duration = Duration::from_millis(100);
 /// Longest wait for a message in [`LinkSource::next_telemetry`] before heartbeats and the mission request
 /// get their turn.
 const TICK: Duration = Duration::from_millis(250);
 /// Period of aloft's HEARTBEAT.
 const HEARTBEAT_PERIOD: Duration = Duration::from_secs(1);
 
-type Link = Connection<MavMessage>;
-
 /// A live MAVLink link as a stream of events (see the module docs).
 pub struct LinkSource {
     url: String,
     options: LinkOptions,
-    link: Arc<Link>,
+    link: Transport,
+    /// On `udpin`: the address of the vehicle's last HEARTBEAT, where aloft's messages go.
+    vehicle_address: Option<SocketAddr>,
     incoming: Receiver<Incoming>,
     stop: Arc<AtomicBool>,
     undecoded: Arc<AtomicU64>,
@@ -238,6 +332,8 @@ pub struct LinkSource {
     request: MissionRequest,
     stats: LinkStats,
     closed: bool,
+    /// Set from outside (Ctrl-C): the stream ends at the next look, within [`TICK`].
+    interrupt: Option<Arc<AtomicBool>>,
 }
 
 impl LinkSource {
@@ -245,14 +341,10 @@ impl LinkSource {
     /// `serial:PATH:BAUD`) and starts reading it.
     pub fn connect(url: &str, options: LinkOptions) -> Result<Self, LinkError> {
         let address = parse_url(url)?;
-        let mut link = address
-            .connect::<MavMessage>()
-            .map_err(|cause| LinkError::Connect {
-                url: url.to_owned(),
-                cause,
-            })?;
-        link.set_allow_recv_any_version(true);
-        let link = Arc::new(link);
+        let link = Transport::open(address).map_err(|cause| LinkError::Connect {
+            url: url.to_owned(),
+            cause,
+        })?;
         let (tx, incoming) = sync_channel(CHANNEL);
         let stop = Arc::new(AtomicBool::new(false));
         let undecoded = Arc::new(AtomicU64::new(0));
@@ -260,7 +352,7 @@ impl LinkSource {
             let (link, stop, undecoded) = (link.clone(), stop.clone(), undecoded.clone());
             std::thread::Builder::new()
                 .name("aloft-link-reader".into())
-                .spawn(move || read_link(&link, &tx, &stop, &undecoded))
+                .spawn(move || link.read(&tx, &stop, &undecoded))
                 .map_err(|cause| LinkError::Connect {
                     url: url.to_owned(),
                     cause,
@@ -270,6 +362,7 @@ impl LinkSource {
             url: url.to_owned(),
             options,
             link,
+            vehicle_address: None,
             incoming,
             stop,
             undecoded,
@@ -287,17 +380,30 @@ impl LinkSource {
             ),
             stats: LinkStats::default(),
             closed: false,
+            interrupt: None,
         })
     }
 
+    /// The same link, ending its stream (`None` from [`LinkSource::next_telemetry`], not an
+    /// error) within 250 ms of `interrupt` being set: how Ctrl-C ends `aloft live --connect`.
+    pub fn until(mut self, interrupt: Arc<AtomicBool>) -> Self {
+        self.interrupt = Some(interrupt);
+        self
+    }
+
     /// The next event: a message's, [`Event::LinkLost`] after [`LinkOptions::timeout`] of the
-    /// vehicle's silence, `None` once the link has ended (after its error was returned).
+    /// vehicle's silence, `None` once the link has ended (after its error was returned) or was
+    /// interrupted ([`LinkSource::until`]).
     pub fn next_telemetry(&mut self) -> Result<Option<Telemetry>, LinkError> {
         loop {
             if let Some(t) = self.queue.pop_front() {
                 return Ok(Some(t));
             }
-            if self.closed {
+            let interrupted = self
+                .interrupt
+                .as_ref()
+                .is_some_and(|i| i.load(Ordering::Relaxed));
+            if self.closed || interrupted {
                 return Ok(None);
             }
             let now = Instant::now();
@@ -321,7 +427,8 @@ impl LinkSource {
                     version,
                     message,
                     at,
-                }) => self.received(&header, version, &message, at)?,
+                    from,
+                }) => self.received(&header, version, &message, (at, from))?,
                 Ok(Incoming::Closed(cause)) => return Err(self.close(cause)),
                 Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => {
@@ -376,7 +483,7 @@ impl LinkSource {
         header: &MavHeader,
         version: MavlinkVersion,
         message: &MavMessage,
-        at: Instant,
+        (at, from): (Instant, Option<SocketAddr>),
     ) -> Result<(), LinkError> {
         self.stats.messages += 1;
         let time_s = self.time_s(at);
@@ -386,6 +493,10 @@ impl LinkSource {
         self.stats.vehicle_messages += 1;
         self.last_vehicle = Some(at);
         self.vehicle_version = version;
+        // On `udpin`, aloft answers where the vehicle's HEARTBEAT came from, whoever else sends.
+        if let (MavMessage::HEARTBEAT(_), Some(from)) = (message, from) {
+            self.vehicle_address = Some(from);
+        }
         if let Some(answer) = self.request.on_vehicle_message(at, header, message) {
             self.send(&answer, answer.message_name())?;
         }
@@ -397,10 +508,9 @@ impl LinkSource {
         let due = self
             .last_heartbeat
             .is_none_or(|t| now.duration_since(t) >= HEARTBEAT_PERIOD);
-        // On `udpin` the only peer is whoever sent last: wait until the vehicle has been heard
-        // (and its MAVLink version with it), else a heartbeat can leave in the wrong version in
-        // the moment between its first datagram and its decoding.
-        let peer_known = !self.url.starts_with("udpin:") || self.last_vehicle.is_some();
+        // On `udpin` there is no one to send to before the vehicle's HEARTBEAT.
+        let peer_known =
+            self.vehicle_address.is_some() || !matches!(self.link, Transport::UdpIn(_));
         if self.options.heartbeat && due && peer_known {
             self.last_heartbeat = Some(now);
             self.send(&gcs_heartbeat(), "HEARTBEAT")?;
@@ -433,19 +543,16 @@ impl LinkSource {
                 MAVLinkMessageRaw::V2(raw)
             }
         };
-        match self.link.send_raw(&raw) {
-            Ok(_) => {
-                self.stats.sent += 1;
+        // Not sent (no vehicle yet on `udpin`, a full socket buffer): the message is dropped.
+        match self.link.send(&raw, self.vehicle_address) {
+            Ok(sent) => {
+                self.stats.sent += u64::from(sent);
                 Ok(())
             }
-            // No peer yet on `udpin`, or a full socket buffer: the message is dropped.
-            Err(mavlink::error::MessageWriteError::Io(e)) if e.kind() == ErrorKind::WouldBlock => {
-                Ok(())
-            }
-            Err(e) => Err(LinkError::Send {
+            Err(cause) => Err(LinkError::Send {
                 url: self.url.clone(),
                 message: name,
-                cause: std::io::Error::other(e.to_string()),
+                cause,
             }),
         }
     }
@@ -473,81 +580,15 @@ impl TelemetrySource for LinkSource {
 
     fn skipped(&self) -> String {
         let undecoded = self.undecoded.load(Ordering::Relaxed);
-        if undecoded == 0 {
-            String::new()
-        } else {
-            format!("{undecoded} undecodable messages")
-        }
+        let frames = match undecoded {
+            0 => String::new(),
+            n => format!("{n} undecodable messages"),
+        };
+        joined([frames, describe_fixes(&self.decoder.fixes())])
     }
 
     fn reply(&mut self, reply: &Reply) -> Result<(), String> {
         LinkSource::reply(self, reply).map_err(|e| e.to_string())
-    }
-}
-
-/// The link address, checked to be one of the supported forms; UDP sockets get a read timeout
-/// so that the reading thread can stop.
-fn parse_url(url: &str) -> Result<ConnectionAddress, LinkError> {
-    let bad = || LinkError::Address {
-        url: url.to_owned(),
-    };
-    let (scheme, rest) = url.split_once(':').ok_or_else(bad)?;
-    let (host, port) = rest.rsplit_once(':').ok_or_else(bad)?;
-    let supported = matches!(scheme, "udpin" | "udpout" | "tcpout" | "serial");
-    if !supported || host.is_empty() || port.is_empty() {
-        return Err(bad());
-    }
-    let numeric = port.parse::<u32>().is_ok();
-    if !numeric {
-        return Err(bad());
-    }
-    match ConnectionAddress::parse_address(url).map_err(|_| bad())? {
-        ConnectionAddress::Udp(c) => Ok(ConnectionAddress::Udp(c.read_timeout(READ_TIMEOUT))),
-        other => Ok(other),
-    }
-}
-
-/// Reads the link until it ends or the source is dropped.
-fn read_link(link: &Link, tx: &SyncSender<Incoming>, stop: &AtomicBool, undecoded: &AtomicU64) {
-    while !stop.load(Ordering::Relaxed) {
-        match link.recv_raw() {
-            Ok(raw) => {
-                let version = raw.version();
-                match MavMessage::parse(version, raw.message_id(), raw.payload()) {
-                    Ok(message) => {
-                        let header = MavHeader {
-                            system_id: raw.system_id(),
-                            component_id: raw.component_id(),
-                            sequence: raw.sequence(),
-                        };
-                        let incoming = Incoming::Message {
-                            header,
-                            version,
-                            message: Box::new(message),
-                            at: Instant::now(),
-                        };
-                        if tx.send(incoming).is_err() {
-                            return;
-                        }
-                    }
-                    Err(_) => {
-                        undecoded.fetch_add(1, Ordering::Relaxed);
-                    }
-                }
-            }
-            Err(MessageReadError::Io(e))
-                if matches!(
-                    e.kind(),
-                    ErrorKind::WouldBlock | ErrorKind::TimedOut | ErrorKind::Interrupted
-                ) => {}
-            Err(MessageReadError::Io(e)) => {
-                let _ = tx.send(Incoming::Closed(e));
-                return;
-            }
-            Err(MessageReadError::Parse(_)) => {
-                undecoded.fetch_add(1, Ordering::Relaxed);
-            }
-        }
     }
 }
 
@@ -616,6 +657,70 @@ mod tests {
         }
         assert!(parse_url("udpin:127.0.0.1:14550").is_ok());
         assert!(parse_url("serial:/dev/ttyUSB0:57600").is_ok());
+    }
+
+    /// A tlog of SYSTEM_TIME frames of the vehicle (after its HEARTBEAT) at these timestamps.
+    fn tlog(stamps_us: &[u64]) -> Vec<u8> {
+        let header = MavHeader {
+            system_id: 1,
+            component_id: 1,
+            sequence: 0,
+        };
+        let vehicle = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+            autopilot: MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA,
+            mavtype: MavType::MAV_TYPE_QUADROTOR,
+            ..HEARTBEAT_DATA::default()
+        });
+        let mut out = Vec::new();
+        for (k, &t) in stamps_us.iter().enumerate() {
+            out.extend(t.to_be_bytes());
+            let msg = match k {
+                0 => vehicle.clone(),
+                _ => MavMessage::MISSION_CURRENT(Default::default()),
+            };
+            mavlink::write_v2_msg(&mut out, header, &msg).unwrap();
+        }
+        out
+    }
+
+    fn events(bytes: &[u8], timeout_s: u64) -> Vec<Telemetry> {
+        let mut s = TlogSource::new(bytes, "t").with_link_timeout(Duration::from_secs(timeout_s));
+        std::iter::from_fn(|| s.next_telemetry().unwrap()).collect()
+    }
+
+    /// Forward by more than the timeout: a lost link of the step's length, and no time; back by
+    /// more than 1 s: said, and no time either; small steps either way are time as before.
+    #[test]
+    fn clock_steps_are_said_and_not_counted() {
+        const T0: u64 = 1_700_000_000_000_000;
+        let s = 1_000_000;
+        let stamps = [
+            T0,
+            T0 + s,
+            T0 + 1_000_001 * s,
+            T0 + 1_000_004 * s,
+            T0 + 1_000_003 * s,
+        ];
+        let ev = events(&tlog(&stamps), 5);
+        let times: Vec<f64> = ev.iter().map(|t| t.time_s).collect();
+        // Heartbeat 0; 1; the step (said at 1) and its frame at 1; 4 s later 4; 1 s back: clamped.
+        assert_eq!(times, [0.0, 1.0, 1.0, 1.0, 4.0, 4.0]);
+        assert_eq!(ev[2].event, Event::LinkLost { silent_s: 1e6 });
+        // The same 3 s step is time under a 2 s timeout; and 100 s back is said.
+        let ev = events(&tlog(&[T0, T0 + 3 * s, T0 - 97 * s, T0 - 96 * s]), 2);
+        let times: Vec<f64> = ev.iter().map(|t| t.time_s).collect();
+        assert_eq!(times, [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+        assert_eq!(ev[1].event, Event::LinkLost { silent_s: 3.0 });
+        assert_eq!(ev[3].event, Event::ClockBack { back_s: 100.0 });
+    }
+
+    #[test]
+    fn a_tlog_without_one_frame_is_an_error_naming_it() {
+        for bytes in [Vec::new(), tlog(&[0, 0, 0]), vec![0xFD; 300]] {
+            let mut s = TlogSource::new(&bytes[..], "x.tlog");
+            let e = s.next_telemetry().unwrap_err().to_string();
+            assert!(e.starts_with("x.tlog: not a telemetry log"), "{e}");
+        }
     }
 
     #[test]

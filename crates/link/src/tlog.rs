@@ -169,6 +169,11 @@ impl<R: Read> TlogReader<R> {
         &self.stats
     }
 
+    /// The name errors give the input (the file's path).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
     /// The input offset of the read position.
     pub fn offset(&self) -> u64 {
         self.base + self.start as u64

@@ -5,7 +5,7 @@ mod common;
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use aloft_link::{Event, TlogFrame, TlogSource};
+use aloft_link::{Event, LinkError, TlogFrame, TlogSource};
 use common::{frames, tlog_bytes};
 use proptest::prelude::*;
 
@@ -162,11 +162,21 @@ fn data_val_cut_files_lose_only_the_cut_frame() {
     }
 }
 
-/// Events of arbitrary bytes: times finite and never going back, sample values finite.
+/// Events of arbitrary bytes: times finite and never going back, sample values finite; bytes
+/// without a single frame end as [`LinkError::NothingReadable`], and only they.
 fn events_are_sane(bytes: &[u8]) {
     let mut s = TlogSource::new(bytes, "fuzz");
     let mut last = 0.0;
-    while let Some(t) = s.next_telemetry().unwrap() {
+    loop {
+        let t = match s.next_telemetry() {
+            Ok(Some(t)) => t,
+            Ok(None) => break,
+            Err(LinkError::NothingReadable { bytes: n, .. }) => {
+                assert_eq!((s.stats().frames, n), (0, bytes.len() as u64));
+                break;
+            }
+            Err(e) => panic!("{e}"),
+        };
         assert!(t.time_s.is_finite() && t.time_s >= last);
         last = t.time_s;
         if let Event::Sample(x) = &t.event {

@@ -52,12 +52,19 @@ pub enum Event {
     /// The vehicle restarted (its boot time went back): what was learned of the flight so far no
     /// longer holds.
     Reboot,
-    /// Live links only: nothing from the vehicle for `silent_s` seconds (the link's timeout). Sent
-    /// again after every further timeout while the silence lasts; the stream goes on, as the link
-    /// may come back.
+    /// Nothing from the vehicle for `silent_s` seconds. On a live link, after the link's timeout,
+    /// and again after every further timeout while the silence lasts; the stream goes on, as the
+    /// link may come back. In a telemetry log, where its timestamps jump forward by more than the
+    /// timeout: the jump is not counted in the stream's times (nothing was received over it).
     LinkLost {
         /// Time since the vehicle's last message (or since the link opened), s.
         silent_s: f64,
+    },
+    /// A telemetry log's timestamps stepped back by `back_s` seconds (the ground station's clock
+    /// was set back): the stream's times go on from before the step.
+    ClockBack {
+        /// The step back, s.
+        back_s: f64,
     },
 }
 
@@ -154,12 +161,17 @@ pub enum Reply {
 
 /// A source played at a pace: event `t` is returned no earlier than `t / speed` seconds of wall
 /// time after the first (a telemetry log "in its own time", `--speed 1`, or faster). The waits
-/// are sleeps; nothing is buffered.
+/// are sleeps; nothing is buffered. With [`Paced::until`], a wait ends as soon as its flag is
+/// set, and the stream with it.
 pub struct Paced<S> {
     source: S,
     speed: f64,
     start: Option<(std::time::Instant, f64)>,
+    stop: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
+
+/// The longest slice of a paced wait before the stop flag is looked at again.
+const STOP_POLL: std::time::Duration = std::time::Duration::from_millis(50);
 
 impl<S: TelemetrySource> Paced<S> {
     /// `source` at `speed` times its own time (positive and finite; the caller checks it).
@@ -168,6 +180,39 @@ impl<S: TelemetrySource> Paced<S> {
             source,
             speed,
             start: None,
+            stop: None,
+        }
+    }
+
+    /// The same, ending (`None` from [`TelemetrySource::next_event`]) once `stop` is set, in the
+    /// middle of a wait too (Ctrl-C).
+    pub fn until(mut self, stop: std::sync::Arc<std::sync::atomic::AtomicBool>) -> Self {
+        self.stop = Some(stop);
+        self
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
+    /// Sleeps until `due_s` of wall time after the first event, in slices that look at the
+    /// stop flag; false when it was set.
+    fn wait_until(&self, wall0: std::time::Instant, due_s: f64) -> bool {
+        loop {
+            if self.stopped() {
+                return false;
+            }
+            let left_s = due_s - wall0.elapsed().as_secs_f64();
+            if left_s <= 0.0 {
+                return true;
+            }
+            let slice = std::time::Duration::from_secs_f64(left_s);
+            std::thread::sleep(match self.stop {
+                Some(_) => slice.min(STOP_POLL),
+                None => slice,
+            });
         }
     }
 }
@@ -180,12 +225,8 @@ impl<S: TelemetrySource> TelemetrySource for Paced<S> {
         let (wall0, t0) = *self
             .start
             .get_or_insert_with(|| (std::time::Instant::now(), t.time_s));
-        let due = ((t.time_s - t0) / self.speed).clamp(0.0, 1e9);
-        let elapsed = wall0.elapsed().as_secs_f64();
-        if due > elapsed {
-            std::thread::sleep(std::time::Duration::from_secs_f64(due - elapsed));
-        }
-        Ok(Some(t))
+        let due_s = ((t.time_s - t0) / self.speed).clamp(0.0, 1e9);
+        Ok(self.wait_until(wall0, due_s).then_some(t))
     }
 
     fn skipped(&self) -> String {

@@ -413,9 +413,22 @@ impl<'a> LiveSession<'a> {
     }
 
     /// The answer now: the state of charge, the efficiency's estimate, the route ahead in
-    /// scenarios and the advice. A mission learned from the link that aloft cannot read, or a
-    /// route the planner refuses, is said in the update's `note`.
+    /// scenarios and the advice. A mission learned from the link that aloft cannot read, a route
+    /// the planner refuses, and a step back of a telemetry log's clock since the last answer are
+    /// said in the update's `note`.
     pub fn update(&mut self) -> LiveUpdate {
+        let mut update = self.answer();
+        if let Some(clock) = self.tracker.clock_note.take() {
+            update.note = Some(match update.note {
+                Some(note) => format!("{clock}; {note}"),
+                None => clock,
+            });
+        }
+        update
+    }
+
+    /// [`LiveSession::update`] but for the clock's note.
+    fn answer(&mut self) -> LiveUpdate {
         let soc = self.soc();
         let t = &self.tracker;
         let rest_s = self.rest_s;

@@ -2,8 +2,10 @@
 //! log or a live MAVLink link (the `live` feature, through the `aloft-link` crate).
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
-use aloft_logs::telemetry::{Paced, TelemetrySource};
+use aloft_logs::telemetry::{Paced, Reply, Telemetry, TelemetrySource};
 
 use super::super::logs::FlightLogs;
 use crate::error::Error;
@@ -26,6 +28,9 @@ pub enum LiveSource {
         path: PathBuf,
         /// Times its own time.
         speed: Option<f64>,
+        /// A forward step of the log's clock longer than this is a lost link (not waited
+        /// through, not counted as flight time), s.
+        timeout_s: f64,
     },
     /// A live MAVLink link.
     Connect {
@@ -48,56 +53,117 @@ impl LiveSource {
     /// the four forms or cannot be opened, and `--tlog`/`--connect` in a build without the `live`
     /// feature.
     pub fn open(&self) -> Result<Box<dyn TelemetrySource>, Error> {
+        self.open_with(None)
+    }
+
+    /// Open the source, to end (as at the end of the log, not as an error) once `stop` is set:
+    /// between two events, in a paced wait, or within 250 ms on a link waiting for its vehicle
+    /// (`aloft live` on Ctrl-C).
+    ///
+    /// # Errors
+    /// As [`LiveSource::open`].
+    pub fn open_until(&self, stop: Arc<AtomicBool>) -> Result<Box<dyn TelemetrySource>, Error> {
+        let source = self.open_with(Some(stop.clone()))?;
+        Ok(Box::new(Until { source, stop }))
+    }
+
+    fn open_with(&self, stop: Option<Arc<AtomicBool>>) -> Result<Box<dyn TelemetrySource>, Error> {
         match self {
             LiveSource::Replay { logs, speed } => {
                 let source: Box<dyn TelemetrySource> = Box::new(logs.events_of_first()?);
-                Ok(paced(source, *speed))
+                Ok(paced(source, *speed, stop))
             }
-            LiveSource::Tlog { path, speed } => Ok(paced(open_tlog(path)?, *speed)),
+            LiveSource::Tlog {
+                path,
+                speed,
+                timeout_s,
+            } => Ok(paced(open_tlog(path, *timeout_s)?, *speed, stop)),
             LiveSource::Connect {
                 url,
                 system_id,
                 component_id,
                 timeout_s,
-            } => connect(url, *system_id, *component_id, *timeout_s),
+            } => connect(url, (*system_id, *component_id), *timeout_s, stop),
         }
     }
 }
 
-/// `source` at `speed` times its own time, or as fast as it goes.
-fn paced(source: Box<dyn TelemetrySource>, speed: Option<f64>) -> Box<dyn TelemetrySource> {
-    match speed {
-        Some(x) => Box::new(Paced::new(source, x)),
-        None => source,
+/// A source that ends once its flag is set.
+struct Until {
+    source: Box<dyn TelemetrySource>,
+    stop: Arc<AtomicBool>,
+}
+
+impl TelemetrySource for Until {
+    fn next_event(&mut self) -> Result<Option<Telemetry>, String> {
+        if self.stop.load(Ordering::Relaxed) {
+            return Ok(None);
+        }
+        self.source.next_event()
+    }
+
+    fn skipped(&self) -> String {
+        self.source.skipped()
+    }
+
+    fn reply(&mut self, reply: &Reply) -> Result<(), String> {
+        self.source.reply(reply)
+    }
+}
+
+/// `source` at `speed` times its own time (its waits ended by `stop`), or as fast as it goes.
+fn paced(
+    source: Box<dyn TelemetrySource>,
+    speed: Option<f64>,
+    stop: Option<Arc<AtomicBool>>,
+) -> Box<dyn TelemetrySource> {
+    match (speed, stop) {
+        (Some(x), Some(stop)) => Box::new(Paced::new(source, x).until(stop)),
+        (Some(x), None) => Box::new(Paced::new(source, x)),
+        (None, _) => source,
     }
 }
 
 #[cfg(feature = "live")]
-fn open_tlog(path: &std::path::Path) -> Result<Box<dyn TelemetrySource>, Error> {
+fn open_tlog(path: &std::path::Path, timeout_s: f64) -> Result<Box<dyn TelemetrySource>, Error> {
     let source = aloft_link::TlogSource::open(path).map_err(|e| Error::Link(e.to_string()))?;
-    Ok(Box::new(source))
+    Ok(Box::new(source.with_link_timeout(timeout(timeout_s)?)))
+}
+
+/// `--link-timeout` as a duration (one too long for a duration is refused, not a panic).
+#[cfg(feature = "live")]
+fn timeout(timeout_s: f64) -> Result<std::time::Duration, Error> {
+    std::time::Duration::try_from_secs_f64(timeout_s).map_err(|_| Error::InvalidInput {
+        name: "link-timeout",
+        value: timeout_s,
+        unit: "s",
+        expected: "a positive number of seconds, at most 1e9",
+    })
 }
 
 #[cfg(feature = "live")]
 fn connect(
     url: &str,
-    system_id: u8,
-    component_id: u8,
+    (system_id, component_id): (u8, u8),
     timeout_s: f64,
+    stop: Option<Arc<AtomicBool>>,
 ) -> Result<Box<dyn TelemetrySource>, Error> {
     let options = aloft_link::LinkOptions {
         system_id,
         component_id,
-        timeout: std::time::Duration::from_secs_f64(timeout_s),
+        timeout: timeout(timeout_s)?,
         ..aloft_link::LinkOptions::default()
     };
     let link =
         aloft_link::LinkSource::connect(url, options).map_err(|e| Error::Link(e.to_string()))?;
-    Ok(Box::new(link))
+    Ok(match stop {
+        Some(stop) => Box::new(link.until(stop)),
+        None => Box::new(link),
+    })
 }
 
 #[cfg(not(feature = "live"))]
-fn open_tlog(path: &std::path::Path) -> Result<Box<dyn TelemetrySource>, Error> {
+fn open_tlog(path: &std::path::Path, _: f64) -> Result<Box<dyn TelemetrySource>, Error> {
     Err(Error::Link(format!(
         "{}: telemetry logs need aloft built with the `live` feature",
         path.display()
@@ -105,7 +171,12 @@ fn open_tlog(path: &std::path::Path) -> Result<Box<dyn TelemetrySource>, Error> 
 }
 
 #[cfg(not(feature = "live"))]
-fn connect(url: &str, _: u8, _: u8, _: f64) -> Result<Box<dyn TelemetrySource>, Error> {
+fn connect(
+    url: &str,
+    _: (u8, u8),
+    _: f64,
+    _: Option<Arc<AtomicBool>>,
+) -> Result<Box<dyn TelemetrySource>, Error> {
     Err(Error::Link(format!(
         "{url}: MAVLink links need aloft built with the `live` feature"
     )))

@@ -95,6 +95,8 @@ pub(crate) struct Tracker {
     last_in_air_s: Option<f64>,
     pub link_lost: bool,
     pub reboots: u32,
+    /// A step back of the source's clock not yet said in an update.
+    pub clock_note: Option<String>,
 }
 
 impl Tracker {
@@ -127,6 +129,7 @@ impl Tracker {
             last_in_air_s: None,
             link_lost: false,
             reboots: 0,
+            clock_note: None,
         }
     }
 
@@ -155,6 +158,12 @@ impl Tracker {
             }
             Event::Reboot => self.reboot(),
             Event::LinkLost { .. } => self.link_lost = true,
+            Event::ClockBack { back_s } => {
+                self.clock_note = Some(format!(
+                    "the telemetry log's clock stepped back {back_s:.0} s at {time_s:.1} s: its \
+                     times go on from before the step"
+                ));
+            }
         }
     }
 

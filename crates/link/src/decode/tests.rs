@@ -181,7 +181,7 @@ fn battery_status_sums_cells_and_reads_consumed_charge() {
 }
 
 #[test]
-fn the_first_fix_is_the_origin_and_positions_are_enu_from_it() {
+fn the_first_fix_confirmed_is_the_origin_and_positions_are_enu_from_it() {
     let mut d = decoder();
     // No fix yet: velocity only, no origin.
     let ev = events(&mut d, 1.0, h(1, 1), gpi(1_000, 0, 0, 0, 0));
@@ -191,31 +191,230 @@ fn the_first_fix_is_the_origin_and_positions_are_enu_from_it() {
     // vx north 1 m/s, vy east -2 m/s, vz down 0.5 m/s.
     let v = s.vel_enu_mps.unwrap();
     assert!(close(v[0], -2.0, TOL) && close(v[1], 1.0, TOL) && close(v[2], -0.5, TOL));
+    // The first fix waits for the next to confirm it: velocity only.
     let ev = events(
         &mut d,
         2.0,
         h(1, 1),
         gpi(2_000, 473_977_000, 85_456_000, 488_000, 1_500),
     );
-    let Event::Origin(o) = ev[0].event else {
-        panic!("{ev:?}")
-    };
-    assert!(close(o.lat_rad.to_degrees(), 47.3977, TOL));
-    assert!(close(o.alt_m, 488.0, TOL));
-    assert_eq!(samples(&ev)[0].pos_enu_m, Some([0.0, 0.0, 0.0]));
-    // 1e-4 deg north (11.1 m) and 10 m higher above home.
+    assert_eq!(ev.len(), 1, "{ev:?}");
+    assert_eq!(samples(&ev)[0].pos_enu_m, None);
+    assert_eq!(d.origin(), None);
+    // 1e-4 deg north (11.1 m) and 10 m higher above home a second later: within reach, so the
+    // first fix is the origin and this one is ENU from it.
     let ev = events(
         &mut d,
         3.0,
         h(1, 1),
         gpi(3_000, 473_978_000, 85_456_000, 498_000, 11_500),
     );
-    assert_eq!(ev.len(), 1, "the origin is sent once");
+    let Event::Origin(o) = ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(o.lat_rad.to_degrees(), 47.3977, TOL));
+    assert!(close(o.alt_m, 488.0, TOL));
+    assert_eq!(ev.len(), 2, "the origin is sent once");
     let p = samples(&ev)[0].pos_enu_m.unwrap();
     // 1e-4 deg of latitude at 47.398 deg is 11.11786 m by the series for the length of a degree
     // of latitude (111132.954 - 559.822 cos 2phi + 1.175 cos 4phi m); 1 mm covers the series'
     // truncation and the tangent plane.
     assert!(close(p[0], 0.0, 1e-6) && close(p[1], 11.11786, 1e-3) && close(p[2], 10.0, TOL));
+    let ev = events(
+        &mut d,
+        4.0,
+        h(1, 1),
+        gpi(4_000, 473_977_000, 85_456_000, 488_000, 1_500),
+    );
+    assert_eq!(ev.len(), 1, "the origin is sent once");
+    assert_eq!(samples(&ev)[0].pos_enu_m, Some([0.0, 0.0, 0.0]));
+    assert!(d.fixes().is_empty());
+}
+
+/// The two fixes of `lat` (1e-7 deg) a second apart from `t`: the origin set there.
+fn origin_at(d: &mut Decoder, t: f64, lat: i32) -> Vec<Telemetry> {
+    let boot = (t * 1000.0) as u32;
+    let mut ev = events(d, t, h(1, 1), gpi(boot, lat, 85_456_000, 488_000, 0));
+    ev.extend(events(
+        d,
+        t + 1.0,
+        h(1, 1),
+        gpi(boot + 1_000, lat, 85_456_000, 488_000, 0),
+    ));
+    assert!(d.origin().is_some(), "{ev:?}");
+    ev
+}
+
+/// Positions of the samples of `ev`.
+fn positions(ev: &[Telemetry]) -> Vec<[f64; 3]> {
+    samples(ev).iter().filter_map(|s| s.pos_enu_m).collect()
+}
+
+/// Latitude 214.7 deg (`i32::MAX`), longitude -214.7 deg, an altitude of 2,147 km: dropped whole
+/// (no sample, the velocity neither), counted; the vehicle stays where it was.
+#[test]
+fn fixes_off_the_earth_are_dropped() {
+    let mut d = decoder();
+    origin_at(&mut d, 1.0, 473_977_000);
+    let off = [
+        gpi(3_000, i32::MAX, 85_456_000, 488_000, 0),
+        gpi(3_200, 473_977_000, i32::MIN, 488_000, 0),
+        gpi(3_400, 473_977_000, 85_456_000, i32::MAX, 0),
+        gpi(3_600, 473_977_000, 85_456_000, 488_000, i32::MIN),
+    ];
+    for (k, p) in off.into_iter().enumerate() {
+        let ev = events(&mut d, 3.0 + 0.2 * k as f64, h(1, 1), p);
+        assert!(ev.is_empty(), "{ev:?}");
+    }
+    assert_eq!(d.fixes().off_earth, 4);
+    let ev = events(
+        &mut d,
+        4.0,
+        h(1, 1),
+        gpi(4_000, 473_977_000, 85_456_000, 488_000, 0),
+    );
+    assert_eq!(positions(&ev), [[0.0, 0.0, 0.0]]);
+}
+
+/// A fix 1 km away 1 s after the last believed (1,000 m > 150 m/s x 1 s + 30 m) is a glitch:
+/// dropped, counted; the same place 10 s after the last believed fix (1,530 m of reach) is
+/// believed.
+#[test]
+fn a_jump_beyond_reach_is_a_glitch_until_time_makes_it_reachable() {
+    let mut d = decoder();
+    origin_at(&mut d, 1.0, 473_977_000);
+    // 0.009 deg of latitude: 1,000.8 m (111,195 m a degree on the sphere; 0.3 % more on the
+    // ellipsoid at 47 deg does not matter against the 180 m of reach).
+    let far = 473_977_000 + 90_000;
+    let ev = events(
+        &mut d,
+        3.0,
+        h(1, 1),
+        gpi(3_000, far, 85_456_000, 488_000, 0),
+    );
+    assert!(ev.is_empty(), "{ev:?}");
+    assert_eq!(d.fixes().out_of_reach, 1);
+    // Back where it was: believed.
+    let ev = events(
+        &mut d,
+        3.2,
+        h(1, 1),
+        gpi(3_200, 473_977_000, 85_456_000, 488_000, 0),
+    );
+    assert_eq!(positions(&ev), [[0.0, 0.0, 0.0]]);
+    let ev = events(
+        &mut d,
+        13.2,
+        h(1, 1),
+        gpi(13_200, far, 85_456_000, 488_000, 0),
+    );
+    let north = positions(&ev)[0][1];
+    assert!((north - 1_000.8).abs() < 5.0, "{north}");
+    // A climb of 1 km in a second is out of reach too.
+    let ev = events(
+        &mut d,
+        14.2,
+        h(1, 1),
+        gpi(14_200, far, 85_456_000, 488_000, 1_000_000),
+    );
+    assert!(ev.is_empty(), "{ev:?}");
+}
+
+/// A first fix 0.5 deg (56 km) away from the next ones: it does not become the origin; the next
+/// two, which agree, do.
+#[test]
+fn a_bad_first_fix_is_not_the_origin() {
+    let mut d = decoder();
+    let bad = events(
+        &mut d,
+        1.0,
+        h(1, 1),
+        gpi(1_000, 478_977_000, 85_456_000, 488_000, 0),
+    );
+    assert!(positions(&bad).is_empty());
+    let ev = events(
+        &mut d,
+        1.2,
+        h(1, 1),
+        gpi(1_200, 473_977_000, 85_456_000, 488_000, 0),
+    );
+    assert!(positions(&ev).is_empty() && d.origin().is_none(), "{ev:?}");
+    let ev = events(
+        &mut d,
+        1.4,
+        h(1, 1),
+        gpi(1_400, 473_977_000, 85_456_000, 488_000, 0),
+    );
+    let Event::Origin(o) = ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!(close(o.lat_rad.to_degrees(), 47.3977, TOL));
+    assert_eq!(positions(&ev), [[0.0, 0.0, 0.0]]);
+    assert_eq!(d.fixes().out_of_reach, 1);
+}
+
+/// Homes off the Earth or over 100 km from the vehicle are dropped; a home 1 km away is taken.
+#[test]
+fn homes_off_the_earth_or_far_from_the_vehicle_are_dropped() {
+    let mut d = decoder();
+    origin_at(&mut d, 1.0, 473_977_000);
+    let home = |latitude: i32, altitude: i32| {
+        MavMessage::HOME_POSITION(HOME_POSITION_DATA {
+            latitude,
+            longitude: 85_456_000,
+            altitude,
+            ..HOME_POSITION_DATA::default()
+        })
+    };
+    for bad in [
+        home(i32::MAX, 488_000),
+        home(473_977_000, i32::MAX),
+        // 1 deg north: 111 km.
+        home(483_977_000, 488_000),
+    ] {
+        assert!(events(&mut d, 3.0, h(1, 1), bad).is_empty());
+    }
+    assert_eq!(d.fixes().homes, 3);
+    let ev = events(&mut d, 3.0, h(1, 1), home(473_977_000 + 90_000, 488_000));
+    let Event::Home(enu) = ev[0].event else {
+        panic!("{ev:?}")
+    };
+    assert!((enu[1] - 1_000.8).abs() < 5.0, "{enu:?}");
+}
+
+/// A velocity faster than 150 m/s is dropped from the sample, the position kept.
+#[test]
+fn velocities_beyond_any_multirotor_are_dropped() {
+    let mut d = decoder();
+    origin_at(&mut d, 1.0, 473_977_000);
+    let fast = MavMessage::GLOBAL_POSITION_INT(GLOBAL_POSITION_INT_DATA {
+        time_boot_ms: 3_000,
+        lat: 473_977_000,
+        lon: 85_456_000,
+        alt: 488_000,
+        vx: i16::MAX,
+        ..GLOBAL_POSITION_INT_DATA::default()
+    });
+    let s = samples(&events(&mut d, 3.0, h(1, 1), fast))[0];
+    assert_eq!((s.vel_enu_mps, s.pos_enu_m), (None, Some([0.0, 0.0, 0.0])));
+    assert_eq!(d.fixes().velocities, 1);
+}
+
+/// After a silence the source took out of its times ([`Decoder::gap`]), the vehicle may have
+/// moved as far as the silence allows.
+#[test]
+fn a_gap_taken_out_of_the_times_still_counts_for_reach() {
+    let mut d = decoder();
+    origin_at(&mut d, 1.0, 473_977_000);
+    d.gap(60.0);
+    // 1 km 0.2 s later by the stream's times, 60.2 s later in fact.
+    let ev = events(
+        &mut d,
+        2.2,
+        h(1, 1),
+        gpi(62_200, 473_977_000 + 90_000, 85_456_000, 488_000, 0),
+    );
+    assert_eq!(positions(&ev).len(), 1, "{ev:?}");
 }
 
 #[test]
@@ -230,13 +429,10 @@ fn home_before_the_first_fix_is_sent_after_the_origin_and_home_moves_shift_up() 
         })
     };
     assert!(events(&mut d, 0.5, h(1, 1), home(488_000)).is_empty());
-    // The first fix 2 m above home.
-    let ev = events(
-        &mut d,
-        1.0,
-        h(1, 1),
-        gpi(1_000, 473_977_000, 85_456_000, 490_000, 2_000),
-    );
+    // The first fix 2 m above home, confirmed by the next.
+    let fix = gpi(1_000, 473_977_000, 85_456_000, 490_000, 2_000);
+    assert!(positions(&events(&mut d, 1.0, h(1, 1), fix.clone())).is_empty());
+    let ev = events(&mut d, 1.2, h(1, 1), fix);
     assert!(matches!(ev[0].event, Event::Origin(_)));
     let Event::Home(home_enu) = ev[1].event else {
         panic!("{ev:?}")
@@ -372,16 +568,28 @@ fn a_reboot_starts_the_flight_over_and_repeats_the_mission() {
         h(1, 1),
         gpi(60_000, 473_977_000, 85_456_000, 0, 0),
     );
-    // Back by 2 s: messages out of order, not a restart.
-    assert_eq!(
-        events(
-            &mut d,
-            3.0,
-            h(1, 1),
-            gpi(58_000, 473_977_000, 85_456_000, 0, 0)
-        )
-        .len(),
-        1
+    // Back by 2 s: messages out of order, not a restart (the fix confirms the origin).
+    let ev = events(
+        &mut d,
+        3.0,
+        h(1, 1),
+        gpi(58_000, 473_977_000, 85_456_000, 0, 0),
+    );
+    assert!(
+        matches!(
+            ev[..],
+            [
+                Telemetry {
+                    event: Event::Origin(_),
+                    ..
+                },
+                Telemetry {
+                    event: Event::Sample(_),
+                    ..
+                }
+            ]
+        ),
+        "{ev:?}"
     );
     let ev = events(
         &mut d,
@@ -391,7 +599,15 @@ fn a_reboot_starts_the_flight_over_and_repeats_the_mission() {
     );
     assert_eq!(ev[0].event, Event::Reboot);
     assert!(matches!(&ev[1].event, Event::Mission(m) if m.len() == 2));
-    let Event::Origin(o) = ev[2].event else {
+    assert_eq!(d.origin(), None);
+    // The first fix after the restart, confirmed by the next, is the new origin.
+    let ev = events(
+        &mut d,
+        4.2,
+        h(1, 1),
+        gpi(1_700, 473_978_000, 85_456_000, 0, 0),
+    );
+    let Event::Origin(o) = ev[0].event else {
         panic!("{ev:?}")
     };
     assert!(close(o.lat_rad.to_degrees(), 47.3978, TOL));

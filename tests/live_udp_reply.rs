@@ -1,0 +1,196 @@
+//! `aloft live --connect udpin:...` answers the vehicle, whoever else sends to its port.
+//!
+//! The vehicle is pymavlink (`tests/python/mavlink_vehicle.py`, the independent MAVLink
+//! implementation), an armed quadrotor hovering in LOITER that sends telemetry at 5 Hz from its
+//! own port of 127.0.0.1 and answers aloft's mission download. A stray sender on another port
+//! sends a datagram every 50 ms, four times as often as the vehicle: bytes that are not MAVLink,
+//! and a ground station's HEARTBEAT (system 254). A listener that answers the last sender (the
+//! `mavlink` crate's `udpin`) sent most of aloft's messages to the stray; aloft must send every
+//! one to the vehicle, and none to the stray.
+//!
+//! It needs python3 with pymavlink (`.ci/run` installs it). Without it the test says so and
+//! passes, unless `ALOFT_PYMAVLINK_TESTS=require` or `CI` is set, where it fails.
+#![cfg(feature = "live")]
+
+use std::net::UdpSocket;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use aloft_link::mavlink::dialects::ardupilotmega::{
+    MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
+};
+use aloft_link::mavlink::{write_v2_msg, MavHeader};
+use serde_json::Value;
+
+/// Seconds the vehicle sends for.
+const VEHICLE_S: u32 = 8;
+
+/// Whether pymavlink can be imported; without it the test fails where it is required.
+fn pymavlink_ready() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import pymavlink"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        let required = std::env::var("ALOFT_PYMAVLINK_TESTS").is_ok_and(|v| v == "require")
+            || std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false");
+        assert!(
+            !required,
+            "ALOFT_PYMAVLINK_TESTS=require or CI is set, but python3 cannot import pymavlink \
+             (python3 -m pip install pymavlink==2.4.50)"
+        );
+        eprintln!("skipped: this test needs python3 with pymavlink 2.4.50");
+    }
+    ok
+}
+
+/// The stray: a datagram every 50 ms to `port` until `stop`, alternately bytes that are not
+/// MAVLink (with magic bytes in them) and a ground station's HEARTBEAT; what it sent and the
+/// datagrams it received.
+fn stray(port: u16, stop: &AtomicBool) -> (u32, u32) {
+    let socket = UdpSocket::bind("127.0.0.1:0").expect("bind");
+    socket
+        .set_read_timeout(Some(Duration::from_millis(50)))
+        .expect("timeout");
+    let gcs = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        custom_mode: 0,
+        mavtype: MavType::MAV_TYPE_GCS,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
+        base_mode: MavModeFlag::empty(),
+        system_status: MavState::MAV_STATE_ACTIVE,
+        mavlink_version: 3,
+    });
+    let mut heartbeat = Vec::new();
+    let header = MavHeader {
+        system_id: 254,
+        component_id: 190,
+        sequence: 0,
+    };
+    write_v2_msg(&mut heartbeat, header, &gcs).expect("frame");
+    let junk: Vec<u8> = (0u8..40).map(|k| k.wrapping_mul(37) ^ 0xFD).collect();
+    let (mut sent, mut received) = (0, 0);
+    let mut buf = [0u8; 2048];
+    while !stop.load(Ordering::Relaxed) {
+        let datagram: &[u8] = if sent % 2 == 0 { &junk } else { &heartbeat };
+        if socket.send_to(datagram, ("127.0.0.1", port)).is_ok() {
+            sent += 1;
+        }
+        if socket.recv(&mut buf).is_ok() {
+            received += 1;
+        }
+    }
+    (sent, received)
+}
+
+/// `aloft live --connect udpin:127.0.0.1:PORT`, JSON, an update every 0.5 s.
+fn aloft_live(port: u16) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(["live", "--connect", &format!("udpin:127.0.0.1:{port}")])
+        .args([
+            "--vehicle",
+            "dji-m100",
+            "--format",
+            "json",
+            "--every",
+            "0.5",
+        ])
+        .args(["--scenarios", "20", "--link-timeout", "30"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("aloft starts")
+}
+
+/// The NAMED_VALUE_FLOAT and STATUSTEXT aloft sent with its updates: four values an update
+/// with a band (two reserves, the point of no return where there is one, the energy left), and
+/// a text where the advice changed.
+fn replies_of(updates: &[Value]) -> (u64, u64) {
+    let mut values = 0;
+    let mut texts = 0;
+    let mut advice = None;
+    for u in updates {
+        values += 2 * u64::from(u.get("landing_soc").is_some())
+            + u64::from(u.get("point_of_no_return_s").is_some())
+            + u64::from(u.get("remaining_wh").is_some());
+        let a = u.get("advice").and_then(Value::as_str);
+        if a.is_some() && a != advice {
+            texts += 1;
+        }
+        advice = a.or(advice);
+    }
+    (values, texts)
+}
+
+#[test]
+fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
+    if !pymavlink_ready() {
+        return;
+    }
+    let port = {
+        let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
+        probe.local_addr().expect("address").port()
+    };
+    let mut aloft = aloft_live(port);
+    std::thread::sleep(Duration::from_millis(500));
+    let stop = Arc::new(AtomicBool::new(false));
+    let stray = {
+        let stop = stop.clone();
+        std::thread::spawn(move || stray(port, &stop))
+    };
+    std::thread::sleep(Duration::from_millis(300));
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mavlink_vehicle.py");
+    let start = Instant::now();
+    let vehicle = Command::new("python3")
+        .arg(&script)
+        .args([port.to_string(), VEHICLE_S.to_string()])
+        .output()
+        .expect("python3 runs");
+    stop.store(true, Ordering::Relaxed);
+    let (stray_sent, stray_received) = stray.join().expect("stray thread");
+    let _ = aloft.kill();
+    let out = aloft.wait_with_output().expect("aloft's output");
+    assert!(
+        vehicle.status.success() && start.elapsed() < Duration::from_secs(60),
+        "{}",
+        String::from_utf8_lossy(&vehicle.stderr)
+    );
+    let got: Value = serde_json::from_slice(&vehicle.stdout).expect("the vehicle's JSON line");
+    let updates: Vec<Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect();
+    let (values, texts) = replies_of(&updates);
+    let count = |t: &str| got["counts"][t].as_u64().unwrap_or(0);
+    eprintln!(
+        "aloft printed {} updates ({values} values, {texts} texts to send); the vehicle got {}; \
+         the stray sent {stray_sent} datagrams and got {stray_received}",
+        updates.len(),
+        got
+    );
+    assert_eq!(stray_received, 0, "aloft answered the stray");
+    assert!(stray_sent > 4 * VEHICLE_S, "{stray_sent}");
+    assert!(values >= 10, "{} updates: {updates:?}", updates.len());
+    assert_eq!(count("NAMED_VALUE_FLOAT"), values, "{got}");
+    assert_eq!(count("STATUSTEXT"), texts, "{got}");
+    assert!(
+        got["texts"][0]
+            .as_str()
+            .unwrap()
+            .starts_with("aloft: continue"),
+        "{got}"
+    );
+    // A heartbeat a second from the vehicle's first message on (the first second may be lost to
+    // the start).
+    assert!(count("HEARTBEAT") >= u64::from(VEHICLE_S) - 1, "{got}");
+    // The mission download ran to its end: asked, both items, acknowledged.
+    assert_eq!(count("MISSION_REQUEST_INT"), 2, "{got}");
+    assert_eq!(count("MISSION_ACK"), 1, "{got}");
+    assert_eq!(got["others"], serde_json::json!({}), "{got}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.trim().is_empty(), "{stderr}");
+}

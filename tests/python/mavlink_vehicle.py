@@ -1,0 +1,95 @@
+#!/usr/bin/env python3
+"""A vehicle on a UDP link, written with pymavlink (the independent MAVLink implementation), for
+tests/live_udp_reply.rs:
+
+    python3 tests/python/mavlink_vehicle.py PORT SECONDS
+
+From an ephemeral port of 127.0.0.1 it sends to 127.0.0.1:PORT, for SECONDS, what an armed
+ArduCopter quadrotor hovering in LOITER 20 m above its home sends (MAVLink 2, system 1,
+component 1): GLOBAL_POSITION_INT and ATTITUDE at 5 Hz; HEARTBEAT, SYS_STATUS,
+EXTENDED_SYS_STATE and HOME_POSITION at 1 Hz. It answers a mission download (MISSION_COUNT 2,
+then each MISSION_ITEM_INT asked for). Then it listens one second more and prints, as one JSON
+line, what it received from system 255 (aloft): messages by type, the NAMED_VALUE_FLOAT names,
+the STATUSTEXT texts, and messages from any other system.
+"""
+import json
+import os
+import sys
+import time
+
+os.environ.setdefault("MAVLINK20", "1")
+from pymavlink import mavutil  # noqa: E402
+from pymavlink.dialects.v20 import ardupilotmega as mav  # noqa: E402
+
+HOME = (473_977_000, 85_456_000, 488_000)  # 1e-7 deg, 1e-7 deg, mm
+UP_MM = 20_000
+PERIOD_S = 0.2
+
+
+def send_telemetry(m, k, boot_ms):
+    """The k-th 0.2 s step of the hover."""
+    if k % 5 == 0:
+        m.mav.heartbeat_send(
+            mav.MAV_TYPE_QUADROTOR,
+            mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
+            mav.MAV_MODE_FLAG_SAFETY_ARMED | mav.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            5,  # LOITER
+            mav.MAV_STATE_ACTIVE,
+        )
+        # 22.8 V, 14 A, 80 % left.
+        m.mav.sys_status_send(0, 0, 0, 0, 22_800, 1_400, 80, 0, 0, 0, 0, 0, 0)
+        m.mav.extended_sys_state_send(0, mav.MAV_LANDED_STATE_IN_AIR)
+        m.mav.home_position_send(HOME[0], HOME[1], HOME[2], 0, 0, 0, [1, 0, 0, 0], 0, 0, 0)
+    m.mav.global_position_int_send(boot_ms, HOME[0], HOME[1], HOME[2] + UP_MM, UP_MM, 0, 0, 0, 0)
+    m.mav.attitude_send(boot_ms, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def answer(m, msg):
+    """The mission download: two items, home and a waypoint 50 m north, 20 m up."""
+    t = msg.get_type()
+    if t == "MISSION_REQUEST_LIST":
+        m.mav.mission_count_send(msg.get_srcSystem(), msg.get_srcComponent(), 2, 0)
+    elif t in ("MISSION_REQUEST_INT", "MISSION_REQUEST"):
+        north = 0 if msg.seq == 0 else 4_500
+        frame = 0 if msg.seq == 0 else 3
+        m.mav.mission_item_int_send(
+            msg.get_srcSystem(), msg.get_srcComponent(), msg.seq, frame, 16, 0, 1,
+            0, 0, 0, 0, HOME[0] + north, HOME[1], 0 if msg.seq == 0 else 20.0, 0,
+        )
+
+
+def main():
+    port, seconds = int(sys.argv[1]), float(sys.argv[2])
+    m = mavutil.mavlink_connection(
+        f"udpout:127.0.0.1:{port}", source_system=1, source_component=1, dialect="ardupilotmega"
+    )
+    counts, names, texts, others = {}, {}, [], {}
+    start = time.monotonic()
+    k = 0
+    while time.monotonic() - start < seconds + 1.0:
+        now = time.monotonic() - start
+        if now < seconds and now >= k * PERIOD_S:
+            send_telemetry(m, k, 60_000 + int(now * 1000))
+            k += 1
+        msg = m.recv_msg()
+        if msg is None:
+            time.sleep(0.005)
+            continue
+        t = msg.get_type()
+        if t == "BAD_DATA":
+            continue
+        if msg.get_srcSystem() != 255:
+            others[t] = others.get(t, 0) + 1
+            continue
+        counts[t] = counts.get(t, 0) + 1
+        if t == "NAMED_VALUE_FLOAT":
+            names[msg.name] = names.get(msg.name, 0) + 1
+        elif t == "STATUSTEXT":
+            texts.append(msg.text)
+        if now < seconds:
+            answer(m, msg)
+    print(json.dumps({"counts": counts, "names": names, "texts": texts, "others": others}))
+
+
+if __name__ == "__main__":
+    main()
