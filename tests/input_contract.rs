@@ -406,3 +406,58 @@ fn successful_answers_carry_no_null_nan_or_inf() {
         }
     }
 }
+
+/// Regressions (issue 32, papercuts): a payload of 1e308 kg printed a 310-digit take-off mass; a
+/// start of 1e308 % said "start_soc = 1e306  is invalid: expected a fraction in (empty point,
+/// 1]". Values are checked in the user's units and printed so.
+#[test]
+fn huge_values_are_named_in_their_units_without_hundreds_of_digits() {
+    for (args, needles) in [
+        (
+            vec!["mission", "--payload-kg", "1e308"],
+            vec!["payload_kg = 1e308 kg", "from 0 to 1e7 kg"],
+        ),
+        (
+            vec!["mission", "--start-percent", "1e308"],
+            vec!["start_percent = 1e308 %", "at most 100 %"],
+        ),
+        (
+            vec!["endurance", "--payload-kg", "1e308"],
+            vec!["1.000e308 kg"],
+        ),
+    ] {
+        assert_refused(&args, &needles);
+        let err = common::stderr(&aloft(&args));
+        // No run of 20 digits anywhere, and no double space before a missing unit.
+        let digits = err
+            .split(|c: char| !c.is_ascii_digit())
+            .map(str::len)
+            .max()
+            .unwrap_or(0);
+        assert!(digits < 20 && !err.contains("  "), "{args:?}: {err}");
+    }
+}
+
+/// Regression (issue 32, papercuts): a plan of 20,000 waypoints and no DO_JUMP was refused as "a
+/// loop repeated too often". It is flown (the planner bounds its segments, not the reader).
+#[test]
+fn a_long_waypoint_file_without_jumps_is_flown() {
+    let p = tmp("long.waypoints");
+    let mut text = String::from("QGC WPL 110\n0\t1\t0\t16\t0\t0\t0\t0\t-35.0\t149.0\t100.0\t1\n");
+    text.push_str("1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1\n");
+    for k in 0..20_500u32 {
+        // Back and forth over 20 m, 1e-4 deg north (11 m) each way.
+        let lat = -35.0 + if k % 2 == 0 { 1e-4 } else { 0.0 };
+        text.push_str(&format!(
+            "{}\t0\t3\t16\t0\t0\t0\t0\t{lat}\t149.0\t20\t1\n",
+            k + 2
+        ));
+    }
+    std::fs::write(&p, text).unwrap();
+    // A coarse step: the route is long (20,500 legs), the point is that it is read.
+    let o = aloft(&["mission", &p, "--time-step", "2", "--format", "json"]);
+    let err = common::stderr(&o);
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{err}");
+    assert!(!err.contains("loop"), "{err}");
+    let _ = std::fs::remove_file(p);
+}

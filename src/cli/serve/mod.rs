@@ -23,7 +23,8 @@
 //!
 //! Errors, each `{"error": "..."}`: 400 for options the command does not take or a file option
 //! naming no given file, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
-//! server's, a page of another origin), 404 for anything else, 408 for a body that stops
+//! server's, a page of another origin), 404 for anything else, 405 for a method a route does
+//! not take, 408 for a body that stops
 //! arriving, 413 for a body past its limit ([`body`]), 422 for a request the engine refuses (the
 //! command line's one-line message, a request for more work than [`work`] allows among them),
 //! 503 with `Retry-After` when the server is busy ([`work`]). Connections are bounded in number
@@ -191,9 +192,18 @@ fn router(shared: Arc<Shared>) -> Router {
         .route("/api/files/{index}", get(files::given_file))
         .route("/api/files/{index}/info", get(files::given_log_info))
         .route("/api/live", get(live::events))
-        .fallback(get(assets::asset))
+        .fallback(get(assets::asset).fallback(not_allowed))
+        .method_not_allowed_fallback(not_allowed)
         .layer(middleware::from_fn_with_state(shared.clone(), guard::check))
         .with_state(shared)
+}
+
+/// 405 for a method a route does not take (`GET /api/mission`), as the other errors: JSON.
+async fn not_allowed(method: axum::http::Method, uri: axum::http::Uri) -> Response {
+    error(
+        StatusCode::METHOD_NOT_ALLOWED,
+        &format!("{method} is not a method of {}", uri.path()),
+    )
 }
 
 /// A JSON error answer.
