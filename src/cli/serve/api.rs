@@ -7,12 +7,13 @@ use axum::body::Body;
 use axum::extract::{Query, State};
 use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
+use axum::routing::{post, MethodRouter};
 
 use aloft::engine::answers;
 use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags};
 use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
 
-use super::body::{declared_too_large, read_whole, MISSION_LIMIT};
+use super::body::{read_whole, within_declared, MISSION_LIMIT};
 use super::files::Names;
 use super::{engine_message, error, json_type, Shared};
 
@@ -50,45 +51,40 @@ pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> Response {
     json(shared.vehicles.clone())
 }
 
+/// An answer, or the refusal that ends the request early (a 4xx with its JSON error): handlers
+/// return it so that each refusal is one `?`.
+pub(super) type Answered = Result<Response, Response>;
+
 /// `GET /api/endurance?OPTIONS`.
 pub(super) async fn endurance(
     State(shared): State<Arc<Shared>>,
     Query(query): QueryPairs,
-) -> Response {
-    let mut flags: EnduranceFlags = match flags("GET /api/endurance", &query, &shared) {
-        Ok(f) => f,
-        Err(m) => return error(StatusCode::BAD_REQUEST, &m),
-    };
+) -> Answered {
+    let mut flags: EnduranceFlags = flags("GET /api/endurance", &query, &shared)?;
     let work = shared.clone();
     let job = move |cancel: &_| {
         work.work.bound(&mut flags.scenarios, cancel);
         answers::endurance_answer(&flags).map_err(engine_message)
     };
-    shared.work.run(job).await
+    Ok(shared.work.run(job).await)
 }
 
-/// `POST /api/mission?file=NAME&OPTIONS`.
-pub(super) async fn mission(
-    State(shared): State<Arc<Shared>>,
-    headers: HeaderMap,
-    Query(query): QueryPairs,
-    body: Body,
-) -> Response {
-    let request = "POST /api/mission";
-    let answer = answers::mission_answer_for;
-    planned(request, (shared, headers), query, body, answer).await
-}
+/// How a mission request is answered: `aloft mission`'s JSON or the page's map.
+type MissionAnswer = fn(&Mission, &MissionScenarioFlags) -> Result<String, aloft::Error>;
 
-/// `POST /api/map?file=NAME&OPTIONS`: the page's map of the plan `/api/mission` answers.
-pub(super) async fn map(
-    State(shared): State<Arc<Shared>>,
-    headers: HeaderMap,
-    Query(query): QueryPairs,
-    body: Body,
-) -> Response {
-    let request = "POST /api/map";
-    let answer = answers::mission_map_answer_for;
-    planned(request, (shared, headers), query, body, answer).await
+/// The route of a mission request (`POST PATH?file=NAME&OPTIONS`, the body a mission file, the
+/// demo when empty): `/api/mission` answers with `answers::mission_answer_for`, `/api/map` (the
+/// page's map of the same plan) with `answers::mission_map_answer_for`.
+pub(super) fn planned_route(
+    request: &'static str,
+    answer: MissionAnswer,
+) -> MethodRouter<Arc<Shared>> {
+    post(
+        move |State(shared): State<Arc<Shared>>,
+              headers: HeaderMap,
+              Query(query): QueryPairs,
+              body: Body| planned(request, (shared, headers), query, body, answer),
+    )
 }
 
 /// A mission request: its options, its mission (the body, or the demo when empty, within
@@ -98,20 +94,12 @@ async fn planned(
     (shared, headers): (Arc<Shared>, HeaderMap),
     query: Vec<(String, String)>,
     body: Body,
-    answer: fn(&Mission, &MissionScenarioFlags) -> Result<String, aloft::Error>,
-) -> Response {
+    answer: MissionAnswer,
+) -> Answered {
     let limit_name = "the limit on mission files";
-    if let Some(refused) = declared_too_large(&headers, MISSION_LIMIT, limit_name) {
-        return refused;
-    }
-    let mut flags: MissionScenarioFlags = match flags(request, &query, &shared) {
-        Ok(f) => f,
-        Err(m) => return error(StatusCode::BAD_REQUEST, &m),
-    };
-    let body = match read_whole(body, MISSION_LIMIT, limit_name).await {
-        Ok(b) => b,
-        Err(refused) => return refused,
-    };
+    within_declared(&headers, MISSION_LIMIT, limit_name)?;
+    let mut flags: MissionScenarioFlags = flags(request, &query, &shared)?;
+    let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
     let job = move |cancel: &_| {
@@ -120,7 +108,7 @@ async fn planned(
             .and_then(|m| answer(&m, &flags))
             .map_err(engine_message)
     };
-    shared.work.run(job).await
+    Ok(shared.work.run(job).await)
 }
 
 /// The mission of an upload: the built-in demo when empty, else the file's text in any of the
@@ -137,20 +125,21 @@ fn mission_of(body: &[u8], origin: &str) -> Result<Mission, aloft::Error> {
 }
 
 /// The query's options (all but `file`) as the command's flag group, the options that name a
-/// file resolved to the files given to the server ([`Names`]); or the message of a 400 (naming
-/// the option and the `request`).
+/// file resolved to the files given to the server ([`Names`]); or a 400 naming the option and
+/// the `request`.
 pub(super) fn flags<T: FlagGroup>(
     request: &str,
     query: &[(String, String)],
     shared: &Shared,
-) -> Result<T, String> {
+) -> Result<T, Response> {
+    let bad = |m: String| error(StatusCode::BAD_REQUEST, &m);
     let file_options = file_keywords::<T>();
     let names = Names(&shared.files);
     // Each key's values, in order: one is a value (or a switch), several are a list.
     let mut values: Vec<(&String, Vec<String>)> = Vec::new();
     for (k, v) in query.iter().filter(|(k, _)| k != "file") {
         let v = match file_options.contains(k) {
-            true => names.resolve(request, k, v)?,
+            true => names.resolve(request, k, v).map_err(bad)?,
             false => v.clone(),
         };
         match values.iter_mut().find(|(g, _)| *g == k) {
@@ -170,7 +159,7 @@ pub(super) fn flags<T: FlagGroup>(
             (k.clone(), value)
         })
         .collect();
-    parse_keywords::<T>(request, &[], &given).map_err(engine_message)
+    parse_keywords::<T>(request, &[], &given).map_err(|e| bad(engine_message(e)))
 }
 
 /// The upload's name (`file=`), else `default`.

@@ -21,18 +21,19 @@ use super::error;
 pub(super) const MISSION_LIMIT: usize = aloft::engine::MAX_INPUT_BYTES as usize;
 
 /// 413 when the body's declared length is over `limit` bytes (`what` names the limit).
-pub(super) fn declared_too_large(
+pub(super) fn within_declared(
     headers: &HeaderMap,
     limit: usize,
     what: &str,
-) -> Option<Response> {
+) -> Result<(), Response> {
     let declared = headers
-        .get(header::CONTENT_LENGTH)?
-        .to_str()
-        .ok()?
-        .parse::<u64>()
-        .ok()?;
-    (declared > limit as u64).then(|| too_large(limit, what))
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<u64>().ok());
+    match declared {
+        Some(d) if d > limit as u64 => Err(too_large(limit, what)),
+        _ => Ok(()),
+    }
 }
 
 /// 413 naming the limit.

@@ -29,8 +29,8 @@ use aloft::engine::{
     builtin_names, check_profile, parse_keywords, read_text_file, read_wind_field, Mission, Vehicle,
 };
 
-use super::api::{file_name, flags, QueryPairs};
-use super::body::{declared_too_large, next_chunk, too_large};
+use super::api::{file_name, flags, Answered, QueryPairs};
+use super::body::{next_chunk, too_large, within_declared};
 use super::{answer, engine_message, error, Shared};
 
 /// A file given on the command line.
@@ -199,20 +199,11 @@ pub(super) async fn log_info(
     headers: HeaderMap,
     Query(query): QueryPairs,
     body: Body,
-) -> Response {
-    let request = "POST /api/log/info";
-    if let Some(refused) = declared_too_large(&headers, shared.max_upload, "--max-upload-mb") {
-        return refused;
-    }
-    let flags: LogInfoFlags = match flags(request, &query, &shared) {
-        Ok(f) => f,
-        Err(m) => return error(StatusCode::BAD_REQUEST, &m),
-    };
+) -> Answered {
+    within_declared(&headers, shared.max_upload, "--max-upload-mb")?;
+    let flags: LogInfoFlags = flags("POST /api/log/info", &query, &shared)?;
     let name = file_name(&query, "upload");
-    let upload = match Upload::receive(&shared.uploads, &name, body, shared.max_upload).await {
-        Ok(u) => u,
-        Err(response) => return response,
-    };
+    let upload = Upload::receive(&shared.uploads, &name, body, shared.max_upload).await?;
     let path = upload.path.clone();
     let work = move |_: &_| {
         // The readers name the file they read: the upload's own, named as it was sent.
@@ -221,7 +212,7 @@ pub(super) async fn log_info(
     };
     let response = shared.work.run(work).await;
     drop(upload);
-    response
+    Ok(response)
 }
 
 /// Uploads so far (each its own folder in the uploads' folder).

@@ -186,8 +186,14 @@ fn router(shared: Arc<Shared>) -> Router {
         .route("/api/config", get(api::config))
         .route("/api/vehicles", get(api::vehicles))
         .route("/api/endurance", get(api::endurance))
-        .route("/api/mission", post(api::mission))
-        .route("/api/map", post(api::map))
+        .route(
+            "/api/mission",
+            api::planned_route("POST /api/mission", answers::mission_answer_for),
+        )
+        .route(
+            "/api/map",
+            api::planned_route("POST /api/map", answers::mission_map_answer_for),
+        )
         .route("/api/log/info", post(files::log_info))
         .route("/api/files/{index}", get(files::given_file))
         .route("/api/files/{index}/info", get(files::given_log_info))
