@@ -198,20 +198,25 @@ fn live(path: &Path, extra: &[&str], limit: Duration) -> (Option<i32>, Vec<Value
 
 const MINUTE: Duration = Duration::from_secs(60);
 
-/// Every update from the first fix on: the vehicle where it hovers (at home, 20 m up, at home's
-/// latitude and longitude), in the air, and the advice `continue`. Every update that is not is
-/// listed in the failure.
-fn at_home_and_continuing(updates: &[Value]) {
+/// The updates with a position: all but the first (which comes with the first message, before
+/// any fix), and at least 15.
+fn placed(updates: &[Value]) -> Vec<&Value> {
     let placed: Vec<&Value> = updates
         .iter()
         .filter(|u| u.get("position").is_some())
         .collect();
-    // The first update comes with the first message, before any fix.
     assert!(
         placed.len() + 1 >= updates.len() && placed.len() >= 15,
         "{updates:?}"
     );
-    let wrong: Vec<String> = placed
+    placed
+}
+
+/// Every update from the first fix on: the vehicle where it hovers (at home, 20 m up, at home's
+/// latitude and longitude), in the air, and the advice `continue`. Every update that is not is
+/// listed in the failure.
+fn at_home_and_continuing(updates: &[Value]) {
+    let wrong: Vec<String> = placed(updates)
         .into_iter()
         .filter(|u| {
             let p = &u["position"];
@@ -279,15 +284,7 @@ fn live_tlog_a_bad_first_fix_is_not_the_origin() {
     assert_eq!(code, Some(0), "{err}");
     // Without a home the origin's height is the ground: the vehicle is at 0 m "above home", in
     // the air by its landed state.
-    let placed: Vec<&Value> = updates
-        .iter()
-        .filter(|u| u.get("position").is_some())
-        .collect();
-    assert!(
-        placed.len() + 1 >= updates.len() && placed.len() >= 15,
-        "{updates:?}"
-    );
-    for u in placed {
+    for u in placed(&updates) {
         let p = &u["position"];
         let horizontal = p["east_m"]
             .as_f64()

@@ -19,9 +19,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use aloft_link::mavlink::dialects::ardupilotmega::{
-    MavAutopilot, MavMessage, MavModeFlag, MavState, MavType, HEARTBEAT_DATA,
-};
 use aloft_link::mavlink::{write_v2_msg, MavHeader};
 use serde_json::Value;
 
@@ -57,14 +54,8 @@ fn stray(port: u16, stop: &AtomicBool) -> (u32, u32) {
     socket
         .set_read_timeout(Some(Duration::from_millis(50)))
         .expect("timeout");
-    let gcs = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
-        custom_mode: 0,
-        mavtype: MavType::MAV_TYPE_GCS,
-        autopilot: MavAutopilot::MAV_AUTOPILOT_INVALID,
-        base_mode: MavModeFlag::empty(),
-        system_status: MavState::MAV_STATE_ACTIVE,
-        mavlink_version: 3,
-    });
+    // Another ground station's: the one aloft itself sends.
+    let gcs = aloft_link::gcs_heartbeat();
     let mut heartbeat = Vec::new();
     let header = MavHeader {
         system_id: 254,

@@ -57,5 +57,7 @@ pub use error::{LinkError, Result};
 pub use mavlink;
 pub use mission::MAX_MISSION_ITEMS;
 pub use modes::mode_name;
-pub use source::{describe_fixes, describe_stats, LinkOptions, LinkSource, LinkStats, TlogSource};
+pub use source::{
+    describe_fixes, describe_stats, gcs_heartbeat, LinkOptions, LinkSource, LinkStats, TlogSource,
+};
 pub use tlog::{TlogFrame, TlogReader, TlogStats};

@@ -592,7 +592,9 @@ impl TelemetrySource for LinkSource {
     }
 }
 
-fn gcs_heartbeat() -> MavMessage {
+/// The HEARTBEAT aloft sends on a link, once a second: a ground station's (MAV_TYPE_GCS, no
+/// autopilot, active).
+pub fn gcs_heartbeat() -> MavMessage {
     MavMessage::HEARTBEAT(HEARTBEAT_DATA {
         custom_mode: 0,
         mavtype: MavType::MAV_TYPE_GCS,
