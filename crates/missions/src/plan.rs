@@ -295,7 +295,8 @@ fn complex_item(
 }
 
 mod item;
-use item::{bad_key, missing, object, short, simple_item};
+pub(crate) use item::{bad_key, missing, short};
+use item::{object, simple_item};
 
 #[cfg(test)]
 mod tests {
