@@ -133,6 +133,10 @@ pub struct Imported {
     pub warnings: Vec<String>,
     /// The items by role.
     pub counted: ItemCounts,
+    /// The surveys of a `.plan`, in file order, each with its description or why it cannot be
+    /// regenerated ([`survey`]); empty for other formats. The segments fly the items stored in
+    /// the file either way.
+    pub surveys: Vec<survey::ImportedSurvey>,
 }
 
 /// Read a planner file (`.plan` or `.waypoints`) recognised from its content.
@@ -190,6 +194,7 @@ fn assemble(
         route,
         format,
         counted: translation.counts,
+        surveys: Vec::new(),
     }
 }
 

@@ -436,6 +436,38 @@ fn a_polygon_narrower_than_two_lines_gets_one_transect_through_its_box_centre() 
     assert!((t[0].points[0].position.longitude_deg - mid).abs() < 1e-9);
 }
 
+#[test]
+fn the_reader_keeps_each_survey_and_still_reads_a_survey_it_cannot_regenerate() {
+    let take_off = json!({"type": "SimpleItem", "command": 22, "frame": 3, "autoContinue": true,
+        "params": [0, 0, 0, null, 47.0, 8.0, 30]});
+    let mut item = complex_item();
+    let r = reangle_survey_item(&item, 0.0, 2, QgcProjection::SphereMean).unwrap();
+    item["TransectStyleComplexItem"] = r["TransectStyleComplexItem"].clone();
+    let plan = |survey: &Value| {
+        json!({"fileType": "Plan", "version": 1, "mission": {"version": 2, "firmwareType": 12,
+            "hoverSpeed": 5, "plannedHomePosition": [47.0, 8.0, 400], "items": [take_off, survey]}})
+        .to_string()
+    };
+    let good = crate::read_plan(&plan(&item)).unwrap();
+    assert_eq!(good.surveys.len(), 1);
+    let s = &good.surveys[0];
+    assert_eq!((s.first_item, s.item_count), (2, LINES * 5 + 2));
+    let kept = s.survey.as_ref().unwrap().params();
+    assert_eq!(kept.polygon, rectangle());
+    assert!((kept.spacing_m - 30.0).abs() < 1e-12 && kept.first_item == 2);
+    item["TransectStyleComplexItem"]["CameraCalc"]["AdjustedFootprintSide"] = 0.2.into();
+    let bad = crate::read_plan(&plan(&item)).unwrap();
+    assert_eq!(bad.spec, good.spec);
+    assert_eq!(bad.warnings, good.warnings);
+    let e = bad.surveys[0].survey.as_ref().unwrap_err().to_string();
+    assert!(
+        e.starts_with(
+            "item 2: key TransectStyleComplexItem.CameraCalc.AdjustedFootprintSide is 0.2"
+        ),
+        "{e}"
+    );
+}
+
 /// The items `generate` hands on fly exactly as the same items written to a `.plan` and read
 /// back: the same segments, counts and warnings (float_roundtrip JSON is exact).
 #[test]
