@@ -289,7 +289,8 @@ impl Survey {
     }
 
     /// The transects as QGroundControl draws them with `projection` (steps 1-8 of the module's
-    /// docs). Empty only when no line crosses the polygon, which a validated polygon prevents.
+    /// docs). Empty only when not even the line through the box centre crosses the polygon
+    /// twice (a self-touching polygon can do that; [`Survey::regenerate`] refuses it).
     pub fn transects(&self, projection: QgcProjection) -> Vec<Transect> {
         transects::all(&self.params, projection)
     }

@@ -2,9 +2,11 @@
 //!
 //! QGroundControl projects the polygon onto a plane tangent at its first vertex
 //! (`QGCGeo.cc` `convertGeoToNed` / `convertNedToGeo`) and has done so three ways; which one
-//! drew a file decides where its lines are, by up to 0.1 % of their distance from the tangent
-//! point (2 m on the shared survey's 300 m). The turnaround and hover points are placed with
-//! `QGeoCoordinate` (Qt's sphere of 6371.0072 km) in every version.
+//! drew a file decides where its lines are. The grid starts 1000 m beyond the polygon's box in
+//! plane metres, so a plane scaled by 0.1 % (the two spheres) moves the lines by about 0.1 % of
+//! 1 km plus the polygon's size: 1.8 m (1.6e-5 deg) on the shared survey. The turnaround and
+//! hover points are placed with `QGeoCoordinate` (Qt's sphere of 6371.0072 km) in every
+//! version.
 
 use crate::geo::LatLon;
 
