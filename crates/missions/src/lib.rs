@@ -16,7 +16,9 @@
 //!   what aloft flies for each command), `jumps.rs` the DO_JUMP unrolling;
 //! - `route.rs`: [`route_figures`], the planned horizontal path, climb, descent and holds of a
 //!   mission spec, whatever its source;
-//! - `geo.rs`: per-leg distances on the WGS-84 ellipsoid.
+//! - `geo.rs`: per-leg distances on the WGS-84 ellipsoid;
+//! - [`survey`]: a QGroundControl survey's description, and its transects and items regenerated
+//!   exactly as QGroundControl draws them (also at a new grid angle, for a writer).
 //!
 //! ## Frame and units
 //! Positions are WGS-84 latitude/longitude in degrees (as the files hold them); heights are
@@ -54,6 +56,7 @@ mod notes;
 mod plan;
 mod raw_item;
 mod route;
+pub mod survey;
 mod wpl;
 
 use serde::{Deserialize, Serialize};
@@ -130,6 +133,10 @@ pub struct Imported {
     pub warnings: Vec<String>,
     /// The items by role.
     pub counted: ItemCounts,
+    /// The surveys of a `.plan`, in file order, each with its description or why it cannot be
+    /// regenerated ([`survey`]); empty for other formats. The segments fly the items stored in
+    /// the file either way.
+    pub surveys: Vec<survey::ImportedSurvey>,
 }
 
 /// Read a planner file (`.plan` or `.waypoints`) recognised from its content.
@@ -187,6 +194,7 @@ fn assemble(
         route,
         format,
         counted: translation.counts,
+        surveys: Vec::new(),
     }
 }
 

@@ -29,6 +29,7 @@ use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
+use crate::survey::{ImportedSurvey, Survey};
 use crate::{assemble, Imported, SourceFormat};
 
 /// QGroundControl's default multirotor planning speed (`hoverSpeed`), m/s, for a file without one.
@@ -60,7 +61,8 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
     check_version(mission)?;
     let (home, home_amsl_m) = planned_home(mission)?;
     let mut notes = Notes::default();
-    let items = flatten(mission, &mut notes)?;
+    let mut surveys = Vec::new();
+    let items = flatten(mission, &mut notes, &mut surveys)?;
     check_vehicle_type(mission, &mut notes)?;
     let autopilot = match mission.get("firmwareType").and_then(Value::as_u64) {
         Some(3) => Autopilot::ArduPilot,
@@ -82,12 +84,9 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
         },
         items.len()
     );
-    Ok(assemble(
-        translation,
-        &source,
-        SourceFormat::QgcPlan,
-        description,
-    ))
+    let mut imported = assemble(translation, &source, SourceFormat::QgcPlan, description);
+    imported.surveys = surveys;
+    Ok(imported)
 }
 
 /// `fileType` must be "Plan".
@@ -201,8 +200,13 @@ fn hover_speed(mission: &Map<String, Value>, notes: &mut Notes) -> Result<f64, I
     }
 }
 
-/// The mission's items, complex items flattened, numbered from 1.
-fn flatten(mission: &Map<String, Value>, notes: &mut Notes) -> Result<Vec<RawItem>, ImportError> {
+/// The mission's items, complex items flattened, numbered from 1; each survey's description
+/// kept in `surveys`.
+fn flatten(
+    mission: &Map<String, Value>,
+    notes: &mut Notes,
+    surveys: &mut Vec<ImportedSurvey>,
+) -> Result<Vec<RawItem>, ImportError> {
     let list = match mission.get("items") {
         Some(Value::Array(a)) => a,
         Some(v) => {
@@ -221,7 +225,7 @@ fn flatten(mission: &Map<String, Value>, notes: &mut Notes) -> Result<Vec<RawIte
         let at = Place::Item(next_number(&items)?);
         let obj = object(v, at, None, "item")?;
         match obj.get("type").and_then(Value::as_str) {
-            Some("ComplexItem") => complex_item(obj, &mut items, notes)?,
+            Some("ComplexItem") => complex_item(v, &mut items, notes, surveys)?,
             _ => items.push(simple_item(obj, next_number(&items)?, notes)?),
         }
     }
@@ -236,13 +240,47 @@ fn next_number(items: &[RawItem]) -> Result<u32, ImportError> {
     })
 }
 
-/// A ComplexItem: a survey's or corridor scan's stored items, or a refusal.
+/// A ComplexItem: a survey's or corridor scan's stored items (and a survey's description), or
+/// a refusal.
 fn complex_item(
-    obj: &Map<String, Value>,
+    item: &Value,
     items: &mut Vec<RawItem>,
     notes: &mut Notes,
+    surveys: &mut Vec<ImportedSurvey>,
 ) -> Result<(), ImportError> {
-    let at = Place::Item(next_number(items)?);
+    let first_item = next_number(items)?;
+    let at = Place::Item(first_item);
+    let obj = object(item, at, None, "item")?;
+    let kind = flown_kind(obj, at)?;
+    let stored = obj
+        .get("TransectStyleComplexItem")
+        .and_then(Value::as_object)
+        .and_then(|t| t.get("Items"))
+        .and_then(Value::as_array)
+        .ok_or_else(|| missing(at, None, &["TransectStyleComplexItem.Items"]))?;
+    for v in stored {
+        let number = next_number(items)?;
+        let inner = object(
+            v,
+            Place::Item(number),
+            None,
+            "TransectStyleComplexItem.Items[]",
+        )?;
+        items.push(simple_item(inner, number, notes)?);
+    }
+    if kind == "survey" {
+        surveys.push(ImportedSurvey {
+            first_item,
+            item_count: stored.len(),
+            survey: Survey::from_complex_item(item, first_item),
+        });
+    }
+    Ok(())
+}
+
+/// The `complexItemType` of a complex item whose stored path aloft flies (a survey or corridor
+/// scan), else a refusal naming it.
+fn flown_kind(obj: &Map<String, Value>, at: Place) -> Result<&str, ImportError> {
     let kind = match obj.get("complexItemType") {
         Some(Value::String(s)) => s.as_str(),
         Some(v) => {
@@ -262,40 +300,20 @@ fn complex_item(
         reason,
     };
     match kind {
-        "survey" | "CorridorScan" => {}
-        "StructureScan" => {
-            return Err(refused(
-                "a structure scan stores no flight path (QGroundControl generates it on upload)",
-            ))
-        }
-        "fwLandingPattern" | "vtolLandingPattern" => {
-            return Err(refused(
-                "a fixed-wing or VTOL landing pattern: aloft models multirotors",
-            ))
-        }
-        _ => return Err(refused("an unknown complex item: its path cannot be read")),
+        "survey" | "CorridorScan" => Ok(kind),
+        "StructureScan" => Err(refused(
+            "a structure scan stores no flight path (QGroundControl generates it on upload)",
+        )),
+        "fwLandingPattern" | "vtolLandingPattern" => Err(refused(
+            "a fixed-wing or VTOL landing pattern: aloft models multirotors",
+        )),
+        _ => Err(refused("an unknown complex item: its path cannot be read")),
     }
-    let stored = obj
-        .get("TransectStyleComplexItem")
-        .and_then(Value::as_object)
-        .and_then(|t| t.get("Items"))
-        .and_then(Value::as_array)
-        .ok_or_else(|| missing(at, None, &["TransectStyleComplexItem.Items"]))?;
-    for v in stored {
-        let number = next_number(items)?;
-        let inner = object(
-            v,
-            Place::Item(number),
-            None,
-            "TransectStyleComplexItem.Items[]",
-        )?;
-        items.push(simple_item(inner, number, notes)?);
-    }
-    Ok(())
 }
 
 mod item;
-use item::{bad_key, missing, object, short, simple_item};
+pub(crate) use item::{bad_key, missing, short};
+use item::{object, simple_item};
 
 #[cfg(test)]
 mod tests {

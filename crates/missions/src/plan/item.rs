@@ -176,7 +176,7 @@ pub(super) fn object<'a>(
 }
 
 /// Keys missing at `at`.
-pub(super) fn missing(at: Place, command: Option<u32>, keys: &[&str]) -> ImportError {
+pub(crate) fn missing(at: Place, command: Option<u32>, keys: &[&str]) -> ImportError {
     let quoted: Vec<String> = keys.iter().map(|k| format!("\"{k}\"")).collect();
     let word = if keys.len() == 1 { "key" } else { "keys" };
     ImportError::MissingKey {
@@ -187,7 +187,7 @@ pub(super) fn missing(at: Place, command: Option<u32>, keys: &[&str]) -> ImportE
 }
 
 /// A key whose value is not what is expected.
-pub(super) fn bad_key(
+pub(crate) fn bad_key(
     at: Place,
     command: Option<u32>,
     key: &str,
@@ -204,7 +204,7 @@ pub(super) fn bad_key(
 }
 
 /// A value as JSON, at most 60 characters.
-pub(super) fn short(v: &Value) -> String {
+pub(crate) fn short(v: &Value) -> String {
     let s = v.to_string();
     if s.chars().count() <= 60 {
         s
