@@ -27,6 +27,16 @@ pub struct LatLon {
     pub longitude_deg: f64,
 }
 
+impl LatLon {
+    /// The point at `latitude_deg`, `longitude_deg`.
+    pub fn new(latitude_deg: f64, longitude_deg: f64) -> Self {
+        Self {
+            latitude_deg,
+            longitude_deg,
+        }
+    }
+}
+
 /// Length of the geodesic from `a` to `b` on the WGS-84 ellipsoid, m.
 pub fn distance_m(a: LatLon, b: LatLon) -> f64 {
     if a == b {
@@ -122,10 +132,7 @@ mod tests {
     use super::*;
 
     fn p(latitude_deg: f64, longitude_deg: f64) -> LatLon {
-        LatLon {
-            latitude_deg,
-            longitude_deg,
-        }
+        LatLon::new(latitude_deg, longitude_deg)
     }
 
     /// Vincenty's own test line (Survey Review 1975, and Geoscience Australia's worked example):

@@ -21,25 +21,10 @@ use serde_json::Value;
 /// Largest coordinate difference accepted, deg (see the module's docs).
 const TOLERANCE_DEG: f64 = 1e-7;
 
-/// The shared data folder: `ALOFT_DATA_DIR`, else `../shared/data` beside the workspace.
-fn data_dir() -> PathBuf {
-    let dir = std::env::var_os("ALOFT_DATA_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            let crate_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
-            let root = crate_dir
-                .ancestors()
-                .find(|d| d.join("Cargo.lock").is_file())
-                .unwrap_or(crate_dir);
-            root.join("../shared/data")
-        });
-    assert!(
-        dir.is_dir(),
-        "{}: the data_val tests need the shared data (set ALOFT_DATA_DIR)",
-        dir.display()
-    );
-    dir
-}
+/// The shared data folder, as the root's tests find it.
+#[path = "../../../tests/common/data.rs"]
+mod data;
+use data::data_dir;
 
 fn plan_text() -> String {
     let path = data_dir().join("missions/neilvaltec_test.plan");

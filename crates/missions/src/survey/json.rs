@@ -210,12 +210,7 @@ fn number(
     prefix: &str,
     key: &str,
 ) -> Result<f64, ImportError> {
-    let full = format!("{prefix}{key}");
-    let v = obj
-        .get(key)
-        .ok_or_else(|| missing(at, None, &[full.as_str()]))?;
-    v.as_f64()
-        .ok_or_else(|| bad_key(at, None, &full, v, "a number"))
+    read_key(obj, (at, prefix, key), Value::as_f64, "a number")
 }
 
 /// A boolean that must be there.
@@ -225,12 +220,21 @@ fn boolean(
     prefix: &str,
     key: &str,
 ) -> Result<bool, ImportError> {
+    read_key(obj, (at, prefix, key), Value::as_bool, "true or false")
+}
+
+/// The value of `key` read by `read` (`what` it must be), which must be there.
+fn read_key<T>(
+    obj: &Map<String, Value>,
+    (at, prefix, key): (Place, &str, &str),
+    read: fn(&Value) -> Option<T>,
+    what: &'static str,
+) -> Result<T, ImportError> {
     let full = format!("{prefix}{key}");
     let v = obj
         .get(key)
         .ok_or_else(|| missing(at, None, &[full.as_str()]))?;
-    v.as_bool()
-        .ok_or_else(|| bad_key(at, None, &full, v, "true or false"))
+    read(v).ok_or_else(|| bad_key(at, None, &full, v, what))
 }
 
 /// A boolean that may be absent (false).

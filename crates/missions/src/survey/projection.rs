@@ -250,10 +250,7 @@ mod tests {
     use super::*;
 
     fn p(latitude_deg: f64, longitude_deg: f64) -> LatLon {
-        LatLon {
-            latitude_deg,
-            longitude_deg,
-        }
+        LatLon::new(latitude_deg, longitude_deg)
     }
 
     /// Forward then reverse returns the point. The spheres' projections are exact inverses:
