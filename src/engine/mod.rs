@@ -138,8 +138,9 @@ pub use validate::{
 };
 pub use vehicles::{list_vehicles, MassParts, TakeoffMass, Vehicle, VehicleEntry};
 
-/// A parser's message on one line (the CLI prints every error on one line).
-pub use aloft_core::one_line;
+/// A parser's message on one line, and an error with its causes on one line (the CLI prints
+/// every error on one line).
+pub use aloft_core::{error_line, one_line};
 
 /// The error of every engine function, and what is wrong with a payload sweep (so callers match
 /// on them through this module alone).

@@ -105,6 +105,30 @@ impl std::fmt::Display for Unit<'_> {
     }
 }
 
+/// An error and its causes on one line, as the command line prints it: each cause through
+/// [`one_line`], joined with `: `, a cause whose text is already there not repeated (errors often
+/// say their cause in their own message).
+///
+/// ```
+/// let e = std::io::Error::other("disk full");
+/// assert_eq!(aloft_core::error_line(&e), "disk full");
+/// ```
+pub fn error_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = String::new();
+    let mut cause = Some(e);
+    while let Some(c) = cause {
+        let line = one_line(&c.to_string());
+        if text.is_empty() {
+            text = line;
+        } else if !text.contains(&line) {
+            text.push_str(": ");
+            text.push_str(&line);
+        }
+        cause = c.source();
+    }
+    text
+}
+
 /// A parser's message on one line: TOML errors come with a snippet of the file (a line number
 /// gutter, the line, a caret under the spot) between their first line and the explanation; the
 /// snippet is dropped and the rest joined with `: `, so a message names the line, the column and

@@ -305,7 +305,7 @@ fn round_trip(m: &Mission, o: &mut Outcome) {
             check: "json-round-trip",
             detail: format!(
                 "its JSON does not read back: {}",
-                crate::check::cli_line(&e)
+                aloft::engine::error_line(&e)
             ),
         }),
     }
@@ -390,7 +390,7 @@ fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions)
                     check: "mcap-round-trip",
                     detail: format!(
                         "aloft cannot read the MCAP it wrote: {}",
-                        crate::check::cli_line(&e)
+                        aloft::engine::error_line(&e)
                     ),
                 }),
                 (_, Err(e)) => o.refuse("log info", &e),
