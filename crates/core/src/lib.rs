@@ -105,6 +105,71 @@ impl std::fmt::Display for Unit<'_> {
     }
 }
 
+/// A parameter outside its valid range, with its value, unit and what a valid value looks like:
+/// the `InvalidParameter` of the model crates' errors (`PlannerError`, `PropulsionError`), which
+/// wrap it.
+///
+/// ```
+/// let e = aloft_core::parameter("rotor_radius_m", -0.2, "m", false, "a positive length");
+/// assert_eq!(
+///     e.unwrap_err().to_string(),
+///     "rotor_radius_m = -0.2 m is invalid: expected a positive length"
+/// );
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InvalidParameter {
+    /// Parameter name, with its unit suffix.
+    pub name: &'static str,
+    /// The rejected value.
+    pub value: f64,
+    /// Unit of `value`.
+    pub unit: &'static str,
+    /// What a valid value looks like.
+    pub expected: &'static str,
+}
+
+impl std::fmt::Display for InvalidParameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Self {
+            name,
+            value,
+            unit,
+            expected,
+        } = *self;
+        write!(
+            f,
+            "{name} = {}{} is invalid: expected {expected}",
+            Num(value),
+            Unit(unit)
+        )
+    }
+}
+
+impl std::error::Error for InvalidParameter {}
+
+/// `value` when `ok`, else [`InvalidParameter`] saying what was `expected`.
+///
+/// # Errors
+/// [`InvalidParameter`] when `ok` is false.
+pub fn parameter(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+    ok: bool,
+    expected: &'static str,
+) -> Result<f64, InvalidParameter> {
+    if ok {
+        Ok(value)
+    } else {
+        Err(InvalidParameter {
+            name,
+            value,
+            unit,
+            expected,
+        })
+    }
+}
+
 /// An error and its causes on one line, as the command line prints it: each cause through
 /// [`one_line`], joined with `: `, a cause whose text is already there not repeated (errors often
 /// say their cause in their own message).

@@ -120,12 +120,13 @@ pub fn differentiate_velocity(
 ) -> Result<Vec<[f64; 3]>, PlannerError> {
     crate::error::positive("acceleration_window_s", window_s, "s")?;
     if times_s.len() != vel_mps.len() || times_s.len() < 2 {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "trajectory points",
             value: times_s.len().min(vel_mps.len()) as f64,
             unit: "",
             expected: "at least two, with a velocity for every time",
-        });
+        }
+        .into());
     }
     let (t0, t1) = (times_s[0], times_s[times_s.len() - 1]);
     let at = |t: f64| -> [f64; 3] {
@@ -169,7 +170,7 @@ pub fn replay(
     wind: &Wind,
 ) -> Result<ReplayReport, PlannerError> {
     let n = points.len() as f64;
-    crate::error::parameter(
+    aloft_core::parameter(
         "trajectory points",
         n,
         "",
@@ -180,12 +181,13 @@ pub fn replay(
         .windows(2)
         .find(|w| !(w[0].time_s.is_finite() && w[1].time_s > w[0].time_s))
     {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "time_s",
             value: w[1].time_s,
             unit: "s",
             expected: "finite times, each later than the one before",
-        });
+        }
+        .into());
     }
     let aircraft = pw.aircraft();
     let r_rotor = aircraft.rotor_radius_m();

@@ -113,12 +113,13 @@ fn check_eq17_range(min_current_a: f64, max_current_a: f64) -> Result<(), Propul
     positive("battery eq17 min_current_a", min_current_a, "A")?;
     positive("battery eq17 max_current_a", max_current_a, "A")?;
     if max_current_a <= min_current_a {
-        return Err(PropulsionError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "battery eq17 max_current_a",
             value: max_current_a,
             unit: "A",
             expected: "a current above eq17 min_current_a",
-        });
+        }
+        .into());
     }
     Ok(())
 }
@@ -470,12 +471,13 @@ impl OcvCurve {
             fraction("ocv state_of_charge", s, true, true)?;
             voltage("ocv cell_v", v)?;
             if k > 0 && (s <= soc[k - 1] || v < cell_v[k - 1]) {
-                return Err(PropulsionError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name: "ocv state_of_charge",
                     value: s,
                     unit: "(fraction)",
                     expected: "strictly increasing state of charge with non-decreasing voltage",
-                });
+                }
+                .into());
             }
         }
         Ok(Self { soc, cell_v })

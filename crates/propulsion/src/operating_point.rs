@@ -15,7 +15,7 @@
 //! The seed's airframe has one pack per motor (four packs, four motors).
 
 use crate::battery::Battery;
-use crate::error::{mass, parameter, positive, PropulsionError};
+use crate::error::{mass, positive, PropulsionError};
 use crate::esc::Esc;
 use crate::motor::Motor;
 use crate::propeller::Propeller;
@@ -328,7 +328,7 @@ pub fn mass_range_kg(from_kg: f64, to_kg: f64, step_kg: f64) -> Result<Vec<f64>,
     let n = ((to_kg - from_kg) / step_kg + 1e-9).floor();
     // `n` is not negative (NaN cannot reach here): `<=` is the negation of `>`.
     let expected = "a step giving at most 100000 points";
-    parameter("sweep step_kg", step_kg, "kg", n <= 1e5, expected)?;
+    aloft_core::parameter("sweep step_kg", step_kg, "kg", n <= 1e5, expected)?;
     Ok((0..=n as usize)
         .map(|k| from_kg + k as f64 * step_kg)
         .collect())

@@ -38,9 +38,7 @@
 //! protocol, dshot150. The seed itself assumes the ESC "only provides a time delay at the start of
 //! the response" (section 4.2).
 
-use crate::error::{
-    kv, mass, non_negative, parameter, positive, resistance, voltage, PropulsionError,
-};
+use crate::error::{kv, mass, non_negative, positive, resistance, voltage, PropulsionError};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -68,12 +66,13 @@ pub fn kt_from_kv(
     let i0 = non_negative("no_load_current_a", no_load_current_a, "A")?;
     let r = resistance("motor_resistance_ohm", resistance_ohm)?;
     if i0 * r >= v0 {
-        return Err(PropulsionError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "no_load_current_a",
             value: i0,
             unit: "A",
             expected: "I0 R below the nominal voltage (eq 3)",
-        });
+        }
+        .into());
     }
     let kv_si = kv_rpm_per_v * 2.0 * PI / 60.0;
     Ok((v0 - i0 * r) / (kv_si * v0))
@@ -104,12 +103,13 @@ pub fn motor_inertia_kgm2(mass_kg: f64, diameter_m: f64) -> Result<f64, Propulsi
     if j > 0.0 {
         Ok(j)
     } else {
-        Err(PropulsionError::InvalidParameter {
+        Err(aloft_core::InvalidParameter {
             name: "motor_diameter",
             value: diameter_m,
             unit: "m",
             expected: "a motor within the range of the eq (9) fit (positive inertia)",
-        })
+        }
+        .into())
     }
 }
 
@@ -128,12 +128,13 @@ pub fn prop_inertia_kgm2(mass_kg: f64, diameter_m: f64) -> Result<f64, Propulsio
     if j > 0.0 {
         Ok(j)
     } else {
-        Err(PropulsionError::InvalidParameter {
+        Err(aloft_core::InvalidParameter {
             name: "prop_diameter",
             value: diameter_m,
             unit: "m",
             expected: "a propeller larger than 0.089 m (3.5 in), the range of the eq (10) fit",
-        })
+        }
+        .into())
     }
 }
 
@@ -458,22 +459,23 @@ impl RotorTransient {
         let w_max = self.steady_speed_radps(self.supply_voltage_v);
         for (name, w) in [("step_from_radps", from), ("step_to_radps", to)] {
             if w > w_max {
-                return Err(PropulsionError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name,
                     value: w,
                     unit: "rad/s",
                     expected: "a speed the supply voltage can hold (at most the full-voltage steady speed)",
-                });
+                }.into());
             }
         }
         // Steps smaller than 1e-6 of the top speed have no meaningful rise time.
         if (to - from).abs() <= 1e-6 * w_max {
-            return Err(PropulsionError::InvalidParameter {
+            return Err(aloft_core::InvalidParameter {
                 name: "step_to_radps",
                 value: to,
                 unit: "rad/s",
                 expected: "a speed different from step_from_radps",
-            });
+            }
+            .into());
         }
         Ok((from, to))
     }
@@ -536,7 +538,7 @@ impl RotorTransient {
         let steps = (duration_s / dt_s).ceil();
         // `steps` is positive (NaN cannot reach here): `<=` is the negation of `>`.
         let expected = "at most 1e8 steps per simulation";
-        parameter("dt_s", dt_s, "s", steps <= 1e8, expected)?;
+        aloft_core::parameter("dt_s", dt_s, "s", steps <= 1e8, expected)?;
         let steps = steps as usize;
         let v0 = self.equilibrium_voltage_v(from);
         let v1 = self.equilibrium_voltage_v(to);
