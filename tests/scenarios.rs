@@ -160,6 +160,7 @@ fn the_same_seed_gives_the_same_answer_on_one_two_or_three_threads() {
         power_sd_percent: 3.0,
         threads,
         soc_fan: true,
+        bounds: Default::default(),
     };
     let one = plan_scenarios(&v, &Mission::demo(), &o, &sc(1)).unwrap();
     for t in [2, 3] {
