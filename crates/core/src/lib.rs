@@ -7,6 +7,7 @@
 //!   and the unit `g` of log columns;
 //! - [`Trapezoid`] and [`trapezoid`], the trapezoid rule for energies (power over time) and any
 //!   other integral of sampled data, sample by sample or over slices;
+//! - [`bisect`], the bracketing of a crossing by halving;
 //! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
 //!   before it is opened, so it cannot block), with a size limit for whole-file inputs.
 //!
@@ -15,9 +16,11 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod bisect;
 pub mod input;
 pub mod integrate;
 
+pub use bisect::bisect;
 pub use input::{open_regular_file, read_regular_text};
 pub use integrate::{trapezoid, Trapezoid};
 
