@@ -40,4 +40,6 @@ pub use motor::{Motor, RotationalLoss};
 pub use operating_point::{mass_range_kg, HoverResult, PropulsionSystem, RotorOperatingPoint};
 pub use propeller::Propeller;
 pub use spec::{rotor_step_response, PropulsionSpec, RotorSpec};
-pub use transient::{EscProtocol, RotorTransient, RotorTransientResult, StepMetrics, StepResponse};
+pub use transient::{
+    EscProtocol, RotorConstants, RotorTransient, RotorTransientResult, StepMetrics, StepResponse,
+};
