@@ -48,25 +48,9 @@ pub(crate) fn aloft_error(message: impl Into<String>) -> PyErr {
     AloftError::new_err(message.into())
 }
 
-/// The CLI's message of an error: the error and its causes on one line, each cause once
-/// (`message` in `src/cli/mod.rs`).
-fn cli_message(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = aloft::engine::one_line(&e.to_string());
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let line = aloft::engine::one_line(&c.to_string());
-        if !text.contains(&line) {
-            text.push_str(": ");
-            text.push_str(&line);
-        }
-        cause = c.source();
-    }
-    text
-}
-
 /// An engine error as Python sees it.
 pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
-    aloft_error(cli_message(&e))
+    aloft_error(aloft::engine::error_line(&e))
 }
 
 /// `aloft mission --format json` as text.
@@ -399,7 +383,7 @@ fn first_failure(
 ) -> PyErr {
     for i in range.clone() {
         if let Err(e) = power_point(v, &s.query(i, base)) {
-            return aloft_error(format!("element {i}: {}", cli_message(&e)));
+            return aloft_error(format!("element {i}: {}", aloft::engine::error_line(&e)));
         }
     }
     aloft_error(format!(
