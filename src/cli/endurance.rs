@@ -15,6 +15,7 @@ use aloft::engine::{
 };
 
 use super::output::{self, Row};
+use super::plot::Line;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -214,32 +215,14 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
 fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
     use plotters::prelude::*;
     let v_max = rows.last().map(|r| r.airspeed_mps).unwrap_or(1.0).max(1.0);
-    let p_max = rows.iter().map(|r| r.power_w).fold(0.0, f64::max) * 1.1 + 1.0;
-    let e_max = rows
-        .iter()
-        .map(|r| r.endurance_s / 60.0)
-        .fold(0.0, f64::max)
-        * 1.1
-        + 1.0;
+    let power = rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect();
+    let endurance = rows.iter().map(|r| (r.airspeed_mps, r.endurance_s / 60.0));
     super::plot::dual_lines_file(
         path,
         (900, 500),
         format!("{name}: power curve (level flight, still air)"),
         (0.0..v_max, "airspeed (m/s)"),
-        super::plot::Line {
-            desc: "electrical power (W)",
-            max: p_max,
-            color: RED,
-            points: rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect(),
-        },
-        super::plot::Line {
-            desc: "endurance (min)",
-            max: e_max,
-            color: BLUE,
-            points: rows
-                .iter()
-                .map(|r| (r.airspeed_mps, r.endurance_s / 60.0))
-                .collect(),
-        },
+        Line::with_headroom("electrical power (W)", RED, power),
+        Line::with_headroom("endurance (min)", BLUE, endurance.collect()),
     )
 }
