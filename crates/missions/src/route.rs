@@ -283,24 +283,19 @@ mod tests {
 
     #[test]
     fn a_return_climbs_to_the_files_rtl_altitude_and_bad_values_are_passed_over() {
+        // A leg to a point that is not a number: passed over by the figures.
+        let nan_leg =
+            "[[segment]]\nkind = \"leg\"\neast_m = nan\nnorth_m = 0.0\nground_speed_mps = 8.0\n";
+        let return_without_speed = "[[segment]]\nkind = \"return\"\n";
         let r = toml(
-            r#"
-            rtl_altitude_m = 50.0
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 20.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = nan
-            north_m = 0.0
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "return"
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-        "#,
+            &[
+                "rtl_altitude_m = 50.0\n",
+                &take_off(20.0, 2.0),
+                nan_leg,
+                return_without_speed,
+                &landing(1.0),
+            ]
+            .concat(),
         );
         assert!((r.climb_m - 50.0).abs() < 1e-12, "{r:?}");
         assert!((r.descent_m - 50.0).abs() < 1e-12);
