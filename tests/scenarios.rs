@@ -9,7 +9,7 @@ use aloft::engine::{
 use proptest::prelude::*;
 
 mod common;
-use common::mission_toml::{landing, leg, return_home, take_off};
+use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
 
 fn m100() -> Vehicle {
     Vehicle::builtin("dji-m100").unwrap()
