@@ -129,7 +129,8 @@ pub use scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
-    Uncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
+    Uncertainty, WithUncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS,
+    MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
