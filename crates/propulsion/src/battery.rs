@@ -45,35 +45,30 @@ pub enum InternalResistance {
         resistance_ohm: f64,
     },
     /// Seed eq (17), `R_b(I) = r1 + r2 ln(I)/I + r3/I`, valid between two currents.
-    Logarithmic {
-        /// `r_1`, ohm.
-        r1_ohm: f64,
-        /// `r_2`, ohm A (per unit of ln A).
-        r2_ohm_a: f64,
-        /// `r_3`, ohm A (i.e. V).
-        r3_ohm_a: f64,
-        /// Smallest current where eq (17) is trusted, A.
-        min_current_a: f64,
-        /// Largest current where eq (17) is trusted, A.
-        max_current_a: f64,
-    },
+    Logarithmic(Eq17Resistance),
+}
+
+/// Seed eq (17), `R_b(I) = r1 + r2 ln(I)/I + r3/I`, with the currents between which it is trusted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eq17Resistance {
+    /// `r_1`, ohm.
+    pub r1_ohm: f64,
+    /// `r_2`, ohm A (per unit of ln A).
+    pub r2_ohm_a: f64,
+    /// `r_3`, ohm A (i.e. V).
+    pub r3_ohm_a: f64,
+    /// Smallest current where eq (17) is trusted, A.
+    pub min_current_a: f64,
+    /// Largest current where eq (17) is trusted, A.
+    pub max_current_a: f64,
 }
 
 impl InternalResistance {
     /// Resistance at `current_a`, ohm (clamped to the valid range for eq 17).
     pub fn at(&self, current_a: f64) -> f64 {
-        match *self {
-            InternalResistance::Constant { resistance_ohm } => resistance_ohm,
-            InternalResistance::Logarithmic {
-                r1_ohm,
-                r2_ohm_a,
-                r3_ohm_a,
-                min_current_a,
-                max_current_a,
-            } => {
-                let i = current_a.clamp(min_current_a, max_current_a);
-                eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i)
-            }
+        match self {
+            InternalResistance::Constant { resistance_ohm } => *resistance_ohm,
+            InternalResistance::Logarithmic(eq17) => eq17.at(current_a),
         }
     }
 
@@ -91,64 +86,70 @@ impl InternalResistance {
                 }
                 Ok(())
             }
-            InternalResistance::Logarithmic {
-                r1_ohm,
-                r2_ohm_a,
-                r3_ohm_a,
-                min_current_a,
-                max_current_a,
-            } => {
-                finite("battery r1_ohm", r1_ohm, "ohm or ohm A")?;
-                finite("battery r2_ohm_a", r2_ohm_a, "ohm or ohm A")?;
-                finite("battery r3_ohm_a", r3_ohm_a, "ohm or ohm A")?;
-                check_eq17_range(min_current_a, max_current_a)?;
-                check_eq17_positive(r1_ohm, r2_ohm_a, r3_ohm_a, min_current_a, max_current_a)
+            InternalResistance::Logarithmic(eq17) => eq17.validate(),
+        }
+    }
+}
+
+impl Eq17Resistance {
+    /// Eq (17) at `current_a` without clamping: `r1 + r2 ln(I)/I + r3/I`, ohm.
+    pub fn resistance_ohm(&self, current_a: f64) -> f64 {
+        self.r1_ohm + self.r2_ohm_a * current_a.ln() / current_a + self.r3_ohm_a / current_a
+    }
+
+    /// Eq (17) at `current_a` clamped to the valid range, ohm.
+    pub fn at(&self, current_a: f64) -> f64 {
+        self.resistance_ohm(current_a.clamp(self.min_current_a, self.max_current_a))
+    }
+
+    /// Whether `current_a` lies where eq (17) is trusted.
+    pub fn in_valid_range(&self, current_a: f64) -> bool {
+        (self.min_current_a..=self.max_current_a).contains(&current_a)
+    }
+
+    /// Finite coefficients, a positive, finite and non-empty current range, and a positive
+    /// resistance over all of it.
+    fn validate(&self) -> Result<(), PropulsionError> {
+        finite("battery r1_ohm", self.r1_ohm, "ohm or ohm A")?;
+        finite("battery r2_ohm_a", self.r2_ohm_a, "ohm or ohm A")?;
+        finite("battery r3_ohm_a", self.r3_ohm_a, "ohm or ohm A")?;
+        self.check_range()?;
+        self.check_positive()
+    }
+
+    /// The current range where eq (17) is trusted: positive, finite, and not empty.
+    fn check_range(&self) -> Result<(), PropulsionError> {
+        let (min_current_a, max_current_a) = (self.min_current_a, self.max_current_a);
+        positive("battery eq17 min_current_a", min_current_a, "A")?;
+        positive("battery eq17 max_current_a", max_current_a, "A")?;
+        let expected = "a current above eq17 min_current_a";
+        let ok = max_current_a > min_current_a;
+        aloft_core::parameter(
+            "battery eq17 max_current_a",
+            max_current_a,
+            "A",
+            ok,
+            expected,
+        )?;
+        Ok(())
+    }
+
+    /// Eq (17) must give a positive resistance over its valid range (checked at 65 currents).
+    fn check_positive(&self) -> Result<(), PropulsionError> {
+        let n = 64;
+        for k in 0..=n {
+            let span = self.max_current_a - self.min_current_a;
+            let i = self.min_current_a + span * k as f64 / n as f64;
+            let r = self.resistance_ohm(i);
+            if r.is_nan() || r <= 0.0 {
+                return Err(PropulsionError::InvalidResistance {
+                    name: "battery eq17 resistance within its valid range",
+                    resistance_ohm: r,
+                });
             }
         }
+        Ok(())
     }
-}
-
-/// The current range where eq (17) is trusted: positive, finite, and not empty.
-fn check_eq17_range(min_current_a: f64, max_current_a: f64) -> Result<(), PropulsionError> {
-    positive("battery eq17 min_current_a", min_current_a, "A")?;
-    positive("battery eq17 max_current_a", max_current_a, "A")?;
-    if max_current_a <= min_current_a {
-        return Err(aloft_core::InvalidParameter {
-            name: "battery eq17 max_current_a",
-            value: max_current_a,
-            unit: "A",
-            expected: "a current above eq17 min_current_a",
-        }
-        .into());
-    }
-    Ok(())
-}
-
-/// Eq (17) must give a positive resistance over its valid range (checked at 65 currents).
-fn check_eq17_positive(
-    r1_ohm: f64,
-    r2_ohm_a: f64,
-    r3_ohm_a: f64,
-    min_current_a: f64,
-    max_current_a: f64,
-) -> Result<(), PropulsionError> {
-    let n = 64;
-    for k in 0..=n {
-        let i = min_current_a + (max_current_a - min_current_a) * k as f64 / n as f64;
-        let r = eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i);
-        if r.is_nan() || r <= 0.0 {
-            return Err(PropulsionError::InvalidResistance {
-                name: "battery eq17 resistance within its valid range",
-                resistance_ohm: r,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Seed eq (17) without clamping: `r1 + r2 ln(I)/I + r3/I`, ohm.
-pub fn eq17_resistance_ohm(r1_ohm: f64, r2_ohm_a: f64, r3_ohm_a: f64, current_a: f64) -> f64 {
-    r1_ohm + r2_ohm_a * current_a.ln() / current_a + r3_ohm_a / current_a
 }
 
 /// A LiPo pack.
@@ -263,7 +264,7 @@ impl Battery {
                     vf * vf / (4.0 * resistance_ohm),
                 )
             }
-            InternalResistance::Logarithmic { .. } => {
+            InternalResistance::Logarithmic(_) => {
                 // Coarse scan then golden-section refinement of the delivered power.
                 let vf = self.full_charge_v();
                 let r_lo = (0..=64)
@@ -344,11 +345,7 @@ impl Battery {
     pub fn resistance_in_valid_range(&self, current_a: f64) -> bool {
         match self.resistance {
             InternalResistance::Constant { .. } => true,
-            InternalResistance::Logarithmic {
-                min_current_a,
-                max_current_a,
-                ..
-            } => (min_current_a..=max_current_a).contains(&current_a),
+            InternalResistance::Logarithmic(eq17) => eq17.in_valid_range(current_a),
         }
     }
 
@@ -384,7 +381,7 @@ impl Battery {
                 let disc = (vf * vf - 4.0 * resistance_ohm * power_w).max(0.0);
                 2.0 * power_w / (vf + disc.sqrt())
             }
-            InternalResistance::Logarithmic { .. } => {
+            InternalResistance::Logarithmic(_) => {
                 // Delivered power rises monotonically on [0, I*]: bisection.
                 let (mut a, mut b) = (0.0, self.current_at_max_power_a);
                 for _ in 0..60 {
@@ -594,13 +591,13 @@ mod tests {
             0.9,
             4.1,
             3.7,
-            InternalResistance::Logarithmic {
+            InternalResistance::Logarithmic(Eq17Resistance {
                 r1_ohm: 0.05,
                 r2_ohm_a: 0.02,
                 r3_ohm_a: 0.3,
                 min_current_a: 5.0,
                 max_current_a: 60.0,
-            },
+            }),
             f64::INFINITY,
         )
         .unwrap();

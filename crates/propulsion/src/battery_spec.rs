@@ -35,7 +35,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::battery::{Battery, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V};
+use crate::battery::{
+    Battery, Eq17Resistance, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V,
+};
 use crate::error::PropulsionError;
 
 fn one() -> u32 {
@@ -190,13 +192,13 @@ impl BatterySpec {
                 resistance_ohm: r,
             }),
             (None, Some(r1), Some(r2), Some(r3), Some(lo), Some(hi)) => {
-                Ok(InternalResistance::Logarithmic {
+                Ok(InternalResistance::Logarithmic(Eq17Resistance {
                     r1_ohm: r1,
                     r2_ohm_a: r2,
                     r3_ohm_a: r3,
                     min_current_a: lo,
                     max_current_a: hi,
-                })
+                }))
             }
             _ => Err(PropulsionError::ConflictingKeys {
                 table: "propulsion.battery",
