@@ -108,7 +108,7 @@ pub use mission::{
 };
 pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
 pub use mission_map::{
-    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocBand, SocLine, MAP_CHART_POINTS,
+    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
