@@ -5,7 +5,7 @@
 mod common;
 
 use aloft::vehicle::VehicleFile;
-use aloft_propulsion::battery::{Battery, InternalResistance};
+use aloft_propulsion::battery::{Battery, BatteryConstants, InternalResistance};
 use aloft_propulsion::motor::{kt_oz_in_per_a, KV_KT_HOBBY};
 use aloft_propulsion::propeller::{self, Propeller};
 use aloft_propulsion::transient::{motor_inertia_kgm2, prop_inertia_kgm2, EQ9_TO_KGM2};
@@ -344,8 +344,16 @@ proptest! {
     /// Eqs (29)-(30): the pack current delivers the asked power and the energy balance closes.
     #[test]
     fn pack_current_delivers_power(p in 0.0f64..1500.0, r in 0.01f64..0.2) {
-        let b = Battery::new(5, 4, 8.0, 0.9, 4.1, 3.7,
-            InternalResistance::Constant { resistance_ohm: r }, f64::INFINITY).unwrap();
+        let b = Battery::new(BatteryConstants {
+            cells_series: 5,
+            cells_parallel: 4,
+            capacity_ah: 8.0,
+            effective_capacity: 0.9,
+            full_cell_v: 4.1,
+            nominal_cell_v: 3.7,
+            resistance: InternalResistance::Constant { resistance_ohm: r },
+            max_current_a: f64::INFINITY,
+        }).unwrap();
         match b.current_for_power_a(p) {
             Ok(i) => {
                 // closed form: relative rounding error only

@@ -36,7 +36,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::battery::{
-    Battery, Eq17Resistance, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V,
+    Battery, BatteryConstants, Eq17Resistance, InternalResistance, SEED_FULL_CELL_V,
+    SEED_NOMINAL_CELL_V,
 };
 use crate::error::PropulsionError;
 
@@ -166,16 +167,16 @@ impl BatterySpec {
             Some(v) if self.cells_series > 0 => v / f64::from(self.cells_series),
             _ => SEED_NOMINAL_CELL_V,
         };
-        Battery::new(
-            self.cells_series,
-            self.cells_parallel,
-            self.capacity_mah / 1000.0,
-            effective,
-            self.full_charge_cell_v.unwrap_or(SEED_FULL_CELL_V),
+        Battery::new(BatteryConstants {
+            cells_series: self.cells_series,
+            cells_parallel: self.cells_parallel,
+            capacity_ah: self.capacity_mah / 1000.0,
+            effective_capacity: effective,
+            full_cell_v: self.full_charge_cell_v.unwrap_or(SEED_FULL_CELL_V),
             nominal_cell_v,
-            self.resistance_model()?,
-            self.max_current_a.unwrap_or(f64::INFINITY),
-        )
+            resistance: self.resistance_model()?,
+            max_current_a: self.max_current_a.unwrap_or(f64::INFINITY),
+        })
     }
 
     /// The resistance of the seed model: a constant, or eq (17) with its valid range.
@@ -331,19 +332,7 @@ mod tests {
             effective_capacity_fraction: Some(0.9),
             ..BatterySpec::default()
         };
-        let direct = Battery::new(
-            5,
-            4,
-            8.0,
-            0.9,
-            4.1,
-            3.7,
-            InternalResistance::Constant {
-                resistance_ohm: 0.0699,
-            },
-            f64::INFINITY,
-        )
-        .unwrap();
+        let direct = Battery::new(crate::battery::seed_pack_constants(0.0699)).unwrap();
         assert_eq!(spec.to_seed_model().unwrap(), direct);
     }
 }

@@ -32,7 +32,7 @@ pub mod propeller;
 pub mod spec;
 pub mod transient;
 
-pub use battery::{Battery, Eq17Resistance, InternalResistance, OcvCurve};
+pub use battery::{Battery, BatteryConstants, Eq17Resistance, InternalResistance, OcvCurve};
 pub use battery_spec::BatterySpec;
 pub use error::PropulsionError;
 pub use esc::Esc;
