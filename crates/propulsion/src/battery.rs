@@ -384,15 +384,8 @@ impl Battery {
             }
             InternalResistance::Logarithmic(_) => {
                 // Delivered power rises monotonically on [0, I*]: bisection.
-                let (mut a, mut b) = (0.0, self.current_at_max_power_a);
-                for _ in 0..60 {
-                    let m = 0.5 * (a + b);
-                    if self.delivered_w(m) < power_w {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
+                let below = |i| self.delivered_w(i) < power_w;
+                let (a, b) = aloft_core::bisect(0.0, self.current_at_max_power_a, 60, below);
                 0.5 * (a + b)
             }
         };
