@@ -32,7 +32,8 @@ use aloft::engine::flags::{
     PowerModelFlags, ValidateFlags,
 };
 use aloft::engine::{
-    plan_mission, power_model, power_point, power_values, Mission, PowerQuery, Vehicle, POWER_KEYS,
+    plan_mission, power_model, power_point, power_values, FlightStateDeg, Mission, PowerModelQuery,
+    PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -283,14 +284,17 @@ struct States<'a> {
 
 impl States<'_> {
     /// The point query of state `i`, as `aloft power` would be asked it.
-    fn query(&self, i: usize, base: &PowerQuery) -> PowerQuery {
+    fn query(&self, i: usize, base: &PowerModelQuery) -> PowerQuery {
         PowerQuery {
-            airspeed_mps: self.airspeed[i],
-            roll_deg: self.roll[i],
-            pitch_deg: self.pitch[i],
-            climb_rate_mps: self.climb[i],
-            air_direction_deg: self.direction.map(|d| d[i]),
-            ..base.clone()
+            model: base.clone(),
+            state: FlightStateDeg {
+                airspeed_mps: self.airspeed[i],
+                roll_deg: self.roll[i],
+                pitch_deg: self.pitch[i],
+                climb_rate_mps: self.climb[i],
+                air_direction_deg: self.direction.map(|d| d[i]),
+            },
+            gradient: false,
         }
     }
 
@@ -330,7 +334,11 @@ impl States<'_> {
 }
 
 /// The power model over arrays: one array per key of `POWER_KEYS`.
-fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<Vec<f64>>, PyErr> {
+fn power_arrays(
+    vehicle: &str,
+    base: &PowerModelQuery,
+    s: &States<'_>,
+) -> Result<Vec<Vec<f64>>, PyErr> {
     let n = s.airspeed.len();
     if let Some((name, i, x)) = s.first_non_finite() {
         return Err(aloft_error(format!(
@@ -343,7 +351,10 @@ fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<
     let first = if n > 0 {
         s.query(0, base)
     } else {
-        base.clone()
+        PowerQuery {
+            model: base.clone(),
+            ..PowerQuery::default()
+        }
     };
     power_point(&v, &first).map_err(engine_error)?;
     let model = power_model(&v, base).map_err(engine_error)?;
@@ -377,7 +388,7 @@ fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<
 /// state as a point query).
 fn first_failure(
     v: &Vehicle,
-    base: &PowerQuery,
+    base: &PowerModelQuery,
     s: &States<'_>,
     range: std::ops::Range<usize>,
 ) -> PyErr {

@@ -7,7 +7,8 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::{
-    power_csv_file, power_point, power_values, PowerAnswer, PowerQuery, Vehicle, POWER_KEYS,
+    power_csv_file, power_point, power_values, FlightStateDeg, PowerAnswer, PowerQuery, Vehicle,
+    POWER_KEYS,
 };
 
 use super::output::{self, Row};
@@ -53,13 +54,15 @@ pub struct PowerArgs {
 impl PowerArgs {
     fn query(&self) -> PowerQuery {
         PowerQuery {
-            airspeed_mps: self.airspeed,
-            roll_deg: self.roll,
-            pitch_deg: self.pitch,
-            climb_rate_mps: self.climb_rate,
-            air_direction_deg: self.air_direction_deg,
+            model: self.model.query(),
+            state: FlightStateDeg {
+                airspeed_mps: self.airspeed,
+                roll_deg: self.roll,
+                pitch_deg: self.pitch,
+                climb_rate_mps: self.climb_rate,
+                air_direction_deg: self.air_direction_deg,
+            },
             gradient: self.gradient,
-            ..self.model.query()
         }
     }
 }
@@ -73,7 +76,7 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
         if args.model.aoa.is_some() || args.air_direction_deg.is_some() {
             bail!("in batch mode the angle of attack is per row: add an air_direction_deg column for the geometric model");
         }
-        power_csv_file(&vehicle, &args.query(), path, args.output.as_deref())?;
+        power_csv_file(&vehicle, &args.model.query(), path, args.output.as_deref())?;
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;

@@ -116,8 +116,8 @@ pub use payload_sweep::{
     payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
 };
 pub use power::{
-    power_csv_file, power_model, power_point, PowerAnswer, PowerContext, PowerGradientDeg,
-    PowerQuery,
+    power_csv_file, power_model, power_point, FlightStateDeg, PowerAnswer, PowerContext,
+    PowerGradientDeg, PowerModelQuery, PowerQuery,
 };
 pub use power_batch::{power_csv, power_values, POWER_KEYS};
 pub use propulsion::{
