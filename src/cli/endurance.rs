@@ -14,7 +14,7 @@ use aloft::engine::{
     EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
-use super::output::{self, Row};
+use super::output;
 use super::plot::Line;
 use super::{Format, Outcome};
 
@@ -179,31 +179,33 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
         s.context.wind,
         reserve_percent
     );
-    let min = |s: f64| output::fixed(s / 60.0, 1);
-    let mut rows = vec![
-        Row::num("hover power", r.hover_power_w, 0, "W"),
-        Row::new("hover endurance", min(r.hover_endurance_s), "min"),
-        Row::num(
+    let min = |s: f64| s / 60.0;
+    let mut rows = output::num_rows(&[
+        ("hover power", r.hover_power_w, 0, "W"),
+        ("hover endurance", min(r.hover_endurance_s), 1, "min"),
+        (
             "best-endurance airspeed",
             r.max_endurance_speed_mps,
             1,
             "m/s",
         ),
-        Row::num("  power there", r.max_endurance_power_w, 0, "W"),
-        Row::new("  endurance", min(r.max_endurance_s), "min"),
-        Row::num("best-range airspeed", r.max_range_speed_mps, 1, "m/s"),
-        Row::num(
+        ("  power there", r.max_endurance_power_w, 0, "W"),
+        ("  endurance", min(r.max_endurance_s), 1, "min"),
+        ("best-range airspeed", r.max_range_speed_mps, 1, "m/s"),
+        (
             "  ground speed on course",
             r.max_range_ground_speed_mps,
             1,
             "m/s",
         ),
-        Row::num("  power there", r.max_range_power_w, 0, "W"),
-        Row::num("  range on course", r.max_range_m / 1000.0, 2, "km"),
-    ];
+        ("  power there", r.max_range_power_w, 0, "W"),
+        ("  range on course", r.max_range_m / 1000.0, 2, "km"),
+    ]);
     if let (Some(p), Some(e)) = (r.orbit_power_w, r.orbit_endurance_s) {
-        rows.push(Row::num("orbit power", p, 0, "W"));
-        rows.push(Row::new("orbit endurance", min(e), "min"));
+        rows.extend(output::num_rows(&[
+            ("orbit power", p, 0, "W"),
+            ("orbit endurance", min(e), 1, "min"),
+        ]));
     }
     output::write_table(out, &title, &rows)?;
     for n in &s.context.notes {
