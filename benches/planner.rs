@@ -21,9 +21,7 @@ use aloft_planner::{
     endurance, plan, AoaModel, BatterySpec, EnduranceQuery, MissionSpec, Pack, PlanOptions, Wind,
 };
 
-#[path = "../tests/common/mission_toml.rs"]
-mod mission_toml;
-use mission_toml::{landing, leg, orbit, return_home, take_off, OrbitFor};
+use aloft_planner::mission_toml::{landing, leg, orbit, return_home, take_off, OrbitFor};
 
 /// One hour: take-off, a leg, a long orbit, a leg back, landing (3600 s in total within a second).
 fn one_hour() -> String {

@@ -7,7 +7,7 @@
 
 use aloft::vehicle::VehicleFile;
 use aloft_propulsion::transient::{kt_from_kv, motor_inertia_kgm2, prop_inertia_kgm2};
-use aloft_propulsion::{EscProtocol, PropulsionSystem, RotorTransient};
+use aloft_propulsion::{EscProtocol, PropulsionSystem, RotorConstants, RotorTransient};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
 
@@ -22,16 +22,16 @@ fn aec() -> PropulsionSystem {
 
 fn mn1806() -> RotorTransient {
     let c = 0.0351 * 1.225 * (6.0f64 * 0.0254).powi(5) / (8.0 * std::f64::consts::PI.powi(3));
-    RotorTransient::new(
-        kt_from_kv(2300.0, 11.1, 0.4, 0.117).unwrap(),
-        0.117,
-        0.4,
-        11.1,
-        motor_inertia_kgm2(0.018, 0.023).unwrap(),
-        prop_inertia_kgm2(0.00186, 6.0 * 0.0254).unwrap(),
-        c,
-        EscProtocol::Dshot300.added_delay_s(),
-    )
+    RotorTransient::new(RotorConstants {
+        kt_nm_per_a: kt_from_kv(2300.0, 11.1, 0.4, 0.117).unwrap(),
+        resistance_ohm: 0.117,
+        no_load_current_a: 0.4,
+        supply_voltage_v: 11.1,
+        motor_inertia_kgm2: motor_inertia_kgm2(0.018, 0.023).unwrap(),
+        prop_inertia_kgm2: prop_inertia_kgm2(0.00186, 6.0 * 0.0254).unwrap(),
+        torque_coefficient_nms2: c,
+        delay_s: EscProtocol::Dshot300.added_delay_s(),
+    })
     .unwrap()
 }
 

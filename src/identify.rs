@@ -329,15 +329,17 @@ pub struct BandNrmse {
     pub nrmse_percent: Option<f64>,
 }
 
-/// One row of the Table I layout: the model with one term dropped (or none).
+/// One row of the Table I layout: the model with one term dropped (or none), its NRMSE over the
+/// whole flight and per airspeed band `B`: one flight's [`BandNrmse`], or the mean over flights
+/// of `aloft validate` ([`crate::engine::MeanBand`], in [`crate::engine::MeanRow`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AblationRow {
+pub struct AblationRow<B = BandNrmse> {
     /// The dropped term: `none`, `parasitic`, `profile`, `induced` or `climb`.
     pub dropped_term: &'static str,
-    /// NRMSE over the whole flight, percent.
+    /// NRMSE over the whole flight (over flights: its mean), percent.
     pub nrmse_percent: f64,
     /// NRMSE per airspeed band.
-    pub bands: Vec<BandNrmse>,
+    pub bands: Vec<B>,
 }
 
 /// The in-flight re-estimate of the efficiency from the start of the flight.

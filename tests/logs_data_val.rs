@@ -97,7 +97,7 @@ fn data_val_kaist_flights_read_clean_and_energy_matches_capacity_drop() {
         let first = log.samples.first().unwrap();
         let last = log.samples.last().unwrap();
         let drop_ah = first.charge_ah.unwrap() - last.charge_ah.unwrap();
-        let v = stats.mean_power_w.unwrap();
+        let v = stats.power.mean_power_w.unwrap();
         println!(
             "{}: {} samples, {:.0} s, {} gaps, {} backwards, {} power values dropped, energy {:.1} Wh, mean {v:.0} W, integral of I {charge_ah:.3} Ah vs capacity drop {drop_ah:.3} Ah ({:.1} %)",
             p.file_name().unwrap().to_string_lossy(),
@@ -106,7 +106,7 @@ fn data_val_kaist_flights_read_clean_and_energy_matches_capacity_drop() {
             log.time.gap_count,
             log.time.non_monotonic_count,
             log.dropped_count,
-            stats.energy_wh.unwrap(),
+            stats.power.energy_wh.unwrap(),
             100.0 * charge_ah / drop_ah,
         );
         assert_eq!(log.time.non_monotonic_count, 0, "{}", p.display());
@@ -175,7 +175,7 @@ fn data_val_px4_flights_join_onto_one_time_base() {
             p.file_name().unwrap().to_string_lossy(),
             log.samples.len(),
             log.time.duration_s,
-            stats.energy_wh.unwrap_or(f64::NAN),
+            stats.power.energy_wh.unwrap_or(f64::NAN),
             log.time.gap_count,
         );
         // Battery and attitude cover all but the samples before their first message.

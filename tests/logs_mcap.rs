@@ -488,9 +488,9 @@ fn a_mission_mcap_reads_back_one_sample_per_instant_with_its_energy() {
         .sum::<f64>()
         / 3600.0;
     // Times pass through whole nanoseconds: 1e-9 relative.
-    let got = stats.energy_wh.unwrap();
+    let got = stats.power.energy_wh.unwrap();
     assert!((got - wh).abs() < 1e-9 * wh, "{got} Wh vs {wh} Wh");
-    assert_eq!(stats.energy_skipped_steps, 0);
+    assert_eq!(stats.power.skipped_steps, 0);
 }
 
 /// The join of one instant keeps the source's samples apart: two samples at one time (both

@@ -4,8 +4,8 @@
 use aloft::engine::{plan_mission, Mission, MissionOptions, Plan, Vehicle};
 
 mod common;
+use aloft_planner::mission_toml::{landing, take_off};
 use common::assert_warned;
-use common::mission_toml::{landing, take_off};
 
 fn plan(text: &str) -> Plan {
     let m100 = Vehicle::builtin("dji-m100").unwrap();

@@ -418,15 +418,7 @@ fn speeds_beyond_the_tilt_limit_fly_at_the_tilt_limited_speed() {
     let (m, g, a) = (2.355f64, 9.80665f64, 2.0f64);
     let drag = |v: f64| v * (0.1816 + v * (-0.02326 + v * 0.004045));
     let budget = m * g * (35.0f64 - 0.25).to_radians().tan() - m * a;
-    let (mut lo, mut hi) = (0.0f64, 17.0f64);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if drag(mid) <= budget {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    let (lo, _) = aloft_core::bisect(0.0, 17.0, 60, |v| drag(v) <= budget);
     for file in [
         "ardupilot_DO_CHANGE_SPEED_mission.txt",
         "droneicarus_test7-Mission_avec_parametre.plan",

@@ -9,7 +9,7 @@ use aloft_planner::{
 use proptest::prelude::*;
 
 mod common;
-use common::mission_toml::{hover, landing, leg, orbit, return_home, take_off, OrbitFor};
+use aloft_planner::mission_toml::{hover, landing, leg, orbit, return_home, take_off, OrbitFor};
 
 const DEMO: &str = include_str!("../fixtures/missions/demo-survey.toml");
 

@@ -1,7 +1,7 @@
 //! End-to-end checks of `aloft mission` and `aloft endurance`: outputs, JSON keys, exit codes.
 
 mod common;
-use common::mission_toml::{hover, landing, orbit, take_off, OrbitFor};
+use aloft_planner::mission_toml::{hover, landing, orbit, take_off, OrbitFor};
 use common::run as aloft;
 
 use std::path::PathBuf;

@@ -44,20 +44,8 @@ fn fly(aircraft: &Aircraft, pack: &Pack, text: &str, wind: &Wind) -> MissionRepo
 fn airspeed_at_drag(aircraft: &Aircraft, force_n: f64) -> f64 {
     let (mu1, mu2, mu3) = aircraft.drag().coefficients();
     let f = |v: f64| mu1 * v + mu2 * v * v + mu3 * v * v * v - force_n;
-    bisect(f, 0.0, 100.0)
-}
-
-/// The root of an increasing `f` in `[lo, hi]`, to rounding.
-fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) < 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
+    // The root of the increasing `f` in [0, 100], to rounding.
+    aloft_core::bisect(0.0, 100.0, 200, |v| f(v) < 0.0).0
 }
 
 /// Speed along the path of a sample, m/s.
@@ -195,14 +183,11 @@ fn an_orbit_too_tight_for_its_speed_is_flown_at_the_speed_the_bank_allows() {
     let g = aircraft.gravity_mps2();
     let (mu1, mu2, mu3) = aircraft.drag().coefficients();
     let budget = m * g * 35f64.to_radians().tan();
-    let want = bisect(
-        |v| {
-            let drag = mu1 * v + mu2 * v * v + mu3 * v * v * v;
-            (m * v * v / 10.0).hypot(drag) - budget
-        },
-        0.0,
-        10.0,
-    );
+    let excess = |v: f64| {
+        let drag = mu1 * v + mu2 * v * v + mu3 * v * v * v;
+        (m * v * v / 10.0).hypot(drag) - budget
+    };
+    let (want, _) = aloft_core::bisect(0.0, 10.0, 200, |v| excess(v) < 0.0);
     // The arc's cruise: samples on the circle with no tangential acceleration (the ramps at
     // its ends accelerate along the path).
     let arc: Vec<&Sample> = r

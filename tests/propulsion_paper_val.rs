@@ -5,7 +5,7 @@
 mod common;
 
 use aloft::vehicle::VehicleFile;
-use aloft_propulsion::battery::{Battery, InternalResistance};
+use aloft_propulsion::battery::{Battery, BatteryConstants, InternalResistance};
 use aloft_propulsion::motor::{kt_oz_in_per_a, KV_KT_HOBBY};
 use aloft_propulsion::propeller::{self, Propeller};
 use aloft_propulsion::transient::{motor_inertia_kgm2, prop_inertia_kgm2, EQ9_TO_KGM2};
@@ -216,20 +216,29 @@ fn paper_val_eq10_prop_inertia_bounds() {
 #[test]
 fn paper_val_mn1806_settling_time() {
     let c = 0.0351 * 1.225 * (6.0f64 * 0.0254).powi(5) / (8.0 * std::f64::consts::PI.powi(3));
+    // The built-in rotor file holds these values: the same decimals read exactly, and c to the
+    // rounding of its 17 digits.
+    let mn1806: RotorSpec =
+        toml::from_str(include_str!("../fixtures/rotors/mn1806-6x2.toml")).unwrap();
+    assert!((mn1806.torque_coefficient_nms2 - c).abs() <= 1e-15 * c);
+    let want = (2300.0, 0.117, 0.4, 11.1, 18.0, 23.0, 1.86, 6.0);
+    let got = (
+        mn1806.motor_kv_rpm_per_v,
+        mn1806.motor_resistance_ohm,
+        mn1806.no_load_current_a,
+        mn1806.voltage_v,
+        mn1806.motor_mass_g,
+        mn1806.motor_diameter_mm,
+        mn1806.prop_mass_g,
+        mn1806.prop_diameter_in,
+    );
+    assert_eq!(got, want);
+    assert_eq!(mn1806.protocol, Some(EscProtocol::Dshot300));
     for (from, to) in [(550.0, 1000.0), (1000.0, 1450.0), (1450.0, 1900.0)] {
         let spec = RotorSpec {
-            motor_kv_rpm_per_v: 2300.0,
-            motor_resistance_ohm: 0.117,
-            no_load_current_a: 0.4,
-            voltage_v: 11.1,
-            motor_mass_g: 18.0,
-            motor_diameter_mm: 23.0,
-            prop_mass_g: 1.86,
-            prop_diameter_in: 6.0,
-            torque_coefficient_nms2: c,
-            protocol: Some(EscProtocol::Dshot300),
             step_from_radps: Some(from),
             step_to_radps: Some(to),
+            ..mn1806.clone()
         };
         let r = rotor_step_response(&spec).unwrap();
         eprintln!(
@@ -335,8 +344,16 @@ proptest! {
     /// Eqs (29)-(30): the pack current delivers the asked power and the energy balance closes.
     #[test]
     fn pack_current_delivers_power(p in 0.0f64..1500.0, r in 0.01f64..0.2) {
-        let b = Battery::new(5, 4, 8.0, 0.9, 4.1, 3.7,
-            InternalResistance::Constant { resistance_ohm: r }, f64::INFINITY).unwrap();
+        let b = Battery::new(BatteryConstants {
+            cells_series: 5,
+            cells_parallel: 4,
+            capacity_ah: 8.0,
+            effective_capacity: 0.9,
+            full_cell_v: 4.1,
+            nominal_cell_v: 3.7,
+            resistance: InternalResistance::Constant { resistance_ohm: r },
+            max_current_a: f64::INFINITY,
+        }).unwrap();
         match b.current_for_power_a(p) {
             Ok(i) => {
                 // closed form: relative rounding error only

@@ -9,7 +9,7 @@ use aloft::engine::{
 use proptest::prelude::*;
 
 mod common;
-use common::mission_toml::{landing, leg, return_home, take_off};
+use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
 
 fn m100() -> Vehicle {
     Vehicle::builtin("dji-m100").unwrap()
@@ -68,16 +68,8 @@ fn normal_cdf(x: f64) -> f64 {
 fn p_feasible_matches_the_normal_cdf_at_the_bisected_payload_threshold() {
     let v = m100();
     // Deterministic bisection of the payload at which the mission stops landing with the reserve.
-    let (mut lo, mut hi) = (0.0, 1.2);
-    assert!(feasible_at(&v, lo) && !feasible_at(&v, hi));
-    for _ in 0..30 {
-        let mid = 0.5 * (lo + hi);
-        if feasible_at(&v, mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    assert!(feasible_at(&v, 0.0) && !feasible_at(&v, 1.2));
+    let (lo, hi) = aloft_core::bisect(0.0, 1.2, 30, |payload_kg| feasible_at(&v, payload_kg));
     let threshold = 0.5 * (lo + hi);
     // Payload drawn around a mean below the threshold; nothing else drawn.
     let (mean, sd) = (threshold - 0.1, 0.2);

@@ -32,7 +32,8 @@ use aloft::engine::flags::{
     PowerModelFlags, ValidateFlags,
 };
 use aloft::engine::{
-    plan_mission, power_model, power_point, power_values, Mission, PowerQuery, Vehicle, POWER_KEYS,
+    plan_mission, power_model, power_point, power_values, FlightStateDeg, Mission, PowerModelQuery,
+    PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -48,25 +49,9 @@ pub(crate) fn aloft_error(message: impl Into<String>) -> PyErr {
     AloftError::new_err(message.into())
 }
 
-/// The CLI's message of an error: the error and its causes on one line, each cause once
-/// (`message` in `src/cli/mod.rs`).
-fn cli_message(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = aloft::engine::one_line(&e.to_string());
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        let line = aloft::engine::one_line(&c.to_string());
-        if !text.contains(&line) {
-            text.push_str(": ");
-            text.push_str(&line);
-        }
-        cause = c.source();
-    }
-    text
-}
-
 /// An engine error as Python sees it.
 pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
-    aloft_error(cli_message(&e))
+    aloft_error(aloft::engine::error_line(&e))
 }
 
 /// `aloft mission --format json` as text.
@@ -299,14 +284,17 @@ struct States<'a> {
 
 impl States<'_> {
     /// The point query of state `i`, as `aloft power` would be asked it.
-    fn query(&self, i: usize, base: &PowerQuery) -> PowerQuery {
+    fn query(&self, i: usize, base: &PowerModelQuery) -> PowerQuery {
         PowerQuery {
-            airspeed_mps: self.airspeed[i],
-            roll_deg: self.roll[i],
-            pitch_deg: self.pitch[i],
-            climb_rate_mps: self.climb[i],
-            air_direction_deg: self.direction.map(|d| d[i]),
-            ..base.clone()
+            model: base.clone(),
+            state: FlightStateDeg {
+                airspeed_mps: self.airspeed[i],
+                roll_deg: self.roll[i],
+                pitch_deg: self.pitch[i],
+                climb_rate_mps: self.climb[i],
+                air_direction_deg: self.direction.map(|d| d[i]),
+            },
+            gradient: false,
         }
     }
 
@@ -346,7 +334,11 @@ impl States<'_> {
 }
 
 /// The power model over arrays: one array per key of `POWER_KEYS`.
-fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<Vec<f64>>, PyErr> {
+fn power_arrays(
+    vehicle: &str,
+    base: &PowerModelQuery,
+    s: &States<'_>,
+) -> Result<Vec<Vec<f64>>, PyErr> {
     let n = s.airspeed.len();
     if let Some((name, i, x)) = s.first_non_finite() {
         return Err(aloft_error(format!(
@@ -359,7 +351,10 @@ fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<
     let first = if n > 0 {
         s.query(0, base)
     } else {
-        base.clone()
+        PowerQuery {
+            model: base.clone(),
+            ..PowerQuery::default()
+        }
     };
     power_point(&v, &first).map_err(engine_error)?;
     let model = power_model(&v, base).map_err(engine_error)?;
@@ -393,13 +388,13 @@ fn power_arrays(vehicle: &str, base: &PowerQuery, s: &States<'_>) -> Result<Vec<
 /// state as a point query).
 fn first_failure(
     v: &Vehicle,
-    base: &PowerQuery,
+    base: &PowerModelQuery,
     s: &States<'_>,
     range: std::ops::Range<usize>,
 ) -> PyErr {
     for i in range.clone() {
         if let Err(e) = power_point(v, &s.query(i, base)) {
-            return aloft_error(format!("element {i}: {}", cli_message(&e)));
+            return aloft_error(format!("element {i}: {}", aloft::engine::error_line(&e)));
         }
     }
     aloft_error(format!(

@@ -14,7 +14,8 @@ use aloft::engine::{
     EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
-use super::output::{self, Row};
+use super::output;
+use super::plot::Line;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -178,31 +179,33 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
         s.context.wind,
         reserve_percent
     );
-    let min = |s: f64| output::fixed(s / 60.0, 1);
-    let mut rows = vec![
-        Row::num("hover power", r.hover_power_w, 0, "W"),
-        Row::new("hover endurance", min(r.hover_endurance_s), "min"),
-        Row::num(
+    let min = |s: f64| s / 60.0;
+    let mut rows = output::num_rows(&[
+        ("hover power", r.hover_power_w, 0, "W"),
+        ("hover endurance", min(r.hover_endurance_s), 1, "min"),
+        (
             "best-endurance airspeed",
             r.max_endurance_speed_mps,
             1,
             "m/s",
         ),
-        Row::num("  power there", r.max_endurance_power_w, 0, "W"),
-        Row::new("  endurance", min(r.max_endurance_s), "min"),
-        Row::num("best-range airspeed", r.max_range_speed_mps, 1, "m/s"),
-        Row::num(
+        ("  power there", r.max_endurance_power_w, 0, "W"),
+        ("  endurance", min(r.max_endurance_s), 1, "min"),
+        ("best-range airspeed", r.max_range_speed_mps, 1, "m/s"),
+        (
             "  ground speed on course",
             r.max_range_ground_speed_mps,
             1,
             "m/s",
         ),
-        Row::num("  power there", r.max_range_power_w, 0, "W"),
-        Row::num("  range on course", r.max_range_m / 1000.0, 2, "km"),
-    ];
+        ("  power there", r.max_range_power_w, 0, "W"),
+        ("  range on course", r.max_range_m / 1000.0, 2, "km"),
+    ]);
     if let (Some(p), Some(e)) = (r.orbit_power_w, r.orbit_endurance_s) {
-        rows.push(Row::num("orbit power", p, 0, "W"));
-        rows.push(Row::new("orbit endurance", min(e), "min"));
+        rows.extend(output::num_rows(&[
+            ("orbit power", p, 0, "W"),
+            ("orbit endurance", min(e), 1, "min"),
+        ]));
     }
     output::write_table(out, &title, &rows)?;
     for n in &s.context.notes {
@@ -214,32 +217,14 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
 fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
     use plotters::prelude::*;
     let v_max = rows.last().map(|r| r.airspeed_mps).unwrap_or(1.0).max(1.0);
-    let p_max = rows.iter().map(|r| r.power_w).fold(0.0, f64::max) * 1.1 + 1.0;
-    let e_max = rows
-        .iter()
-        .map(|r| r.endurance_s / 60.0)
-        .fold(0.0, f64::max)
-        * 1.1
-        + 1.0;
+    let power = rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect();
+    let endurance = rows.iter().map(|r| (r.airspeed_mps, r.endurance_s / 60.0));
     super::plot::dual_lines_file(
         path,
         (900, 500),
         format!("{name}: power curve (level flight, still air)"),
         (0.0..v_max, "airspeed (m/s)"),
-        super::plot::Line {
-            desc: "electrical power (W)",
-            max: p_max,
-            color: RED,
-            points: rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect(),
-        },
-        super::plot::Line {
-            desc: "endurance (min)",
-            max: e_max,
-            color: BLUE,
-            points: rows
-                .iter()
-                .map(|r| (r.airspeed_mps, r.endurance_s / 60.0))
-                .collect(),
-        },
+        Line::with_headroom("electrical power (W)", RED, power),
+        Line::with_headroom("endurance (min)", BLUE, endurance.collect()),
     )
 }

@@ -14,6 +14,7 @@ use super::mission_view::{
     write_segments_head, write_sorties, Area,
 };
 use super::output;
+use super::plot::Line;
 use super::{Format, Outcome};
 
 pub fn run(args: MissionArgs) -> Result<Outcome> {
@@ -101,18 +102,15 @@ fn write_segments(out: &mut impl Write, r: &MissionReport) -> Result<()> {
 fn plot_power(area: &Area<'_>, name: &str, report: &MissionReport, s: &[Sample]) -> Result<()> {
     use plotters::prelude::*;
     let t_max = s[s.len() - 1].time_s.max(1.0);
-    let p_max = s.iter().map(|x| x.power_w).fold(0.0, f64::max) * 1.1 + 1.0;
+    let power = s.iter().map(|x| (x.time_s, x.power_w)).collect();
+    let power = Line::with_headroom("power (W)", RED, power);
+    let p_max = power.max;
     let mut chart = super::plot::dual_lines(
         area,
         format!("{name}: electrical power and state of charge"),
         (0.0..t_max, "time (s)"),
-        super::plot::Line {
-            desc: "power (W)",
-            max: p_max,
-            color: RED,
-            points: s.iter().map(|x| (x.time_s, x.power_w)).collect(),
-        },
-        super::plot::Line {
+        power,
+        Line {
             desc: "state of charge (%)",
             max: 100.0,
             color: BLUE,

@@ -158,15 +158,5 @@ fn engine_message(e: aloft::Error) -> String {
 /// The error and its causes on one line, each cause once: engine errors already say their
 /// cause in their own message, so a cause whose text is already there is not repeated.
 fn message(e: &anyhow::Error) -> String {
-    let mut text = String::new();
-    for cause in e.chain() {
-        let c = aloft::engine::one_line(&cause.to_string());
-        if text.is_empty() {
-            text = c;
-        } else if !text.contains(&c) {
-            text.push_str(": ");
-            text.push_str(&c);
-        }
-    }
-    text
+    aloft::engine::error_line(e.as_ref())
 }

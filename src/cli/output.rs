@@ -33,6 +33,12 @@ impl<'a> Row<'a> {
     }
 }
 
+/// Rows of numbers from a table of label, value, decimals and unit.
+pub fn num_rows<'a>(table: &[(&'a str, f64, usize, &'a str)]) -> Vec<Row<'a>> {
+    let row = |&(label, value, decimals, unit)| Row::num(label, value, decimals, unit);
+    table.iter().map(row).collect()
+}
+
 /// A number with `decimals` digits after the point, as tables show it.
 pub fn fixed(value: f64, decimals: usize) -> String {
     format!("{value:.decimals$}")

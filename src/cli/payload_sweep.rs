@@ -145,16 +145,12 @@ pub fn plot(path: &Path, curve: &PayloadCurve) -> Result<()> {
     let root = SVGBackend::new(path, (900, 800)).into_drawing_area();
     root.fill(&WHITE)?;
     let (top, bottom) = root.split_vertically(400);
-    let lo = curve
+    let (lo, hi) = curve
         .rows
         .iter()
-        .map(|r| r.payload_kg)
-        .fold(f64::INFINITY, f64::min);
-    let hi = curve
-        .rows
-        .iter()
-        .map(|r| r.payload_kg)
-        .fold(f64::NEG_INFINITY, f64::max);
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), r| {
+            (lo.min(r.payload_kg), hi.max(r.payload_kg))
+        });
     let x = if hi > lo { lo..hi } else { lo..lo + 1.0 };
     let series = |y: fn(&PayloadRow) -> f64| -> Vec<super::plot::Series> {
         curve

@@ -29,6 +29,19 @@ pub struct Line<'s> {
     pub points: Vec<(f64, f64)>,
 }
 
+impl<'s> Line<'s> {
+    /// A line whose axis runs a tenth and one unit above its highest point (from 0).
+    pub fn with_headroom(desc: &'s str, color: RGBColor, points: Vec<(f64, f64)>) -> Self {
+        let max = points.iter().map(|&(_, y)| y).fold(0.0, f64::max) * 1.1 + 1.0;
+        Self {
+            desc,
+            max,
+            color,
+            points,
+        }
+    }
+}
+
 /// Draw `left` against the left axis and `right` against the right axis over `x` (its range and
 /// description); y axes start at 0. Returns the chart so callers can add series before
 /// [`legend`].

@@ -7,10 +7,11 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::{
-    power_csv_file, power_point, power_values, PowerAnswer, PowerQuery, Vehicle, POWER_KEYS,
+    power_csv_file, power_point, power_values, FlightStateDeg, PowerAnswer, PowerQuery, Vehicle,
+    POWER_KEYS,
 };
 
-use super::output::{self, Row};
+use super::output;
 use super::{Format, Outcome};
 use aloft::engine::flags::{finite, PowerModelFlags};
 
@@ -53,13 +54,15 @@ pub struct PowerArgs {
 impl PowerArgs {
     fn query(&self) -> PowerQuery {
         PowerQuery {
-            airspeed_mps: self.airspeed,
-            roll_deg: self.roll,
-            pitch_deg: self.pitch,
-            climb_rate_mps: self.climb_rate,
-            air_direction_deg: self.air_direction_deg,
+            model: self.model.query(),
+            state: FlightStateDeg {
+                airspeed_mps: self.airspeed,
+                roll_deg: self.roll,
+                pitch_deg: self.pitch,
+                climb_rate_mps: self.climb_rate,
+                air_direction_deg: self.air_direction_deg,
+            },
             gradient: self.gradient,
-            ..self.model.query()
         }
     }
 }
@@ -73,7 +76,7 @@ pub fn run(args: PowerArgs) -> Result<Outcome> {
         if args.model.aoa.is_some() || args.air_direction_deg.is_some() {
             bail!("in batch mode the angle of attack is per row: add an air_direction_deg column for the geometric model");
         }
-        power_csv_file(&vehicle, &args.query(), path, args.output.as_deref())?;
+        power_csv_file(&vehicle, &args.model.query(), path, args.output.as_deref())?;
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;
@@ -112,38 +115,35 @@ fn write_table(out: &mut impl Write, args: &PowerArgs, a: &PowerAnswer) -> Resul
         "{}, {}\nairspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
         a.context.vehicle, a.context.mass, args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
     );
-    let mut rows = vec![
-        Row::num("thrust", p.thrust_n, 2, "N"),
-        Row::num("induced velocity", p.induced_velocity_mps, 2, "m/s"),
-        Row::num(
+    let mut rows = output::num_rows(&[
+        ("thrust", p.thrust_n, 2, "N"),
+        ("induced velocity", p.induced_velocity_mps, 2, "m/s"),
+        (
             "hover induced velocity",
             p.hover_induced_velocity_mps,
             2,
             "m/s",
         ),
-        Row::num("induced power (eq 8)", p.induced_w, 1, "W"),
-        Row::num("parasitic power (eq 11)", p.parasitic_w, 1, "W"),
-        Row::num("profile power (eq 12)", p.profile_w, 1, "W"),
-        Row::num(
+        ("induced power (eq 8)", p.induced_w, 1, "W"),
+        ("parasitic power (eq 11)", p.parasitic_w, 1, "W"),
+        ("profile power (eq 12)", p.profile_w, 1, "W"),
+        (
             "acceleration work (eq 8, exact AoA)",
             p.acceleration_w,
             1,
             "W",
         ),
-        Row::num("climb power (eq 13)", p.climb_w, 1, "W"),
-        Row::num("aerodynamic total (eq 7)", p.aero_w, 1, "W"),
-        Row::num("electrical (eq 14)", p.electrical_w, 1, "W"),
-        Row::num("efficiency eta", a.context.efficiency, 4, ""),
-    ];
+        ("climb power (eq 13)", p.climb_w, 1, "W"),
+        ("aerodynamic total (eq 7)", p.aero_w, 1, "W"),
+        ("electrical (eq 14)", p.electrical_w, 1, "W"),
+        ("efficiency eta", a.context.efficiency, 4, ""),
+    ]);
     if let Some(g) = &a.electrical_gradient {
-        rows.push(Row::num(
-            "dP/d airspeed",
-            g.d_airspeed_w_per_mps,
-            2,
-            "W per m/s",
-        ));
-        rows.push(Row::num("dP/d roll", g.d_roll_w_per_deg, 2, "W per deg"));
-        rows.push(Row::num("dP/d pitch", g.d_pitch_w_per_deg, 2, "W per deg"));
+        rows.extend(output::num_rows(&[
+            ("dP/d airspeed", g.d_airspeed_w_per_mps, 2, "W per m/s"),
+            ("dP/d roll", g.d_roll_w_per_deg, 2, "W per deg"),
+            ("dP/d pitch", g.d_pitch_w_per_deg, 2, "W per deg"),
+        ]));
     }
     output::write_table(out, &title, &rows)?;
     if !a.context.removed.is_empty() {

@@ -25,10 +25,11 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
         payload_kg: args.flags.payload_kg.unwrap_or(0.0),
         lag_s: args.lag,
         acceleration: match args.acceleration {
-            AccelArg::Velocity => ReplayAcceleration::Velocity,
+            AccelArg::Velocity => ReplayAcceleration::Velocity {
+                window_s: args.acceleration_window,
+            },
             AccelArg::Log => ReplayAcceleration::Log,
         },
-        acceleration_window_s: args.acceleration_window,
         aoa: args.flags.aoa,
         wind: args.flags.wind.spec(),
         battery: args.flags.battery.clone(),

@@ -106,6 +106,21 @@ macro_rules! ok_scalars {
     };
 }
 
+/// Tuple and struct variants are walked as sequences (a trait method each, so a macro).
+macro_rules! variants_are_sequences {
+    ($($name:ident: $part:ident),*) => {$(
+        fn $name(
+            self,
+            _: &'static str,
+            _: u32,
+            _: &'static str,
+            len: usize,
+        ) -> Result<Self::$part, Found> {
+            self.serialize_seq(Some(len))
+        }
+    )*};
+}
+
 impl<'w> ser::Serializer for &'w mut Walker {
     type Ok = ();
     type Error = Found;
@@ -117,6 +132,10 @@ impl<'w> ser::Serializer for &'w mut Walker {
     type SerializeStruct = Part<'w>;
     type SerializeStructVariant = Part<'w>;
 
+    variants_are_sequences!(
+        serialize_tuple_variant: SerializeTupleVariant,
+        serialize_struct_variant: SerializeStructVariant
+    );
     ok_scalars!(serialize_bool: bool, serialize_i8: i8, serialize_i16: i16, serialize_i32: i32,
         serialize_i64: i64, serialize_u8: u8, serialize_u16: u16, serialize_u32: u32,
         serialize_u64: u64, serialize_char: char, serialize_str: &str, serialize_bytes: &[u8]);
@@ -176,28 +195,10 @@ impl<'w> ser::Serializer for &'w mut Walker {
     fn serialize_tuple_struct(self, _: &'static str, len: usize) -> Result<Part<'w>, Found> {
         self.serialize_seq(Some(len))
     }
-    fn serialize_tuple_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        len: usize,
-    ) -> Result<Part<'w>, Found> {
-        self.serialize_seq(Some(len))
-    }
     fn serialize_map(self, len: Option<usize>) -> Result<Part<'w>, Found> {
         self.serialize_seq(len)
     }
     fn serialize_struct(self, _: &'static str, len: usize) -> Result<Part<'w>, Found> {
-        self.serialize_seq(Some(len))
-    }
-    fn serialize_struct_variant(
-        self,
-        _: &'static str,
-        _: u32,
-        _: &'static str,
-        len: usize,
-    ) -> Result<Part<'w>, Found> {
         self.serialize_seq(Some(len))
     }
 }

@@ -24,7 +24,7 @@ use super::logs::{FlightLogs, LogReadOptions};
 use super::mission_file::Mission;
 use super::mission_options::{GustSpec, MissionOptions};
 use super::payload_sweep::PayloadSweep;
-use super::power::PowerQuery;
+use super::power::PowerModelQuery;
 use super::scenarios::{ScenarioOptions, WorkBounds, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
 use super::validate::ValidateRequest;
 use super::EnduranceOptions;
@@ -584,15 +584,14 @@ pub struct PowerModelFlags {
 }
 
 impl PowerModelFlags {
-    /// The engine's power query of these options, in hover (the caller sets the state).
-    pub fn query(&self) -> PowerQuery {
-        PowerQuery {
+    /// The engine's power model of these options (the caller gives the state).
+    pub fn query(&self) -> PowerModelQuery {
+        PowerModelQuery {
             battery: self.battery.clone(),
             payload_kg: self.payload_kg,
             without: self.without.clone(),
             profile_cutoff_mps: self.profile_cutoff,
             aoa: self.aoa,
-            ..PowerQuery::default()
         }
     }
 }

@@ -284,7 +284,7 @@ fn power_facts(
             Some(BinaryLogInfo::of(b, battery_instance)),
         ),
         None => {
-            let available = stats.energy_wh.is_some() || stats.mean_power_w.is_some();
+            let available = stats.power.energy_wh.is_some() || stats.power.mean_power_w.is_some();
             let warnings = if available {
                 Vec::new()
             } else {
@@ -292,7 +292,7 @@ fn power_facts(
                     "the log has no battery data: no voltage and current (or power) channel".into(),
                 ]
             };
-            (stats.energy_wh, available, warnings, None)
+            (stats.power.energy_wh, available, warnings, None)
         }
     }
 }
@@ -386,8 +386,8 @@ pub fn log_info(
             topics: reader.topics().map(|t| t.iter().map(topic).collect()),
             power_available,
             energy_wh,
-            mean_power_w: stats.mean_power_w,
-            max_power_w: stats.max_power_w,
+            mean_power_w: stats.power.mean_power_w,
+            max_power_w: stats.power.max_power_w,
             time: LogTime::from(&time),
             dropped_values,
             dropped,

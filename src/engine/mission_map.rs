@@ -35,7 +35,7 @@ pub struct MissionMap {
     pub battery: SocLine,
     /// Its 5th, 50th and 95th percentiles over time, with scenarios (`samples`).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub band: Option<SocBand>,
+    pub band: Option<SocFan>,
 }
 
 /// A point on the ground.
@@ -87,19 +87,6 @@ pub struct SocLine {
     pub soc: Vec<f64>,
 }
 
-/// Percentile bands of the state of charge over time, over the scenarios.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SocBand {
-    /// Mission time, s.
-    pub time_s: Vec<f64>,
-    /// 5th percentile, fraction of capacity.
-    pub p5: Vec<f64>,
-    /// Median.
-    pub p50: Vec<f64>,
-    /// 95th percentile.
-    pub p95: Vec<f64>,
-}
-
 /// The map of `plan` (planned with the chart samples kept) of `mission`, with the band of `fan`.
 pub fn mission_map(plan: &Plan, mission: &Mission, fan: Option<SocFan>) -> MissionMap {
     let home = &mission.spec().home;
@@ -141,12 +128,7 @@ pub fn mission_map(plan: &Plan, mission: &Mission, fan: Option<SocFan>) -> Missi
         segments,
         point_of_no_return,
         battery: soc_line(plan),
-        band: fan.map(|f| SocBand {
-            time_s: f.time_s,
-            p5: f.p5,
-            p50: f.p50,
-            p95: f.p95,
-        }),
+        band: fan,
     }
 }
 

@@ -108,7 +108,7 @@ pub use mission::{
 };
 pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
 pub use mission_map::{
-    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocBand, SocLine, MAP_CHART_POINTS,
+    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
@@ -116,8 +116,8 @@ pub use payload_sweep::{
     payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
 };
 pub use power::{
-    power_csv_file, power_model, power_point, PowerAnswer, PowerContext, PowerGradientDeg,
-    PowerQuery,
+    power_csv_file, power_model, power_point, FlightStateDeg, PowerAnswer, PowerContext,
+    PowerGradientDeg, PowerModelQuery, PowerQuery,
 };
 pub use power_batch::{power_csv, power_values, POWER_KEYS};
 pub use propulsion::{
@@ -129,7 +129,8 @@ pub use scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
-    Uncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
+    Uncertainty, WithUncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS,
+    MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
@@ -138,8 +139,9 @@ pub use validate::{
 };
 pub use vehicles::{list_vehicles, MassParts, TakeoffMass, Vehicle, VehicleEntry};
 
-/// A parser's message on one line (the CLI prints every error on one line).
-pub use aloft_core::one_line;
+/// A parser's message on one line, and an error with its causes on one line (the CLI prints
+/// every error on one line).
+pub use aloft_core::{error_line, one_line};
 
 /// The error of every engine function, and what is wrong with a payload sweep (so callers match
 /// on them through this module alone).

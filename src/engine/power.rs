@@ -18,17 +18,42 @@ use super::power_batch::power_csv;
 use super::vehicles::{TakeoffMass, Vehicle};
 use crate::error::Error;
 
-/// A point query of the power model (the options of `aloft power`). Angles in degrees.
+/// A point query of the power model (the options of `aloft power`): the model and the flight
+/// state, angles in degrees.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct PowerQuery {
+    /// The model: take-off mass, terms, angle of attack.
+    pub model: PowerModelQuery,
+    /// The flight state.
+    pub state: FlightStateDeg,
+    /// Also compute the gradient of electrical power.
+    pub gradient: bool,
+}
+
+/// The model a power query flies.
 ///
 /// The model flies the vehicle's take-off mass ([`Vehicle::takeoff_mass`]): airframe + pack
 /// (`battery`, default the vehicle's default pack) + `payload_kg`, as `aloft endurance` and
 /// `aloft mission` do.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct PowerQuery {
+pub struct PowerModelQuery {
     /// Pack by name (default: the vehicle's default pack).
     pub battery: Option<String>,
     /// Payload, kg (default 0).
     pub payload_kg: f64,
+    /// Terms removed (the ablation rows of the paper's Table I).
+    pub without: Vec<Term>,
+    /// Hybrid model: drop the profile term above this airspeed, m/s.
+    pub profile_cutoff_mps: Option<f64>,
+    /// Angle-of-attack model; default the paper's, or geometric when the state's
+    /// `air_direction_deg` is given.
+    pub aoa: Option<AoaModel>,
+}
+
+/// The flight state of a point query, angles in degrees (the power model's [`FlightState`] in
+/// the units of `aloft power`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FlightStateDeg {
     /// Airspeed, m/s (horizontal, as the paper assumes).
     pub airspeed_mps: f64,
     /// Roll, deg (positive right side down).
@@ -37,16 +62,8 @@ pub struct PowerQuery {
     pub pitch_deg: f64,
     /// Vertical speed, m/s, positive up.
     pub climb_rate_mps: f64,
-    /// Terms removed (the ablation rows of the paper's Table I).
-    pub without: Vec<Term>,
-    /// Hybrid model: drop the profile term above this airspeed, m/s.
-    pub profile_cutoff_mps: Option<f64>,
-    /// Angle-of-attack model; default the paper's, or geometric when `air_direction_deg` is given.
-    pub aoa: Option<AoaModel>,
     /// Direction of the air-relative velocity from the nose, deg (selects the geometric model).
     pub air_direction_deg: Option<f64>,
-    /// Also compute the gradient of electrical power.
-    pub gradient: bool,
 }
 
 /// The gradient of electrical power with respect to airspeed, roll and pitch (per degree).
@@ -98,19 +115,18 @@ pub struct PowerContext {
 }
 
 /// The four-term model of `vehicle` at the query's take-off mass (its `battery` and
-/// `payload_kg`), with its terms removed and its profile cutoff; the state fields of the query
-/// are not read.
+/// `payload_kg`), with its terms removed and its profile cutoff.
 ///
 /// # Errors
 /// No `[power]` table, a take-off mass [`Vehicle::takeoff_mass`] refuses, or an invalid cutoff.
-pub fn power_model(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerModel, Error> {
+pub fn power_model(vehicle: &Vehicle, query: &PowerModelQuery) -> Result<PowerModel, Error> {
     Ok(model_and_mass(vehicle, query)?.0)
 }
 
 /// The four-term model at the query's take-off mass with its terms and cutoff, and that mass.
 fn model_and_mass(
     vehicle: &Vehicle,
-    query: &PowerQuery,
+    query: &PowerModelQuery,
 ) -> Result<(PowerModel, TakeoffMass), Error> {
     let (model, mass) = vehicle.power_model_with(query.battery.as_deref(), query.payload_kg)?;
     let options = ModelOptions {
@@ -129,22 +145,23 @@ fn model_and_mass(
 /// angle-of-attack choice (geometric without a direction, the paper's with one); a state the
 /// model rejects (negative airspeed, tilt of 90 deg or more).
 pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer, Error> {
-    let (model, mass) = model_and_mass(vehicle, query)?;
-    let aoa = aoa_input(query.aoa, query.air_direction_deg)?;
+    let (model, mass) = model_and_mass(vehicle, &query.model)?;
+    let s = &query.state;
+    let aoa = aoa_input(query.model.aoa, s.air_direction_deg)?;
     let state = FlightState {
-        airspeed_mps: query.airspeed_mps,
-        roll_rad: query.roll_deg.to_radians(),
-        pitch_rad: query.pitch_deg.to_radians(),
-        climb_rate_mps: query.climb_rate_mps,
+        airspeed_mps: s.airspeed_mps,
+        roll_rad: s.roll_deg.to_radians(),
+        pitch_rad: s.pitch_deg.to_radians(),
+        climb_rate_mps: s.climb_rate_mps,
         aoa,
     };
     let invalid = |source| Error::FlightState {
         state: format!(
             "airspeed_mps {}, roll_deg {}, pitch_deg {}, climb_rate_mps {}",
-            Num(query.airspeed_mps),
-            Num(query.roll_deg),
-            Num(query.pitch_deg),
-            Num(query.climb_rate_mps)
+            Num(s.airspeed_mps),
+            Num(s.roll_deg),
+            Num(s.pitch_deg),
+            Num(s.climb_rate_mps)
         ),
         source,
     };
@@ -174,10 +191,10 @@ pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer,
                     AoaInput::Paper => "paper eqs 3-4".to_string(),
                     AoaInput::Geometric { .. } => format!(
                         "geometric, air from {:.1} deg off the nose",
-                        query.air_direction_deg.unwrap_or_default()
+                        s.air_direction_deg.unwrap_or_default()
                     ),
                 },
-                removed: query.without.iter().map(|t| t.name()).collect(),
+                removed: query.model.without.iter().map(|t| t.name()).collect(),
             },
         },
         "power",
@@ -211,7 +228,7 @@ fn aoa_input(aoa: Option<AoaModel>, air_direction_deg: Option<f64>) -> Result<Ao
 /// As [`power_model`] and [`power_csv`], and files that cannot be opened or created.
 pub fn power_csv_file(
     vehicle: &Vehicle,
-    query: &PowerQuery,
+    query: &PowerModelQuery,
     input: &Path,
     output: Option<&Path>,
 ) -> Result<u64, Error> {

@@ -203,40 +203,23 @@ fn merged_spec(b: Option<&RotorSpec>, o: &RotorOverrides) -> Result<RotorSpec, E
             hint: "give it, or a rotor file with --rotor (e.g. --rotor mn1806-6x2)",
         })
     };
+    // A field of the overrides, else of the base file, else an error naming its flag (a field by
+    // name, so a macro).
+    macro_rules! need {
+        ($field:ident, $flag:literal) => {
+            need(o.$field, b.map(|s| s.$field), $flag)?
+        };
+    }
     Ok(RotorSpec {
-        motor_kv_rpm_per_v: need(
-            o.motor_kv_rpm_per_v,
-            b.map(|s| s.motor_kv_rpm_per_v),
-            "--motor-kv",
-        )?,
-        motor_resistance_ohm: need(
-            o.motor_resistance_ohm,
-            b.map(|s| s.motor_resistance_ohm),
-            "--motor-resistance",
-        )?,
-        no_load_current_a: need(
-            o.no_load_current_a,
-            b.map(|s| s.no_load_current_a),
-            "--no-load-current",
-        )?,
-        voltage_v: need(o.voltage_v, b.map(|s| s.voltage_v), "--voltage")?,
-        motor_mass_g: need(o.motor_mass_g, b.map(|s| s.motor_mass_g), "--motor-mass")?,
-        motor_diameter_mm: need(
-            o.motor_diameter_mm,
-            b.map(|s| s.motor_diameter_mm),
-            "--motor-diameter",
-        )?,
-        prop_mass_g: need(o.prop_mass_g, b.map(|s| s.prop_mass_g), "--prop-mass")?,
-        prop_diameter_in: need(
-            o.prop_diameter_in,
-            b.map(|s| s.prop_diameter_in),
-            "--prop-diameter",
-        )?,
-        torque_coefficient_nms2: need(
-            o.torque_coefficient_nms2,
-            b.map(|s| s.torque_coefficient_nms2),
-            "--torque-coefficient",
-        )?,
+        motor_kv_rpm_per_v: need!(motor_kv_rpm_per_v, "--motor-kv"),
+        motor_resistance_ohm: need!(motor_resistance_ohm, "--motor-resistance"),
+        no_load_current_a: need!(no_load_current_a, "--no-load-current"),
+        voltage_v: need!(voltage_v, "--voltage"),
+        motor_mass_g: need!(motor_mass_g, "--motor-mass"),
+        motor_diameter_mm: need!(motor_diameter_mm, "--motor-diameter"),
+        prop_mass_g: need!(prop_mass_g, "--prop-mass"),
+        prop_diameter_in: need!(prop_diameter_in, "--prop-diameter"),
+        torque_coefficient_nms2: need!(torque_coefficient_nms2, "--torque-coefficient"),
         protocol: o.protocol.or(b.and_then(|s| s.protocol)),
         step_from_radps: o.step_from_radps.or(b.and_then(|s| s.step_from_radps)),
         step_to_radps: o.step_to_radps.or(b.and_then(|s| s.step_to_radps)),

@@ -26,13 +26,21 @@ use crate::error::Error;
 use crate::identify::{align_flight, power_samples, AlignOptions};
 
 /// Where the replay takes the acceleration from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ReplayAcceleration {
-    /// Centred difference of the logged velocity over a window (default).
-    #[default]
-    Velocity,
+    /// Centred difference of the logged velocity over a window (default, 1 s).
+    Velocity {
+        /// Window of the difference, s.
+        window_s: f64,
+    },
     /// The log's acceleration channel.
     Log,
+}
+
+impl Default for ReplayAcceleration {
+    fn default() -> Self {
+        Self::Velocity { window_s: 1.0 }
+    }
 }
 
 /// A replay request (the options of `aloft mission --replay`).
@@ -48,8 +56,6 @@ pub struct ReplayRequest {
     pub lag_s: Option<f64>,
     /// Where the acceleration comes from.
     pub acceleration: ReplayAcceleration,
-    /// Window of the velocity difference, s.
-    pub acceleration_window_s: f64,
     /// Angle-of-attack model of the power model.
     pub aoa: AoaModel,
     /// Wind where the log has none (default still air).
@@ -66,8 +72,7 @@ impl Default for ReplayRequest {
             profile: None,
             payload_kg: 0.0,
             lag_s: None,
-            acceleration: ReplayAcceleration::Velocity,
-            acceleration_window_s: 1.0,
+            acceleration: ReplayAcceleration::default(),
             aoa: AoaModel::Geometric,
             wind: None,
             battery: None,
@@ -215,10 +220,9 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     let context = ReplayContext {
         mass: flown.described.clone(),
         acceleration: match request.acceleration {
-            ReplayAcceleration::Velocity => format!(
-                "differentiated velocity over {} s",
-                request.acceleration_window_s
-            ),
+            ReplayAcceleration::Velocity { window_s } => {
+                format!("differentiated velocity over {window_s} s")
+            }
             ReplayAcceleration::Log => "the log's".to_string(),
         },
         wind: if logged_wind {
@@ -260,7 +264,7 @@ fn answer(
         points,
         duration_s: span_s,
         acceleration: match request.acceleration {
-            ReplayAcceleration::Velocity => "velocity",
+            ReplayAcceleration::Velocity { .. } => "velocity",
             ReplayAcceleration::Log => "log",
         },
         lag_s,
@@ -347,8 +351,8 @@ fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajecto
         });
     }
     let accs: Vec<[f64; 3]> = match request.acceleration {
-        ReplayAcceleration::Velocity => {
-            differentiate_velocity(&times, &vels, request.acceleration_window_s)?
+        ReplayAcceleration::Velocity { window_s } => {
+            differentiate_velocity(&times, &vels, window_s)?
         }
         ReplayAcceleration::Log => rows
             .iter()

@@ -374,16 +374,20 @@ pub struct Uncertainty {
     pub soc_fan: Option<SocFan>,
 }
 
-/// A mission's summary with its `uncertainty`: the JSON of `aloft mission --samples N --format
-/// json` (the C ABI's `aloft_mission_json` with a `scenarios` object gives the same bytes).
+/// A deterministic answer with its `uncertainty` over scenarios: the answer's keys, then
+/// `uncertainty` ([`MissionWithUncertainty`], [`EnduranceWithUncertainty`]).
 #[derive(Debug, Clone, Serialize)]
-pub struct MissionWithUncertainty<'a> {
+pub struct WithUncertainty<'a, A, U> {
     /// The deterministic answer.
     #[serde(flatten)]
-    pub summary: &'a MissionSummary,
+    pub summary: &'a A,
     /// How sure it is.
-    pub uncertainty: &'a Uncertainty,
+    pub uncertainty: &'a U,
 }
+
+/// A mission's summary with its `uncertainty`: the JSON of `aloft mission --samples N --format
+/// json` (the C ABI's `aloft_mission_json` with a `scenarios` object gives the same bytes).
+pub type MissionWithUncertainty<'a> = WithUncertainty<'a, MissionSummary, Uncertainty>;
 
 impl MissionWithUncertainty<'_> {
     /// Pretty JSON, as the CLI prints it (without the CLI's trailing newline).
@@ -989,14 +993,8 @@ pub struct EnduranceUncertainty {
 }
 
 /// An endurance answer with its `uncertainty` (the JSON of `aloft endurance --samples N`).
-#[derive(Debug, Clone, Serialize)]
-pub struct EnduranceWithUncertainty<'a> {
-    /// The deterministic answer.
-    #[serde(flatten)]
-    pub summary: &'a super::EnduranceSummary,
-    /// How sure it is.
-    pub uncertainty: &'a EnduranceUncertainty,
-}
+pub type EnduranceWithUncertainty<'a> =
+    WithUncertainty<'a, super::EnduranceSummary, EnduranceUncertainty>;
 
 /// Draw `sc.samples` scenarios around the request of [`super::endurance`] (wind speed and
 /// direction, payload, pack capacity, model error; no gusts) and answer the queries in each:

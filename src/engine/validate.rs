@@ -8,7 +8,7 @@ use super::finite::finite;
 use super::logs::FlightLogs;
 use super::vehicles::Vehicle;
 use crate::error::Error;
-use crate::identify::{predict, validate_flight, FlightValidation, AIRSPEED_BANDS};
+use crate::identify::{predict, validate_flight, AblationRow, FlightValidation, AIRSPEED_BANDS};
 
 /// A validation request (the options of `aloft validate`).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -39,15 +39,7 @@ pub struct MeanBand {
 }
 
 /// Mean over flights of one Table I row.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct MeanRow {
-    /// The dropped term (`none`, `parasitic`, `profile`, `induced`, `climb`).
-    pub dropped_term: &'static str,
-    /// Mean whole-flight NRMSE, percent.
-    pub nrmse_percent: f64,
-    /// Per airspeed band.
-    pub bands: Vec<MeanBand>,
-}
+pub type MeanRow = AblationRow<MeanBand>;
 
 /// The JSON of `aloft validate --format json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]

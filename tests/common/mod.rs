@@ -1,11 +1,11 @@
 //! Helpers shared by the integration tests: running the `aloft` binary, the shared real-data
-//! folder and the repository's fixtures, files and checks several tests make, mission segments as
-//! TOML ([`mission_toml`]) and ROS 2 messages ([`ros2`]; both also taken by the benches with
-//! `#[path]`). Each test file takes what it needs with `mod common;`.
+//! folder and the repository's fixtures, files and checks several tests make, and ROS 2 messages
+//! ([`ros2`]; also taken by the benches with `#[path]`). Missions written in code take their
+//! segments from `aloft_planner::mission_toml`. Each test file takes what it needs with
+//! `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
 
 mod data;
-pub mod mission_toml;
 pub mod ros2;
 pub mod serve;
 

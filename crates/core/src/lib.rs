@@ -7,6 +7,7 @@
 //!   and the unit `g` of log columns;
 //! - [`Trapezoid`] and [`trapezoid`], the trapezoid rule for energies (power over time) and any
 //!   other integral of sampled data, sample by sample or over slices;
+//! - [`bisect`], the bracketing of a crossing by halving;
 //! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
 //!   before it is opened, so it cannot block), with a size limit for whole-file inputs.
 //!
@@ -15,9 +16,11 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod bisect;
 pub mod input;
 pub mod integrate;
 
+pub use bisect::bisect;
 pub use input::{open_regular_file, read_regular_text};
 pub use integrate::{trapezoid, Trapezoid};
 
@@ -103,6 +106,95 @@ impl std::fmt::Display for Unit<'_> {
             u => write!(f, " {u}"),
         }
     }
+}
+
+/// A parameter outside its valid range, with its value, unit and what a valid value looks like:
+/// the `InvalidParameter` of the model crates' errors (`PlannerError`, `PropulsionError`), which
+/// wrap it.
+///
+/// ```
+/// let e = aloft_core::parameter("rotor_radius_m", -0.2, "m", false, "a positive length");
+/// assert_eq!(
+///     e.unwrap_err().to_string(),
+///     "rotor_radius_m = -0.2 m is invalid: expected a positive length"
+/// );
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InvalidParameter {
+    /// Parameter name, with its unit suffix.
+    pub name: &'static str,
+    /// The rejected value.
+    pub value: f64,
+    /// Unit of `value`.
+    pub unit: &'static str,
+    /// What a valid value looks like.
+    pub expected: &'static str,
+}
+
+impl std::fmt::Display for InvalidParameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Self {
+            name,
+            value,
+            unit,
+            expected,
+        } = *self;
+        write!(
+            f,
+            "{name} = {}{} is invalid: expected {expected}",
+            Num(value),
+            Unit(unit)
+        )
+    }
+}
+
+impl std::error::Error for InvalidParameter {}
+
+/// `value` when `ok`, else [`InvalidParameter`] saying what was `expected`.
+///
+/// # Errors
+/// [`InvalidParameter`] when `ok` is false.
+pub fn parameter(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+    ok: bool,
+    expected: &'static str,
+) -> Result<f64, InvalidParameter> {
+    if ok {
+        Ok(value)
+    } else {
+        Err(InvalidParameter {
+            name,
+            value,
+            unit,
+            expected,
+        })
+    }
+}
+
+/// An error and its causes on one line, as the command line prints it: each cause through
+/// [`one_line`], joined with `: `, a cause whose text is already there not repeated (errors often
+/// say their cause in their own message).
+///
+/// ```
+/// let e = std::io::Error::other("disk full");
+/// assert_eq!(aloft_core::error_line(&e), "disk full");
+/// ```
+pub fn error_line(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = String::new();
+    let mut cause = Some(e);
+    while let Some(c) = cause {
+        let line = one_line(&c.to_string());
+        if text.is_empty() {
+            text = line;
+        } else if !text.contains(&line) {
+            text.push_str(": ");
+            text.push_str(&line);
+        }
+        cause = c.source();
+    }
+    text
 }
 
 /// A parser's message on one line: TOML errors come with a snippet of the file (a line number

@@ -50,7 +50,8 @@ use std::sync::{LazyLock, Mutex, MutexGuard};
 
 use aloft::engine::{
     endurance, options_from_json, plan_mission, plan_scenarios, power_point, EnduranceOptions,
-    FlightState, Mission, MissionOptions, MissionWithUncertainty, Plan, PowerQuery, Vehicle,
+    FlightState, FlightStateDeg, Mission, MissionOptions, MissionWithUncertainty, Plan,
+    PowerModelQuery, PowerQuery, Vehicle,
 };
 use aloft::Error;
 
@@ -605,13 +606,19 @@ pub unsafe extern "C" fn aloft_vehicle_power_json(
                 Failure::new(AloftStatus::Parse, format!("invalid flight state: {e}"))
             })?;
             let query = PowerQuery {
-                battery: s.battery,
-                payload_kg: s.payload_kg,
-                airspeed_mps: s.airspeed_mps,
-                roll_deg: s.roll_deg,
-                pitch_deg: s.pitch_deg,
-                climb_rate_mps: s.climb_rate_mps,
-                ..PowerQuery::default()
+                model: PowerModelQuery {
+                    battery: s.battery,
+                    payload_kg: s.payload_kg,
+                    ..PowerModelQuery::default()
+                },
+                state: FlightStateDeg {
+                    airspeed_mps: s.airspeed_mps,
+                    roll_deg: s.roll_deg,
+                    pitch_deg: s.pitch_deg,
+                    climb_rate_mps: s.climb_rate_mps,
+                    air_direction_deg: None,
+                },
+                gradient: false,
             };
             let json = serde_json::to_string_pretty(&power_point(v, &query)?)
                 .map_err(|e| Failure::new(AloftStatus::InvalidInput, e.to_string()))?;

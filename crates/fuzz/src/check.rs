@@ -1,8 +1,6 @@
 //! What a target answers for one input, and the checks of that answer: no number that is not
 //! finite and no `null` in an answer, every refusal on one line.
 
-use std::error::Error as StdError;
-
 use serde_json::Value;
 
 /// One answer a target computed, as the command line would print it.
@@ -66,7 +64,7 @@ impl Outcome {
     pub fn refuse(&mut self, what: &'static str, e: &aloft::Error) {
         self.refusals.push(Refusal {
             what,
-            line: cli_line(e),
+            line: aloft::engine::error_line(e),
             non_finite: matches!(e, aloft::Error::NonFinite { .. }),
         });
     }
@@ -85,24 +83,6 @@ impl Outcome {
             Err(e) => self.refuse(what, e),
         }
     }
-}
-
-/// The error and its causes on one line, as `aloft` prints it (`src/cli/mod.rs`, `message`):
-/// each cause through [`aloft::engine::one_line`], a cause already in the text not repeated.
-pub fn cli_line(e: &(dyn StdError + 'static)) -> String {
-    let mut text = String::new();
-    let mut cause: Option<&(dyn StdError + 'static)> = Some(e);
-    while let Some(c) = cause {
-        let line = aloft::engine::one_line(&c.to_string());
-        if text.is_empty() {
-            text = line;
-        } else if !text.contains(&line) {
-            text.push_str(": ");
-            text.push_str(&line);
-        }
-        cause = c.source();
-    }
-    text
 }
 
 /// A failed check of an answer or a refusal.
@@ -274,7 +254,7 @@ mod tests {
             message: "TOML parse error at line 1\n  |\n1 | x\n  | ^\nexpected".into(),
         };
         assert_eq!(
-            cli_line(&e),
+            aloft::engine::error_line(&e),
             "invalid vehicle description v.toml: TOML parse error at line 1: expected"
         );
     }

@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use aloft::engine::{
     calibrate_spec, convert_log, endurance, hover, log_info, plan_mission, power_csv, power_model,
-    power_point, EnduranceOptions, HoverRequest, LiveRequest, LiveSession, LogReadOptions, Mission,
-    MissionOptions, PowerQuery, SpecSheet, Vehicle,
+    power_point, EnduranceOptions, FlightStateDeg, HoverRequest, LiveRequest, LiveSession,
+    LogReadOptions, Mission, MissionOptions, PowerModelQuery, PowerQuery, SpecSheet, Vehicle,
 };
 use aloft::power::{ModelOptions, PowerModel};
 use aloft_planner::Aircraft;
@@ -190,9 +190,12 @@ fn vehicle_toml(data: &[u8]) -> Outcome {
     let mut o = accepted();
     o.step("power at hover", &power_point(&v, &PowerQuery::default()));
     let forward = PowerQuery {
-        airspeed_mps: 12.0,
-        pitch_deg: -10.0,
-        climb_rate_mps: 1.0,
+        state: FlightStateDeg {
+            airspeed_mps: 12.0,
+            pitch_deg: -10.0,
+            climb_rate_mps: 1.0,
+            ..FlightStateDeg::default()
+        },
         gradient: true,
         ..PowerQuery::default()
     };
@@ -305,7 +308,7 @@ fn round_trip(m: &Mission, o: &mut Outcome) {
             check: "json-round-trip",
             detail: format!(
                 "its JSON does not read back: {}",
-                crate::check::cli_line(&e)
+                aloft::engine::error_line(&e)
             ),
         }),
     }
@@ -313,8 +316,9 @@ fn round_trip(m: &Mission, o: &mut Outcome) {
 
 fn power_csv_target(data: &[u8]) -> Outcome {
     static MODEL: OnceLock<PowerModel> = OnceLock::new();
-    let model = MODEL
-        .get_or_init(|| power_model(m100(), &PowerQuery::default()).expect("dji-m100 has a model"));
+    let model = MODEL.get_or_init(|| {
+        power_model(m100(), &PowerModelQuery::default()).expect("dji-m100 has a model")
+    });
     let mut out = Vec::new();
     match power_csv(model, data, &mut out, "fuzz-states.csv") {
         Ok(_) => {
@@ -390,7 +394,7 @@ fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions)
                     check: "mcap-round-trip",
                     detail: format!(
                         "aloft cannot read the MCAP it wrote: {}",
-                        crate::check::cli_line(&e)
+                        aloft::engine::error_line(&e)
                     ),
                 }),
                 (_, Err(e)) => o.refuse("log info", &e),

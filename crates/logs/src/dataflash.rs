@@ -787,14 +787,14 @@ impl<R: Read> Iterator for DataflashRecords<R> {
 
 #[cfg(test)]
 mod tests {
-    use crate::synth::{dataflash_fmt, dataflash_record};
+    use crate::synth::{att_fmt, dataflash_fmt, dataflash_fmt_of_fmt, dataflash_record};
     use crate::{read_dataflash, BinaryOptions};
 
     /// Fuzz finding `fixtures/fuzz/dataflash/07eadf3218906b21.bin`: an `FMT` declaring `TimeUS`
     /// as a float let a NaN time into the base topic, and the span of the flight was NaN.
     #[test]
     fn a_time_that_is_not_finite_is_no_time() {
-        let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+        let mut b = dataflash_fmt_of_fmt();
         b.extend(dataflash_fmt(
             1,
             3 + 16,
@@ -839,14 +839,8 @@ mod tests {
     /// without a time stamp (old logs) takes the time of the record before it.
     #[test]
     fn events_give_the_landed_state() {
-        let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
-        b.extend(dataflash_fmt(
-            1,
-            3 + 8 + 12,
-            "ATT",
-            "Qfff",
-            "TimeUS,Roll,Pitch,Yaw",
-        ));
+        let mut b = dataflash_fmt_of_fmt();
+        b.extend(att_fmt(1));
         b.extend(dataflash_fmt(2, 3 + 8 + 1, "EV", "QB", "TimeUS,Id"));
         b.extend(dataflash_fmt(3, 3 + 1, "EV", "B", "Id"));
         let ev = |t_us: u64, id: u8| {
@@ -893,14 +887,8 @@ mod tests {
             (true, 255, None),
             (false, 69, None),
         ] {
-            let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
-            b.extend(dataflash_fmt(
-                1,
-                3 + 8 + 12,
-                "ATT",
-                "Qfff",
-                "TimeUS,Roll,Pitch,Yaw",
-            ));
+            let mut b = dataflash_fmt_of_fmt();
+            b.extend(att_fmt(1));
             let (format, cols) = match with_rem {
                 true => ("QffB", "TimeUS,Volt,Curr,RemPct"),
                 false => ("Qff", "TimeUS,Volt,Curr"),
@@ -940,7 +928,7 @@ mod tests {
             (-1.0, None),
             (5000.0, Some(5.0)),
         ] {
-            let mut b = dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+            let mut b = dataflash_fmt_of_fmt();
             b.extend(dataflash_fmt(
                 3,
                 3 + 8 + 16 + 4,

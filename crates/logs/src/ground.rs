@@ -311,6 +311,16 @@ mod tests {
     // Time comparisons below: points are 0.1 s apart, so 0.05 s separates "this point" from
     // its neighbours.
 
+    /// The airborne spans of `r` are `want` (start, end), each end to 0.05 s.
+    fn assert_spans(r: &GroundReport, want: &[(f64, f64)]) {
+        let near = |s: &Span, &(a, b): &(f64, f64)| {
+            (s.start_s - a).abs() < 0.05 && (s.end_s - b).abs() < 0.05
+        };
+        let all =
+            r.airborne.len() == want.len() && r.airborne.iter().zip(want).all(|(s, w)| near(s, w));
+        assert!(all, "{:?}, want {want:?}", r.airborne);
+    }
+
     #[test]
     fn two_flights_with_ground_before_between_and_after() {
         // 10 s idle at 12 W, 20 s flight at 200 W, 8 s idle, 15 s flight, 5 s idle.
@@ -322,13 +332,7 @@ mod tests {
             (53.0, 58.0, 0.3, 0.0, Some(12.0)),
         ]);
         let r = run(powered(), &pts);
-        assert_eq!(r.airborne.len(), 2, "{:?}", r.airborne);
-        for (s, (a, b)) in r.airborne.iter().zip([(10.0, 30.0), (38.0, 53.0)]) {
-            assert!(
-                (s.start_s - a).abs() < 0.05 && (s.end_s - b).abs() < 0.05,
-                "{s:?}"
-            );
-        }
+        assert_spans(&r, &[(10.0, 30.0), (38.0, 53.0)]);
         assert_eq!(r.detected_points, pts.len() as u64);
         assert!(r.airborne_at(20.0) && !r.airborne_at(35.0) && !r.airborne_at(5.0));
     }
@@ -343,10 +347,8 @@ mod tests {
             (25.0, 30.0, 5.0, 2.0, Some(200.0)),
         ]);
         let r = run(powered(), &pts);
-        assert_eq!(r.airborne.len(), 1, "{:?}", r.airborne);
-        assert!((r.airborne[0].start_s - 5.0).abs() < 0.05);
         // Flying to the end of the record.
-        assert!((r.airborne[0].end_s - 29.9).abs() < 0.05);
+        assert_spans(&r, &[(5.0, 29.9)]);
     }
 
     #[test]
@@ -376,12 +378,7 @@ mod tests {
             (14.0, 17.0, 0.6, 0.0, None),
         ]);
         let r = run(GroundOptions::default(), &pts);
-        assert_eq!(r.airborne.len(), 1, "{:?}", r.airborne);
-        let s = r.airborne[0];
-        assert!(
-            (s.start_s - 4.0).abs() < 0.05 && (s.end_s - 14.0).abs() < 0.05,
-            "{s:?}"
-        );
+        assert_spans(&r, &[(4.0, 14.0)]);
         // A still hover at 3 m without power is in the air.
         let pts = points(&[(0.0, 4.0, 0.0, 0.0, None), (4.0, 14.0, 3.0, 0.0, None)]);
         let r = run(GroundOptions::default(), &pts);
@@ -404,12 +401,7 @@ mod tests {
             })
             .collect();
         let r = run(powered(), &pts);
-        assert_eq!(r.airborne.len(), 1);
-        let s = r.airborne[0];
-        assert!(
-            (s.start_s - 2.0).abs() < 0.05 && (s.end_s - 6.0).abs() < 0.05,
-            "{s:?}"
-        );
+        assert_spans(&r, &[(2.0, 6.0)]);
         assert_eq!((r.logged_points, r.detected_points), (100, 0));
     }
 
@@ -430,13 +422,8 @@ mod tests {
             });
         }
         let r = run(GroundOptions::default(), &pts);
-        assert_eq!(r.airborne.len(), 1);
-        let s = r.airborne[0];
         // The last point before the gap is at 2.9 s.
-        assert!(
-            (s.start_s - 1.0).abs() < 0.05 && (s.end_s - 2.9).abs() < 0.05,
-            "{s:?}"
-        );
+        assert_spans(&r, &[(1.0, 2.9)]);
     }
 
     #[test]

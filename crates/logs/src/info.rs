@@ -29,22 +29,12 @@ impl ChannelStats {
     }
 }
 
-/// Streaming accumulator of [`ChannelStats`] and the electrical energy.
-///
-/// Energy is the trapezoidal integral of the electrical power (V x I when both are logged, else
-/// the power channel) over consecutive power samples with increasing time; steps where time does
-/// not increase are skipped and counted. Intervals across gaps are integrated as they are (the
-/// gaps are in the time report).
+/// Streaming accumulator of [`ChannelStats`] and the electrical power ([`PowerAccumulator`]).
 #[derive(Debug, Clone, Default)]
 pub struct InfoAccumulator {
     stats: Vec<ChannelStats>,
     samples: u64,
-    last_power: Option<(f64, f64)>,
-    energy_j: f64,
-    power_samples: u64,
-    power_sum_w: f64,
-    power_max_w: Option<f64>,
-    skipped_steps: u64,
+    power: PowerAccumulator,
     t_min: Option<f64>,
     t_max: Option<f64>,
 }
@@ -58,14 +48,68 @@ pub struct LogStats {
     pub duration_s: f64,
     /// Per channel, for the channels present.
     pub channels: Vec<ChannelStats>,
-    /// Integrated electrical energy, W h (`None` without power data).
+    /// The electrical power.
+    pub power: PowerStats,
+}
+
+/// The electrical power of a log: energy, mean and peak ([`PowerAccumulator::finish`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PowerStats {
+    /// Integrated electrical energy, W h (`None` with fewer than two power samples).
     pub energy_wh: Option<f64>,
     /// Mean electrical power over the power samples, W.
     pub mean_power_w: Option<f64>,
     /// Largest electrical power, W.
     pub max_power_w: Option<f64>,
     /// Power steps skipped because time did not increase.
-    pub energy_skipped_steps: u64,
+    pub skipped_steps: u64,
+}
+
+/// Streaming accumulator of [`PowerStats`].
+///
+/// Energy is the trapezoidal integral of the electrical power (V x I when both are logged, else
+/// the power channel) over consecutive power samples with increasing time; steps where time does
+/// not increase are skipped and counted. Intervals across gaps are integrated as they are (the
+/// gaps are in the time report).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PowerAccumulator {
+    last: Option<(f64, f64)>,
+    energy_j: f64,
+    samples: u64,
+    sum_w: f64,
+    max_w: Option<f64>,
+    skipped_steps: u64,
+}
+
+impl PowerAccumulator {
+    /// Add the power `p` (W) at time `t` (s): its statistics, and the energy of the step from
+    /// the previous power sample.
+    pub fn push(&mut self, t: f64, p: f64) {
+        self.samples += 1;
+        self.sum_w += p;
+        self.max_w = Some(self.max_w.map_or(p, |m| m.max(p)));
+        if let Some((t0, p0)) = self.last {
+            if t > t0 {
+                // One panel of the trapezoid rule at a time: a step where time does not
+                // increase is skipped and the next panel starts from it, which a single
+                // streaming `Trapezoid` cannot express.
+                self.energy_j += trapezoid(&[t0, t], &[p0, p]);
+            } else {
+                self.skipped_steps += 1;
+            }
+        }
+        self.last = Some((t, p));
+    }
+
+    /// The statistics.
+    pub fn finish(&self) -> PowerStats {
+        PowerStats {
+            energy_wh: (self.samples > 1).then(|| self.energy_j / SECONDS_PER_HOUR),
+            mean_power_w: (self.samples > 0).then(|| self.sum_w / self.samples as f64),
+            max_power_w: self.max_w,
+            skipped_steps: self.skipped_steps,
+        }
+    }
 }
 
 impl InfoAccumulator {
@@ -86,7 +130,7 @@ impl InfoAccumulator {
             }
         }
         if let Some(p) = s.electrical_power_w() {
-            self.add_power(t, p);
+            self.power.push(t, p);
         }
     }
 
@@ -106,24 +150,6 @@ impl InfoAccumulator {
         }
     }
 
-    /// Power statistics, and the energy of the step from the previous power sample.
-    fn add_power(&mut self, t: f64, p: f64) {
-        self.power_samples += 1;
-        self.power_sum_w += p;
-        self.power_max_w = Some(self.power_max_w.map_or(p, |m| m.max(p)));
-        if let Some((t0, p0)) = self.last_power {
-            if t > t0 {
-                // One panel of the trapezoid rule at a time: a step where time does not
-                // increase is skipped and the next panel starts from it, which a single
-                // streaming `Trapezoid` cannot express.
-                self.energy_j += trapezoid(&[t0, t], &[p0, p]);
-            } else {
-                self.skipped_steps += 1;
-            }
-        }
-        self.last_power = Some((t, p));
-    }
-
     /// The summary.
     pub fn finish(mut self) -> LogStats {
         self.stats.sort_by_key(|s| s.channel);
@@ -134,11 +160,7 @@ impl InfoAccumulator {
                 _ => 0.0,
             },
             channels: self.stats,
-            energy_wh: (self.power_samples > 1).then(|| self.energy_j / SECONDS_PER_HOUR),
-            mean_power_w: (self.power_samples > 0)
-                .then(|| self.power_sum_w / self.power_samples as f64),
-            max_power_w: self.power_max_w,
-            energy_skipped_steps: self.skipped_steps,
+            power: self.power.finish(),
         }
     }
 }
@@ -176,7 +198,7 @@ mod tests {
         }
         let s = a.finish();
         // 100 W for 3600 s is 100 W h; trapezoids of a constant are exact to rounding.
-        assert!((s.energy_wh.unwrap() - 100.0).abs() < 1e-9);
+        assert!((s.power.energy_wh.unwrap() - 100.0).abs() < 1e-9);
         assert_eq!(s.channels.len(), 2);
         assert!((s.channels[0].rate_hz().unwrap() - 1.0).abs() < 1e-12);
     }
@@ -189,6 +211,6 @@ mod tests {
             pos_enu_m: Some([0.0; 3]),
             ..Sample::default()
         });
-        assert_eq!(a.finish().energy_wh, None);
+        assert_eq!(a.finish().power.energy_wh, None);
     }
 }

@@ -70,7 +70,7 @@ pub use column_map::ColumnMap;
 pub use csv_read::CsvSamples;
 pub use error::{LogError, Result};
 pub use ground::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Span};
-pub use info::{ChannelStats, InfoAccumulator, LogStats};
+pub use info::{ChannelStats, InfoAccumulator, LogStats, PowerAccumulator, PowerStats};
 pub use lag::{estimate_lag_s, resample_uniform, LagEstimate};
 pub use mcap_read::{McapOptions, McapSamples, McapTime, TopicInfo};
 pub use mcap_write::{

@@ -385,6 +385,20 @@ impl Log {
 mod tests {
     use super::*;
 
+    /// Samples, then the count of gaps and the index of the first, then the same of the steps
+    /// back in time.
+    fn events(r: &TimeReport) -> (u64, u64, Option<u64>, u64, Option<u64>) {
+        let first_gap = r.gaps.first().map(|g| g.index);
+        let first_back = r.non_monotonic.first().map(|n| n.index);
+        (
+            r.samples,
+            r.gap_count,
+            first_gap,
+            r.non_monotonic_count,
+            first_back,
+        )
+    }
+
     #[test]
     fn checker_reports_gap_and_backwards_step() {
         let mut c = TimeChecker::new();
@@ -396,11 +410,7 @@ mod tests {
             c.push(*t);
         }
         let r = c.finish();
-        assert_eq!(r.samples, 53);
-        assert_eq!(r.gap_count, 1);
-        assert_eq!(r.gaps[0].index, 50);
-        assert_eq!(r.non_monotonic_count, 1);
-        assert_eq!(r.non_monotonic[0].index, 51);
+        assert_eq!(events(&r), (53, 1, Some(50), 1, Some(51)));
         // Duration is max - first, 10 s; 1e-12 covers the rounding of 0.1 multiples.
         assert!((r.duration_s - 10.0).abs() < 1e-12);
         assert!((r.nominal_period_s.unwrap() - 0.1).abs() < 1e-12);
@@ -421,11 +431,7 @@ mod tests {
         c.push(10.0);
         c.push(9.9); // back
         let r = c.finish();
-        assert_eq!(r.samples, 83);
-        assert_eq!(r.non_monotonic_count, 1);
-        assert_eq!(r.non_monotonic[0].index, 82);
-        assert_eq!(r.gap_count, 1);
-        assert_eq!(r.gaps[0].index, 80);
+        assert_eq!(events(&r), (83, 1, Some(80), 1, Some(82)));
         // The median of the positive intervals: 0.1 s (zero steps are no intervals).
         assert!((r.nominal_period_s.unwrap() - 0.1).abs() < 1e-12);
     }

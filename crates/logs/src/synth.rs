@@ -20,6 +20,17 @@ pub fn ulog_record(t: u8, payload: &[u8]) -> Vec<u8> {
     r
 }
 
+/// The start of a ULog: the header, the flag bits (`B`, none set) and a format record (`F`) per
+/// entry of `formats` (`name:type field;...`).
+pub fn ulog_start(formats: &[impl AsRef<str>]) -> Vec<u8> {
+    let mut b = ULOG_HEADER.to_vec();
+    b.extend(ulog_record(b'B', &[0u8; 40]));
+    for f in formats {
+        b.extend(ulog_record(b'F', f.as_ref().as_bytes()));
+    }
+    b
+}
+
 /// A ULog data record (`D`) of subscription `id` at `t_us` with `floats`.
 pub fn ulog_data(id: u16, t_us: u64, floats: &[f32]) -> Vec<u8> {
     let mut d = id.to_le_bytes().to_vec();
@@ -41,16 +52,10 @@ pub fn ulog_subscription(id: u16, name: &str) -> Vec<u8> {
 /// A small ULog: 50 local positions at 10 Hz (NED 1, 2, -3) and 50 battery records of 16 V,
 /// 10 A (160 W), a `BAT1_N_CELLS = 4` parameter.
 pub fn ulog_small() -> Vec<u8> {
-    let mut b = ULOG_HEADER.to_vec();
-    b.extend(ulog_record(b'B', &[0u8; 40]));
-    b.extend(ulog_record(
-        b'F',
-        b"battery_status:uint64_t timestamp;float voltage_v;float current_a;uint8_t[4] _padding0;",
-    ));
-    b.extend(ulog_record(
-        b'F',
-        b"vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;",
-    ));
+    let mut b = ulog_start(&[
+        "battery_status:uint64_t timestamp;float voltage_v;float current_a;uint8_t[4] _padding0;",
+        "vehicle_local_position:uint64_t timestamp;float x;float y;float z;float vx;float vy;float vz;",
+    ]);
     let mut p = vec![20u8];
     p.extend_from_slice(b"int32_t BAT1_N_CELLS");
     p.extend_from_slice(&4i32.to_le_bytes());
@@ -68,8 +73,6 @@ pub fn ulog_small() -> Vec<u8> {
 /// A ULog of `seconds` of flight with the topic mix of a real one: sensor_combined 200 Hz (not
 /// read by aloft), vehicle_attitude 50 Hz, vehicle_local_position 10 Hz, battery_status 5 Hz.
 pub fn ulog_flight(seconds: u64) -> Vec<u8> {
-    let mut b = ULOG_HEADER.to_vec();
-    b.extend(ulog_record(b'B', &[0u8; 40]));
     let position = ["x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az"];
     let formats: [(&str, u16, String); 4] = [
         (
@@ -81,10 +84,11 @@ pub fn ulog_flight(seconds: u64) -> Vec<u8> {
         ("vehicle_local_position", 3, floats(&position)),
         ("battery_status", 4, floats(&["voltage_v", "current_a"])),
     ];
-    for (name, _, body) in &formats {
-        let text = format!("{name}:uint64_t timestamp;{body}");
-        b.extend(ulog_record(b'F', text.as_bytes()));
-    }
+    let texts: Vec<String> = formats
+        .iter()
+        .map(|(name, _, body)| format!("{name}:uint64_t timestamp;{body}"))
+        .collect();
+    let mut b = ulog_start(&texts);
     for (name, id, _) in &formats {
         b.extend(ulog_subscription(*id, name));
     }
@@ -133,12 +137,12 @@ pub fn dataflash_record(t: u8, t_us: u64, floats: &[f32]) -> Vec<u8> {
 }
 
 /// The `FMT` record that declares `FMT` itself.
-fn dataflash_fmt_of_fmt() -> Vec<u8> {
+pub fn dataflash_fmt_of_fmt() -> Vec<u8> {
     dataflash_fmt(0x80, 89, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns")
 }
 
 /// The `FMT` of an `ATT` record (roll, pitch, yaw in degrees) as type `t`.
-fn att_fmt(t: u8) -> Vec<u8> {
+pub fn att_fmt(t: u8) -> Vec<u8> {
     dataflash_fmt(t, 3 + 8 + 12, "ATT", "Qfff", "TimeUS,Roll,Pitch,Yaw")
 }
 

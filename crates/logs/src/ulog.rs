@@ -790,23 +790,17 @@ pub fn ulog_samples<R: Read>(
 
 #[cfg(test)]
 mod tests {
-    use crate::synth::{ulog_data, ulog_record, ulog_subscription, ULOG_HEADER};
+    use crate::synth::{ulog_data, ulog_start, ulog_subscription};
     use crate::{read_ulog, BinaryOptions};
 
     /// `battery_status.remaining` is the reported state of charge of the samples it is joined
     /// onto; PX4's "unknown" (negative, NaN) is none; a value above 1 is carried as reported.
     #[test]
     fn remaining_is_the_reported_state_of_charge() {
-        let mut b = ULOG_HEADER.to_vec();
-        b.extend(ulog_record(b'B', &[0u8; 40]));
-        b.extend(ulog_record(
-            b'F',
-            b"battery_status:uint64_t timestamp;float voltage_v;float current_a;float remaining;",
-        ));
-        b.extend(ulog_record(
-            b'F',
-            b"vehicle_local_position:uint64_t timestamp;float x;float y;float z;",
-        ));
+        let mut b = ulog_start(&[
+            "battery_status:uint64_t timestamp;float voltage_v;float current_a;float remaining;",
+            "vehicle_local_position:uint64_t timestamp;float x;float y;float z;",
+        ]);
         b.extend(ulog_subscription(1, "battery_status"));
         b.extend(ulog_subscription(2, "vehicle_local_position"));
         let remaining = [0.69, 0.69, -1.0, f32::NAN, 1.5, 0.68];

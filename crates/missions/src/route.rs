@@ -243,6 +243,9 @@ fn point(given: [Option<f64>; 4]) -> Option<Pos> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use aloft_planner::mission_toml::{
+        at_altitude, hover, landing, leg, orbit, return_home, take_off, OrbitFor::Laps,
+    };
 
     fn toml(text: &str) -> RouteFigures {
         let spec = MissionSpec::from_toml_str(text).unwrap();
@@ -255,35 +258,18 @@ mod tests {
     #[test]
     fn the_figures_of_a_local_mission_are_its_lines_circles_and_heights() {
         let r = toml(
-            r#"
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 30.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = 200.0
-            north_m = 0.0
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "orbit"
-            centre_east_m = 200.0
-            centre_north_m = 100.0
-            altitude_m = 40.0
-            radius_m = 25.0
-            ground_speed_mps = 4.0
-            direction = "clockwise"
-            laps = 1.5
-            [[segment]]
-            kind = "hover"
-            duration_s = 30.0
-            [[segment]]
-            kind = "return"
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-        "#,
+            &[
+                take_off(30.0, 2.0),
+                leg(200.0, 0.0, 8.0),
+                at_altitude(
+                    orbit([200.0, 100.0], 25.0, 4.0, "clockwise", Laps(1.5)),
+                    40.0,
+                ),
+                hover(30.0),
+                return_home(8.0),
+                landing(1.0),
+            ]
+            .concat(),
         );
         let expected = 200.0 + 100.0 + 1.5 * std::f64::consts::TAU * 25.0 + 200f64.hypot(100.0);
         // Sums of a handful of exact terms: rounding only.
@@ -297,24 +283,19 @@ mod tests {
 
     #[test]
     fn a_return_climbs_to_the_files_rtl_altitude_and_bad_values_are_passed_over() {
+        // A leg to a point that is not a number: passed over by the figures.
+        let nan_leg =
+            "[[segment]]\nkind = \"leg\"\neast_m = nan\nnorth_m = 0.0\nground_speed_mps = 8.0\n";
+        let return_without_speed = "[[segment]]\nkind = \"return\"\n";
         let r = toml(
-            r#"
-            rtl_altitude_m = 50.0
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 20.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = nan
-            north_m = 0.0
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "return"
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-        "#,
+            &[
+                "rtl_altitude_m = 50.0\n",
+                &take_off(20.0, 2.0),
+                nan_leg,
+                return_without_speed,
+                &landing(1.0),
+            ]
+            .concat(),
         );
         assert!((r.climb_m - 50.0).abs() < 1e-12, "{r:?}");
         assert!((r.descent_m - 50.0).abs() < 1e-12);

@@ -194,20 +194,22 @@ impl Airframe {
             }
         }
         if spec.max_tilt_deg >= 90.0 {
-            return Err(PlannerError::InvalidParameter {
+            return Err(aloft_core::InvalidParameter {
                 name: "airframe max_tilt_deg",
                 value: spec.max_tilt_deg,
                 unit: "deg",
                 expected: "below 90 deg",
-            });
+            }
+            .into());
         }
         if spec.max_takeoff_mass_kg < spec.mass_kg {
-            return Err(PlannerError::InvalidParameter {
+            return Err(aloft_core::InvalidParameter {
                 name: "airframe max_takeoff_mass_kg",
                 value: spec.max_takeoff_mass_kg,
                 unit: "kg",
                 expected: "at least the airframe mass",
-            });
+            }
+            .into());
         }
         for (name, value, unit, max, expected) in optional_checks(&spec) {
             if let Some(v) = value {

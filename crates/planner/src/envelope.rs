@@ -460,16 +460,7 @@ mod tests {
         let (mu1, mu2, mu3) = (0.1816, -0.02326, 0.004045);
         let target = mass_kg * g * tilt_deg.to_radians().tan();
         let f = |v: f64| mu1 * v + mu2 * v * v + mu3 * v * v * v - target;
-        let (mut lo, mut hi) = (0.0, 100.0);
-        for _ in 0..200 {
-            let mid = 0.5 * (lo + hi);
-            if f(mid) < 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        lo
+        aloft_core::bisect(0.0, 100.0, 200, |v| f(v) < 0.0).0
     }
 
     #[test]
@@ -592,20 +583,12 @@ mod tests {
     ) -> Option<f64> {
         let beyond =
             |q: f64| env.exceeded(pw, acc.map(|a| a * q * q), vel.map(|v| v * q), wind, fwd);
-        let mut lo = (1..=1000)
+        let lo = (1..=1000)
             .rev()
             .map(|k| k as f64 / 1000.0)
             .find(|&q| beyond(q).is_none())?;
-        let mut hi = (lo + 1e-3).min(1.0);
-        for _ in 0..45 {
-            let mid = 0.5 * (lo + hi);
-            if beyond(mid).is_none() {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        Some(lo)
+        let hi = (lo + 1e-3).min(1.0);
+        Some(aloft_core::bisect(lo, hi, 45, |q| beyond(q).is_none()).0)
     }
 
     #[test]

@@ -14,17 +14,8 @@ pub enum PlannerError {
     #[error(transparent)]
     Propulsion(#[from] aloft_propulsion::PropulsionError),
     /// A parameter outside its valid range.
-    #[error("{name} = {}{} is invalid: expected {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
-    InvalidParameter {
-        /// Parameter name (with its unit suffix).
-        name: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// Unit of `value`.
-        unit: &'static str,
-        /// What a valid value looks like.
-        expected: &'static str,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] aloft_core::InvalidParameter),
     /// A mission text that does not parse or does not match the format.
     #[error("invalid mission file: {message}")]
     MissionFormat {
@@ -178,26 +169,6 @@ pub enum PlannerError {
     },
 }
 
-/// `value` when `ok`, else [`PlannerError::InvalidParameter`] saying what was `expected`.
-pub(crate) fn parameter(
-    name: &'static str,
-    value: f64,
-    unit: &'static str,
-    ok: bool,
-    expected: &'static str,
-) -> Result<f64, PlannerError> {
-    if ok {
-        Ok(value)
-    } else {
-        Err(PlannerError::InvalidParameter {
-            name,
-            value,
-            unit,
-            expected,
-        })
-    }
-}
-
 /// Reject NaN, infinities and values that are zero or negative.
 pub(crate) fn positive(
     name: &'static str,
@@ -205,7 +176,13 @@ pub(crate) fn positive(
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
     let ok = value.is_finite() && value > 0.0;
-    parameter(name, value, unit, ok, "a positive finite number")
+    Ok(aloft_core::parameter(
+        name,
+        value,
+        unit,
+        ok,
+        "a positive finite number",
+    )?)
 }
 
 /// Reject NaN, infinities and negative values.
@@ -215,7 +192,13 @@ pub(crate) fn non_negative(
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
     let ok = value.is_finite() && value >= 0.0;
-    parameter(name, value, unit, ok, "a finite number, not negative")
+    Ok(aloft_core::parameter(
+        name,
+        value,
+        unit,
+        ok,
+        "a finite number, not negative",
+    )?)
 }
 
 /// Check that `value` lies in `[min, max]` (a finite range), naming the range in the error.
@@ -227,13 +210,19 @@ pub(crate) fn within(
     expected: &'static str,
 ) -> Result<f64, PlannerError> {
     let ok = (min..=max).contains(&value);
-    parameter(name, value, unit, ok, expected)
+    Ok(aloft_core::parameter(name, value, unit, ok, expected)?)
 }
 
 /// A reserve: a fraction of the capacity in `[0, 1)`.
 pub(crate) fn reserve_fraction(value: f64) -> Result<f64, PlannerError> {
     let ok = (0.0..1.0).contains(&value);
-    parameter("reserve_fraction", value, "", ok, "a fraction in [0, 1)")
+    Ok(aloft_core::parameter(
+        "reserve_fraction",
+        value,
+        "",
+        ok,
+        "a fraction in [0, 1)",
+    )?)
 }
 
 /// `, item 7` after a segment's kind when it came from a planner file, else nothing.

@@ -13,7 +13,8 @@
 //!
 //! ## Models, one per file
 //! - [`mission`]: the mission spec (what every mission source produces, the mission file) and its
-//!   compilation into trajectory pieces;
+//!   compilation into trajectory pieces; [`mission_toml`], its segments as TOML text for the
+//!   missions tests and benches write in code;
 //! - [`trajectory`]: closed-form kinematics (trapezoidal speed, lines, arcs, holds);
 //! - [`wind`]: constant, power-law and logarithmic profiles, gridded field, seeded gusts;
 //! - [`trim`]: thrust vector from the force balance, attitude, electrical power;
@@ -132,6 +133,7 @@ pub mod error;
 pub mod geodesy;
 pub mod ground_effect;
 pub mod mission;
+pub mod mission_toml;
 pub mod pack_cursor;
 pub mod plan;
 pub mod queries;

@@ -258,12 +258,13 @@ pub fn orbit_power_w(
     crate::error::positive("orbit ground_speed_mps", speed_mps, "m/s")?;
     let airframe = p.aircraft.airframe();
     if speed_mps > airframe.max_speed_mps() {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "orbit ground_speed_mps",
             value: speed_mps,
             unit: "m/s",
             expected: "at most the vehicle's maximum speed",
-        });
+        }
+        .into());
     }
     let envelope = Envelope::of(airframe, p.aircraft().gravity_mps2());
     let ac = speed_mps * speed_mps / radius_m;
@@ -288,12 +289,12 @@ pub fn orbit_power_w(
                 })
             }
             Err(_) => {
-                return Err(PlannerError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name: "orbit radius_m",
                     value: radius_m,
                     unit: "m",
                     expected: "a circle the vehicle can turn within its tilt limit at 1 % of the speed or more",
-                })
+                }.into())
             }
         };
         let trim = p.trim(
@@ -321,15 +322,16 @@ pub fn endurance(
     let norm = q.course[0].hypot(q.course[1]);
     // A unit vector to 1e-6 (course vectors come from sin/cos of an angle).
     if norm.is_nan() || (norm - 1.0).abs() >= 1e-6 {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "course (unit vector norm)",
             value: norm,
             unit: "",
             expected: "a unit vector",
-        });
+        }
+        .into());
     }
     let ok = q.start_soc > 0.0 && q.start_soc <= 1.0;
-    crate::error::parameter("start_soc", q.start_soc, "", ok, "a fraction in (0, 1]")?;
+    aloft_core::parameter("start_soc", q.start_soc, "", ok, "a fraction in (0, 1]")?;
     crate::error::reserve_fraction(q.reserve_fraction)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     // The searches stay within the vehicle's speed and its envelope's steady airspeed.
@@ -404,7 +406,7 @@ pub fn sweep_speed(
     crate::error::positive("sweep max_airspeed_mps", max_airspeed_mps, "m/s")?;
     let n = (max_airspeed_mps / step_mps + 1e-9).floor() as usize + 1;
     let expected = "a step giving at most 10 000 rows";
-    crate::error::parameter("sweep step_mps", step_mps, "m/s", n <= 10_000, expected)?;
+    aloft_core::parameter("sweep step_mps", step_mps, "m/s", n <= 10_000, expected)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     let mut rows = Vec::with_capacity(n);
     for k in 0..n {

@@ -120,12 +120,13 @@ pub fn differentiate_velocity(
 ) -> Result<Vec<[f64; 3]>, PlannerError> {
     crate::error::positive("acceleration_window_s", window_s, "s")?;
     if times_s.len() != vel_mps.len() || times_s.len() < 2 {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "trajectory points",
             value: times_s.len().min(vel_mps.len()) as f64,
             unit: "",
             expected: "at least two, with a velocity for every time",
-        });
+        }
+        .into());
     }
     let (t0, t1) = (times_s[0], times_s[times_s.len() - 1]);
     let at = |t: f64| -> [f64; 3] {
@@ -169,7 +170,7 @@ pub fn replay(
     wind: &Wind,
 ) -> Result<ReplayReport, PlannerError> {
     let n = points.len() as f64;
-    crate::error::parameter(
+    aloft_core::parameter(
         "trajectory points",
         n,
         "",
@@ -180,12 +181,13 @@ pub fn replay(
         .windows(2)
         .find(|w| !(w[0].time_s.is_finite() && w[1].time_s > w[0].time_s))
     {
-        return Err(PlannerError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "time_s",
             value: w[1].time_s,
             unit: "s",
             expected: "finite times, each later than the one before",
-        });
+        }
+        .into());
     }
     let aircraft = pw.aircraft();
     let r_rotor = aircraft.rotor_radius_m();
@@ -257,6 +259,7 @@ pub fn replay(
 mod tests {
     use super::*;
     use crate::mission::MissionSpec;
+    use crate::mission_toml::{landing, leg, orbit, return_home, take_off, OrbitFor};
     use crate::plan::{plan, PlanOptions};
     use crate::test_support::{m100_aircraft, tb47d};
     use aloft_power::AoaModel;
@@ -272,36 +275,18 @@ mod tests {
         // only at the pieces' ends (a few of 2,000 steps): well within 0.5 %.
         let aircraft = m100();
         let battery = crate::Pack::new(&tb47d()).unwrap();
-        let mission = MissionSpec::from_toml_str(
-            r#"
-            [[segment]]
-            kind = "take-off"
-            altitude_m = 20.0
-            climb_rate_mps = 2.0
-            [[segment]]
-            kind = "leg"
-            east_m = 300.0
-            north_m = 100.0
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "orbit"
-            centre_east_m = 300.0
-            centre_north_m = 150.0
-            radius_m = 50.0
-            ground_speed_mps = 6.0
-            direction = "clockwise"
-            laps = 1.0
-            [[segment]]
-            kind = "return"
-            ground_speed_mps = 8.0
-            [[segment]]
-            kind = "landing"
-            rate_mps = 1.0
-            "#,
-        )
-        .unwrap()
-        .compile(aircraft.airframe(), battery.mass_kg(), None)
-        .unwrap();
+        let text = [
+            take_off(20.0, 2.0),
+            leg(300.0, 100.0, 8.0),
+            orbit([300.0, 150.0], 50.0, 6.0, "clockwise", OrbitFor::Laps(1.0)),
+            return_home(8.0),
+            landing(1.0),
+        ]
+        .concat();
+        let mission = MissionSpec::from_toml_str(&text)
+            .unwrap()
+            .compile(aircraft.airframe(), battery.mass_kg(), None)
+            .unwrap();
         let wind = Wind::constant(5.0, 250.0).unwrap();
         let opts = PlanOptions {
             record_samples: true,

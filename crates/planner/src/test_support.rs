@@ -4,6 +4,7 @@ use crate::aircraft::Aircraft;
 use crate::airframe::{Airframe, AirframeSpec};
 use crate::battery::{BatterySpec, Pack};
 use crate::mission::{Mission, MissionSpec};
+use crate::mission_toml::{at_altitude, landing, leg, take_off};
 
 /// The M100 airframe of `fixtures/vehicles/dji-m100.toml` (DJI's specification).
 pub(crate) fn m100_airframe() -> Airframe {
@@ -93,18 +94,7 @@ pub(crate) fn compile_mission(text: &str, aircraft: &Aircraft, battery: &Pack) -
 
 /// A leg steeper than the M100's 5 m/s climb limit allows at its ground speed: 30 m up over
 /// 20 m east at 10 m/s over the ground (15 m/s up).
-pub(crate) const STEEP_LEG: &str = r#"
-    [[segment]]
-    kind = "take-off"
-    altitude_m = 10.0
-    climb_rate_mps = 2.0
-    [[segment]]
-    kind = "leg"
-    east_m = 20.0
-    north_m = 0.0
-    altitude_m = 40.0
-    ground_speed_mps = 10.0
-    [[segment]]
-    kind = "landing"
-    rate_mps = 1.0
-"#;
+pub(crate) fn steep_leg() -> String {
+    let steep = at_altitude(leg(20.0, 0.0, 10.0), 40.0);
+    [take_off(10.0, 2.0), steep, landing(1.0)].concat()
+}

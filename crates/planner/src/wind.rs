@@ -318,7 +318,7 @@ impl Wind {
         let range = (0.0, MAX_WIND_MPS);
         crate::error::within("wind_speed_mps", speed_mps, range, "m/s", "at most 100 m/s")?;
         let ok = from_deg.is_finite();
-        crate::error::parameter("wind_from_deg", from_deg, "deg", ok, "a finite direction")?;
+        aloft_core::parameter("wind_from_deg", from_deg, "deg", ok, "a finite direction")?;
         match profile {
             Profile::Uniform => {}
             Profile::PowerLaw {
@@ -337,7 +337,7 @@ impl Wind {
                 check_reference_height(reference_height_m)?;
                 crate::error::positive("roughness_m", roughness_m, "m")?;
                 let ok = roughness_m < reference_height_m;
-                crate::error::parameter(
+                aloft_core::parameter(
                     "roughness_m",
                     roughness_m,
                     "m",

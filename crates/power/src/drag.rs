@@ -88,14 +88,7 @@ impl CubicDrag {
         if !(force_n.is_finite() && force_n >= 0.0) || self.force_n(max_mps) < force_n {
             return None;
         }
-        let (mut lo, mut hi) = (0.0, max_mps);
-        for _ in 0..64 {
-            let mid = 0.5 * (lo + hi);
-            match self.force_n(mid) < force_n {
-                true => lo = mid,
-                false => hi = mid,
-            }
-        }
+        let (lo, hi) = aloft_core::bisect(0.0, max_mps, 64, |v| self.force_n(v) < force_n);
         Some(0.5 * (lo + hi))
     }
 

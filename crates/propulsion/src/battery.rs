@@ -45,35 +45,30 @@ pub enum InternalResistance {
         resistance_ohm: f64,
     },
     /// Seed eq (17), `R_b(I) = r1 + r2 ln(I)/I + r3/I`, valid between two currents.
-    Logarithmic {
-        /// `r_1`, ohm.
-        r1_ohm: f64,
-        /// `r_2`, ohm A (per unit of ln A).
-        r2_ohm_a: f64,
-        /// `r_3`, ohm A (i.e. V).
-        r3_ohm_a: f64,
-        /// Smallest current where eq (17) is trusted, A.
-        min_current_a: f64,
-        /// Largest current where eq (17) is trusted, A.
-        max_current_a: f64,
-    },
+    Logarithmic(Eq17Resistance),
+}
+
+/// Seed eq (17), `R_b(I) = r1 + r2 ln(I)/I + r3/I`, with the currents between which it is trusted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eq17Resistance {
+    /// `r_1`, ohm.
+    pub r1_ohm: f64,
+    /// `r_2`, ohm A (per unit of ln A).
+    pub r2_ohm_a: f64,
+    /// `r_3`, ohm A (i.e. V).
+    pub r3_ohm_a: f64,
+    /// Smallest current where eq (17) is trusted, A.
+    pub min_current_a: f64,
+    /// Largest current where eq (17) is trusted, A.
+    pub max_current_a: f64,
 }
 
 impl InternalResistance {
     /// Resistance at `current_a`, ohm (clamped to the valid range for eq 17).
     pub fn at(&self, current_a: f64) -> f64 {
-        match *self {
-            InternalResistance::Constant { resistance_ohm } => resistance_ohm,
-            InternalResistance::Logarithmic {
-                r1_ohm,
-                r2_ohm_a,
-                r3_ohm_a,
-                min_current_a,
-                max_current_a,
-            } => {
-                let i = current_a.clamp(min_current_a, max_current_a);
-                eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i)
-            }
+        match self {
+            InternalResistance::Constant { resistance_ohm } => *resistance_ohm,
+            InternalResistance::Logarithmic(eq17) => eq17.at(current_a),
         }
     }
 
@@ -91,78 +86,99 @@ impl InternalResistance {
                 }
                 Ok(())
             }
-            InternalResistance::Logarithmic {
-                r1_ohm,
-                r2_ohm_a,
-                r3_ohm_a,
-                min_current_a,
-                max_current_a,
-            } => {
-                finite("battery r1_ohm", r1_ohm, "ohm or ohm A")?;
-                finite("battery r2_ohm_a", r2_ohm_a, "ohm or ohm A")?;
-                finite("battery r3_ohm_a", r3_ohm_a, "ohm or ohm A")?;
-                check_eq17_range(min_current_a, max_current_a)?;
-                check_eq17_positive(r1_ohm, r2_ohm_a, r3_ohm_a, min_current_a, max_current_a)
+            InternalResistance::Logarithmic(eq17) => eq17.validate(),
+        }
+    }
+}
+
+impl Eq17Resistance {
+    /// Eq (17) at `current_a` without clamping: `r1 + r2 ln(I)/I + r3/I`, ohm.
+    pub fn resistance_ohm(&self, current_a: f64) -> f64 {
+        self.r1_ohm + self.r2_ohm_a * current_a.ln() / current_a + self.r3_ohm_a / current_a
+    }
+
+    /// Eq (17) at `current_a` clamped to the valid range, ohm.
+    pub fn at(&self, current_a: f64) -> f64 {
+        self.resistance_ohm(current_a.clamp(self.min_current_a, self.max_current_a))
+    }
+
+    /// Whether `current_a` lies where eq (17) is trusted.
+    pub fn in_valid_range(&self, current_a: f64) -> bool {
+        (self.min_current_a..=self.max_current_a).contains(&current_a)
+    }
+
+    /// Finite coefficients, a positive, finite and non-empty current range, and a positive
+    /// resistance over all of it.
+    fn validate(&self) -> Result<(), PropulsionError> {
+        finite("battery r1_ohm", self.r1_ohm, "ohm or ohm A")?;
+        finite("battery r2_ohm_a", self.r2_ohm_a, "ohm or ohm A")?;
+        finite("battery r3_ohm_a", self.r3_ohm_a, "ohm or ohm A")?;
+        self.check_range()?;
+        self.check_positive()
+    }
+
+    /// The current range where eq (17) is trusted: positive, finite, and not empty.
+    fn check_range(&self) -> Result<(), PropulsionError> {
+        let (min_current_a, max_current_a) = (self.min_current_a, self.max_current_a);
+        positive("battery eq17 min_current_a", min_current_a, "A")?;
+        positive("battery eq17 max_current_a", max_current_a, "A")?;
+        let expected = "a current above eq17 min_current_a";
+        let ok = max_current_a > min_current_a;
+        aloft_core::parameter(
+            "battery eq17 max_current_a",
+            max_current_a,
+            "A",
+            ok,
+            expected,
+        )?;
+        Ok(())
+    }
+
+    /// Eq (17) must give a positive resistance over its valid range (checked at 65 currents).
+    fn check_positive(&self) -> Result<(), PropulsionError> {
+        let n = 64;
+        for k in 0..=n {
+            let span = self.max_current_a - self.min_current_a;
+            let i = self.min_current_a + span * k as f64 / n as f64;
+            let r = self.resistance_ohm(i);
+            if r.is_nan() || r <= 0.0 {
+                return Err(PropulsionError::InvalidResistance {
+                    name: "battery eq17 resistance within its valid range",
+                    resistance_ohm: r,
+                });
             }
         }
+        Ok(())
     }
-}
-
-/// The current range where eq (17) is trusted: positive, finite, and not empty.
-fn check_eq17_range(min_current_a: f64, max_current_a: f64) -> Result<(), PropulsionError> {
-    positive("battery eq17 min_current_a", min_current_a, "A")?;
-    positive("battery eq17 max_current_a", max_current_a, "A")?;
-    if max_current_a <= min_current_a {
-        return Err(PropulsionError::InvalidParameter {
-            name: "battery eq17 max_current_a",
-            value: max_current_a,
-            unit: "A",
-            expected: "a current above eq17 min_current_a",
-        });
-    }
-    Ok(())
-}
-
-/// Eq (17) must give a positive resistance over its valid range (checked at 65 currents).
-fn check_eq17_positive(
-    r1_ohm: f64,
-    r2_ohm_a: f64,
-    r3_ohm_a: f64,
-    min_current_a: f64,
-    max_current_a: f64,
-) -> Result<(), PropulsionError> {
-    let n = 64;
-    for k in 0..=n {
-        let i = min_current_a + (max_current_a - min_current_a) * k as f64 / n as f64;
-        let r = eq17_resistance_ohm(r1_ohm, r2_ohm_a, r3_ohm_a, i);
-        if r.is_nan() || r <= 0.0 {
-            return Err(PropulsionError::InvalidResistance {
-                name: "battery eq17 resistance within its valid range",
-                resistance_ohm: r,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Seed eq (17) without clamping: `r1 + r2 ln(I)/I + r3/I`, ohm.
-pub fn eq17_resistance_ohm(r1_ohm: f64, r2_ohm_a: f64, r3_ohm_a: f64, current_a: f64) -> f64 {
-    r1_ohm + r2_ohm_a * current_a.ln() / current_a + r3_ohm_a / current_a
 }
 
 /// A LiPo pack.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Battery {
-    cells_series: u32,
-    cells_parallel: u32,
-    capacity_ah: f64,
-    effective_capacity: f64,
-    full_cell_v: f64,
-    nominal_cell_v: f64,
-    resistance: InternalResistance,
-    max_current_a: f64,
+    c: BatteryConstants,
     max_power_w: f64,
     current_at_max_power_a: f64,
+}
+
+/// The constants of a pack, as [`Battery::new`] checks them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BatteryConstants {
+    /// Cells in series.
+    pub cells_series: u32,
+    /// Cells in parallel.
+    pub cells_parallel: u32,
+    /// Rated capacity of the pack, A h.
+    pub capacity_ah: f64,
+    /// Effective-capacity coefficient `C_e` of eq (31), in `(0, 1]`.
+    pub effective_capacity: f64,
+    /// Full-charge cell voltage, V (seed: 4.1 V).
+    pub full_cell_v: f64,
+    /// Nominal cell voltage, V (seed: 3.7 V).
+    pub nominal_cell_v: f64,
+    /// Internal resistance model.
+    pub resistance: InternalResistance,
+    /// Rated continuous current, A (`f64::INFINITY` for none).
+    pub max_current_a: f64,
 }
 
 fn check_cell_counts(cells_series: u32, cells_parallel: u32) -> Result<(), PropulsionError> {
@@ -200,46 +216,33 @@ fn check_cell_voltages(
 }
 
 impl Battery {
-    /// A pack of `cells_series` x `cells_parallel` cells.
-    ///
-    /// `capacity_ah` is the pack's rated capacity; `effective_capacity` is `C_e` in `(0, 1]`;
-    /// `full_cell_v` and `nominal_cell_v` are per cell (seed: 4.1 V and 3.7 V); `max_current_a`
-    /// is the rated continuous current (`f64::INFINITY` for none).
+    /// A pack of `c.cells_series` x `c.cells_parallel` cells.
     ///
     /// # Errors
     /// Zero cell counts, non-positive capacity or voltages, nominal above full-charge voltage,
     /// `C_e` outside `(0, 1]`, negative resistance coefficients, an invalid eq (17) range.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        cells_series: u32,
-        cells_parallel: u32,
-        capacity_ah: f64,
-        effective_capacity: f64,
-        full_cell_v: f64,
-        nominal_cell_v: f64,
-        resistance_model: InternalResistance,
-        max_current_a: f64,
-    ) -> Result<Self, PropulsionError> {
-        check_cell_counts(cells_series, cells_parallel)?;
-        let capacity_ah = positive("battery capacity_ah", capacity_ah, "A h")?;
+    pub fn new(c: BatteryConstants) -> Result<Self, PropulsionError> {
+        check_cell_counts(c.cells_series, c.cells_parallel)?;
+        let capacity_ah = positive("battery capacity_ah", c.capacity_ah, "A h")?;
         let effective_capacity = fraction(
             "battery effective_capacity_fraction",
-            effective_capacity,
+            c.effective_capacity,
             false,
             true,
         )?;
-        let (full_cell_v, nominal_cell_v) = check_cell_voltages(full_cell_v, nominal_cell_v)?;
-        resistance_model.validate()?;
-        let max_current_a = current_limit("battery max_current_a", max_current_a)?;
-        let mut b = Self {
-            cells_series,
-            cells_parallel,
+        let (full_cell_v, nominal_cell_v) = check_cell_voltages(c.full_cell_v, c.nominal_cell_v)?;
+        c.resistance.validate()?;
+        let max_current_a = current_limit("battery max_current_a", c.max_current_a)?;
+        let c = BatteryConstants {
             capacity_ah,
             effective_capacity,
             full_cell_v,
             nominal_cell_v,
-            resistance: resistance_model,
             max_current_a,
+            ..c
+        };
+        let mut b = Self {
+            c,
             max_power_w: 0.0,
             current_at_max_power_a: 0.0,
         };
@@ -250,11 +253,11 @@ impl Battery {
     }
 
     fn delivered_w(&self, current_a: f64) -> f64 {
-        self.full_charge_v() * current_a - self.resistance.at(current_a) * current_a * current_a
+        self.full_charge_v() * current_a - self.c.resistance.at(current_a) * current_a * current_a
     }
 
     fn find_max_power(&self) -> (f64, f64) {
-        match self.resistance {
+        match self.c.resistance {
             InternalResistance::Constant { resistance_ohm } => {
                 let vf = self.full_charge_v();
                 (
@@ -262,11 +265,11 @@ impl Battery {
                     vf * vf / (4.0 * resistance_ohm),
                 )
             }
-            InternalResistance::Logarithmic { .. } => {
+            InternalResistance::Logarithmic(_) => {
                 // Coarse scan then golden-section refinement of the delivered power.
                 let vf = self.full_charge_v();
                 let r_lo = (0..=64)
-                    .map(|k| self.resistance.at(1e-3 + k as f64 * 1e4 / 64.0))
+                    .map(|k| self.c.resistance.at(1e-3 + k as f64 * 1e4 / 64.0))
                     .fold(f64::INFINITY, f64::min);
                 let i_hi = vf / r_lo;
                 let n = 400;
@@ -300,54 +303,50 @@ impl Battery {
 
     /// Cells in series.
     pub fn cells_series(&self) -> u32 {
-        self.cells_series
+        self.c.cells_series
     }
 
     /// Cells in parallel.
     pub fn cells_parallel(&self) -> u32 {
-        self.cells_parallel
+        self.c.cells_parallel
     }
 
     /// Rated capacity `C_b`, A h.
     pub fn capacity_ah(&self) -> f64 {
-        self.capacity_ah
+        self.c.capacity_ah
     }
 
     /// Effective-capacity coefficient `C_e`.
     pub fn effective_capacity(&self) -> f64 {
-        self.effective_capacity
+        self.c.effective_capacity
     }
 
     /// Full-charge pack voltage `V_f` (eq 30), V.
     pub fn full_charge_v(&self) -> f64 {
-        self.cells_series as f64 * self.full_cell_v
+        self.c.cells_series as f64 * self.c.full_cell_v
     }
 
     /// Nominal pack voltage `V_0` (eq 31), V.
     pub fn nominal_v(&self) -> f64 {
-        self.cells_series as f64 * self.nominal_cell_v
+        self.c.cells_series as f64 * self.c.nominal_cell_v
     }
 
     /// Internal-resistance model.
     pub fn internal_resistance(&self) -> InternalResistance {
-        self.resistance
+        self.c.resistance
     }
 
     /// Internal resistance at `current_a`, ohm.
     pub fn resistance_ohm(&self, current_a: f64) -> f64 {
-        self.resistance.at(current_a)
+        self.c.resistance.at(current_a)
     }
 
     /// Whether `current_a` lies where the resistance model is trusted (always true for a
     /// constant resistance).
     pub fn resistance_in_valid_range(&self, current_a: f64) -> bool {
-        match self.resistance {
+        match self.c.resistance {
             InternalResistance::Constant { .. } => true,
-            InternalResistance::Logarithmic {
-                min_current_a,
-                max_current_a,
-                ..
-            } => (min_current_a..=max_current_a).contains(&current_a),
+            InternalResistance::Logarithmic(eq17) => eq17.in_valid_range(current_a),
         }
     }
 
@@ -358,7 +357,7 @@ impl Battery {
 
     /// Rated continuous current, A.
     pub fn max_current_a(&self) -> f64 {
-        self.max_current_a
+        self.c.max_current_a
     }
 
     /// Eqs (29)-(30): the pack current that delivers `power_w` to the load, A.
@@ -376,31 +375,24 @@ impl Battery {
             });
         }
         let vf = self.full_charge_v();
-        let i = match self.resistance {
+        let i = match self.c.resistance {
             InternalResistance::Constant { resistance_ohm } => {
                 // Smaller root of R I^2 - V_f I + P = 0, written in the cancellation-free form
                 // 2P / (V_f + sqrt(V_f^2 - 4 R P)).
                 let disc = (vf * vf - 4.0 * resistance_ohm * power_w).max(0.0);
                 2.0 * power_w / (vf + disc.sqrt())
             }
-            InternalResistance::Logarithmic { .. } => {
+            InternalResistance::Logarithmic(_) => {
                 // Delivered power rises monotonically on [0, I*]: bisection.
-                let (mut a, mut b) = (0.0, self.current_at_max_power_a);
-                for _ in 0..60 {
-                    let m = 0.5 * (a + b);
-                    if self.delivered_w(m) < power_w {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
+                let below = |i| self.delivered_w(i) < power_w;
+                let (a, b) = aloft_core::bisect(0.0, self.current_at_max_power_a, 60, below);
                 0.5 * (a + b)
             }
         };
-        if i > self.max_current_a {
+        if i > self.c.max_current_a {
             return Err(PropulsionError::PackCurrentLimit {
                 current_a: i,
-                limit_a: self.max_current_a,
+                limit_a: self.c.max_current_a,
             });
         }
         Ok(i)
@@ -413,17 +405,17 @@ impl Battery {
 
     /// Heat dissipated in the pack at `current_a`, `I^2 R_b(I)`, W.
     pub fn heat_w(&self, current_a: f64) -> f64 {
-        self.resistance.at(current_a) * current_a * current_a
+        self.c.resistance.at(current_a) * current_a * current_a
     }
 
     /// Terminal voltage at `current_a` in the seed's model, `V_f - I R_b(I)`, V.
     pub fn terminal_v(&self, current_a: f64) -> f64 {
-        self.full_charge_v() - self.resistance.at(current_a) * current_a
+        self.full_charge_v() - self.c.resistance.at(current_a) * current_a
     }
 
     /// Eq (31): flight duration at a constant pack current, minutes.
     pub fn flight_duration_min(&self, current_a: f64) -> f64 {
-        60.0 * self.nominal_v() * self.capacity_ah * self.effective_capacity
+        60.0 * self.nominal_v() * self.c.capacity_ah * self.c.effective_capacity
             / (self.full_charge_v() * current_a)
     }
 }
@@ -470,12 +462,13 @@ impl OcvCurve {
             fraction("ocv state_of_charge", s, true, true)?;
             voltage("ocv cell_v", v)?;
             if k > 0 && (s <= soc[k - 1] || v < cell_v[k - 1]) {
-                return Err(PropulsionError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name: "ocv state_of_charge",
                     value: s,
                     unit: "(fraction)",
                     expected: "strictly increasing state of charge with non-decreasing voltage",
-                });
+                }
+                .into());
             }
         }
         Ok(Self { soc, cell_v })
@@ -541,22 +534,28 @@ impl OcvCurve {
     }
 }
 
+/// The pack the crate's tests fly: 5S4P, 8 A h, `C_e` 0.9, the seed's cell voltages, a constant
+/// `resistance_ohm`, no current limit.
+#[cfg(test)]
+pub(crate) fn seed_pack_constants(resistance_ohm: f64) -> BatteryConstants {
+    BatteryConstants {
+        cells_series: 5,
+        cells_parallel: 4,
+        capacity_ah: 8.0,
+        effective_capacity: 0.9,
+        full_cell_v: SEED_FULL_CELL_V,
+        nominal_cell_v: SEED_NOMINAL_CELL_V,
+        resistance: InternalResistance::Constant { resistance_ohm },
+        max_current_a: f64::INFINITY,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn seed_pack(r: f64) -> Battery {
-        Battery::new(
-            5,
-            4,
-            8.0,
-            0.9,
-            SEED_FULL_CELL_V,
-            SEED_NOMINAL_CELL_V,
-            InternalResistance::Constant { resistance_ohm: r },
-            f64::INFINITY,
-        )
-        .unwrap()
+        Battery::new(seed_pack_constants(r)).unwrap()
     }
 
     #[test]
@@ -585,22 +584,16 @@ mod tests {
 
     #[test]
     fn eq17_pack_solves_and_reports_its_range() {
-        let b = Battery::new(
-            5,
-            4,
-            8.0,
-            0.9,
-            4.1,
-            3.7,
-            InternalResistance::Logarithmic {
+        let b = Battery::new(BatteryConstants {
+            resistance: InternalResistance::Logarithmic(Eq17Resistance {
                 r1_ohm: 0.05,
                 r2_ohm_a: 0.02,
                 r3_ohm_a: 0.3,
                 min_current_a: 5.0,
                 max_current_a: 60.0,
-            },
-            f64::INFINITY,
-        )
+            }),
+            ..seed_pack_constants(0.07)
+        })
         .unwrap();
         let i = b.current_for_power_a(700.0).unwrap();
         // bisection to 60 halvings: far below 1e-6 W
@@ -620,17 +613,37 @@ mod tests {
 
     #[test]
     fn bad_battery_inputs() {
-        let r = InternalResistance::Constant {
-            resistance_ohm: 0.07,
+        let good = BatteryConstants {
+            cells_parallel: 1,
+            ..seed_pack_constants(0.07)
         };
-        assert!(Battery::new(0, 1, 8.0, 0.9, 4.1, 3.7, r, f64::INFINITY).is_err());
-        assert!(Battery::new(5, 1, 0.0, 0.9, 4.1, 3.7, r, f64::INFINITY).is_err());
-        assert!(Battery::new(5, 1, 8.0, 1.2, 4.1, 3.7, r, f64::INFINITY).is_err());
+        assert!(Battery::new(BatteryConstants {
+            cells_series: 0,
+            ..good
+        })
+        .is_err());
+        assert!(Battery::new(BatteryConstants {
+            capacity_ah: 0.0,
+            ..good
+        })
+        .is_err());
+        assert!(Battery::new(BatteryConstants {
+            effective_capacity: 1.2,
+            ..good
+        })
+        .is_err());
         assert!(matches!(
-            Battery::new(5, 1, 8.0, 0.9, -4.1, 3.7, r, f64::INFINITY),
+            Battery::new(BatteryConstants {
+                full_cell_v: -4.1,
+                ..good
+            }),
             Err(PropulsionError::InvalidVoltage { .. })
         ));
-        assert!(Battery::new(5, 1, 8.0, 0.9, 3.6, 3.7, r, f64::INFINITY).is_err());
+        assert!(Battery::new(BatteryConstants {
+            full_cell_v: 3.6,
+            ..good
+        })
+        .is_err());
     }
 
     #[test]

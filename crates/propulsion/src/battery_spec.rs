@@ -35,7 +35,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::battery::{Battery, InternalResistance, SEED_FULL_CELL_V, SEED_NOMINAL_CELL_V};
+use crate::battery::{
+    Battery, BatteryConstants, Eq17Resistance, InternalResistance, SEED_FULL_CELL_V,
+    SEED_NOMINAL_CELL_V,
+};
 use crate::error::PropulsionError;
 
 fn one() -> u32 {
@@ -164,16 +167,16 @@ impl BatterySpec {
             Some(v) if self.cells_series > 0 => v / f64::from(self.cells_series),
             _ => SEED_NOMINAL_CELL_V,
         };
-        Battery::new(
-            self.cells_series,
-            self.cells_parallel,
-            self.capacity_mah / 1000.0,
-            effective,
-            self.full_charge_cell_v.unwrap_or(SEED_FULL_CELL_V),
+        Battery::new(BatteryConstants {
+            cells_series: self.cells_series,
+            cells_parallel: self.cells_parallel,
+            capacity_ah: self.capacity_mah / 1000.0,
+            effective_capacity: effective,
+            full_cell_v: self.full_charge_cell_v.unwrap_or(SEED_FULL_CELL_V),
             nominal_cell_v,
-            self.resistance_model()?,
-            self.max_current_a.unwrap_or(f64::INFINITY),
-        )
+            resistance: self.resistance_model()?,
+            max_current_a: self.max_current_a.unwrap_or(f64::INFINITY),
+        })
     }
 
     /// The resistance of the seed model: a constant, or eq (17) with its valid range.
@@ -190,13 +193,13 @@ impl BatterySpec {
                 resistance_ohm: r,
             }),
             (None, Some(r1), Some(r2), Some(r3), Some(lo), Some(hi)) => {
-                Ok(InternalResistance::Logarithmic {
+                Ok(InternalResistance::Logarithmic(Eq17Resistance {
                     r1_ohm: r1,
                     r2_ohm_a: r2,
                     r3_ohm_a: r3,
                     min_current_a: lo,
                     max_current_a: hi,
-                })
+                }))
             }
             _ => Err(PropulsionError::ConflictingKeys {
                 table: "propulsion.battery",
@@ -329,19 +332,7 @@ mod tests {
             effective_capacity_fraction: Some(0.9),
             ..BatterySpec::default()
         };
-        let direct = Battery::new(
-            5,
-            4,
-            8.0,
-            0.9,
-            4.1,
-            3.7,
-            InternalResistance::Constant {
-                resistance_ohm: 0.0699,
-            },
-            f64::INFINITY,
-        )
-        .unwrap();
+        let direct = Battery::new(crate::battery::seed_pack_constants(0.0699)).unwrap();
         assert_eq!(spec.to_seed_model().unwrap(), direct);
     }
 }

@@ -42,17 +42,8 @@ pub enum PropulsionError {
         resistance_ohm: f64,
     },
     /// Any other parameter outside its valid range.
-    #[error("{name} = {}{} is invalid: expected {expected}", aloft_core::Num::of(.value), aloft_core::Unit(.unit))]
-    InvalidParameter {
-        /// Parameter name, with its unit suffix.
-        name: &'static str,
-        /// The rejected value.
-        value: f64,
-        /// Unit of `value`.
-        unit: &'static str,
-        /// What a valid value looks like.
-        expected: &'static str,
-    },
+    #[error(transparent)]
+    InvalidParameter(#[from] aloft_core::InvalidParameter),
     /// A count (rotors, packs, cells) that is zero or inconsistent.
     #[error("{name} = {count} is invalid: expected {expected}")]
     InvalidCount {
@@ -170,26 +161,6 @@ pub const MAX_RESISTANCE_OHM: f64 = 1e3;
 /// Largest velocity constant, rpm/V.
 pub const MAX_KV_RPM_PER_V: f64 = 1e5;
 
-/// `value` when `ok`, else [`PropulsionError::InvalidParameter`] saying what was `expected`.
-pub(crate) fn parameter(
-    name: &'static str,
-    value: f64,
-    unit: &'static str,
-    ok: bool,
-    expected: &'static str,
-) -> Result<f64, PropulsionError> {
-    if ok {
-        Ok(value)
-    } else {
-        Err(PropulsionError::InvalidParameter {
-            name,
-            value,
-            unit,
-            expected,
-        })
-    }
-}
-
 /// Check that `value` is finite.
 pub(crate) fn finite(
     name: &'static str,
@@ -197,13 +168,13 @@ pub(crate) fn finite(
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
     let ok = value.is_finite() && value.abs() <= MAX_PARAMETER;
-    parameter(
+    Ok(aloft_core::parameter(
         name,
         value,
         unit,
         ok,
         "a finite number of at most 1e6 in magnitude",
-    )
+    )?)
 }
 
 /// Check that `value` is finite and strictly positive.
@@ -213,7 +184,13 @@ pub(crate) fn positive(
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
     let ok = value.is_finite() && value > 0.0 && value <= MAX_PARAMETER;
-    parameter(name, value, unit, ok, "a positive finite number up to 1e6")
+    Ok(aloft_core::parameter(
+        name,
+        value,
+        unit,
+        ok,
+        "a positive finite number up to 1e6",
+    )?)
 }
 
 /// Check that `value` is finite and not negative.
@@ -223,26 +200,26 @@ pub(crate) fn non_negative(
     unit: &'static str,
 ) -> Result<f64, PropulsionError> {
     let ok = (0.0..=MAX_PARAMETER).contains(&value);
-    parameter(
+    Ok(aloft_core::parameter(
         name,
         value,
         unit,
         ok,
         "a non-negative finite number up to 1e6",
-    )
+    )?)
 }
 
 /// Check a rated current limit: positive, infinity for none.
 pub(crate) fn current_limit(name: &'static str, current_a: f64) -> Result<f64, PropulsionError> {
     let ok = !(current_a.is_nan() || current_a <= 0.0)
         && (current_a.is_infinite() || current_a <= MAX_PARAMETER);
-    parameter(
+    Ok(aloft_core::parameter(
         name,
         current_a,
         "A",
         ok,
         "a positive current (or infinity for no limit)",
-    )
+    )?)
 }
 
 /// Check a fraction in `[0, 1)` (losses) or `(0, 1]` (coefficients).
@@ -261,12 +238,13 @@ pub(crate) fn fraction(
     if value.is_finite() && lower_ok && upper_ok {
         Ok(value)
     } else {
-        Err(PropulsionError::InvalidParameter {
+        Err(aloft_core::InvalidParameter {
             name,
             value,
             unit: "(fraction)",
             expected: "a fraction between 0 and 1",
-        })
+        }
+        .into())
     }
 }
 

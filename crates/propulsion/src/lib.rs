@@ -32,7 +32,7 @@ pub mod propeller;
 pub mod spec;
 pub mod transient;
 
-pub use battery::{Battery, InternalResistance, OcvCurve};
+pub use battery::{Battery, BatteryConstants, Eq17Resistance, InternalResistance, OcvCurve};
 pub use battery_spec::BatterySpec;
 pub use error::PropulsionError;
 pub use esc::Esc;
@@ -40,4 +40,6 @@ pub use motor::{Motor, RotationalLoss};
 pub use operating_point::{mass_range_kg, HoverResult, PropulsionSystem, RotorOperatingPoint};
 pub use propeller::Propeller;
 pub use spec::{rotor_step_response, PropulsionSpec, RotorSpec};
-pub use transient::{EscProtocol, RotorTransient, RotorTransientResult, StepMetrics, StepResponse};
+pub use transient::{
+    EscProtocol, RotorConstants, RotorTransient, RotorTransientResult, StepMetrics, StepResponse,
+};

@@ -15,7 +15,7 @@
 //! The seed's airframe has one pack per motor (four packs, four motors).
 
 use crate::battery::Battery;
-use crate::error::{mass, parameter, positive, PropulsionError};
+use crate::error::{mass, positive, PropulsionError};
 use crate::esc::Esc;
 use crate::motor::Motor;
 use crate::propeller::Propeller;
@@ -328,7 +328,7 @@ pub fn mass_range_kg(from_kg: f64, to_kg: f64, step_kg: f64) -> Result<Vec<f64>,
     let n = ((to_kg - from_kg) / step_kg + 1e-9).floor();
     // `n` is not negative (NaN cannot reach here): `<=` is the negation of `>`.
     let expected = "a step giving at most 100000 points";
-    parameter("sweep step_kg", step_kg, "kg", n <= 1e5, expected)?;
+    aloft_core::parameter("sweep step_kg", step_kg, "kg", n <= 1e5, expected)?;
     Ok((0..=n as usize)
         .map(|k| from_kg + k as f64 * step_kg)
         .collect())
@@ -337,7 +337,6 @@ pub fn mass_range_kg(from_kg: f64, to_kg: f64, step_kg: f64) -> Result<Vec<f64>,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::battery::InternalResistance;
     use crate::motor::motor_with_no_load_current;
     use aloft_core::{ISA_SEA_LEVEL_DENSITY_KG_M3, STANDARD_GRAVITY_MPS2};
 
@@ -349,19 +348,7 @@ mod tests {
                 .unwrap(),
             motor_with_no_load_current(515.0, 0.07, 1.5, 55.0).unwrap(),
             Esc::ideal(),
-            Battery::new(
-                5,
-                4,
-                8.0,
-                0.9,
-                4.1,
-                3.7,
-                InternalResistance::Constant {
-                    resistance_ohm: 0.07,
-                },
-                f64::INFINITY,
-            )
-            .unwrap(),
+            Battery::new(crate::battery::seed_pack_constants(0.07)).unwrap(),
             4,
             4,
             7.484,

@@ -230,12 +230,13 @@ impl Propeller {
                 n_rpm -= f / df;
             }
             if !(n_rpm.is_finite() && n_rpm >= 0.0 && self.ct_at(n_rpm) > 0.0) {
-                return Err(PropulsionError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name: "ct_per_krpm",
                     value: self.ct_per_krpm,
                     unit: "1/krpm",
                     expected: "a speed dependence that keeps C_T positive at the operating speed",
-                });
+                }
+                .into());
             }
         }
         Ok(n_rpm)
@@ -300,7 +301,7 @@ mod tests {
     fn bad_inputs_are_typed_errors() {
         assert!(matches!(
             Propeller::new(0.0, 0.1, 0.04),
-            Err(PropulsionError::InvalidParameter { .. })
+            Err(PropulsionError::InvalidParameter(_))
         ));
         assert!(Propeller::new(0.3, f64::NAN, 0.04).is_err());
         assert!(Propeller::new(0.3, 0.1, 0.04)

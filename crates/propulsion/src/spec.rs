@@ -45,7 +45,7 @@ use crate::motor::{Motor, RotationalLoss};
 use crate::operating_point::PropulsionSystem;
 use crate::propeller::{Propeller, M_PER_IN};
 use crate::transient::{
-    kt_from_kv, motor_inertia_kgm2, prop_inertia_kgm2, EscProtocol, RotorTransient,
+    kt_from_kv, motor_inertia_kgm2, prop_inertia_kgm2, EscProtocol, RotorConstants, RotorTransient,
     RotorTransientResult,
 };
 use serde::{Deserialize, Serialize};
@@ -269,16 +269,16 @@ impl RotorSpec {
         let prop_mass_kg = mass("prop_mass_g (in kg)", self.prop_mass_g * 1e-3)?;
         let motor_d_m = positive("motor_diameter_mm", self.motor_diameter_mm, "mm")? * 1e-3;
         let prop_d_m = positive("prop_diameter_in", self.prop_diameter_in, "in")? * M_PER_IN;
-        RotorTransient::new(
-            kt,
-            self.motor_resistance_ohm,
-            self.no_load_current_a,
-            self.voltage_v,
-            motor_inertia_kgm2(motor_mass_kg, motor_d_m)?,
-            prop_inertia_kgm2(prop_mass_kg, prop_d_m)?,
-            self.torque_coefficient_nms2,
-            self.protocol.map_or(0.0, EscProtocol::added_delay_s),
-        )
+        RotorTransient::new(RotorConstants {
+            kt_nm_per_a: kt,
+            resistance_ohm: self.motor_resistance_ohm,
+            no_load_current_a: self.no_load_current_a,
+            supply_voltage_v: self.voltage_v,
+            motor_inertia_kgm2: motor_inertia_kgm2(motor_mass_kg, motor_d_m)?,
+            prop_inertia_kgm2: prop_inertia_kgm2(prop_mass_kg, prop_d_m)?,
+            torque_coefficient_nms2: self.torque_coefficient_nms2,
+            delay_s: self.protocol.map_or(0.0, EscProtocol::added_delay_s),
+        })
     }
 }
 

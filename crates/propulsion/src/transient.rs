@@ -38,9 +38,7 @@
 //! protocol, dshot150. The seed itself assumes the ESC "only provides a time delay at the start of
 //! the response" (section 4.2).
 
-use crate::error::{
-    kv, mass, non_negative, parameter, positive, resistance, voltage, PropulsionError,
-};
+use crate::error::{kv, mass, non_negative, positive, resistance, voltage, PropulsionError};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -68,12 +66,13 @@ pub fn kt_from_kv(
     let i0 = non_negative("no_load_current_a", no_load_current_a, "A")?;
     let r = resistance("motor_resistance_ohm", resistance_ohm)?;
     if i0 * r >= v0 {
-        return Err(PropulsionError::InvalidParameter {
+        return Err(aloft_core::InvalidParameter {
             name: "no_load_current_a",
             value: i0,
             unit: "A",
             expected: "I0 R below the nominal voltage (eq 3)",
-        });
+        }
+        .into());
     }
     let kv_si = kv_rpm_per_v * 2.0 * PI / 60.0;
     Ok((v0 - i0 * r) / (kv_si * v0))
@@ -101,16 +100,9 @@ pub fn motor_inertia_kgm2(mass_kg: f64, diameter_m: f64) -> Result<f64, Propulsi
     let m = mass("motor_mass", mass_kg)?;
     let d = positive("motor_diameter", diameter_m, "m")?;
     let j = EQ9_TO_KGM2 * (EQ9_A[0] + EQ9_A[1] * m * d * d + EQ9_A[2] * m * d);
-    if j > 0.0 {
-        Ok(j)
-    } else {
-        Err(PropulsionError::InvalidParameter {
-            name: "motor_diameter",
-            value: diameter_m,
-            unit: "m",
-            expected: "a motor within the range of the eq (9) fit (positive inertia)",
-        })
-    }
+    let expected = "a motor within the range of the eq (9) fit (positive inertia)";
+    aloft_core::parameter("motor_diameter", diameter_m, "m", j > 0.0, expected)?;
+    Ok(j)
 }
 
 /// Propeller inertia from mass and diameter, eq (10): `J_p = B1 m d^2 - B2 m d`, SI (kg, m,
@@ -125,16 +117,9 @@ pub fn prop_inertia_kgm2(mass_kg: f64, diameter_m: f64) -> Result<f64, Propulsio
     let m = mass("prop_mass", mass_kg)?;
     let d = positive("prop_diameter", diameter_m, "m")?;
     let j = EQ10_B[0] * m * d * d - EQ10_B[1] * m * d;
-    if j > 0.0 {
-        Ok(j)
-    } else {
-        Err(PropulsionError::InvalidParameter {
-            name: "prop_diameter",
-            value: diameter_m,
-            unit: "m",
-            expected: "a propeller larger than 0.089 m (3.5 in), the range of the eq (10) fit",
-        })
-    }
+    let expected = "a propeller larger than 0.089 m (3.5 in), the range of the eq (10) fit";
+    aloft_core::parameter("prop_diameter", diameter_m, "m", j > 0.0, expected)?;
+    Ok(j)
 }
 
 /// ESC command protocols of the transient seed's Table 4.
@@ -234,14 +219,28 @@ impl std::fmt::Display for EscProtocol {
 /// A rotor (motor + propeller + ESC) for transient analysis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RotorTransient {
-    kt_nm_per_a: f64,
-    resistance_ohm: f64,
-    no_load_current_a: f64,
-    supply_voltage_v: f64,
-    motor_inertia_kgm2: f64,
-    prop_inertia_kgm2: f64,
-    torque_coefficient_nms2: f64,
-    delay_s: f64,
+    c: RotorConstants,
+}
+
+/// The constants of a rotor for transient analysis, as [`RotorTransient::new`] checks them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RotorConstants {
+    /// Torque constant `K_T = K_E`, eq (3), N m/A.
+    pub kt_nm_per_a: f64,
+    /// Motor resistance `R`, ohm (positive: eq 2 divides by it).
+    pub resistance_ohm: f64,
+    /// No-load current `I0`, A.
+    pub no_load_current_a: f64,
+    /// Supply voltage, V.
+    pub supply_voltage_v: f64,
+    /// Motor inertia `J_m`, kg m^2.
+    pub motor_inertia_kgm2: f64,
+    /// Propeller inertia `J_p`, kg m^2.
+    pub prop_inertia_kgm2: f64,
+    /// Load-torque coefficient `c` of `tau = c w^2`, N m s^2.
+    pub torque_coefficient_nms2: f64,
+    /// Delay of the ESC protocol, s.
+    pub delay_s: f64,
 }
 
 /// Metrics of a simulated step.
@@ -310,49 +309,40 @@ impl RotorTransient {
     /// # Errors
     /// Non-finite or non-positive constants (zero resistance is rejected: eq 2 divides by `R`),
     /// a negative load coefficient or delay.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        kt_nm_per_a: f64,
-        resistance_ohm: f64,
-        no_load_current_a: f64,
-        supply_voltage_v: f64,
-        motor_inertia_kgm2: f64,
-        prop_inertia_kgm2: f64,
-        torque_coefficient_nms2: f64,
-        delay_s: f64,
-    ) -> Result<Self, PropulsionError> {
-        let resistance_ohm = resistance("motor_resistance_ohm", resistance_ohm)?;
+    pub fn new(c: RotorConstants) -> Result<Self, PropulsionError> {
+        let resistance_ohm = resistance("motor_resistance_ohm", c.resistance_ohm)?;
         if resistance_ohm <= 0.0 {
             return Err(PropulsionError::InvalidResistance {
                 name: "motor_resistance_ohm (eq 2 needs R > 0)",
                 resistance_ohm,
             });
         }
-        Ok(Self {
-            kt_nm_per_a: positive("kt_nm_per_a", kt_nm_per_a, "N m/A")?,
+        let c = RotorConstants {
+            kt_nm_per_a: positive("kt_nm_per_a", c.kt_nm_per_a, "N m/A")?,
             resistance_ohm,
-            no_load_current_a: non_negative("no_load_current_a", no_load_current_a, "A")?,
-            supply_voltage_v: voltage("voltage_v", supply_voltage_v)?,
-            motor_inertia_kgm2: positive("motor_inertia_kgm2", motor_inertia_kgm2, "kg m^2")?,
-            prop_inertia_kgm2: non_negative("prop_inertia_kgm2", prop_inertia_kgm2, "kg m^2")?,
+            no_load_current_a: non_negative("no_load_current_a", c.no_load_current_a, "A")?,
+            supply_voltage_v: voltage("voltage_v", c.supply_voltage_v)?,
+            motor_inertia_kgm2: positive("motor_inertia_kgm2", c.motor_inertia_kgm2, "kg m^2")?,
+            prop_inertia_kgm2: non_negative("prop_inertia_kgm2", c.prop_inertia_kgm2, "kg m^2")?,
             torque_coefficient_nms2: non_negative(
                 "torque_coefficient_nms2",
-                torque_coefficient_nms2,
+                c.torque_coefficient_nms2,
                 "N m s^2",
             )?,
-            delay_s: non_negative("protocol delay_s", delay_s, "s")?,
-        })
+            delay_s: non_negative("protocol delay_s", c.delay_s, "s")?,
+        };
+        Ok(Self { c })
     }
 
     /// Total inertia `J_m + J_p` (eq 4), kg m^2.
     pub fn inertia_kgm2(&self) -> f64 {
-        self.motor_inertia_kgm2 + self.prop_inertia_kgm2
+        self.c.motor_inertia_kgm2 + self.c.prop_inertia_kgm2
     }
 
     /// Returns a copy with another total-inertia split (used by the inertia fit): the propeller
     /// share is set to `prop_inertia_kgm2`.
     pub fn with_prop_inertia(mut self, prop_inertia_kgm2: f64) -> Self {
-        self.prop_inertia_kgm2 = prop_inertia_kgm2.max(0.0);
+        self.c.prop_inertia_kgm2 = prop_inertia_kgm2.max(0.0);
         self
     }
 
@@ -361,74 +351,74 @@ impl RotorTransient {
     pub fn with_total_inertia(mut self, inertia_kgm2: f64) -> Self {
         let scale = inertia_kgm2 / self.inertia_kgm2();
         if scale.is_finite() && scale > 0.0 {
-            self.motor_inertia_kgm2 *= scale;
-            self.prop_inertia_kgm2 *= scale;
+            self.c.motor_inertia_kgm2 *= scale;
+            self.c.prop_inertia_kgm2 *= scale;
         }
         self
     }
 
     /// Motor resistance `R`, ohm.
     pub fn resistance_ohm(&self) -> f64 {
-        self.resistance_ohm
+        self.c.resistance_ohm
     }
 
     /// Load-torque coefficient `c`, N m s^2.
     pub fn torque_coefficient_nms2(&self) -> f64 {
-        self.torque_coefficient_nms2
+        self.c.torque_coefficient_nms2
     }
 
     /// Returns a copy with another ESC delay, s.
     pub fn with_delay(mut self, delay_s: f64) -> Self {
-        self.delay_s = delay_s.max(0.0);
+        self.c.delay_s = delay_s.max(0.0);
         self
     }
 
     /// `K_T = K_E`, N m/A.
     pub fn kt_nm_per_a(&self) -> f64 {
-        self.kt_nm_per_a
+        self.c.kt_nm_per_a
     }
 
     /// Motor inertia, kg m^2.
     pub fn motor_inertia_kgm2(&self) -> f64 {
-        self.motor_inertia_kgm2
+        self.c.motor_inertia_kgm2
     }
 
     /// Propeller inertia, kg m^2.
     pub fn prop_inertia_kgm2(&self) -> f64 {
-        self.prop_inertia_kgm2
+        self.c.prop_inertia_kgm2
     }
 
     /// ESC delay, s.
     pub fn delay_s(&self) -> f64 {
-        self.delay_s
+        self.c.delay_s
     }
 
     /// Seed eq (7): `J R / (K_T^2 + c R w)`, s.
     pub fn time_constant_eq7_s(&self, speed_radps: f64) -> f64 {
-        self.inertia_kgm2() * self.resistance_ohm
-            / (self.kt_nm_per_a.powi(2)
-                + self.torque_coefficient_nms2 * self.resistance_ohm * speed_radps)
+        self.inertia_kgm2() * self.c.resistance_ohm
+            / (self.c.kt_nm_per_a.powi(2)
+                + self.c.torque_coefficient_nms2 * self.c.resistance_ohm * speed_radps)
     }
 
     /// Linearised eq (2): `J R / (K_T^2 + 2 c R w)`, s.
     pub fn time_constant_linearised_s(&self, speed_radps: f64) -> f64 {
-        self.inertia_kgm2() * self.resistance_ohm
-            / (self.kt_nm_per_a.powi(2)
-                + 2.0 * self.torque_coefficient_nms2 * self.resistance_ohm * speed_radps)
+        self.inertia_kgm2() * self.c.resistance_ohm
+            / (self.c.kt_nm_per_a.powi(2)
+                + 2.0 * self.c.torque_coefficient_nms2 * self.c.resistance_ohm * speed_radps)
     }
 
     /// Motor voltage that holds `speed_radps` steady: `K_E w + c w^2 R / K_T`, V.
     pub fn equilibrium_voltage_v(&self, speed_radps: f64) -> f64 {
-        self.kt_nm_per_a * speed_radps
-            + self.torque_coefficient_nms2 * speed_radps * speed_radps * self.resistance_ohm
-                / self.kt_nm_per_a
+        self.c.kt_nm_per_a * speed_radps
+            + self.c.torque_coefficient_nms2 * speed_radps * speed_radps * self.c.resistance_ohm
+                / self.c.kt_nm_per_a
     }
 
     /// Steady speed at motor voltage `voltage_v`, rad/s (positive root of eq 2 at rest).
     pub fn steady_speed_radps(&self, voltage_v: f64) -> f64 {
-        let k = self.kt_nm_per_a;
-        let r = self.resistance_ohm;
-        let c = self.torque_coefficient_nms2;
+        let k = self.c.kt_nm_per_a;
+        let r = self.c.resistance_ohm;
+        let c = self.c.torque_coefficient_nms2;
         if c <= 0.0 {
             return voltage_v / k;
         }
@@ -441,39 +431,43 @@ impl RotorTransient {
     /// Supply-side current at motor voltage `voltage_v` and speed `w`, eq (5) with the
     /// electromagnetic torque (see the module's Deviation), A.
     pub fn current_a(&self, voltage_v: f64, w: f64) -> f64 {
-        let torque = self.kt_nm_per_a / self.resistance_ohm * (voltage_v - self.kt_nm_per_a * w);
-        voltage_v / self.supply_voltage_v * (torque / self.kt_nm_per_a + self.no_load_current_a)
+        let torque =
+            self.c.kt_nm_per_a / self.c.resistance_ohm * (voltage_v - self.c.kt_nm_per_a * w);
+        voltage_v / self.c.supply_voltage_v
+            * (torque / self.c.kt_nm_per_a + self.c.no_load_current_a)
     }
 
     /// Steady supply current at speed `w`, eq (5) with `tau_l = c w^2`, A.
     pub fn steady_current_a(&self, w: f64) -> f64 {
         let v = self.equilibrium_voltage_v(w);
-        v / self.supply_voltage_v
-            * (self.torque_coefficient_nms2 * w * w / self.kt_nm_per_a + self.no_load_current_a)
+        v / self.c.supply_voltage_v
+            * (self.c.torque_coefficient_nms2 * w * w / self.c.kt_nm_per_a
+                + self.c.no_load_current_a)
     }
 
     fn check_step(&self, from_radps: f64, to_radps: f64) -> Result<(f64, f64), PropulsionError> {
         let from = non_negative("step_from_radps", from_radps, "rad/s")?;
         let to = non_negative("step_to_radps", to_radps, "rad/s")?;
-        let w_max = self.steady_speed_radps(self.supply_voltage_v);
+        let w_max = self.steady_speed_radps(self.c.supply_voltage_v);
         for (name, w) in [("step_from_radps", from), ("step_to_radps", to)] {
             if w > w_max {
-                return Err(PropulsionError::InvalidParameter {
+                return Err(aloft_core::InvalidParameter {
                     name,
                     value: w,
                     unit: "rad/s",
                     expected: "a speed the supply voltage can hold (at most the full-voltage steady speed)",
-                });
+                }.into());
             }
         }
         // Steps smaller than 1e-6 of the top speed have no meaningful rise time.
         if (to - from).abs() <= 1e-6 * w_max {
-            return Err(PropulsionError::InvalidParameter {
+            return Err(aloft_core::InvalidParameter {
                 name: "step_to_radps",
                 value: to,
                 unit: "rad/s",
                 expected: "a speed different from step_from_radps",
-            });
+            }
+            .into());
         }
         Ok((from, to))
     }
@@ -536,7 +530,7 @@ impl RotorTransient {
         let steps = (duration_s / dt_s).ceil();
         // `steps` is positive (NaN cannot reach here): `<=` is the negation of `>`.
         let expected = "at most 1e8 steps per simulation";
-        parameter("dt_s", dt_s, "s", steps <= 1e8, expected)?;
+        aloft_core::parameter("dt_s", dt_s, "s", steps <= 1e8, expected)?;
         let steps = steps as usize;
         let v0 = self.equilibrium_voltage_v(from);
         let v1 = self.equilibrium_voltage_v(to);
@@ -545,9 +539,9 @@ impl RotorTransient {
         let (w10, w90) = (from + 0.1 * dw, from + 0.9 * dw);
         let sign = dw.signum();
         let j = self.inertia_kgm2();
-        let ka = self.kt_nm_per_a / (self.resistance_ohm * j);
-        let kb = self.kt_nm_per_a * self.kt_nm_per_a / (self.resistance_ohm * j);
-        let kg = self.torque_coefficient_nms2 / j;
+        let ka = self.c.kt_nm_per_a / (self.c.resistance_ohm * j);
+        let kb = self.c.kt_nm_per_a * self.c.kt_nm_per_a / (self.c.resistance_ohm * j);
+        let kg = self.c.torque_coefficient_nms2 / j;
         let mut w = from;
         let mut t = 0.0;
         let mut t10 = f64::NAN;
@@ -558,7 +552,7 @@ impl RotorTransient {
         for k in 0..steps {
             let t_next = (k + 1) as f64 * dt_s;
             // Voltage is piecewise constant; the switch is placed on the step grid.
-            let v = if t + 0.5 * dt_s >= self.delay_s {
+            let v = if t + 0.5 * dt_s >= self.c.delay_s {
                 v1
             } else {
                 v0
@@ -612,21 +606,21 @@ impl RotorTransient {
             .time_constant_eq7_s(to)
             .max(self.time_constant_eq7_s(from))
             .max(self.time_constant_linearised_s(from.min(to)));
-        let duration = (self.delay_s + 20.0 * tau).max(0.5);
+        let duration = (self.c.delay_s + 20.0 * tau).max(0.5);
         let dt = (tau / 50.0).min(1e-4);
         let m = self.simulate_step_metrics(from, to, duration, dt)?;
         let tau7 = self.time_constant_eq7_s(to);
         Ok(RotorTransientResult {
-            motor_inertia_kgm2: self.motor_inertia_kgm2,
-            prop_inertia_kgm2: self.prop_inertia_kgm2,
+            motor_inertia_kgm2: self.c.motor_inertia_kgm2,
+            prop_inertia_kgm2: self.c.prop_inertia_kgm2,
             time_constant_s: tau7,
             rise_time_s: m.rise_time_s,
             settling_time_s: m.settling_time_s,
             steady_current_a: self.steady_current_a(to),
             linearised_time_constant_s: self.time_constant_linearised_s(to),
             rise_time_eq8_s: 2.2 * tau7,
-            protocol_delay_s: self.delay_s,
-            kt_nm_per_a: self.kt_nm_per_a,
+            protocol_delay_s: self.c.delay_s,
+            kt_nm_per_a: self.c.kt_nm_per_a,
             step_from_radps: from,
             step_to_radps: to,
             step_from_voltage_v: self.equilibrium_voltage_v(from),
@@ -637,7 +631,7 @@ impl RotorTransient {
 
     /// Steady speed at the full supply voltage, rad/s.
     pub fn full_voltage_speed_radps(&self) -> f64 {
-        self.steady_speed_radps(self.supply_voltage_v)
+        self.steady_speed_radps(self.c.supply_voltage_v)
     }
 }
 
@@ -646,7 +640,17 @@ mod tests {
     use super::*;
 
     fn rotor(c: f64) -> RotorTransient {
-        RotorTransient::new(4e-3, 0.1, 0.4, 11.1, 1e-6, 2e-6, c, 0.0).unwrap()
+        RotorTransient::new(RotorConstants {
+            kt_nm_per_a: 4e-3,
+            resistance_ohm: 0.1,
+            no_load_current_a: 0.4,
+            supply_voltage_v: 11.1,
+            motor_inertia_kgm2: 1e-6,
+            prop_inertia_kgm2: 2e-6,
+            torque_coefficient_nms2: c,
+            delay_s: 0.0,
+        })
+        .unwrap()
     }
 
     #[test]

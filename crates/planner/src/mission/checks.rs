@@ -161,23 +161,25 @@ pub(super) fn home_position_m(home: &HomeSpec) -> Result<[f64; 3], PlannerError>
     let home_m = [home.east_m.unwrap_or(0.0), home.north_m.unwrap_or(0.0), 0.0];
     for (v, name) in [(home_m[0], "home east_m"), (home_m[1], "home north_m")] {
         if !(v.is_finite() && v.abs() <= MAX_MISSION_VALUE) {
-            return Err(PlannerError::InvalidParameter {
+            return Err(aloft_core::InvalidParameter {
                 name,
                 value: v,
                 unit: "m",
                 expected: "a finite coordinate of at most 1e7 m in magnitude",
-            });
+            }
+            .into());
         }
     }
     let (lo, hi) = HOME_AMSL_RANGE_M;
     match home.altitude_amsl_m {
         // `contains` is false for NaN.
-        Some(v) if !(lo..=hi).contains(&v) => Err(PlannerError::InvalidParameter {
+        Some(v) if !(lo..=hi).contains(&v) => Err(aloft_core::InvalidParameter {
             name: "home altitude_amsl_m",
             value: v,
             unit: "m",
             expected: "a finite ground altitude from -500 to 10000 m above mean sea level",
-        }),
+        }
+        .into()),
         _ => Ok(home_m),
     }
 }
@@ -211,20 +213,21 @@ impl Points {
                 (None, None, Some(la), Some(lo)) => {
                     let ok = la.is_finite() && la.abs() < 90.0;
                     let expected = "a latitude within (-90, 90)";
-                    crate::error::parameter("home latitude_deg", la, "deg", ok, expected)?;
+                    aloft_core::parameter("home latitude_deg", la, "deg", ok, expected)?;
                     let ok = lo.is_finite() && lo.abs() <= 180.0;
                     let expected = "a longitude within [-180, 180]";
-                    crate::error::parameter("home longitude_deg", lo, "deg", ok, expected)?;
+                    aloft_core::parameter("home longitude_deg", lo, "deg", ok, expected)?;
                     Some((la, lo))
                 }
                 (_, _, None, None) => None,
-                _ => return Err(PlannerError::InvalidParameter {
+                _ => return Err(aloft_core::InvalidParameter {
                     name: "home latitude_deg",
                     value: home.latitude_deg.unwrap_or(f64::NAN),
                     unit: "deg",
                     expected:
                         "home as east_m/north_m or as latitude_deg/longitude_deg, not both or half",
-                }),
+                }
+                .into()),
             };
         Ok(Self {
             last: frame.map(|(la, lo)| (la, lo, [0.0, 0.0])),

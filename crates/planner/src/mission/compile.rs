@@ -189,7 +189,7 @@ impl<'a> Compiler<'a> {
     /// progress.
     fn start_in_air(&mut self, start_m: [f64; 3]) -> Result<(), PlannerError> {
         for (name, value) in [("start_east_m", start_m[0]), ("start_north_m", start_m[1])] {
-            crate::error::parameter(name, value, "m", value.is_finite(), "a finite number")?;
+            aloft_core::parameter(name, value, "m", value.is_finite(), "a finite number")?;
         }
         crate::error::positive("start_up_m", start_m[2], "m")?;
         self.pos_m = [

@@ -365,7 +365,7 @@ mod tests {
     /// mission and a planner file alike.
     #[test]
     fn a_steep_leg_compiles_as_planned() {
-        let text = crate::test_support::STEEP_LEG;
+        let text = &crate::test_support::steep_leg();
         let mut spec = MissionSpec::from_toml_str(text).unwrap();
         let aloft = spec.compile(&m100_airframe(), 0.68, None).unwrap();
         spec.clamp_speeds = true;

@@ -713,7 +713,7 @@ mod tests {
         // limit is 5 m/s, so the leg is flown with its vertical speed at 5 m/s and its ground
         // speed at 5 x 20 / 30 = 3.33 m/s where the plan asks for more.
         let (aircraft, battery) = m100();
-        let text = crate::test_support::STEEP_LEG;
+        let text = &crate::test_support::steep_leg();
         let mission = compile_mission(text, &aircraft, &battery);
         let opts = PlanOptions {
             record_samples: true,

@@ -486,7 +486,7 @@ impl PlanOptions {
         crate::error::reserve_fraction(self.reserve_fraction)?;
         let ok = self.start_soc > battery.empty_soc() && self.start_soc <= 1.0;
         let expected = "a fraction in (empty point, 1]";
-        crate::error::parameter("start_soc", self.start_soc, "", ok, expected)?;
+        aloft_core::parameter("start_soc", self.start_soc, "", ok, expected)?;
         crate::error::positive("pnr_interval_s", self.pnr_interval_s, "s")?;
         let return_rate = match self.return_descent_rate_mps {
             Some(r) => crate::error::positive("return_descent_rate_mps", r, "m/s")?,

@@ -6,23 +6,15 @@
 //! valid range reported is the range of currents in the data.
 
 use super::{check_columns, minimize, rmse};
-use crate::battery::{eq17_resistance_ohm, InternalResistance};
+use crate::battery::{Eq17Resistance, InternalResistance};
 use crate::error::PropulsionError;
 use aloft_core::{trapezoid, SECONDS_PER_HOUR};
 
 /// Result of an eq (17) fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ResistanceFit {
-    /// `r_1`, ohm.
-    pub r1_ohm: f64,
-    /// `r_2`, ohm A.
-    pub r2_ohm_a: f64,
-    /// `r_3`, ohm A.
-    pub r3_ohm_a: f64,
-    /// Smallest current in the data, A.
-    pub min_current_a: f64,
-    /// Largest current in the data, A.
-    pub max_current_a: f64,
+    /// The coefficients, valid between the smallest and the largest current in the data.
+    pub eq17: Eq17Resistance,
     /// RMSE of the voltage drop, V.
     pub rmse_voltage_v: f64,
 }
@@ -30,18 +22,12 @@ pub struct ResistanceFit {
 impl ResistanceFit {
     /// The fit as an [`InternalResistance`] valid over the data's current range.
     pub fn to_model(&self) -> InternalResistance {
-        InternalResistance::Logarithmic {
-            r1_ohm: self.r1_ohm,
-            r2_ohm_a: self.r2_ohm_a,
-            r3_ohm_a: self.r3_ohm_a,
-            min_current_a: self.min_current_a,
-            max_current_a: self.max_current_a,
-        }
+        InternalResistance::Logarithmic(self.eq17)
     }
 
     /// Resistance at `current_a` (unclamped eq 17), ohm.
     pub fn resistance_ohm(&self, current_a: f64) -> f64 {
-        eq17_resistance_ohm(self.r1_ohm, self.r2_ohm_a, self.r3_ohm_a, current_a)
+        self.eq17.resistance_ohm(current_a)
     }
 }
 
@@ -93,11 +79,13 @@ pub fn fit_internal_resistance(
             (a.min(r.0), b.max(r.0))
         });
     Ok(ResistanceFit {
-        r1_ohm: p[0],
-        r2_ohm_a: p[1],
-        r3_ohm_a: p[2],
-        min_current_a: lo,
-        max_current_a: hi,
+        eq17: Eq17Resistance {
+            r1_ohm: p[0],
+            r2_ohm_a: p[1],
+            r3_ohm_a: p[2],
+            min_current_a: lo,
+            max_current_a: hi,
+        },
         rmse_voltage_v: rmse(rows.iter().map(|&(i, v)| model(&p, i) - v)),
     })
 }
@@ -109,18 +97,23 @@ mod tests {
     #[test]
     fn recovers_eq17_coefficients() {
         let (r1, r2, r3) = (0.05, 0.03, 0.2);
+        let truth = Eq17Resistance {
+            r1_ohm: r1,
+            r2_ohm_a: r2,
+            r3_ohm_a: r3,
+            min_current_a: 3.0,
+            max_current_a: 60.0,
+        };
         let i: Vec<f64> = (1..=20).map(|k| 3.0 * k as f64).collect();
-        let dv: Vec<f64> = i
-            .iter()
-            .map(|&x| eq17_resistance_ohm(r1, r2, r3, x) * x)
-            .collect();
+        let dv: Vec<f64> = i.iter().map(|&x| truth.resistance_ohm(x) * x).collect();
         let f = fit_internal_resistance(&i, &dv).unwrap();
+        let e = f.eq17;
         // noise-free: recovered to 1e-4 absolute (Nelder-Mead with restart)
-        assert!((f.r1_ohm - r1).abs() < 1e-4, "{f:?}");
-        assert!((f.r2_ohm_a - r2).abs() < 1e-3, "{f:?}");
-        assert!((f.r3_ohm_a - r3).abs() < 3e-3, "{f:?}");
+        assert!((e.r1_ohm - r1).abs() < 1e-4, "{f:?}");
+        assert!((e.r2_ohm_a - r2).abs() < 1e-3, "{f:?}");
+        assert!((e.r3_ohm_a - r3).abs() < 3e-3, "{f:?}");
         assert!(f.rmse_voltage_v < 1e-3);
-        assert!((f.min_current_a - 3.0).abs() < 1e-12 && (f.max_current_a - 60.0).abs() < 1e-12);
+        assert!((e.min_current_a - 3.0).abs() < 1e-12 && (e.max_current_a - 60.0).abs() < 1e-12);
     }
 }
 

@@ -128,11 +128,21 @@ pub fn fit_rotor_inertia(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::transient::RotorConstants;
 
     #[test]
     fn recovers_inertia_and_delay_from_a_simulated_step() {
-        let truth =
-            RotorTransient::new(4e-3, 0.12, 0.4, 11.1, 1.1e-6, 2.4e-6, 1.4e-8, 0.004).unwrap();
+        let truth = RotorTransient::new(RotorConstants {
+            kt_nm_per_a: 4e-3,
+            resistance_ohm: 0.12,
+            no_load_current_a: 0.4,
+            supply_voltage_v: 11.1,
+            motor_inertia_kgm2: 1.1e-6,
+            prop_inertia_kgm2: 2.4e-6,
+            torque_coefficient_nms2: 1.4e-8,
+            delay_s: 0.004,
+        })
+        .unwrap();
         // sampled at 130 Hz like the seed's dynamometer
         let t: Vec<f64> = (0..40).map(|k| k as f64 / 130.0).collect();
         let s = truth.simulate_step(800.0, 1400.0, 0.31, 1e-5).unwrap();

@@ -1,7 +1,8 @@
-//! Mission segments as TOML text, for tests and benches that write their missions in code.
-//! Numbers print in Rust's shortest round-trip form (`30.0`, `1e-320`), so the mission a test
-//! flies is the one its arguments name; the keys are those of `fixtures/missions/example.toml`.
-#![allow(dead_code)] // not every user takes every segment
+//! Mission segments as TOML text, for the tests, benches and examples that write their missions
+//! in code: each function gives one `[[segment]]` table of a mission file, and a mission is their
+//! concatenation (`[take_off(30.0, 2.0), leg(100.0, 0.0, 8.0), landing(1.0)].concat()`). Numbers
+//! print in Rust's shortest round-trip form (`30.0`, `1e-320`), so the mission a test flies is the
+//! one its arguments name; the keys are those of `fixtures/missions/example.toml`.
 
 /// A vertical take-off to `altitude_m` above home at `climb_rate_mps`.
 pub fn take_off(altitude_m: f64, climb_rate_mps: f64) -> String {
@@ -59,4 +60,10 @@ pub fn orbit(
          radius_m = {radius_m:?}\nground_speed_mps = {ground_speed_mps:?}\n\
          direction = \"{direction}\"\n{until}\n"
     )
+}
+
+/// `segment` (a leg or an orbit) flown at `altitude_m` above home instead of the height it starts
+/// at.
+pub fn at_altitude(segment: String, altitude_m: f64) -> String {
+    format!("{segment}altitude_m = {altitude_m:?}\n")
 }
