@@ -15,7 +15,7 @@ use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT};
 use super::files::Names;
-use super::{engine_message, error, json_type, Shared};
+use super::{engine_message, error, json_type, Refused, Shared};
 
 /// The query of a request: its keys and values in order.
 pub(super) type QueryPairs = Query<Vec<(String, String)>>;
@@ -53,7 +53,7 @@ pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> Response {
 
 /// An answer, or the refusal that ends the request early (a 4xx with its JSON error): handlers
 /// return it so that each refusal is one `?`.
-pub(super) type Answered = Result<Response, Response>;
+pub(super) type Answered = Result<Response, Refused>;
 
 /// `GET /api/endurance?OPTIONS`.
 pub(super) async fn endurance(
@@ -131,8 +131,8 @@ pub(super) fn flags<T: FlagGroup>(
     request: &str,
     query: &[(String, String)],
     shared: &Shared,
-) -> Result<T, Response> {
-    let bad = |m: String| error(StatusCode::BAD_REQUEST, &m);
+) -> Result<T, Refused> {
+    let bad = |m: String| Refused::from(error(StatusCode::BAD_REQUEST, &m));
     let file_options = file_keywords::<T>();
     let names = Names(&shared.files);
     // Each key's values, in order: one is a value (or a switch), several are a list.

@@ -15,7 +15,7 @@ use axum::response::Response;
 use futures_util::{Stream, StreamExt};
 
 use super::conn::BODY_IDLE_TIMEOUT;
-use super::error;
+use super::{error, Refused};
 
 /// Largest mission body, bytes.
 pub(super) const MISSION_LIMIT: usize = aloft::engine::MAX_INPUT_BYTES as usize;
@@ -25,13 +25,13 @@ pub(super) fn within_declared(
     headers: &HeaderMap,
     limit: usize,
     what: &str,
-) -> Result<(), Response> {
+) -> Result<(), Refused> {
     let declared = headers
         .get(header::CONTENT_LENGTH)
         .and_then(|v| v.to_str().ok())
         .and_then(|v| v.parse::<u64>().ok());
     match declared {
-        Some(d) if d > limit as u64 => Err(too_large(limit, what)),
+        Some(d) if d > limit as u64 => Err(too_large(limit, what).into()),
         _ => Ok(()),
     }
 }

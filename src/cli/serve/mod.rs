@@ -212,6 +212,22 @@ async fn not_allowed(method: axum::http::Method, uri: axum::http::Uri) -> Respon
     )
 }
 
+/// A request refused before its answer (a 4xx with its JSON error), boxed: an answer is large,
+/// and a refusal travels up through `?`.
+pub(super) struct Refused(Box<Response>);
+
+impl From<Response> for Refused {
+    fn from(response: Response) -> Self {
+        Self(Box::new(response))
+    }
+}
+
+impl IntoResponse for Refused {
+    fn into_response(self) -> Response {
+        *self.0
+    }
+}
+
 /// A JSON error answer.
 fn error(status: StatusCode, message: &str) -> Response {
     let body = serde_json::json!({ "error": message }).to_string();
