@@ -50,6 +50,24 @@ pub enum Error {
     /// Work stopped because its caller no longer wants the answer (a client that went away).
     #[error("the work was cancelled: its answer is no longer wanted")]
     Cancelled,
+    /// No way of cutting a mission into sorties keeps the reserve (`aloft plan`).
+    #[error("no plan keeps the reserve: {reason}")]
+    NoPlan {
+        /// Why (the part of the route a full pack cannot fly out and back).
+        reason: String,
+    },
+    /// A mission format `aloft plan` does not write.
+    #[error("aloft plan writes aloft TOML and JSON missions; {format} files are not written yet")]
+    PlanFormat {
+        /// The input's format.
+        format: &'static str,
+    },
+    /// A file that would be overwritten.
+    #[error("{path} exists: give --force to overwrite it")]
+    FileExists {
+        /// The file.
+        path: String,
+    },
     /// A CSV input lacks a required column.
     #[error("{origin}: missing column '{column}' (none of the {columns} columns of its first line is named so)")]
     ColumnMissing {

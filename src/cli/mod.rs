@@ -13,6 +13,7 @@ mod mission_args;
 mod mission_view;
 mod output;
 mod payload_sweep;
+mod plan;
 mod plot;
 mod power;
 mod propulsion;
@@ -63,6 +64,9 @@ enum Command {
     Mission(Box<mission_args::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
     Endurance(endurance::EnduranceArgs),
+    /// The missions to fly: one file per battery, cut where each pack reaches the reserve, at
+    /// the speeds the wind favours.
+    Plan(Box<plan::PlanArgs>),
     /// A local web server whose JSON API is the command line (`/api/mission`, `/api/endurance`,
     /// `/api/vehicles`).
     #[cfg(feature = "serve")]
@@ -107,6 +111,7 @@ pub fn main() -> ExitCode {
         Command::Live(args) => live::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
+        Command::Plan(args) => plan::run(*args),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve::run(args),
     };

@@ -19,6 +19,7 @@ use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
 use super::fit::{fit_parameter, FitRequest};
+use super::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
 use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
 use super::logs::{FlightLogs, LogReadOptions};
 use super::mission_file::Mission;
@@ -606,6 +607,73 @@ pub struct MissionScenarioFlags {
     /// Its scenarios.
     #[command(flatten)]
     pub scenarios: ScenarioFlags,
+}
+
+/// `wind|energy|keep`, parsed into the engine's [`SpeedChoice`].
+fn speeds_parser() -> impl TypedValueParser<Value = SpeedChoice> {
+    words([
+        (
+            "wind",
+            "Legs without a speed of their own at the speed of least energy in their wind",
+            SpeedChoice::Wind,
+        ),
+        (
+            "energy",
+            "Every leg at the speed of least energy in its wind, the operator's speeds too",
+            SpeedChoice::Energy,
+        ),
+        ("keep", "Every speed as it is", SpeedChoice::Keep),
+    ])
+}
+
+/// The options of `aloft plan` (the mission's, and how the plan is made).
+#[derive(Debug, Clone, Args)]
+pub struct PlanFlags {
+    /// The mission's options.
+    #[command(flatten)]
+    pub mission: MissionFlags,
+    /// How far back along the route a sortie resumes, m: it re-flies that much of where the
+    /// last one turned home (for a survey's image overlap).
+    #[arg(value_parser = finite(), long, default_value_t = DEFAULT_OVERLAP_M, value_name = "M",
+        allow_negative_numbers = true)]
+    pub overlap_m: f64,
+    /// Which legs are given the ground speed that costs least energy per metre in their wind.
+    #[arg(long, value_parser = speeds_parser(), default_value = "wind", value_name = "WHICH")]
+    pub speeds: SpeedChoice,
+    /// Highest ground speed a leg is given, m/s (the vehicle's limits apply anyway).
+    #[arg(value_parser = finite(), long, value_name = "M/S", allow_negative_numbers = true)]
+    pub max_speed: Option<f64>,
+}
+
+impl PlanFlags {
+    /// The engine's plan request of these flags.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] for an overlap or a top speed out of range.
+    pub fn request(&self) -> Result<FlyPlanRequest, Error> {
+        if !(0.0..=1000.0).contains(&self.overlap_m) {
+            return Err(Error::InvalidInput {
+                name: "overlap_m",
+                value: self.overlap_m,
+                unit: "m",
+                expected: "from 0 to 1000 m",
+            });
+        }
+        if let Some(v) = self.max_speed.filter(|v| !(*v > 0.0 && *v <= 100.0)) {
+            return Err(Error::InvalidInput {
+                name: "max_speed",
+                value: v,
+                unit: "m/s",
+                expected: "a ground speed above 0 and at most 100 m/s",
+            });
+        }
+        Ok(FlyPlanRequest {
+            options: self.mission.options(),
+            overlap_m: self.overlap_m,
+            speeds: self.speeds,
+            max_speed_mps: self.max_speed,
+        })
+    }
 }
 
 /// The route ahead of `aloft live` (`--route`).

@@ -260,23 +260,14 @@ fn plan_in(
         vehicle: vehicle.name().to_string(),
         source: Box::new(e),
     };
-    check_options(options)?;
-    let flight = Flight {
-        aircraft,
-        pack: &battery,
-        wind,
-        options: planner_options(options, mission.spec())?,
-    };
-    let (spec, planning_speed) = flown_spec(mission, vehicle, options);
-    let (spec, loiter) =
-        match resolve_loiter(&flight, &spec, options.payload_kg).map_err(in_mission)? {
-            Some((flown, loiter)) => (flown, Some(loiter)),
-            None => (spec, None),
-        };
-    let (spec, way_home_note) = flight.home_at_mission_end(spec);
-    let compiled = flight
-        .compile(&spec, options.payload_kg)
-        .map_err(in_mission)?;
+    let Prepared {
+        flight,
+        spec,
+        compiled,
+        planning_speed,
+        loiter,
+        way_home_note,
+    } = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
     let (report, plot_samples) = fly_into_outputs(&flight, &compiled, outputs, in_mission)?;
     // A vehicle that cannot make progress somewhere cannot fly that part on any pack.
     let stuck = matches!(report.shortfall, Some(Shortfall::NoProgress(_)));
@@ -332,6 +323,66 @@ fn plan_in(
         context,
         compiled,
         plot_samples,
+    })
+}
+
+/// A request's flight and the mission it flies: the spec with the options applied, a loiter
+/// until the reserve resolved and the way home of a mission that ends in the air added, compiled.
+pub(super) struct Prepared<'a> {
+    /// What every flight of the request shares.
+    pub(super) flight: Flight<'a>,
+    /// The mission flown.
+    pub(super) spec: MissionSpec,
+    /// It compiled.
+    pub(super) compiled: aloft_planner::Mission,
+    /// The planning speed applied, when the options or the vehicle gave one.
+    pub(super) planning_speed: Option<super::flown::PlanningSpeed>,
+    /// The loiter until the reserve, when the mission ends in one.
+    pub(super) loiter: Option<super::loiter::LoiterSummary>,
+    /// Why a way home was added, when it was.
+    pub(super) way_home_note: Option<String>,
+}
+
+/// The steps before a request's flight (see [`Prepared`]), with the aircraft, pack and wind it
+/// flies.
+///
+/// # Errors
+/// Invalid options, and a mission the planner refuses.
+pub(super) fn prepare<'a>(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    (aircraft, pack, wind): (&'a aloft_planner::Aircraft, &'a Pack, &'a Wind),
+) -> Result<Prepared<'a>, Error> {
+    let in_mission = |e| Error::Mission {
+        origin: mission.origin().to_string(),
+        vehicle: vehicle.name().to_string(),
+        source: Box::new(e),
+    };
+    check_options(options)?;
+    let flight = Flight {
+        aircraft,
+        pack,
+        wind,
+        options: planner_options(options, mission.spec())?,
+    };
+    let (spec, planning_speed) = flown_spec(mission, vehicle, options);
+    let (spec, loiter) =
+        match resolve_loiter(&flight, &spec, options.payload_kg).map_err(in_mission)? {
+            Some((flown, loiter)) => (flown, Some(loiter)),
+            None => (spec, None),
+        };
+    let (spec, way_home_note) = flight.home_at_mission_end(spec);
+    let compiled = flight
+        .compile(&spec, options.payload_kg)
+        .map_err(in_mission)?;
+    Ok(Prepared {
+        flight,
+        spec,
+        compiled,
+        planning_speed,
+        loiter,
+        way_home_note,
     })
 }
 

@@ -56,6 +56,7 @@ mod fit;
 pub mod flags;
 mod flight;
 mod flown;
+mod fly_plan;
 mod keywords;
 mod live;
 mod logs;
@@ -93,6 +94,10 @@ pub use estimator::InFlightEstimator;
 pub use files::{read_text_file, MAX_INPUT_BYTES};
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use flown::PlanningSpeed;
+pub use fly_plan::{
+    plan_to_fly, FlyPlan, FlyPlanRequest, FlySortie, PlanChanges, PlanFigures, SpeedChange,
+    SpeedChoice, DEFAULT_OVERLAP_M,
+};
 pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::{
     follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveRecorder, LiveReplayRequest,

@@ -16,9 +16,18 @@
 //!    the air;
 //! 3. the sortie to that end, with its way home, is flown; while it does not land with the
 //!    reserve (its return is the mission's, not the point of no return's best-range one), the
-//!    end is searched by bisection among the earlier segments.
+//!    end is searched by bisection among the earlier segments;
+//! 4. with [`SplitOptions::inside_legs`] (`aloft plan`), the sortie then goes on into the next
+//!    segment when it is a leg: the farthest point along it from which the sortie still lands
+//!    with the reserve, found by bisection to a metre, ends it (a waypoint is added there), so
+//!    that a pack is used to the reserve rather than to the last whole item;
+//! 5. with [`SplitOptions::overlap_m`], the next sortie resumes that far back along the route's
+//!    legs (it re-flies the stretch, as an operator resuming a survey a few waypoints back does
+//!    for the images' overlap), never before where the sortie it follows began.
 //!
-//! Each sortie's answer is its own flight: energy, end state of charge, duration.
+//! A leg is straight from where the one before it ends to its waypoint, its height changing
+//! evenly along it: a point a fraction of the way along is that fraction of the way in all three
+//! coordinates. Each sortie's answer is its own flight: energy, end state of charge, duration.
 
 use serde::{Deserialize, Serialize};
 
@@ -66,6 +75,56 @@ pub(super) struct Sorties {
     pub(super) note: Option<String>,
 }
 
+/// How sorties are cut: at whole segments (`aloft mission`), or inside legs with an overlap
+/// (`aloft plan`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct SplitOptions {
+    /// End a sortie inside a leg when the pack allows part of it (module step 4).
+    pub(super) inside_legs: bool,
+    /// How far back along the route's legs the next sortie resumes, m (module step 5).
+    pub(super) overlap_m: f64,
+}
+
+/// A point of the route where a sortie ends: the end of segment `segment` (`fraction` 1), or a
+/// point `fraction` of the way along it (a leg).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Cut {
+    /// The segment, an index of the mission's segments.
+    pub(super) segment: usize,
+    /// How far along it, 0 (exclusive) to 1.
+    pub(super) fraction: f64,
+}
+
+impl Cut {
+    fn whole(segment: usize) -> Self {
+        Self {
+            segment,
+            fraction: 1.0,
+        }
+    }
+
+    fn is_whole(self) -> bool {
+        self.fraction >= 1.0
+    }
+}
+
+/// One sortie: where it resumes the route (`None`: the mission's own start), where it leaves it
+/// (`None`: the mission's own end), its mission and its flight.
+#[derive(Debug, Clone)]
+pub(super) struct SortiePlan {
+    /// The point it flies to after its take-off (the last one's end, less the overlap).
+    pub(super) start: Option<Cut>,
+    /// The point it turns home at.
+    pub(super) end: Option<Cut>,
+    /// Its mission: take-off, transit, route, way home.
+    pub(super) spec: MissionSpec,
+    /// Its flight.
+    pub(super) report: MissionReport,
+    /// The mission's segments it flies, whole or in part (the first sortie's take-off and the
+    /// last one's way down included).
+    pub(super) route: std::ops::Range<usize>,
+}
+
 /// The sorties of `spec` (compiled as `compiled`), a mission one pack cannot fly; a route that
 /// cannot be split says why (a sortie that cannot be compiled or flown is one that cannot be
 /// flown).
@@ -74,42 +133,76 @@ pub(super) fn split(flight: &Flight<'_>, spec: &MissionSpec, compiled: &Compiled
         Ok(r) => r,
         Err(why) => return unsplit(why),
     };
-    let mut sorties = Vec::new();
-    let mut start = route.first;
+    match plan_sorties(flight, &route, SplitOptions::default()) {
+        Ok(plans) => {
+            let mut sorties: Vec<SortieSummary> = plans.iter().map(|p| route.summary(p)).collect();
+            let batteries_required = u32::try_from(sorties.len()).ok();
+            if sorties.len() == 1 {
+                sorties.clear();
+            }
+            Sorties {
+                batteries_required,
+                sorties,
+                note: None,
+            }
+        }
+        Err(why) => unsplit(why),
+    }
+}
+
+/// The sorties of `spec` cut as `options` say, each with its mission and its flight; or why the
+/// route cannot be split.
+pub(super) fn sortie_plans(
+    flight: &Flight<'_>,
+    spec: &MissionSpec,
+    compiled: &Compiled,
+    options: SplitOptions,
+) -> Result<Vec<SortiePlan>, String> {
+    let route = Route::of(spec, compiled)?;
+    plan_sorties(flight, &route, options)
+}
+
+/// The sorties of `route`, greedily (module steps 1-5).
+fn plan_sorties(
+    flight: &Flight<'_>,
+    route: &Route<'_>,
+    options: SplitOptions,
+) -> Result<Vec<SortiePlan>, String> {
+    let mut plans: Vec<SortiePlan> = Vec::new();
+    let mut start: Option<Cut> = None;
+    if options.inside_legs {
+        route.within_reach(flight)?;
+    }
     loop {
-        if sorties.len() == MAX_SORTIES {
-            return unsplit(format!("the route takes more than {MAX_SORTIES} sorties"));
+        if plans.len() == MAX_SORTIES {
+            return Err(format!("the route takes more than {MAX_SORTIES} sorties"));
         }
-        let rest = flight.trial(&route.sortie(flight, start, None), None);
-        let rest = match rest {
-            Ok(r) => r,
-            Err(e) => return unsplit(format!("a sortie cannot be flown: {e}")),
-        };
+        let spec = route.sortie(flight, start, None);
+        let rest = flight
+            .trial(&spec, None)
+            .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
+        let from = start.map_or(0, |_| route.resumes_at(start));
         if rest.feasible {
-            sorties.push(route.summary(start, None, &rest));
-            break;
+            plans.push(SortiePlan {
+                start,
+                end: None,
+                spec,
+                report: rest,
+                route: from..route.spec.segments.len(),
+            });
+            return Ok(plans);
         }
-        let Some((end, report)) = sortie_end(flight, &route, start, &rest) else {
-            let seg = &spec.segments[start];
-            let name = match seg.item() {
-                Some(i) => format!("item {i} ({})", seg.kind()),
-                None => format!("segment {} ({})", start + 1, seg.kind()),
-            };
-            return unsplit(format!(
-                "{name} cannot be flown from home and back with the reserve on one pack"
-            ));
+        let Some((end, spec, report)) = sortie_end(flight, route, start, &rest, options) else {
+            return Err(route.cannot_fly(start));
         };
-        sorties.push(route.summary(start, Some(end), &report));
-        start = end + 1;
-    }
-    let batteries_required = u32::try_from(sorties.len()).ok();
-    if sorties.len() == 1 {
-        sorties.clear();
-    }
-    Sorties {
-        batteries_required,
-        sorties,
-        note: None,
+        plans.push(SortiePlan {
+            start,
+            end: Some(end),
+            spec,
+            report,
+            route: from..end.segment + 1,
+        });
+        start = Some(route.back_along(end, options.overlap_m, start));
     }
 }
 
@@ -132,44 +225,121 @@ fn unsplit(why: String) -> Sorties {
     }
 }
 
-/// The end of the sortie that starts at segment `start` (see the module's steps 2 and 3) and its
-/// flight; `None` when not even its first segment can be flown there and back.
+/// A sortie's end, its mission and its flight.
+type Ending = (Cut, MissionSpec, MissionReport);
+
+/// The end of the sortie that starts at `start` (see the module's steps 2 to 4) and its flight;
+/// `None` when not even the beginning of its route can be flown there and back.
 fn sortie_end(
     flight: &Flight<'_>,
     route: &Route<'_>,
-    start: usize,
+    start: Option<Cut>,
     rest: &MissionReport,
-) -> Option<(usize, MissionReport)> {
+    options: SplitOptions,
+) -> Option<Ending> {
+    let whole = whole_end(flight, route, start, rest);
+    if !options.inside_legs {
+        return whole;
+    }
+    let next = whole
+        .as_ref()
+        .map_or(route.resumes_at(start), |(c, _, _)| c.segment + 1);
+    partial_end(flight, route, start, next).or(whole)
+}
+
+/// The last whole segment a sortie from `start` can end with (module steps 2 and 3).
+fn whole_end(
+    flight: &Flight<'_>,
+    route: &Route<'_>,
+    start: Option<Cut>,
+    rest: &MissionReport,
+) -> Option<Ending> {
     // Without a point of no return (every straight return held, yet the mission's own way down
     // lands short), every segment of the route is a candidate.
     let limit_s = rest.point_of_no_return.map_or(f64::INFINITY, |p| p.time_s);
     let ends = route.ends_before(start, rest, limit_s);
     // A sortie that cannot be compiled (a transit beyond a limit) is one that cannot be flown.
-    let try_end = |end: usize| {
-        flight
-            .trial(&route.sortie(flight, start, Some(end)), None)
-            .ok()
-            .filter(|r| r.feasible)
-    };
+    let try_end = |end: usize| route.try_sortie(flight, start, Cut::whole(end));
     // The candidate first, then bisection among the earlier ends (fewer segments, less energy
     // before the return).
     let &candidate = ends.last()?;
-    if let Some(r) = try_end(candidate) {
-        return Some((candidate, r));
+    if let Some(found) = try_end(candidate) {
+        return Some(found);
     }
     let (mut lo, mut hi) = (0usize, ends.len() - 1); // ends[hi] fails; find the last that holds
     let mut best = None;
     while lo < hi {
         let mid = (lo + hi) / 2;
         match try_end(ends[mid]) {
-            Some(r) => {
-                best = Some((ends[mid], r));
+            Some(found) => {
+                best = Some(found);
                 lo = mid + 1;
             }
             None => hi = mid,
         }
     }
     best
+}
+
+/// Bisection on the fraction of a leg stops when the interval is shorter than this, m.
+const CUT_RESOLUTION_M: f64 = 1.0;
+
+/// The farthest point of leg `segment` a sortie from `start` can end at (module step 4), when
+/// the segment is a leg of the route beyond `start`.
+fn partial_end(
+    flight: &Flight<'_>,
+    route: &Route<'_>,
+    start: Option<Cut>,
+    segment: usize,
+) -> Option<Ending> {
+    let length_m = route.leg_length_m(segment)?;
+    let mut lo = match start {
+        Some(c) if c.segment == segment => c.fraction,
+        _ => 0.0,
+    };
+    let mut hi = 1.0;
+    let mut best = None;
+    // Each step halves the interval; 64 steps reach any leg's metre.
+    for _ in 0..64 {
+        if (hi - lo) * length_m < CUT_RESOLUTION_M {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        match route.try_sortie(
+            flight,
+            start,
+            Cut {
+                segment,
+                fraction: mid,
+            },
+        ) {
+            Some(found) => {
+                best = Some(found);
+                lo = mid;
+            }
+            None => hi = mid,
+        }
+    }
+    best
+}
+
+/// Where each of the `n` segments of `compiled` ends, ENU m (a segment without a piece where the
+/// one before it ended, home before the first).
+pub(super) fn segment_ends_m(compiled: &Compiled, n: usize) -> Vec<[f64; 3]> {
+    let mut end_m: Vec<Option<[f64; 3]>> = vec![None; n];
+    for p in compiled.pieces() {
+        if let Some(slot) = end_m.get_mut(p.segment) {
+            *slot = Some(p.end_m());
+        }
+    }
+    let mut last = compiled.home_m();
+    end_m
+        .into_iter()
+        .map(|e| {
+            last = e.unwrap_or(last);
+            last
+        })
+        .collect()
 }
 
 /// The route of a mission and what its sorties need to know about it.
@@ -185,6 +355,8 @@ struct Route<'a> {
     payload_kg: Vec<f64>,
     /// The take-off's climb rate, m/s.
     climb_rate_mps: f64,
+    /// Home, ENU m.
+    home_m: [f64; 3],
 }
 
 impl<'a> Route<'a> {
@@ -212,22 +384,18 @@ impl<'a> Route<'a> {
             return Err("the mission has no route between its take-off and landing".to_string());
         }
         let n = segments.len();
-        let mut end_m: Vec<Option<[f64; 3]>> = vec![None; n];
         let mut phase: Vec<Option<usize>> = vec![None; n];
         for p in compiled.pieces() {
-            end_m[p.segment] = Some(p.end_m());
             phase[p.segment].get_or_insert(p.mass_phase);
         }
         let payloads = compiled.payloads_kg();
-        let (mut last_end, mut last_phase) = (compiled.home_m(), 0);
-        let mut ends = Vec::with_capacity(n);
+        let mut last_phase = 0;
         let mut payload_kg = Vec::with_capacity(n);
-        for i in 0..n {
-            last_end = end_m[i].unwrap_or(last_end);
-            last_phase = phase[i].unwrap_or(last_phase);
-            ends.push(last_end);
+        for p in phase {
+            last_phase = p.unwrap_or(last_phase);
             payload_kg.push(payloads.get(last_phase).copied().unwrap_or(0.0));
         }
+        let ends = segment_ends_m(compiled, n);
         Ok(Self {
             spec,
             first: 1,
@@ -235,19 +403,147 @@ impl<'a> Route<'a> {
             end_m: ends,
             payload_kg,
             climb_rate_mps,
+            home_m: compiled.home_m(),
         })
+    }
+
+    /// The first segment of the route a sortie from `start` flies (the remainder of a leg it
+    /// resumes inside of, else the one after).
+    fn resumes_at(&self, start: Option<Cut>) -> usize {
+        match start {
+            None => self.first,
+            Some(c) if c.is_whole() => c.segment + 1,
+            Some(c) => c.segment,
+        }
+    }
+
+    /// Where segment `segment` begins, ENU m.
+    fn start_m(&self, segment: usize) -> [f64; 3] {
+        match segment.checked_sub(1) {
+            Some(previous) => self.end_m[previous],
+            None => self.home_m,
+        }
+    }
+
+    /// The length of segment `segment` when it is a leg of the route (before its way down), m.
+    fn leg_length_m(&self, segment: usize) -> Option<f64> {
+        let is_leg = matches!(
+            self.spec.segments.get(segment),
+            Some(SegmentSpec::Leg { .. })
+        );
+        if !is_leg || segment < self.first || segment >= self.tail {
+            return None;
+        }
+        let (a, b) = (self.start_m(segment), self.end_m[segment]);
+        Some((b[0] - a[0]).hypot(b[1] - a[1]).hypot(b[2] - a[2]))
+    }
+
+    /// The point of the route at `cut`, ENU m.
+    pub(super) fn point_m(&self, cut: Cut) -> [f64; 3] {
+        let (a, b) = (self.start_m(cut.segment), self.end_m[cut.segment]);
+        let f = cut.fraction.clamp(0.0, 1.0);
+        [0, 1, 2].map(|k| a[k] + f * (b[k] - a[k]))
+    }
+
+    /// The point `overlap_m` back along the route's legs from `end` (module step 5), no farther
+    /// back than where the sortie from `start` began, nor across a segment that is not a leg.
+    fn back_along(&self, end: Cut, overlap_m: f64, start: Option<Cut>) -> Cut {
+        let floor = start.map_or((self.first, 0.0), |c| match c.is_whole() {
+            true => (c.segment + 1, 0.0),
+            false => (c.segment, c.fraction),
+        });
+        let (mut segment, mut fraction, mut left_m) = (end.segment, end.fraction, overlap_m);
+        while left_m > 0.0 {
+            let Some(length_m) = self.leg_length_m(segment).filter(|l| *l > 0.0) else {
+                break;
+            };
+            let lowest = if segment == floor.0 { floor.1 } else { 0.0 };
+            let available_m = (fraction - lowest) * length_m;
+            if available_m >= left_m {
+                fraction -= left_m / length_m;
+                break;
+            }
+            left_m -= available_m;
+            fraction = lowest;
+            if segment <= floor.0 || lowest > 0.0 {
+                break;
+            }
+            segment -= 1;
+            fraction = 1.0;
+        }
+        match fraction > 0.0 {
+            true => Cut { segment, fraction },
+            // At a leg's start: the end of the segment before it.
+            false => Cut::whole(segment - 1),
+        }
+    }
+
+    /// The sortie from `start` to `end` with its flight, when it lands with the reserve (one
+    /// that cannot be compiled, a transit beyond a limit, cannot be flown).
+    fn try_sortie(&self, flight: &Flight<'_>, start: Option<Cut>, end: Cut) -> Option<Ending> {
+        let spec = self.sortie(flight, start, Some(end));
+        let report = flight.trial(&spec, None).ok().filter(|r| r.feasible)?;
+        Some((end, spec, report))
+    }
+
+    /// Whether a pack can fly to the route's farthest point from home and back (a sortie that
+    /// only goes there): when it cannot, no way of cutting the route keeps the reserve, and the
+    /// sorties cut inside legs would otherwise creep toward that point by ever shorter steps.
+    ///
+    /// # Errors
+    /// The farthest point and its item (or segment), when it is out of reach.
+    fn within_reach(&self, flight: &Flight<'_>) -> Result<(), String> {
+        let home = self.home_m;
+        let distance = |p: [f64; 3]| (p[0] - home[0]).hypot(p[1] - home[1]);
+        let Some(far) = (self.first..self.tail)
+            .max_by(|&a, &b| distance(self.end_m[a]).total_cmp(&distance(self.end_m[b])))
+        else {
+            return Ok(());
+        };
+        let cut = Cut::whole(far);
+        let mut spec = self.spec.clone();
+        spec.payload_kg = self.payload_kg[far];
+        spec.allow_end_in_air = false;
+        spec.segments = self.resume(cut, far + 1).to_vec();
+        spec.segments.extend(flight.way_home(self.spec));
+        if flight.trial(&spec, None).is_ok_and(|r| r.feasible) {
+            return Ok(());
+        }
+        let seg = &self.spec.segments[far];
+        let name = match seg.item() {
+            Some(i) => format!("item {i}"),
+            None => format!("segment {}", far + 1),
+        };
+        Err(format!(
+            "the route reaches {:.0} m from home at {name} ({}): a full pack cannot fly there and \
+             back with the reserve",
+            distance(self.end_m[far]),
+            seg.kind()
+        ))
+    }
+
+    /// Why no sortie from `start` can be flown.
+    fn cannot_fly(&self, start: Option<Cut>) -> String {
+        let at = self.resumes_at(start);
+        let seg = &self.spec.segments[at.min(self.spec.segments.len() - 1)];
+        let name = match seg.item() {
+            Some(i) => format!("item {i} ({})", seg.kind()),
+            None => format!("segment {} ({})", at + 1, seg.kind()),
+        };
+        format!("{name} cannot be flown from home and back with the reserve on one pack")
     }
 
     /// The ends a sortie from `start` may have (segments of the route that end in the air)
     /// completed by mission time `limit_s` in `rest`, the flight of the rest of the route from
     /// `start`.
-    fn ends_before(&self, start: usize, rest: &MissionReport, limit_s: f64) -> Vec<usize> {
+    fn ends_before(&self, start: Option<Cut>, rest: &MissionReport, limit_s: f64) -> Vec<usize> {
         let prefix = self.prefix_len(start);
+        let from = self.resumes_at(start);
         let mut t = 0.0;
         let mut ends = Vec::new();
         for s in &rest.segments {
             t += s.duration_s;
-            let Some(original) = (s.index - 1).checked_sub(prefix).map(|k| start + k) else {
+            let Some(original) = (s.index - 1).checked_sub(prefix).map(|k| from + k) else {
                 continue;
             };
             if original >= self.tail || t > limit_s {
@@ -262,50 +558,31 @@ impl<'a> Route<'a> {
 
     /// Segments a sortie from `start` flies before the route: the first sortie flies the
     /// mission's own take-off (segment 0); the others a take-off and a transit.
-    fn prefix_len(&self, start: usize) -> usize {
-        if start == self.first {
-            self.first
-        } else {
-            2
+    fn prefix_len(&self, start: Option<Cut>) -> usize {
+        match start {
+            None => self.first,
+            Some(_) => 2,
         }
     }
 
-    /// The mission of the sortie from `start` to `end` (the route's end and the mission's way
-    /// down when `None`).
-    fn sortie(&self, flight: &Flight<'_>, start: usize, end: Option<usize>) -> MissionSpec {
+    /// The mission of the sortie from `start` (`None`: the mission's own start) to `end` (the
+    /// route's end and the mission's way down when `None`).
+    fn sortie(&self, flight: &Flight<'_>, start: Option<Cut>, end: Option<Cut>) -> MissionSpec {
         let spec = self.spec;
+        let from = self.resumes_at(start);
         let mut s = spec.clone();
-        s.payload_kg = self.payload_kg[start];
+        s.payload_kg = self.payload_kg[from];
         s.allow_end_in_air = false;
         let mut segments = Vec::new();
-        if start == self.first {
-            segments.extend_from_slice(&spec.segments[..start]);
-        } else {
-            let [east_m, north_m, up_m] = self.end_m[start - 1];
-            segments.push(SegmentSpec::TakeOff {
-                altitude_m: up_m,
-                climb_rate_mps: self.climb_rate_mps,
-                item: None,
-            });
-            segments.push(SegmentSpec::Leg {
-                east_m: Some(east_m),
-                north_m: Some(north_m),
-                latitude_deg: None,
-                longitude_deg: None,
-                altitude_m: Some(up_m),
-                ground_speed_mps: match spec.default_speed_mps {
-                    Some(_) => None,
-                    None => first_speed(&spec.segments[start..]),
-                },
-                payload_after_kg: None,
-                acceptance_radius_m: None,
-                item: None,
-            });
+        match start {
+            None => segments.extend_from_slice(&spec.segments[..from]),
+            Some(c) => segments.extend(self.resume(c, from)),
         }
         match end {
-            None => segments.extend_from_slice(&spec.segments[start..]),
+            None => segments.extend_from_slice(&spec.segments[from..]),
             Some(e) => {
-                segments.extend_from_slice(&spec.segments[start..=e]);
+                segments.extend_from_slice(&spec.segments[from..e.segment]);
+                segments.push(self.to_cut(e));
                 segments.extend(flight.way_home(spec));
             }
         }
@@ -313,11 +590,72 @@ impl<'a> Route<'a> {
         s
     }
 
-    /// The answer of the sortie from `start` to `end` (`None`: to the mission's end).
-    fn summary(&self, start: usize, end: Option<usize>, report: &MissionReport) -> SortieSummary {
+    /// A take-off at home to the height of `cut` and a straight transit there, at the planning
+    /// speed (else the first speed of the route from `from`, else none).
+    fn resume(&self, cut: Cut, from: usize) -> [SegmentSpec; 2] {
+        let spec = self.spec;
+        let [east_m, north_m, up_m] = self.point_m(cut);
+        [
+            SegmentSpec::TakeOff {
+                altitude_m: up_m,
+                climb_rate_mps: self.climb_rate_mps,
+                item: None,
+            },
+            SegmentSpec::Leg {
+                east_m: Some(east_m),
+                north_m: Some(north_m),
+                latitude_deg: None,
+                longitude_deg: None,
+                altitude_m: Some(up_m),
+                ground_speed_mps: match spec.default_speed_mps {
+                    Some(_) => None,
+                    None => first_speed(&spec.segments[from..]),
+                },
+                payload_after_kg: None,
+                acceptance_radius_m: None,
+                item: None,
+            },
+        ]
+    }
+
+    /// The segment that ends the route at `cut`: the segment itself when whole, else its leg
+    /// to the point (the item's speed and number kept, its payload change not reached).
+    fn to_cut(&self, cut: Cut) -> SegmentSpec {
+        let segment = self.spec.segments[cut.segment].clone();
+        if cut.is_whole() {
+            return segment;
+        }
+        let [east, north, up] = self.point_m(cut);
+        match segment {
+            SegmentSpec::Leg {
+                ground_speed_mps,
+                acceptance_radius_m,
+                item,
+                ..
+            } => SegmentSpec::Leg {
+                east_m: Some(east),
+                north_m: Some(north),
+                latitude_deg: None,
+                longitude_deg: None,
+                altitude_m: Some(up),
+                ground_speed_mps,
+                payload_after_kg: None,
+                acceptance_radius_m,
+                item,
+            },
+            other => other,
+        }
+    }
+
+    /// The answer of a sortie.
+    fn summary(&self, plan: &SortiePlan) -> SortieSummary {
         let segments = &self.spec.segments;
-        let first = if start == self.first { 0 } else { start };
-        let last = end.unwrap_or(segments.len() - 1);
+        let first = match plan.start {
+            None => 0,
+            Some(_) => self.resumes_at(plan.start),
+        };
+        let last = plan.end.map_or(segments.len() - 1, |c| c.segment);
+        let report = &plan.report;
         SortieSummary {
             first_item: segments[first..=last].iter().find_map(SegmentSpec::item),
             last_item: segments[first..=last]

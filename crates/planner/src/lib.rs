@@ -158,8 +158,8 @@ pub use plan::{
     PointOfNoReturn, Sample, SampleSink, SegmentReport, Shortfall, Stuck, DEFAULT_MAX_SAMPLES,
 };
 pub use queries::{
-    best_range, endurance, endurance_at_power_s, orbit_power_w, sweep_speed, BestRange,
-    EnduranceQuery, EnduranceReport, SweepRow,
+    best_range, best_range_within_limits, endurance, endurance_at_power_s, orbit_power_w,
+    sweep_speed, BestRange, EnduranceQuery, EnduranceReport, SweepRow,
 };
 pub use replay::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint, ReplayReport};
 pub use trim::{attitude_rad, bank_rad, Trim, TRIM_BLOCK};

@@ -149,6 +149,30 @@ pub fn best_range(
     }
 }
 
+/// [`best_range`] within the vehicle's speed and its envelope's steady airspeed (the limits
+/// [`endurance`] searches within): the ground speed along `course` that costs least energy per
+/// metre in the horizontal wind `wind_mps`.
+///
+/// # Errors
+/// As [`best_range`].
+pub fn best_range_within_limits(
+    p: &Powered<'_>,
+    course: [f64; 2],
+    wind_mps: [f64; 2],
+) -> Result<BestRange, PlannerError> {
+    best_range(p, course, wind_mps, max_airspeed_mps(p))
+}
+
+/// The most airspeed the searches take: the vehicle's speed, capped by its envelope's steady
+/// airspeed at the mass flown.
+fn max_airspeed_mps(p: &Powered<'_>) -> f64 {
+    let envelope = Envelope::of(p.aircraft().airframe(), p.aircraft().gravity_mps2());
+    p.aircraft()
+        .airframe()
+        .max_speed_mps()
+        .min(envelope.max_level_airspeed_mps(p).0)
+}
+
 /// Time the pack delivers a constant `power_w` from `start_soc` down to `stop_soc`, s; stops early
 /// at the cut-off voltage; 0 when the pack cannot deliver the power at all.
 ///
@@ -335,12 +359,7 @@ pub fn endurance(
     crate::error::reserve_fraction(q.reserve_fraction)?;
     let stop = stop_soc(battery, q.reserve_fraction);
     // The searches stay within the vehicle's speed and its envelope's steady airspeed.
-    let envelope = Envelope::of(p.aircraft().airframe(), p.aircraft().gravity_mps2());
-    let vmax = p
-        .aircraft()
-        .airframe()
-        .max_speed_mps()
-        .min(envelope.max_level_airspeed_mps(p).0);
+    let vmax = max_airspeed_mps(p);
     let hover_power_w = p.level_power_w([-q.wind_mps[0], -q.wind_mps[1]], q.course)?;
     let hover_endurance_s = endurance_at_power_s(battery, hover_power_w, q.start_soc, stop);
     // Best endurance: in the air mass, so along any heading in still air.

@@ -1,0 +1,130 @@
+//! `aloft plan`: the missions to fly, one file per battery, at the speeds the wind favours,
+//! beside the mission as given.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{bail, Result};
+use clap::Args;
+
+use aloft::engine::flags::PlanFlags;
+use aloft::engine::{plan_to_fly, FlyPlan, Mission, PlanFigures, Vehicle};
+
+use super::mission_view::mmss;
+use super::output;
+use super::{Format, Outcome};
+
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// Mission file (any format `aloft mission` reads; the files written are in its format).
+    /// Without it, the built-in demonstration.
+    pub mission: Option<PathBuf>,
+    /// The mission's options and how the plan is made.
+    #[command(flatten)]
+    pub flags: PlanFlags,
+    /// Folder to write the files into (created if missing), named MISSION-K-of-N.EXT.
+    #[arg(short = 'o', long, value_name = "DIR")]
+    pub output: PathBuf,
+    /// Overwrite files that exist.
+    #[arg(long)]
+    pub force: bool,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+}
+
+pub fn run(args: PlanArgs) -> Result<Outcome> {
+    if args.format == Format::Csv {
+        bail!("aloft plan writes table or json");
+    }
+    let vehicle = Vehicle::load(&args.flags.mission.vehicle)?;
+    let mission = Mission::load(args.mission.as_deref())?;
+    let request = args.flags.request()?;
+    let mut plan = match plan_to_fly(&vehicle, &mission, &request) {
+        Ok(p) => p,
+        // No plan keeps the reserve: the answer of an infeasible mission, no file written.
+        Err(aloft::Error::NoPlan { reason }) => {
+            let mut out = std::io::stdout().lock();
+            match args.format {
+                Format::Json => writeln!(
+                    out,
+                    "{}",
+                    serde_json::json!({ "feasible": false, "reason": reason })
+                )?,
+                _ => writeln!(out, "NO PLAN keeps the reserve: {reason}")?,
+            }
+            return Ok(Outcome::Failed);
+        }
+        Err(e) => return Err(e.into()),
+    };
+    plan.write(&args.output, args.force)?;
+    output::print_table_or_json(args.format, &plan, |out| write_table(out, &plan))?;
+    Ok(Outcome::Ok)
+}
+
+/// The plan beside the mission as given, its sorties and what changed.
+fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
+    let row = |out: &mut dyn Write, name: &str, f: &PlanFigures| -> std::io::Result<()> {
+        writeln!(
+            out,
+            "  {name:<10} {:>9} {:>10.1} {:>11}",
+            f.batteries,
+            f.energy_wh,
+            mmss(f.duration_s)
+        )
+    };
+    writeln!(
+        out,
+        "  {:<10} {:>9} {:>10} {:>11}",
+        "", "batteries", "energy Wh", "time min:s"
+    )?;
+    if let Some(given) = &plan.as_given {
+        row(out, "as given", given)?;
+    }
+    let figures = PlanFigures {
+        batteries: plan.batteries,
+        energy_wh: plan.energy_wh,
+        duration_s: plan.duration_s,
+    };
+    row(out, "plan", &figures)?;
+    writeln!(out)?;
+    writeln!(out, "Sorties")?;
+    writeln!(
+        out,
+        "   #  items      energy     min:s  battery end  point of no return  file"
+    )?;
+    for (k, s) in plan.sorties.iter().enumerate() {
+        let items = match (s.first_item, s.last_item) {
+            (Some(a), Some(b)) => format!("{a}-{b}"),
+            _ => "-".to_string(),
+        };
+        let pnr = s
+            .point_of_no_return_s
+            .map_or_else(|| "none".to_string(), mmss);
+        writeln!(
+            out,
+            "  {:>2}  {items:<9} {:>6.1} Wh {:>7} {:>10.1} %  {pnr:>18}  {}",
+            k + 1,
+            s.energy_wh,
+            mmss(s.duration_s),
+            100.0 * s.end_soc,
+            s.file
+        )?;
+    }
+    let speeds = &plan.changes.speeds;
+    if !speeds.is_empty() {
+        writeln!(out)?;
+        writeln!(
+            out,
+            "{} legs at the speed of least energy in their wind",
+            speeds.len()
+        )?;
+    }
+    if plan.changes.cut_inside_legs {
+        writeln!(
+            out,
+            "sorties end inside legs, where each pack reaches the reserve"
+        )?;
+    }
+    Ok(())
+}

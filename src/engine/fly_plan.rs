@@ -1,0 +1,526 @@
+//! Plans to fly (`aloft plan`): the missions aloft would fly for an operator's mission, one per
+//! battery, at the speeds the wind favours.
+//!
+//! The steps, each candidate flown by the planner that answers `aloft mission`:
+//!
+//! 1. **As given**: the mission planned as `aloft mission` plans it, split into sorties at whole
+//!    items (`as_given` in the answer).
+//! 2. **Speeds for the wind** ([`SpeedChoice`]): each leg at the ground speed that costs least
+//!    energy per metre along its course in the wind at its height
+//!    ([`aloft_planner::best_range_within_limits`]: within the vehicle's speed and its steady
+//!    envelope), at most `max_speed_mps`, rounded to 0.1 m/s. A speed the operator set on a leg
+//!    is kept unless [`SpeedChoice::Energy`]; [`SpeedChoice::Keep`] changes none.
+//! 3. **Sorties cut inside legs** ([`super::sorties`], steps 4 and 5): each pack used to the
+//!    reserve, the next sortie resuming `overlap_m` back along the route.
+//! 4. **The best**: of the candidates (the mission's own speeds and the wind's, each cut inside
+//!    legs, and the as-given split), the one with the fewest batteries, then the least energy; so
+//!    the plan never needs more batteries or energy than the mission as given.
+//! 5. **Files**, one per sortie in the input's format ([`FlyPlan::files`]), each a complete
+//!    mission that `aloft mission` flies in the same conditions to the sortie's answer.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use aloft_missions::SourceFormat;
+use aloft_planner::{best_range_within_limits, MissionSpec, SegmentSpec, Wind};
+
+use super::finite::finite;
+use super::mission::{plan_mission, prepare, Prepared};
+use super::mission_file::Mission;
+use super::mission_options::MissionOptions;
+use super::sorties::{segment_ends_m, sortie_plans, SortiePlan, SplitOptions};
+use super::vehicles::Vehicle;
+use super::wind::mission_wind;
+use crate::error::Error;
+
+/// How far back along the route a sortie resumes by default, m: a frame of a survey camera at
+/// the usual 10-30 m trigger distance, so that the last images of one sortie and the first of the
+/// next overlap (QGroundControl issue #4254 asks for a few waypoints back).
+pub const DEFAULT_OVERLAP_M: f64 = 10.0;
+
+/// Which legs get the wind's speed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpeedChoice {
+    /// Legs without a speed of their own (they fly the planning speed, which is no per-leg
+    /// choice); a speed the operator set is kept.
+    #[default]
+    Wind,
+    /// Every leg, the operator's speeds too.
+    Energy,
+    /// No leg: every speed as it is.
+    Keep,
+}
+
+/// What `aloft plan` is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlyPlanRequest {
+    /// The mission's options (as `aloft mission`'s).
+    pub options: MissionOptions,
+    /// How far back along the route a sortie resumes, m.
+    pub overlap_m: f64,
+    /// Which legs get the wind's speed.
+    pub speeds: SpeedChoice,
+    /// Highest ground speed a leg is given, m/s (the vehicle's own limits apply anyway).
+    pub max_speed_mps: Option<f64>,
+}
+
+impl Default for FlyPlanRequest {
+    fn default() -> Self {
+        Self {
+            options: MissionOptions::default(),
+            overlap_m: DEFAULT_OVERLAP_M,
+            speeds: SpeedChoice::default(),
+            max_speed_mps: None,
+        }
+    }
+}
+
+/// The figures of a way of flying the mission.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlanFigures {
+    /// Packs it takes.
+    pub batteries: u32,
+    /// Energy of all its flights, Wh.
+    pub energy_wh: f64,
+    /// Flight time of all its flights, s.
+    pub duration_s: f64,
+}
+
+/// One sortie of the plan: one file, one pack.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlySortie {
+    /// Its file's name.
+    pub file: String,
+    /// The first item of the input it flies (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_item: Option<u32>,
+    /// The last item of the input it flies, whole or in part.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub last_item: Option<u32>,
+    /// Where it turns home inside a leg: the fraction of that leg flown (absent: at an item).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ends_inside_leg_fraction: Option<f64>,
+    /// Electrical energy drawn from its pack, Wh.
+    pub energy_wh: f64,
+    /// Flight time, take-off to landing, s.
+    pub duration_s: f64,
+    /// State of charge of its pack at landing.
+    pub end_soc: f64,
+    /// Its point of no return, s after take-off (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_of_no_return_s: Option<f64>,
+}
+
+/// A leg given another speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedChange {
+    /// The leg's item (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub item: Option<u32>,
+    /// The leg, from 1.
+    pub segment: usize,
+    /// Its ground speed as given (absent: the planning speed), m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from_mps: Option<f64>,
+    /// Its ground speed in the plan, m/s.
+    pub to_mps: f64,
+}
+
+/// What changed from the mission as given.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PlanChanges {
+    /// Legs given another speed.
+    pub speeds: Vec<SpeedChange>,
+    /// Whether the sorties end inside legs (else at items, as given).
+    pub cut_inside_legs: bool,
+}
+
+/// The answer of `aloft plan`: the plan beside the mission as given, its sorties and files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlyPlan {
+    /// The files, in flight order (their paths once written, else their names).
+    pub files: Vec<String>,
+    /// Packs the plan takes.
+    pub batteries: u32,
+    /// Energy of all its flights, Wh.
+    pub energy_wh: f64,
+    /// Flight time of all its flights, s.
+    pub duration_s: f64,
+    /// The sorties, one per file.
+    pub sorties: Vec<FlySortie>,
+    /// The mission as given, split at whole items as `aloft mission` splits it (absent when
+    /// it cannot be split so).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub as_given: Option<PlanFigures>,
+    /// What changed.
+    pub changes: PlanChanges,
+    /// The files' texts, in flight order (not in the JSON: written by [`FlyPlan::write`]).
+    #[serde(skip)]
+    pub texts: Vec<String>,
+}
+
+/// Plan the missions to fly for `mission` with `vehicle` (module steps 1-5).
+///
+/// # Errors
+/// As [`plan_mission`]; [`Error::NoPlan`] when no way of cutting the route keeps the reserve (a
+/// leg a full pack cannot fly out and back); a mission format aloft cannot write yet.
+pub fn plan_to_fly(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+) -> Result<FlyPlan, Error> {
+    let options = &request.options;
+    let as_given = as_given_figures(vehicle, mission, options)?;
+    let (wind, _) = mission_wind(options, mission, vehicle)?;
+    let aircraft = vehicle.aircraft()?;
+    let battery = vehicle.battery(options.battery.as_deref())?;
+    let prepared = prepare(vehicle, mission, options, (aircraft, &battery, &wind))?;
+    let candidates = candidates(vehicle, &prepared, &wind, request)?;
+    let best = best_candidate(&prepared, candidates)?;
+    let plan = answer(mission, &best, as_given)?;
+    finite(plan, "plan", || {
+        format!(
+            "plan of mission {} with {}",
+            mission.origin(),
+            vehicle.name()
+        )
+    })
+}
+
+/// The mission as given: its batteries and the energy and time of its sorties (or its one
+/// flight).
+fn as_given_figures(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+) -> Result<Option<PlanFigures>, Error> {
+    let plan = plan_mission(vehicle, mission, options)?;
+    let summary = plan.summary();
+    let Some(batteries) = summary.batteries_required else {
+        return Ok(None);
+    };
+    let (energy_wh, duration_s) = match summary.sorties.is_empty() {
+        true => (summary.energy_wh, summary.duration_s),
+        false => summary
+            .sorties
+            .iter()
+            .fold((0.0, 0.0), |(e, t), s| (e + s.energy_wh, t + s.duration_s)),
+    };
+    Ok(Some(PlanFigures {
+        batteries,
+        energy_wh,
+        duration_s,
+    }))
+}
+
+/// A way of flying the mission: its spec, how it is cut and the speeds changed.
+struct Candidate {
+    spec: MissionSpec,
+    split: SplitOptions,
+    speeds: Vec<SpeedChange>,
+}
+
+/// The candidates of module step 4.
+fn candidates(
+    vehicle: &Vehicle,
+    prepared: &Prepared<'_>,
+    wind: &Wind,
+    request: &FlyPlanRequest,
+) -> Result<Vec<Candidate>, Error> {
+    let inside = SplitOptions {
+        inside_legs: true,
+        overlap_m: request.overlap_m,
+    };
+    let mut out = vec![
+        Candidate {
+            spec: prepared.spec.clone(),
+            split: inside,
+            speeds: Vec::new(),
+        },
+        Candidate {
+            spec: prepared.spec.clone(),
+            split: SplitOptions::default(),
+            speeds: Vec::new(),
+        },
+    ];
+    if request.speeds != SpeedChoice::Keep {
+        let (spec, speeds) = speeds_for_wind(vehicle, prepared, wind, request)?;
+        if !speeds.is_empty() {
+            out.push(Candidate {
+                spec,
+                split: inside,
+                speeds,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The spec with its legs at the wind's speeds (module step 2), and the legs changed.
+fn speeds_for_wind(
+    vehicle: &Vehicle,
+    prepared: &Prepared<'_>,
+    wind: &Wind,
+    request: &FlyPlanRequest,
+) -> Result<(MissionSpec, Vec<SpeedChange>), Error> {
+    let flight = &prepared.flight;
+    let payload = prepared
+        .compiled
+        .payloads_kg()
+        .first()
+        .copied()
+        .unwrap_or(0.0);
+    let mass = vehicle.takeoff_mass_with(flight.pack, payload)?;
+    let powered = flight
+        .aircraft
+        .at_mass(mass.total_kg, request.options.aoa)?;
+    let mut spec = prepared.spec.clone();
+    let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
+    let mut changes = Vec::new();
+    for (i, segment) in spec.segments.iter_mut().enumerate() {
+        let SegmentSpec::Leg {
+            ground_speed_mps,
+            item,
+            ..
+        } = segment
+        else {
+            continue;
+        };
+        if request.speeds == SpeedChoice::Wind && ground_speed_mps.is_some() {
+            continue;
+        }
+        let start = if i == 0 {
+            prepared.compiled.home_m()
+        } else {
+            ends[i - 1]
+        };
+        let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), request.max_speed_mps) else {
+            continue;
+        };
+        if ground_speed_mps.is_some_and(|g| (g - v).abs() < 0.05) {
+            continue;
+        }
+        changes.push(SpeedChange {
+            item: *item,
+            segment: i + 1,
+            from_mps: *ground_speed_mps,
+            to_mps: v,
+        });
+        *ground_speed_mps = Some(v);
+    }
+    Ok((spec, changes))
+}
+
+/// The ground speed of least energy per metre along the leg from `a` to `b` in the wind at its
+/// middle, at most the vehicle's speed and `max_mps`, rounded down to 0.1 m/s; `None` for a leg without a horizontal course
+/// (shorter than 1 m) or without headway.
+fn leg_speed_mps(
+    powered: &aloft_planner::Powered<'_>,
+    wind: &Wind,
+    (a, b): ([f64; 3], [f64; 3]),
+    max_mps: Option<f64>,
+) -> Option<f64> {
+    let (de, dn) = (b[0] - a[0], b[1] - a[1]);
+    let length_m = de.hypot(dn);
+    if length_m < 1.0 {
+        return None;
+    }
+    let course = [de / length_m, dn / length_m];
+    let middle = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+    let w = wind.mean_at(middle)?;
+    let best = best_range_within_limits(powered, course, [w[0], w[1]]).ok()?;
+    // The vehicle's speed bounds its ground speed too (the planner holds a leg's ground speed at
+    // it), whatever a tail wind would allow.
+    let vehicle_mps = powered.aircraft().airframe().max_speed_mps();
+    let v = best
+        .ground_speed_mps
+        .min(vehicle_mps)
+        .min(max_mps.unwrap_or(f64::INFINITY));
+    let rounded = (v * 10.0).floor() / 10.0;
+    (rounded > 0.0).then_some(rounded)
+}
+
+/// A candidate cut into sorties, with its figures.
+struct Flown {
+    candidate: Candidate,
+    plans: Vec<SortiePlan>,
+    figures: PlanFigures,
+}
+
+/// The best candidate (module step 4).
+///
+/// # Errors
+/// [`Error::NoPlan`] when none can be cut into sorties that keep the reserve.
+fn best_candidate(prepared: &Prepared<'_>, candidates: Vec<Candidate>) -> Result<Flown, Error> {
+    let mut best: Option<Flown> = None;
+    // Why the first candidate (the route cut inside legs, as given) has no plan.
+    let mut why: Option<String> = None;
+    for candidate in candidates {
+        let flight = &prepared.flight;
+        let compiled = match flight.compile(&candidate.spec, None) {
+            Ok(c) => c,
+            Err(e) => {
+                why.get_or_insert(e.to_string());
+                continue;
+            }
+        };
+        match sortie_plans(flight, &candidate.spec, &compiled, candidate.split) {
+            Ok(plans) => {
+                let figures = figures(&plans);
+                let better = best.as_ref().is_none_or(|b| {
+                    (figures.batteries, figures.energy_wh)
+                        < (b.figures.batteries, b.figures.energy_wh)
+                });
+                if better {
+                    best = Some(Flown {
+                        candidate,
+                        plans,
+                        figures,
+                    });
+                }
+            }
+            Err(e) => {
+                why.get_or_insert(e);
+            }
+        }
+    }
+    best.ok_or_else(|| Error::NoPlan {
+        reason: why.unwrap_or_default(),
+    })
+}
+
+/// The figures of a set of sorties.
+fn figures(plans: &[SortiePlan]) -> PlanFigures {
+    PlanFigures {
+        batteries: u32::try_from(plans.len()).unwrap_or(u32::MAX),
+        energy_wh: plans.iter().map(|p| p.report.energy_wh).sum(),
+        duration_s: plans.iter().map(|p| p.report.duration_s).sum(),
+    }
+}
+
+/// The answer of the best candidate: its sorties named as files in the input's format.
+fn answer(
+    mission: &Mission,
+    best: &Flown,
+    as_given: Option<PlanFigures>,
+) -> Result<FlyPlan, Error> {
+    let (stem, extension) = file_stem_and_extension(mission)?;
+    let n = best.plans.len();
+    let mut files = Vec::with_capacity(n);
+    let mut texts = Vec::with_capacity(n);
+    let mut sorties = Vec::with_capacity(n);
+    for (k, plan) in best.plans.iter().enumerate() {
+        let file = format!("{stem}-{}-of-{n}.{extension}", k + 1);
+        texts.push(sortie_text(mission, plan, k + 1, n)?);
+        sorties.push(sortie_answer(&file, plan, &best.candidate.spec));
+        files.push(file);
+    }
+    Ok(FlyPlan {
+        files,
+        batteries: best.figures.batteries,
+        energy_wh: best.figures.energy_wh,
+        duration_s: best.figures.duration_s,
+        sorties,
+        as_given,
+        changes: PlanChanges {
+            speeds: best.candidate.speeds.clone(),
+            cut_inside_legs: best.candidate.split.inside_legs
+                && best
+                    .plans
+                    .iter()
+                    .any(|p| p.end.is_some_and(|c| c.fraction < 1.0)),
+        },
+        texts,
+    })
+}
+
+/// One sortie's answer.
+fn sortie_answer(file: &str, plan: &SortiePlan, spec: &MissionSpec) -> FlySortie {
+    let items = || {
+        spec.segments[plan.route.clone()]
+            .iter()
+            .filter_map(SegmentSpec::item)
+    };
+    FlySortie {
+        file: file.to_string(),
+        first_item: items().next(),
+        last_item: items().next_back(),
+        ends_inside_leg_fraction: plan.end.filter(|c| c.fraction < 1.0).map(|c| c.fraction),
+        energy_wh: plan.report.energy_wh,
+        duration_s: plan.report.duration_s,
+        end_soc: plan.report.end_soc,
+        point_of_no_return_s: plan.report.point_of_no_return.map(|p| p.time_s),
+    }
+}
+
+/// The name a plan's files are given and their extension: the input's (the built-in demo's is
+/// `demo-survey.toml`).
+fn file_stem_and_extension(mission: &Mission) -> Result<(String, &'static str), Error> {
+    let extension = match mission.route().source_format {
+        SourceFormat::AloftToml => "toml",
+        SourceFormat::AloftJson => "json",
+        other => {
+            return Err(Error::PlanFormat {
+                format: other.as_str(),
+            })
+        }
+    };
+    let origin = Path::new(mission.origin());
+    let stem = match origin.file_stem().and_then(|s| s.to_str()) {
+        Some(s) if origin.extension().is_some() => s.to_string(),
+        _ => mission.display_name().to_string(),
+    };
+    Ok((stem, extension))
+}
+
+/// The text of sortie `k` of `n`: its mission in the input's format, named so.
+fn sortie_text(mission: &Mission, plan: &SortiePlan, k: usize, n: usize) -> Result<String, Error> {
+    let mut spec = plan.spec.clone();
+    spec.name = format!("{} ({k} of {n})", mission.display_name());
+    let text = match mission.route().source_format {
+        SourceFormat::AloftJson => serde_json::to_string_pretty(&spec).map_err(|e| e.to_string()),
+        _ => toml::to_string(&spec).map_err(|e| e.to_string()),
+    };
+    text.map_err(|message| Error::OptionsFormat {
+        what: "plan file",
+        message,
+    })
+}
+
+impl FlyPlan {
+    /// Write the files into `dir` (created if missing), each to a temporary name there first
+    /// and then renamed, so that none is ever half-written; an existing file is refused unless
+    /// `force`. The answer's `files` become their paths.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the folder or the file; an existing file without `force`.
+    pub fn write(&mut self, dir: &Path, force: bool) -> Result<(), Error> {
+        let io = |what: String| {
+            move |source| Error::Io {
+                origin: what,
+                source,
+            }
+        };
+        std::fs::create_dir_all(dir).map_err(io(format!("cannot create {}", dir.display())))?;
+        let paths: Vec<PathBuf> = self.files.iter().map(|f| dir.join(f)).collect();
+        if !force {
+            if let Some(p) = paths.iter().find(|p| p.exists()) {
+                return Err(Error::FileExists {
+                    path: p.display().to_string(),
+                });
+            }
+        }
+        for (path, text) in paths.iter().zip(&self.texts) {
+            let tmp = path.with_extension("aloft-tmp");
+            std::fs::write(&tmp, text).map_err(io(format!("cannot write {}", tmp.display())))?;
+            std::fs::rename(&tmp, path).map_err(io(format!("cannot write {}", path.display())))?;
+        }
+        self.files = paths.iter().map(|p| p.display().to_string()).collect();
+        for (sortie, file) in self.sorties.iter_mut().zip(&self.files) {
+            sortie.file.clone_from(file);
+        }
+        Ok(())
+    }
+}
