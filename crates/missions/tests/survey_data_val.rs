@@ -12,8 +12,6 @@
 //! larger: the sphere of the WGS-84 semi-major axis (QGroundControl 2024-2026) moves the lines by
 //! 1.6e-5 deg, which the test checks it sees.
 
-use std::path::{Path, PathBuf};
-
 use aloft_missions::survey::{reangle_survey_item, QgcProjection, Survey};
 use aloft_missions::{distance_m, read_plan, LatLon};
 use serde_json::Value;
