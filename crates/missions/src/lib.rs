@@ -52,6 +52,7 @@ mod error;
 mod geo;
 mod items;
 mod jumps;
+pub mod kept;
 mod notes;
 mod plan;
 mod raw_item;
@@ -61,12 +62,14 @@ mod wpl;
 
 use serde::{Deserialize, Serialize};
 
+pub use aloft_logs::telemetry::MissionItem;
 pub use aloft_planner::{HomeSpec, MissionSpec, SegmentSpec};
 pub use detect::detect;
 pub use error::{ImportError, Place};
 pub use geo::{distance_m, great_circle_m, LatLon, MEAN_RADIUS_M};
 pub use items::MIN_HEIGHT_M;
 pub use jumps::MAX_REPEATED_ITEMS;
+pub use kept::{FlownItem, Home, ItemOrigin, PlanFile, PlanHeader};
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};
@@ -137,6 +140,22 @@ pub struct Imported {
     /// regenerated ([`survey`]); empty for other formats. The segments fly the items stored in
     /// the file either way.
     pub surveys: Vec<survey::ImportedSurvey>,
+    /// The home as the file gives it (`plannedHomePosition`, the `.waypoints` home row, a
+    /// link's item 0 when it is a home row), where it has one; `spec.home` is where aloft puts
+    /// home (the first position of a file without a usable home row).
+    pub home: Option<Home>,
+    /// The file's mission items in file order (home excluded), as a `.waypoints` row or a
+    /// MAVLink item holds them: `seq` is the item's number (the `item` of its segments), NaN a
+    /// parameter not set. A `.plan`'s surveys and corridor scans are flattened, their stored
+    /// items numbered in sequence; a DO_JUMP's p1 is the target as the file names it (a
+    /// `doJumpId` in a `.plan`, a row INDEX in a `.waypoints` file).
+    pub items: Vec<MissionItem>,
+    /// A `.plan`'s header and the entry each item came from; none for other formats.
+    pub plan: Option<PlanFile>,
+    /// The items in flying order (DO_JUMPs unrolled, up to where the route ends), each with the
+    /// range of `spec.segments` it produced: the ranges follow each other and cover every
+    /// segment ([`kept`] lists the segments the reader adds, and to which item).
+    pub flown: Vec<FlownItem>,
 }
 
 /// Read a planner file (`.plan` or `.waypoints`) recognised from its content.
@@ -165,10 +184,11 @@ pub fn import_bytes(bytes: &[u8]) -> Result<Imported, ImportError> {
     import(text)
 }
 
-/// The spec, route and warnings of a translation.
+/// The spec, route and warnings of a translation of `items`; `home` as the file gives it.
 fn assemble(
     translation: items::Translation,
     source: &items::Source,
+    (items, home): (&[raw_item::RawItem], Option<Home>),
     format: SourceFormat,
     description: String,
 ) -> Imported {
@@ -195,6 +215,10 @@ fn assemble(
         format,
         counted: translation.counts,
         surveys: Vec::new(),
+        home,
+        items: items.iter().map(raw_item::RawItem::mission_item).collect(),
+        plan: None,
+        flown: translation.flown,
     }
 }
 

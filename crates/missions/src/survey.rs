@@ -315,6 +315,8 @@ pub struct ImportedSurvey {
     /// Its description, or why it cannot be regenerated (the reader flies the stored items
     /// either way).
     pub survey: Result<Survey, ImportError>,
+    /// The complex item as the file holds it: what [`reangle_survey_item`] takes.
+    pub complex_item: serde_json::Value,
 }
 
 /// A refused value of the description, as [`ImportError::BadKey`].

@@ -17,6 +17,7 @@ use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
+use crate::kept::Home;
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
 use crate::{assemble, Imported, SourceFormat};
@@ -100,6 +101,7 @@ fn from_rows(
     what: &str,
 ) -> Result<Imported, ImportError> {
     let mut notes = Notes::default();
+    let home_row = home_row(&rows);
     let (home, home_amsl_m, items) = split_home(rows, &mut notes)?;
     let source = Source {
         home,
@@ -110,7 +112,24 @@ fn from_rows(
     };
     let translation = translate(&items, &source, notes)?;
     let description = format!("{what}, {} items", items.len());
-    Ok(assemble(translation, &source, format, description))
+    Ok(assemble(
+        translation,
+        &source,
+        (&items, home_row),
+        format,
+        description,
+    ))
+}
+
+/// The home row (INDEX 0, NAV_WAYPOINT, frame 0) as written, when the first row is one.
+fn home_row(rows: &[RawItem]) -> Option<Home> {
+    rows.first()
+        .filter(|r| r.number == 0 && r.command == 16 && r.frame == 0)
+        .map(|r| Home {
+            latitude_deg: r.params[4],
+            longitude_deg: r.params[5],
+            altitude_amsl_m: Some(r.params[6]),
+        })
 }
 
 /// One line (number `line`, from 1) as an item.
@@ -167,9 +186,7 @@ fn split_home(
     mut rows: Vec<RawItem>,
     notes: &mut Notes,
 ) -> Result<(LatLon, Option<f64>, Vec<RawItem>), ImportError> {
-    let home_row = rows
-        .first()
-        .is_some_and(|r| r.number == 0 && r.command == 16 && r.frame == 0);
+    let home_row = home_row(&rows).is_some();
     if home_row {
         let h = rows.remove(0);
         let [.., lat, lon, alt] = h.params;
