@@ -4,7 +4,9 @@
 //! `INDEX CURRENT FRAME COMMAND P1 P2 P3 P4 LAT LON ALT AUTOCONTINUE` (QGroundControl's
 //! `MissionItem::load(QTextStream&)` and ArduPilot's `AP_Mission` text format). CRLF line ends,
 //! trailing blank space and blank lines are tolerated; a line whose fields are separated by
-//! spaces instead of tabs is read when it has 12 of them.
+//! spaces instead of tabs is read when it has 12 of them. P1-P4 may be `NaN` (or `nan`): MAVLink's
+//! "not set", as a `.plan`'s `null` (Mission Planner writes a NaN parameter so, pymavlink as
+//! `nan`); LAT, LON and ALT must be finite numbers.
 //!
 //! Row 0 is the home position (AMSL altitude) when it is a home row: INDEX 0, NAV_WAYPOINT (16),
 //! frame 0. A script-written file whose row 0 is something else (a take-off) keeps it as a
@@ -46,8 +48,8 @@ const FIELDS: [&str; 12] = [
 ///
 /// # Errors
 /// A header other than `QGC WPL 110`, a line without 12 fields, a field that is not a finite
-/// number (naming the line and the column), no home position, and the errors of the items'
-/// semantics (see the crate's docs).
+/// number (naming the line and the column; P1-P4 may also be `NaN`, "not set"), no home
+/// position, and the errors of the items' semantics (see the crate's docs).
 pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
     let text = text.trim_start_matches('\u{feff}');
     let mut lines = text.lines().enumerate();
@@ -158,10 +160,11 @@ fn row(line: usize, text: &str) -> Result<RawItem, ImportError> {
     let mut params = [0.0; 7];
     for (j, p) in params.iter_mut().enumerate() {
         let k = 4 + j;
+        // P1-P4 may be NaN (MAVLink's "not set", as Mission Planner writes a NaN parameter).
         *p = fields[k]
             .parse::<f64>()
             .ok()
-            .filter(|v| v.is_finite())
+            .filter(|v| v.is_finite() || (j < 4 && v.is_nan()))
             .ok_or_else(|| ImportError::BadField {
                 line,
                 field: FIELDS[k],
@@ -272,6 +275,20 @@ mod tests {
         assert_eq!(err(&inf), "line 3: field P1 is \"inf\", not a number");
         let index = format!("QGC WPL 110\n{HOME}\n-1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1\n");
         assert_eq!(err(&index), "line 3: field INDEX is \"-1\", not a number");
+    }
+
+    /// Mission Planner writes a NaN parameter `NaN`, pymavlink `nan`: P1-P4 not set.
+    #[test]
+    fn nan_in_p1_to_p4_is_not_set_and_refused_in_a_position() {
+        let t = format!(
+            "QGC WPL 110\n{HOME}\n{TAKEOFF}\n2\t0\t3\t16\tnan\t0\t0\tNaN\t-35.001\t149.0\t20\t1\n"
+        );
+        let i = read_waypoints(&t).unwrap();
+        assert!(i.items[1].params[0].is_nan() && i.items[1].params[3].is_nan());
+        let zero = t.replace("nan", "0").replace("NaN", "0");
+        assert_eq!(i.spec, read_waypoints(&zero).unwrap().spec);
+        let lat = t.replace("-35.001", "NaN");
+        assert_eq!(err(&lat), "line 4: field LAT is \"NaN\", not a number");
     }
 
     #[test]
