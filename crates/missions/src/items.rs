@@ -164,7 +164,7 @@ fn check_items(items: &[RawItem]) -> Result<(), ImportError> {
 
 /// Each parameter finite or not set; a position item's latitude within (-90, 90), longitude
 /// within [-180, 180], altitude within 1e6 m.
-fn check_params(item: &RawItem) -> Result<(), ImportError> {
+pub(crate) fn check_params(item: &RawItem) -> Result<(), ImportError> {
     const KEYS: [&str; 7] = [
         "param1",
         "param2",
@@ -203,7 +203,7 @@ fn check_params(item: &RawItem) -> Result<(), ImportError> {
 }
 
 /// Commands whose p5-p7 are a position.
-fn has_position(command: u32) -> bool {
+pub(crate) fn has_position(command: u32) -> bool {
     use commands::*;
     matches!(
         command,

@@ -59,6 +59,7 @@ mod raw_item;
 mod route;
 pub mod survey;
 mod wpl;
+pub mod write;
 
 use serde::{Deserialize, Serialize};
 
@@ -73,6 +74,7 @@ pub use kept::{FlownItem, Home, ItemOrigin, PlanFile, PlanHeader};
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};
+pub use write::{write_like_source, write_plan, write_waypoints, MissionEntry};
 
 /// The format a mission text is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
