@@ -2,7 +2,7 @@
 //!
 //! Reads QGroundControl `.plan` files and Mission Planner / ArduPilot `.waypoints` files
 //! ("QGC WPL 110") into the same [`MissionSpec`] that aloft's own TOML and JSON missions produce,
-//! and computes the planned [`RouteFigures`] of any mission spec.
+//! computes the planned [`RouteFigures`] of any mission spec, and writes both formats ([`write`]).
 //!
 //! Sans-I/O: every function takes the text (or bytes) handed to it and returns data or an
 //! [`ImportError`]; opening files is the caller's job, so the readers can be fuzzed and embedded.
@@ -18,7 +18,12 @@
 //!   mission spec, whatever its source;
 //! - `geo.rs`: per-leg distances on the WGS-84 ellipsoid;
 //! - [`survey`]: a QGroundControl survey's description, and its transects and items regenerated
-//!   exactly as QGroundControl draws them (also at a new grid angle, for a writer).
+//!   exactly as QGroundControl draws them (also at a new grid angle, for a writer);
+//! - [`kept`]: what the readers keep besides the spec ([`Imported::home`], [`Imported::items`],
+//!   [`Imported::plan`], [`Imported::flown`]): enough to write the file again, and to go from a
+//!   segment back to its item;
+//! - [`write`]: the writers, [`write_plan`] (`.plan`), [`write_waypoints`] (`.waypoints`) and
+//!   [`write_like_source`]; text out, read back by aloft and by MAVSDK and pymavlink in the tests.
 //!
 //! ## Frame and units
 //! Positions are WGS-84 latitude/longitude in degrees (as the files hold them); heights are
@@ -158,6 +163,17 @@ pub struct Imported {
     /// range of `spec.segments` it produced: the ranges follow each other and cover every
     /// segment ([`kept`] lists the segments the reader adds, and to which item).
     pub flown: Vec<FlownItem>,
+}
+
+impl Imported {
+    /// The item flown that produced segment `segment` of `spec.segments` (its entry of
+    /// [`Imported::flown`]: the item's index in [`Imported::items`] and its range), none past
+    /// the last segment. A repeated item (in a DO_JUMP loop) is found at the pass that made the
+    /// segment.
+    pub fn flown_item(&self, segment: usize) -> Option<&FlownItem> {
+        let k = self.flown.partition_point(|f| f.segments.end <= segment);
+        self.flown.get(k).filter(|f| f.segments.contains(&segment))
+    }
 }
 
 /// Read a planner file (`.plan` or `.waypoints`) recognised from its content.

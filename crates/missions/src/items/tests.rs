@@ -402,6 +402,10 @@ fn the_flying_order_gives_each_item_flown_its_segments() {
     ]);
     assert_eq!(i.items[5].seq, 6);
     assert_eq!(items(&i)[5..7], [Some(6), Some(6)]);
+    // From a segment back to its item: the leg of the second pass is the item at index 1.
+    assert_eq!(i.flown_item(2), Some(&i.flown[4]));
+    assert_eq!(i.flown_item(6).map(|f| i.items[f.item].seq), Some(6));
+    assert_eq!(i.flown_item(10), None);
     assert_eq!(i.items.len(), 8, "row 8 kept, never flown");
 }
 

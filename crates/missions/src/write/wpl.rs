@@ -12,8 +12,9 @@ use crate::kept::Home;
 /// A Mission Planner `.waypoints` file ("QGC WPL 110") of `entries`, `home` its row 0.
 ///
 /// # Errors
-/// The refusals of the module's docs (naming the item by its `seq`): a survey entry, a DO_JUMP,
-/// a position not set, a home without an altitude.
+/// The refusals of the module's docs, naming the item by its `seq`: a DO_JUMP, a position not
+/// set, an infinite value; a survey entry (named by the row it would take); a home without an
+/// altitude or out of range.
 pub fn write_waypoints(home: &Home, entries: &[MissionEntry]) -> Result<String, ImportError> {
     rows(Some(home), entries)
 }
