@@ -34,7 +34,7 @@ impl fmt::Display for Place {
     }
 }
 
-/// Everything the importers refuse, and what the writers ([`crate::write`]) refuse to write.
+/// Everything the importers refuse, and what the writers ([`mod@crate::write`]) refuse to write.
 /// Each message is one line that names the place ([`Place`]) and the command or key.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]

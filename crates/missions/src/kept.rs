@@ -1,5 +1,5 @@
 //! What the readers keep of a planner file besides its mission spec, so that it can be written
-//! again ([`crate::write`]) and a segment traced back to the item that made it.
+//! again ([`mod@crate::write`]) and a segment traced back to the item that made it.
 //!
 //! - [`Home`]: the home as the file gives it (`plannedHomePosition`, a `.waypoints` home row);
 //! - [`crate::Imported::items`]: the file's mission items in file order, as MAVLink items;

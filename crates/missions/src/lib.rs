@@ -2,7 +2,7 @@
 //!
 //! Reads QGroundControl `.plan` files and Mission Planner / ArduPilot `.waypoints` files
 //! ("QGC WPL 110") into the same [`MissionSpec`] that aloft's own TOML and JSON missions produce,
-//! computes the planned [`RouteFigures`] of any mission spec, and writes both formats ([`write`]).
+//! computes the planned [`RouteFigures`] of any mission spec, and writes both formats ([`mod@write`]).
 //!
 //! Sans-I/O: every function takes the text (or bytes) handed to it and returns data or an
 //! [`ImportError`]; opening files is the caller's job, so the readers can be fuzzed and embedded.
@@ -22,7 +22,7 @@
 //! - [`kept`]: what the readers keep besides the spec ([`Imported::home`], [`Imported::items`],
 //!   [`Imported::plan`], [`Imported::flown`]): enough to write the file again, and to go from a
 //!   segment back to its item;
-//! - [`write`]: the writers, [`write_plan`] (`.plan`), [`write_waypoints`] (`.waypoints`) and
+//! - [`mod@write`]: the writers, [`write_plan`] (`.plan`), [`write_waypoints`] (`.waypoints`) and
 //!   [`write_like_source`]; text out, read back by aloft and by MAVSDK and pymavlink in the tests.
 //!
 //! ## Frame and units
