@@ -34,8 +34,8 @@ impl fmt::Display for Place {
     }
 }
 
-/// Everything the importers refuse. Each message is one line that names the place ([`Place`])
-/// and the command or key.
+/// Everything the importers refuse, and what the writers ([`mod@crate::write`]) refuse to write.
+/// Each message is one line that names the place ([`Place`]) and the command or key.
 #[derive(Debug, Clone, PartialEq, Error)]
 #[non_exhaustive]
 pub enum ImportError {
@@ -129,7 +129,8 @@ pub enum ImportError {
         /// What is accepted.
         expected: &'static str,
     },
-    /// Something aloft does not fly: a VTOL or fixed-wing item or vehicle, a structure scan.
+    /// Something aloft does not fly (a VTOL or fixed-wing item or vehicle, a structure scan), or
+    /// does not write (a DO_JUMP, a survey in a `.waypoints` file).
     #[error("{at}: {what} is refused: {reason}")]
     Refused {
         /// Where.
@@ -185,6 +186,17 @@ pub enum ImportError {
         at: Place,
         /// Where a home would be.
         hint: &'static str,
+    },
+    /// A home position a writer cannot write (a coordinate out of range or not a number, no
+    /// altitude for a `.waypoints` home row).
+    #[error("home: {what} = {} is invalid: expected {expected}", Num(*.value))]
+    BadHome {
+        /// The value (`latitude`, `longitude`, `altitude above mean sea level`).
+        what: &'static str,
+        /// Its value (NaN when there is none).
+        value: f64,
+        /// What is accepted.
+        expected: &'static str,
     },
     /// A file none of whose items flies (only camera or speed items, or no items).
     #[error("no mission item that flies ({items} items read): nothing to plan")]

@@ -37,6 +37,7 @@ use crate::commands::{self, role, CommandName, Role};
 use crate::error::ImportError;
 use crate::geo::{distance_m, LatLon};
 use crate::jumps::{flying_order, JumpsBy};
+use crate::kept::FlownItem;
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
 use crate::ItemCounts;
@@ -112,6 +113,8 @@ pub(crate) struct Translation {
     pub(crate) counts: ItemCounts,
     /// Warnings.
     pub(crate) notes: Vec<String>,
+    /// The items flown, in order, with the segments each made.
+    pub(crate) flown: Vec<FlownItem>,
 }
 
 /// Fly `items` from `source`'s home.
@@ -130,7 +133,13 @@ pub(crate) fn translate(
     let mut end = None;
     for &k in &order {
         flight.reached[k] = true;
-        if let Some(why) = flight.item(&items[k])? {
+        let first = flight.segments.len();
+        let ends = flight.item(&items[k])?;
+        flight.flown.push(FlownItem {
+            item: k,
+            segments: first..flight.segments.len(),
+        });
+        if let Some(why) = ends {
             end = Some((items[k].at, why));
             break;
         }
@@ -155,7 +164,7 @@ fn check_items(items: &[RawItem]) -> Result<(), ImportError> {
 
 /// Each parameter finite or not set; a position item's latitude within (-90, 90), longitude
 /// within [-180, 180], altitude within 1e6 m.
-fn check_params(item: &RawItem) -> Result<(), ImportError> {
+pub(crate) fn check_params(item: &RawItem) -> Result<(), ImportError> {
     const KEYS: [&str; 7] = [
         "param1",
         "param2",
@@ -194,7 +203,7 @@ fn check_params(item: &RawItem) -> Result<(), ImportError> {
 }
 
 /// Commands whose p5-p7 are a position.
-fn has_position(command: u32) -> bool {
+pub(crate) fn has_position(command: u32) -> bool {
     use commands::*;
     matches!(
         command,
@@ -233,6 +242,7 @@ struct Flight<'a> {
     airborne: bool,
     speed_mps: Option<f64>,
     reached: Vec<bool>,
+    flown: Vec<FlownItem>,
 }
 
 impl<'a> Flight<'a> {
@@ -246,6 +256,7 @@ impl<'a> Flight<'a> {
             airborne: false,
             speed_mps: None,
             reached: vec![false; items],
+            flown: Vec::new(),
         }
     }
 

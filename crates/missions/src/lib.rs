@@ -2,7 +2,7 @@
 //!
 //! Reads QGroundControl `.plan` files and Mission Planner / ArduPilot `.waypoints` files
 //! ("QGC WPL 110") into the same [`MissionSpec`] that aloft's own TOML and JSON missions produce,
-//! and computes the planned [`RouteFigures`] of any mission spec.
+//! computes the planned [`RouteFigures`] of any mission spec, and writes both formats ([`mod@write`]).
 //!
 //! Sans-I/O: every function takes the text (or bytes) handed to it and returns data or an
 //! [`ImportError`]; opening files is the caller's job, so the readers can be fuzzed and embedded.
@@ -18,7 +18,12 @@
 //!   mission spec, whatever its source;
 //! - `geo.rs`: per-leg distances on the WGS-84 ellipsoid;
 //! - [`survey`]: a QGroundControl survey's description, and its transects and items regenerated
-//!   exactly as QGroundControl draws them (also at a new grid angle, for a writer).
+//!   exactly as QGroundControl draws them (also at a new grid angle, for a writer);
+//! - [`kept`]: what the readers keep besides the spec ([`Imported::home`], [`Imported::items`],
+//!   [`Imported::plan`], [`Imported::flown`]): enough to write the file again, and to go from a
+//!   segment back to its item;
+//! - [`mod@write`]: the writers, [`write_plan`] (`.plan`), [`write_waypoints`] (`.waypoints`) and
+//!   [`write_like_source`]; text out, read back by aloft and by MAVSDK and pymavlink in the tests.
 //!
 //! ## Frame and units
 //! Positions are WGS-84 latitude/longitude in degrees (as the files hold them); heights are
@@ -52,24 +57,29 @@ mod error;
 mod geo;
 mod items;
 mod jumps;
+pub mod kept;
 mod notes;
 mod plan;
 mod raw_item;
 mod route;
 pub mod survey;
 mod wpl;
+pub mod write;
 
 use serde::{Deserialize, Serialize};
 
+pub use aloft_logs::telemetry::MissionItem;
 pub use aloft_planner::{HomeSpec, MissionSpec, SegmentSpec};
 pub use detect::detect;
 pub use error::{ImportError, Place};
 pub use geo::{distance_m, great_circle_m, LatLon, MEAN_RADIUS_M};
 pub use items::MIN_HEIGHT_M;
 pub use jumps::MAX_REPEATED_ITEMS;
+pub use kept::{FlownItem, Home, ItemOrigin, PlanFile, PlanHeader};
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};
+pub use write::{write_like_source, write_plan, write_waypoints, MissionEntry};
 
 /// The format a mission text is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]
@@ -137,6 +147,33 @@ pub struct Imported {
     /// regenerated ([`survey`]); empty for other formats. The segments fly the items stored in
     /// the file either way.
     pub surveys: Vec<survey::ImportedSurvey>,
+    /// The home as the file gives it (`plannedHomePosition`, the `.waypoints` home row, a
+    /// link's item 0 when it is a home row), where it has one; `spec.home` is where aloft puts
+    /// home (the first position of a file without a usable home row).
+    pub home: Option<Home>,
+    /// The file's mission items in file order (home excluded), as a `.waypoints` row or a
+    /// MAVLink item holds them: `seq` is the item's number (the `item` of its segments), NaN a
+    /// parameter not set. A `.plan`'s surveys and corridor scans are flattened, their stored
+    /// items numbered in sequence; a DO_JUMP's p1 is the target as the file names it (a
+    /// `doJumpId` in a `.plan`, a row INDEX in a `.waypoints` file).
+    pub items: Vec<MissionItem>,
+    /// A `.plan`'s header and the entry each item came from; none for other formats.
+    pub plan: Option<PlanFile>,
+    /// The items in flying order (DO_JUMPs unrolled, up to where the route ends), each with the
+    /// range of `spec.segments` it produced: the ranges follow each other and cover every
+    /// segment ([`kept`] lists the segments the reader adds, and to which item).
+    pub flown: Vec<FlownItem>,
+}
+
+impl Imported {
+    /// The item flown that produced segment `segment` of `spec.segments` (its entry of
+    /// [`Imported::flown`]: the item's index in [`Imported::items`] and its range), none past
+    /// the last segment. A repeated item (in a DO_JUMP loop) is found at the pass that made the
+    /// segment.
+    pub fn flown_item(&self, segment: usize) -> Option<&FlownItem> {
+        let k = self.flown.partition_point(|f| f.segments.end <= segment);
+        self.flown.get(k).filter(|f| f.segments.contains(&segment))
+    }
 }
 
 /// Read a planner file (`.plan` or `.waypoints`) recognised from its content.
@@ -165,10 +202,11 @@ pub fn import_bytes(bytes: &[u8]) -> Result<Imported, ImportError> {
     import(text)
 }
 
-/// The spec, route and warnings of a translation.
+/// The spec, route and warnings of a translation of `items`; `home` as the file gives it.
 fn assemble(
     translation: items::Translation,
     source: &items::Source,
+    (items, home): (&[raw_item::RawItem], Option<Home>),
     format: SourceFormat,
     description: String,
 ) -> Imported {
@@ -195,6 +233,10 @@ fn assemble(
         format,
         counted: translation.counts,
         surveys: Vec::new(),
+        home,
+        items: items.iter().map(raw_item::RawItem::mission_item).collect(),
+        plan: None,
+        flown: translation.flown,
     }
 }
 

@@ -27,6 +27,7 @@ use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
+use crate::kept::{Home, ItemOrigin, PlanFile, PlanHeader};
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
 use crate::survey::{ImportedSurvey, Survey};
@@ -62,7 +63,8 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
     let (home, home_amsl_m) = planned_home(mission)?;
     let mut notes = Notes::default();
     let mut surveys = Vec::new();
-    let items = flatten(mission, &mut notes, &mut surveys)?;
+    let mut origins = Vec::new();
+    let items = flatten(mission, &mut notes, (&mut surveys, &mut origins))?;
     check_vehicle_type(mission, &mut notes)?;
     let autopilot = match mission.get("firmwareType").and_then(Value::as_u64) {
         Some(3) => Autopilot::ArduPilot,
@@ -84,9 +86,44 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
         },
         items.len()
     );
-    let mut imported = assemble(translation, &source, SourceFormat::QgcPlan, description);
+    let file_home = Home {
+        latitude_deg: home.latitude_deg,
+        longitude_deg: home.longitude_deg,
+        altitude_amsl_m: home_amsl_m,
+    };
+    let mut imported = assemble(
+        translation,
+        &source,
+        (&items, Some(file_home)),
+        SourceFormat::QgcPlan,
+        description,
+    );
     imported.surveys = surveys;
+    imported.plan = Some(PlanFile {
+        header: header(mission),
+        origins,
+    });
     Ok(imported)
+}
+
+/// The mission keys kept for a writer, where they are numbers of their type.
+fn header(mission: &Map<String, Value>) -> PlanHeader {
+    let whole = |key| {
+        mission
+            .get(key)
+            .and_then(Value::as_u64)
+            .and_then(|v| u32::try_from(v).ok())
+    };
+    let number = |key| mission.get(key).and_then(Value::as_f64);
+    PlanHeader {
+        firmware_type: whole("firmwareType"),
+        vehicle_type: whole("vehicleType"),
+        cruise_speed_mps: number("cruiseSpeed"),
+        hover_speed_mps: number("hoverSpeed"),
+        global_plan_altitude_mode: mission
+            .get("globalPlanAltitudeMode")
+            .and_then(Value::as_i64),
+    }
 }
 
 /// `fileType` must be "Plan".
@@ -201,11 +238,11 @@ fn hover_speed(mission: &Map<String, Value>, notes: &mut Notes) -> Result<f64, I
 }
 
 /// The mission's items, complex items flattened, numbered from 1; each survey's description
-/// kept in `surveys`.
+/// kept in `surveys`, each item's entry in `origins`.
 fn flatten(
     mission: &Map<String, Value>,
     notes: &mut Notes,
-    surveys: &mut Vec<ImportedSurvey>,
+    (surveys, origins): (&mut Vec<ImportedSurvey>, &mut Vec<ItemOrigin>),
 ) -> Result<Vec<RawItem>, ImportError> {
     let list = match mission.get("items") {
         Some(Value::Array(a)) => a,
@@ -221,13 +258,25 @@ fn flatten(
         None => return Err(missing(Place::File, None, &["mission.items"])),
     };
     let mut items = Vec::with_capacity(list.len());
-    for v in list {
+    for (entry, v) in list.iter().enumerate() {
         let at = Place::Item(next_number(&items)?);
         let obj = object(v, at, None, "item")?;
-        match obj.get("type").and_then(Value::as_str) {
-            Some("ComplexItem") => complex_item(v, &mut items, notes, surveys)?,
-            _ => items.push(simple_item(obj, next_number(&items)?, notes)?),
-        }
+        let before = items.len();
+        let origin = match obj.get("type").and_then(Value::as_str) {
+            Some("ComplexItem") => {
+                let survey = surveys.len();
+                let kind = complex_item(v, &mut items, notes, surveys)?;
+                match kind {
+                    ComplexKind::Survey => ItemOrigin::Survey { entry, survey },
+                    ComplexKind::CorridorScan => ItemOrigin::CorridorScan { entry },
+                }
+            }
+            _ => {
+                items.push(simple_item(obj, next_number(&items)?, notes)?);
+                ItemOrigin::Simple { entry }
+            }
+        };
+        origins.resize(origins.len() + items.len() - before, origin);
     }
     Ok(items)
 }
@@ -240,6 +289,13 @@ fn next_number(items: &[RawItem]) -> Result<u32, ImportError> {
     })
 }
 
+/// The complex items whose stored path aloft flies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum ComplexKind {
+    Survey,
+    CorridorScan,
+}
+
 /// A ComplexItem: a survey's or corridor scan's stored items (and a survey's description), or
 /// a refusal.
 fn complex_item(
@@ -247,7 +303,7 @@ fn complex_item(
     items: &mut Vec<RawItem>,
     notes: &mut Notes,
     surveys: &mut Vec<ImportedSurvey>,
-) -> Result<(), ImportError> {
+) -> Result<ComplexKind, ImportError> {
     let first_item = next_number(items)?;
     let at = Place::Item(first_item);
     let obj = object(item, at, None, "item")?;
@@ -273,9 +329,11 @@ fn complex_item(
             first_item,
             item_count: stored.len(),
             survey: Survey::from_complex_item(item, first_item),
+            complex_item: item.clone(),
         });
+        return Ok(ComplexKind::Survey);
     }
-    Ok(())
+    Ok(ComplexKind::CorridorScan)
 }
 
 /// The `complexItemType` of a complex item whose stored path aloft flies (a survey or corridor

@@ -18,3 +18,15 @@ pub(crate) struct RawItem {
     /// A `.plan`'s `doJumpId`.
     pub(crate) jump_id: Option<i64>,
 }
+
+impl RawItem {
+    /// The item as a MAVLink item (`seq` its number).
+    pub(crate) fn mission_item(&self) -> aloft_logs::telemetry::MissionItem {
+        aloft_logs::telemetry::MissionItem {
+            seq: self.number,
+            frame: self.frame,
+            command: self.command,
+            params: self.params,
+        }
+    }
+}

@@ -80,6 +80,7 @@ use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 
 pub use projection::QgcProjection;
+pub(crate) use write::number_json;
 pub use write::reangle_survey_item;
 
 /// Smallest line spacing regenerated, m (see the module's deviations).
@@ -315,6 +316,9 @@ pub struct ImportedSurvey {
     /// Its description, or why it cannot be regenerated (the reader flies the stored items
     /// either way).
     pub survey: Result<Survey, ImportError>,
+    /// The complex item as the file holds it: what [`reangle_survey_item`] takes, and what
+    /// [`crate::write_like_source`] writes back verbatim.
+    pub complex_item: serde_json::Value,
 }
 
 /// A refused value of the description, as [`ImportError::BadKey`].

@@ -4,7 +4,9 @@
 //! `INDEX CURRENT FRAME COMMAND P1 P2 P3 P4 LAT LON ALT AUTOCONTINUE` (QGroundControl's
 //! `MissionItem::load(QTextStream&)` and ArduPilot's `AP_Mission` text format). CRLF line ends,
 //! trailing blank space and blank lines are tolerated; a line whose fields are separated by
-//! spaces instead of tabs is read when it has 12 of them.
+//! spaces instead of tabs is read when it has 12 of them. P1-P4 may be `NaN` (or `nan`): MAVLink's
+//! "not set", as a `.plan`'s `null` (Mission Planner writes a NaN parameter so, pymavlink as
+//! `nan`); LAT, LON and ALT must be finite numbers.
 //!
 //! Row 0 is the home position (AMSL altitude) when it is a home row: INDEX 0, NAV_WAYPOINT (16),
 //! frame 0. A script-written file whose row 0 is something else (a take-off) keeps it as a
@@ -17,6 +19,7 @@ use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 use crate::items::{translate, Autopilot, Source};
 use crate::jumps::JumpsBy;
+use crate::kept::Home;
 use crate::notes::Notes;
 use crate::raw_item::RawItem;
 use crate::{assemble, Imported, SourceFormat};
@@ -45,8 +48,8 @@ const FIELDS: [&str; 12] = [
 ///
 /// # Errors
 /// A header other than `QGC WPL 110`, a line without 12 fields, a field that is not a finite
-/// number (naming the line and the column), no home position, and the errors of the items'
-/// semantics (see the crate's docs).
+/// number (naming the line and the column; P1-P4 may also be `NaN`, "not set"), no home
+/// position, and the errors of the items' semantics (see the crate's docs).
 pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
     let text = text.trim_start_matches('\u{feff}');
     let mut lines = text.lines().enumerate();
@@ -100,6 +103,7 @@ fn from_rows(
     what: &str,
 ) -> Result<Imported, ImportError> {
     let mut notes = Notes::default();
+    let home_row = home_row(&rows);
     let (home, home_amsl_m, items) = split_home(rows, &mut notes)?;
     let source = Source {
         home,
@@ -110,7 +114,24 @@ fn from_rows(
     };
     let translation = translate(&items, &source, notes)?;
     let description = format!("{what}, {} items", items.len());
-    Ok(assemble(translation, &source, format, description))
+    Ok(assemble(
+        translation,
+        &source,
+        (&items, home_row),
+        format,
+        description,
+    ))
+}
+
+/// The home row (INDEX 0, NAV_WAYPOINT, frame 0) as written, when the first row is one.
+fn home_row(rows: &[RawItem]) -> Option<Home> {
+    rows.first()
+        .filter(|r| r.number == 0 && r.command == 16 && r.frame == 0)
+        .map(|r| Home {
+            latitude_deg: r.params[4],
+            longitude_deg: r.params[5],
+            altitude_amsl_m: Some(r.params[6]),
+        })
 }
 
 /// One line (number `line`, from 1) as an item.
@@ -139,10 +160,11 @@ fn row(line: usize, text: &str) -> Result<RawItem, ImportError> {
     let mut params = [0.0; 7];
     for (j, p) in params.iter_mut().enumerate() {
         let k = 4 + j;
+        // P1-P4 may be NaN (MAVLink's "not set", as Mission Planner writes a NaN parameter).
         *p = fields[k]
             .parse::<f64>()
             .ok()
-            .filter(|v| v.is_finite())
+            .filter(|v| v.is_finite() || (j < 4 && v.is_nan()))
             .ok_or_else(|| ImportError::BadField {
                 line,
                 field: FIELDS[k],
@@ -167,9 +189,7 @@ fn split_home(
     mut rows: Vec<RawItem>,
     notes: &mut Notes,
 ) -> Result<(LatLon, Option<f64>, Vec<RawItem>), ImportError> {
-    let home_row = rows
-        .first()
-        .is_some_and(|r| r.number == 0 && r.command == 16 && r.frame == 0);
+    let home_row = home_row(&rows).is_some();
     if home_row {
         let h = rows.remove(0);
         let [.., lat, lon, alt] = h.params;
@@ -255,6 +275,20 @@ mod tests {
         assert_eq!(err(&inf), "line 3: field P1 is \"inf\", not a number");
         let index = format!("QGC WPL 110\n{HOME}\n-1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t20\t1\n");
         assert_eq!(err(&index), "line 3: field INDEX is \"-1\", not a number");
+    }
+
+    /// Mission Planner writes a NaN parameter `NaN`, pymavlink `nan`: P1-P4 not set.
+    #[test]
+    fn nan_in_p1_to_p4_is_not_set_and_refused_in_a_position() {
+        let t = format!(
+            "QGC WPL 110\n{HOME}\n{TAKEOFF}\n2\t0\t3\t16\tnan\t0\t0\tNaN\t-35.001\t149.0\t20\t1\n"
+        );
+        let i = read_waypoints(&t).unwrap();
+        assert!(i.items[1].params[0].is_nan() && i.items[1].params[3].is_nan());
+        let zero = t.replace("nan", "0").replace("NaN", "0");
+        assert_eq!(i.spec, read_waypoints(&zero).unwrap().spec);
+        let lat = t.replace("-35.001", "NaN");
+        assert_eq!(err(&lat), "line 4: field LAT is \"NaN\", not a number");
     }
 
     #[test]

@@ -288,6 +288,7 @@ impl Flight<'_> {
             segments: self.segments,
             counts,
             notes: self.notes.finish(),
+            flown: self.flown,
         })
     }
 }

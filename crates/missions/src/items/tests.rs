@@ -372,6 +372,43 @@ fn do_jump_repeats_by_row_index_in_waypoints_and_by_do_jump_id_in_a_plan() {
     assert_eq!(items(&p), [1, 2, 3, 2, 3].map(Some));
 }
 
+/// The flying order unrolls the jump (indices into the items, repeated), each item with the
+/// segments it made; the take-off the reader adds after a landing and the return's descent and
+/// landing are in their item's range; what follows the return is not flown.
+#[test]
+fn the_flying_order_gives_each_item_flown_its_segments() {
+    let i = wpl(&[
+        take_off(20.0),
+        row(2, 3, 16, [0.0; 4], -35.001, 149.0, 20.0),
+        row(3, 2, 178, [1.0, 4.0, 0.0, 0.0], 0.0, 0.0, 0.0),
+        row(4, 2, 177, [2.0, 1.0, 0.0, 0.0], 0.0, 0.0, 0.0),
+        row(5, 3, 21, [0.0; 4], 0.0, 0.0, 0.0),
+        row(6, 3, 16, [0.0; 4], -35.002, 149.0, 15.0),
+        row(7, 0, 20, [0.0; 4], 0.0, 0.0, 0.0),
+        row(8, 3, 16, [0.0; 4], -35.003, 149.0, 15.0),
+    ]);
+    let flown: Vec<(usize, std::ops::Range<usize>)> = i
+        .flown
+        .iter()
+        .map(|f| (f.item, f.segments.clone()))
+        .collect();
+    #[rustfmt::skip]
+    assert_eq!(flown, [
+        (0, 0..1), (1, 1..2), (2, 2..2), (3, 2..2), // take-off, leg, speed, jump
+        (1, 2..3), (2, 3..3), (3, 3..3),            // the loop once more
+        (4, 3..5),                                  // land: descent, landing
+        (5, 5..7),                                  // take-off added, leg
+        (6, 7..10),                                 // return, descent, landing
+    ]);
+    assert_eq!(i.items[5].seq, 6);
+    assert_eq!(items(&i)[5..7], [Some(6), Some(6)]);
+    // From a segment back to its item: the leg of the second pass is the item at index 1.
+    assert_eq!(i.flown_item(2), Some(&i.flown[4]));
+    assert_eq!(i.flown_item(6).map(|f| i.items[f.item].seq), Some(6));
+    assert_eq!(i.flown_item(10), None);
+    assert_eq!(i.items.len(), 8, "row 8 kept, never flown");
+}
+
 #[test]
 fn a_gripper_release_drops_the_payload_after_the_last_segment_flown() {
     let i = wpl(&[

@@ -188,12 +188,15 @@ fn item_json(item: &RawItem) -> Value {
     })
 }
 
-/// A number as Qt's JSON writes it: whole values below 2^53 as integers, NaN as `null`.
+/// A number as Qt's JSON writes it: whole values below 2^53 as integers, NaN as `null`. It
+/// reads back as the same `f64` to the last bit (serde_json writes the shortest decimal that
+/// does; -0 keeps its sign as `-0.0`).
 pub(crate) fn number_json(v: f64) -> Value {
     const EXACT: f64 = 9_007_199_254_740_992.0; // 2^53
+    let negative_zero = v == 0.0 && v.is_sign_negative();
     if !v.is_finite() {
         Value::Null
-    } else if v.fract() == 0.0 && v.abs() < EXACT {
+    } else if v.fract() == 0.0 && v.abs() < EXACT && !negative_zero {
         Value::from(v as i64)
     } else {
         Value::from(v)
