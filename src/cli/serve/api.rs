@@ -127,8 +127,6 @@ fn mission_of(body: &[u8], origin: &str) -> Result<Mission, aloft::Error> {
 /// The query's options (all but `file`) as the command's flag group, the options that name a
 /// file resolved to the files given to the server ([`Names`]); or a 400 naming the option and
 /// the `request`.
-// The refusal is the response itself, made at most once per request: boxing it saves nothing.
-#[allow(clippy::result_large_err)]
 pub(super) fn flags<T: FlagGroup>(
     request: &str,
     query: &[(String, String)],

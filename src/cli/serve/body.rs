@@ -21,8 +21,6 @@ use super::{error, Refused};
 pub(super) const MISSION_LIMIT: usize = aloft::engine::MAX_INPUT_BYTES as usize;
 
 /// 413 when the body's declared length is over `limit` bytes (`what` names the limit).
-// The refusal is the response itself, made at most once per request: boxing it saves nothing.
-#[allow(clippy::result_large_err)]
 pub(super) fn within_declared(
     headers: &HeaderMap,
     limit: usize,
