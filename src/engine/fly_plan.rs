@@ -29,7 +29,7 @@ use super::finite::finite;
 use super::mission::{plan_mission, prepare, Prepared};
 use super::mission_file::Mission;
 use super::mission_options::MissionOptions;
-use super::sorties::{segment_ends_m, sortie_plans, SortiePlan, SplitOptions};
+use super::sorties::{segment_ends_m, sortie_plans, Route, SortiePlan, SpecSorties, SplitOptions};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use crate::error::Error;
@@ -366,7 +366,18 @@ fn best_candidate(prepared: &Prepared<'_>, candidates: Vec<Candidate>) -> Result
                 continue;
             }
         };
-        match sortie_plans(flight, &candidate.spec, &compiled, candidate.split) {
+        let route = match Route::of(&candidate.spec, &compiled) {
+            Ok(r) => r,
+            Err(e) => {
+                why.get_or_insert(e);
+                continue;
+            }
+        };
+        let maker = SpecSorties {
+            route: &route,
+            flight,
+        };
+        match sortie_plans(flight, &route, candidate.split, &maker) {
             Ok(plans) => {
                 let figures = figures(&plans);
                 let better = best.as_ref().is_none_or(|b| {

@@ -133,7 +133,11 @@ pub(super) fn split(flight: &Flight<'_>, spec: &MissionSpec, compiled: &Compiled
         Ok(r) => r,
         Err(why) => return unsplit(why),
     };
-    match plan_sorties(flight, &route, SplitOptions::default()) {
+    let maker = SpecSorties {
+        route: &route,
+        flight,
+    };
+    match sortie_plans(flight, &route, SplitOptions::default(), &maker) {
         Ok(plans) => {
             let mut sorties: Vec<SortieSummary> = plans.iter().map(|p| route.summary(p)).collect();
             let batteries_required = u32::try_from(sorties.len()).ok();
@@ -150,34 +154,56 @@ pub(super) fn split(flight: &Flight<'_>, spec: &MissionSpec, compiled: &Compiled
     }
 }
 
-/// The sorties of `spec` cut as `options` say, each with its mission and its flight; or why the
-/// route cannot be split.
-pub(super) fn sortie_plans(
-    flight: &Flight<'_>,
-    spec: &MissionSpec,
-    compiled: &Compiled,
-    options: SplitOptions,
-) -> Result<Vec<SortiePlan>, String> {
-    let route = Route::of(spec, compiled)?;
-    plan_sorties(flight, &route, options)
+/// What a sortie's mission is, from where it resumes the route to where it leaves it: aloft's
+/// own segments ([`Route::sortie`]), or the items of a planner file as `aloft mission` reads them
+/// back. The route is cut the same way whatever the maker.
+pub(super) trait SortieMaker {
+    /// The mission flown from `start` (`None`: the mission's own start) to `end` (`None`: its
+    /// own end and way down).
+    ///
+    /// # Errors
+    /// Why that sortie cannot be made (a file it cannot write or read back).
+    fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String>;
 }
 
-/// The sorties of `route`, greedily (module steps 1-5).
-fn plan_sorties(
+/// The sorties' missions as aloft's own segments.
+pub(super) struct SpecSorties<'r, 'f> {
+    /// The route cut.
+    pub(super) route: &'r Route<'r>,
+    /// What every flight shares (the way home's speed and landing).
+    pub(super) flight: &'r Flight<'f>,
+}
+
+impl SortieMaker for SpecSorties<'_, '_> {
+    fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String> {
+        Ok(self.route.sortie(self.flight, start, end))
+    }
+}
+
+/// The sorties of `route` cut as `options` say, each with its mission (made by `maker`) and its
+/// flight; or why the route cannot be split.
+pub(super) fn sortie_plans(
     flight: &Flight<'_>,
     route: &Route<'_>,
     options: SplitOptions,
+    maker: &dyn SortieMaker,
 ) -> Result<Vec<SortiePlan>, String> {
-    let mut plans: Vec<SortiePlan> = Vec::new();
-    let mut start: Option<Cut> = None;
     if options.inside_legs {
         route.within_reach(flight)?;
     }
+    let spec_maker = SpecSorties { route, flight };
+    let maker = if options.inside_legs {
+        maker
+    } else {
+        &spec_maker as &dyn SortieMaker
+    };
+    let mut plans: Vec<SortiePlan> = Vec::new();
+    let mut start: Option<Cut> = None;
     loop {
         if plans.len() == MAX_SORTIES {
             return Err(format!("the route takes more than {MAX_SORTIES} sorties"));
         }
-        let spec = route.sortie(flight, start, None);
+        let spec = maker.sortie(start, None)?;
         let rest = flight
             .trial(&spec, None)
             .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
@@ -192,7 +218,11 @@ fn plan_sorties(
             });
             return Ok(plans);
         }
-        let Some((end, spec, report)) = sortie_end(flight, route, start, &rest, options) else {
+        let found = match options.inside_legs {
+            true => farthest_end(flight, route, maker, start),
+            false => whole_end(flight, route, start, &rest),
+        };
+        let Some((end, spec, report)) = found else {
             return Err(route.cannot_fly(start));
         };
         plans.push(SortiePlan {
@@ -228,23 +258,38 @@ fn unsplit(why: String) -> Sorties {
 /// A sortie's end, its mission and its flight.
 type Ending = (Cut, MissionSpec, MissionReport);
 
-/// The end of the sortie that starts at `start` (see the module's steps 2 to 4) and its flight;
-/// `None` when not even the beginning of its route can be flown there and back.
-fn sortie_end(
+/// The farthest point a sortie from `start` can turn home at (module step 4): the last whole
+/// segment of the route it can end with, by bisection, then the farthest point along the next
+/// one when it is a leg; with its mission and its flight.
+fn farthest_end(
     flight: &Flight<'_>,
     route: &Route<'_>,
+    maker: &dyn SortieMaker,
     start: Option<Cut>,
-    rest: &MissionReport,
-    options: SplitOptions,
 ) -> Option<Ending> {
-    let whole = whole_end(flight, route, start, rest);
-    if !options.inside_legs {
-        return whole;
+    let try_end = |cut: Cut| {
+        let spec = maker.sortie(start, Some(cut)).ok()?;
+        let report = flight.trial(&spec, None).ok().filter(|r| r.feasible)?;
+        Some((cut, spec, report))
+    };
+    let from = route.resumes_at(start);
+    let ends: Vec<usize> = (from..route.tail)
+        .filter(|&e| route.end_m[e][2] > 0.0)
+        .collect();
+    let (mut lo, mut hi) = (0usize, ends.len());
+    let mut best = None;
+    while lo < hi {
+        let mid = (lo + hi) / 2;
+        match try_end(Cut::whole(ends[mid])) {
+            Some(found) => {
+                best = Some(found);
+                lo = mid + 1;
+            }
+            None => hi = mid,
+        }
     }
-    let next = whole
-        .as_ref()
-        .map_or(route.resumes_at(start), |(c, _, _)| c.segment + 1);
-    partial_end(flight, route, start, next).or(whole)
+    let next = best.as_ref().map_or(from, |(c, _, _)| c.segment + 1);
+    partial_end(route, start, next, &try_end).or(best)
 }
 
 /// The last whole segment a sortie from `start` can end with (module steps 2 and 3).
@@ -287,10 +332,10 @@ const CUT_RESOLUTION_M: f64 = 1.0;
 /// The farthest point of leg `segment` a sortie from `start` can end at (module step 4), when
 /// the segment is a leg of the route beyond `start`.
 fn partial_end(
-    flight: &Flight<'_>,
     route: &Route<'_>,
     start: Option<Cut>,
     segment: usize,
+    try_end: &dyn Fn(Cut) -> Option<Ending>,
 ) -> Option<Ending> {
     let length_m = route.leg_length_m(segment)?;
     let mut lo = match start {
@@ -305,14 +350,10 @@ fn partial_end(
             break;
         }
         let mid = 0.5 * (lo + hi);
-        match route.try_sortie(
-            flight,
-            start,
-            Cut {
-                segment,
-                fraction: mid,
-            },
-        ) {
+        match try_end(Cut {
+            segment,
+            fraction: mid,
+        }) {
             Some(found) => {
                 best = Some(found);
                 lo = mid;
@@ -343,7 +384,7 @@ pub(super) fn segment_ends_m(compiled: &Compiled, n: usize) -> Vec<[f64; 3]> {
 }
 
 /// The route of a mission and what its sorties need to know about it.
-struct Route<'a> {
+pub(super) struct Route<'a> {
     spec: &'a MissionSpec,
     /// First segment after the take-off.
     first: usize,
@@ -361,7 +402,7 @@ struct Route<'a> {
 
 impl<'a> Route<'a> {
     /// The route of `spec`: its first segment must be a take-off and its last a landing.
-    fn of(spec: &'a MissionSpec, compiled: &Compiled) -> Result<Self, String> {
+    pub(super) fn of(spec: &'a MissionSpec, compiled: &Compiled) -> Result<Self, String> {
         let segments = &spec.segments;
         let Some(&SegmentSpec::TakeOff { climb_rate_mps, .. }) = segments.first() else {
             return Err("the mission does not begin with a take-off".to_string());
