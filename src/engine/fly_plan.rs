@@ -29,7 +29,10 @@ use super::finite::finite;
 use super::mission::{plan_mission, prepare, Prepared};
 use super::mission_file::Mission;
 use super::mission_options::MissionOptions;
-use super::sorties::{segment_ends_m, sortie_plans, Route, SortiePlan, SpecSorties, SplitOptions};
+use super::plan_files::PlannerSorties;
+use super::sorties::{
+    segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
+};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use crate::error::Error;
@@ -176,9 +179,19 @@ pub fn plan_to_fly(
     let (wind, _) = mission_wind(options, mission, vehicle)?;
     let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
-    let prepared = prepare(vehicle, mission, options, (aircraft, &battery, &wind))?;
+    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, &wind))?;
+    // The take-off payload the request gives is the candidates' own (each is compiled again).
+    if let Some(payload_kg) = options.payload_kg {
+        prepared.spec.payload_kg = payload_kg;
+    }
     let candidates = candidates(vehicle, &prepared, &wind, request)?;
-    let best = best_candidate(&prepared, candidates)?;
+    let cx = Context {
+        vehicle,
+        mission,
+        options,
+        prepared: &prepared,
+    };
+    let best = best_candidate(&cx, candidates)?;
     let plan = answer(mission, &best, as_given)?;
     finite(plan, "plan", || {
         format!(
@@ -277,6 +290,15 @@ fn speeds_for_wind(
         .aircraft
         .at_mass(mass.total_kg, request.options.aoa)?;
     let mut spec = prepared.spec.clone();
+    // A planner file's speeds are flown at most at what the vehicle holds within its tilt limit
+    // in still air (as `aloft mission` flies them): a faster choice would be written and not flown.
+    let tilt_mps = spec
+        .clamp_speeds
+        .then(|| flight.aircraft.tilt_limited_speed_mps(mass.total_kg));
+    let max_mps = match (request.max_speed_mps, tilt_mps) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
     let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
     let mut changes = Vec::new();
     for (i, segment) in spec.segments.iter_mut().enumerate() {
@@ -296,7 +318,7 @@ fn speeds_for_wind(
         } else {
             ends[i - 1]
         };
-        let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), request.max_speed_mps) else {
+        let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), max_mps) else {
             continue;
         };
         if ground_speed_mps.is_some_and(|g| (g - v).abs() < 0.05) {
@@ -342,54 +364,39 @@ fn leg_speed_mps(
     (rounded > 0.0).then_some(rounded)
 }
 
-/// A candidate cut into sorties, with its figures.
+/// A candidate cut into sorties, with its figures and its files' texts.
 struct Flown {
     candidate: Candidate,
     plans: Vec<SortiePlan>,
     figures: PlanFigures,
+    texts: Vec<String>,
+}
+
+/// What the candidates are flown for.
+struct Context<'a> {
+    vehicle: &'a Vehicle,
+    mission: &'a Mission,
+    options: &'a MissionOptions,
+    prepared: &'a Prepared<'a>,
 }
 
 /// The best candidate (module step 4).
 ///
 /// # Errors
 /// [`Error::NoPlan`] when none can be cut into sorties that keep the reserve.
-fn best_candidate(prepared: &Prepared<'_>, candidates: Vec<Candidate>) -> Result<Flown, Error> {
+fn best_candidate(cx: &Context<'_>, candidates: Vec<Candidate>) -> Result<Flown, Error> {
     let mut best: Option<Flown> = None;
     // Why the first candidate (the route cut inside legs, as given) has no plan.
     let mut why: Option<String> = None;
     for candidate in candidates {
-        let flight = &prepared.flight;
-        let compiled = match flight.compile(&candidate.spec, None) {
-            Ok(c) => c,
-            Err(e) => {
-                why.get_or_insert(e.to_string());
-                continue;
-            }
-        };
-        let route = match Route::of(&candidate.spec, &compiled) {
-            Ok(r) => r,
-            Err(e) => {
-                why.get_or_insert(e);
-                continue;
-            }
-        };
-        let maker = SpecSorties {
-            route: &route,
-            flight,
-        };
-        match sortie_plans(flight, &route, candidate.split, &maker) {
-            Ok(plans) => {
-                let figures = figures(&plans);
+        match fly_candidate(cx, candidate) {
+            Ok(flown) => {
                 let better = best.as_ref().is_none_or(|b| {
-                    (figures.batteries, figures.energy_wh)
+                    (flown.figures.batteries, flown.figures.energy_wh)
                         < (b.figures.batteries, b.figures.energy_wh)
                 });
                 if better {
-                    best = Some(Flown {
-                        candidate,
-                        plans,
-                        figures,
-                    });
+                    best = Some(flown);
                 }
             }
             Err(e) => {
@@ -400,6 +407,85 @@ fn best_candidate(prepared: &Prepared<'_>, candidates: Vec<Candidate>) -> Result
     best.ok_or_else(|| Error::NoPlan {
         reason: why.unwrap_or_default(),
     })
+}
+
+/// A candidate cut into sorties, each flown from its own file's mission (the file aloft writes,
+/// read back as `aloft mission` reads it), and the files' texts.
+fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String> {
+    let flight = &cx.prepared.flight;
+    let compiled = flight
+        .compile(&candidate.spec, None)
+        .map_err(|e| e.to_string())?;
+    let route = Route::of(&candidate.spec, &compiled)?;
+    let maker = Maker::of(cx, &route, &candidate);
+    let mut plans = sortie_plans(flight, &route, candidate.split, maker.as_dyn())?;
+    let n = plans.len();
+    let mut texts = Vec::with_capacity(n);
+    for (k, plan) in plans.iter_mut().enumerate() {
+        plan.spec = maker.as_dyn().sortie(plan.start, plan.end)?;
+        plan.report = flight
+            .trial(&plan.spec, None)
+            .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
+        if !plan.report.feasible {
+            return Err(format!(
+                "sortie {} of {n} misses the reserve once written",
+                k + 1
+            ));
+        }
+        texts.push(maker.text(cx.mission, plan, (k + 1, n))?);
+    }
+    Ok(Flown {
+        figures: figures(&plans),
+        candidate,
+        plans,
+        texts,
+    })
+}
+
+/// Who makes the sorties' missions and files: aloft's own segments (TOML, JSON) or the items of a
+/// planner file.
+enum Maker<'a> {
+    Spec(SpecSorties<'a, 'a>),
+    Planner(PlannerSorties<'a>),
+}
+
+impl<'a> Maker<'a> {
+    fn of(cx: &'a Context<'a>, route: &'a Route<'a>, candidate: &'a Candidate) -> Self {
+        match cx.mission.kept() {
+            Some(kept) => Maker::Planner(PlannerSorties {
+                route,
+                kept,
+                spec: &candidate.spec,
+                speeds_changed: !candidate.speeds.is_empty(),
+                vehicle: cx.vehicle,
+                options: cx.options,
+            }),
+            None => Maker::Spec(SpecSorties {
+                route,
+                flight: &cx.prepared.flight,
+            }),
+        }
+    }
+
+    fn as_dyn(&self) -> &dyn SortieMaker {
+        match self {
+            Maker::Spec(m) => m,
+            Maker::Planner(m) => m,
+        }
+    }
+
+    /// The file of sortie `k` of `n`.
+    fn text(
+        &self,
+        mission: &Mission,
+        plan: &SortiePlan,
+        (k, n): (usize, usize),
+    ) -> Result<String, String> {
+        match self {
+            Maker::Spec(_) => sortie_text(mission, plan, k, n).map_err(|e| e.to_string()),
+            Maker::Planner(m) => m.text(plan.start, plan.end),
+        }
+    }
 }
 
 /// The figures of a set of sorties.
@@ -424,10 +510,10 @@ fn answer(
     let mut sorties = Vec::with_capacity(n);
     for (k, plan) in best.plans.iter().enumerate() {
         let file = format!("{stem}-{}-of-{n}.{extension}", k + 1);
-        texts.push(sortie_text(mission, plan, k + 1, n)?);
         sorties.push(sortie_answer(&file, plan, &best.candidate.spec));
         files.push(file);
     }
+    texts.extend(best.texts.iter().cloned());
     Ok(FlyPlan {
         files,
         batteries: best.figures.batteries,
@@ -472,11 +558,8 @@ fn file_stem_and_extension(mission: &Mission) -> Result<(String, &'static str), 
     let extension = match mission.route().source_format {
         SourceFormat::AloftToml => "toml",
         SourceFormat::AloftJson => "json",
-        other => {
-            return Err(Error::PlanFormat {
-                format: other.as_str(),
-            })
-        }
+        SourceFormat::QgcPlan => "plan",
+        SourceFormat::QgcWpl | SourceFormat::MavlinkItems => "waypoints",
     };
     let origin = Path::new(mission.origin());
     let stem = match origin.file_stem().and_then(|s| s.to_str()) {

@@ -23,6 +23,26 @@ pub struct Mission {
     spec: MissionSpec,
     origin: String,
     route: RouteFigures,
+    /// What a planner file keeps to be written again (`aloft plan`), from a `.plan` or a
+    /// `.waypoints` file.
+    kept: Option<Box<PlannerKept>>,
+}
+
+/// What a planner file keeps besides its spec, to be written again ([`aloft_missions::write`]):
+/// its home, its items in file order, a `.plan`'s header and the entry each item came from, and
+/// each item flown with the segments it made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlannerKept {
+    /// The file's format.
+    pub format: SourceFormat,
+    /// Its home as written.
+    pub home: Option<aloft_missions::Home>,
+    /// Its items, in file order.
+    pub items: Vec<aloft_logs::telemetry::MissionItem>,
+    /// A `.plan`'s header and the entry of each item.
+    pub plan: Option<aloft_missions::PlanFile>,
+    /// The flying order, each item with the range of the spec's segments it made.
+    pub flown: Vec<aloft_missions::FlownItem>,
 }
 
 impl Mission {
@@ -57,6 +77,7 @@ impl Mission {
             route: route_figures(&spec, format, Vec::new()),
             spec,
             origin: origin.to_string(),
+            kept: None,
         }
     }
 
@@ -123,10 +144,18 @@ impl Mission {
             origin: origin.to_string(),
             source,
         })?;
+        let kept = PlannerKept {
+            format: imported.format,
+            home: imported.home,
+            items: imported.items,
+            plan: imported.plan,
+            flown: imported.flown,
+        };
         Ok(Self {
             spec: imported.spec,
             origin: origin.to_string(),
             route: imported.route,
+            kept: Some(Box::new(kept)),
         })
     }
 
@@ -157,6 +186,11 @@ impl Mission {
             what: "mission",
             message: e.to_string(),
         })
+    }
+
+    /// What a planner file keeps to be written again (none for aloft's own formats).
+    pub fn kept(&self) -> Option<&PlannerKept> {
+        self.kept.as_deref()
     }
 
     /// The parsed mission file.

@@ -67,6 +67,7 @@ mod mission_map;
 mod mission_options;
 mod mission_outputs;
 mod payload_sweep;
+mod plan_files;
 mod power;
 mod power_batch;
 mod propulsion;
@@ -111,7 +112,7 @@ pub use loiter::LoiterSummary;
 pub use mission::{
     plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
 };
-pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
+pub use mission_file::{Mission, PlannerKept, DEMO_MISSION, DEMO_ORIGIN};
 pub use mission_map::{
     mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };

@@ -450,12 +450,22 @@ impl<'a> Route<'a> {
 
     /// The first segment of the route a sortie from `start` flies (the remainder of a leg it
     /// resumes inside of, else the one after).
-    fn resumes_at(&self, start: Option<Cut>) -> usize {
+    pub(super) fn resumes_at(&self, start: Option<Cut>) -> usize {
         match start {
             None => self.first,
             Some(c) if c.is_whole() => c.segment + 1,
             Some(c) => c.segment,
         }
+    }
+
+    /// The payload a sortie from `start` takes off with, kg.
+    pub(super) fn payload_at_kg(&self, start: Option<Cut>) -> f64 {
+        self.payload_kg[self.resumes_at(start)]
+    }
+
+    /// Home's height, ENU m (the heights of a planner file are above it).
+    pub(super) fn home_up_m(&self) -> f64 {
+        self.home_m[2]
     }
 
     /// Where segment `segment` begins, ENU m.
@@ -612,7 +622,7 @@ impl<'a> Route<'a> {
         let spec = self.spec;
         let from = self.resumes_at(start);
         let mut s = spec.clone();
-        s.payload_kg = self.payload_kg[from];
+        s.payload_kg = self.payload_at_kg(start);
         s.allow_end_in_air = false;
         let mut segments = Vec::new();
         match start {
