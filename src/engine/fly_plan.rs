@@ -3,8 +3,11 @@
 //!
 //! The steps, each candidate flown by the planner that answers `aloft mission`:
 //!
-//! 1. **As given**: the mission planned as `aloft mission` plans it, split into sorties at whole
-//!    items (`as_given` in the answer).
+//! 1. **As given**: the mission with its own speeds, split into sorties at whole items as
+//!    `aloft mission` splits it, flown from the files that split gives (each ending with a return
+//!    to launch, as every file does: a mission that ends in the air is priced with its autopilot's
+//!    return rather than `aloft mission`'s generic way home). `as_given` in the answer; where
+//!    that split has no files that keep the reserve, the figures of `aloft mission`.
 //! 2. **Speeds for the wind** ([`SpeedChoice`]): each leg at the ground speed that costs least
 //!    energy per metre along its course in the wind at its height
 //!    ([`aloft_planner::best_range_within_limits`]: within the vehicle's speed and its steady
@@ -153,8 +156,8 @@ pub struct FlyPlan {
     pub duration_s: f64,
     /// The sorties, one per file.
     pub sorties: Vec<FlySortie>,
-    /// The mission as given, split at whole items as `aloft mission` splits it (absent when
-    /// it cannot be split so).
+    /// The mission as given, split at whole items as `aloft mission` splits it and flown from
+    /// the files of that split (module step 1; absent when it cannot be split so).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub as_given: Option<PlanFigures>,
     /// What changed.
@@ -175,7 +178,6 @@ pub fn plan_to_fly(
     request: &FlyPlanRequest,
 ) -> Result<FlyPlan, Error> {
     let options = &request.options;
-    let as_given = as_given_figures(vehicle, mission, options)?;
     let (wind, _) = mission_wind(options, mission, vehicle)?;
     let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
@@ -191,7 +193,11 @@ pub fn plan_to_fly(
         options,
         prepared: &prepared,
     };
-    let best = best_candidate(&cx, candidates)?;
+    let (best, given) = best_candidate(&cx, candidates)?;
+    let as_given = match given {
+        Some(figures) => Some(figures),
+        None => as_given_figures(vehicle, mission, options)?,
+    };
     let plan = answer(mission, &best, as_given)?;
     finite(plan, "plan", || {
         format!(
@@ -228,11 +234,13 @@ fn as_given_figures(
     }))
 }
 
-/// A way of flying the mission: its spec, how it is cut and the speeds changed.
+/// A way of flying the mission: its spec, how it is cut and the speeds changed; `as_given` for
+/// the mission as given split at whole items.
 struct Candidate {
     spec: MissionSpec,
     split: SplitOptions,
     speeds: Vec<SpeedChange>,
+    as_given: bool,
 }
 
 /// The candidates of module step 4.
@@ -251,11 +259,13 @@ fn candidates(
             spec: prepared.spec.clone(),
             split: inside,
             speeds: Vec::new(),
+            as_given: false,
         },
         Candidate {
             spec: prepared.spec.clone(),
             split: SplitOptions::default(),
             speeds: Vec::new(),
+            as_given: true,
         },
     ];
     if request.speeds != SpeedChoice::Keep {
@@ -265,6 +275,7 @@ fn candidates(
                 spec,
                 split: inside,
                 speeds,
+                as_given: false,
             });
         }
     }
@@ -380,17 +391,25 @@ struct Context<'a> {
     prepared: &'a Prepared<'a>,
 }
 
-/// The best candidate (module step 4).
+/// The best candidate (module step 4), and the figures of the mission as given split at whole
+/// items, flown from its files, when it has them.
 ///
 /// # Errors
 /// [`Error::NoPlan`] when none can be cut into sorties that keep the reserve.
-fn best_candidate(cx: &Context<'_>, candidates: Vec<Candidate>) -> Result<Flown, Error> {
+fn best_candidate(
+    cx: &Context<'_>,
+    candidates: Vec<Candidate>,
+) -> Result<(Flown, Option<PlanFigures>), Error> {
     let mut best: Option<Flown> = None;
+    let mut given: Option<PlanFigures> = None;
     // Why the first candidate (the route cut inside legs, as given) has no plan.
     let mut why: Option<String> = None;
     for candidate in candidates {
         match fly_candidate(cx, candidate) {
             Ok(flown) => {
+                if flown.candidate.as_given {
+                    given = Some(flown.figures);
+                }
                 let better = best.as_ref().is_none_or(|b| {
                     (flown.figures.batteries, flown.figures.energy_wh)
                         < (b.figures.batteries, b.figures.energy_wh)
@@ -404,9 +423,10 @@ fn best_candidate(cx: &Context<'_>, candidates: Vec<Candidate>) -> Result<Flown,
             }
         }
     }
-    best.ok_or_else(|| Error::NoPlan {
+    let best = best.ok_or_else(|| Error::NoPlan {
         reason: why.unwrap_or_default(),
-    })
+    })?;
+    Ok((best, given))
 }
 
 /// A candidate cut into sorties, each flown from its own file's mission (the file aloft writes,
@@ -459,6 +479,7 @@ impl<'a> Maker<'a> {
                 speeds_changed: !candidate.speeds.is_empty(),
                 vehicle: cx.vehicle,
                 options: cx.options,
+                flight: &cx.prepared.flight,
             }),
             None => Maker::Spec(SpecSorties {
                 route,

@@ -366,20 +366,53 @@ pub(super) fn prepare<'a>(
         wind,
         options: planner_options(options, mission.spec())?,
     };
-    let (spec, planning_speed) = flown_spec(mission, vehicle, options);
-    let (spec, loiter) =
-        match resolve_loiter(&flight, &spec, options.payload_kg).map_err(in_mission)? {
-            Some((flown, loiter)) => (flown, Some(loiter)),
-            None => (spec, None),
-        };
-    let (spec, way_home_note) = flight.home_at_mission_end(spec);
+    let flown = flown_mission(&flight, mission, vehicle, (options, options.payload_kg))
+        .map_err(in_mission)?;
     let compiled = flight
-        .compile(&spec, options.payload_kg)
+        .compile(&flown.spec, options.payload_kg)
         .map_err(in_mission)?;
     Ok(Prepared {
         flight,
-        spec,
+        spec: flown.spec,
         compiled,
+        planning_speed: flown.planning_speed,
+        loiter: flown.loiter,
+        way_home_note: flown.way_home_note,
+    })
+}
+
+/// The mission a request flies, before it is compiled (see [`Prepared`]).
+pub(super) struct FlownMission {
+    /// The spec flown.
+    pub(super) spec: MissionSpec,
+    /// The planning speed applied, when the options or the vehicle gave one.
+    pub(super) planning_speed: Option<super::flown::PlanningSpeed>,
+    /// The loiter until the reserve, when the mission ends in one.
+    pub(super) loiter: Option<super::loiter::LoiterSummary>,
+    /// Why a way home was added, when it was.
+    pub(super) way_home_note: Option<String>,
+}
+
+/// The spec `mission` is flown as: the options applied, a loiter until the reserve resolved
+/// (taking off with `payload_kg`, else the mission's payload) and the way home of a mission that
+/// ends in the air added. `aloft plan` flies each file it writes so, as `aloft mission` reads it.
+///
+/// # Errors
+/// A loiter the planner cannot fly.
+pub(super) fn flown_mission(
+    flight: &Flight<'_>,
+    mission: &Mission,
+    vehicle: &Vehicle,
+    (options, payload_kg): (&MissionOptions, Option<f64>),
+) -> Result<FlownMission, aloft_planner::PlannerError> {
+    let (spec, planning_speed) = flown_spec(mission, vehicle, options);
+    let (spec, loiter) = match resolve_loiter(flight, &spec, payload_kg)? {
+        Some((flown, loiter)) => (flown, Some(loiter)),
+        None => (spec, None),
+    };
+    let (spec, way_home_note) = flight.home_at_mission_end(spec);
+    Ok(FlownMission {
+        spec,
         planning_speed,
         loiter,
         way_home_note,

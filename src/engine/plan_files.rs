@@ -13,7 +13,8 @@
 //! where it resumes), and, where it turns home inside a leg, a waypoint there (NAV_WAYPOINT 16,
 //! frame 3); the camera stopped when it was on (206 with 0; IMAGE_STOP_CAPTURE 2001 after a
 //! timed capture: QGroundControl #5737, cameras that kept triggering through RTL); a return to
-//! launch (NAV_RETURN_TO_LAUNCH 20). The last sortie flies the file's own way down.
+//! launch (NAV_RETURN_TO_LAUNCH 20). The last sortie flies the file's own way down (the camera
+//! stopped and a return to launch written when the file ends in the air).
 //!
 //! **Items in force** where a sortie resumes (as QGroundControl's resume mission keeps them,
 //! `MissionManager::generateResumeMission`): the last of each of DO_CHANGE_SPEED (178, per speed
@@ -29,16 +30,20 @@
 //! one in force, in place of the file's own; the planning speed is written as its value (an
 //! autopilot may ignore "back to default").
 //!
+//! **DO_JUMP loops** are unrolled: the items follow the flying order the reader gives (its loops
+//! repeated, at most as many items as it flies), without the DO_JUMP items.
+//!
 //! **Positions**: a point inside a leg is placed as the planner places the leg, in the tangent
 //! plane of the leg's start (the last position before it, home at first), so that the file read
 //! back puts it where the plan cut the route; its height is above home (frame 3).
 
 use aloft_logs::telemetry::MissionItem;
-use aloft_missions::{write_plan, write_waypoints, Home, MissionEntry, SourceFormat};
+use aloft_missions::{write_plan, write_waypoint_rows, Home, MissionEntry, SourceFormat};
 use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::{MissionSpec, SegmentSpec};
 
-use super::flown::flown_spec;
+use super::flight::Flight;
+use super::mission::flown_mission;
 use super::mission_file::{Mission, PlannerKept};
 use super::mission_options::MissionOptions;
 use super::sorties::{Cut, Route, SortieMaker};
@@ -49,6 +54,7 @@ mod cmd {
     pub const NAV_WAYPOINT: u32 = 16;
     pub const NAV_RETURN_TO_LAUNCH: u32 = 20;
     pub const NAV_TAKEOFF: u32 = 22;
+    pub const DO_JUMP: u32 = 177;
     pub const DO_CHANGE_SPEED: u32 = 178;
     pub const DO_SET_CAM_TRIGG_DIST: u32 = 206;
     pub const IMAGE_START_CAPTURE: u32 = 2000;
@@ -74,14 +80,24 @@ pub(super) struct PlannerSorties<'a> {
     pub(super) vehicle: &'a Vehicle,
     /// The request's options.
     pub(super) options: &'a MissionOptions,
+    /// The request's flight, to fly a file as `aloft mission` does.
+    pub(super) flight: &'a Flight<'a>,
 }
 
 impl SortieMaker for PlannerSorties<'_> {
     fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String> {
         let text = self.text(start, end)?;
         let mission = Mission::from_text(&text, "the sortie's file").map_err(|e| e.to_string())?;
-        let mut spec = flown_spec(&mission, self.vehicle, self.options).0;
-        spec.payload_kg = self.route.payload_at_kg(start);
+        let payload_kg = self.route.payload_at_kg(start);
+        let flown = flown_mission(
+            self.flight,
+            &mission,
+            self.vehicle,
+            (self.options, Some(payload_kg)),
+        )
+        .map_err(|e| e.to_string())?;
+        let mut spec = flown.spec;
+        spec.payload_kg = payload_kg;
         Ok(spec)
     }
 }
@@ -97,7 +113,9 @@ impl PlannerSorties<'_> {
         let entries: Vec<MissionEntry> = items.into_iter().map(MissionEntry::Item).collect();
         let written = match (self.kept.format, &self.kept.plan) {
             (SourceFormat::QgcPlan, Some(plan)) => write_plan(&plan.header, &home, &entries),
-            _ => write_waypoints(&home, &entries),
+            // A file without a home row is written without one, as it was read: its first
+            // position (the take-off) is home.
+            _ => write_waypoint_rows(self.kept.home.as_ref(), &entries),
         };
         written.map_err(|e| e.to_string())
     }
@@ -127,7 +145,17 @@ impl PlannerSorties<'_> {
             Some(c) => self.resume_items(home, c, first),
         };
         match end {
-            None => out.extend(self.flown_items(first..flown.len())),
+            None => {
+                out.extend(self.flown_items(first..flown.len()));
+                // A file that ends in the air gets its way home written (every file lands).
+                let last = out
+                    .iter()
+                    .rev()
+                    .find(|i| has_position(i.command) || ends(i.command));
+                if !last.is_some_and(|i| ends(i.command)) {
+                    self.home_items(&mut out);
+                }
+            }
             Some(e) if e.fraction >= 1.0 => {
                 out.extend(self.flown_items(first..self.flown_at(e.segment) + 1));
                 self.home_items(&mut out);
@@ -162,11 +190,14 @@ impl PlannerSorties<'_> {
             .unwrap_or(flown.len())
     }
 
-    /// The items of the flying order `range`, each tagged with the segment it begins at.
+    /// The items of the flying order `range`. The flying order has its DO_JUMP loops unrolled
+    /// (as the reader flies them, bounded): the DO_JUMP items themselves are left out, as their
+    /// targets' numbers are not the written file's.
     fn flown_items(&self, range: std::ops::Range<usize>) -> Vec<MissionItem> {
         self.kept.flown[range]
             .iter()
             .map(|f| self.kept.items[f.item])
+            .filter(|it| it.command != cmd::DO_JUMP)
             .collect()
     }
 
@@ -300,6 +331,11 @@ impl PlannerSorties<'_> {
 /// Whether an item flies to a position (its leg has a speed).
 fn moves(it: &MissionItem) -> bool {
     has_position(it.command) && it.command != cmd::NAV_TAKEOFF
+}
+
+/// Whether a command ends the flight (a return to launch, a landing).
+fn ends(command: u32) -> bool {
+    matches!(command, cmd::NAV_RETURN_TO_LAUNCH | 21)
 }
 
 /// Whether a command has a position.

@@ -79,7 +79,9 @@ pub use kept::{FlownItem, Home, ItemOrigin, PlanFile, PlanHeader};
 pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};
-pub use write::{write_like_source, write_plan, write_waypoints, MissionEntry};
+pub use write::{
+    write_like_source, write_plan, write_waypoint_rows, write_waypoints, MissionEntry,
+};
 
 /// The format a mission text is in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, Serialize, Deserialize)]

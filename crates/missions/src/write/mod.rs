@@ -81,7 +81,7 @@ use crate::raw_item::RawItem;
 use crate::{Imported, SourceFormat};
 
 pub use plan::write_plan;
-pub use wpl::write_waypoints;
+pub use wpl::{write_waypoint_rows, write_waypoints};
 
 /// One entry of a mission to write.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +120,7 @@ pub fn write_like_source(imported: &Imported) -> Result<String, ImportError> {
                 .iter()
                 .map(|i| MissionEntry::Item(*i))
                 .collect();
-            wpl::rows(imported.home.as_ref(), &entries)
+            wpl::write_waypoint_rows(imported.home.as_ref(), &entries)
         }
         _ => Err(ImportError::UnknownFormat),
     }

@@ -16,12 +16,19 @@ use crate::kept::Home;
 /// set, an infinite value; a survey entry (named by the row it would take); a home without an
 /// altitude or out of range.
 pub fn write_waypoints(home: &Home, entries: &[MissionEntry]) -> Result<String, ImportError> {
-    rows(Some(home), entries)
+    write_waypoint_rows(Some(home), entries)
 }
 
-/// The text: the home row when there is one (the items from INDEX 1), else the items from
-/// INDEX 0 (a file read without a home row, written back as it was).
-pub(super) fn rows(home: Option<&Home>, entries: &[MissionEntry]) -> Result<String, ImportError> {
+/// A `.waypoints` file of `entries` with `home` as its row 0 when there is one (the items from
+/// INDEX 1), else the items from INDEX 0: a file read without a home row, written as it was (its
+/// home is the first position in it).
+///
+/// # Errors
+/// As [`write_waypoints`].
+pub fn write_waypoint_rows(
+    home: Option<&Home>,
+    entries: &[MissionEntry],
+) -> Result<String, ImportError> {
     let mut out = String::from("QGC WPL 110\n");
     let mut index: u32 = 0;
     if let Some(h) = home {
