@@ -643,6 +643,15 @@ pub struct PlanFlags {
     /// Highest ground speed a leg is given, m/s (the vehicle's limits apply anyway).
     #[arg(value_parser = finite(), long, value_name = "M/S", allow_negative_numbers = true)]
     pub max_speed: Option<f64>,
+    /// The camera's shortest time between photos, s: a leg flown with the camera triggering
+    /// every D m is given at most D / this (default: a survey's `CameraCalc.MinTriggerInterval`
+    /// in a .plan, else 2 s).
+    #[arg(value_parser = finite(), long, value_name = "S", allow_negative_numbers = true)]
+    pub camera_interval_s: Option<f64>,
+    /// Keep every survey's grid angle (else each QGroundControl survey is turned to the wind
+    /// where that saves energy, its transects drawn again as QGroundControl draws them).
+    #[arg(long)]
+    pub keep_angle: bool,
 }
 
 impl PlanFlags {
@@ -667,11 +676,24 @@ impl PlanFlags {
                 expected: "a ground speed above 0 and at most 100 m/s",
             });
         }
+        if let Some(v) = self
+            .camera_interval_s
+            .filter(|v| !(*v > 0.0 && *v <= 3600.0))
+        {
+            return Err(Error::InvalidInput {
+                name: "camera_interval_s",
+                value: v,
+                unit: "s",
+                expected: "a time above 0 and at most 3600 s",
+            });
+        }
         Ok(FlyPlanRequest {
             options: self.mission.options(),
             overlap_m: self.overlap_m,
             speeds: self.speeds,
             max_speed_mps: self.max_speed,
+            camera_interval_s: self.camera_interval_s,
+            keep_angle: self.keep_angle,
         })
     }
 }

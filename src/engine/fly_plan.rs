@@ -36,6 +36,7 @@ use super::plan_files::PlannerSorties;
 use super::sorties::{
     segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
 };
+use super::survey_angle::{turned_to_wind, AngleChange};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use crate::error::Error;
@@ -44,6 +45,11 @@ use crate::error::Error;
 /// the usual 10-30 m trigger distance, so that the last images of one sortie and the first of the
 /// next overlap (QGroundControl issue #4254 asks for a few waypoints back).
 pub const DEFAULT_OVERLAP_M: f64 = 10.0;
+
+/// The camera's shortest time between photos when neither the request nor the file gives one,
+/// s: a conservative interval for a survey camera that does not state its own (give
+/// `--camera-interval-s` for yours), so that no photo is skipped.
+pub const DEFAULT_CAMERA_INTERVAL_S: f64 = 2.0;
 
 /// Which legs get the wind's speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -70,6 +76,12 @@ pub struct FlyPlanRequest {
     pub speeds: SpeedChoice,
     /// Highest ground speed a leg is given, m/s (the vehicle's own limits apply anyway).
     pub max_speed_mps: Option<f64>,
+    /// The camera's shortest time between photos, s (default: a `.plan` survey's
+    /// `CameraCalc.MinTriggerInterval`, else [`DEFAULT_CAMERA_INTERVAL_S`]).
+    pub camera_interval_s: Option<f64>,
+    /// Keep the grid angle of every survey (else each is turned to the wind where that saves
+    /// energy: [`super::survey_angle`]).
+    pub keep_angle: bool,
 }
 
 impl Default for FlyPlanRequest {
@@ -79,6 +91,8 @@ impl Default for FlyPlanRequest {
             overlap_m: DEFAULT_OVERLAP_M,
             speeds: SpeedChoice::default(),
             max_speed_mps: None,
+            camera_interval_s: None,
+            keep_angle: false,
         }
     }
 }
@@ -141,6 +155,9 @@ pub struct PlanChanges {
     pub speeds: Vec<SpeedChange>,
     /// Whether the sorties end inside legs (else at items, as given).
     pub cut_inside_legs: bool,
+    /// Surveys given another grid angle.
+    #[serde(default)]
+    pub angles: Vec<AngleChange>,
 }
 
 /// The answer of `aloft plan`: the plan beside the mission as given, its sorties and files.
@@ -179,26 +196,30 @@ pub fn plan_to_fly(
 ) -> Result<FlyPlan, Error> {
     let options = &request.options;
     let (wind, _) = mission_wind(options, mission, vehicle)?;
-    let aircraft = vehicle.aircraft()?;
-    let battery = vehicle.battery(options.battery.as_deref())?;
-    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, &wind))?;
-    // The take-off payload the request gives is the candidates' own (each is compiled again).
-    if let Some(payload_kg) = options.payload_kg {
-        prepared.spec.payload_kg = payload_kg;
-    }
-    let candidates = candidates(vehicle, &prepared, &wind, request)?;
-    let cx = Context {
-        vehicle,
-        mission,
-        options,
-        prepared: &prepared,
+    let (best, given) = plan_for(vehicle, mission, request, &wind)?;
+    let turned = match request.keep_angle {
+        true => None,
+        false => turned_to_wind(vehicle, mission, request, &wind)?,
     };
-    let (best, given) = best_candidate(&cx, candidates)?;
+    // The surveys turned to the wind, when that needs fewer batteries or less energy.
+    let (best, angles) = match turned {
+        Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind) {
+            Ok((t, _))
+                if (t.figures.batteries, t.figures.energy_wh)
+                    < (best.figures.batteries, best.figures.energy_wh) =>
+            {
+                (t, angles)
+            }
+            _ => (best, Vec::new()),
+        },
+        None => (best, Vec::new()),
+    };
     let as_given = match given {
         Some(figures) => Some(figures),
         None => as_given_figures(vehicle, mission, options)?,
     };
-    let plan = answer(mission, &best, as_given)?;
+    let mut plan = answer(mission, &best, as_given)?;
+    plan.changes.angles = angles;
     finite(plan, "plan", || {
         format!(
             "plan of mission {} with {}",
@@ -206,6 +227,32 @@ pub fn plan_to_fly(
             vehicle.name()
         )
     })
+}
+
+/// The best candidate of `mission` (module steps 2-4) and the figures of the mission as given,
+/// flown from its files, when it has them.
+fn plan_for(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+    wind: &Wind,
+) -> Result<(Flown, Option<PlanFigures>), Error> {
+    let options = &request.options;
+    let aircraft = vehicle.aircraft()?;
+    let battery = vehicle.battery(options.battery.as_deref())?;
+    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
+    // The take-off payload the request gives is the candidates' own (each is compiled again).
+    if let Some(payload_kg) = options.payload_kg {
+        prepared.spec.payload_kg = payload_kg;
+    }
+    let candidates = candidates((vehicle, mission), &prepared, wind, request)?;
+    let cx = Context {
+        vehicle,
+        mission,
+        options,
+        prepared: &prepared,
+    };
+    best_candidate(&cx, candidates)
 }
 
 /// The mission as given: its batteries and the energy and time of its sorties (or its one
@@ -245,7 +292,7 @@ struct Candidate {
 
 /// The candidates of module step 4.
 fn candidates(
-    vehicle: &Vehicle,
+    (vehicle, mission): (&Vehicle, &Mission),
     prepared: &Prepared<'_>,
     wind: &Wind,
     request: &FlyPlanRequest,
@@ -269,7 +316,7 @@ fn candidates(
         },
     ];
     if request.speeds != SpeedChoice::Keep {
-        let (spec, speeds) = speeds_for_wind(vehicle, prepared, wind, request)?;
+        let (spec, speeds) = speeds_for_wind((vehicle, mission), prepared, wind, request)?;
         if !speeds.is_empty() {
             out.push(Candidate {
                 spec,
@@ -283,8 +330,8 @@ fn candidates(
 }
 
 /// The spec with its legs at the wind's speeds (module step 2), and the legs changed.
-fn speeds_for_wind(
-    vehicle: &Vehicle,
+pub(super) fn speeds_for_wind(
+    (vehicle, mission): (&Vehicle, &Mission),
     prepared: &Prepared<'_>,
     wind: &Wind,
     request: &FlyPlanRequest,
@@ -311,6 +358,8 @@ fn speeds_for_wind(
         (a, b) => a.or(b),
     };
     let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
+    let triggers = camera_triggers_m(mission);
+    let interval_s = camera_interval_s(mission, request);
     let mut changes = Vec::new();
     for (i, segment) in spec.segments.iter_mut().enumerate() {
         let SegmentSpec::Leg {
@@ -329,6 +378,15 @@ fn speeds_for_wind(
         } else {
             ends[i - 1]
         };
+        // A leg flown with the camera triggering every D m: at most D per camera interval.
+        let camera_mps = triggers
+            .get(i)
+            .filter(|d| **d > 0.0)
+            .map(|d| d / interval_s);
+        let max_mps = match (max_mps, camera_mps) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
         let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), max_mps) else {
             continue;
         };
@@ -344,6 +402,45 @@ fn speeds_for_wind(
         *ground_speed_mps = Some(v);
     }
     Ok((spec, changes))
+}
+
+/// The camera trigger distance in force on each segment of a planner file's mission, m (0: the
+/// camera off; empty for aloft's own formats): the last DO_SET_CAM_TRIGG_DIST (206) flown before
+/// the item that made the segment.
+fn camera_triggers_m(mission: &Mission) -> Vec<f64> {
+    let Some(imported) = mission.kept() else {
+        return Vec::new();
+    };
+    let mut out = vec![0.0; imported.spec.segments.len()];
+    let mut in_force = 0.0;
+    for f in &imported.flown {
+        for s in f.segments.clone() {
+            if let Some(slot) = out.get_mut(s) {
+                *slot = in_force;
+            }
+        }
+        let item = &imported.items[f.item];
+        if item.command == 206 && item.params[0].is_finite() {
+            in_force = item.params[0].max(0.0);
+        }
+    }
+    out
+}
+
+/// The camera's shortest time between photos, s: the request's, else the longest
+/// `CameraCalc.MinTriggerInterval` of a `.plan`'s surveys, else [`DEFAULT_CAMERA_INTERVAL_S`].
+fn camera_interval_s(mission: &Mission, request: &FlyPlanRequest) -> f64 {
+    let of_file = mission.kept().and_then(|k| {
+        k.surveys
+            .iter()
+            .filter_map(|s| s.survey.as_ref().ok()?.params().min_trigger_interval_s)
+            .filter(|t| *t > 0.0)
+            .reduce(f64::max)
+    });
+    request
+        .camera_interval_s
+        .or(of_file)
+        .unwrap_or(DEFAULT_CAMERA_INTERVAL_S)
 }
 
 /// The ground speed of least energy per metre along the leg from `a` to `b` in the wind at its
@@ -544,6 +641,7 @@ fn answer(
         as_given,
         changes: PlanChanges {
             speeds: best.candidate.speeds.clone(),
+            angles: Vec::new(),
             cut_inside_legs: best.candidate.split.inside_legs
                 && best
                     .plans

@@ -23,26 +23,9 @@ pub struct Mission {
     spec: MissionSpec,
     origin: String,
     route: RouteFigures,
-    /// What a planner file keeps to be written again (`aloft plan`), from a `.plan` or a
-    /// `.waypoints` file.
-    kept: Option<Box<PlannerKept>>,
-}
-
-/// What a planner file keeps besides its spec, to be written again ([`aloft_missions::write`]):
-/// its home, its items in file order, a `.plan`'s header and the entry each item came from, and
-/// each item flown with the segments it made.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PlannerKept {
-    /// The file's format.
-    pub format: SourceFormat,
-    /// Its home as written.
-    pub home: Option<aloft_missions::Home>,
-    /// Its items, in file order.
-    pub items: Vec<aloft_logs::telemetry::MissionItem>,
-    /// A `.plan`'s header and the entry of each item.
-    pub plan: Option<aloft_missions::PlanFile>,
-    /// The flying order, each item with the range of the spec's segments it made.
-    pub flown: Vec<aloft_missions::FlownItem>,
+    /// The planner file as read (`.plan`, `.waypoints`): what `aloft plan` needs to write it
+    /// again (its home, items, a `.plan`'s header and surveys, the flying order).
+    kept: Option<Box<aloft_missions::Imported>>,
 }
 
 impl Mission {
@@ -144,18 +127,11 @@ impl Mission {
             origin: origin.to_string(),
             source,
         })?;
-        let kept = PlannerKept {
-            format: imported.format,
-            home: imported.home,
-            items: imported.items,
-            plan: imported.plan,
-            flown: imported.flown,
-        };
         Ok(Self {
-            spec: imported.spec,
+            spec: imported.spec.clone(),
             origin: origin.to_string(),
-            route: imported.route,
-            kept: Some(Box::new(kept)),
+            route: imported.route.clone(),
+            kept: Some(Box::new(imported)),
         })
     }
 
@@ -188,8 +164,8 @@ impl Mission {
         })
     }
 
-    /// What a planner file keeps to be written again (none for aloft's own formats).
-    pub fn kept(&self) -> Option<&PlannerKept> {
+    /// The planner file as read, to be written again (none for aloft's own formats).
+    pub fn kept(&self) -> Option<&aloft_missions::Imported> {
         self.kept.as_deref()
     }
 

@@ -76,6 +76,7 @@ mod scenario_stats;
 mod scenarios;
 mod sorties;
 mod summary;
+mod survey_angle;
 mod validate;
 mod vehicles;
 mod wind;
@@ -112,7 +113,7 @@ pub use loiter::LoiterSummary;
 pub use mission::{
     plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
 };
-pub use mission_file::{Mission, PlannerKept, DEMO_MISSION, DEMO_ORIGIN};
+pub use mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
 pub use mission_map::{
     mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };

@@ -38,13 +38,13 @@
 //! back puts it where the plan cut the route; its height is above home (frame 3).
 
 use aloft_logs::telemetry::MissionItem;
-use aloft_missions::{write_plan, write_waypoint_rows, Home, MissionEntry, SourceFormat};
+use aloft_missions::{write_plan, write_waypoint_rows, Home, Imported, MissionEntry, SourceFormat};
 use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::{MissionSpec, SegmentSpec};
 
 use super::flight::Flight;
 use super::mission::flown_mission;
-use super::mission_file::{Mission, PlannerKept};
+use super::mission_file::Mission;
 use super::mission_options::MissionOptions;
 use super::sorties::{Cut, Route, SortieMaker};
 use super::vehicles::Vehicle;
@@ -71,7 +71,7 @@ pub(super) struct PlannerSorties<'a> {
     /// The route cut.
     pub(super) route: &'a Route<'a>,
     /// What the file keeps to be written again.
-    pub(super) kept: &'a PlannerKept,
+    pub(super) kept: &'a Imported,
     /// The mission flown (the candidate's: its legs' speeds).
     pub(super) spec: &'a MissionSpec,
     /// Whether the plan changed speeds (then every speed is written from `spec`).

@@ -191,12 +191,6 @@ pub(super) fn sortie_plans(
     if options.inside_legs {
         route.within_reach(flight)?;
     }
-    let spec_maker = SpecSorties { route, flight };
-    let maker = if options.inside_legs {
-        maker
-    } else {
-        &spec_maker as &dyn SortieMaker
-    };
     let mut plans: Vec<SortiePlan> = Vec::new();
     let mut start: Option<Cut> = None;
     loop {
@@ -220,7 +214,7 @@ pub(super) fn sortie_plans(
         }
         let found = match options.inside_legs {
             true => farthest_end(flight, route, maker, start),
-            false => whole_end(flight, route, start, &rest),
+            false => whole_end(flight, route, maker, (start, &rest)),
         };
         let Some((end, spec, report)) = found else {
             return Err(route.cannot_fly(start));
@@ -296,15 +290,20 @@ fn farthest_end(
 fn whole_end(
     flight: &Flight<'_>,
     route: &Route<'_>,
-    start: Option<Cut>,
-    rest: &MissionReport,
+    maker: &dyn SortieMaker,
+    (start, rest): (Option<Cut>, &MissionReport),
 ) -> Option<Ending> {
     // Without a point of no return (every straight return held, yet the mission's own way down
     // lands short), every segment of the route is a candidate.
     let limit_s = rest.point_of_no_return.map_or(f64::INFINITY, |p| p.time_s);
     let ends = route.ends_before(start, rest, limit_s);
     // A sortie that cannot be compiled (a transit beyond a limit) is one that cannot be flown.
-    let try_end = |end: usize| route.try_sortie(flight, start, Cut::whole(end));
+    let try_end = |end: usize| {
+        let cut = Cut::whole(end);
+        let spec = maker.sortie(start, Some(cut)).ok()?;
+        let report = flight.trial(&spec, None).ok().filter(|r| r.feasible)?;
+        Some((cut, spec, report))
+    };
     // The candidate first, then bisection among the earlier ends (fewer segments, less energy
     // before the return).
     let &candidate = ends.last()?;
@@ -527,14 +526,6 @@ impl<'a> Route<'a> {
             // At a leg's start: the end of the segment before it.
             false => Cut::whole(segment - 1),
         }
-    }
-
-    /// The sortie from `start` to `end` with its flight, when it lands with the reserve (one
-    /// that cannot be compiled, a transit beyond a limit, cannot be flown).
-    fn try_sortie(&self, flight: &Flight<'_>, start: Option<Cut>, end: Cut) -> Option<Ending> {
-        let spec = self.sortie(flight, start, Some(end));
-        let report = flight.trial(&spec, None).ok().filter(|r| r.feasible)?;
-        Some((end, spec, report))
     }
 
     /// Whether a pack can fly to the route's farthest point from home and back (a sortie that

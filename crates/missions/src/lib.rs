@@ -80,7 +80,7 @@ pub use plan::read_plan;
 pub use route::{route_figures, RouteFigures};
 pub use wpl::{read_items, read_waypoints};
 pub use write::{
-    write_like_source, write_plan, write_waypoint_rows, write_waypoints, MissionEntry,
+    plan_entries, write_like_source, write_plan, write_waypoint_rows, write_waypoints, MissionEntry,
 };
 
 /// The format a mission text is in.

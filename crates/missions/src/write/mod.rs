@@ -76,7 +76,7 @@ use aloft_logs::telemetry::MissionItem;
 use crate::commands::{CommandName, DO_JUMP};
 use crate::error::{ImportError, Place};
 use crate::items::{check_params, has_position};
-use crate::kept::{Home, ItemOrigin, PlanFile};
+use crate::kept::{Home, ItemOrigin};
 use crate::raw_item::RawItem;
 use crate::{Imported, SourceFormat};
 
@@ -112,7 +112,7 @@ pub fn write_like_source(imported: &Imported) -> Result<String, ImportError> {
                 at: Place::File,
                 hint: "a .plan is written with its plannedHomePosition",
             })?;
-            write_plan(&plan.header, &home, &plan_entries(imported, plan))
+            write_plan(&plan.header, &home, &plan_entries(imported, &[])?)
         }
         (SourceFormat::QgcWpl | SourceFormat::MavlinkItems, _) => {
             let entries: Vec<MissionEntry> = imported
@@ -126,15 +126,37 @@ pub fn write_like_source(imported: &Imported) -> Result<String, ImportError> {
     }
 }
 
-/// The entries of a `.plan`: each survey once, where its first item was.
-fn plan_entries(imported: &Imported, plan: &PlanFile) -> Vec<MissionEntry> {
+/// The entries of the `.plan` read as `imported`, in file order: its SimpleItems (a corridor
+/// scan's stored items among them), and each survey once, where its first item was: its complex
+/// item as read, or regenerated at the grid angle `angles` gives it (pairs of an index in
+/// [`Imported::surveys`] and an angle in degrees, with [`crate::survey::reangle_survey_item`]
+/// in QGroundControl's default projection). No entries for a file that is not a `.plan`.
+///
+/// # Errors
+/// The errors of [`crate::survey::reangle_survey_item`] for a survey given an angle.
+pub fn plan_entries(
+    imported: &Imported,
+    angles: &[(usize, f64)],
+) -> Result<Vec<MissionEntry>, ImportError> {
+    let Some(plan) = &imported.plan else {
+        return Ok(Vec::new());
+    };
     let mut entries = Vec::with_capacity(imported.items.len());
     let mut last_survey = None;
     for (item, origin) in imported.items.iter().zip(&plan.origins) {
         match *origin {
             ItemOrigin::Survey { survey, .. } => {
                 if last_survey != Some(survey) {
-                    let json = imported.surveys[survey].complex_item.clone();
+                    let read = &imported.surveys[survey];
+                    let json = match angles.iter().find(|(s, _)| *s == survey) {
+                        Some(&(_, angle)) => crate::survey::reangle_survey_item(
+                            &read.complex_item,
+                            angle,
+                            read.first_item,
+                            crate::survey::QgcProjection::default(),
+                        )?,
+                        None => read.complex_item.clone(),
+                    };
                     entries.push(MissionEntry::Survey(json));
                     last_survey = Some(survey);
                 }
@@ -144,7 +166,7 @@ fn plan_entries(imported: &Imported, plan: &PlanFile) -> Vec<MissionEntry> {
             }
         }
     }
-    entries
+    Ok(entries)
 }
 
 /// An item both formats can hold: no DO_JUMP, parameters finite or NaN, a position item's
