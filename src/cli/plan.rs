@@ -114,10 +114,17 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
     let speeds = &plan.changes.speeds;
     if !speeds.is_empty() {
         writeln!(out)?;
+        let legs = match speeds.len() {
+            1 => "1 leg".to_string(),
+            n => format!("{n} legs"),
+        };
+        writeln!(out, "{legs} at the speed of least energy in their wind")?;
+    }
+    for a in &plan.changes.angles {
         writeln!(
             out,
-            "{} legs at the speed of least energy in their wind",
-            speeds.len()
+            "survey at item {} turned to the wind: grid angle {}\u{b0} -> {}\u{b0}",
+            a.item, a.from_deg, a.to_deg
         )?;
     }
     if plan.changes.cut_inside_legs {
