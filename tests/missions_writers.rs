@@ -357,3 +357,71 @@ fn pymavlink_loads_every_waypoints_file_aloft_writes_with_the_rows_aloft_wrote()
     // 128 items and 9 home rows (one file has none).
     assert_eq!(compared, 128 + 9);
 }
+
+/// The files of `aloft plan` (sorties cut inside legs, resumed, the camera restored and
+/// stopped, speeds written): the shared survey split into `.plan` files and an ArduPilot file
+/// into `.waypoints` files, each read by MAVSDK's importer or pymavlink's loader with the items
+/// aloft reads from it.
+#[test]
+fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
+    if !python_ready("mavsdk, pymavlink") {
+        return;
+    }
+    let sorties = |name: &str, extra: &[&str]| -> Vec<Written> {
+        let input = common::files("missions", |n| n == name);
+        let input = input.first().unwrap().display().to_string();
+        let dir = common::scratch("writers-sorties", &format!("{name}{}", extra.join("")));
+        let _ = std::fs::remove_dir_all(&dir);
+        let d = dir.display().to_string();
+        let mut args = vec!["plan", input.as_str(), "-o", d.as_str(), "--format", "json"];
+        args.extend_from_slice(extra);
+        let answer = common::ok_json(&args);
+        let files = answer["files"].as_array().unwrap();
+        files
+            .iter()
+            .map(|f| {
+                let path = PathBuf::from(f.as_str().unwrap());
+                let i = import(&std::fs::read_to_string(&path).unwrap()).unwrap();
+                Written {
+                    path,
+                    home: i.home,
+                    items: i.items,
+                }
+            })
+            .collect()
+    };
+    let plans = sorties(
+        "neilvaltec_test.plan",
+        &[
+            "--reserve-percent",
+            "70",
+            "--wind-speed",
+            "8",
+            "--wind-from",
+            "0",
+        ],
+    );
+    assert!(plans.len() >= 2);
+    // One pack with its own speeds: the survey turned and written as its complex item.
+    let mut plans = plans;
+    plans.extend(sorties(
+        "neilvaltec_test.plan",
+        &["--speeds", "keep", "--wind-speed", "8", "--wind-from", "0"],
+    ));
+    let mut args = vec!["mavsdk".into(), "--autopilot".into(), "px4".into()];
+    args.extend(paths(&plans));
+    let compared = compare(&readers(&args), &plans, |w| mavsdk_expected(w, false));
+    let waypoints = sorties(
+        "ardupilot_copter_loiterturns_mission.txt",
+        &["--reserve-percent", "90"],
+    );
+    assert!(waypoints.len() >= 2);
+    let mut args = vec!["mavwp".into()];
+    args.extend(paths(&waypoints));
+    let rows = compare(&readers(&args), &waypoints, mavwp_expected);
+    eprintln!(
+        "{} sortie .plan files, {compared} items; {} .waypoints files, {rows} rows",
+        plans.len(),
+        waypoints.len()
+    );
+}

@@ -266,7 +266,7 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
         );
         // Read back by `aloft mission`: the reserve kept, the sortie's energy.
         let mut args = vec!["mission", path, "--format", "json"];
-        args.extend(extra.iter().map(String::as_str));
+        args.extend(mission_flags(extra));
         let (code, out, err) = run(&args);
         assert_eq!(code, 0, "{tag}: {path} read back: {err}");
         let flown: Value = serde_json::from_str(&out).unwrap();
@@ -378,6 +378,23 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
         }
         seen.camera_m += (leg.to[0] - leg.from[0]).hypot(leg.to[1] - leg.from[1]);
     }
+}
+
+/// The flags of `extra` that `aloft mission` takes (those of the plan alone left out).
+fn mission_flags(extra: &[String]) -> Vec<&str> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < extra.len() {
+        match extra[k].as_str() {
+            "--speeds" | "--overlap-m" | "--camera-interval-s" | "--max-speed" => k += 2,
+            "--keep-angle" => k += 1,
+            flag => {
+                out.push(flag);
+                k += 1;
+            }
+        }
+    }
+    out
 }
 
 /// Whether the plan changed any leg's speed.
@@ -502,5 +519,92 @@ fn a_do_jump_loop_is_unrolled_into_the_sorties() {
         (seen.camera_m - 2.0 * 3.0 * 1600.0).abs() < 10.0,
         "{}",
         seen.camera_m
+    );
+}
+
+/// The shared ArduPilot files at a 90 % reserve, where their routes need several packs: each
+/// sortie keeps the reserve, the camera-on legs covered, nothing worse than as given.
+#[test]
+fn data_val_the_shared_waypoints_files_split_at_a_90_percent_reserve() {
+    let mut seen = Seen::default();
+    for name in [
+        "ardupilot_DO_CHANGE_SPEED_mission.txt",
+        "ardupilot_copter_loiterturns_mission.txt",
+    ] {
+        let file = common::files("missions", |n| n == name);
+        let file = file
+            .first()
+            .unwrap_or_else(|| panic!("{name} in the shared missions"));
+        for (speed, from) in [(0.0, 0.0), (8.0, 90.0)] {
+            let extra: Vec<String> = [
+                "--reserve-percent",
+                "90",
+                "--wind-speed",
+                &speed.to_string(),
+                "--wind-from",
+                &from.to_string(),
+            ]
+            .map(String::from)
+            .to_vec();
+            check(file, &extra, &mut seen);
+        }
+    }
+    eprintln!(
+        "plans {} (split {}), no plan {}",
+        seen.plans, seen.split, seen.no_plan
+    );
+    assert_eq!(seen.plans + seen.no_plan, 4);
+    assert!(seen.plans >= 3, "{}", seen.plans);
+    assert_eq!(seen.split, seen.plans, "a 90 % reserve needs several packs");
+}
+
+/// The shared survey on one pack with its own speeds in an 8 m/s northerly: turned to the wind
+/// and written back as a survey complex item at its new angle (QGroundControl shows and edits
+/// it), which `aloft mission` flies to the plan's energy; the polygon covered as before.
+#[test]
+fn data_val_a_survey_turned_on_one_pack_is_written_as_its_complex_item() {
+    let file = common::files("missions", |n| n == "neilvaltec_test.plan");
+    let file = file
+        .first()
+        .expect("neilvaltec_test.plan in the shared missions");
+    let extra: Vec<String> = ["--speeds", "keep", "--wind-speed", "8", "--wind-from", "0"]
+        .map(String::from)
+        .to_vec();
+    let mut seen = Seen::default();
+    check(file, &extra, &mut seen);
+    assert_eq!(seen.turned, 1, "the survey is turned");
+    let dir = scratch("plan-files", "turned-one");
+    let (code, answer, err) = plan(file, &dir, &extra);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(answer["batteries"], 1);
+    let to = f(&answer["changes"]["angles"][0]["to_deg"]);
+    let from = f(&answer["changes"]["angles"][0]["from_deg"]);
+    assert!((to - from).abs() > 1.0);
+    let written: Value = serde_json::from_str(
+        &std::fs::read_to_string(answer["files"][0].as_str().unwrap()).unwrap(),
+    )
+    .unwrap();
+    let items = written["mission"]["items"].as_array().unwrap();
+    let surveys: Vec<&Value> = items
+        .iter()
+        .filter(|i| i["complexItemType"] == "survey")
+        .collect();
+    assert_eq!(surveys.len(), 1);
+    assert_eq!(f(&surveys[0]["angle"]), to);
+    // The same polygon, spacing and trigger distance as the input's.
+    let input: Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+    let own = input["mission"]["items"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|i| i["complexItemType"] == "survey")
+        .unwrap();
+    assert_eq!(surveys[0]["polygon"], own["polygon"]);
+    let camera = |v: &Value| v["TransectStyleComplexItem"]["CameraCalc"].clone();
+    assert_eq!(camera(surveys[0]), camera(own));
+    assert_eq!(
+        items.last().unwrap()["command"],
+        20,
+        "a return to launch last"
     );
 }

@@ -127,6 +127,9 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
             a.item, a.from_deg, a.to_deg
         )?;
     }
+    for note in &plan.notes {
+        writeln!(out, "note: {note}")?;
+    }
     if plan.changes.cut_inside_legs {
         writeln!(
             out,

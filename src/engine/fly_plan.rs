@@ -36,7 +36,7 @@ use super::plan_files::PlannerSorties;
 use super::sorties::{
     segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
 };
-use super::survey_angle::{turned_to_wind, AngleChange};
+use super::survey_angle::{turned_to_wind, unturnable, AngleChange};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use crate::error::Error;
@@ -179,6 +179,9 @@ pub struct FlyPlan {
     pub as_given: Option<PlanFigures>,
     /// What changed.
     pub changes: PlanChanges,
+    /// What the plan could not do, and why (a survey it could not draw again).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// The files' texts, in flight order (not in the JSON: written by [`FlyPlan::write`]).
     #[serde(skip)]
     pub texts: Vec<String>,
@@ -220,6 +223,9 @@ pub fn plan_to_fly(
     };
     let mut plan = answer(mission, &best, as_given)?;
     plan.changes.angles = angles;
+    if !request.keep_angle {
+        plan.notes = unturnable(mission);
+    }
     finite(plan, "plan", || {
         format!(
             "plan of mission {} with {}",
@@ -648,6 +654,7 @@ fn answer(
                     .iter()
                     .any(|p| p.end.is_some_and(|c| c.fraction < 1.0)),
         },
+        notes: Vec::new(),
         texts,
     })
 }

@@ -16,6 +16,10 @@
 //! launch (NAV_RETURN_TO_LAUNCH 20). The last sortie flies the file's own way down (the camera
 //! stopped and a return to launch written when the file ends in the air).
 //!
+//! A `.plan` flown whole on one pack with its own speeds keeps its survey complex items (turned
+//! to the wind where the plan turned them), so that QGroundControl shows and edits them; a survey
+//! cut between packs, or given speeds, is written as its items.
+//!
 //! **Items in force** where a sortie resumes (as QGroundControl's resume mission keeps them,
 //! `MissionManager::generateResumeMission`): the last of each of DO_CHANGE_SPEED (178, per speed
 //! type), DO_SET_CAM_TRIGG_DIST (206), the region of interest (DO_SET_ROI 201,
@@ -109,8 +113,14 @@ impl PlannerSorties<'_> {
     /// A file without a home, and the writers' refusals.
     pub(super) fn text(&self, start: Option<Cut>, end: Option<Cut>) -> Result<String, String> {
         let home = self.home()?;
-        let items = self.items(&home, start, end);
-        let entries: Vec<MissionEntry> = items.into_iter().map(MissionEntry::Item).collect();
+        let entries = match self.whole_with_surveys(start, end) {
+            Some(entries) => entries,
+            None => self
+                .items(&home, start, end)
+                .into_iter()
+                .map(MissionEntry::Item)
+                .collect(),
+        };
         let written = match (self.kept.format, &self.kept.plan) {
             (SourceFormat::QgcPlan, Some(plan)) => write_plan(&plan.header, &home, &entries),
             // A file without a home row is written without one, as it was read: its first
@@ -118,6 +128,34 @@ impl PlannerSorties<'_> {
             _ => write_waypoint_rows(self.kept.home.as_ref(), &entries),
         };
         written.map_err(|e| e.to_string())
+    }
+
+    /// The entries of a `.plan` flown whole on one pack with its own speeds, when it has a
+    /// survey: the file's own, each survey as its complex item (turned, where the plan turned
+    /// it), so that QGroundControl shows and edits the survey; a return to launch after them
+    /// when the file ends in the air. `None` otherwise (the items are then written one by one).
+    fn whole_with_surveys(
+        &self,
+        start: Option<Cut>,
+        end: Option<Cut>,
+    ) -> Option<Vec<MissionEntry>> {
+        let whole = start.is_none() && end.is_none() && !self.speeds_changed;
+        if !whole || self.kept.surveys.is_empty() {
+            return None;
+        }
+        let mut entries = aloft_missions::plan_entries(self.kept, &[]).ok()?;
+        let flown = self.flown_items(0..self.kept.flown.len());
+        let last = flown
+            .iter()
+            .rev()
+            .find(|i| has_position(i.command) || ends(i.command));
+        if !last.is_some_and(|i| ends(i.command)) {
+            let mut home_items = flown;
+            let n = home_items.len();
+            self.home_items(&mut home_items);
+            entries.extend(home_items.drain(n..).map(MissionEntry::Item));
+        }
+        Some(entries)
     }
 
     /// The file's home, or where a file without a home row launches (its first position, the

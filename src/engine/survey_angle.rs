@@ -121,6 +121,21 @@ pub(super) fn turned_to_wind(
     Ok(Some((turned, changes)))
 }
 
+/// Why each survey of `mission` that cannot be drawn again is flown as its stored items and not
+/// turned (a polygon of fewer than 3 distinct vertices, a spacing of 0, a coordinate that is not
+/// a number: the reader's reason, naming the survey's first item and the key).
+pub(super) fn unturnable(mission: &Mission) -> Vec<String> {
+    let Some(imported) = mission.kept() else {
+        return Vec::new();
+    };
+    imported
+        .surveys
+        .iter()
+        .filter_map(|s| s.survey.as_ref().err())
+        .map(|e| format!("survey not turned, flown as its stored items: {e}"))
+        .collect()
+}
+
 /// The grid on which coverage is counted, m.
 const COVERAGE_GRID_M: f64 = 3.0;
 
