@@ -786,7 +786,7 @@
 
   // As given against the plan: batteries, flight time, energy.
   function flyFigures(plan) {
-    const head = el('tr', {}, ['', 'Batteries', 'Flight time (min:s)', 'Energy (Wh)'].map((h) => el('th', { text: h })));
+    const head = el('tr', {}, [['', ''], ['Batteries', ''], ['Flight time', 'min:s'], ['Energy', 'Wh']].map(headCell));
     const row = (label, f, cls) =>
       el('tr', { class: cls }, [
         el('th', { text: label }),
@@ -802,8 +802,8 @@
 
   // One row per sortie, in its map colour.
   function flySorties(plan) {
-    const heads = ['#', 'File', 'Items', 'Energy (Wh)', 'Time (min:s)', 'Landing (%)', 'No return (min:s)'];
-    const head = el('tr', {}, heads.map((h) => el('th', { text: h })));
+    const heads = [['#', ''], ['File', ''], ['Items', ''], ['Energy', 'Wh'], ['Time', 'min:s'], ['Landing', '%'], ['No return', 'min:s']];
+    const head = el('tr', {}, heads.map(headCell));
     const rows = plan.sorties.map((s, k) => {
       let items = s.first_item !== undefined ? `${s.first_item}–${s.last_item}` : '–';
       const inside = typeof s.ends_inside_leg_fraction === 'number';
@@ -828,7 +828,13 @@
       tr.addEventListener('mouseleave', () => lightSortie(k, false));
       return tr;
     });
-    return el('div', { class: 'table-wrap' }, [el('table', { class: 'fly fly-sorties' }, [el('thead', {}, [head]), el('tbody', {}, rows)])]);
+    const key = el('p', { class: 'fly-key muted', text: 'On the map: each sortie in its colour, the route solid, the way out dashed, the way home dotted; * turns home inside a leg.' });
+    return el('div', {}, [el('div', { class: 'table-wrap' }, [el('table', { class: 'fly fly-sorties' }, [el('thead', {}, [head]), el('tbody', {}, rows)])]), key]);
+  }
+
+  // A header cell: its name, and its unit below it.
+  function headCell([name, unit]) {
+    return el('th', {}, unit ? [name, el('br'), el('span', { class: 'unit', text: `(${unit})` })] : [name]);
   }
 
   // What changed from the mission as given.
