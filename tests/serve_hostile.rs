@@ -44,6 +44,7 @@ fn a_request_names_no_file_of_the_server() {
         ("POST", "/api/mission?wind_field=/etc/passwd"),
         ("POST", "/api/mission?vehicle=/etc/passwd"),
         ("POST", "/api/map?vehicle=/proc/self/environ"),
+        ("POST", "/api/plan?wind_field=/etc/passwd"),
         ("GET", "/api/endurance?vehicle=/etc/passwd"),
         ("POST", "/api/log/info?profile=/etc/passwd"),
         ("POST", "/api/mission?vehicle=../../../../etc/passwd"),

@@ -24,6 +24,10 @@
     routeLayer: null,
     segLayers: new Map(), // segment index -> polyline
     liveLayer: null,
+    flyLayer: null, // the sorties of the plan to fly
+    flyLines: [], // sortie -> its polylines
+    flyUrls: [], // the plan's download links (object URLs)
+    flySeq: 0,
     liveMarker: null,
     liveTrackLine: null,
     liveTrack: [],
@@ -219,6 +223,8 @@
   async function replan() {
     const seq = ++state.planSeq;
     const entry = state.current;
+    // A plan to fly shown was made for the mission and conditions that are changing.
+    if (state.flyLayer && $('#fly').dataset.state !== 'none') clearFly();
     busy(1);
     let ok = false;
     try {
@@ -401,6 +407,7 @@
     state.map = map;
     state.mapGeo = geo;
     state.routeLayer = L.featureGroup().addTo(map);
+    state.flyLayer = L.featureGroup().addTo(map);
     state.liveLayer = L.featureGroup().addTo(map);
     state.liveMarker = null;
     state.liveTrackLine = null;
@@ -684,6 +691,289 @@
     }
   }
 
+  // ---------------------------------------------------------------- plan to fly
+
+  // The sorties' colours on the map and in the table (none of them the battery scale's greens
+  // and reds of the route underneath).
+  const SORTIE_COLOURS = ['#1f5fbf', '#8e24aa', '#ef6c00', '#00838f', '#c2185b', '#5d4037', '#3949ab', '#9e9d24'];
+  const sortieColour = (k) => SORTIE_COLOURS[k % SORTIE_COLOURS.length];
+
+  function mmss(s) {
+    if (typeof s !== 'number' || !Number.isFinite(s)) return '–';
+    const total = Math.round(Math.max(0, s));
+    return `${Math.floor(total / 60)}:${String(total % 60).padStart(2, '0')}`;
+  }
+
+  // The plan's options: the page's controls (no scenarios: a plan has none) and the panel's own.
+  function flyOptions() {
+    const q = options();
+    q.delete('samples');
+    const add = (key, id) => {
+      const v = $(id).value.trim();
+      if (v !== '') q.set(key, v);
+    };
+    add('speeds', '#fly-speeds');
+    add('overlap_m', '#fly-overlap');
+    add('max_speed', '#fly-max-speed');
+    return q;
+  }
+
+  // Forget the plan shown (the mission or its conditions changed): its layers, its links.
+  function clearFly(note) {
+    state.flySeq += 1;
+    for (const url of state.flyUrls) URL.revokeObjectURL(url);
+    state.flyUrls = [];
+    if (state.flyLayer) state.flyLayer.clearLayers();
+    $('#map').classList.remove('flying');
+    $('#fly-title').textContent = '';
+    const box = $('#fly');
+    box.dataset.state = 'none';
+    delete box.dataset.batteries;
+    box.replaceChildren(el('p', { class: 'muted', text: note || 'The files to upload, one per battery, for this mission in these conditions.' }));
+  }
+
+  async function planToFly() {
+    const entry = state.current;
+    if (!entry || entry.key === 'none') {
+      showError('Plan to fly: no mission selected');
+      return;
+    }
+    clearFly('planning…');
+    const seq = state.flySeq;
+    const planSeq = state.planSeq;
+    const box = $('#fly');
+    box.dataset.state = 'loading';
+    $('#plan-fly').disabled = true;
+    let ok = false;
+    try {
+      if (entry.text === null) entry.text = await fetchText(`/api/files/${entry.index}`);
+      const q = flyOptions();
+      if (entry.name) q.set('file', entry.name);
+      const plan = await api(`/api/plan?${q.toString()}`, { method: 'POST', body: entry.text, headers: { 'Content-Type': 'text/plain' } });
+      if (seq !== state.flySeq || planSeq !== state.planSeq) return;
+      renderFly(plan);
+      clearError();
+      ok = true;
+    } catch (e) {
+      if (seq !== state.flySeq) return;
+      clearFly('No plan.');
+      box.dataset.state = 'error';
+      showError(`Plan to fly: ${e instanceof Error ? e.message : String(e)}`);
+    } finally {
+      $('#plan-fly').disabled = false;
+      // Ready unless an error is shown (this plan's, or a re-plan's that replaced it).
+      settle(ok || $('#error').hidden);
+    }
+  }
+
+  function renderFly(plan) {
+    const box = $('#fly');
+    if (plan.feasible === false) {
+      box.dataset.state = 'infeasible';
+      box.replaceChildren(el('p', { class: 'bad', text: `No plan keeps the reserve: ${plan.reason}` }));
+      return;
+    }
+    $('#fly-title').textContent = `${plan.batteries} ${plan.batteries === 1 ? 'battery' : 'batteries'}`;
+    const children = [flyFigures(plan), flySorties(plan)];
+    const changes = flyChanges(plan);
+    if (changes) children.push(changes);
+    children.push(flyDownloads(plan));
+    box.replaceChildren(...children);
+    drawFly(plan);
+    box.dataset.batteries = String(plan.batteries);
+    box.dataset.state = 'ready';
+  }
+
+  // As given against the plan: batteries, flight time, energy.
+  function flyFigures(plan) {
+    const head = el('tr', {}, [['', ''], ['Batteries', ''], ['Flight time', 'min:s'], ['Energy', 'Wh']].map(headCell));
+    const row = (label, f, cls) =>
+      el('tr', { class: cls }, [
+        el('th', { text: label }),
+        el('td', { class: 'n', text: f ? String(f.batteries) : '–' }),
+        el('td', { class: 'n', text: f ? mmss(f.duration_s) : '–' }),
+        el('td', { class: 'n', text: f ? fmt(f.energy_wh, 1) : '–' }),
+      ]);
+    const given = plan.as_given;
+    const rows = [row('as given', given, 'fly-given'), row('plan', plan, 'fly-plan')];
+    if (!given) rows[0].title = 'the mission as given cannot be split at whole items';
+    return el('table', { class: 'fly fly-figures' }, [el('thead', {}, [head]), el('tbody', {}, rows)]);
+  }
+
+  // One row per sortie, in its map colour.
+  function flySorties(plan) {
+    const heads = [['#', ''], ['File', ''], ['Items', ''], ['Energy', 'Wh'], ['Time', 'min:s'], ['Landing', '%'], ['No return', 'min:s']];
+    const head = el('tr', {}, heads.map(headCell));
+    const rows = plan.sorties.map((s, k) => {
+      let items = s.first_item !== undefined ? `${s.first_item}–${s.last_item}` : '–';
+      const inside = typeof s.ends_inside_leg_fraction === 'number';
+      if (inside) items += '*';
+      const tr = el('tr', {
+        'data-sortie': String(k + 1),
+        'data-file': s.file,
+        'data-energy-wh': String(s.energy_wh),
+        'data-duration-s': String(s.duration_s),
+        'data-end-soc': String(s.end_soc),
+      }, [
+        el('td', { class: 'n' }, [el('span', { class: 'swatch', style: `background:${sortieColour(k)}` }), String(k + 1)]),
+        el('td', { class: 'file', text: s.file }),
+        el('td', { class: 'n', text: items }),
+        el('td', { class: 'n', text: fmt(s.energy_wh, 1) }),
+        el('td', { class: 'n', text: mmss(s.duration_s) }),
+        el('td', { class: 'n', text: pct(s.end_soc) }),
+        el('td', { class: 'n', text: typeof s.point_of_no_return_s === 'number' ? mmss(s.point_of_no_return_s) : 'none' }),
+      ]);
+      if (inside) tr.title = `turns home ${fmt(s.ends_inside_leg_fraction * 100, 0)} % of the way along the leg to item ${s.last_item}`;
+      tr.addEventListener('mouseenter', () => lightSortie(k, true));
+      tr.addEventListener('mouseleave', () => lightSortie(k, false));
+      return tr;
+    });
+    const key = el('p', { class: 'fly-key muted', text: 'On the map: each sortie in its colour, the route solid, the way out dashed, the way home dotted; * turns home inside a leg.' });
+    return el('div', {}, [el('div', { class: 'table-wrap' }, [el('table', { class: 'fly fly-sorties' }, [el('thead', {}, [head]), el('tbody', {}, rows)])]), key]);
+  }
+
+  // A header cell: its name, and its unit below it.
+  function headCell([name, unit]) {
+    return el('th', {}, unit ? [name, el('br'), el('span', { class: 'unit', text: `(${unit})` })] : [name]);
+  }
+
+  // What changed from the mission as given.
+  function flyChanges(plan) {
+    const c = plan.changes || {};
+    const speeds = c.speeds || [];
+    const lines = [];
+    if (c.cut_inside_legs) lines.push(el('li', { text: 'sorties end inside legs (*), where each pack reaches the reserve' }));
+    if (speeds.length) {
+      const leg = (s) => (s.item !== undefined ? `item ${s.item}` : `segment ${s.segment}`);
+      const from = (s) => (typeof s.from_mps === 'number' ? `${fmt(s.from_mps, 1)} m/s` : 'planning speed');
+      const list = el('ul', {}, speeds.map((s) => el('li', { text: `${leg(s)}: ${from(s)} → ${fmt(s.to_mps, 1)} m/s` })));
+      const n = speeds.length;
+      lines.push(el('li', {}, [el('details', {}, [el('summary', { text: `${n} ${n === 1 ? 'leg' : 'legs'} at the speed of least energy in ${n === 1 ? 'its' : 'their'} wind` }), list])]));
+    }
+    if (!lines.length) return null;
+    return el('ul', { class: 'fly-changes' }, lines);
+  }
+
+  // Each file as a download, and all of them in one zip.
+  function flyDownloads(plan) {
+    const link = (name, blob, cls) => {
+      const url = URL.createObjectURL(blob);
+      state.flyUrls.push(url);
+      return el('a', { href: url, download: name, class: cls, text: name });
+    };
+    const files = (plan.texts || []).map((t) => ({ name: t.file, text: t.text }));
+    const links = files.map((f) => link(f.name, new Blob([f.text], { type: 'text/plain;charset=utf-8' }), 'fly-file'));
+    const stem = files.length ? files[0].name.replace(/-1-of-\d+\.[^.]+$/, '') : 'plan';
+    links.push(link(`${stem}-plan.zip`, zipStored(files), 'fly-all'));
+    return el('p', { class: 'fly-downloads' }, ['Files: ', ...links.flatMap((a, k) => (k ? [' ', a] : [a]))]);
+  }
+
+  // Each sortie's flown path in its own colour: its way out and way home dashed.
+  function drawFly(plan) {
+    if (!state.map) return;
+    state.flyLayer.clearLayers();
+    state.flyLines = [];
+    const geo = state.mapGeo;
+    const pathOf = (seg) => (geo && seg.points_deg ? seg.points_deg.map((p) => [p[0], p[1]]) : (seg.points_m || []).map((p) => [p[1], p[0]]));
+    (plan.maps || []).forEach((m, k) => {
+      const colour = sortieColour(k);
+      const lines = [];
+      for (const [part, dash] of [['way_out', '6 6'], ['route', null], ['way_home', '2 6']]) {
+        const latlngs = (m[part] || []).flatMap(pathOf);
+        if (!latlngs.length) continue;
+        const line = L.polyline(latlngs, {
+          color: colour,
+          weight: part === 'route' ? 4 : 3,
+          opacity: 0.95,
+          dashArray: dash,
+          className: `fly fly-${part.replace('_', '-')} fly-sortie-${k + 1}`,
+          lineCap: 'round',
+          lineJoin: 'round',
+        });
+        const s = plan.sorties[k];
+        line.bindTooltip(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}<br>${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`, { sticky: true });
+        line.on('mouseover', () => lightSortie(k, true));
+        line.on('mouseout', () => lightSortie(k, false));
+        line.addTo(state.flyLayer);
+        lines.push(line);
+      }
+      const pnr = m.point_of_no_return;
+      if (pnr) {
+        const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
+        L.circleMarker(at, { radius: 5, className: 'fly-pnr', color: colour, weight: 2, fillColor: '#fff', fillOpacity: 1 })
+          .bindTooltip(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`)
+          .addTo(state.flyLayer);
+      }
+      state.flyLines.push(lines);
+    });
+    $('#map').classList.add('flying');
+    const bounds = state.flyLayer.getBounds();
+    if (bounds.isValid()) state.map.fitBounds(bounds, { padding: [30, 30], maxZoom: geo ? 19 : 4 });
+  }
+
+  function lightSortie(k, on) {
+    for (const line of (state.flyLines || [])[k] || []) {
+      line.setStyle({ weight: on ? 7 : line.options.className.includes('fly-route') ? 4 : 3 });
+      if (on) line.bringToFront();
+    }
+    const tr = document.querySelector(`#fly tr[data-sortie="${k + 1}"]`);
+    if (tr) tr.classList.toggle('highlight', on);
+  }
+
+  // A zip of text files, stored (no compression): the files of a plan in one download.
+  function zipStored(files) {
+    const enc = new TextEncoder();
+    const table = crcTable();
+    const crc32 = (bytes) => {
+      let c = 0xffffffff;
+      for (const b of bytes) c = table[(c ^ b) & 0xff] ^ (c >>> 8);
+      return (c ^ 0xffffffff) >>> 0;
+    };
+    const now = new Date();
+    const time = (now.getHours() << 11) | (now.getMinutes() << 5) | (now.getSeconds() >> 1);
+    const date = ((now.getFullYear() - 1980) << 9) | ((now.getMonth() + 1) << 5) | now.getDate();
+    const parts = [];
+    const central = [];
+    let offset = 0;
+    for (const f of files) {
+      const name = enc.encode(f.name);
+      const data = enc.encode(f.text);
+      const crc = crc32(data);
+      // version 2.0, flags: names in UTF-8 (bit 11), stored
+      const common = [[20, 2], [0x0800, 2], [0, 2], [time, 2], [date, 2], [crc, 4], [data.length, 4], [data.length, 4], [name.length, 2], [0, 2]];
+      const local = le([[0x04034b50, 4], ...common]);
+      parts.push(local, name, data);
+      central.push(le([[0x02014b50, 4], [20, 2], ...common, [0, 2], [0, 2], [0, 2], [0, 4], [offset, 4]]), name);
+      offset += local.length + name.length + data.length;
+    }
+    const size = central.reduce((n, p) => n + p.length, 0);
+    const end = le([[0x06054b50, 4], [0, 2], [0, 2], [files.length, 2], [files.length, 2], [size, 4], [offset, 4], [0, 2]]);
+    return new Blob([...parts, ...central, end], { type: 'application/zip' });
+  }
+
+  // Little-endian fields [value, bytes].
+  function le(fields) {
+    const out = new Uint8Array(fields.reduce((n, [, w]) => n + w, 0));
+    let at = 0;
+    for (const [v, w] of fields) {
+      for (let i = 0; i < w; i++) out[at + i] = (v >>> (8 * i)) & 0xff;
+      at += w;
+    }
+    return out;
+  }
+
+  let crcCache = null;
+  function crcTable() {
+    if (crcCache) return crcCache;
+    crcCache = new Uint32Array(256);
+    for (let n = 0; n < 256; n++) {
+      let c = n;
+      for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+      crcCache[n] = c >>> 0;
+    }
+    return crcCache;
+  }
+
   // ---------------------------------------------------------------- vehicles
 
   function fillVehicles() {
@@ -887,6 +1177,9 @@
       input.addEventListener('input', replanSoon);
       input.addEventListener('change', replanSoon);
     }
+    $('#plan-fly').addEventListener('click', () => {
+      planToFly();
+    });
     $('#file').addEventListener('change', (e) => {
       const files = [...(e.target.files || [])];
       e.target.value = '';

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::flags::PlanFlags;
-use aloft::engine::{plan_to_fly, FlyPlan, Mission, PlanFigures, Vehicle};
+use aloft::engine::{answers, plan_to_fly, FlyPlan, Mission, PlanFigures, Vehicle};
 
 use super::mission_view::mmss;
 use super::output;
@@ -46,11 +46,7 @@ pub fn run(args: PlanArgs) -> Result<Outcome> {
         Err(aloft::Error::NoPlan { reason }) => {
             let mut out = std::io::stdout().lock();
             match args.format {
-                Format::Json => writeln!(
-                    out,
-                    "{}",
-                    serde_json::json!({ "feasible": false, "reason": reason })
-                )?,
+                Format::Json => writeln!(out, "{}", answers::no_plan_answer(&reason))?,
                 _ => writeln!(out, "NO PLAN keeps the reserve: {reason}")?,
             }
             return Ok(Outcome::Failed);

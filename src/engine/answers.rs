@@ -8,15 +8,17 @@
 
 use std::path::Path;
 
+use serde::Serialize;
+
 use super::flags::{
-    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags,
+    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags, PlanFlags,
     ValidateFlags,
 };
 use super::{
-    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, follow_live, list_vehicles,
-    log_info, mission_map, payload_sweep, plan_mission, plan_mission_with, plan_scenarios,
-    power_curve, replay_live, validate_logs, EnduranceWithUncertainty, LiveUpdate, Mission,
-    MissionOutputs, MissionWithUncertainty, Vehicle,
+    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, fly_plan_map, follow_live,
+    list_vehicles, log_info, mission_map, payload_sweep, plan_mission, plan_mission_with,
+    plan_scenarios, plan_to_fly, power_curve, replay_live, validate_logs, EnduranceWithUncertainty,
+    FlyPlan, LiveUpdate, Mission, MissionOutputs, MissionWithUncertainty, SortieMap, Vehicle,
 };
 use crate::error::Error;
 
@@ -91,6 +93,63 @@ pub fn mission_map_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Resu
         what: "answer",
         message: e.to_string(),
     })
+}
+
+/// `aloft plan MISSION --format json` of a mission already read, with what the page needs that
+/// the command line writes to files instead: each file's text (`texts`, in flight order, as
+/// `{"file", "text"}`) and each sortie's flown path (`maps`: [`fly_plan_map`]). No file is
+/// written. When no plan keeps the reserve, the command line's answer of that
+/// ([`no_plan_answer`]). Compact, as the page's map.
+///
+/// # Errors
+/// As [`plan_to_fly`] (but [`Error::NoPlan`], which is an answer) and [`PlanFlags::request`].
+pub fn plan_answer_for(m: &Mission, flags: &PlanFlags) -> Result<String, Error> {
+    let v = Vehicle::load(&flags.mission.vehicle)?;
+    let request = flags.request()?;
+    let plan = match plan_to_fly(&v, m, &request) {
+        Ok(plan) => plan,
+        Err(Error::NoPlan { reason }) => return Ok(no_plan_answer(&reason)),
+        Err(e) => return Err(e),
+    };
+    let answer = PlanAnswer {
+        texts: plan
+            .sorties
+            .iter()
+            .zip(&plan.texts)
+            .map(|(s, text)| PlanText {
+                file: &s.file,
+                text,
+            })
+            .collect(),
+        maps: fly_plan_map(&v, &plan, &request)?,
+        plan: &plan,
+    };
+    serde_json::to_string(&answer).map_err(|e| Error::OptionsFormat {
+        what: "answer",
+        message: e.to_string(),
+    })
+}
+
+/// `aloft plan --format json` when no plan keeps the reserve (exit 1 on the command line): the
+/// answer of an infeasible mission, `{"feasible":false,"reason":...}`.
+pub fn no_plan_answer(reason: &str) -> String {
+    serde_json::json!({ "feasible": false, "reason": reason }).to_string()
+}
+
+/// The answer of [`plan_answer_for`]: the plan's JSON, its files' texts and its sorties' maps.
+#[derive(Serialize)]
+struct PlanAnswer<'a> {
+    #[serde(flatten)]
+    plan: &'a FlyPlan,
+    texts: Vec<PlanText<'a>>,
+    maps: Vec<SortieMap>,
+}
+
+/// A file of a plan and its text.
+#[derive(Serialize)]
+struct PlanText<'a> {
+    file: &'a str,
+    text: &'a str,
 }
 
 /// `aloft endurance --format json`: the power curve with `--sweep-speed`, endurance against

@@ -21,6 +21,7 @@
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
 //! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `mission_map.rs` |
+//! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `plan_map.rs` |
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
 //! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
@@ -68,6 +69,7 @@ mod mission_options;
 mod mission_outputs;
 mod payload_sweep;
 mod plan_files;
+mod plan_map;
 mod power;
 mod power_batch;
 mod propulsion;
@@ -122,6 +124,7 @@ pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
 pub use payload_sweep::{
     payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
 };
+pub use plan_map::{fly_plan_map, SortieMap};
 pub use power::{
     power_csv_file, power_model, power_point, FlightStateDeg, PowerAnswer, PowerContext,
     PowerGradientDeg, PowerModelQuery, PowerQuery,

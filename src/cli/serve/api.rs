@@ -1,6 +1,7 @@
 //! The JSON API's requests that answer from options alone or a mission's text: each is the
 //! command line's `--format json` (or the page's map of the same plan).
 
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use axum::body::Body;
@@ -10,11 +11,12 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{post, MethodRouter};
 
 use aloft::engine::answers;
-use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags};
+use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
 use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT};
 use super::files::Names;
+use super::work::Pool;
 use super::{engine_message, error, json_type, Refused, Shared};
 
 /// The query of a request: its keys and values in order.
@@ -69,15 +71,35 @@ pub(super) async fn endurance(
     Ok(shared.work.run(job).await)
 }
 
-/// How a mission request is answered: `aloft mission`'s JSON or the page's map.
-type MissionAnswer = fn(&Mission, &MissionScenarioFlags) -> Result<String, aloft::Error>;
+/// The options of a request with a mission as its body: a flag group whose work the server
+/// bounds ([`super::work`]).
+pub(super) trait MissionRequest: FlagGroup + Send + 'static {
+    /// Bound the request's work within the pool's, with the cancellation flag of its client.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>);
+}
+
+impl MissionRequest for MissionScenarioFlags {
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) {
+        pool.bound(&mut self.scenarios, cancel);
+    }
+}
+
+impl MissionRequest for PlanFlags {
+    /// A plan has no scenarios to bound: it flies a few candidates (the planner's own limit on
+    /// each flight, at most [`aloft::engine::MAX_SORTIES`] sorties each) and runs to its end.
+    fn bound(&mut self, _: &Pool, _: &Arc<AtomicBool>) {}
+}
+
+/// How a mission request is answered: `aloft mission`'s JSON, the page's map, `aloft plan`'s.
+type MissionAnswer<T> = fn(&Mission, &T) -> Result<String, aloft::Error>;
 
 /// The route of a mission request (`POST PATH?file=NAME&OPTIONS`, the body a mission file, the
 /// demo when empty): `/api/mission` answers with `answers::mission_answer_for`, `/api/map` (the
-/// page's map of the same plan) with `answers::mission_map_answer_for`.
-pub(super) fn planned_route(
+/// page's map of the same plan) with `answers::mission_map_answer_for`, both with the options
+/// of `aloft mission`; `/api/plan` with `answers::plan_answer_for` and those of `aloft plan`.
+pub(super) fn planned_route<T: MissionRequest>(
     request: &'static str,
-    answer: MissionAnswer,
+    answer: MissionAnswer<T>,
 ) -> MethodRouter<Arc<Shared>> {
     post(
         move |State(shared): State<Arc<Shared>>,
@@ -89,21 +111,21 @@ pub(super) fn planned_route(
 
 /// A mission request: its options, its mission (the body, or the demo when empty, within
 /// [`MISSION_LIMIT`]), the answer.
-async fn planned(
+async fn planned<T: MissionRequest>(
     request: &str,
     (shared, headers): (Arc<Shared>, HeaderMap),
     query: Vec<(String, String)>,
     body: Body,
-    answer: MissionAnswer,
+    answer: MissionAnswer<T>,
 ) -> Answered {
     let limit_name = "the limit on mission files";
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
-    let mut flags: MissionScenarioFlags = flags(request, &query, &shared)?;
+    let mut flags: T = flags(request, &query, &shared)?;
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
     let job = move |cancel: &_| {
-        work.work.bound(&mut flags.scenarios, cancel);
+        flags.bound(&work.work, cancel);
         mission_of(&body, &origin)
             .and_then(|m| answer(&m, &flags))
             .map_err(engine_message)

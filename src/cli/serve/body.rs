@@ -6,7 +6,7 @@
 //!
 //! | body | limit |
 //! |---|---|
-//! | a mission (`/api/mission`, `/api/map`) | [`MISSION_LIMIT`]: the command line's limit on whole-file inputs, as the text is held and parsed whole |
+//! | a mission (`/api/mission`, `/api/map`, `/api/plan`) | [`MISSION_LIMIT`]: the command line's limit on whole-file inputs, as the text is held and parsed whole |
 //! | a log (`/api/log/info`) | `--max-upload-mb` (256 MiB by default): streamed to a file, never held |
 
 use axum::body::{Body, Bytes};

@@ -9,6 +9,7 @@
 //! | `GET /api/endurance?OPTIONS` | `aloft endurance OPTIONS --format json` |
 //! | `POST /api/mission?file=NAME&OPTIONS` (body: the mission file; empty: the built-in demo) | `aloft mission NAME OPTIONS --format json` |
 //! | `POST /api/map?file=NAME&OPTIONS` (as `/api/mission`) | the route, point of no return and state of charge over time that the page draws ([`aloft::engine::MissionMap`]) |
+//! | `POST /api/plan?file=NAME&OPTIONS` (as `/api/mission`, the options of `aloft plan`) | `aloft plan NAME OPTIONS --format json`, with each file's text (`texts`) and each sortie's path (`maps`, [`aloft::engine::SortieMap`]); no file is written |
 //! | `POST /api/log/info?file=NAME&OPTIONS` (body: the log) | `aloft log info NAME OPTIONS --format json` |
 //! | `GET /api/files/N` | the N-th file given on the command line (a mission's text) |
 //! | `GET /api/files/N/info` | `aloft log info FILE --format json` of the N-th file, a log |
@@ -19,7 +20,8 @@
 //! be given it (its name in the answer). An option that names a file (`vehicle`, `wind_field`,
 //! `profile`) names a built-in or a file given on the command line, never another file of the
 //! server ([`files`]). Every answer is the engine's ([`aloft::engine::answers`]), so it is the
-//! command line's text; an infeasible mission is an answer (200).
+//! command line's text; an infeasible mission is an answer (200), and so is a mission no plan
+//! keeps the reserve for (`{"feasible": false, "reason": ...}`, as `aloft plan` answers it).
 //!
 //! Errors, each `{"error": "..."}`: 400 for options the command does not take or a file option
 //! naming no given file, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
@@ -193,6 +195,10 @@ fn router(shared: Arc<Shared>) -> Router {
         .route(
             "/api/map",
             api::planned_route("POST /api/map", answers::mission_map_answer_for),
+        )
+        .route(
+            "/api/plan",
+            api::planned_route("POST /api/plan", answers::plan_answer_for),
         )
         .route("/api/log/info", post(files::log_info))
         .route("/api/files/{index}", get(files::given_file))
