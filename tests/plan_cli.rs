@@ -269,3 +269,19 @@ fn bad_input_and_no_plan_are_refused() {
     );
     assert!(!out_dir.exists());
 }
+
+/// A plan whose caller has given up (`aloft serve`'s client left) stops with
+/// `Error::Cancelled` before its next candidate; the same request not cancelled is answered.
+#[test]
+fn a_cancelled_plan_stops() {
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    let mission = aloft::engine::Mission::from_text(&survey_lines(24), "lines.toml").unwrap();
+    let vehicle = aloft::engine::Vehicle::builtin("dji-m100").unwrap();
+    let mut request = aloft::engine::FlyPlanRequest::default();
+    let plan = aloft::engine::plan_to_fly(&vehicle, &mission, &request).unwrap();
+    assert!(plan.batteries >= 2);
+    request.bounds.cancel = Some(Arc::new(AtomicBool::new(true)));
+    let e = aloft::engine::plan_to_fly(&vehicle, &mission, &request).unwrap_err();
+    assert!(matches!(e, aloft::Error::Cancelled), "{e}");
+}

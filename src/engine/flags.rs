@@ -652,6 +652,10 @@ pub struct PlanFlags {
     /// where that saves energy, its transects drawn again as QGroundControl draws them).
     #[arg(long)]
     pub keep_angle: bool,
+    /// What the request may spend (set by a caller that serves others: its cancellation; no
+    /// flag).
+    #[arg(skip)]
+    pub bounds: WorkBounds,
 }
 
 impl PlanFlags {
@@ -694,6 +698,7 @@ impl PlanFlags {
             max_speed_mps: self.max_speed,
             camera_interval_s: self.camera_interval_s,
             keep_angle: self.keep_angle,
+            bounds: self.bounds.clone(),
         })
     }
 }

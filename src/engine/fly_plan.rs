@@ -33,6 +33,7 @@ use super::mission::{plan_mission, prepare, Prepared};
 use super::mission_file::Mission;
 use super::mission_options::MissionOptions;
 use super::plan_files::PlannerSorties;
+use super::scenarios::WorkBounds;
 use super::sorties::{
     segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
 };
@@ -82,6 +83,9 @@ pub struct FlyPlanRequest {
     /// Keep the grid angle of every survey (else each is turned to the wind where that saves
     /// energy: [`super::survey_angle`]).
     pub keep_angle: bool,
+    /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
+    /// candidate, angle or sortie once cancelled (its steps are the planner's own to bound).
+    pub bounds: WorkBounds,
 }
 
 impl Default for FlyPlanRequest {
@@ -93,6 +97,7 @@ impl Default for FlyPlanRequest {
             max_speed_mps: None,
             camera_interval_s: None,
             keep_angle: false,
+            bounds: WorkBounds::default(),
         }
     }
 }
@@ -257,6 +262,7 @@ fn plan_for(
         mission,
         options,
         prepared: &prepared,
+        bounds: &request.bounds,
     };
     best_candidate(&cx, candidates)
 }
@@ -492,6 +498,7 @@ struct Context<'a> {
     mission: &'a Mission,
     options: &'a MissionOptions,
     prepared: &'a Prepared<'a>,
+    bounds: &'a WorkBounds,
 }
 
 /// The best candidate (module step 4), and the figures of the mission as given split at whole
@@ -508,6 +515,9 @@ fn best_candidate(
     // Why the first candidate (the route cut inside legs, as given) has no plan.
     let mut why: Option<String> = None;
     for candidate in candidates {
+        if cx.bounds.cancelled() {
+            return Err(Error::Cancelled);
+        }
         match fly_candidate(cx, candidate) {
             Ok(flown) => {
                 if flown.candidate.as_given {

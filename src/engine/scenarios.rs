@@ -152,7 +152,7 @@ pub struct WorkBounds {
 
 impl WorkBounds {
     /// Whether the caller has given up on the answer.
-    fn cancelled(&self) -> bool {
+    pub(super) fn cancelled(&self) -> bool {
         self.cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed))

@@ -74,6 +74,9 @@ pub(super) fn turned_to_wind(
             continue;
         };
         for angle in candidate_angles(survey.params(), wind) {
+            if request.bounds.cancelled() {
+                return Err(Error::Cancelled);
+            }
             // The polygon covered as before (a line lost at a corner is a gap in the images).
             let turned_survey = survey.with_angle(angle).ok();
             if turned_survey

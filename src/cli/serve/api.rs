@@ -85,9 +85,12 @@ impl MissionRequest for MissionScenarioFlags {
 }
 
 impl MissionRequest for PlanFlags {
-    /// A plan has no scenarios to bound: it flies a few candidates (the planner's own limit on
-    /// each flight, at most [`aloft::engine::MAX_SORTIES`] sorties each) and runs to its end.
-    fn bound(&mut self, _: &Pool, _: &Arc<AtomicBool>) {}
+    /// A plan has no scenarios: it flies a few candidates (the planner's own limit on each
+    /// flight, at most [`aloft::engine::MAX_SORTIES`] sorties each) and stops before its next
+    /// candidate or survey angle when its client leaves.
+    fn bound(&mut self, _: &Pool, cancel: &Arc<AtomicBool>) {
+        self.bounds.cancel = Some(cancel.clone());
+    }
 }
 
 /// How a mission request is answered: `aloft mission`'s JSON, the page's map, `aloft plan`'s.

@@ -10,9 +10,8 @@
 //!   its own state, so the threads bound the memory too). One flight is bounded by the planner's
 //!   own limit of ten million steps.
 //! - **For whom**: when the client goes away (its connection closes), the request's future is
-//!   dropped, which cancels its work: the scenarios stop before their next flight. A plan to
-//!   fly (`/api/plan`) has no scenarios: its few candidate flights run to their end, holding
-//!   the request's permit.
+//!   dropped, which cancels its work: the scenarios stop before their next flight, a plan to
+//!   fly (`/api/plan`) before its next candidate or survey angle.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
