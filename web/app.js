@@ -850,6 +850,10 @@
       const n = speeds.length;
       lines.push(el('li', {}, [el('details', {}, [el('summary', { text: `${n} ${n === 1 ? 'leg' : 'legs'} at the speed of least energy in ${n === 1 ? 'its' : 'their'} wind` }), list])]));
     }
+    for (const a of c.angles || []) {
+      lines.push(el('li', { text: `survey at item ${a.item} turned to the wind: grid angle ${fmt(a.from_deg, 0)}° → ${fmt(a.to_deg, 0)}°` }));
+    }
+    for (const note of plan.notes || []) lines.push(el('li', { text: `note: ${note}` }));
     if (!lines.length) return null;
     return el('ul', { class: 'fly-changes' }, lines);
   }

@@ -204,11 +204,22 @@ pub fn plan_to_fly(
 ) -> Result<FlyPlan, Error> {
     let options = &request.options;
     let (wind, _) = mission_wind(options, mission, vehicle)?;
-    let (best, given) = plan_for(vehicle, mission, request, &wind)?;
-    let turned = match request.keep_angle {
-        true => None,
-        false => turned_to_wind(vehicle, mission, request, &wind)?,
-    };
+    // The mission as given is planned while its surveys are turned (two threads).
+    let (planned, turned) = std::thread::scope(|scope| {
+        let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind));
+        let turned = match request.keep_angle {
+            true => Ok(None),
+            false => turned_to_wind(vehicle, mission, request, &wind),
+        };
+        let planned = planned.join().unwrap_or_else(|_| {
+            Err(Error::NoPlan {
+                reason: "the plan's flight failed".into(),
+            })
+        });
+        (planned, turned)
+    });
+    let (best, given) = planned?;
+    let turned = turned?;
     // The surveys turned to the wind, when that needs fewer batteries or less energy.
     let (best, angles) = match turned {
         Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind) {
@@ -514,11 +525,29 @@ fn best_candidate(
     let mut given: Option<PlanFigures> = None;
     // Why the first candidate (the route cut inside legs, as given) has no plan.
     let mut why: Option<String> = None;
-    for candidate in candidates {
-        if cx.bounds.cancelled() {
-            return Err(Error::Cancelled);
-        }
-        match fly_candidate(cx, candidate) {
+    if cx.bounds.cancelled() {
+        return Err(Error::Cancelled);
+    }
+    // The candidates fly at once, one thread each (a handful); the answer is taken in their
+    // order, so it does not depend on which finishes first.
+    let flown: Vec<Result<Flown, String>> = std::thread::scope(|scope| {
+        let running: Vec<_> = candidates
+            .into_iter()
+            .map(|c| scope.spawn(move || fly_candidate(cx, c)))
+            .collect();
+        running
+            .into_iter()
+            .map(|r| {
+                r.join()
+                    .unwrap_or_else(|_| Err("a candidate's flight failed".to_string()))
+            })
+            .collect()
+    });
+    if cx.bounds.cancelled() {
+        return Err(Error::Cancelled);
+    }
+    for result in flown {
+        match result {
             Ok(flown) => {
                 if flown.candidate.as_given {
                     given = Some(flown.figures);

@@ -492,6 +492,13 @@ async function main() {
       assert(figures[0][1] === String(cli.json.as_given.batteries) && figures[0][2] === mmss(cli.json.as_given.duration_s), `as given ${figures[0]}`);
       assert(figures[1][1] === String(n) && figures[1][2] === mmss(cli.json.duration_s), `plan ${figures[1]}`);
       assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
+      // What changed names each survey the plan turned, with the angles aloft plan gives.
+      const changed = await page.$eval('#fly ul.fly-changes', (u) => u.textContent);
+      const angles = cli.json.changes.angles || [];
+      assert(angles.length >= 1, 'aloft plan turns the survey in this wind');
+      for (const a of angles) {
+        assert(changed.includes(`survey at item ${a.item} turned to the wind`) && changed.includes(`${Math.round(a.to_deg)}°`), changed);
+      }
     });
     console.log(`# plan to fly: ${n} sorties of ${path.basename(PLAN_MISSION)} in ${seconds.toFixed(2)} s from the click to the table (target 3 s)`);
     await check('plan to fly: each sortie drawn in its own colour (way out, route, way home), the route behind', async () => {
