@@ -91,6 +91,16 @@ def mission(
 def mission_map(
     path: Optional[PathLike] = None, **options: Unpack[ScenarioKeywords]
 ) -> Dict[str, Any]: ...
+def plan(
+    path: Optional[PathLike] = None,
+    *,
+    output: Optional[PathLike] = None,
+    force: bool = False,
+    overlap_m: Optional[float] = None,
+    speeds: Optional[Literal["wind", "energy", "keep"]] = None,
+    max_speed_mps: Optional[float] = None,
+    **options: Unpack[MissionKeywords],
+) -> Dict[str, Any]: ...
 def timeseries(path: Optional[PathLike] = None, **options: Unpack[MissionKeywords]) -> Any: ...
 def endurance(**options: Unpack[EnduranceKeywords]) -> Dict[str, Any]: ...
 def log_info(
