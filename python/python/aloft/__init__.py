@@ -126,8 +126,9 @@ def plan(
 
     Each sortie is used to the reserve (cut inside a leg where its pack reaches it) and the next
     resumes ``overlap_m`` back along the route; legs are flown at the ground speed of least
-    energy per metre in their wind; of the candidates the one with the fewest batteries, then
-    the least energy, is kept (never more than the mission as given). Each file is a complete
+    energy per metre in their wind; a QGroundControl survey is turned to the wind; of the
+    candidates the one with the fewest batteries, then the least energy, is kept (never more
+    than the mission as given). Each file is a complete
     mission in the input's format, which :func:`mission` flies with the same options to its
     sortie's figures.
 
@@ -145,12 +146,16 @@ def plan(
             without a speed of their own), ``"energy"`` (every leg) or ``"keep"`` (none).
         max_speed_mps: Highest ground speed a leg is given, m/s (``--max-speed``; the vehicle's
             own limits apply anyway).
-        **options: The mission's options, as :func:`mission`'s without the Monte-Carlo ones:
-            ``vehicle``, ``battery``, ``payload_kg`` (kg), ``wind_speed`` (m/s) and
-            ``wind_from`` (deg, blowing FROM), ``wind_profile``, ``wind_field``, ``gust_std``,
-            ``reserve_percent`` (% of the usable capacity at landing), ``start_percent``,
-            ``time_step`` (s), ``speed`` (m/s), ``rtl_altitude_m`` (m), ``corners``, ``aoa``,
-            ``no_ground_effect``.
+        **options: ``aloft plan``'s ``camera_interval_s`` (s: the camera's shortest time
+            between photos; a leg where it triggers every D m is given at most D / this;
+            default a ``.plan`` survey's ``MinTriggerInterval``, else 2) and ``keep_angle``
+            (True: keep every survey's grid angle; else a QGroundControl survey is turned to the
+            wind where that saves energy); and the mission's options, as :func:`mission`'s
+            without the Monte-Carlo ones: ``vehicle``, ``battery``, ``payload_kg`` (kg),
+            ``wind_speed`` (m/s) and ``wind_from`` (deg, blowing FROM), ``wind_profile``,
+            ``wind_field``, ``gust_std``, ``reserve_percent`` (% of the usable capacity at
+            landing), ``start_percent``, ``time_step`` (s), ``speed`` (m/s),
+            ``rtl_altitude_m`` (m), ``corners``, ``aoa``, ``no_ground_effect``.
 
     Returns:
         The CLI's JSON answer as a dict: ``files`` (in flight order), ``batteries``,
@@ -159,8 +164,8 @@ def plan(
         ``ends_inside_leg_fraction`` where it turns home inside a leg, ``energy_wh``,
         ``duration_s``, ``end_soc`` (0-1), ``point_of_no_return_s``), ``as_given`` (the
         mission split at whole items: ``batteries``, ``energy_wh``, ``duration_s``), ``changes``
-        (``speeds``: the legs given another speed, m/s; ``cut_inside_legs``); and ``texts``,
-        the files' texts in flight order. When no way of cutting the route keeps the reserve
+        (``speeds``: the legs given another speed, m/s; ``angles``: the surveys turned, deg;
+        ``cut_inside_legs``); and ``texts``, the files' texts in flight order. When no way of cutting the route keeps the reserve
         (the CLI exits 1) the answer is ``{"feasible": False, "reason": ..., "texts": []}``,
         not an error, and no file is written.
 

@@ -65,6 +65,12 @@ class ScenarioKeywords(MissionKeywords, total=False):
     power_sd_percent: Optional[float]
     threads: Optional[int]
 
+class PlanKeywords(MissionKeywords, total=False):
+    """`aloft plan`'s own flags beyond the mission's (the rest are arguments of `plan`)."""
+
+    camera_interval_s: Optional[float]
+    keep_angle: bool
+
 class EnduranceKeywords(VehicleKeywords, WindKeywords, total=False):
     """`aloft endurance`'s flags."""
 
@@ -99,7 +105,7 @@ def plan(
     overlap_m: Optional[float] = None,
     speeds: Optional[Literal["wind", "energy", "keep"]] = None,
     max_speed_mps: Optional[float] = None,
-    **options: Unpack[MissionKeywords],
+    **options: Unpack[PlanKeywords],
 ) -> Dict[str, Any]: ...
 def timeseries(path: Optional[PathLike] = None, **options: Unpack[MissionKeywords]) -> Any: ...
 def endurance(**options: Unpack[EnduranceKeywords]) -> Dict[str, Any]: ...
