@@ -5,17 +5,19 @@
 //! QGroundControl survey v5 of 52 waypoints and 15 camera triggers, about 5 km, flown by the
 //! DJI M100 with its default pack. Two cases, each a reserve that makes several sorties:
 //!
-//! - `plan/plan_to_fly/survey_wind_8mps`: wind 8 m/s from the north, reserve 70 %
-//!   (3 sorties when written; the legs get the wind's speeds);
+//! - `plan/plan_to_fly/survey_wind_8mps`: wind 8 m/s from the north, reserve 70 % (2 sorties
+//!   when written: the survey turned to the wind, the legs at the wind's speeds);
 //! - `plan/plan_to_fly/survey_still_air`: still air, reserve 80 % (4 sorties when written).
 //!
-//! Each plan flies every candidate (the mission's speeds and the wind's, cut inside legs, and
-//! the as-given split) and each candidate's sorties from their own files read back; no file
-//! is written. Without the shared data the bench says so and measures nothing.
+//! Each plan flies every candidate (the mission's speeds and the wind's, cut inside legs, the
+//! as-given split, the survey redrawn at each grid angle) and each candidate's sorties from their
+//! own files read back; no file is written. Without the shared data the bench says so and
+//! measures nothing.
 //!
-//! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples):
-//! `survey_wind_8mps` 241-277 ms and `survey_still_air` 339-374 ms at a load average of about 2;
-//! 496-554 ms and 418-483 ms while other builds kept the load at about 6.
+//! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples) while
+//! other builds kept its load average at about 3: `survey_wind_8mps` 518-650 ms,
+//! `survey_still_air` 403-525 ms. Before surveys were turned to the wind (3 sorties in the wind),
+//! at a load average of about 2: 241-277 ms and 339-374 ms.
 
 use std::hint::black_box;
 use std::path::PathBuf;
