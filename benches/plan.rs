@@ -10,8 +10,8 @@
 //! - `plan/plan_to_fly/survey_still_air`: still air, reserve 80 % (4 sorties when written).
 //!
 //! Each plan flies every candidate (the mission's speeds and the wind's, cut inside legs, the
-//! as-given split, the survey redrawn at each grid angle) and each candidate's sorties from their
-//! own files read back; no file is written. Without the shared data the bench says so and
+//! as-given split; then the same for the survey turned to the angle of least energy, where one
+//! saves energy) and each candidate's sorties from their own files read back; no file is written. Without the shared data the bench says so and
 //! measures nothing.
 //!
 //! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples) while
