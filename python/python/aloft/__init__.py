@@ -165,7 +165,8 @@ def plan(
         ``duration_s``, ``end_soc`` (0-1), ``point_of_no_return_s``), ``as_given`` (the
         mission split at whole items: ``batteries``, ``energy_wh``, ``duration_s``), ``changes``
         (``speeds``: the legs given another speed, m/s; ``angles``: the surveys turned, deg;
-        ``cut_inside_legs``); and ``texts``, the files' texts in flight order. When no way of cutting the route keeps the reserve
+        ``cut_inside_legs``), ``notes`` when there is something the plan could not do (a
+        survey it could not draw again); and ``texts``, the files' texts in flight order. When no way of cutting the route keeps the reserve
         (the CLI exits 1) the answer is ``{"feasible": False, "reason": ..., "texts": []}``,
         not an error, and no file is written.
 
