@@ -15,8 +15,8 @@
 //! measures nothing.
 //!
 //! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples) while
-//! other builds kept its load average at about 3: `survey_wind_8mps` 518-650 ms,
-//! `survey_still_air` 403-525 ms. Before surveys were turned to the wind (3 sorties in the wind),
+//! other builds kept its load average at about 3.5: `survey_wind_8mps` 623-749 ms,
+//! `survey_still_air` 402-467 ms. Before surveys were turned to the wind (3 sorties in the wind),
 //! at a load average of about 2: 241-277 ms and 339-374 ms.
 
 use std::hint::black_box;
