@@ -17,6 +17,7 @@
 #![deny(clippy::float_cmp)]
 
 mod options;
+mod plan;
 
 use std::path::PathBuf;
 
@@ -470,6 +471,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fit_json, m)?)?;
     m.add_function(wrap_pyfunction!(validate_json, m)?)?;
     m.add_function(wrap_pyfunction!(live_json, m)?)?;
+    m.add_function(wrap_pyfunction!(plan::plan_json, m)?)?;
     m.add_function(wrap_pyfunction!(power, m)?)?;
     m.add_function(wrap_pyfunction!(version, m)?)?;
     Ok(())

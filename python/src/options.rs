@@ -71,6 +71,15 @@ pub fn parse<T: FlagGroup>(
     positional: &[(&str, Keyword)],
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<T> {
+    let given = given(function, options)?;
+    parse_keywords::<T>(&format!("aloft.{function}"), positional, &given).map_err(engine_error)
+}
+
+/// The keyword arguments of `aloft.<function>` that are given (not `None`), as flag values.
+pub fn given(
+    function: &str,
+    options: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Vec<(String, Keyword)>> {
     let mut given = Vec::new();
     if let Some(d) = options {
         for (k, v) in d.iter() {
@@ -80,7 +89,7 @@ pub fn parse<T: FlagGroup>(
             }
         }
     }
-    parse_keywords::<T>(&format!("aloft.{function}"), positional, &given).map_err(engine_error)
+    Ok(given)
 }
 
 /// Paths given positionally (the logs of `fit` and `validate`).

@@ -152,6 +152,54 @@ struct PlanText<'a> {
     text: &'a str,
 }
 
+/// The answer of `aloft plan` as the command line gives it: its `--format json` text and the
+/// texts of the files it writes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlanWithTexts {
+    /// `aloft plan ... --format json`: the plan (`files`, `batteries`, `energy_wh`,
+    /// `duration_s`, `sorties`, `as_given`, `changes`), or [`no_plan_answer`] when no plan keeps
+    /// the reserve (the command's exit 1; no file written).
+    pub json: String,
+    /// The files' texts, in flight order (none without a plan).
+    pub texts: Vec<String>,
+}
+
+/// `aloft plan [PATH] -o DIR --format json` (`None`: the built-in demo): the missions to fly,
+/// one per battery. With `output` (the folder, and whether to overwrite files that exist) the
+/// files are written there by [`FlyPlan::write`] and the answer's `files` are their paths, as
+/// the command's; without it nothing is written and `files` are the names they would have.
+///
+/// # Errors
+/// As [`plan_to_fly`] (but for [`Error::NoPlan`], an answer) and [`PlanFlags::request`]; an
+/// existing file without `force` ([`Error::FileExists`]).
+pub fn plan_answer(
+    path: Option<&Path>,
+    flags: &PlanFlags,
+    output: Option<(&Path, bool)>,
+) -> Result<PlanWithTexts, Error> {
+    // In the command's order: the vehicle, the mission, the request.
+    let v = Vehicle::load(&flags.mission.vehicle)?;
+    let m = Mission::load(path)?;
+    let request = flags.request()?;
+    let mut plan = match plan_to_fly(&v, &m, &request) {
+        Ok(plan) => plan,
+        Err(Error::NoPlan { reason }) => {
+            return Ok(PlanWithTexts {
+                json: no_plan_answer(&reason),
+                texts: Vec::new(),
+            })
+        }
+        Err(e) => return Err(e),
+    };
+    if let Some((dir, force)) = output {
+        plan.write(dir, force)?;
+    }
+    Ok(PlanWithTexts {
+        json: json_text(&plan)?,
+        texts: std::mem::take(&mut plan.texts),
+    })
+}
+
 /// `aloft endurance --format json`: the power curve with `--sweep-speed`, endurance against
 /// payload with `--payload-sweep`, with its uncertainty when the flags ask for scenarios.
 ///

@@ -38,6 +38,7 @@ __all__ = [
     "log_info",
     "mission",
     "mission_map",
+    "plan",
     "power",
     "timeseries",
     "validate",
@@ -109,6 +110,76 @@ def mission_map(path: Optional[PathLike] = None, **options: Any) -> Dict[str, An
         AloftError: As :func:`mission`.
     """
     return json.loads(_native.mission_map_json(_path(path), options))
+
+
+def plan(
+    path: Optional[PathLike] = None,
+    *,
+    output: Optional[PathLike] = None,
+    force: bool = False,
+    overlap_m: Optional[float] = None,
+    speeds: Optional[str] = None,
+    max_speed_mps: Optional[float] = None,
+    **options: Any,
+) -> Dict[str, Any]:
+    """The missions to fly, one file per battery: ``aloft plan PATH -o OUTPUT --format json``.
+
+    Each sortie is used to the reserve (cut inside a leg where its pack reaches it) and the next
+    resumes ``overlap_m`` back along the route; legs are flown at the ground speed of least
+    energy per metre in their wind; a QGroundControl survey is turned to the wind; of the
+    candidates the one with the fewest batteries, then the least energy, is kept (never more
+    than the mission as given). Each file is a complete
+    mission in the input's format, which :func:`mission` flies with the same options to its
+    sortie's figures.
+
+    Args:
+        path: The mission, as :func:`mission` takes it (aloft TOML or JSON, a QGroundControl
+            ``.plan``, a ``.waypoints`` file); ``None`` for the built-in demonstration survey.
+        output: The folder to write the files into (created if missing), named
+            ``MISSION-K-of-N.EXT``; the answer's ``files`` are then their paths. ``None``: no
+            file is written (``files`` are the names they would have; ``texts`` holds them).
+        force: Overwrite files that exist in ``output`` (without it an existing file is refused
+            before any file is written).
+        overlap_m: How far back along the route a sortie resumes, m (``--overlap-m``, default
+            10; from 0 to 1000).
+        speeds: Which legs get the wind's speed (``--speeds``): ``"wind"`` (default: the legs
+            without a speed of their own), ``"energy"`` (every leg) or ``"keep"`` (none).
+        max_speed_mps: Highest ground speed a leg is given, m/s (``--max-speed``; the vehicle's
+            own limits apply anyway).
+        **options: ``aloft plan``'s ``camera_interval_s`` (s: the camera's shortest time
+            between photos; a leg where it triggers every D m is given at most D / this;
+            default a ``.plan`` survey's ``MinTriggerInterval``, else 2) and ``keep_angle``
+            (True: keep every survey's grid angle; else a QGroundControl survey is turned to the
+            wind where that saves energy); and the mission's options, as :func:`mission`'s
+            without the Monte-Carlo ones: ``vehicle``, ``battery``, ``payload_kg`` (kg),
+            ``wind_speed`` (m/s) and ``wind_from`` (deg, blowing FROM), ``wind_profile``,
+            ``wind_field``, ``gust_std``, ``reserve_percent`` (% of the usable capacity at
+            landing), ``start_percent``, ``time_step`` (s), ``speed`` (m/s),
+            ``rtl_altitude_m`` (m), ``corners``, ``aoa``, ``no_ground_effect``.
+
+    Returns:
+        The CLI's JSON answer as a dict: ``files`` (in flight order), ``batteries``,
+        ``energy_wh`` (Wh, all sorties), ``duration_s`` (s, all sorties), ``sorties`` (per
+        file: ``file``, ``first_item`` and ``last_item`` of a planner file,
+        ``ends_inside_leg_fraction`` where it turns home inside a leg, ``energy_wh``,
+        ``duration_s``, ``end_soc`` (0-1), ``point_of_no_return_s``), ``as_given`` (the
+        mission split at whole items: ``batteries``, ``energy_wh``, ``duration_s``), ``changes``
+        (``speeds``: the legs given another speed, m/s; ``angles``: the surveys turned, deg;
+        ``cut_inside_legs``), ``notes`` when there is something the plan could not do (a
+        survey it could not draw again); and ``texts``, the files' texts in flight order. When no way of cutting the route keeps the reserve
+        (the CLI exits 1) the answer is ``{"feasible": False, "reason": ..., "texts": []}``,
+        not an error, and no file is written.
+
+    Raises:
+        AloftError: What ``aloft plan`` refuses with exit code 2 (an unknown vehicle, a
+            mission that does not read, a bad option, named), with its message; a file in
+            ``output`` that exists without ``force=True``.
+    """
+    opts = dict(options, overlap_m=overlap_m, speeds=speeds, max_speed_mps=max_speed_mps)
+    answer_json, texts = _native.plan_json(_path(path), opts, _path(output), force)
+    answer = json.loads(answer_json)
+    answer["texts"] = list(texts)
+    return answer
 
 
 def timeseries(path: Optional[PathLike] = None, **options: Any) -> Any:

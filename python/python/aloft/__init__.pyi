@@ -65,6 +65,12 @@ class ScenarioKeywords(MissionKeywords, total=False):
     power_sd_percent: Optional[float]
     threads: Optional[int]
 
+class PlanKeywords(MissionKeywords, total=False):
+    """`aloft plan`'s own flags beyond the mission's (the rest are arguments of `plan`)."""
+
+    camera_interval_s: Optional[float]
+    keep_angle: bool
+
 class EnduranceKeywords(VehicleKeywords, WindKeywords, total=False):
     """`aloft endurance`'s flags."""
 
@@ -90,6 +96,16 @@ def mission(
 ) -> Dict[str, Any]: ...
 def mission_map(
     path: Optional[PathLike] = None, **options: Unpack[ScenarioKeywords]
+) -> Dict[str, Any]: ...
+def plan(
+    path: Optional[PathLike] = None,
+    *,
+    output: Optional[PathLike] = None,
+    force: bool = False,
+    overlap_m: Optional[float] = None,
+    speeds: Optional[Literal["wind", "energy", "keep"]] = None,
+    max_speed_mps: Optional[float] = None,
+    **options: Unpack[PlanKeywords],
 ) -> Dict[str, Any]: ...
 def timeseries(path: Optional[PathLike] = None, **options: Unpack[MissionKeywords]) -> Any: ...
 def endurance(**options: Unpack[EnduranceKeywords]) -> Dict[str, Any]: ...
