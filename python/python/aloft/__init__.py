@@ -119,7 +119,7 @@ def plan(
     force: bool = False,
     overlap_m: Optional[float] = None,
     speeds: Optional[str] = None,
-    max_speed_mps: Optional[float] = None,
+    max_speed: Optional[float] = None,
     **options: Any,
 ) -> Dict[str, Any]:
     """The missions to fly, one file per battery: ``aloft plan PATH -o OUTPUT --format json``.
@@ -144,7 +144,7 @@ def plan(
             10; from 0 to 1000).
         speeds: Which legs get the wind's speed (``--speeds``): ``"wind"`` (default: the legs
             without a speed of their own), ``"energy"`` (every leg) or ``"keep"`` (none).
-        max_speed_mps: Highest ground speed a leg is given, m/s (``--max-speed``; the vehicle's
+        max_speed: Highest ground speed a leg is given, m/s (``--max-speed``; the vehicle's
             own limits apply anyway).
         **options: ``aloft plan``'s ``camera_interval_s`` (s: the camera's shortest time
             between photos; a leg where it triggers every D m is given at most D / this;
@@ -175,7 +175,7 @@ def plan(
             mission that does not read, a bad option, named), with its message; a file in
             ``output`` that exists without ``force=True``.
     """
-    opts = dict(options, overlap_m=overlap_m, speeds=speeds, max_speed_mps=max_speed_mps)
+    opts = dict(options, overlap_m=overlap_m, speeds=speeds, max_speed=max_speed)
     answer_json, texts = _native.plan_json(_path(path), opts, _path(output), force)
     answer = json.loads(answer_json)
     answer["texts"] = list(texts)

@@ -104,7 +104,7 @@ def plan(
     force: bool = False,
     overlap_m: Optional[float] = None,
     speeds: Optional[Literal["wind", "energy", "keep"]] = None,
-    max_speed_mps: Optional[float] = None,
+    max_speed: Optional[float] = None,
     **options: Unpack[PlanKeywords],
 ) -> Dict[str, Any]: ...
 def timeseries(path: Optional[PathLike] = None, **options: Unpack[MissionKeywords]) -> Any: ...
