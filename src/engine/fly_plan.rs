@@ -80,8 +80,9 @@ pub struct FlyPlanRequest {
     /// The camera's shortest time between photos, s (default: a `.plan` survey's
     /// `CameraCalc.MinTriggerInterval`, else [`DEFAULT_CAMERA_INTERVAL_S`]).
     pub camera_interval_s: Option<f64>,
-    /// Keep the grid angle of every survey (else each is turned to the wind where that saves
-    /// energy: [`super::survey_angle`]).
+    /// Keep the grid angle of every survey (else each QGroundControl survey is turned to the
+    /// wind where that saves energy and covers its polygon as before, its transects drawn again
+    /// at every [`ANGLE_STEP_DEG`](super::ANGLE_STEP_DEG) degrees and along and across the wind).
     pub keep_angle: bool,
     /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
     /// candidate, angle or sortie once cancelled (its steps are the planner's own to bound).

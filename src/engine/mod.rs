@@ -21,9 +21,10 @@
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
 //! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `mission_map.rs` |
+//! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `fly_plan.rs`, `sorties.rs`, `plan_files.rs`, `survey_angle.rs` |
 //! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `plan_map.rs` |
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
-//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
+//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
 //!
 //! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
@@ -100,7 +101,7 @@ pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFi
 pub use flown::PlanningSpeed;
 pub use fly_plan::{
     plan_to_fly, FlyPlan, FlyPlanRequest, FlySortie, PlanChanges, PlanFigures, SpeedChange,
-    SpeedChoice, DEFAULT_OVERLAP_M,
+    SpeedChoice, DEFAULT_CAMERA_INTERVAL_S, DEFAULT_OVERLAP_M,
 };
 pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::{
@@ -144,6 +145,7 @@ pub use scenarios::{
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
 pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
+pub use survey_angle::{AngleChange, ANGLE_STEP_DEG};
 pub use validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,
 };
