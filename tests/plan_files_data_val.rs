@@ -144,15 +144,15 @@ fn surveys(file: &Path, home: [f64; 2]) -> Vec<(Vec<[f64; 2]>, f64)> {
     items
         .iter()
         .filter(|i| i["complexItemType"] == "survey")
-        .map(|i| {
-            let polygon = i["polygon"]
-                .as_array()
-                .unwrap()
+        .filter_map(|i| {
+            // A polygon with a vertex that is not a number covers nothing to check.
+            let polygon: Option<Vec<[f64; 2]>> = i["polygon"]
+                .as_array()?
                 .iter()
-                .map(|v| local_m(home, f(&v[0]), f(&v[1])))
+                .map(|v| Some(local_m(home, v[0].as_f64()?, v[1].as_f64()?)))
                 .collect();
             let spacing = f(&i["TransectStyleComplexItem"]["CameraCalc"]["AdjustedFootprintSide"]);
-            (polygon, spacing)
+            Some((polygon?, spacing))
         })
         .collect()
 }
@@ -327,6 +327,11 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
     // lie within half a line spacing of a camera-on leg as in the input.
     for (polygon, spacing_m) in surveys(file, home) {
         let points = grid_inside(&polygon, 5.0);
+        if points.is_empty() || spacing_m < 0.5 {
+            // A degenerate polygon or spacing: its lines (the stored items) are checked one by
+            // one below.
+            continue;
+        }
         let covered = |legs: &[Leg]| {
             points
                 .iter()
@@ -607,4 +612,70 @@ fn data_val_a_survey_turned_on_one_pack_is_written_as_its_complex_item() {
         20,
         "a return to launch last"
     );
+}
+
+/// A survey that cannot be drawn again (a degenerate polygon, a 0 m line spacing, a vertex that
+/// is not a number) is planned as its stored items, not turned, with a note naming the item and
+/// the key; its files fly their sorties as every other.
+#[test]
+fn data_val_a_survey_that_cannot_be_drawn_again_is_flown_as_stored_and_said() {
+    let file = common::files("missions", |n| n == "neilvaltec_test.plan");
+    let file = file
+        .first()
+        .expect("neilvaltec_test.plan in the shared missions");
+    let source: Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
+    type Spoil = fn(&mut Value);
+    let variants: [(&str, Spoil, &str); 3] = [
+        (
+            "degenerate",
+            |s| {
+                let first = s["polygon"][0].clone();
+                s["polygon"] = Value::Array(vec![first; 4]);
+            },
+            "key polygon is 1 distinct vertices",
+        ),
+        (
+            "spacing0",
+            |s| s["TransectStyleComplexItem"]["CameraCalc"]["AdjustedFootprintSide"] = 0.into(),
+            "key TransectStyleComplexItem.CameraCalc.AdjustedFootprintSide is 0",
+        ),
+        (
+            "nan",
+            |s| s["polygon"][1][0] = Value::Null,
+            "key polygon[1] is [null,",
+        ),
+    ];
+    for (name, spoil, said) in variants {
+        let mut plan_json = source.clone();
+        let items = plan_json["mission"]["items"].as_array_mut().unwrap();
+        let survey = items
+            .iter_mut()
+            .find(|i| i["complexItemType"] == "survey")
+            .unwrap();
+        spoil(survey);
+        let path = scratch("plan-files", &format!("bad-{name}.plan"));
+        std::fs::write(&path, serde_json::to_string(&plan_json).unwrap()).unwrap();
+        let extra: Vec<String> = [
+            "--wind-speed",
+            "8",
+            "--wind-from",
+            "0",
+            "--reserve-percent",
+            "70",
+        ]
+        .map(String::from)
+        .to_vec();
+        let mut seen = Seen::default();
+        check(&path, &extra, &mut seen);
+        assert_eq!((seen.plans, seen.turned), (1, 0), "{name}");
+        let dir = scratch("plan-files", &format!("bad-{name}-out"));
+        let (code, answer, err) = plan(&path, &dir, &extra);
+        assert_eq!(code, 0, "{name}: {err}");
+        let notes = answer["notes"].to_string();
+        assert!(
+            notes.contains("item 3: ") && notes.contains(said),
+            "{name}: {notes}"
+        );
+        assert_eq!(answer["changes"]["angles"], serde_json::json!([]), "{name}");
+    }
 }
