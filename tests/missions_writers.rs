@@ -390,23 +390,17 @@ fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
             })
             .collect()
     };
+    let words = |text: &'static str| text.split(' ').collect::<Vec<&str>>();
     let plans = sorties(
         "neilvaltec_test.plan",
-        &[
-            "--reserve-percent",
-            "70",
-            "--wind-speed",
-            "8",
-            "--wind-from",
-            "0",
-        ],
+        &words("--reserve-percent 70 --wind-speed 8 --wind-from 0"),
     );
     assert!(plans.len() >= 2);
     // One pack with its own speeds: the survey turned and written as its complex item.
     let mut plans = plans;
     plans.extend(sorties(
         "neilvaltec_test.plan",
-        &["--speeds", "keep", "--wind-speed", "8", "--wind-from", "0"],
+        &words("--speeds keep --wind-speed 8 --wind-from 0"),
     ));
     let mut args = vec!["mavsdk".into(), "--autopilot".into(), "px4".into()];
     args.extend(paths(&plans));

@@ -104,16 +104,19 @@ fn legs(origin: [f64; 2], home: [f64; 2], items: &[MissionItem]) -> Vec<Leg> {
     out
 }
 
-/// Distance from `p` to the segment `a`-`b`, m.
+/// Distance from `p` to the segment `a`-`b`, m: to the line where the foot of the perpendicular
+/// falls within the segment, else to the nearer end.
 fn to_segment_m(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let len2 = d[0] * d[0] + d[1] * d[1];
-    let t = if len2 > 0.0 {
-        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p[0] - a[0] - t * d[0]).hypot(p[1] - a[1] - t * d[1])
+    let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+    let (to_a, to_b) = (
+        (p[0] - a[0]).hypot(p[1] - a[1]),
+        (p[0] - b[0]).hypot(p[1] - b[1]),
+    );
+    let along = ((p[0] - a[0]) * (b[0] - a[0]) + (p[1] - a[1]) * (b[1] - a[1])) / length;
+    match length > 0.0 && (0.0..=length).contains(&along) {
+        true => ((p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0])).abs() / length,
+        false => to_a.min(to_b),
+    }
 }
 
 /// Points every `step_m` along a leg, its ends included.
@@ -402,6 +405,11 @@ fn mission_flags(extra: &[String]) -> Vec<&str> {
     out
 }
 
+/// The words of `text`, as a command's arguments.
+fn flags(text: &str) -> Vec<String> {
+    text.split_whitespace().map(String::from).collect()
+}
+
 /// Whether the plan changed any leg's speed.
 fn seen_changes(answer: &Value) -> bool {
     answer["changes"]["speeds"]
@@ -541,16 +549,9 @@ fn data_val_the_shared_waypoints_files_split_at_a_90_percent_reserve() {
             .first()
             .unwrap_or_else(|| panic!("{name} in the shared missions"));
         for (speed, from) in [(0.0, 0.0), (8.0, 90.0)] {
-            let extra: Vec<String> = [
-                "--reserve-percent",
-                "90",
-                "--wind-speed",
-                &speed.to_string(),
-                "--wind-from",
-                &from.to_string(),
-            ]
-            .map(String::from)
-            .to_vec();
+            let extra = flags(&format!(
+                "--reserve-percent 90 --wind-speed {speed} --wind-from {from}"
+            ));
             check(file, &extra, &mut seen);
         }
     }
@@ -572,9 +573,7 @@ fn data_val_a_survey_turned_on_one_pack_is_written_as_its_complex_item() {
     let file = file
         .first()
         .expect("neilvaltec_test.plan in the shared missions");
-    let extra: Vec<String> = ["--speeds", "keep", "--wind-speed", "8", "--wind-from", "0"]
-        .map(String::from)
-        .to_vec();
+    let extra = flags("--speeds keep --wind-speed 8 --wind-from 0");
     let mut seen = Seen::default();
     check(file, &extra, &mut seen);
     assert_eq!(seen.turned, 1, "the survey is turned");
@@ -655,16 +654,7 @@ fn data_val_a_survey_that_cannot_be_drawn_again_is_flown_as_stored_and_said() {
         spoil(survey);
         let path = scratch("plan-files", &format!("bad-{name}.plan"));
         std::fs::write(&path, serde_json::to_string(&plan_json).unwrap()).unwrap();
-        let extra: Vec<String> = [
-            "--wind-speed",
-            "8",
-            "--wind-from",
-            "0",
-            "--reserve-percent",
-            "70",
-        ]
-        .map(String::from)
-        .to_vec();
+        let extra = flags("--wind-speed 8 --wind-from 0 --reserve-percent 70");
         let mut seen = Seen::default();
         check(&path, &extra, &mut seen);
         assert_eq!((seen.plans, seen.turned), (1, 0), "{name}");
