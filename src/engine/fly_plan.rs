@@ -210,7 +210,12 @@ pub fn plan_to_fly(
         let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind));
         let turned = match request.keep_angle {
             true => Ok(None),
-            false => turned_to_wind(vehicle, mission, request, &wind),
+            false => turned_to_wind(
+                mission,
+                &wind,
+                &|m| energy_wh(vehicle, m, request, &wind),
+                &request.bounds,
+            ),
         };
         let planned = planned.join().unwrap_or_else(|_| {
             Err(Error::NoPlan {
@@ -783,4 +788,31 @@ impl FlyPlan {
         }
         Ok(())
     }
+}
+
+/// The energy of `mission` flown whole with the legs' speeds for the wind, Wh; `None` when it
+/// cannot be flown.
+fn energy_wh(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+    wind: &Wind,
+) -> Option<f64> {
+    let options = &request.options;
+    let aircraft = vehicle.aircraft().ok()?;
+    let battery = vehicle.battery(options.battery.as_deref()).ok()?;
+    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind)).ok()?;
+    if let Some(payload_kg) = options.payload_kg {
+        prepared.spec.payload_kg = payload_kg;
+    }
+    let spec = match request.speeds {
+        SpeedChoice::Keep => prepared.spec.clone(),
+        _ => {
+            speeds_for_wind((vehicle, mission), &prepared, wind, request)
+                .ok()?
+                .0
+        }
+    };
+    let report = prepared.flight.trial(&spec, None).ok()?;
+    Some(report.energy_wh)
 }

@@ -20,10 +20,8 @@ use aloft_missions::{plan_entries, write_plan, Imported};
 use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::Wind;
 
-use super::fly_plan::{speeds_for_wind, FlyPlanRequest, SpeedChoice};
-use super::mission::prepare;
 use super::mission_file::Mission;
-use super::vehicles::Vehicle;
+use super::scenarios::WorkBounds;
 use crate::error::Error;
 
 /// The step of the candidate angles, deg.
@@ -44,12 +42,13 @@ pub struct AngleChange {
 /// be turned or no turn saves energy.
 ///
 /// # Errors
-/// As [`prepare`] for the mission as given.
+/// [`Error::Cancelled`] once `bounds` say the caller gave up. `energy_wh` flies a mission whole
+/// as the plan would (`None`: it cannot be flown).
 pub(super) fn turned_to_wind(
-    vehicle: &Vehicle,
     mission: &Mission,
-    request: &FlyPlanRequest,
     wind: &Wind,
+    energy_wh: &dyn Fn(&Mission) -> Option<f64>,
+    bounds: &WorkBounds,
 ) -> Result<Option<(Mission, Vec<AngleChange>)>, Error> {
     let Some(imported) = mission.kept().filter(|k| k.plan.is_some()) else {
         return Ok(None);
@@ -60,7 +59,7 @@ pub(super) fn turned_to_wind(
     if turnable.is_empty() {
         return Ok(None);
     }
-    let Some(mut best_wh) = energy_wh(vehicle, mission, request, wind) else {
+    let Some(mut best_wh) = energy_wh(mission) else {
         return Ok(None);
     };
     let mut angles: Vec<(usize, f64)> = Vec::new();
@@ -74,7 +73,7 @@ pub(super) fn turned_to_wind(
             continue;
         };
         for angle in candidate_angles(survey.params(), wind) {
-            if request.bounds.cancelled() {
+            if bounds.cancelled() {
                 return Err(Error::Cancelled);
             }
             // The polygon covered as before (a line lost at a corner is a gap in the images).
@@ -91,7 +90,7 @@ pub(super) fn turned_to_wind(
             let Some(turned) = turned_mission(mission, imported, &trial) else {
                 continue;
             };
-            let Some(wh) = energy_wh(vehicle, &turned, request, wind) else {
+            let Some(wh) = energy_wh(&turned) else {
                 continue;
             };
             // A saving of at least a part in 10^6: an angle as good as the operator's is not a
@@ -263,31 +262,4 @@ fn turned_mission(
     let entries = plan_entries(imported, angles).ok()?;
     let text = write_plan(&plan.header, &home, &entries).ok()?;
     Mission::from_text(&text, mission.origin()).ok()
-}
-
-/// The energy of `mission` flown whole with the legs' speeds for the wind, Wh; `None` when it
-/// cannot be flown.
-fn energy_wh(
-    vehicle: &Vehicle,
-    mission: &Mission,
-    request: &FlyPlanRequest,
-    wind: &Wind,
-) -> Option<f64> {
-    let options = &request.options;
-    let aircraft = vehicle.aircraft().ok()?;
-    let battery = vehicle.battery(options.battery.as_deref()).ok()?;
-    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind)).ok()?;
-    if let Some(payload_kg) = options.payload_kg {
-        prepared.spec.payload_kg = payload_kg;
-    }
-    let spec = match request.speeds {
-        SpeedChoice::Keep => prepared.spec.clone(),
-        _ => {
-            speeds_for_wind((vehicle, mission), &prepared, wind, request)
-                .ok()?
-                .0
-        }
-    };
-    let report = prepared.flight.trial(&spec, None).ok()?;
-    Some(report.energy_wh)
 }
