@@ -47,6 +47,19 @@ pub enum Error {
         /// The most scenarios within the bound.
         max_samples: u64,
     },
+    /// A value of the day's air outside its range (`--elevation-m`, `--temperature-c`,
+    /// `--humidity-percent`, `--qnh-hpa`).
+    #[error("{name} = {} {unit} is outside the air aloft flies in: expected {expected}", aloft_core::Num::of(.value))]
+    Air {
+        /// The option's name (its JSON key).
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// The range, in words.
+        expected: &'static str,
+    },
     /// Work stopped because its caller no longer wants the answer (a client that went away).
     #[error("the work was cancelled: its answer is no longer wanted")]
     Cancelled,

@@ -69,6 +69,8 @@ pub struct AlignedFlight {
     pub skipped: usize,
     /// Samples left out as on the ground (measured power below the idle fraction of the median).
     pub idle: usize,
+    /// The log's own mean air density (PX4 `vehicle_air_data.rho`), kg/m^3, when it has one.
+    pub air_density_kg_m3: Option<f64>,
 }
 
 fn interpolate(times: &[f64], values: &[f64], t: f64) -> Option<f64> {
@@ -140,6 +142,7 @@ pub fn align_flight(log: &Log, options: &AlignOptions) -> Result<AlignedFlight, 
         times_s,
         samples,
         skipped,
+        air_density_kg_m3: None,
     })
 }
 
@@ -397,6 +400,11 @@ pub struct FlightValidation {
     /// With a calibration window: the re-estimated efficiency and the errors after it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub calibration: Option<Calibration>,
+    /// The density the model flew this flight in, kg/m^3 (the given air, else the log's own,
+    /// else the vehicle file's).
+    pub air_density_kg_m3: f64,
+    /// Where it came from (`given`, `log`, `isa`, `vehicle_file`).
+    pub density_source: crate::engine::AirSource,
 }
 
 /// Airspeed bands of the Table I layout, centred on the paper's hover, 2, 4, 6, 8 m/s.
@@ -475,6 +483,8 @@ pub fn validate_flight(
         samples: measured.len(),
         table_i,
         calibration,
+        air_density_kg_m3: model.vehicle().air_density_kg_m3(),
+        density_source: crate::engine::AirSource::VehicleFile,
     })
 }
 

@@ -225,3 +225,43 @@ fn data_val_energy_matches_pyulog_and_pymavlink_when_present() {
         assert!((got - e).abs() <= 1e-6 * e, "{name}: {got} vs {e}");
     }
 }
+
+/// The log's own air from ArduPilot's `BARO` records (issue 34): the mean of `Press / (Rd (Temp +
+/// 273.15))` over the records, with the pressure and temperature decoded by `ardupilot-binlog`
+/// (Rd = 287.053 J/(kg K), dry air), equals the density aloft reads from the file.
+#[test]
+fn data_val_dataflash_air_density_from_baro_agrees_with_ardupilot_binlog() {
+    let mut checked = 0;
+    for (name, _, _) in FIGURES.iter().filter(|f| !f.0.ends_with(".ulg")) {
+        let p = path(name);
+        let file = ardupilot_binlog::File::open(&p).unwrap();
+        let (mut sum, mut n) = (0.0, 0u32);
+        for e in file.entries().unwrap().map_while(Result::ok) {
+            if e.name != "BARO" {
+                continue;
+            }
+            let (Some(pa), Some(t)) = (e.get_f64("Press"), e.get_f64("Temp")) else {
+                continue;
+            };
+            let rho = pa / (287.053 * (t + 273.15));
+            if (0.3..=1.6).contains(&rho) {
+                sum += rho;
+                n += 1;
+            }
+        }
+        let ours = read(&p).summary.air_density_kg_m3;
+        if n == 0 {
+            assert_eq!(ours, None, "{name}: no BARO, yet a density");
+            continue;
+        }
+        let theirs = sum / f64::from(n);
+        let ours = ours.unwrap_or_else(|| panic!("{name}: {n} BARO records, no density"));
+        // The same records, the same formula: to rounding.
+        assert!(
+            (ours / theirs - 1.0).abs() < 1e-9,
+            "{name}: {ours} vs {theirs}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 1, "no shared DataFlash log has BARO records");
+}

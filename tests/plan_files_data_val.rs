@@ -535,10 +535,12 @@ fn a_do_jump_loop_is_unrolled_into_the_sorties() {
     );
 }
 
-/// The shared ArduPilot files at a 90 % reserve, where their routes need several packs: each
-/// sortie keeps the reserve, the camera-on legs covered, nothing worse than as given.
+/// The shared ArduPilot files at an 88 % reserve, where their routes need several packs: each
+/// sortie keeps the reserve, the camera-on legs covered, nothing worse than as given. (They fly
+/// in the air of their home altitude, 584 m: at 90 % one loiter-turns orbit can no longer be
+/// flown out and back on one pack.)
 #[test]
-fn data_val_the_shared_waypoints_files_split_at_a_90_percent_reserve() {
+fn data_val_the_shared_waypoints_files_split_at_an_88_percent_reserve() {
     let mut seen = Seen::default();
     for name in [
         "ardupilot_DO_CHANGE_SPEED_mission.txt",
@@ -550,7 +552,7 @@ fn data_val_the_shared_waypoints_files_split_at_a_90_percent_reserve() {
             .unwrap_or_else(|| panic!("{name} in the shared missions"));
         for (speed, from) in [(0.0, 0.0), (8.0, 90.0)] {
             let extra = flags(&format!(
-                "--reserve-percent 90 --wind-speed {speed} --wind-from {from}"
+                "--reserve-percent 88 --wind-speed {speed} --wind-from {from}"
             ));
             check(file, &extra, &mut seen);
         }
@@ -561,7 +563,10 @@ fn data_val_the_shared_waypoints_files_split_at_a_90_percent_reserve() {
     );
     assert_eq!(seen.plans + seen.no_plan, 4);
     assert!(seen.plans >= 3, "{}", seen.plans);
-    assert_eq!(seen.split, seen.plans, "a 90 % reserve needs several packs");
+    assert_eq!(
+        seen.split, seen.plans,
+        "an 88 % reserve needs several packs"
+    );
 }
 
 /// The shared survey on one pack with its own speeds in an 8 m/s northerly: turned to the wind

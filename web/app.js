@@ -166,6 +166,8 @@
     add('wind_speed', $('#wind-speed').value);
     add('wind_from', $('#wind-from').value);
     add('reserve_percent', $('#reserve').value);
+    add('elevation_m', $('#elevation').value);
+    add('temperature_c', $('#temperature').value);
     const samples = $('#samples').value.trim();
     if (samples !== '' && Number(samples) !== 0) q.set('samples', samples);
     return q;
@@ -299,6 +301,12 @@
     const row = (label, value, cls) => rows.push(el('dt', { text: label }), el('dd', { class: cls }, [value]));
     row('Mission', m.mission);
     row('Vehicle', `${m.vehicle} · ${m.battery}`);
+    if (typeof m.air_density_kg_m3 === 'number') {
+      const where = [];
+      if (typeof m.elevation_m === 'number') where.push(`${fmt(m.elevation_m, 0)} m`);
+      if (typeof m.temperature_c === 'number') where.push(`${fmt(m.temperature_c, 1)} °C`);
+      row('Air', `${fmt(m.air_density_kg_m3, 3)} kg/m³${where.length ? ' (' + where.join(', ') + ')' : ''}`);
+    }
     row('Feasible', m.feasible ? 'yes' : `no${m.reason ? ' — ' + m.reason : ''}`, m.feasible ? 'good' : 'bad');
     row('Duration', duration(m.duration_s));
     row('Distance', distance(m.distance_m));
@@ -1176,7 +1184,7 @@
       $('#battery').value = '';
       replanSoon();
     });
-    for (const id of ['#battery', '#payload', '#wind-speed', '#wind-from', '#reserve', '#samples']) {
+    for (const id of ['#battery', '#payload', '#wind-speed', '#wind-from', '#reserve', '#elevation', '#temperature', '#samples']) {
       const input = $(id);
       input.addEventListener('input', replanSoon);
       input.addEventListener('change', replanSoon);

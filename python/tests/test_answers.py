@@ -26,6 +26,10 @@ MISSION_CASES = [
      ["--aoa", "paper", "--no-ground-effect", "--start-percent", "90",
       "--wind-speed", "4", "--wind-from", "45", "--wind-profile", "power-law", "--gust-std", "0.5",
       "--gust-seed", "7"]),
+    # The day's air: 2000 m, 30 C, 40 % humidity, QNH 1005 hPa.
+    (None, {"elevation_m": 2000, "temperature_c": 30, "humidity_percent": 40, "qnh_hpa": 1005},
+     ["--elevation-m", "2000", "--temperature-c", "30", "--humidity-percent", "40",
+      "--qnh-hpa", "1005"]),
 ]
 
 
@@ -108,8 +112,11 @@ def test_power_equals_cli_per_state(cli):
     for i, (va, vr, vp, vc) in enumerate(STATES):
         expected = cli.json("power", "--airspeed", repr(va), "--roll", repr(vr), "--pitch", repr(vp),
                             "--climb-rate", repr(vc))
-        # The CLI's JSON also names the take-off mass the arrays were computed at.
-        assert set(expected) == set(aloft.POWER_KEYS) | {"takeoff_mass_kg", "battery", "payload_kg"}
+        # The CLI's JSON also names the take-off mass and the air the arrays were computed at.
+        assert set(expected) == set(aloft.POWER_KEYS) | {
+            "takeoff_mass_kg", "battery", "payload_kg",
+            "air_density_kg_m3", "density_source", "density_altitude_m"}
+        assert expected["air_density_kg_m3"] == 1.225 and expected["density_source"] == "isa"
         assert expected["takeoff_mass_kg"] == 1.755 + 0.600  # airframe + TB47D, no payload
         for k in aloft.POWER_KEYS:
             assert got[k][i] == expected[k], (k, i)  # bit for bit, no tolerance
@@ -125,6 +132,16 @@ def test_power_options_equal_cli(cli):
     got = aloft.power(14.0, 0.0, -16.0, profile_cutoff=10.0)
     expected = cli.json("power", "--airspeed", "14", "--pitch", "-16", "--profile-cutoff", "10")
     assert {k: float(got[k]) for k in aloft.POWER_KEYS} == {k: expected[k] for k in aloft.POWER_KEYS}
+
+
+def test_power_in_the_days_air_equals_cli(cli):
+    got = aloft.power(0.0, 0.0, 0.0, elevation_m=3000, temperature_c=-4.5)
+    expected = cli.json("power", "--airspeed", "0", "--elevation-m", "3000", "--temperature-c", "-4.5")
+    assert {k: float(got[k]) for k in aloft.POWER_KEYS} == {k: expected[k] for k in aloft.POWER_KEYS}
+    sea = aloft.power(0.0, 0.0, 0.0)
+    # Hover at a fixed mass: every term of eq (14) scales by sqrt(rho0 / rho), 1.161 at 3000 m ISA.
+    assert abs(float(got["electrical_w"] / sea["electrical_w"]) - (1.225 / expected["air_density_kg_m3"]) ** 0.5) < 1e-9
+    assert abs(expected["air_density_kg_m3"] - 0.9091) < 0.001
 
 
 def test_power_takeoff_mass_options_equal_cli(cli):

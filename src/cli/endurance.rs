@@ -133,12 +133,13 @@ fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) 
     let c = &curve.context;
     writeln!(
         out,
-        "{} with {}, {}, wind {}, course {:.0} deg: power curve",
+        "{} with {}, {}, wind {}, course {:.0} deg: power curve\nAir: {}",
         c.vehicle,
         c.battery,
         c.mass.describe(),
         c.wind,
-        course_deg
+        course_deg,
+        c.air.describe()
     )?;
     for [v, g, p, e, r] in [
         ["airspeed", "ground", "power", "endurance", "range"],
@@ -171,13 +172,14 @@ fn write_curve_table(out: &mut impl Write, curve: &PowerCurve, course_deg: f64) 
 fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64) -> Result<()> {
     let r = &s.report;
     let title = format!(
-        "{} with {} ({} Wh), {}, wind {}, reserve {:.0} %",
+        "{} with {} ({} Wh), {}, wind {}, reserve {:.0} %\nAir: {}",
         s.vehicle,
         s.battery,
         s.context.battery_energy_wh,
         s.context.mass.describe(),
         s.context.wind,
-        reserve_percent
+        reserve_percent,
+        s.air.describe()
     );
     let min = |s: f64| s / 60.0;
     let mut rows = output::num_rows(&[

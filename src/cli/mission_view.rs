@@ -71,6 +71,7 @@ pub(super) fn header(plan: &Plan) -> Result<String> {
         r.takeoff_mass_kg
     )?;
     writeln!(head, "Wind: {}", c.wind)?;
+    writeln!(head, "Air: {}", s.air.describe())?;
     if let Some(v) = &s.planning_speed {
         writeln!(
             head,

@@ -69,6 +69,7 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
             mmss(f.duration_s)
         )
     };
+    writeln!(out, "Air: {}", plan.air.describe())?;
     writeln!(
         out,
         "  {:<10} {:>9} {:>10} {:>11}",

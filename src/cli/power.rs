@@ -112,8 +112,8 @@ fn write_csv(out: impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
 fn write_table(out: &mut impl Write, args: &PowerArgs, a: &PowerAnswer) -> Result<()> {
     let p = &a.power;
     let title = format!(
-        "{}, {}\nairspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
-        a.context.vehicle, a.context.mass, args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
+        "{}, {}\nAir: {}\nairspeed {:.2} m/s, roll {:.2} deg, pitch {:.2} deg, climb {:.2} m/s (angle of attack: {})",
+        a.context.vehicle, a.context.mass, a.air.describe(), args.airspeed, args.roll, args.pitch, args.climb_rate, a.context.aoa
     );
     let mut rows = output::num_rows(&[
         ("thrust", p.thrust_n, 2, "N"),

@@ -33,6 +33,7 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
         aoa: args.flags.aoa,
         wind: args.flags.wind.spec(),
         battery: args.flags.battery.clone(),
+        air: args.flags.air.input(),
     };
     let answer = replay_log(&vehicle, &request)?;
     for n in &answer.context.notes {
@@ -50,8 +51,10 @@ fn write_table(out: &mut impl std::io::Write, a: &ReplayAnswer) -> Result<()> {
     )?;
     writeln!(
         out,
-        "Acceleration: {}; wind: {}",
-        a.context.acceleration, a.context.wind
+        "Acceleration: {}; wind: {}\nAir: {}",
+        a.context.acceleration,
+        a.context.wind,
+        a.air.describe()
     )?;
     writeln!(
         out,

@@ -9,6 +9,7 @@ use aloft_planner::{
 };
 use aloft_power::AoaModel;
 
+use super::air::{vehicle_air, Air, AirInput};
 use super::finite::finite;
 use super::vehicles::{TakeoffMass, Vehicle};
 use super::wind::{describe_wind_spec, steady};
@@ -35,6 +36,9 @@ pub struct EnduranceOptions {
     pub orbit_speed_mps: Option<f64>,
     /// Angle-of-attack model (default geometric).
     pub aoa: AoaModel,
+    /// The day's air (default: the vehicle file's density, ISA sea level unless it says
+    /// otherwise).
+    pub air: AirInput,
 }
 
 impl Default for EnduranceOptions {
@@ -48,6 +52,7 @@ impl Default for EnduranceOptions {
             orbit_radius_m: None,
             orbit_speed_mps: None,
             aoa: AoaModel::Geometric,
+            air: AirInput::default(),
         }
     }
 }
@@ -74,6 +79,9 @@ pub struct EnduranceSummary {
     pub battery: String,
     /// Take-off mass, kg.
     pub takeoff_mass_kg: f64,
+    /// The air flown in (flattened: `air_density_kg_m3`, `density_source`, ...).
+    #[serde(flatten)]
+    pub air: Air,
     /// The queries' answers (flattened).
     #[serde(flatten)]
     pub report: EnduranceReport,
@@ -127,6 +135,8 @@ pub struct CurveContext {
     pub mass: TakeoffMass,
     /// The wind in words.
     pub wind: String,
+    /// The air flown in.
+    pub air: Air,
 }
 
 /// Hover and orbit endurance, best-endurance and best-range speeds along a course in a constant
@@ -137,6 +147,8 @@ pub struct CurveContext {
 /// gusts, a reserve outside `[0, 100)`, only one of the orbit's radius and speed, no headway along
 /// the course, and what the planner rejects.
 pub fn endurance(vehicle: &Vehicle, options: &EnduranceOptions) -> Result<EnduranceSummary, Error> {
+    let (vehicle, air) = vehicle_air(vehicle, &options.air)?;
+    let vehicle = &vehicle;
     let setup = Setup::new(vehicle, options)?;
     let report = aloft_planner::endurance(&setup.powered, &setup.battery, &setup.query)?;
     finite(
@@ -144,6 +156,7 @@ pub fn endurance(vehicle: &Vehicle, options: &EnduranceOptions) -> Result<Endura
             vehicle: vehicle.name().to_string(),
             battery: setup.battery.name().to_string(),
             takeoff_mass_kg: setup.mass.total_kg,
+            air,
             report,
             context: EnduranceContext {
                 mass: setup.mass.clone(),
@@ -167,6 +180,8 @@ pub fn power_curve(
     options: &EnduranceOptions,
     step_mps: f64,
 ) -> Result<PowerCurve, Error> {
+    let (vehicle, air) = vehicle_air(vehicle, &options.air)?;
+    let vehicle = &vehicle;
     let setup = Setup::new(vehicle, options)?;
     let vmax = vehicle.aircraft()?.airframe().max_speed_mps();
     let rows =
@@ -179,6 +194,7 @@ pub fn power_curve(
                 battery: setup.battery.name().to_string(),
                 mass: setup.mass,
                 wind: setup.wind_text,
+                air,
             },
         },
         "power curve",

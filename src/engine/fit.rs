@@ -140,6 +140,19 @@ pub struct FitAnswer {
 pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
     let mut vehicle = template.power_model()?.vehicle().clone();
     let flights = request.logs.load()?;
+    // The logs' own air: the constants are fitted in it and written for the template's density
+    // (ISA sea level unless the template says otherwise), term by term as the model carries
+    // density (`aloft_power::VehicleParams::in_air`).
+    let reference_density = vehicle.air_density_kg_m3();
+    let densities: Vec<f64> = flights
+        .iter()
+        .filter_map(|(f, _)| f.air_density_kg_m3)
+        .collect();
+    let log_density =
+        (!densities.is_empty()).then(|| densities.iter().sum::<f64>() / densities.len() as f64);
+    if let Some(rho) = log_density {
+        vehicle = aloft_power::Vehicle::new(vehicle.params().in_air(rho))?;
+    }
     let mut logs = Vec::new();
     let mut samples: Vec<FitSample> = Vec::new();
     let mut forces: Vec<ForceSample> = Vec::new();
@@ -174,6 +187,16 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     kept.extend(bounded.kept);
     let efficiency_relative_sd = efficiency_spread(&power, &flights)?;
     power.vehicle.efficiency_relative_sd = efficiency_relative_sd;
+    if let Some(rho) = log_density {
+        power.vehicle = power.vehicle.in_air(reference_density);
+        notes.push(format!(
+            "fitted in the logs' own air, {rho:.4} kg/m^3 (the mean of the logs' own, PX4 vehicle_air_data or ArduPilot BARO, over {} of {} logs), and written for {reference_density:.4} kg/m^3: kappa1 x {:.4}, drag x {:.4} (the fitted values above are the logs' air's)",
+            densities.len(),
+            flights.len(),
+            (rho / reference_density).sqrt(),
+            reference_density / rho
+        ));
+    }
     let mut fitted_parameters: Vec<String> = power
         .parameters
         .iter()

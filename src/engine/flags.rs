@@ -18,6 +18,7 @@ use clap::Args;
 use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
+use super::air::AirInput;
 use super::fit::{fit_parameter, FitRequest};
 use super::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
 use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
@@ -176,6 +177,39 @@ impl WindFlags {
     }
 }
 
+/// The day's air: elevation, temperature, humidity, QNH. Each unset value has its default
+/// ([`AirInput`]): the mission's home altitude, ISA's temperature there, dry air, 1013.25 hPa;
+/// with none set and no home altitude, the vehicle file's density.
+#[derive(Debug, Clone, Copy, Args)]
+pub struct AirFlags {
+    /// Elevation of the flight above mean sea level, m (-430 to 11000; default: the mission's
+    /// home altitude, else sea level).
+    #[arg(value_parser = finite(), long, value_name = "M", allow_negative_numbers = true)]
+    pub elevation_m: Option<f64>,
+    /// Air temperature, C (-60 to 60; default: ISA's at the elevation).
+    #[arg(value_parser = finite(), long, value_name = "C", allow_negative_numbers = true)]
+    pub temperature_c: Option<f64>,
+    /// Relative humidity, percent (0 to 100; default 0, dry air).
+    #[arg(value_parser = finite(), long, value_name = "PERCENT")]
+    pub humidity_percent: Option<f64>,
+    /// The day's QNH (altimeter setting), hPa (850 to 1100; default ISA's 1013.25).
+    #[arg(value_parser = finite(), long, value_name = "HPA")]
+    pub qnh_hpa: Option<f64>,
+}
+
+impl AirFlags {
+    /// The engine's air input of these flags.
+    pub fn input(&self) -> AirInput {
+        AirInput {
+            elevation_m: self.elevation_m,
+            temperature_c: self.temperature_c,
+            humidity_percent: self.humidity_percent,
+            qnh_hpa: self.qnh_hpa,
+            air_density_kg_m3: None,
+        }
+    }
+}
+
 /// The options of `aloft mission` (and of Python's `aloft.mission`, `aloft.timeseries`).
 #[derive(Debug, Clone, Args)]
 pub struct MissionFlags {
@@ -228,6 +262,9 @@ pub struct MissionFlags {
     /// Leave out ground effect (survey eq 35) near the ground.
     #[arg(long)]
     pub no_ground_effect: bool,
+    /// The day's air.
+    #[command(flatten)]
+    pub air: AirFlags,
 }
 
 impl MissionFlags {
@@ -251,6 +288,7 @@ impl MissionFlags {
             speed_mps: self.speed,
             rtl_altitude_m: self.rtl_altitude_m,
             corners: self.corners,
+            air: self.air.input(),
         }
     }
 }
@@ -369,6 +407,9 @@ pub struct EnduranceFlags {
     /// Monte-Carlo scenarios (--samples N and the spreads; no gusts).
     #[command(flatten)]
     pub scenarios: ScenarioFlags,
+    /// The day's air.
+    #[command(flatten)]
+    pub air: AirFlags,
 }
 
 impl EnduranceFlags {
@@ -383,6 +424,7 @@ impl EnduranceFlags {
             orbit_radius_m: self.orbit_radius,
             orbit_speed_mps: self.orbit_speed,
             aoa: self.aoa,
+            air: self.air.input(),
         }
     }
 }
@@ -542,6 +584,9 @@ pub struct ValidateFlags {
     /// station would in flight, and report the errors over the rest.
     #[arg(value_parser = finite(), long, value_name = "S")]
     pub calibrate_first: Option<f64>,
+    /// The day's air of every flight (default: each log's own, PX4 vehicle_air_data or ArduPilot BARO).
+    #[command(flatten)]
+    pub air: AirFlags,
 }
 
 impl ValidateFlags {
@@ -554,6 +599,7 @@ impl ValidateFlags {
             payload_kg: self.payload_kg,
             calibrate_first_s: self.calibrate_first,
             series,
+            air: self.air.input(),
         }
     }
 }
@@ -582,6 +628,9 @@ pub struct PowerModelFlags {
     /// Angle-of-attack model. Default: paper, or geometric when --air-direction-deg is given.
     #[arg(long, value_parser = aoa_parser())]
     pub aoa: Option<AoaModel>,
+    /// The day's air.
+    #[command(flatten)]
+    pub air: AirFlags,
 }
 
 impl PowerModelFlags {
@@ -593,6 +642,7 @@ impl PowerModelFlags {
             without: self.without.clone(),
             profile_cutoff_mps: self.profile_cutoff,
             aoa: self.aoa,
+            air: self.air.input(),
         }
     }
 }
@@ -771,6 +821,10 @@ pub struct LiveFlags {
     /// forward step of its clock longer than this, not waited through nor counted as time).
     #[arg(value_parser = finite(), long, default_value_t = 5.0, value_name = "S")]
     pub link_timeout: f64,
+    /// The day's air (default: with --route log the log's own; else the mission's home
+    /// altitude, else the vehicle file's density).
+    #[command(flatten)]
+    pub air: AirFlags,
 }
 
 /// The pace of a replayed source (`--speed`).
@@ -829,6 +883,7 @@ impl LiveFlags {
                 battery: self.battery.clone(),
                 payload_kg: self.payload_kg,
                 every_s: self.every,
+                air: self.air.input(),
             }));
         }
         let speed = match self.speed {
@@ -877,6 +932,7 @@ impl LiveFlags {
                 reserve_percent: self.reserve_percent,
                 speed_mps: None,
                 scenarios: self.scenarios,
+                air: self.air.input(),
             }),
         })
     }

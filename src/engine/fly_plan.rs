@@ -177,6 +177,9 @@ pub struct FlyPlan {
     pub energy_wh: f64,
     /// Flight time of all its flights, s.
     pub duration_s: f64,
+    /// The air flown in (flattened: `air_density_kg_m3`, `density_source`, ...).
+    #[serde(flatten)]
+    pub air: super::air::Air,
     /// The sorties, one per file.
     pub sorties: Vec<FlySortie>,
     /// The mission as given, split at whole items as `aloft mission` splits it and flown from
@@ -203,6 +206,18 @@ pub fn plan_to_fly(
     mission: &Mission,
     request: &FlyPlanRequest,
 ) -> Result<FlyPlan, Error> {
+    let options = &request.options;
+    // The air once: every candidate flies the vehicle in it (and finds it so when it decides
+    // the air again from its own file).
+    let (vehicle, air) = super::air::mission_air(vehicle, mission, &options.air)?;
+    let vehicle = &vehicle;
+    let request = &FlyPlanRequest {
+        options: MissionOptions {
+            air: super::air::AirInput::of_density(air.air_density_kg_m3),
+            ..options.clone()
+        },
+        ..request.clone()
+    };
     let options = &request.options;
     let (wind, _) = mission_wind(options, mission, vehicle)?;
     // The mission as given is planned while its surveys are turned (two threads).
@@ -244,6 +259,7 @@ pub fn plan_to_fly(
         None => as_given_figures(vehicle, mission, options)?,
     };
     let mut plan = answer(mission, &best, as_given)?;
+    plan.air = air;
     plan.changes.angles = angles;
     if !request.keep_angle {
         plan.notes = unturnable(mission);
@@ -688,6 +704,7 @@ fn answer(
         batteries: best.figures.batteries,
         energy_wh: best.figures.energy_wh,
         duration_s: best.figures.duration_s,
+        air: super::air::Air::sea_level(),
         sorties,
         as_given,
         changes: PlanChanges {

@@ -181,7 +181,7 @@ pub struct BinaryLogInfo {
     /// Battery capacity (parameters), A h.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub battery_capacity_ah: Option<f64>,
-    /// Mean air density (PX4 `vehicle_air_data`), kg/m^3.
+    /// Mean air density (PX4 `vehicle_air_data`, ArduPilot `BARO`), kg/m^3.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub air_density_kg_m3: Option<f64>,
     /// Time not landed (PX4 `vehicle_land_detected`), s.
@@ -655,6 +655,10 @@ impl FlightLogs {
                 .into());
             }
             let mut flight = align_flight(&log, &align)?;
+            flight.air_density_kg_m3 = reader
+                .binary_summary()
+                .and_then(|b| b.air_density_kg_m3)
+                .filter(|rho| rho.is_finite() && (0.3..=1.6).contains(rho));
             if self.aoa == AoaModel::Paper {
                 for s in &mut flight.samples {
                     s.state.aoa = aloft_power::AoaInput::Paper;

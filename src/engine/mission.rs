@@ -7,6 +7,7 @@ use serde::Serialize;
 use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Shortfall, Wind};
 use aloft_power::AoaModel;
 
+use super::air::{mission_air, Air};
 use super::finite::finite;
 use super::flight::Flight;
 use super::flown::flown_spec;
@@ -223,8 +224,9 @@ pub fn plan_mission_with(
     options: &MissionOptions,
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
-    let (wind, wind_text) = mission_wind(options, mission, vehicle)?;
-    plan_in(vehicle, mission, options, (&wind, wind_text), outputs)
+    let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
+    let (wind, wind_text) = mission_wind(options, mission, &vehicle)?;
+    plan_in(&vehicle, mission, options, (&wind, wind_text, air), outputs)
 }
 
 /// [`plan_mission`] in a wind built by the caller, which replaces the options' and the mission
@@ -238,8 +240,9 @@ pub fn plan_mission_in(
     options: &MissionOptions,
     wind: &Wind,
 ) -> Result<Plan, Error> {
-    let wind = (wind, "given by the caller".to_string());
-    plan_in(vehicle, mission, options, wind, &MissionOutputs::default())
+    let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
+    let wind = (wind, "given by the caller".to_string(), air);
+    plan_in(&vehicle, mission, options, wind, &MissionOutputs::default())
 }
 
 /// The steps of a plan: the pack and the flight's fixed parts, the spec flown (the options
@@ -249,7 +252,7 @@ fn plan_in(
     vehicle: &Vehicle,
     mission: &Mission,
     options: &MissionOptions,
-    (wind, wind_text): (&Wind, String),
+    (wind, wind_text, air): (&Wind, String, Air),
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
     // The aircraft first: a vehicle without an airframe is told so, before its packs.
@@ -286,6 +289,7 @@ fn plan_in(
         battery.name(),
         payload,
     );
+    summary.air = air;
     summary.route = mission.route().clone();
     summary.planning_speed = planning_speed;
     summary.loiter = loiter;

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use aloft_planner::{CornerMode, WindSpec};
 use aloft_power::AoaModel;
 
+use super::air::AirInput;
 use crate::error::Error;
 
 /// Options of [`plan_mission`]: the options of `aloft mission` (JSON keys as the field names;
@@ -48,6 +49,10 @@ pub struct MissionOptions {
     /// Corners: `pass` (through waypoints without a hold, as autopilots fly) or `stop`
     /// (overrides the mission's; default pass).
     pub corners: Option<CornerMode>,
+    /// The day's air (elevation, temperature, humidity, QNH): see [`AirInput`] for the
+    /// precedence (default: the mission's home altitude in ISA air, else the vehicle file's
+    /// density).
+    pub air: AirInput,
 }
 
 impl Default for MissionOptions {
@@ -67,6 +72,7 @@ impl Default for MissionOptions {
             speed_mps: None,
             rtl_altitude_m: None,
             corners: None,
+            air: AirInput::default(),
         }
     }
 }

@@ -48,6 +48,7 @@
 //! # Ok::<(), aloft::Error>(())
 //! ```
 
+mod air;
 pub mod answers;
 mod calibrate;
 mod endurance;
@@ -86,6 +87,7 @@ mod wind;
 
 /// The route figures of a mission and the formats a mission file may be in (from the
 /// `aloft-missions` importers), for the CLI and embedding programs.
+pub use air::{resolve_air, Air, AirInput, AirSource};
 pub use aloft_missions::{ItemCounts, RouteFigures, SourceFormat};
 pub use calibrate::{
     calibrate_hover, calibrate_spec, calibrate_spec_file, HoverCalibration, PublishedHover,

@@ -250,6 +250,8 @@ pub fn payload_sweep(
             ),
         });
     }
+    let (vehicle, _air) = super::air::vehicle_air(vehicle, &options.air)?;
+    let vehicle = &vehicle;
     let airframe = vehicle.aircraft()?.airframe();
     let mut curve = PayloadCurve {
         vehicle: vehicle.name().to_string(),

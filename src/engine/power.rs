@@ -12,6 +12,7 @@ use serde::Serialize;
 use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown, PowerModel};
 use aloft_power::{Term, Terms};
 
+use super::air::{vehicle_air, Air, AirInput};
 use super::files::open_input_file;
 use super::finite::finite;
 use super::power_batch::power_csv;
@@ -48,6 +49,8 @@ pub struct PowerModelQuery {
     /// Angle-of-attack model; default the paper's, or geometric when the state's
     /// `air_direction_deg` is given.
     pub aoa: Option<AoaModel>,
+    /// The day's air (default: the vehicle file's density).
+    pub air: AirInput,
 }
 
 /// The flight state of a point query, angles in degrees (the power model's [`FlightState`] in
@@ -88,6 +91,9 @@ pub struct PowerAnswer {
     pub battery: Option<String>,
     /// The payload in that mass, kg.
     pub payload_kg: f64,
+    /// The air the model flew in (flattened: `air_density_kg_m3`, `density_source`, ...).
+    #[serde(flatten)]
+    pub air: Air,
     /// Every term of the model.
     #[serde(flatten)]
     pub power: PowerBreakdown,
@@ -123,18 +129,20 @@ pub fn power_model(vehicle: &Vehicle, query: &PowerModelQuery) -> Result<PowerMo
     Ok(model_and_mass(vehicle, query)?.0)
 }
 
-/// The four-term model at the query's take-off mass with its terms and cutoff, and that mass.
+/// The four-term model in the query's air at its take-off mass with its terms and cutoff, that
+/// mass and that air.
 fn model_and_mass(
     vehicle: &Vehicle,
     query: &PowerModelQuery,
-) -> Result<(PowerModel, TakeoffMass), Error> {
+) -> Result<(PowerModel, TakeoffMass, Air), Error> {
+    let (vehicle, air) = vehicle_air(vehicle, &query.air)?;
     let (model, mass) = vehicle.power_model_with(query.battery.as_deref(), query.payload_kg)?;
     let options = ModelOptions {
         terms: Terms::all_but(&query.without),
         profile_cutoff_mps: query.profile_cutoff_mps,
     };
     let model = PowerModel::with_options(model.vehicle().clone(), options)?;
-    Ok((model, mass))
+    Ok((model, mass, air))
 }
 
 /// Every term of the four-term model (power seed eqs 3-14) at one flight state, at the
@@ -145,7 +153,7 @@ fn model_and_mass(
 /// angle-of-attack choice (geometric without a direction, the paper's with one); a state the
 /// model rejects (negative airspeed, tilt of 90 deg or more).
 pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer, Error> {
-    let (model, mass) = model_and_mass(vehicle, &query.model)?;
+    let (model, mass, air) = model_and_mass(vehicle, &query.model)?;
     let s = &query.state;
     let aoa = aoa_input(query.model.aoa, s.air_direction_deg)?;
     let state = FlightState {
@@ -181,6 +189,7 @@ pub fn power_point(vehicle: &Vehicle, query: &PowerQuery) -> Result<PowerAnswer,
             takeoff_mass_kg: mass.total_kg,
             battery: mass.battery().map(str::to_string),
             payload_kg: mass.payload_kg(),
+            air,
             power,
             electrical_gradient,
             context: PowerContext {

@@ -19,6 +19,7 @@ use aloft_logs::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Log};
 use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint};
 use aloft_power::{AoaModel, ModelOptions};
 
+use super::air::{log_air, Air, AirInput};
 use super::finite::finite;
 use super::vehicles::{MassParts, Vehicle};
 use super::wind::{describe_wind_spec, steady};
@@ -63,6 +64,9 @@ pub struct ReplayRequest {
     /// The pack flown, by name (`None`: the vehicle's default pack); its mass is part of the
     /// mass flown.
     pub battery: Option<String>,
+    /// The day's air (default: the log's own density where it has one, else the vehicle
+    /// file's).
+    pub air: AirInput,
 }
 
 impl Default for ReplayRequest {
@@ -76,6 +80,7 @@ impl Default for ReplayRequest {
             aoa: AoaModel::Geometric,
             wind: None,
             battery: None,
+            air: AirInput::default(),
         }
     }
 }
@@ -96,6 +101,10 @@ pub struct ReplayAnswer {
     pub battery: Option<String>,
     /// Mass flown, kg.
     pub mass_kg: f64,
+    /// The air flown in (flattened: `air_density_kg_m3`, `density_source`, ...): the given
+    /// day's, else the log's own (`log`), else the vehicle file's.
+    #[serde(flatten)]
+    pub air: Air,
     /// Trajectory points replayed.
     pub points: usize,
     /// Span compared, s.
@@ -192,10 +201,13 @@ struct Flown {
 /// airframe), an unreadable log, a log with fewer than two velocity samples, no acceleration in
 /// the log when asked for it, a power channel that does not overlap the trajectory.
 pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAnswer, Error> {
+    let (log, log_density) = read_replay_log(request)?;
+    // The flight in its own air: the given day, else the log's, else the vehicle file's.
+    let air = log_air(&request.air, log_density, vehicle)?;
+    let vehicle = &vehicle.in_air(&air)?;
     let flown = replay_aircraft(vehicle, request)?;
     let powered = flown.aircraft.at_mass(flown.mass_kg, request.aoa)?;
     let path = request.log.display().to_string();
-    let log = read_replay_log(request)?;
     let trajectory = trajectory(&log, request, &path)?;
     let (wind, wind_text) = match &request.wind {
         Some(w) => (steady(w)?, describe_wind_spec(w)),
@@ -232,7 +244,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         },
         notes,
     };
-    let answer = answer(
+    let mut answer = answer(
         vehicle,
         request,
         flown,
@@ -240,6 +252,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         (&ground, books, window),
         context,
     );
+    answer.air = air;
     finite(answer, "replay", || request.log.display().to_string())
 }
 
@@ -261,6 +274,7 @@ fn answer(
         vehicle: vehicle.name().to_string(),
         battery: flown.battery,
         mass_kg: flown.mass_kg,
+        air: Air::sea_level(),
         points,
         duration_s: span_s,
         acceleration: match request.acceleration {
@@ -317,18 +331,22 @@ fn replay_aircraft(vehicle: &Vehicle, request: &ReplayRequest) -> Result<Flown, 
     })
 }
 
-/// The log, read whole (the replay needs every sample twice: the trajectory and the power).
-fn read_replay_log(request: &ReplayRequest) -> Result<Log, Error> {
+/// The log, read whole (the replay needs every sample twice: the trajectory and the power),
+/// and its own mean air density when it logs one (PX4 `vehicle_air_data.rho`, ArduPilot `BARO`), kg/m^3.
+fn read_replay_log(request: &ReplayRequest) -> Result<(Log, Option<f64>), Error> {
     let profile = request
         .profile
         .as_deref()
         .map(aloft_logs::Profile::resolve)
         .transpose()?;
-    Ok(aloft_logs::read_log(
-        &request.log,
-        profile.as_ref(),
-        &Default::default(),
-    )?)
+    let mut reader =
+        aloft_logs::open_log_with(&request.log, profile.as_ref(), &Default::default())?;
+    let log = reader.read_rest(&request.log.display().to_string())?;
+    let density = reader
+        .binary_summary()
+        .and_then(|b| b.air_density_kg_m3)
+        .filter(|rho| rho.is_finite() && (0.3..=1.6).contains(rho));
+    Ok((log, density))
 }
 
 /// The samples with a velocity, strictly increasing in time, with their accelerations.

@@ -829,6 +829,8 @@ pub fn plan_scenarios(
     sc: &ScenarioOptions,
 ) -> Result<Uncertainty, Error> {
     sc.check()?;
+    let (vehicle, _air) = super::air::mission_air(vehicle, mission, &options.air)?;
+    let vehicle = &vehicle;
     let setup = MissionScenarios::new(vehicle, mission, options, sc)?;
     let n = sc.samples as usize;
     let keep_segments = n.saturating_mul(setup.spec.segments.len().max(1)) <= MAX_SEGMENT_VALUES;
@@ -1009,6 +1011,8 @@ pub fn endurance_scenarios(
     sc: &ScenarioOptions,
 ) -> Result<EnduranceUncertainty, Error> {
     sc.check()?;
+    let (vehicle, _air) = super::air::vehicle_air(vehicle, &options.air)?;
+    let vehicle = &vehicle;
     let aircraft = vehicle.aircraft()?;
     let pack = vehicle.battery(options.battery.as_deref())?;
     let n = sc.samples as usize;

@@ -7,6 +7,7 @@ use aloft_missions::RouteFigures;
 use aloft_planner::wind::speed_and_from_deg;
 use aloft_planner::{Limit, MissionReport, SegmentReport, Shortfall};
 
+use super::air::Air;
 use super::flown::PlanningSpeed;
 use super::loiter::LoiterSummary;
 use super::sorties::SortieSummary;
@@ -85,6 +86,10 @@ pub struct MissionSummary {
     pub takeoff_mass_kg: f64,
     /// Payload at take-off, kg.
     pub payload_kg: f64,
+    /// The air flown in: `air_density_kg_m3`, `density_source`, `elevation_m`,
+    /// `temperature_c`, ... (see [`Air`]).
+    #[serde(flatten)]
+    pub air: Air,
     /// Flight time, s.
     pub duration_s: f64,
     /// Time flown beyond the plan because the vehicle flew at the edge of its envelope (slower
@@ -184,6 +189,7 @@ pub fn mission_summary(
             .map(|s| reason(s, &report.segments, vehicle_name)),
         takeoff_mass_kg: report.takeoff_mass_kg,
         payload_kg,
+        air: Air::sea_level(),
         duration_s: report.duration_s,
         time_lost_s: Some(report.segments.iter().map(|s| s.time_lost_s).sum::<f64>())
             .filter(|&t| t > 0.0),

@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use super::air::{log_air, AirInput};
 use super::finite::finite;
 use super::logs::FlightLogs;
 use super::vehicles::Vehicle;
@@ -24,6 +25,9 @@ pub struct ValidateRequest {
     pub calibrate_first_s: Option<f64>,
     /// Also return the measured and predicted power of every flight (for a plot).
     pub series: bool,
+    /// The day's air for every flight (default: each log's own density where it has one, else
+    /// the vehicle file's).
+    pub air: AirInput,
 }
 
 /// Mean over flights of one Table I cell.
@@ -80,25 +84,25 @@ pub fn validate_logs(
     vehicle: &Vehicle,
     request: &ValidateRequest,
 ) -> Result<ValidateAnswer, Error> {
-    let (model, mass) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
-    let model = &model;
+    let (_, mass) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
     let flights = request.logs.load()?;
-    let results = flights
-        .iter()
-        .map(|(f, _)| validate_flight(model, f, request.calibrate_first_s))
-        .collect::<Result<Vec<_>, _>>()?;
-    let series = if request.series {
-        flights
-            .iter()
-            .map(|(f, _)| {
-                let predicted = predict(model, f)?;
-                let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
-                Ok((f.source.clone(), f.times_s.clone(), measured, predicted))
-            })
-            .collect::<Result<_, Error>>()?
-    } else {
-        Vec::new()
-    };
+    let mut results = Vec::with_capacity(flights.len());
+    let mut series = Vec::new();
+    for (f, _) in &flights {
+        // Each flight in its own air: the given day, else the log's, else the vehicle file's.
+        let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
+        let (model, _) = vehicle
+            .in_air(&air)?
+            .power_model_with(request.battery.as_deref(), request.payload_kg)?;
+        let mut result = validate_flight(&model, f, request.calibrate_first_s)?;
+        result.density_source = air.density_source;
+        results.push(result);
+        if request.series {
+            let predicted = predict(&model, f)?;
+            let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
+            series.push((f.source.clone(), f.times_s.clone(), measured, predicted));
+        }
+    }
     let table_i = mean_table_i(&results);
     let report = ValidateReport {
         vehicle: vehicle.name().to_string(),

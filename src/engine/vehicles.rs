@@ -300,6 +300,51 @@ impl Vehicle {
         Self::from_file(file)
     }
 
+    /// The density the vehicle file's constants hold at, kg/m^3: its `[power]` table's
+    /// `air_density_kg_m3`, else its `[propulsion]` table's, else ISA sea level.
+    pub fn air_density_kg_m3(&self) -> f64 {
+        self.file
+            .power
+            .as_ref()
+            .map(|p| p.air_density_kg_m3)
+            .or_else(|| self.file.propulsion.as_ref().map(|p| p.air_density_kg_m3))
+            .unwrap_or(aloft_core::ISA_SEA_LEVEL_DENSITY_KG_M3)
+    }
+
+    /// The same vehicle in `air`: the four-term constants carried to its density term by term
+    /// (`aloft_power::VehicleParams::in_air`: induced and `kappa1` profile power at fixed thrust
+    /// `∝ rho^-1/2`, body drag `∝ rho`), the propulsion chain computing in it, and a stated
+    /// `max_thrust_n` (a fixed-pitch rotor at its largest speed: thrust `∝ rho`) with the largest
+    /// take-off mass falling in proportion in thinner air (never rising in denser). A vehicle
+    /// that does not state its maximum thrust keeps its envelope: its default limit is a lower
+    /// bound drawn from its take-off mass and tilt, not a measurement. Flying a vehicle in the
+    /// air it is already in returns it unchanged.
+    ///
+    /// # Errors
+    /// A density the model rejects (not positive, above 10 kg/m^3).
+    pub fn in_air(&self, air: &super::air::Air) -> Result<Self, Error> {
+        let rho = air.air_density_kg_m3;
+        let s = rho / self.air_density_kg_m3();
+        // Within 1e-12: the same air (a vehicle flown twice in it).
+        if (s - 1.0).abs() < 1e-12 {
+            return Ok(self.clone());
+        }
+        let mut file = self.file.clone();
+        if let Some(power) = file.power.as_mut() {
+            *power = power.in_air(rho);
+        }
+        if let Some(propulsion) = file.propulsion.as_mut() {
+            propulsion.air_density_kg_m3 = rho;
+        }
+        if let Some(airframe) = file.airframe.as_mut() {
+            if let Some(thrust) = airframe.max_thrust_n.as_mut() {
+                *thrust *= s;
+                airframe.max_takeoff_mass_kg *= s.min(1.0);
+            }
+        }
+        Self::from_file(file)
+    }
+
     /// Notes for the reader about how the vehicle is modelled (e.g. a propulsion chain without a
     /// drag law).
     pub fn notes(&self) -> Vec<String> {

@@ -375,6 +375,22 @@ async function main() {
       assert(String(cli.json.energy_wh) !== String(still.json.energy_wh), 'the wind changed nothing');
     });
 
+    await check('elevation 2000 m at 30 °C re-plans and the table equals aloft mission --elevation-m 2000 --temperature-c 30', async () => {
+      const before = await plans(page);
+      await setOptions(page, { elevation: '2000', temperature: '30' });
+      await waitReady(page, before);
+      const args = ['--wind-speed', '8', '--wind-from', '270', '--elevation-m', '2000', '--temperature-c', '30'];
+      const cli = cliMission(null, args);
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const air = await page.$eval('#summary', (e) => e.textContent);
+      assert(air.includes(cli.json.air_density_kg_m3.toFixed(3)), `the summary does not show the density ${cli.json.air_density_kg_m3}`);
+      const sea = cliMission(null, ['--wind-speed', '8', '--wind-from', '270']);
+      assert(cli.json.energy_wh > sea.json.energy_wh, 'thin air cost no more energy');
+      const b2 = await plans(page);
+      await setOptions(page, { elevation: '', temperature: '' });
+      await waitReady(page, b2);
+    });
+
     // --- 5: samples draw the band
     await check('samples 50 draw the p5-p95 band and the dashed p50', async () => {
       const before = await plans(page);

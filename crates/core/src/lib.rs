@@ -7,6 +7,8 @@
 //!   and the unit `g` of log columns;
 //! - [`Trapezoid`] and [`trapezoid`], the trapezoid rule for energies (power over time) and any
 //!   other integral of sampled data, sample by sample or over slices;
+//! - [`atmosphere`]: the International Standard Atmosphere and the density of a day's air
+//!   (elevation, temperature, humidity, QNH);
 //! - [`bisect`], the bracketing of a crossing by halving;
 //! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
 //!   before it is opened, so it cannot block), with a size limit for whole-file inputs.
@@ -16,6 +18,7 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod atmosphere;
 pub mod bisect;
 pub mod input;
 pub mod integrate;

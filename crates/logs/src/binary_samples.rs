@@ -99,7 +99,8 @@ pub struct BinarySummary {
     pub battery_cells: Option<u32>,
     /// Capacity of the battery, from the parameters (`BAT1_CAPACITY`, `BATT_CAPACITY`), A h.
     pub battery_capacity_ah: Option<f64>,
-    /// Mean air density of `vehicle_air_data`, kg/m^3.
+    /// Mean air density of the log: PX4 `vehicle_air_data.rho`, ArduPilot `BARO` pressure and
+    /// temperature (dry air), kg/m^3.
     pub air_density_kg_m3: Option<f64>,
     /// Time the vehicle was not landed (`vehicle_land_detected`), s.
     pub in_air_s: Option<f64>,

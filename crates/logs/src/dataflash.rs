@@ -224,6 +224,7 @@ enum Role {
     Gps,
     Bat,
     Curr,
+    Baro,
     Event,
     Arm,
     Parm,
@@ -240,6 +241,7 @@ fn role(name: &str) -> Role {
         "GPS" => Role::Gps,
         "BAT" => Role::Bat,
         "CURR" => Role::Curr,
+        "BARO" => Role::Baro,
         "EV" => Role::Event,
         "ARM" => Role::Arm,
         "PARM" => Role::Parm,
@@ -471,6 +473,17 @@ impl DataflashDecoder {
                 if name == "BATT_CAPACITY" {
                     s.battery_capacity_ah =
                         crate::binary_samples::capacity_ah(v).or(s.battery_capacity_ah);
+                }
+            }
+            Role::Baro => {
+                // The log's own air: the barometer's pressure (Pa) and temperature (C), dry air.
+                // The sensor sits on the board, whose warmth may bias the density low.
+                let pa = f.num(p, "Press")?;
+                let t_k = f.num(p, "Temp")? + aloft_core::atmosphere::ZERO_CELSIUS_K;
+                let rho = aloft_core::atmosphere::air_density_kg_m3(pa, t_k, 0.0);
+                if rho.is_finite() && (0.3..=1.6).contains(&rho) {
+                    s.rho_sum += rho;
+                    s.rho_n += 1;
                 }
             }
             Role::Event | Role::Arm => return self.landed(r, f, p),

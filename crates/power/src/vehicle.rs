@@ -117,6 +117,45 @@ pub struct VehicleParams {
     pub efficiency_relative_sd: Option<f64>,
 }
 
+impl VehicleParams {
+    /// The same vehicle in air of density `rho_kg_m3`: the constants, stated at this table's
+    /// `air_density_kg_m3` (`rho_ref`), carried to the new air term by term with `s = rho /
+    /// rho_ref`, at fixed thrust:
+    ///
+    /// | term | scaling | why |
+    /// |---|---|---|
+    /// | induced, eqs (8)-(10) | through `vh = sqrt(m g / (2 rho A))`: `rho^-1/2` in hover | momentum theory; nothing to change but `rho` |
+    /// | profile `kappa1 T^1.5`, eq (12) | `kappa1 s^-1/2` | a fixed-pitch rotor at fixed thrust spins faster in thin air: `T = C_T rho A (Omega R)^2` gives `Omega R ∝ rho^-1/2`, and the blade profile power `rho A (Omega R)^3 delta s / 8 ∝ T^1.5 rho^-1/2` |
+    /// | profile `kappa2 V^2 T^0.5`, eq (12) | `kappa2 s^1/2` | the advance-ratio part `rho A (Omega R) V^2 ∝ T^0.5 rho^1/2 V^2` |
+    /// | parasitic, eq (6) (`mu1`, `mu2`, `mu3`, body axes) | `mu s` | body drag is dynamic pressure times an area: `∝ rho` at a given airspeed |
+    /// | efficiency `eta`, eq (14) | unchanged | a ratio of powers (motor and rotor efficiencies shift with Reynolds number and load: ignored) |
+    ///
+    /// So the whole hover power at a fixed mass scales as `sqrt(rho_ref / rho)` (1.161 at 3000 m
+    /// ISA), not only its induced part, and forward flight gains less (its drag power falls).
+    /// `s = 1` returns the table bit for bit. The result is not validated here: build a
+    /// [`Vehicle`] from it.
+    // Exact comparison: the same density returns the same table, bit for bit.
+    #[allow(clippy::float_cmp)]
+    pub fn in_air(&self, rho_kg_m3: f64) -> Self {
+        if rho_kg_m3 == self.air_density_kg_m3 {
+            return self.clone();
+        }
+        let s = rho_kg_m3 / self.air_density_kg_m3;
+        let root = s.sqrt();
+        Self {
+            air_density_kg_m3: rho_kg_m3,
+            kappa1_w_per_n1_5: self.kappa1_w_per_n1_5 / root,
+            kappa2_w_s2_per_m2_n0_5: self.kappa2_w_s2_per_m2_n0_5 * root,
+            mu1_n_s_per_m: self.mu1_n_s_per_m * s,
+            mu2_n_s2_per_m2: self.mu2_n_s2_per_m2 * s,
+            mu3_n_s3_per_m3: self.mu3_n_s3_per_m3 * s,
+            mu2_x_n_s2_per_m2: self.mu2_x_n_s2_per_m2.map(|m| m * s),
+            mu2_y_n_s2_per_m2: self.mu2_y_n_s2_per_m2.map(|m| m * s),
+            ..self.clone()
+        }
+    }
+}
+
 /// Standard gravity (aloft-core's), the default when a vehicle file does not give one, m/s^2.
 fn default_gravity() -> f64 {
     STANDARD_GRAVITY_MPS2
@@ -387,6 +426,57 @@ pub(crate) mod tests {
             mu2_y_n_s2_per_m2: None,
             efficiency_relative_sd: None,
         }
+    }
+
+    /// The air a vehicle flies in, term by term (`VehicleParams::in_air`), at 3000 m ISA
+    /// (0.9091 kg/m^3, PX4's check value): at a fixed mass the induced power of hover eq (8)-(10)
+    /// and the profile power `kappa1 T^1.5` of eq (12) each grow by `sqrt(rho0 / rho)` (1.161),
+    /// so the whole hover power does; the parasitic power of eq (11) at a given airspeed falls by
+    /// `rho / rho0`; the in-plane profile term `kappa2` grows by `sqrt(rho / rho0)` at fixed
+    /// thrust and speed; the climb power of eq (13) does not move.
+    #[test]
+    fn each_term_carries_density_as_the_physics_says() {
+        use crate::four_term::{FlightState, PowerModel};
+        let rho0: f64 = 1.225;
+        let rho: f64 = 0.9091;
+        let ratio = (rho0 / rho).sqrt();
+        let mut p = m100_params();
+        p.kappa2_w_s2_per_m2_n0_5 = 0.01;
+        let sea = PowerModel::new(Vehicle::new(p.clone()).unwrap());
+        let high = PowerModel::new(Vehicle::new(p.in_air(rho)).unwrap());
+        let hover = FlightState::new(0.0, 0.0, 0.0, 0.0);
+        let (a, b) = (
+            sea.evaluate(&hover).unwrap(),
+            high.evaluate(&hover).unwrap(),
+        );
+        // Relative 1e-12: the same arithmetic in another order.
+        let close = |x: f64, y: f64| ((x / y) - 1.0).abs() < 1e-12;
+        assert!(close(b.induced_w / a.induced_w, ratio));
+        assert!(close(b.profile_w / a.profile_w, ratio));
+        assert!(close(b.electrical_w / a.electrical_w, ratio));
+        assert!((ratio - 1.161).abs() < 0.001);
+        // Forward flight: thrust and inflow differ with the air, so compare the terms' laws at
+        // one thrust and speed. Parasitic power is the drag law at the airspeed, eq (11).
+        let v = 10.0;
+        let drag = |p: &VehicleParams| {
+            p.mu1_n_s_per_m * v + p.mu2_n_s2_per_m2 * v * v + p.mu3_n_s3_per_m3 * v * v * v
+        };
+        let thin = p.in_air(rho);
+        assert!(close(drag(&thin) / drag(&p), rho / rho0));
+        let t = 40.0_f64;
+        let in_plane = |p: &VehicleParams| p.kappa2_w_s2_per_m2_n0_5 * v * v * t.sqrt();
+        assert!(close(in_plane(&thin) / in_plane(&p), (rho / rho0).sqrt()));
+        let climb = FlightState::new(0.0, 0.0, 0.0, 2.0);
+        let (c, d) = (
+            sea.evaluate(&climb).unwrap(),
+            high.evaluate(&climb).unwrap(),
+        );
+        assert!(close(c.climb_w, d.climb_w));
+        // The same air is the same table, bit for bit; there and back is the table again.
+        assert_eq!(p.in_air(rho0), p);
+        let back = thin.in_air(rho0);
+        assert!(close(back.kappa1_w_per_n1_5, p.kappa1_w_per_n1_5));
+        assert!(close(back.mu3_n_s3_per_m3, p.mu3_n_s3_per_m3));
     }
 
     type Mutation = fn(&mut VehicleParams);

@@ -74,7 +74,11 @@ def mission(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
             ``wind_reference_height``, ``wind_exponent``, ``wind_roughness``, ``wind_field``
             (CSV path), ``gust_std``, ``gust_seed``, ``reserve_percent``, ``start_percent``,
             ``time_step``, ``speed``, ``rtl_altitude_m``, ``corners`` (``"pass"``, ``"stop"``),
-            ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``; and the Monte-Carlo
+            ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``; the day's air:
+            ``elevation_m`` (m above mean sea level; default the mission's home altitude),
+            ``temperature_c`` (C; default ISA's at the elevation), ``humidity_percent``,
+            ``qnh_hpa`` (the answer carries ``air_density_kg_m3``, ``density_source``,
+            ``elevation_m``, ``temperature_c`` and where each came from); and the Monte-Carlo
             options of ``--samples N``: ``samples``, ``seed``, ``wind_speed_sd``,
             ``wind_from_sd``, ``payload_sd_kg``, ``capacity_sd_percent``, ``power_sd_percent``,
             ``threads`` (the spreads need ``samples``).
@@ -155,7 +159,8 @@ def plan(
             ``wind_speed`` (m/s) and ``wind_from`` (deg, blowing FROM), ``wind_profile``,
             ``wind_field``, ``gust_std``, ``reserve_percent`` (% of the usable capacity at
             landing), ``start_percent``, ``time_step`` (s), ``speed`` (m/s),
-            ``rtl_altitude_m`` (m), ``corners``, ``aoa``, ``no_ground_effect``.
+            ``rtl_altitude_m`` (m), ``corners``, ``aoa``, ``no_ground_effect``, and the day's
+            air ``elevation_m``, ``temperature_c``, ``humidity_percent``, ``qnh_hpa``.
 
     Returns:
         The CLI's JSON answer as a dict: ``files`` (in flight order), ``batteries``,
@@ -205,7 +210,9 @@ def endurance(**options: Any) -> Dict[str, Any]:
         **options: ``vehicle``, ``battery``, ``payload_kg`` (default 0), ``wind_speed``,
             ``wind_from``, ``wind_profile``, ``wind_reference_height``, ``wind_exponent``,
             ``wind_roughness``, ``course`` (deg, default 0), ``reserve_percent`` (default 0),
-            ``orbit_radius`` and ``orbit_speed`` (together), ``aoa``; ``sweep_speed`` (m/s) for
+            ``orbit_radius`` and ``orbit_speed`` (together), ``aoa``, the day's air
+            (``elevation_m``, ``temperature_c``, ``humidity_percent``, ``qnh_hpa``; default the
+            vehicle file's density); ``sweep_speed`` (m/s) for
             the power curve instead (``aloft endurance --sweep-speed S --format json``), or
             ``payload_sweep`` (``"START:STOP:STEP"`` in kg, or a tuple of the three numbers) for
             endurance against payload, one curve per pack, instead
@@ -327,6 +334,10 @@ def power(
     profile_cutoff: Optional[float] = None,
     aoa: Optional[str] = None,
     air_direction_deg: Any = None,
+    elevation_m: Optional[float] = None,
+    temperature_c: Optional[float] = None,
+    humidity_percent: Optional[float] = None,
+    qnh_hpa: Optional[float] = None,
 ) -> Dict[str, np.ndarray]:
     """The four-term power model over arrays of flight states: ``aloft power`` vectorised.
 
@@ -350,6 +361,11 @@ def power(
         aoa: ``"paper"`` (default) or ``"geometric"`` (needs ``air_direction_deg``).
         air_direction_deg: Direction of the air-relative velocity from the nose, degrees
             (array or scalar); selects the geometric angle of attack.
+        elevation_m, temperature_c, humidity_percent, qnh_hpa: The day's air (``--elevation-m``
+            m, ``--temperature-c`` C, ``--humidity-percent`` %, ``--qnh-hpa`` hPa; default the
+            vehicle file's density, ISA sea level 1.225 kg/m^3): the density of the
+            International Standard Atmosphere at the elevation with the given temperature,
+            humidity and QNH.
 
     Returns:
         A dict of float64 arrays keyed by :data:`POWER_KEYS`: ``thrust_n``,
@@ -378,6 +394,10 @@ def power(
         "without": without,
         "profile_cutoff": profile_cutoff,
         "aoa": aoa,
+        "elevation_m": elevation_m,
+        "temperature_c": temperature_c,
+        "humidity_percent": humidity_percent,
+        "qnh_hpa": qnh_hpa,
     }
     direction = flat[4] if air_direction_deg is not None else None
     out = _native.power(flat[0], flat[1], flat[2], flat[3], direction, options)

@@ -38,7 +38,15 @@ class WindKeywords(TypedDict, total=False):
     wind_exponent: Optional[float]
     wind_roughness: Optional[float]
 
-class MissionKeywords(VehicleKeywords, WindKeywords, total=False):
+class AirKeywords(TypedDict, total=False):
+    """The day's air: elevation (m AMSL), temperature (C), humidity (%), QNH (hPa)."""
+
+    elevation_m: Optional[float]
+    temperature_c: Optional[float]
+    humidity_percent: Optional[float]
+    qnh_hpa: Optional[float]
+
+class MissionKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     """How a mission is flown (`aloft mission`'s flags)."""
 
     wind_field: Optional[PathLike]
@@ -71,7 +79,7 @@ class PlanKeywords(MissionKeywords, total=False):
     camera_interval_s: Optional[float]
     keep_angle: bool
 
-class EnduranceKeywords(VehicleKeywords, WindKeywords, total=False):
+class EnduranceKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     """`aloft endurance`'s flags."""
 
     course: Optional[float]
@@ -164,6 +172,10 @@ def power(
     profile_cutoff: Optional[float] = None,
     aoa: Optional[Aoa] = None,
     air_direction_deg: Optional[ArrayLike] = None,
+    elevation_m: Optional[float] = None,
+    temperature_c: Optional[float] = None,
+    humidity_percent: Optional[float] = None,
+    qnh_hpa: Optional[float] = None,
 ) -> Dict[str, npt.NDArray[np.float64]]: ...
 
 def vehicles() -> List[Dict[str, Any]]: ...

@@ -158,6 +158,8 @@ impl Ahead<'_> {
             start_percent: (100.0 * soc).clamp(0.1, 100.0),
             time_step_s: Some(LIVE_TIME_STEP_S),
             speed_mps: self.speed_mps,
+            // The air the flight was decided to fly in (the vehicle is in it already).
+            air: crate::engine::AirInput::of_density(vehicle.air_density_kg_m3()),
             ..MissionOptions::default()
         };
         let sc = ScenarioOptions {

@@ -18,6 +18,7 @@ use serde::Serialize;
 use aloft_logs::frame::enu_to_geodetic;
 use aloft_logs::telemetry::{Reply, TelemetrySource};
 
+use super::air::AirInput;
 use super::finite::finite;
 use super::mission_file::Mission;
 use super::scenario_stats::Percentiles;
@@ -145,6 +146,9 @@ pub struct LiveRequest {
     pub speed_mps: Option<f64>,
     /// Scenarios per update (default [`LIVE_SCENARIOS`]).
     pub scenarios: u32,
+    /// The day's air (default: the mission's home altitude in ISA air, else the vehicle file's
+    /// density).
+    pub air: AirInput,
 }
 
 impl LiveRequest {
@@ -158,6 +162,7 @@ impl LiveRequest {
             reserve_percent: None,
             speed_mps: None,
             scenarios: LIVE_SCENARIOS,
+            air: AirInput::default(),
         }
     }
 }
@@ -200,6 +205,13 @@ pub fn follow_live(
     emit: &mut dyn FnMut(&LiveUpdate) -> Result<(), Error>,
 ) -> Result<LiveSummary, Error> {
     check_every(request.every_s)?;
+    // The flight's air: the given day, else the mission's home altitude, else the vehicle's.
+    let home_amsl_m = request
+        .mission
+        .as_ref()
+        .and_then(|m| m.spec().home.altitude_amsl_m);
+    let air = super::air::resolve_air(&request.air, home_amsl_m, vehicle)?;
+    let vehicle = &vehicle.in_air(&air)?;
     let mut follower = LiveSession::new(vehicle, request)?;
     let mut updates = 0;
     let (mut first_s, mut next_s) = (None, f64::NEG_INFINITY);

@@ -44,6 +44,9 @@ pub struct LiveReplayRequest {
     pub payload_kg: f64,
     /// An update every this many seconds of flight time.
     pub every_s: f64,
+    /// The day's air (default: the log's own density where it has one, else the vehicle
+    /// file's).
+    pub air: crate::engine::AirInput,
 }
 
 /// The end of a validation replay: how the predictions did against the measured rest.
@@ -91,9 +94,13 @@ pub fn replay_live(
     emit: &mut dyn FnMut(&LiveUpdate) -> Result<(), Error>,
 ) -> Result<LiveCheck, Error> {
     super::check_every(request.every_s)?;
-    let (model, _) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
     let mut flights = request.logs.load()?;
     let (flight, _) = flights.swap_remove(0);
+    // The flight in its own air: the given day, else the log's, else the vehicle file's.
+    let air = super::super::air::log_air(&request.air, flight.air_density_kg_m3, vehicle)?;
+    let (model, _) = vehicle
+        .in_air(&air)?
+        .power_model_with(request.battery.as_deref(), request.payload_kg)?;
     let predicted = predict(&model, &flight)?;
     let series = Series::new(&flight, predicted);
     let prior_sd = super::estimate::prior_sd(&model);
