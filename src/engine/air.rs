@@ -300,7 +300,7 @@ fn rounded_density_altitude_m(rho: f64) -> f64 {
 /// As [`resolve_air`] and [`Vehicle::in_air`].
 pub(crate) fn vehicle_air(vehicle: &Vehicle, input: &AirInput) -> Result<(Vehicle, Air), Error> {
     let air = resolve_air(input, None, vehicle)?;
-    Ok((vehicle.in_air(&air)?, air))
+    Ok((vehicle.in_air(air.air_density_kg_m3)?, air))
 }
 
 /// The air of a logged flight: the caller's day when given (without a mission, so from the
@@ -329,7 +329,7 @@ pub(crate) fn mission_air(
     input: &AirInput,
 ) -> Result<(Vehicle, Air), Error> {
     let air = resolve_air(input, mission.spec().home.altitude_amsl_m, vehicle)?;
-    Ok((vehicle.in_air(&air)?, air))
+    Ok((vehicle.in_air(air.air_density_kg_m3)?, air))
 }
 
 #[cfg(test)]

@@ -204,7 +204,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     let (log, log_density) = read_replay_log(request)?;
     // The flight in its own air: the given day, else the log's, else the vehicle file's.
     let air = log_air(&request.air, log_density, vehicle)?;
-    let vehicle = &vehicle.in_air(&air)?;
+    let vehicle = &vehicle.in_air(air.air_density_kg_m3)?;
     let flown = replay_aircraft(vehicle, request)?;
     let powered = flown.aircraft.at_mass(flown.mass_kg, request.aoa)?;
     let path = request.log.display().to_string();

@@ -92,7 +92,7 @@ pub fn validate_logs(
         // Each flight in its own air: the given day, else the log's, else the vehicle file's.
         let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
         let (model, _) = vehicle
-            .in_air(&air)?
+            .in_air(air.air_density_kg_m3)?
             .power_model_with(request.battery.as_deref(), request.payload_kg)?;
         let mut result = validate_flight(&model, f, request.calibrate_first_s)?;
         result.density_source = air.density_source;

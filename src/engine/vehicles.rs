@@ -311,7 +311,7 @@ impl Vehicle {
             .unwrap_or(aloft_core::ISA_SEA_LEVEL_DENSITY_KG_M3)
     }
 
-    /// The same vehicle in `air`: the four-term constants carried to its density term by term
+    /// The same vehicle in air of density `rho` (kg/m^3, decided by `super::air`): the four-term constants carried to its density term by term
     /// (`aloft_power::VehicleParams::in_air`: induced and `kappa1` profile power at fixed thrust
     /// `∝ rho^-1/2`, body drag `∝ rho`), the propulsion chain computing in it, and a stated
     /// `max_thrust_n` (a fixed-pitch rotor at its largest speed: thrust `∝ rho`) with the largest
@@ -322,8 +322,7 @@ impl Vehicle {
     ///
     /// # Errors
     /// A density the model rejects (not positive, above 10 kg/m^3).
-    pub fn in_air(&self, air: &super::air::Air) -> Result<Self, Error> {
-        let rho = air.air_density_kg_m3;
+    pub fn in_air(&self, rho: f64) -> Result<Self, Error> {
         let s = rho / self.air_density_kg_m3();
         // Within 1e-12: the same air (a vehicle flown twice in it).
         if (s - 1.0).abs() < 1e-12 {

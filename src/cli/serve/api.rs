@@ -15,7 +15,7 @@ use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
 use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT};
-use super::files::Names;
+use super::given::Names;
 use super::work::Pool;
 use super::{engine_message, error, json_type, Refused, Shared};
 

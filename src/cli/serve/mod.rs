@@ -37,6 +37,7 @@ mod assets;
 mod body;
 mod conn;
 mod files;
+mod given;
 mod guard;
 mod live;
 mod work;
@@ -108,7 +109,7 @@ struct Shared {
     /// The names the server answers to.
     hosts: guard::Hosts,
     /// The files given on the command line.
-    files: Vec<files::Given>,
+    files: Vec<given::Given>,
     /// The tile layer: URL template and attribution.
     tiles: Option<(String, String)>,
     /// The followed flight's updates, with `--live` or `--tlog`.
@@ -129,7 +130,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
             anyhow::bail!("--tiles '{t}': the URL template needs {{z}}, {{x}} and {{y}}");
         }
     }
-    let given = files::read_given(&args.files)?;
+    let given = given::read_given(&args.files)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -158,7 +159,7 @@ fn uploads_folder() -> std::io::Result<tempfile::TempDir> {
     builder.tempdir()
 }
 
-async fn serve(args: ServeArgs, given: Vec<files::Given>, uploads: PathBuf) -> Result<()> {
+async fn serve(args: ServeArgs, given: Vec<given::Given>, uploads: PathBuf) -> Result<()> {
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;

@@ -211,7 +211,7 @@ pub fn follow_live(
         .as_ref()
         .and_then(|m| m.spec().home.altitude_amsl_m);
     let air = super::air::resolve_air(&request.air, home_amsl_m, vehicle)?;
-    let vehicle = &vehicle.in_air(&air)?;
+    let vehicle = &vehicle.in_air(air.air_density_kg_m3)?;
     let mut follower = LiveSession::new(vehicle, request)?;
     let mut updates = 0;
     let (mut first_s, mut next_s) = (None, f64::NEG_INFINITY);

@@ -99,7 +99,7 @@ pub fn replay_live(
     // The flight in its own air: the given day, else the log's, else the vehicle file's.
     let air = super::super::air::log_air(&request.air, flight.air_density_kg_m3, vehicle)?;
     let (model, _) = vehicle
-        .in_air(&air)?
+        .in_air(air.air_density_kg_m3)?
         .power_model_with(request.battery.as_deref(), request.payload_kg)?;
     let predicted = predict(&model, &flight)?;
     let series = Series::new(&flight, predicted);
