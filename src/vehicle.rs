@@ -56,6 +56,11 @@ macro_rules! builtin {
     };
 }
 
+/// A commented vehicle file for one's own multirotor (`aloft vehicles template`): every value a
+/// mission needs, the ones to change marked, loadable as it is (a 1.2 kg 3S quadrotor). Every key
+/// is documented in docs/vehicle-file.md.
+pub const VEHICLE_TEMPLATE: &str = include_str!("vehicle_template.toml");
+
 /// The built-in vehicles, the default first.
 pub const BUILTIN_VEHICLES: &[BuiltinVehicle] = &[
     builtin!("dji-m100"),

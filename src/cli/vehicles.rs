@@ -1,10 +1,13 @@
 //! `aloft vehicles`: list the built-in vehicles with their sources; `aloft vehicles calibrate`:
-//! a vehicle file from a spec sheet.
+//! a vehicle file from a spec sheet; `aloft vehicles template`: a commented vehicle file to
+//! fill in.
 
 use std::io::Write;
 use std::path::PathBuf;
 
-use aloft::engine::{calibrate_spec_file, list_vehicles, SpecCalibration, VehicleEntry};
+use aloft::engine::{
+    calibrate_spec_file, list_vehicles, SpecCalibration, VehicleEntry, VEHICLE_TEMPLATE,
+};
 use anyhow::Result;
 use clap::{Args, Subcommand};
 
@@ -24,6 +27,9 @@ enum VehiclesAction {
     /// Make a vehicle file from a spec sheet: rotors, masses, battery and one published hover time
     /// (the efficiency is calibrated on it; see "A vehicle from its spec sheet" in docs/guide.md).
     Calibrate(CalibrateArgs),
+    /// Print a commented vehicle file for your own multirotor, which loads as it is: replace the
+    /// values marked CHANGE (every key, unit, range and default: docs/vehicle-file.md).
+    Template,
 }
 
 #[derive(Debug, Args)]
@@ -42,6 +48,10 @@ struct CalibrateArgs {
 pub fn run(args: VehiclesArgs) -> Result<Outcome> {
     match args.action {
         Some(VehiclesAction::Calibrate(c)) => calibrate(c),
+        Some(VehiclesAction::Template) => {
+            std::io::stdout().lock().write_all(VEHICLE_TEMPLATE.as_bytes())?;
+            Ok(Outcome::Ok)
+        }
         None => list(args.format),
     }
 }

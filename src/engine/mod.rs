@@ -162,7 +162,7 @@ pub use aloft_core::{error_line, one_line};
 pub use crate::error::{Error, SweepProblem};
 
 /// The vehicle every command uses when none is named.
-pub use crate::vehicle::{builtin_names, DEFAULT_VEHICLE};
+pub use crate::vehicle::{builtin_names, DEFAULT_VEHICLE, VEHICLE_TEMPLATE};
 pub use wind::{describe_wind_spec, read_wind_field};
 
 /// Model types that appear in requests and answers, re-exported so callers of the engine (the
