@@ -60,6 +60,12 @@ pub enum Error {
         /// The range, in words.
         expected: &'static str,
     },
+    /// No log of a fit could be used (`aloft fit` exits 1).
+    #[error("no log can be used for the fit: {reasons}")]
+    NoUsableLog {
+        /// Each log's reason, `; `-separated.
+        reasons: String,
+    },
     /// Work stopped because its caller no longer wants the answer (a client that went away).
     #[error("the work was cancelled: its answer is no longer wanted")]
     Cancelled,

@@ -29,7 +29,9 @@ fn accepted(text: &str, header: &str) -> BTreeSet<String> {
             lines.join("\n")
         }
     };
-    let e = Vehicle::from_toml(&changed, "probe").unwrap_err().to_string();
+    let e = Vehicle::from_toml(&changed, "probe")
+        .unwrap_err()
+        .to_string();
     // serde's words: "expected one of `a`, `b`, `c`", or "expected `a` or `b`" for two.
     let list = e
         .split("expected one of ")

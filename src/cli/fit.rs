@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 
 use aloft::engine::flags::FitFlags;
-use aloft::engine::{fit_logs, FitAnswer, FitRequest, Vehicle};
+use aloft::engine::{fit_logs, FitAnswer, FitQuality, FitRequest, Vehicle};
 
 use super::flights::file_name;
 use super::output::{self, Row};
@@ -48,7 +48,26 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    let answer = answer?;
+    let answer = match answer {
+        Ok(a) => a,
+        // No log can be used: the answer of a failed check (exit 1), saying why.
+        Err(aloft::Error::NoUsableLog { reasons }) => {
+            let mut out = std::io::stdout().lock();
+            match args.format {
+                Format::Json => writeln!(
+                    out,
+                    "{}",
+                    serde_json::json!({ "quality": null, "reason": reasons })
+                )?,
+                _ => writeln!(out, "NO FIT: no log can be used: {reasons}")?,
+            }
+            return Ok(Outcome::Failed);
+        }
+        Err(e) => return Err(e.into()),
+    };
+    for s in &answer.skipped_logs {
+        eprintln!("aloft fit: skipped {}: {}", file_name(&s.file), s.reason);
+    }
     for l in &answer.logs {
         eprintln!(
             "aloft fit: {}: power lags motion by {:.2} s{}",
@@ -69,6 +88,15 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
         |out| render(out, &answer),
     )?;
     Ok(Outcome::Ok)
+}
+
+/// The verdict as the table prints it.
+fn quality_word(q: FitQuality) -> &'static str {
+    match q {
+        FitQuality::Good => "good",
+        FitQuality::Usable => "usable",
+        FitQuality::Poor => "poor",
+    }
 }
 
 /// The fitted constants: name, value, standard error and unit.
@@ -149,5 +177,12 @@ fn render(out: &mut impl Write, r: &FitAnswer) -> Result<()> {
         "\nFitted vehicle -> {}: mass {} kg (template), efficiency {:.4}, rotor radius {:.4} m, kappa1 {:.4}, mu {:.4} {:.5} {:.6}",
         r.output, v.mass_kg, v.efficiency, v.rotor_radius_m, v.kappa1_w_per_n1_5, v.mu1_n_s_per_m, v.mu2_n_s2_per_m2, v.mu3_n_s3_per_m3
     )?;
+    writeln!(out, "\nQuality: {}", quality_word(r.quality))?;
+    for reason in &r.quality_reasons {
+        writeln!(out, "  {reason}")?;
+    }
+    for s in &r.skipped_logs {
+        writeln!(out, "Skipped {}: {}", file_name(&s.file), s.reason)?;
+    }
     Ok(())
 }

@@ -49,7 +49,9 @@ pub fn run(args: VehiclesArgs) -> Result<Outcome> {
     match args.action {
         Some(VehiclesAction::Calibrate(c)) => calibrate(c),
         Some(VehiclesAction::Template) => {
-            std::io::stdout().lock().write_all(VEHICLE_TEMPLATE.as_bytes())?;
+            std::io::stdout()
+                .lock()
+                .write_all(VEHICLE_TEMPLATE.as_bytes())?;
             Ok(Outcome::Ok)
         }
         None => list(args.format),

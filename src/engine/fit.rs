@@ -15,6 +15,7 @@ use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
 use super::finite::finite;
+use super::fit_quality::{judge_fit, Envelope, FitQuality};
 use super::logs::FlightLogs;
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -93,10 +94,25 @@ pub struct LogFitReport {
     pub pack: Option<PackResistanceFit>,
 }
 
+/// A log a fit could not use, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkippedLog {
+    /// The file.
+    pub file: String,
+    /// Why (the error that reading or aligning it gave).
+    pub reason: String,
+}
+
 /// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitAnswer {
-    /// Per log.
+    /// The verdict: `good`, `usable` or `poor` (see [`super::fit_quality`]).
+    pub quality: FitQuality,
+    /// Why, one reason a line.
+    pub quality_reasons: Vec<String>,
+    /// The logs left out, with their reasons.
+    pub skipped_logs: Vec<SkippedLog>,
+    /// Per log used.
     pub logs: Vec<LogFitReport>,
     /// The power-model fit.
     pub power: PowerFit,
@@ -134,12 +150,35 @@ pub struct FitAnswer {
 /// Gauss-Newton, fit each pack's resistance, and write the template with its `[power]` table
 /// replaced.
 ///
+/// A log that cannot be read or aligned is skipped with its reason ([`FitAnswer::skipped_logs`]);
+/// the answer says how good the fit is ([`FitAnswer::quality`]).
+///
 /// # Errors
-/// Unreadable logs, logs without power or motion, a template without `[power]`, a fit the data
+/// [`Error::NoUsableLog`] when no log can be used; a template without `[power]`, a fit the data
 /// cannot identify, an output that cannot be written.
 pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
     let mut vehicle = template.power_model()?.vehicle().clone();
-    let flights = request.logs.load()?;
+    // Each log on its own: one that cannot be used is skipped with its reason.
+    let mut flights = Vec::new();
+    let mut skipped_logs = Vec::new();
+    for (path, loaded) in request.logs.logs.iter().zip(request.logs.load_each()?) {
+        match loaded {
+            Ok(flight) => flights.push(flight),
+            Err(e) => skipped_logs.push(SkippedLog {
+                file: path.display().to_string(),
+                reason: e.to_string(),
+            }),
+        }
+    }
+    if flights.is_empty() {
+        return Err(Error::NoUsableLog {
+            reasons: skipped_logs
+                .iter()
+                .map(|s| s.reason.clone())
+                .collect::<Vec<_>>()
+                .join("; "),
+        });
+    }
     // The logs' own air: the constants are fitted in it and written for the template's density
     // (ISA sea level unless the template says otherwise), term by term as the model carries
     // density (`aloft_power::VehicleParams::in_air`).
@@ -209,6 +248,11 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             k.name, k.value, k.unit, k.reason
         )
     }));
+    let envelope = template.file().airframe.as_ref().map(|a| Envelope {
+        max_speed_mps: a.max_speed_mps,
+        max_climb_rate_mps: a.max_climb_rate_mps,
+    });
+    let (quality, quality_reasons) = judge_fit(power.nrmse, &logs, &samples, envelope);
     let vehicle_toml =
         fitted_vehicle_toml(template.file(), &power, drag.as_ref(), &logs, &vehicle)?;
     if let Some(path) = &request.output {
@@ -219,6 +263,9 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     }
     finite(
         FitAnswer {
+            quality,
+            quality_reasons,
+            skipped_logs,
             logs,
             power,
             drag,

@@ -637,38 +637,58 @@ impl FlightLogs {
 
     /// Read every log, align power with motion, and set the angle-of-attack model.
     pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
+        self.load_each()?.into_iter().collect()
+    }
+
+    /// [`Self::load`], each log on its own: a log that cannot be read or aligned is its error,
+    /// and the others are read all the same (a fit skips it). The error of the whole is only for
+    /// what every log shares (a profile that cannot be read).
+    pub(crate) fn load_each(&self) -> Result<Vec<LoadedLog>, Error> {
         let (profile, open) = self.open_options()?;
         let align = AlignOptions {
             max_lag_s: self.max_lag_s,
             lag_s: self.lag_s,
             ..AlignOptions::default()
         };
-        let mut out = Vec::new();
-        for path in &self.logs {
-            let mut reader = open_log_with(path, profile.as_ref(), &open)?;
-            let log = reader.read_rest(&path.display().to_string())?;
-            if let Some(reason) = reader.binary_summary().and_then(|b| b.no_power_reason()) {
-                return Err(LogError::NoBatteryData {
-                    source_name: path.display().to_string(),
-                    reason,
-                }
-                .into());
+        Ok(self
+            .logs
+            .iter()
+            .map(|path| self.load_one(path, profile.as_ref(), &open, &align))
+            .collect())
+    }
+
+    fn load_one(
+        &self,
+        path: &Path,
+        profile: Option<&Profile>,
+        open: &OpenOptions,
+        align: &AlignOptions,
+    ) -> LoadedLog {
+        let mut reader = open_log_with(path, profile, open)?;
+        let log = reader.read_rest(&path.display().to_string())?;
+        if let Some(reason) = reader.binary_summary().and_then(|b| b.no_power_reason()) {
+            return Err(LogError::NoBatteryData {
+                source_name: path.display().to_string(),
+                reason,
             }
-            let mut flight = align_flight(&log, &align)?;
-            flight.air_density_kg_m3 = reader
-                .binary_summary()
-                .and_then(|b| b.air_density_kg_m3)
-                .filter(|rho| rho.is_finite() && (0.3..=1.6).contains(rho));
-            if self.aoa == AoaModel::Paper {
-                for s in &mut flight.samples {
-                    s.state.aoa = aloft_power::AoaInput::Paper;
-                }
-            }
-            out.push((flight, log));
+            .into());
         }
-        Ok(out)
+        let mut flight = align_flight(&log, align)?;
+        flight.air_density_kg_m3 = reader
+            .binary_summary()
+            .and_then(|b| b.air_density_kg_m3)
+            .filter(|rho| rho.is_finite() && (0.3..=1.6).contains(rho));
+        if self.aoa == AoaModel::Paper {
+            for s in &mut flight.samples {
+                s.state.aoa = aloft_power::AoaInput::Paper;
+            }
+        }
+        Ok((flight, log))
     }
 }
+
+/// One log of [`FlightLogs::load_each`]: aligned with its samples, or why not.
+pub(crate) type LoadedLog = Result<(AlignedFlight, aloft_logs::Log), Error>;
 
 #[cfg(test)]
 mod tests {

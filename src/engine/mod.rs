@@ -56,6 +56,7 @@ mod estimator;
 mod files;
 mod finite;
 mod fit;
+mod fit_quality;
 pub mod flags;
 mod flight;
 mod flown;
@@ -99,7 +100,10 @@ pub use endurance::{
 };
 pub use estimator::InFlightEstimator;
 pub use files::{read_text_file, MAX_INPUT_BYTES};
-pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
+pub use fit::{
+    fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport, SkippedLog,
+};
+pub use fit_quality::FitQuality;
 pub use flown::PlanningSpeed;
 pub use fly_plan::{
     plan_to_fly, FlyPlan, FlyPlanRequest, FlySortie, PlanChanges, PlanFigures, SpeedChange,

@@ -1,0 +1,220 @@
+//! How good a fit is: a verdict (`good`, `usable`, `poor`) with its reasons, from what the fit
+//! and its logs show. The worst rule decides.
+//!
+//! | rule | good | usable | poor |
+//! |---|---|---|---|
+//! | NRMSE of the fitted model (normalised by the mean measured power) | at most 10 % | at most 20 % (the power seed's Table I, full model: 7-18 %) | above 20 % |
+//! | a log's alignment: correlation of power with tilt at the lag | 0.5 or more | 0.3 to 0.5 | below 0.3 |
+//! | a log's lag: power leading motion (a negative lag) | - | any lead beyond 0.5 s (suspect: a power that responds before the motion asks for it) | - |
+//! | samples used | 500 or more | 100 to 500 | fewer than 100 |
+//! | the speed covered: the 95th percentile of the fitted airspeeds against the vehicle's `max_speed_mps` | at least 70 % of it | below (the drag is extrapolated) | - |
+//! | the climb covered: the 95th percentile of the fitted climb rates against `max_climb_rate_mps` | at least 50 % of it | below | - |
+//!
+//! The thresholds are stated, not tuned: the NRMSE bands are the paper's own accuracy; the
+//! alignment bands are where a lag estimate from a correlation that weak is as likely wrong as
+//! right (the flugdrohne log aligned at -2.6 s with correlation 0.28, issue 35).
+
+use serde::Serialize;
+
+use aloft_power::FitSample;
+
+use super::fit::LogFitReport;
+
+/// The verdict of a fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitQuality {
+    /// Within the paper's accuracy, on well-aligned logs that cover the envelope.
+    Good,
+    /// Fit for planning with the reasons in mind.
+    Usable,
+    /// Not to be trusted: see the reasons.
+    Poor,
+}
+
+/// What the fit covered of the vehicle's envelope, where the vehicle has one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Envelope {
+    /// The vehicle's largest speed, m/s.
+    pub max_speed_mps: f64,
+    /// The vehicle's largest climb rate, m/s.
+    pub max_climb_rate_mps: f64,
+}
+
+/// The verdict and why, from the fit's NRMSE (a fraction), its logs and the samples it used.
+pub fn judge_fit(
+    nrmse: f64,
+    logs: &[LogFitReport],
+    samples: &[FitSample],
+    envelope: Option<Envelope>,
+) -> (FitQuality, Vec<String>) {
+    let mut verdict = FitQuality::Good;
+    let mut reasons = Vec::new();
+    let mut say = |q: FitQuality, reason: String| {
+        verdict = verdict.max(q);
+        reasons.push(reason);
+    };
+    let pct = 100.0 * nrmse;
+    let q = match pct {
+        p if p <= 10.0 => FitQuality::Good,
+        p if p <= 20.0 => FitQuality::Usable,
+        _ => FitQuality::Poor,
+    };
+    say(
+        q,
+        format!(
+            "NRMSE {pct:.1} % (good at most 10 %, usable at most 20 %, the power seed's 7-18 %)"
+        ),
+    );
+    for l in logs {
+        let name = l.file.rsplit('/').next().unwrap_or(&l.file);
+        if let Some(c) = l.lag_correlation {
+            if c < 0.3 {
+                say(
+                    FitQuality::Poor,
+                    format!("{name}: aligned at {:.2} s with correlation {c:.2} (below 0.3: the lag is a guess)", l.lag_s),
+                );
+            } else if c < 0.5 {
+                say(
+                    FitQuality::Usable,
+                    format!(
+                        "{name}: aligned at {:.2} s with correlation {c:.2} (below 0.5)",
+                        l.lag_s
+                    ),
+                );
+            }
+        }
+        if l.lag_s < -0.5 {
+            say(
+                FitQuality::Usable,
+                format!(
+                    "{name}: power leads motion by {:.2} s (suspect: check the log's clocks)",
+                    -l.lag_s
+                ),
+            );
+        }
+    }
+    let n = samples.len();
+    if n < 100 {
+        say(FitQuality::Poor, format!("{n} samples (fewer than 100)"));
+    } else if n < 500 {
+        say(FitQuality::Usable, format!("{n} samples (fewer than 500)"));
+    }
+    let p95 = |f: &dyn Fn(&FitSample) -> f64| {
+        let mut v: Vec<f64> = samples.iter().map(f).filter(|x| x.is_finite()).collect();
+        v.sort_by(f64::total_cmp);
+        v.get(((v.len() as f64 - 1.0) * 0.95).round().max(0.0) as usize)
+            .copied()
+    };
+    let speed = p95(&|s| s.state.airspeed_mps);
+    let climb = p95(&|s| s.state.climb_rate_mps.abs());
+    match (envelope, speed) {
+        (Some(e), Some(v)) if v < 0.7 * e.max_speed_mps => say(
+            FitQuality::Usable,
+            format!(
+                "drag fitted up to {v:.1} m/s (95 % of the samples), used up to {:.1} m/s (the vehicle's max_speed_mps)",
+                e.max_speed_mps
+            ),
+        ),
+        (None, Some(v)) => say(
+            FitQuality::Good,
+            format!("samples up to {v:.1} m/s airspeed (95 %)"),
+        ),
+        _ => {}
+    }
+    if let (Some(e), Some(c)) = (envelope, climb) {
+        if c < 0.5 * e.max_climb_rate_mps {
+            say(
+                FitQuality::Usable,
+                format!(
+                    "climb fitted up to {c:.1} m/s (95 %), flown up to {:.1} m/s (max_climb_rate_mps)",
+                    e.max_climb_rate_mps
+                ),
+            );
+        }
+    }
+    (verdict, reasons)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aloft_power::FlightState;
+
+    fn samples(n: usize, speed: f64, climb: f64) -> Vec<FitSample> {
+        (0..n)
+            .map(|k| FitSample {
+                state: FlightState::new(speed * k as f64 / n as f64, 0.0, 0.0, climb),
+                measured_power_w: 100.0,
+            })
+            .collect()
+    }
+
+    fn log(lag_s: f64, c: Option<f64>) -> LogFitReport {
+        LogFitReport {
+            file: "a/b.ulg".into(),
+            lag_s,
+            lag_correlation: c,
+            samples: 1000,
+            skipped: 0,
+            pack: None,
+        }
+    }
+
+    const ENVELOPE: Envelope = Envelope {
+        max_speed_mps: 12.0,
+        max_climb_rate_mps: 3.0,
+    };
+
+    /// A good fit, a misaligned log and a slow-only flight each get the verdict its rule says.
+    #[test]
+    fn verdicts_follow_their_rules() {
+        let good = judge_fit(
+            0.08,
+            &[log(0.2, Some(0.8))],
+            &samples(1000, 12.0, 2.0),
+            Some(ENVELOPE),
+        );
+        assert_eq!(good.0, FitQuality::Good, "{:?}", good.1);
+        let misaligned = judge_fit(
+            0.08,
+            &[log(-2.6, Some(0.28))],
+            &samples(1000, 12.0, 2.0),
+            Some(ENVELOPE),
+        );
+        assert_eq!(misaligned.0, FitQuality::Poor);
+        assert!(misaligned
+            .1
+            .iter()
+            .any(|r| r.contains("-2.60 s") && r.contains("0.28")));
+        assert!(misaligned.1.iter().any(|r| r.contains("leads motion")));
+        let slow = judge_fit(
+            0.08,
+            &[log(0.2, Some(0.8))],
+            &samples(1000, 5.0, 2.0),
+            Some(ENVELOPE),
+        );
+        assert_eq!(slow.0, FitQuality::Usable);
+        assert!(
+            slow.1
+                .iter()
+                .any(|r| r.contains("drag fitted up to 4.7 m/s") && r.contains("12.0 m/s")),
+            "{:?}",
+            slow.1
+        );
+        let rough = judge_fit(
+            0.338,
+            &[log(0.2, Some(0.8))],
+            &samples(1000, 12.0, 2.0),
+            Some(ENVELOPE),
+        );
+        assert_eq!(rough.0, FitQuality::Poor);
+        let few = judge_fit(
+            0.05,
+            &[log(0.2, None)],
+            &samples(50, 12.0, 2.0),
+            Some(ENVELOPE),
+        );
+        assert_eq!(few.0, FitQuality::Poor);
+    }
+}
