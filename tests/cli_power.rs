@@ -445,8 +445,16 @@ fn fit_and_validate_reject_bad_input() {
         args
     };
     let none = common::scratch("fitbad", "none.csv").display().to_string();
+    // A log that cannot be used is skipped with its reason (issue 35): with no other, the fit is
+    // a failed check (exit 1) that names the log's problem.
+    let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(fit("kaist_missing_cur.csv", "dji-m100", &[]))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(said.starts_with("NO FIT") && said.contains("cur"), "{said}");
     let cases: Vec<(Vec<String>, &str)> = vec![
-        (fit("kaist_missing_cur.csv", "dji-m100", &[]), "cur"),
         (fit("kaist_small.csv", "aec-quadrotor", &[]), "[power]"),
         (
             fit("kaist_small.csv", "dji-m100", &["--free", "k,drag"]),
