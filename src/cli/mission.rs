@@ -17,14 +17,19 @@ use super::output;
 use super::plot::Line;
 use super::{Format, Outcome};
 
-pub fn run(args: MissionArgs) -> Result<Outcome> {
+pub fn run(mut args: MissionArgs) -> Result<Outcome> {
     if args.replay.is_some() {
         return super::replay::run(&args);
     }
     if args.format == Format::Csv {
         bail!("aloft mission writes table or json; use --timeseries for a CSV of samples");
     }
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    args.flags.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     let mission = Mission::load(args.mission.as_deref())?;
     let plan = plan_mission_with(&vehicle, &mission, &args.flags.options(), &args.outputs())?;
     if let Some(sc) = args.scenarios.options(args.plot.is_some()) {
