@@ -152,7 +152,9 @@ pub use scenarios::{
     MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
-pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
+pub use summary::{
+    mission_summary, FailsafeTime, MissionSummary, PointOfNoReturnSummary, SegmentSummary,
+};
 pub use survey_angle::{AngleChange, ANGLE_STEP_DEG};
 pub use validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,

@@ -122,6 +122,18 @@ pub struct FlyingPack {
     pub failsafe: Option<Failsafe>,
 }
 
+impl FlyingPack {
+    /// `options` with the pack file's failsafes where the options give none (the options' own
+    /// thresholds, from the flags, come first).
+    pub fn with_failsafes(&self, mut options: super::MissionOptions) -> super::MissionOptions {
+        if let Some(f) = &self.failsafe {
+            options.low_voltage_v = options.low_voltage_v.or(f.low_voltage_v);
+            options.critical_voltage_v = options.critical_voltage_v.or(f.critical_voltage_v);
+        }
+        options
+    }
+}
+
 /// The vehicle and the pack a command flies: `battery` as given when it is a pack name (or
 /// none); when it names a pack file ([`is_pack_file`]), that pack added to the vehicle's packs
 /// (replacing one of the same name) and selected, with its failsafes.
