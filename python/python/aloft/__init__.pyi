@@ -52,6 +52,8 @@ class MissionKeywords(VehicleKeywords, WindKeywords, total=False):
     corners: Optional[Literal["pass", "stop"]]
     aoa: Optional[Aoa]
     no_ground_effect: bool
+    low_voltage_v: Optional[float]
+    critical_voltage_v: Optional[float]
 
 class ScenarioKeywords(MissionKeywords, total=False):
     """A mission with Monte-Carlo scenarios around it (`--samples` and the spreads)."""
