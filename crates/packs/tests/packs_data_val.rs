@@ -177,6 +177,7 @@ fn data_val_flugdrohne_step_resistance() {
         .collect();
     files.sort();
     assert_eq!(files.len(), 5);
+    let mut clocks = 0;
     for p in files {
         let l = read(&p, None);
         assert_eq!(l.format, "ulog");
@@ -194,7 +195,34 @@ fn data_val_flugdrohne_step_resistance() {
         // PX4 1.14 has no resistance estimate in battery_status (§2.3).
         assert_eq!(r.autopilot_internal_resistance_ohm, None);
         assert!(r.vehicle_id.is_some(), "sys_uuid is in every ULog's info");
+        // The wall clock from the GPS (`time_utc_usec`): on the day the file is named after
+        // (`log_20_2023-6-7-...`: 2023-06-07), within the day either side for the time zone.
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        // A flight without a GPS time (no fix) has none; the two flights of 2023-06-07 have it.
+        if let (Some(day_unix_s), Some(t)) = (day_of_name(&name), l.start_unix_s) {
+            assert!(
+                (t - day_unix_s).abs() < 2.0 * 86_400.0,
+                "{name}: {t} vs {day_unix_s}"
+            );
+            clocks += 1;
+        }
     }
+    assert!(clocks >= 2, "{clocks} flights with a GPS clock");
+}
+
+/// Midnight UTC of the date in a flugdrohne file name `log_N_YYYY-M-D-...`, s since 1970.
+fn day_of_name(name: &str) -> Option<f64> {
+    let date = name.split('_').nth(2)?;
+    let mut it = date.split('-').map(|x| x.parse::<i64>().ok());
+    let (y, m, d) = (it.next()??, it.next()??, it.next()??);
+    // Days from 1970-01-01 to y-m-d (civil calendar, Howard Hinnant's days_from_civil).
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let mp = (m + 9) % 12;
+    let doy = (153 * mp + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    Some((era * 146_097 + doe - 719_468) as f64 * 86_400.0)
 }
 
 /// §6.5: the ArduCopter 4.7 SITL log's `BAT.Res` is read as the pack's resistance.
