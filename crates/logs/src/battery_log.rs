@@ -444,6 +444,27 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// Hostile bytes after a valid start (a ULog with a battery, a DataFlash with BAT and
+        /// BCL) never panic and never give a non-finite record.
+        #[test]
+        fn hostile_bytes_never_panic(tail in proptest::collection::vec(proptest::num::u8::ANY, 0..600), cut in 0usize..400) {
+            let mut u = px4_log(Some(4));
+            u.truncate(u.len().saturating_sub(cut));
+            u.extend(&tail);
+            if let Ok(l) = read_ulog_battery(&u[..], &BinaryOptions::default()) {
+                for s in &l.samples {
+                    proptest::prop_assert!(s.voltage_v.is_finite() && s.time_s.is_finite());
+                    proptest::prop_assert!(s.autopilot_resistance_ohm.is_none_or(f64::is_finite));
+                    proptest::prop_assert!(s.cell_v.iter().all(|c| c.is_finite()));
+                }
+            }
+            let mut d = dataflash_fmt_of_fmt();
+            d.extend(&tail);
+            let _ = read_dataflash_battery(&d[..], &BinaryOptions::default());
+        }
+    }
+
     fn parm(name: &str, v: f32) -> Vec<u8> {
         let mut r = vec![0xA3, 0x95, 3];
         r.extend(5_000_000u64.to_le_bytes());
