@@ -12,6 +12,7 @@ mod mission;
 mod mission_args;
 mod mission_view;
 mod output;
+mod pack;
 mod payload_sweep;
 mod plan;
 mod plot;
@@ -58,6 +59,8 @@ enum Command {
     Fit(fit::FitArgs),
     /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
     Validate(validate::ValidateArgs),
+    /// Battery packs from their own logs: `aloft pack fit LOG... -o pack.toml`.
+    Pack(pack::PackArgs),
     /// Follow a flight as it flies: the energy of the rest, its spread, and what to do.
     Live(live::LiveArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
@@ -109,6 +112,7 @@ pub fn main() -> ExitCode {
         Command::Fit(args) => fit::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Live(args) => live::run(args),
+        Command::Pack(args) => pack::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
         Command::Plan(args) => plan::run(*args),

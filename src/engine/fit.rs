@@ -16,7 +16,7 @@ use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
 use super::finite::finite;
 use super::fit_quality::{judge_fit, Envelope, FitQuality};
-use super::logs::FlightLogs;
+use super::logs::{FlightLogs, SkippedLog};
 use super::vehicles::Vehicle;
 use crate::error::Error;
 use crate::identify::force_samples;
@@ -92,15 +92,6 @@ pub struct LogFitReport {
     /// Pack internal resistance from voltage and current, when logged.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pack: Option<PackResistanceFit>,
-}
-
-/// A log a fit could not use, and why.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SkippedLog {
-    /// The file.
-    pub file: String,
-    /// Why (the error that reading or aligning it gave).
-    pub reason: String,
 }
 
 /// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.

@@ -265,6 +265,14 @@ pub struct MissionFlags {
     /// The day's air.
     #[command(flatten)]
     pub air: AirFlags,
+    /// The autopilot's low-voltage failsafe, pack volts (ArduPilot BATT_LOW_VOLT): the answer
+    /// says when the predicted voltage under load first falls below it (default: the pack
+    /// file's [failsafe]).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub low_voltage_v: Option<f64>,
+    /// The autopilot's critical-voltage failsafe, pack volts (ArduPilot BATT_CRT_VOLT).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub critical_voltage_v: Option<f64>,
 }
 
 impl MissionFlags {
@@ -289,6 +297,8 @@ impl MissionFlags {
             rtl_altitude_m: self.rtl_altitude_m,
             corners: self.corners,
             air: self.air.input(),
+            low_voltage_v: self.low_voltage_v,
+            critical_voltage_v: self.critical_voltage_v,
         }
     }
 }

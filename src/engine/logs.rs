@@ -687,6 +687,15 @@ impl FlightLogs {
     }
 }
 
+/// A log a request left out (`aloft fit`, `aloft pack fit`), and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkippedLog {
+    /// The log.
+    pub file: String,
+    /// Why, in words (the error that reading or using it gave).
+    pub reason: String,
+}
+
 /// One log of [`FlightLogs::load_each`]: aligned with its samples, or why not.
 pub(crate) type LoadedLog = Result<(AlignedFlight, aloft_logs::Log), Error>;
 

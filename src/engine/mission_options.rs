@@ -53,6 +53,11 @@ pub struct MissionOptions {
     /// precedence (default: the mission's home altitude in ISA air, else the vehicle file's
     /// density).
     pub air: AirInput,
+    /// The autopilot's low-voltage failsafe, pack volts: the answer says when the predicted
+    /// terminal voltage under load first falls below it (default: the pack file's `[failsafe]`).
+    pub low_voltage_v: Option<f64>,
+    /// The autopilot's critical-voltage failsafe, pack volts (as `low_voltage_v`).
+    pub critical_voltage_v: Option<f64>,
 }
 
 impl Default for MissionOptions {
@@ -63,6 +68,8 @@ impl Default for MissionOptions {
             wind: None,
             wind_field: None,
             gusts: None,
+            low_voltage_v: None,
+            critical_voltage_v: None,
             reserve_percent: None,
             start_percent: 100.0,
             time_step_s: None,

@@ -60,6 +60,8 @@ class MissionKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     corners: Optional[Literal["pass", "stop"]]
     aoa: Optional[Aoa]
     no_ground_effect: bool
+    low_voltage_v: Optional[float]
+    critical_voltage_v: Optional[float]
 
 class ScenarioKeywords(MissionKeywords, total=False):
     """A mission with Monte-Carlo scenarios around it (`--samples` and the spreads)."""
