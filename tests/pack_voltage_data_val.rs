@@ -17,10 +17,13 @@ use std::path::PathBuf;
 use aloft_logs::{read_battery_log, BatteryLog, OpenOptions, Profile};
 use aloft_planner::{BatterySpec, Pack};
 
+/// A record: time s, voltage V, current A.
+type Record = (f64, f64, f64);
+
 /// The (time s, voltage V, current A) of a log's records with a current, each record once (the
 /// KAIST rows repeat the pack's 1 Hz values at 10 Hz).
-fn records(log: &BatteryLog) -> Vec<(f64, f64, f64)> {
-    let mut out: Vec<(f64, f64, f64)> = Vec::new();
+fn records(log: &BatteryLog) -> Vec<Record> {
+    let mut out: Vec<Record> = Vec::new();
     for s in &log.samples {
         let Some(i) = s.current_a else { continue };
         if out.last().is_some_and(|&(_, v, c)| {
@@ -67,7 +70,7 @@ fn pack(capacity_mah: f64, r_ohm: f64) -> Pack {
 /// The RMS (V) of the terminal voltage the pack predicts for the logged power, against the
 /// logged voltage: the state of charge starts where the first record's voltage plus `I R` sits on
 /// the open-circuit curve and is counted down by the current the pack gives for the logged power.
-fn rms_v(pack: &Pack, recs: &[(f64, f64, f64)]) -> f64 {
+fn rms_v(pack: &Pack, recs: &[Record]) -> f64 {
     let (_, v0, i0) = recs[0];
     let mut soc = pack.soc_at_ocv_v(v0 + i0 * pack.resistance_ohm());
     let mut sum = 0.0;
@@ -84,7 +87,7 @@ fn rms_v(pack: &Pack, recs: &[(f64, f64, f64)]) -> f64 {
 }
 
 /// The capacity (mA h, 250 mA h steps) whose predicted voltage fits `recs` best with `r_ohm`.
-fn best_capacity(recs: &[(f64, f64, f64)], r_ohm: f64) -> f64 {
+fn best_capacity(recs: &[Record], r_ohm: f64) -> f64 {
     (20..=200)
         .map(|k| f64::from(k) * 250.0)
         .min_by(|a, b| rms_v(&pack(*a, r_ohm), recs).total_cmp(&rms_v(&pack(*b, r_ohm), recs)))
@@ -107,7 +110,7 @@ fn data_val_kaist_voltage_under_load_on_held_out_flights() {
         n.ends_with(".csv") && !n.contains("testgpsfense")
     });
     assert_eq!(long.len(), 10);
-    let flights: Vec<(String, Vec<(f64, f64, f64)>, f64)> = long
+    let flights: Vec<(String, Vec<Record>, f64)> = long
         .iter()
         .map(|p| {
             let log = read_battery_log(p, Some(&profile), &OpenOptions::default()).unwrap();
