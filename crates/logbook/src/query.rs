@@ -6,7 +6,7 @@ use rusqlite::Row;
 use serde::Serialize;
 
 use crate::error::Result;
-use crate::ingest::Logbook;
+use crate::ingest::{Logbook, UNKNOWN};
 
 /// Flights a vehicle's power drift is measured over (the last this many).
 pub const DRIFT_FLIGHTS: usize = 30;
@@ -194,7 +194,8 @@ pub struct VehicleSummary {
     pub packs: Vec<String>,
     /// Power per flight, in flying order.
     pub power: Vec<PowerPoint>,
-    /// Drift of the power over the last flights (at least two with a power).
+    /// Drift of the power over the last flights (at least two with a power; none for the
+    /// vehicle "unknown", whose flights are of any vehicle).
     pub power_drift: Option<PowerDrift>,
 }
 
@@ -234,7 +235,7 @@ pub struct PackSummary {
     pub vehicles: Vec<String>,
     /// Resistance per flight, ohm.
     pub resistance: Vec<PackPoint>,
-    /// Its trend (slope in ohm per flight).
+    /// Its trend (slope in ohm per flight; none for the pack "unknown").
     pub resistance_trend: Option<Trend>,
     /// Capacity estimates, mAh.
     pub capacity: Vec<PackPoint>,
@@ -409,6 +410,8 @@ fn pack_summary(
     let resistance = points(|f| f.resistance_ohm);
     let values: Vec<f64> = resistance.iter().map(|p| p.value).collect();
     let discharged_mah: f64 = flights.iter().filter_map(|f| f.discharged_mah).sum();
+    // The flights of "unknown" are of any pack: no one pack's trend.
+    let resistance_trend = trend(&values).filter(|_| key != UNKNOWN);
     PackSummary {
         equivalent_cycles: rated_capacity_mah
             .filter(|r| *r > 0.0)
@@ -422,7 +425,7 @@ fn pack_summary(
         discharged_mah,
         energy_wh: flights.iter().map(|f| f.energy_wh).sum(),
         vehicles: distinct(flights.iter().map(|f| &f.vehicle_key)),
-        resistance_trend: trend(&values),
+        resistance_trend,
         resistance,
         capacity: points(|f| f.capacity_mah),
         imbalance_minor_min: sum_present(flights.iter().map(|f| f.imbalance_minor_min)),
