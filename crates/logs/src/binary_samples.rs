@@ -22,6 +22,10 @@ pub struct BinaryOptions {
     pub battery_instance: u8,
     /// Longest interval of a topic across which values are interpolated, s.
     pub max_bracket_s: f64,
+    /// Collect every battery record with its details (cells, resistance, counters), the
+    /// battery parameters and the identities, for [`crate::battery_log`] (off: the samples
+    /// only).
+    pub battery_details: bool,
 }
 
 impl Default for BinaryOptions {
@@ -31,6 +35,7 @@ impl Default for BinaryOptions {
         Self {
             battery_instance: 0,
             max_bracket_s: 1.0,
+            battery_details: false,
         }
     }
 }
@@ -109,6 +114,9 @@ pub struct BinarySummary {
     pub base_span_s: f64,
     /// What went wrong or was left out, with byte offsets.
     pub warnings: Vec<String>,
+    /// The battery records in detail, when [`BinaryOptions::battery_details`] is set.
+    #[serde(skip)]
+    pub(crate) battery_details: Option<crate::battery_log::BatteryDetails>,
     #[serde(skip)]
     pub(crate) rho_sum: f64,
     #[serde(skip)]
@@ -229,11 +237,15 @@ pub struct BinarySamples<R, D> {
 
 impl<R: Read, D: Decoder> BinarySamples<R, D> {
     pub(crate) fn with_decoder(reader: R, decoder: D, options: &BinaryOptions) -> Self {
+        let summary = BinarySummary {
+            battery_details: options.battery_details.then(Default::default),
+            ..BinarySummary::default()
+        };
         Self {
             window: ByteWindow::new(reader),
             decoder,
             joiner: Joiner::new(options.max_bracket_s),
-            summary: BinarySummary::default(),
+            summary,
             checker: TimeChecker::new(),
             first_s: None,
             base_first_s: None,

@@ -224,6 +224,7 @@ enum Role {
     Gps,
     Bat,
     Curr,
+    Bcl,
     Event,
     Arm,
     Parm,
@@ -240,6 +241,7 @@ fn role(name: &str) -> Role {
         "GPS" => Role::Gps,
         "BAT" => Role::Bat,
         "CURR" => Role::Curr,
+        "BCL" => Role::Bcl,
         "EV" => Role::Event,
         "ARM" => Role::Arm,
         "PARM" => Role::Parm,
@@ -472,7 +474,13 @@ impl DataflashDecoder {
                     s.battery_capacity_ah =
                         crate::binary_samples::capacity_ah(v).or(s.battery_capacity_ah);
                 }
+                if let Some(d) = &mut s.battery_details {
+                    if crate::battery_log::is_battery_parameter(&name) && v.is_finite() {
+                        d.parameters.insert(name, v);
+                    }
+                }
             }
+            Role::Bcl => self.cells(f, p, s),
             Role::Event | Role::Arm => return self.landed(r, f, p),
             Role::Att | Role::Pos | Role::Gps | Role::Bat | Role::Curr => {
                 let Some(time_s) = boot_time_s(f, p) else {
@@ -483,7 +491,10 @@ impl DataflashDecoder {
                 let (stream, sample) = match r {
                     Role::Att => (Stream::Base, self.attitude(f, p)?),
                     Role::Pos => (Stream::Position, self.position(f, p)?),
-                    Role::Gps => return self.gps(f, p, time_s),
+                    Role::Gps => {
+                        gps_clock(f, p, time_s, s);
+                        return self.gps(f, p, time_s);
+                    }
                     _ => (Stream::Battery, self.battery(r, f, p, time_s, s)?),
                 };
                 return Some(Event {
@@ -633,6 +644,21 @@ impl DataflashDecoder {
             s.battery.no_voltage += 1;
             return None;
         }
+        if let Some(d) = &mut s.battery_details {
+            let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
+            d.samples.push(crate::battery_log::BatterySample {
+                time_s: t,
+                voltage_v: v,
+                current_a: Some(i),
+                remaining: f.num(p, "RemPct").and_then(reported_soc),
+                remaining_mah: None,
+                consumed_mah: finite(f.num(p, "CurrTot")),
+                cell_v: Vec::new(),
+                // BAT.Res is the whole pack's, ohm; 0 before the first estimate.
+                autopilot_resistance_ohm: finite(f.num(p, "Res")).filter(|r| *r > 0.0),
+                temperature_c: finite(f.num(p, "Temp")).filter(|c| (-60.0..150.0).contains(c)),
+            });
+        }
         s.battery.push(t, v, i);
         Some(Sample {
             voltage_v: Some(v),
@@ -642,6 +668,31 @@ impl DataflashDecoder {
         })
     }
 
+    /// A `BCL` record of the chosen instance: its cells (mV, `V1..V12`) onto the last battery
+    /// record of the details.
+    fn cells(&self, f: &Format, p: &[u8], s: &mut BinarySummary) {
+        let Some(d) = &mut s.battery_details else {
+            return;
+        };
+        let inst = f
+            .num(p, "Instance")
+            .or_else(|| f.num(p, "Inst"))
+            .unwrap_or(0.0);
+        if (inst - f64::from(self.options.battery_instance)).abs() > 0.5 {
+            return;
+        }
+        let cells: Vec<f64> = (1..=12)
+            .filter_map(|k| f.num(p, &format!("V{k}")))
+            .map(|mv| mv * 1e-3)
+            .filter(|v| crate::battery_log::valid_cell(*v))
+            .collect();
+        if let Some(last) = d.samples.last_mut() {
+            if last.cell_v.is_empty() {
+                last.cell_v = cells;
+            }
+        }
+    }
+
     fn declare(&mut self, s: &mut BinarySummary) {
         let names =
             |n: &str| (0..=255u8).any(|t| self.framer.format(t).is_some_and(|f| f.name == n));
@@ -649,6 +700,29 @@ impl DataflashDecoder {
         self.has_pos = names("POS");
         s.battery_declared = self.has_bat || names("CURR");
         self.events_declared = names("EV") || names("ARM");
+    }
+}
+
+/// Seconds from the GPS epoch (1980-01-06) to the Unix epoch.
+const GPS_EPOCH_UNIX_S: f64 = 315_964_800.0;
+/// GPS time runs ahead of UTC by the leap seconds since 1980: 18 s since 2017-01-01 (none added
+/// since), which is the era of the logs that carry `GWk`.
+const GPS_LEAP_S: f64 = 18.0;
+
+/// The first GPS record with a fix and a week number gives the log's wall clock.
+fn gps_clock(f: &Format, p: &[u8], time_s: f64, s: &mut BinarySummary) {
+    let Some(d) = &mut s.battery_details else {
+        return;
+    };
+    if d.gps_clock.is_some() || f.num(p, "Status").is_none_or(|st| st < 3.0) {
+        return;
+    }
+    let (Some(wk), Some(ms)) = (f.num(p, "GWk"), f.num(p, "GMS")) else {
+        return;
+    };
+    if wk >= 1.0 && ms.is_finite() && wk.is_finite() {
+        let utc = GPS_EPOCH_UNIX_S + wk * 604_800.0 + ms * 1e-3 - GPS_LEAP_S;
+        d.gps_clock = Some((time_s, utc));
     }
 }
 

@@ -36,6 +36,7 @@
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
 
+pub mod battery_log;
 pub mod binary;
 mod binary_samples;
 pub mod bytes;
@@ -63,6 +64,9 @@ pub mod synth;
 pub mod telemetry;
 pub mod ulog;
 
+pub use battery_log::{
+    read_battery_log, read_dataflash_battery, read_ulog_battery, BatteryLog, BatterySample,
+};
 pub use binary::{
     read_dataflash, read_ulog, BinaryLog, BinaryOptions, BinarySamples, BinarySummary,
 };

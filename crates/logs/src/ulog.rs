@@ -222,6 +222,51 @@ struct Sub {
     timestamp: Option<Loc>,
     topic: Option<Topic>,
     locs: Vec<Option<Loc>>,
+    /// `battery_status` fields read for [`crate::battery_log`].
+    battery: Option<Box<BatteryLocs>>,
+    /// `time_utc_usec` of a GPS topic (`vehicle_gps_position`, `sensor_gps`).
+    utc: Option<Loc>,
+}
+
+/// Where the `battery_status` fields of [`crate::battery_log`] lie in a data record.
+#[derive(Debug, Clone, Default)]
+struct BatteryLocs {
+    voltage: Option<Loc>,
+    current: Option<Loc>,
+    remaining: Option<Loc>,
+    discharged_mah: Option<Loc>,
+    resistance_per_cell: Option<Loc>,
+    temperature: Option<Loc>,
+    cell_count: Option<Loc>,
+    cells: Vec<Loc>,
+    /// The serial number: `uint16` in older releases, `char[32]` in the versioned message.
+    serial: Option<(Loc, usize)>,
+    cycle_count: Option<Loc>,
+    state_of_health: Option<Loc>,
+}
+
+impl BatteryLocs {
+    fn new(named: &HashMap<String, Loc>, arrays: &HashMap<String, (Loc, usize)>) -> Self {
+        let g = |k: &str| named.get(k).copied();
+        Self {
+            voltage: g("voltage_v"),
+            current: g("current_a"),
+            remaining: g("remaining"),
+            discharged_mah: g("discharged_mah"),
+            resistance_per_cell: g("internal_resistance_estimate"),
+            temperature: g("temperature"),
+            cell_count: g("cell_count"),
+            cells: (0..16)
+                .map_while(|i| g(&format!("voltage_cell_v[{i}]")))
+                .collect(),
+            serial: arrays
+                .get("serial_number")
+                .copied()
+                .or_else(|| g("serial_number").map(|l| (l, 1))),
+            cycle_count: g("cycle_count"),
+            state_of_health: g("state_of_health"),
+        }
+    }
 }
 
 /// The state of the ULog decoder.
@@ -289,10 +334,14 @@ impl UlogDecoder {
         let full = size_of(&self.formats, name, 0)?;
         let mut at = 0usize;
         let mut named: HashMap<String, Loc> = HashMap::new();
+        let mut arrays: HashMap<String, (Loc, usize)> = HashMap::new();
         let mut trailing_pad = 0usize;
         for f in fields {
             let one = size_of(&self.formats, &f.type_name, 1)?;
             if let Some(prim) = Prim::parse(&f.type_name) {
+                if f.count > 1 {
+                    arrays.insert(f.name.clone(), (Loc { offset: at, prim }, f.count));
+                }
                 if f.count == 1 {
                     named.insert(f.name.clone(), Loc { offset: at, prim });
                 } else if f.count <= 16 {
@@ -321,6 +370,11 @@ impl UlogDecoder {
             timestamp: named.get("timestamp").copied(),
             topic,
             locs,
+            battery: (name == "battery_status" && self.options.battery_details)
+                .then(|| Box::new(BatteryLocs::new(&named, &arrays))),
+            utc: matches!(name, "vehicle_gps_position" | "sensor_gps")
+                .then(|| named.get("time_utc_usec").copied())
+                .flatten(),
         })
     }
 }
@@ -447,6 +501,7 @@ impl UlogDecoder {
                 self.formats.insert(name, fields);
             }
             b'P' => self.parameter(b, s)?,
+            b'I' if self.options.battery_details => info(b, s),
             b'A' => self.add_logged(b, s)?,
             b'R' => {
                 let id = le::u16(b, 0).ok_or("short remove record")?;
@@ -489,6 +544,11 @@ impl UlogDecoder {
             Some(("float", _)) => f32::from_le_bytes(value) as f64,
             _ => return Err(format!("parameter '{key}' of unknown type")),
         };
+        if let (Some(name), Some(d)) = (key.split_once(' ').map(|k| k.1), &mut s.battery_details) {
+            if crate::battery_log::is_battery_parameter(name) && v.is_finite() {
+                d.parameters.insert(name.to_string(), v);
+            }
+        }
         match key.split_once(' ').map(|k| k.1) {
             Some("BAT1_N_CELLS") if v >= 1.0 => s.battery_cells = Some(v as u32),
             Some("BAT_N_CELLS") if v >= 1.0 && s.battery_cells.is_none() => {
@@ -544,6 +604,9 @@ impl UlogDecoder {
                 payload.len(),
                 sub.full
             ));
+        }
+        if s.battery_details.is_some() {
+            battery_details(sub, payload, self.options.battery_instance, s);
         }
         // Instance 0 of every topic but the battery (whose instance is chosen).
         let Some(topic) = sub
@@ -760,6 +823,93 @@ impl Decoder for UlogDecoder {
             }
         }
     }
+}
+
+/// An information record (`I`): the vehicle's `sys_uuid` into the battery details.
+fn info(b: &[u8], s: &mut BinarySummary) {
+    let Some(kl) = b.first().map(|k| *k as usize) else {
+        return;
+    };
+    let (Some(key), Some(value)) = (b.get(1..1 + kl), b.get(1 + kl..)) else {
+        return;
+    };
+    let Ok(key) = std::str::from_utf8(key) else {
+        return;
+    };
+    if key.starts_with("char[") && key.ends_with(" sys_uuid") {
+        let text = crate::battery_log::text_id(value);
+        if let (Some(d), Some(t)) = (&mut s.battery_details, text) {
+            d.vehicle_id = Some(t);
+        }
+    }
+}
+
+/// A `battery_status` record of the chosen instance (and the GPS clock) into the details.
+fn battery_details(sub: &Sub, payload: &[u8], instance: u8, s: &mut BinarySummary) {
+    let Some(d) = &mut s.battery_details else {
+        return;
+    };
+    let read = |l: Option<Loc>| l.and_then(|l| l.prim.read(payload, l.offset));
+    let t = read(sub.timestamp).filter(|t| *t > 0.0).map(|t| t * 1e-6);
+    if let (Some(utc), Some(t), None) = (sub.utc, t, d.gps_clock) {
+        if let Some(us) = utc.prim.read(payload, utc.offset).filter(|u| *u > 1e15) {
+            d.gps_clock = Some((t, us * 1e-6));
+        }
+    }
+    let (Some(l), Some(t)) = (&sub.battery, t) else {
+        return;
+    };
+    if sub.multi_id != instance {
+        return;
+    }
+    let Some(volt) = read(l.voltage).filter(|v| v.is_finite() && *v > 0.0) else {
+        return;
+    };
+    let cells: Vec<f64> = l
+        .cells
+        .iter()
+        .filter_map(|c| c.prim.read(payload, c.offset))
+        .filter(|v| crate::battery_log::valid_cell(*v))
+        .collect();
+    if let Some(n) = read(l.cell_count).filter(|n| *n >= 1.0 && *n <= 64.0) {
+        d.cells_logged = Some(n as u32);
+    }
+    if let Some((loc, count)) = l.serial {
+        let id = if count > 1 {
+            payload
+                .get(loc.offset..loc.offset + count)
+                .and_then(crate::battery_log::text_id)
+        } else {
+            read(Some(loc))
+                .filter(|v| *v >= 1.0)
+                .map(|v| format!("{}", v as u64))
+        };
+        if id.is_some() {
+            d.pack_id = id;
+        }
+    }
+    if let Some(c) = read(l.cycle_count).filter(|c| *c >= 1.0) {
+        d.cycle_count = Some(c as u32);
+    }
+    if let Some(h) = read(l.state_of_health).filter(|h| *h > 0.0 && *h <= 100.0) {
+        d.state_of_health_percent = Some(h);
+    }
+    let r_cell = read(l.resistance_per_cell).filter(|r| r.is_finite() && *r > 0.0);
+    if let Some(r) = r_cell {
+        d.per_cell_resistance.push((d.samples.len(), r));
+    }
+    d.samples.push(crate::battery_log::BatterySample {
+        time_s: t,
+        voltage_v: volt,
+        current_a: read(l.current).filter(|i| i.is_finite() && *i >= 0.0),
+        remaining: read(l.remaining).filter(|r| r.is_finite() && (0.0..=1.0).contains(r)),
+        remaining_mah: None,
+        consumed_mah: read(l.discharged_mah).filter(|c| c.is_finite() && *c >= 0.0),
+        cell_v: cells,
+        // Per cell: made the pack's at the end, once the cell count is known.
+        autopilot_resistance_ohm: None,
+        temperature_c: read(l.temperature).filter(|c| c.is_finite() && (-60.0..150.0).contains(c)),
+    });
 }
 
 /// Whether `head` (the first bytes of a file) is a ULog.

@@ -1,0 +1,54 @@
+//! The errors of the pack analysis.
+
+/// Why an analysis, or one of its estimates, cannot be made. The capacity variants are the
+/// reasons a capacity is refused, in words.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PackError {
+    /// Fewer than two battery records.
+    #[error("{source_name}: {records} battery record(s): at least 2 are needed")]
+    TooFewRecords {
+        /// The log.
+        source_name: String,
+        /// Records it has.
+        records: usize,
+    },
+    /// No record measures the current.
+    #[error("no current is logged (voltage only): nothing to count or step on")]
+    NoCurrent,
+    /// The number of cells in series is unknown, so no rested voltage reads as a state of charge.
+    #[error("the number of cells in series is unknown: a rested voltage cannot be read on the per-cell OCV curve")]
+    CellsUnknown,
+    /// The log does not start with a rest.
+    #[error("no rest before the flight: the current is {current_a:.2} A at the first record, above the rest limit of {limit_a:.2} A, and never held below it for {hold_s:.0} s before the discharge")]
+    NoRestBefore {
+        /// The current at the first record, A.
+        current_a: f64,
+        /// The rest limit, A.
+        limit_a: f64,
+        /// How long a rest must hold, s.
+        hold_s: f64,
+    },
+    /// The log does not end with a rest.
+    #[error("no rest after the flight: the log ends {tail_s:.1} s after the last current above the rest limit of {limit_a:.2} A (a rest must hold {hold_s:.0} s)")]
+    NoRestAfter {
+        /// Time from the last loaded record to the end of the log, s.
+        tail_s: f64,
+        /// The rest limit, A.
+        limit_a: f64,
+        /// How long a rest must hold, s.
+        hold_s: f64,
+    },
+    /// The state of charge fell too little between the rests for a capacity.
+    #[error("the state of charge fell only {drop:.3} between the rests ({soc_before:.3} to {soc_after:.3}); at least {min_drop:.2} is needed for a capacity")]
+    SocDropTooSmall {
+        /// State of charge at the rest before, 0-1.
+        soc_before: f64,
+        /// State of charge at the rest after, 0-1.
+        soc_after: f64,
+        /// The drop, 0-1.
+        drop: f64,
+        /// The smallest drop used, 0-1.
+        min_drop: f64,
+    },
+}

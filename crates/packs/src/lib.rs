@@ -1,0 +1,255 @@
+//! # aloft-packs
+//!
+//! A battery pack's health from its own flight logs: the internal resistance from current
+//! steps ([`resistance_from_steps`]), the charge drawn and the capacity between two rested
+//! points ([`capacity_between_rests`]), equivalent full cycles, cell balance
+//! ([`cell_balance`]), and the autopilot's own figures beside them ([`analyse`] →
+//! [`PackReport`]). Input is an [`aloft_logs::BatteryLog`] (read by
+//! [`aloft_logs::read_battery_log`]); this crate does no I/O.
+//!
+//! Units: SI with the unit in the name, except charge in mA h (`_mah`, as packs are rated) and
+//! imbalance time in minutes (`_min`, as fleet tools report it). Currents are positive when
+//! discharging.
+
+#![deny(missing_docs)]
+#![deny(clippy::float_cmp)]
+
+pub mod balance;
+pub mod capacity;
+pub mod error;
+pub mod resistance;
+
+pub use balance::{cell_balance, CellBalance, MAJOR_SPREAD_V, MINOR_SPREAD_V};
+pub use capacity::{
+    capacity_between_rests, coulomb_count_mah, reported_drop_mah, rest_limit_a, CapacityEstimate,
+    REST_CURRENT_UNRATED_A, REST_C_RATE, REST_HOLD_S,
+};
+pub use error::PackError;
+pub use resistance::{resistance_from_steps, updates, ResistanceEstimate};
+
+use aloft_logs::BatteryLog;
+use serde::Serialize;
+
+/// What the caller knows about the pack that the log may not say.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PackOptions {
+    /// Rated capacity, mA h (overrides the log's parameter).
+    pub rated_capacity_mah: Option<f64>,
+    /// Cells in series (overrides the log's).
+    pub cells_series: Option<u32>,
+}
+
+/// Everything one log says about its pack. Keys carry their units.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PackReport {
+    /// The log.
+    pub source: String,
+    /// Its container (`ulog`, `dataflash`, `csv`, `mcap`).
+    pub format: String,
+    /// The vehicle's identity, when logged.
+    pub vehicle_id: Option<String>,
+    /// The pack's identity, when logged.
+    pub pack_id: Option<String>,
+    /// Wall-clock start, s since 1970 (UTC), when logged.
+    pub start_unix_s: Option<f64>,
+    /// Cells in series.
+    pub cells_series: Option<u32>,
+    /// Rated capacity, mA h.
+    pub rated_capacity_mah: Option<f64>,
+    /// Battery records.
+    pub records: usize,
+    /// First to last battery record, s.
+    pub duration_s: f64,
+    /// Energy drawn, ∫V·I dt, W h.
+    pub energy_wh: f64,
+    /// Lowest terminal voltage, V.
+    pub min_voltage_v: f64,
+    /// Highest terminal voltage, V.
+    pub max_voltage_v: f64,
+    /// Largest current, A.
+    pub max_current_a: Option<f64>,
+    /// Charge drawn, ∫I dt (the coulomb count), mA h.
+    pub discharged_mah: Option<f64>,
+    /// The drop of charge the pack or autopilot reported over the log, mA h.
+    pub reported_drop_mah: Option<f64>,
+    /// Where [`Self::reported_drop_mah`] comes from.
+    pub reported_drop_source: Option<String>,
+    /// Coulomb count / reported drop.
+    pub coulomb_to_reported_ratio: Option<f64>,
+    /// Discharged charge / rated charge.
+    pub equivalent_cycles: Option<f64>,
+    /// The pack's internal resistance from current steps (median), Ω.
+    pub internal_resistance_ohm: Option<f64>,
+    /// The resistance estimate in full.
+    pub resistance: Option<ResistanceEstimate>,
+    /// The autopilot's own resistance estimate of the whole pack (median of its log), Ω.
+    pub autopilot_internal_resistance_ohm: Option<f64>,
+    /// Capacity between two rests, mA h.
+    pub capacity_mah: Option<f64>,
+    /// The capacity estimate in full.
+    pub capacity: Option<CapacityEstimate>,
+    /// Why there is no capacity, in words.
+    pub capacity_refused: Option<String>,
+    /// Time with a cell spread above 0.01 V, min.
+    pub imbalance_minor_min: Option<f64>,
+    /// Time with a cell spread above 0.07 V, min.
+    pub imbalance_major_min: Option<f64>,
+    /// Cell balance in full.
+    pub cell_balance: Option<CellBalance>,
+    /// A smart pack's cycle count.
+    pub cycle_count: Option<u32>,
+    /// A smart pack's state of health, percent.
+    pub state_of_health_percent: Option<f64>,
+    /// ArduPilot's low-voltage failsafe, V.
+    pub low_voltage_failsafe_v: Option<f64>,
+    /// ArduPilot's critical-voltage failsafe, V.
+    pub critical_voltage_failsafe_v: Option<f64>,
+}
+
+/// [`analyse_with`] with what the log says.
+///
+/// # Errors
+/// [`PackError::TooFewRecords`] with fewer than two battery records.
+pub fn analyse(log: &BatteryLog) -> Result<PackReport, PackError> {
+    analyse_with(log, &PackOptions::default())
+}
+
+/// Everything `log` says about its pack; `options` fill in what it does not.
+///
+/// # Errors
+/// [`PackError::TooFewRecords`] with fewer than two battery records.
+pub fn analyse_with(log: &BatteryLog, options: &PackOptions) -> Result<PackReport, PackError> {
+    let s = &log.samples;
+    if s.len() < 2 {
+        return Err(PackError::TooFewRecords {
+            source_name: log.source.clone(),
+            records: s.len(),
+        });
+    }
+    let rated = options
+        .rated_capacity_mah
+        .or(log.rated_capacity_mah)
+        .filter(|c| c.is_finite() && *c > 0.0);
+    let cells = options.cells_series.or(log.cells_series);
+    let has_current = log.has_current();
+    let discharged = has_current.then(|| coulomb_count_mah(s));
+    let reported = reported_drop_mah(s, rated);
+    let resistance = resistance_from_steps(s);
+    let capacity = capacity_between_rests(s, cells, rated);
+    let balance = cell_balance(s);
+    let mut ap: Vec<f64> = s
+        .iter()
+        .filter_map(|x| x.autopilot_resistance_ohm)
+        .filter(|r| r.is_finite() && *r > 0.0)
+        .collect();
+    let ratio = match (discharged, reported) {
+        (Some(q), Some((r, _))) if r > 0.0 => Some(q / r),
+        _ => None,
+    };
+    let (cap_ok, cap_err) = match capacity {
+        Ok(c) => (Some(c), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
+    Ok(PackReport {
+        source: log.source.clone(),
+        format: log.format.clone(),
+        vehicle_id: log.vehicle_id.clone(),
+        pack_id: log.pack_id.clone(),
+        start_unix_s: log.start_unix_s.filter(|t| t.is_finite()),
+        cells_series: cells,
+        rated_capacity_mah: rated,
+        records: s.len(),
+        duration_s: log.duration_s(),
+        energy_wh: energy_wh(log),
+        min_voltage_v: s.iter().map(|x| x.voltage_v).fold(f64::INFINITY, f64::min),
+        max_voltage_v: s.iter().map(|x| x.voltage_v).fold(0.0, f64::max),
+        max_current_a: s.iter().filter_map(|x| x.current_a).reduce(f64::max),
+        discharged_mah: discharged,
+        reported_drop_mah: reported.map(|r| r.0),
+        reported_drop_source: reported.map(|r| r.1.to_string()),
+        coulomb_to_reported_ratio: ratio,
+        equivalent_cycles: discharged.zip(rated).map(|(q, c)| q / c),
+        internal_resistance_ohm: resistance.as_ref().map(|r| r.ohm),
+        resistance,
+        autopilot_internal_resistance_ohm: resistance::median(&mut ap),
+        capacity_mah: cap_ok.as_ref().map(|c| c.capacity_mah),
+        capacity: cap_ok,
+        capacity_refused: cap_err,
+        imbalance_minor_min: balance.as_ref().map(|b| b.imbalance_minor_min),
+        imbalance_major_min: balance.as_ref().map(|b| b.imbalance_major_min),
+        cell_balance: balance,
+        cycle_count: log.cycle_count,
+        state_of_health_percent: log.state_of_health_percent,
+        low_voltage_failsafe_v: log.low_voltage_failsafe_v,
+        critical_voltage_failsafe_v: log.critical_voltage_failsafe_v,
+    })
+}
+
+/// Energy drawn, ∫V·I dt (trapezoid; gaps over [`capacity::MAX_GAP_S`] not bridged), W h.
+pub fn energy_wh(log: &BatteryLog) -> f64 {
+    let mut e = 0.0;
+    let mut last: Option<(f64, f64)> = None;
+    for s in &log.samples {
+        let Some(i) = s.current_a else { continue };
+        let p = s.voltage_v * i;
+        if let Some((t0, p0)) = last {
+            let dt = s.time_s - t0;
+            if dt > 0.0 && dt <= capacity::MAX_GAP_S {
+                e += 0.5 * (p0 + p) * dt;
+            }
+        }
+        last = Some((s.time_s, p));
+    }
+    e / 3600.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aloft_logs::BatterySample;
+
+    fn log(samples: Vec<BatterySample>) -> BatteryLog {
+        BatteryLog {
+            source: "t".into(),
+            format: "csv".into(),
+            rated_capacity_mah: Some(1000.0),
+            samples,
+            ..BatteryLog::default()
+        }
+    }
+
+    /// 1 h at 0.5 A from a 1000 mA h pack: 500 mA h, half a cycle; 12 V: 6 W h.
+    #[test]
+    fn cycles_and_energy() {
+        let s = (0..=3600)
+            .map(|k| BatterySample {
+                time_s: k as f64,
+                voltage_v: 12.0,
+                current_a: Some(0.5),
+                ..BatterySample::default()
+            })
+            .collect();
+        let r = analyse(&log(s)).unwrap();
+        assert!((r.discharged_mah.unwrap() - 500.0).abs() < 1e-9);
+        assert!((r.equivalent_cycles.unwrap() - 0.5).abs() < 1e-12);
+        assert!((r.energy_wh - 6.0).abs() < 1e-9);
+        let j = serde_json::to_value(&r).unwrap();
+        for k in [
+            "internal_resistance_ohm",
+            "capacity_mah",
+            "autopilot_internal_resistance_ohm",
+            "discharged_mah",
+            "equivalent_cycles",
+            "imbalance_minor_min",
+            "imbalance_major_min",
+        ] {
+            assert!(j.get(k).is_some(), "{k} missing");
+        }
+    }
+
+    #[test]
+    fn one_record_is_an_error() {
+        let e = analyse(&log(vec![BatterySample::default()])).unwrap_err();
+        assert!(matches!(e, PackError::TooFewRecords { records: 1, .. }));
+    }
+}
