@@ -4,7 +4,8 @@
 
 use std::path::Path;
 
-use aloft_logs::{open_log_with, BinaryOptions, LogFormat, OpenOptions, Profile, Sample};
+use aloft_logs::{open_log_with, read_battery_log, BinaryOptions, OpenOptions, Profile, Sample};
+use aloft_packs::analyse;
 
 /// How a log is read: the CSV profile and the battery instance.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -18,7 +19,7 @@ pub struct ReadOptions {
 /// What one log says of its flight: the figures of a `flights` row before the keys are chosen.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FlightFacts {
-    /// The log's container: `csv`, `px4_csv`, `mcap`, `px4_ulog`, `ardupilot_dataflash`.
+    /// The log's container: `ulog`, `dataflash`, `csv`, `mcap`.
     pub format: String,
     /// The vehicle's identity in the log (PX4 `sys_uuid`, ArduPilot `BRD_SERIAL_NUM`).
     pub vehicle_id: Option<String>,
@@ -58,23 +59,24 @@ pub struct FlightFacts {
     pub imbalance_major_min: Option<f64>,
 }
 
-/// The snake_case name of a log format (as `aloft log info` writes it).
-pub(crate) fn format_name(f: LogFormat) -> &'static str {
-    match f {
-        LogFormat::Csv => "csv",
-        LogFormat::Px4Csv => "px4_csv",
-        LogFormat::Mcap => "mcap",
-        LogFormat::Px4Ulog => "px4_ulog",
-        LogFormat::ArduPilotDataflash => "ardupilot_dataflash",
-    }
-}
-
-/// Read the log at `path` into the figures of its flight.
+/// Read the log at `path` into the figures of its flight: the pack's figures from its battery
+/// records ([`aloft_logs::read_battery_log`], [`aloft_packs::analyse`]), the hover power from
+/// its samples joined onto the motion (absent when the log has no velocity).
 ///
 /// # Errors
 /// Why the log is not a flight of the logbook, in words (the `skipped` table's reason): it
-/// cannot be opened or decoded, or it has no battery data (voltage and current) to measure.
+/// cannot be opened or decoded, or it has fewer than two battery records.
 pub fn read_flight(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
+    read(path, options).map_err(|reason| {
+        // The reason is stored beside the file's name: without the path the readers lead with.
+        let prefix = format!("{}: ", path.display());
+        reason
+            .strip_prefix(&prefix)
+            .map_or_else(|| reason.clone(), str::to_string)
+    })
+}
+
+fn read(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
     let profile = options
         .profile
         .as_deref()
@@ -88,60 +90,38 @@ pub fn read_flight(path: &Path, options: &ReadOptions) -> Result<FlightFacts, St
         },
         ..OpenOptions::default()
     };
-    let mut reader = open_log_with(path, profile.as_ref(), &open).map_err(|e| e.to_string())?;
-    let log = reader
-        .read_rest(&path.display().to_string())
-        .map_err(|e| e.to_string())?;
-    let binary = reader.binary_summary();
-    if let Some(reason) = binary.and_then(|b| b.no_power_reason()) {
-        return Err(reason);
-    }
-    let mut facts = battery_figures(&log.samples).ok_or_else(|| {
-        "the log has no battery data: fewer than two samples with voltage and current".to_string()
-    })?;
-    facts.format = format_name(reader.format()).to_string();
-    if let Some(b) = binary {
-        // A binary log's energy is the trapezoid over its own battery records (not the samples
-        // joined onto the motion topic).
-        if let Some(e) = b.energy_wh() {
-            facts.energy_wh = e;
-        }
-        facts.cells_series = b.battery_cells;
-        facts.rated_capacity_mah = b.battery_capacity_ah.map(|c| c * 1000.0);
-    }
-    facts.mean_power_w =
-        (facts.duration_s > 0.0).then(|| facts.energy_wh * 3600.0 / facts.duration_s);
-    facts.hover_power_w = hover_power_w(&log.samples);
-    Ok(facts)
+    let battery = read_battery_log(path, profile.as_ref(), &open).map_err(|e| e.to_string())?;
+    let r = analyse(&battery).map_err(|e| e.to_string())?;
+    Ok(FlightFacts {
+        format: r.format,
+        vehicle_id: r.vehicle_id,
+        pack_id: r.pack_id,
+        rated_capacity_mah: r.rated_capacity_mah,
+        cells_series: r.cells_series,
+        start_unix_s: r.start_unix_s,
+        duration_s: r.duration_s,
+        energy_wh: r.energy_wh,
+        discharged_mah: r.discharged_mah,
+        max_current_a: r.max_current_a,
+        min_voltage_v: Some(r.min_voltage_v).filter(|v| v.is_finite()),
+        mean_power_w: (r.duration_s > 0.0 && r.discharged_mah.is_some())
+            .then(|| r.energy_wh * 3600.0 / r.duration_s),
+        hover_power_w: hover_of(path, profile.as_ref(), &open),
+        resistance_ohm: r.internal_resistance_ohm,
+        autopilot_resistance_ohm: r.autopilot_internal_resistance_ohm,
+        capacity_mah: r.capacity_mah,
+        capacity_refusal: r.capacity_refused,
+        imbalance_minor_min: r.imbalance_minor_min,
+        imbalance_major_min: r.imbalance_major_min,
+    })
 }
 
-/// Duration, energy, charge and extremes over the samples that carry voltage and current
-/// (trapezoids between consecutive such samples; a step back in time adds nothing).
-fn battery_figures(samples: &[Sample]) -> Option<FlightFacts> {
-    let vi: Vec<(f64, f64, f64)> = samples
-        .iter()
-        .filter_map(|s| Some((s.time_s, s.voltage_v?, s.current_a?)))
-        .filter(|(t, v, i)| t.is_finite() && v.is_finite() && i.is_finite())
-        .collect();
-    if vi.len() < 2 {
-        return None;
-    }
-    let (mut energy_j, mut charge_c) = (0.0, 0.0);
-    for w in vi.windows(2) {
-        let dt = (w[1].0 - w[0].0).max(0.0);
-        energy_j += 0.5 * (w[0].1 * w[0].2 + w[1].1 * w[1].2) * dt;
-        charge_c += 0.5 * (w[0].2 + w[1].2) * dt;
-    }
-    let first = vi.first().map_or(0.0, |s| s.0);
-    let last = vi.last().map_or(0.0, |s| s.0);
-    Some(FlightFacts {
-        duration_s: (last - first).max(0.0),
-        energy_wh: energy_j / 3600.0,
-        discharged_mah: Some(charge_c / 3.6),
-        max_current_a: vi.iter().map(|s| s.2).reduce(f64::max),
-        min_voltage_v: vi.iter().map(|s| s.1).reduce(f64::min),
-        ..FlightFacts::default()
-    })
+/// The hover power of the log's samples (`None` when they cannot be read: the battery figures
+/// stand without it).
+fn hover_of(path: &Path, profile: Option<&Profile>, open: &OpenOptions) -> Option<f64> {
+    let mut reader = open_log_with(path, profile, open).ok()?;
+    let log = reader.read_rest(&path.display().to_string()).ok()?;
+    hover_power_w(&log.samples)
 }
 
 /// Horizontal ground speed below which a sample is hovering, m/s.
@@ -203,27 +183,17 @@ mod tests {
         }
     }
 
-    /// 100 s at 20 V and 10 A: 200 W, 5.555... Wh, 277.7... mAh; the hover power is that of
-    /// the still samples only.
+    /// 100 s at 20 V and 10 A, still for the first 50: the hover power is 200 W; with fewer
+    /// than ten still seconds there is none.
     #[test]
-    fn figures_of_a_constant_draw() {
+    fn hover_power_of_the_still_samples() {
         let s: Vec<Sample> = (0..=100)
             .map(|k| sample(f64::from(k), 20.0, 10.0, if k < 50 { 0.2 } else { 5.0 }))
             .collect();
-        let f = battery_figures(&s).unwrap();
-        assert!((f.duration_s - 100.0).abs() < 1e-9);
-        assert!((f.energy_wh - 2000.0 / 3.6 / 100.0).abs() < 1e-9);
-        assert!((f.discharged_mah.unwrap() - 1000.0 / 3.6).abs() < 1e-9);
         assert!((hover_power_w(&s).unwrap() - 200.0).abs() < 1e-9);
-        // Fewer than ten still seconds: no hover power.
         let fast: Vec<Sample> = (0..=100)
             .map(|k| sample(f64::from(k), 20.0, 10.0, if k < 5 { 0.2 } else { 5.0 }))
             .collect();
         assert_eq!(hover_power_w(&fast), None);
-    }
-
-    #[test]
-    fn one_sample_is_no_flight() {
-        assert!(battery_figures(&[sample(0.0, 20.0, 1.0, 0.0)]).is_none());
     }
 }
