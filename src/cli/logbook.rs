@@ -165,14 +165,22 @@ fn list<T: Serialize>(
 ) -> Result<Outcome> {
     let mut out = std::io::stdout().lock();
     match format {
-        BookFormat::Json => {
-            let mut map = serde_json::Map::new();
-            map.insert(key.to_string(), serde_json::to_value(items)?);
-            output::write_json(&mut out, &map)?;
-        }
+        BookFormat::Json => output::write_json(&mut out, &Keyed(key, items))?,
         BookFormat::Table => table(&mut out)?,
     }
     Ok(Outcome::Ok)
+}
+
+/// `{"<key>": [...]}`, each item's fields in their declared order.
+struct Keyed<'a, T>(&'a str, &'a [T]);
+
+impl<T: Serialize> Serialize for Keyed<'_, T> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(1))?;
+        map.serialize_entry(self.0, self.1)?;
+        map.end()
+    }
 }
 
 /// One file's outcome, as `add --format json` lists it.
@@ -409,7 +417,12 @@ fn packs_table(out: &mut impl Write, packs: &[PackSummary]) -> Result<()> {
                     opt(t.slope_per_flight.map(|s| s * 1000.0), 2),
                     t.n
                 ),
-                None => "n/a: no estimate".into(),
+                None if p.resistance.is_empty() => "n/a: no estimate".into(),
+                None => format!(
+                    "{} estimates, no trend (the flights of \"{}\" are of any pack)",
+                    p.resistance.len(),
+                    aloft_logbook::UNKNOWN
+                ),
             },
             "",
         ));
