@@ -349,3 +349,54 @@ print(json.dumps(out))
     let secs = v["flights"][1].as_f64().unwrap();
     assert!((secs - 1319.7).abs() < 0.5, "{secs}");
 }
+
+/// `aloft serve --logbook FILE`: `/api/logbook/KIND` is `aloft logbook KIND --format json`; an
+/// unknown list and a server without a logbook are 404; a missing file stops the server at its
+/// start (exit 2 naming it).
+#[cfg(feature = "serve")]
+#[test]
+fn logbook_served_as_the_command_line_answers() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let f = kaist();
+    let (code, _, err) = run(&[
+        "logbook",
+        "add",
+        "--db",
+        s(&db),
+        s(&f[0]),
+        s(&f[10]),
+        "--vehicle-label",
+        "kaist-m600",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let server = common::serve::Server::start(&["--logbook", s(&db)]);
+    for kind in ["flights", "vehicles", "packs", "skipped"] {
+        let (status, body) = server.get(&format!("/api/logbook/{kind}"));
+        assert_eq!(status, 200, "{body}");
+        let served: Value = serde_json::from_str(&body).unwrap();
+        assert_eq!(
+            served,
+            json(&["logbook", kind, "--db", s(&db), "--format", "json"]),
+            "{kind}"
+        );
+    }
+    assert_eq!(server.get("/api/logbook/etc").0, 404);
+    let (_, config) = server.get("/api/config");
+    assert!(config.contains("\"logbook\":true"), "{config}");
+    drop(server);
+    let plain = common::serve::Server::start(&[]);
+    let (status, body) = plain.get("/api/logbook/vehicles");
+    assert_eq!(status, 404, "{body}");
+    assert!(body.contains("--logbook"), "{body}");
+    drop(plain);
+    let (code, _, err) = run(&[
+        "serve",
+        "--logbook",
+        s(&tmp.path().join("none.sqlite")),
+        "--listen",
+        "127.0.0.1:0",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("none.sqlite"), "{err}");
+}

@@ -171,6 +171,27 @@ fn list<T: Serialize>(
     Ok(Outcome::Ok)
 }
 
+/// The JSON answer of `aloft logbook KIND --format json` (KIND: `flights`, `vehicles`, `packs`,
+/// `skipped`) from the logbook at `db`, or the command line's message (the page's
+/// `/api/logbook/KIND`).
+#[cfg(feature = "serve")]
+pub(crate) fn answer_json(db: &Path, kind: &str) -> Result<String, String> {
+    let text = |e: &dyn std::fmt::Display| e.to_string();
+    let book = Logbook::open(db).map_err(|e| text(&e))?;
+    let json = match kind {
+        "flights" => serde_json::to_string(&Keyed(kind, &book.flights().map_err(|e| text(&e))?)),
+        "vehicles" => serde_json::to_string(&Keyed(kind, &book.vehicles().map_err(|e| text(&e))?)),
+        "packs" => serde_json::to_string(&Keyed(kind, &book.packs().map_err(|e| text(&e))?)),
+        "skipped" => serde_json::to_string(&Keyed(kind, &book.skipped().map_err(|e| text(&e))?)),
+        _ => {
+            return Err(format!(
+                "{kind}: not a list of the logbook (flights, vehicles, packs, skipped)"
+            ))
+        }
+    };
+    json.map_err(|e| text(&e))
+}
+
 /// `{"<key>": [...]}`, each item's fields in their declared order.
 struct Keyed<'a, T>(&'a str, &'a [T]);
 

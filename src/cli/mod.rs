@@ -9,7 +9,7 @@ mod flights;
 mod live;
 mod log;
 #[cfg(feature = "logbook")]
-mod logbook;
+pub(crate) mod logbook;
 mod mission;
 mod mission_args;
 mod mission_view;

@@ -245,6 +245,9 @@ pub struct PackSummary {
     pub imbalance_major_min: Option<f64>,
 }
 
+/// A row of `packs`: key, key source, rated capacity (mAh), cells in series.
+type PackRow = (String, String, Option<f64>, Option<u32>);
+
 /// Sum of the values present (`None` when none is).
 fn sum_present(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
     values
@@ -332,7 +335,7 @@ impl Logbook {
     /// # Errors
     /// The database cannot be read.
     pub fn packs(&self) -> Result<Vec<PackSummary>> {
-        let run = || -> rusqlite::Result<Vec<(String, String, Option<f64>, Option<u32>)>> {
+        let run = || -> rusqlite::Result<Vec<PackRow>> {
             let mut st = self.conn.prepare(
                 "SELECT key, key_source, rated_capacity_mah, cells_series FROM packs ORDER BY key",
             )?;
