@@ -132,6 +132,24 @@ pub enum Error {
         /// The CSV parser's message.
         message: String,
     },
+    /// A pack file (`--battery pack.toml`, the output of `aloft pack fit`) that does not read or
+    /// whose `[battery]` is not a pack the planner flies.
+    #[error("invalid pack file {path}: {message}")]
+    PackFile {
+        /// The file.
+        path: String,
+        /// What is wrong (the key, its value and its range).
+        message: String,
+    },
+    /// A key of the pack `aloft pack fit` writes that neither the logs, a flag nor `--battery`
+    /// gives.
+    #[error("aloft pack fit: {key} is unknown: {hint}")]
+    PackKeyMissing {
+        /// The `[battery]` key.
+        key: &'static str,
+        /// Where it can come from.
+        hint: &'static str,
+    },
     /// Reading or writing failed.
     #[error("{origin}: {source}")]
     Io {

@@ -32,8 +32,13 @@ pub struct EnduranceArgs {
     format: Format,
 }
 
-pub fn run(args: EnduranceArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+pub fn run(mut args: EnduranceArgs) -> Result<Outcome> {
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    args.flags.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     let options = args.flags.options();
     if let Some(sweep) = &args.flags.payload_sweep {
         return run_payload_sweep(&args, &vehicle, &options, sweep);

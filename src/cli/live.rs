@@ -38,8 +38,13 @@ pub struct LiveArgs {
     mcap: Option<std::path::PathBuf>,
 }
 
-pub fn run(args: LiveArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+pub fn run(mut args: LiveArgs) -> Result<Outcome> {
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    args.flags.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     let task = args.flags.request()?;
     let stdout = std::io::stdout();
     let panel = args.format == LiveFormat::Table

@@ -10,28 +10,34 @@ use aloft::engine::{plan_mission_with, Mission, MissionReport, Plan, Sample, Veh
 
 use super::mission_args::MissionArgs;
 use super::mission_view::{
-    header, plan_warnings, plot_over_track, segment_cells, summary_rows, write_model_line,
+    header, mmss, plan_warnings, plot_over_track, segment_cells, summary_rows, write_model_line,
     write_segments_head, write_sorties, Area,
 };
 use super::output;
 use super::plot::Line;
 use super::{Format, Outcome};
 
-pub fn run(args: MissionArgs) -> Result<Outcome> {
+pub fn run(mut args: MissionArgs) -> Result<Outcome> {
     if args.replay.is_some() {
         return super::replay::run(&args);
     }
     if args.format == Format::Csv {
         bail!("aloft mission writes table or json; use --timeseries for a CSV of samples");
     }
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    args.flags.battery = flying.battery.clone();
+    let options = flying.with_failsafes(args.flags.options());
+    let vehicle = flying.vehicle;
     let mission = Mission::load(args.mission.as_deref())?;
-    let plan = plan_mission_with(&vehicle, &mission, &args.flags.options(), &args.outputs())?;
+    let plan = plan_mission_with(&vehicle, &mission, &options, &args.outputs())?;
     if let Some(sc) = args.scenarios.options(args.plot.is_some()) {
         let run = super::scenarios::MissionRun {
             vehicle: &vehicle,
             mission: &mission,
-            options: &args.flags.options(),
+            options: &options,
             plan: &plan,
             plot: args.plot.as_deref(),
             format: args.format,
@@ -55,12 +61,42 @@ pub fn run(args: MissionArgs) -> Result<Outcome> {
     })
 }
 
+/// When each voltage failsafe would trigger, one sentence each: "the low-voltage failsafe
+/// (21.0 V) would trigger at 17:40, in segment 12".
+fn failsafe_lines(s: &aloft::engine::MissionSummary) -> Vec<String> {
+    s.failsafes
+        .iter()
+        .map(|f| {
+            let name = format!("the {}-voltage failsafe ({:.1} V)", f.kind, f.voltage_v);
+            match (f.time_s, f.segment) {
+                (Some(t), Some(seg)) => {
+                    let item = f.item.map(|i| format!(" (item {i})")).unwrap_or_default();
+                    format!(
+                        "{name} would trigger at {}, in segment {seg}{item}",
+                        mmss(t)
+                    )
+                }
+                _ => format!(
+                    "{name} would not trigger: the lowest predicted voltage is {:.2} V",
+                    s.min_voltage_v
+                ),
+            }
+        })
+        .collect()
+}
+
 /// The mission as a reader sees it: header, verdict, summary, segments, the model used.
 fn write_table(out: &mut impl Write, plan: &Plan) -> Result<()> {
     out.write_all(header(plan)?.as_bytes())?;
     writeln!(out)?;
     output::write_table(out, "Summary", &summary_rows(plan.report()))?;
     writeln!(out)?;
+    for line in failsafe_lines(plan.summary()) {
+        writeln!(out, "{line}")?;
+    }
+    if !plan.summary().failsafes.is_empty() {
+        writeln!(out)?;
+    }
     write_segments(out, plan.report())?;
     writeln!(out)?;
     write_sorties(out, plan.summary())?;

@@ -14,6 +14,7 @@ mod mission;
 mod mission_args;
 mod mission_view;
 mod output;
+mod pack;
 mod payload_sweep;
 mod plan;
 mod plot;
@@ -60,6 +61,8 @@ enum Command {
     Fit(fit::FitArgs),
     /// Validate a vehicle's power model against flight logs (NRMSE per airspeed band, energy error).
     Validate(validate::ValidateArgs),
+    /// Battery packs from their own logs: `aloft pack fit LOG... -o pack.toml`.
+    Pack(pack::PackArgs),
     /// Follow a flight as it flies: the energy of the rest, its spread, and what to do.
     Live(live::LiveArgs),
     /// The operator's logbook: flights, vehicles and packs from their own logs, in one SQLite
@@ -117,6 +120,7 @@ pub fn main() -> ExitCode {
         Command::Live(args) => live::run(args),
         #[cfg(feature = "logbook")]
         Command::Logbook(args) => logbook::run(args),
+        Command::Pack(args) => pack::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
         Command::Plan(args) => plan::run(*args),

@@ -33,11 +33,16 @@ pub struct PlanArgs {
     pub format: Format,
 }
 
-pub fn run(args: PlanArgs) -> Result<Outcome> {
+pub fn run(mut args: PlanArgs) -> Result<Outcome> {
     if args.format == Format::Csv {
         bail!("aloft plan writes table or json");
     }
-    let vehicle = Vehicle::load(&args.flags.mission.vehicle)?;
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.mission.vehicle)?,
+        args.flags.mission.battery.as_deref(),
+    )?;
+    args.flags.mission.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     let mission = Mission::load(args.mission.as_deref())?;
     let request = args.flags.request()?;
     let mut plan = match plan_to_fly(&vehicle, &mission, &request) {

@@ -67,8 +67,13 @@ impl PowerArgs {
     }
 }
 
-pub fn run(args: PowerArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.model.vehicle)?;
+pub fn run(mut args: PowerArgs) -> Result<Outcome> {
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.model.vehicle)?,
+        args.model.battery.as_deref(),
+    )?;
+    args.model.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     if let Some(path) = &args.input {
         if matches!(args.format, Some(Format::Json | Format::Table)) {
             bail!("batch mode (--input) writes CSV only; drop --format or use --format csv");

@@ -18,7 +18,11 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
     if args.flags.wind_field.is_some() || args.flags.gust_std.is_some() {
         bail!("--replay takes a steady wind (--wind-speed, --wind-from) for logs without one; a field or gusts belong to a planned mission");
     }
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    let vehicle = flying.vehicle;
     let request = ReplayRequest {
         log: log.clone(),
         profile: args.profile.clone(),
@@ -32,7 +36,7 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
         },
         aoa: args.flags.aoa,
         wind: args.flags.wind.spec(),
-        battery: args.flags.battery.clone(),
+        battery: flying.battery,
     };
     let answer = replay_log(&vehicle, &request)?;
     for n in &answer.context.notes {

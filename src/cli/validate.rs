@@ -27,8 +27,13 @@ pub struct ValidateArgs {
     format: Format,
 }
 
-pub fn run(args: ValidateArgs) -> Result<Outcome> {
-    let vehicle = Vehicle::load(&args.flags.vehicle)?;
+pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
+    let flying = aloft::engine::fly_with_battery(
+        Vehicle::load(&args.flags.vehicle)?,
+        args.flags.battery.as_deref(),
+    )?;
+    args.flags.battery = flying.battery.clone();
+    let vehicle = flying.vehicle;
     let request = args.flags.request(args.plot.is_some());
     let answer = validate_logs(&vehicle, &request)?;
     for f in &answer.report.flights {

@@ -228,6 +228,14 @@ pub struct MissionFlags {
     /// Leave out ground effect (survey eq 35) near the ground.
     #[arg(long)]
     pub no_ground_effect: bool,
+    /// The autopilot's low-voltage failsafe, pack volts (ArduPilot BATT_LOW_VOLT): the answer
+    /// says when the predicted voltage under load first falls below it (default: the pack
+    /// file's [failsafe]).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub low_voltage_v: Option<f64>,
+    /// The autopilot's critical-voltage failsafe, pack volts (ArduPilot BATT_CRT_VOLT).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub critical_voltage_v: Option<f64>,
 }
 
 impl MissionFlags {
@@ -251,6 +259,8 @@ impl MissionFlags {
             speed_mps: self.speed,
             rtl_altitude_m: self.rtl_altitude_m,
             corners: self.corners,
+            low_voltage_v: self.low_voltage_v,
+            critical_voltage_v: self.critical_voltage_v,
         }
     }
 }

@@ -15,7 +15,7 @@ use super::mission_file::Mission;
 use super::mission_options::MissionOptions;
 use super::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use super::sorties::{split, Sorties};
-use super::summary::{edge_warnings, mission_summary, MissionSummary};
+use super::summary::{edge_warnings, mission_summary, FailsafeTime, MissionSummary};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
 use crate::error::Error;
@@ -268,7 +268,10 @@ fn plan_in(
         loiter,
         way_home_note,
     } = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
-    let (report, plot_samples) = fly_into_outputs(&flight, &compiled, outputs, in_mission)?;
+    let watched = failsafe_thresholds(options)?;
+    let thresholds: Vec<f64> = watched.iter().map(|w| w.1).collect();
+    let (report, plot_samples, crossings) =
+        fly_into_outputs(&flight, &compiled, (outputs, &thresholds), in_mission)?;
     // A vehicle that cannot make progress somewhere cannot fly that part on any pack.
     let stuck = matches!(report.shortfall, Some(Shortfall::NoProgress(_)));
     let sorties = if report.feasible || compiled.ends_in_air() || stuck {
@@ -291,6 +294,17 @@ fn plan_in(
     summary.loiter = loiter;
     summary.batteries_required = sorties.batteries_required;
     summary.sorties = sorties.sorties;
+    summary.failsafes = watched
+        .iter()
+        .zip(crossings)
+        .map(|((kind, voltage_v), at)| FailsafeTime {
+            kind: kind.to_string(),
+            voltage_v: *voltage_v,
+            time_s: at.map(|a| a.0),
+            segment: at.map(|a| a.1),
+            item: at.and_then(|a| summary.segments.get(a.1.wrapping_sub(1))?.item),
+        })
+        .collect();
     summary.warnings = compiled.warnings().to_vec();
     summary.warnings.extend(way_home_note);
     summary
@@ -422,29 +436,54 @@ pub(super) fn flown_mission(
 /// Fly the compiled mission, writing the files of `outputs` (removed again after a failed run)
 /// and keeping a chart's samples; without outputs, the planner's report alone (with every sample
 /// when the options ask).
+#[allow(clippy::type_complexity)]
 fn fly_into_outputs(
     flight: &Flight<'_>,
     compiled: &aloft_planner::Mission,
-    outputs: &MissionOutputs,
+    (outputs, thresholds_v): (&MissionOutputs, &[f64]),
     in_mission: impl Fn(aloft_planner::PlannerError) -> Error,
-) -> Result<(MissionReport, Vec<Sample>), Error> {
-    if !outputs.any() {
+) -> Result<(MissionReport, Vec<Sample>, Vec<Option<(f64, usize)>>), Error> {
+    if !outputs.any() && thresholds_v.is_empty() {
         let report = flight.fly(compiled).map_err(in_mission)?;
-        return Ok((report, Vec::new()));
+        return Ok((report, Vec::new(), Vec::new()));
     }
     let keep_all = flight.options.record_samples;
     let mut sink = OutputSink::create(outputs, path_points(compiled), keep_all)?;
+    sink.watch_voltage(thresholds_v);
     match flight.fly_into(compiled, &mut sink) {
         Ok(mut report) => {
+            let crossings = sink.crossings();
             let (plot, all) = sink.finish()?;
             report.samples = all;
-            Ok((report, plot))
+            Ok((report, plot, crossings))
         }
         Err(e) => {
             sink.discard();
             Err(sink.take_failure().unwrap_or_else(|| in_mission(e)))
         }
     }
+}
+
+/// The voltage failsafes a mission watches: (`low` / `critical`, pack volts), each positive and
+/// finite.
+fn failsafe_thresholds(options: &MissionOptions) -> Result<Vec<(&'static str, f64)>, Error> {
+    let mut out = Vec::new();
+    for (kind, name, v) in [
+        ("low", "low_voltage_v", options.low_voltage_v),
+        ("critical", "critical_voltage_v", options.critical_voltage_v),
+    ] {
+        let Some(v) = v else { continue };
+        if !(v.is_finite() && v > 0.0 && v <= 1e4) {
+            return Err(Error::InvalidInput {
+                name,
+                value: v,
+                unit: "V",
+                expected: "a positive pack voltage up to 10000 V",
+            });
+        }
+        out.push((kind, v));
+    }
+    Ok(out)
 }
 
 /// The options' own values, before anything is flown: a planning speed and an RTL altitude are

@@ -48,6 +48,11 @@ pub struct MissionOptions {
     /// Corners: `pass` (through waypoints without a hold, as autopilots fly) or `stop`
     /// (overrides the mission's; default pass).
     pub corners: Option<CornerMode>,
+    /// The autopilot's low-voltage failsafe, pack volts: the answer says when the predicted
+    /// terminal voltage under load first falls below it (default: the pack file's `[failsafe]`).
+    pub low_voltage_v: Option<f64>,
+    /// The autopilot's critical-voltage failsafe, pack volts (as `low_voltage_v`).
+    pub critical_voltage_v: Option<f64>,
 }
 
 impl Default for MissionOptions {
@@ -58,6 +63,8 @@ impl Default for MissionOptions {
             wind: None,
             wind_field: None,
             gusts: None,
+            low_voltage_v: None,
+            critical_voltage_v: None,
             reserve_percent: None,
             start_percent: 100.0,
             time_step_s: None,

@@ -49,6 +49,8 @@ pub(crate) struct OutputSink {
     created: Vec<PathBuf>,
     /// The first failure, with the file it names (the planner only sees that the sink failed).
     failure: Option<Error>,
+    /// Voltage thresholds watched: (threshold V, first sample below it as (time s, segment)).
+    watch: Vec<(f64, Option<(f64, usize)>)>,
 }
 
 impl OutputSink {
@@ -66,6 +68,7 @@ impl OutputSink {
             all: keep_all.then(Vec::new),
             created: Vec::new(),
             failure: None,
+            watch: Vec::new(),
         };
         if let Some(path) = &outputs.timeseries {
             let file = File::create(path).map_err(|source| Error::Io {
@@ -106,6 +109,17 @@ impl OutputSink {
         }
         let plot = self.plot.take().map(|d| d.samples).unwrap_or_default();
         Ok((plot, self.all.take().unwrap_or_default()))
+    }
+
+    /// Watch the terminal voltage for `thresholds_v` (pack volts).
+    pub(crate) fn watch_voltage(&mut self, thresholds_v: &[f64]) {
+        self.watch = thresholds_v.iter().map(|v| (*v, None)).collect();
+    }
+
+    /// For each watched threshold, the first sample whose terminal voltage fell below it: its
+    /// time, s, and segment (from 1).
+    pub(crate) fn crossings(&self) -> Vec<Option<(f64, usize)>> {
+        self.watch.iter().map(|w| w.1).collect()
     }
 
     /// Remove the files created (after a failed run, so no half-written file looks valid).
@@ -160,6 +174,11 @@ impl SampleSink for OutputSink {
         }
         if let Some(all) = &mut self.all {
             all.push(*s);
+        }
+        for (v, first) in &mut self.watch {
+            if first.is_none() && s.voltage_v < *v {
+                *first = Some((s.time_s, s.segment));
+            }
         }
         Ok(())
     }

@@ -17,6 +17,7 @@
 //! | propulsion | [`hover`], [`hover_sweep`], [`RotorRequest`] → [`rotor_response`] | [`HoverResult`], [`HoverSweep`], [`RotorAnswer`] | `propulsion.rs` |
 //! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
 //! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `fit.rs`, `validate.rs` |
+//! | packs | [`PackFitRequest`] → [`fit_pack`] (logs → a pack file); a `--battery` value → [`fly_with_battery`] (a pack name, or a [`PackFile`] flown, for every command that flies) | [`PackFitAnswer`], [`FlyingPack`] | `pack_fit.rs`, `pack_file.rs` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `estimator.rs` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
@@ -68,6 +69,8 @@ mod mission_file;
 mod mission_map;
 mod mission_options;
 mod mission_outputs;
+mod pack_file;
+mod pack_fit;
 mod payload_sweep;
 mod plan_files;
 mod plan_map;
@@ -122,6 +125,11 @@ pub use mission_map::{
 };
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
+pub use pack_file::{fly_with_battery, is_pack_file, Failsafe, FlyingPack, PackFile};
+pub use pack_fit::{
+    fit_pack, PackFitAnswer, PackFitRequest, SkippedLog, DEFAULT_CUTOFF_CELL_V,
+    DEFAULT_NOMINAL_CELL_V,
+};
 pub use payload_sweep::{
     payload_sweep, PayloadCurve, PayloadRow, PayloadSweep, SweptPack, MAX_PAYLOAD_POINTS,
 };
@@ -144,7 +152,9 @@ pub use scenarios::{
     MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
-pub use summary::{mission_summary, MissionSummary, PointOfNoReturnSummary, SegmentSummary};
+pub use summary::{
+    mission_summary, FailsafeTime, MissionSummary, PointOfNoReturnSummary, SegmentSummary,
+};
 pub use survey_angle::{AngleChange, ANGLE_STEP_DEG};
 pub use validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,

@@ -65,6 +65,23 @@ pub struct PointOfNoReturnSummary {
     pub point_of_no_return_item: Option<u32>,
 }
 
+/// When an autopilot's voltage failsafe would trigger: the first time the predicted terminal
+/// voltage under load falls below its threshold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailsafeTime {
+    /// `low` (ArduPilot `BATT_LOW_VOLT`) or `critical` (`BATT_CRT_VOLT`).
+    pub kind: String,
+    /// The threshold, pack volts.
+    pub voltage_v: f64,
+    /// Time from take-off when the voltage first falls below it, s (`null`: never).
+    pub time_s: Option<f64>,
+    /// The segment it falls in, from 1 (`null`: never).
+    pub segment: Option<usize>,
+    /// The operator's mission item of that segment, when the mission came from a planner file.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub item: Option<u32>,
+}
+
 /// The summary of a planned mission: its JSON is exactly that of `aloft mission --format json`
 /// (same keys in the same order, same values; absent values omitted). The keys are documented in
 /// `aloft mission`'s JSON keys in docs/guide.md.
@@ -133,6 +150,10 @@ pub struct MissionSummary {
     /// The sorties, when the route takes more than one pack.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sorties: Vec<SortieSummary>,
+    /// The voltage failsafes watched (`--low-voltage-v`, `--critical-voltage-v`, a pack file's
+    /// `[failsafe]`) and when each would trigger.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failsafes: Vec<FailsafeTime>,
     /// What the reader should know: speeds clamped to the vehicle's, why a route was not split.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -218,6 +239,7 @@ pub fn mission_summary(
         loiter: None,
         batteries_required: report.feasible.then_some(1),
         sorties: Vec::new(),
+        failsafes: Vec::new(),
         warnings: Vec::new(),
         route: RouteFigures::default(),
         segments: report

@@ -1,0 +1,190 @@
+//! `aloft pack fit`: a pack file from the pack's own logs (the pipeline is
+//! `aloft::engine::fit_pack`; this module parses and renders).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, Subcommand};
+
+use aloft::engine::flags::finite;
+use aloft::engine::{fit_pack, PackFitAnswer, PackFitRequest, Vehicle, DEFAULT_VEHICLE};
+
+use super::flights::file_name;
+use super::output::{self, Row};
+use super::{Format, Outcome};
+
+#[derive(Debug, Args)]
+pub struct PackArgs {
+    #[command(subcommand)]
+    command: PackCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum PackCommand {
+    /// Fit a pack file from logs: internal resistance from current steps, capacity between
+    /// rests, the autopilot's own figures and failsafes beside them. Exit 1 when no log is usable.
+    Fit(PackFitArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct PackFitArgs {
+    /// Logs: PX4 .ulg, ArduPilot .bin, CSV (with --profile), PX4 CSV tables, MCAP.
+    #[arg(required = true, value_name = "LOG")]
+    logs: Vec<PathBuf>,
+    /// The pack of --vehicle whose mass, nominal voltage and cut-off the logs cannot give (its
+    /// resistance, and capacity when estimated, are replaced).
+    #[arg(long, value_name = "NAME")]
+    battery: Option<String>,
+    /// Vehicle of --battery: a built-in name or a vehicle TOML file.
+    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
+    vehicle: String,
+    /// CSV profile (kaist, px4) or a column-map TOML file.
+    #[arg(long, value_name = "PROFILE")]
+    profile: Option<String>,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0)]
+    battery_instance: u8,
+    /// The pack file to write.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// The pack's name in the file (default: the --battery pack's, the logged serial, `fitted`).
+    #[arg(long)]
+    name: Option<String>,
+    /// Cells in series (default: --battery's, else the logs').
+    #[arg(long, value_name = "N")]
+    cells: Option<u32>,
+    /// Rated capacity, mA h, when none is estimated between rests (default: --battery's, else
+    /// the logs' BAT1_CAPACITY / BATT_CAPACITY).
+    #[arg(long, value_parser = finite(), value_name = "MAH")]
+    capacity_mah: Option<f64>,
+    /// Pack mass, kg (required without --battery).
+    #[arg(long, value_parser = finite(), value_name = "KG")]
+    mass_kg: Option<f64>,
+    /// Nominal pack voltage, V (default: --battery's, else 3.7 V per cell).
+    #[arg(long, value_parser = finite(), value_name = "V")]
+    nominal_v: Option<f64>,
+    /// Cut-off cell voltage under load, V (default: --battery's, else 3.3 V).
+    #[arg(long, value_parser = finite(), value_name = "V")]
+    cutoff_cell_v: Option<f64>,
+    /// Fraction of the capacity that may be drawn (default: --battery's, else 1).
+    #[arg(long, value_parser = finite(), value_name = "FRACTION")]
+    usable_fraction: Option<f64>,
+    /// Output format of the report (stdout).
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+}
+
+pub fn run(args: PackArgs) -> Result<Outcome> {
+    match args.command {
+        PackCommand::Fit(a) => fit(a),
+    }
+}
+
+fn fit(a: PackFitArgs) -> Result<Outcome> {
+    let vehicle = match &a.battery {
+        Some(_) => Some(Vehicle::load(&a.vehicle)?),
+        None => None,
+    };
+    let request = PackFitRequest {
+        logs: a.logs.clone(),
+        profile: a.profile.clone(),
+        battery_instance: a.battery_instance,
+        vehicle,
+        battery: a.battery.clone(),
+        name: a.name.clone(),
+        cells_series: a.cells,
+        capacity_mah: a.capacity_mah,
+        mass_kg: a.mass_kg,
+        nominal_v: a.nominal_v,
+        cutoff_cell_v: a.cutoff_cell_v,
+        usable_fraction: a.usable_fraction,
+        output: Some(a.output.clone()),
+    };
+    let answer = fit_pack(&request)?;
+    for s in &answer.skipped {
+        eprintln!(
+            "aloft pack fit: {}: skipped: {}",
+            file_name(&s.file),
+            s.reason
+        );
+    }
+    for n in &answer.notes {
+        eprintln!("aloft pack fit: {n}");
+    }
+    if answer.pack.is_none() {
+        eprintln!("aloft pack fit: no usable log: no pack written");
+        return Ok(Outcome::Failed);
+    }
+    output::print_table_or_json(a.format, &answer, |out| render(out, &answer))?;
+    Ok(Outcome::Ok)
+}
+
+fn opt(v: Option<f64>, decimals: usize) -> String {
+    v.map_or_else(|| "-".to_string(), |v| output::fixed(v, decimals))
+}
+
+fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
+    for r in &a.logs {
+        let rows = vec![
+            Row::num("duration", r.duration_s, 1, "s"),
+            Row::num("energy", r.energy_wh, 2, "Wh"),
+            Row::num("lowest voltage", r.min_voltage_v, 2, "V"),
+            Row::new(
+                "discharged (coulomb count)",
+                opt(r.discharged_mah, 0),
+                "mAh",
+            ),
+            Row::new("reported drop", opt(r.reported_drop_mah, 0), "mAh"),
+            Row::new(
+                "internal resistance (steps)",
+                opt(r.internal_resistance_ohm, 4),
+                "ohm",
+            ),
+            Row::new(
+                "current steps",
+                r.resistance
+                    .as_ref()
+                    .map_or("-".into(), |e| e.steps.to_string()),
+                "",
+            ),
+            Row::new(
+                "autopilot's resistance",
+                opt(r.autopilot_internal_resistance_ohm, 4),
+                "ohm",
+            ),
+            Row::new("capacity between rests", opt(r.capacity_mah, 0), "mAh"),
+            Row::new(
+                "cell imbalance > 0.01 V",
+                opt(r.imbalance_minor_min, 1),
+                "min",
+            ),
+            Row::new(
+                "cell imbalance > 0.07 V",
+                opt(r.imbalance_major_min, 1),
+                "min",
+            ),
+        ];
+        output::write_table(out, file_name(&r.source), &rows)?;
+        if let Some(why) = &r.capacity_refused {
+            writeln!(out, "  capacity: {why}")?;
+        }
+    }
+    let rows = vec![
+        Row::new(
+            "internal resistance",
+            opt(a.internal_resistance_ohm, 4),
+            "ohm",
+        ),
+        Row::new(
+            "autopilot's resistance",
+            opt(a.autopilot_internal_resistance_ohm, 4),
+            "ohm",
+        ),
+        Row::new("capacity written", opt(a.pack_capacity_mah, 0), "mAh"),
+        Row::num("discharged over the logs", a.discharged_mah, 0, "mAh"),
+        Row::new("equivalent full cycles", opt(a.equivalent_cycles, 2), ""),
+    ];
+    output::write_table(out, &format!("pack written to {}", a.output), &rows)?;
+    Ok(())
+}

@@ -1,0 +1,423 @@
+//! `aloft pack fit`: a pack file from the pack's own logs.
+//!
+//! Each log is read for its battery records ([`aloft_logs::read_battery_log`]) and analysed
+//! ([`aloft_packs::analyse_with`]); the flights combine into one pack:
+//!
+//! - `internal_resistance_ohm`: the median over the flights of each flight's step estimate (a
+//!   flight without enough current steps gives none); without any, the median of the
+//!   autopilot's own estimates; without that, the `--battery` pack's, with a note.
+//! - `capacity_mah`: the median of the capacities estimated between two rests; else
+//!   `--capacity-mah`, the `--battery` pack's, or the logs' rated capacity (`BAT1_CAPACITY`,
+//!   `BATT_CAPACITY`), in that order.
+//! - `cells_series`: `--cells`, the `--battery` pack's, else the logs'.
+//! - what logs cannot give (mass, nominal voltage, cut-off, usable fraction): the flags, else the
+//!   `--battery` pack of the vehicle, else the documented defaults [`DEFAULT_NOMINAL_CELL_V`]
+//!   (nominal voltage), [`DEFAULT_CUTOFF_CELL_V`] (cut-off) and a usable fraction of 1; the
+//!   mass has no default.
+//! - `[failsafe]`: ArduPilot's `BATT_LOW_VOLT` / `BATT_CRT_VOLT` as logged (the last log's).
+//!
+//! A log that cannot be read is an error naming it (exit 2); a log without battery records or
+//! without current is skipped with its reason; with none usable the answer has no pack (exit 1).
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use aloft_logs::{read_battery_log, OpenOptions, Profile};
+use aloft_packs::{analyse_with, PackOptions, PackReport};
+
+use super::finite::finite;
+use super::pack_file::{Failsafe, PackFile};
+use super::vehicles::Vehicle;
+use crate::error::Error;
+
+/// Nominal cell voltage of a LiPo cell when nothing gives the pack's, V.
+pub const DEFAULT_NOMINAL_CELL_V: f64 = 3.7;
+/// Cut-off cell voltage under load when nothing gives the pack's, V.
+pub const DEFAULT_CUTOFF_CELL_V: f64 = 3.3;
+
+/// What `aloft pack fit` is asked.
+#[derive(Debug, Clone, Default)]
+pub struct PackFitRequest {
+    /// The logs.
+    pub logs: Vec<PathBuf>,
+    /// CSV profile (`kaist`, `px4`) or column-map file.
+    pub profile: Option<String>,
+    /// The battery instance of ULog / DataFlash logs.
+    pub battery_instance: u8,
+    /// The vehicle whose `--battery` pack gives the keys the logs cannot.
+    pub vehicle: Option<Vehicle>,
+    /// That pack's name.
+    pub battery: Option<String>,
+    /// The pack's name in the file (default: the `--battery` pack's, else the logged serial,
+    /// else `fitted`).
+    pub name: Option<String>,
+    /// Cells in series.
+    pub cells_series: Option<u32>,
+    /// Rated capacity, mA h (used when no capacity is estimated, and for cycles).
+    pub capacity_mah: Option<f64>,
+    /// Pack mass, kg.
+    pub mass_kg: Option<f64>,
+    /// Nominal pack voltage, V.
+    pub nominal_v: Option<f64>,
+    /// Cut-off cell voltage under load, V.
+    pub cutoff_cell_v: Option<f64>,
+    /// Usable fraction of the capacity.
+    pub usable_fraction: Option<f64>,
+    /// Where to write the pack file.
+    pub output: Option<PathBuf>,
+}
+
+/// A log left out, and why.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SkippedLog {
+    /// The log.
+    pub file: String,
+    /// Why, in words.
+    pub reason: String,
+}
+
+/// What `aloft pack fit` answers.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PackFitAnswer {
+    /// Each usable log's analysis.
+    pub logs: Vec<PackReport>,
+    /// Logs left out.
+    pub skipped: Vec<SkippedLog>,
+    /// The pack's internal resistance written, Ω.
+    pub internal_resistance_ohm: Option<f64>,
+    /// Where it came from: `current steps`, `autopilot`, `--battery pack`.
+    pub internal_resistance_source: Option<String>,
+    /// The autopilot's own estimate over the flights (median), Ω.
+    pub autopilot_internal_resistance_ohm: Option<f64>,
+    /// Capacity estimated between rests (median over the flights), mA h.
+    pub capacity_mah: Option<f64>,
+    /// Capacity written, mA h.
+    pub pack_capacity_mah: Option<f64>,
+    /// Charge drawn over all the logs, mA h.
+    pub discharged_mah: f64,
+    /// Discharged charge / rated charge over all the logs.
+    pub equivalent_cycles: Option<f64>,
+    /// The pack written (none when no log was usable).
+    pub pack: Option<PackFile>,
+    /// Its TOML text.
+    pub pack_toml: Option<String>,
+    /// The file written (empty when none).
+    pub output: String,
+    /// Notes for the reader.
+    pub notes: Vec<String>,
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    Some(if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    })
+}
+
+/// Read, analyse and combine the logs into a pack (see the module docs).
+///
+/// # Errors
+/// A log that cannot be read ([`Error::LogFile`], naming it), an unknown `--battery` pack, a key no
+/// source gives ([`Error::PackKeyMissing`]), a pack the planner refuses, an output that cannot be
+/// written.
+pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
+    let profile = request
+        .profile
+        .as_deref()
+        .map(Profile::resolve)
+        .transpose()?;
+    let mut open = OpenOptions::default();
+    open.binary.battery_instance = request.battery_instance;
+    let base = match (&request.vehicle, &request.battery) {
+        (Some(v), Some(b)) => Some(
+            v.file()
+                .batteries
+                .iter()
+                .find(|s| s.name.eq_ignore_ascii_case(b))
+                .cloned()
+                .ok_or_else(|| {
+                    // The vehicle's own message lists its packs.
+                    v.battery(Some(b)).err().unwrap_or(Error::PackKeyMissing {
+                        key: "name",
+                        hint: "no such pack",
+                    })
+                })?,
+        ),
+        _ => None,
+    };
+    let options = PackOptions {
+        rated_capacity_mah: request
+            .capacity_mah
+            .or(base.as_ref().map(|b| b.capacity_mah)),
+        cells_series: request
+            .cells_series
+            .or(base.as_ref().map(|b| b.cells_series)),
+    };
+    let mut logs = Vec::new();
+    let mut skipped = Vec::new();
+    let mut failsafe = Failsafe::default();
+    let mut serial = None;
+    for path in &request.logs {
+        let file = path.display().to_string();
+        // The log reader's error names the file. A log that reads but holds no battery record
+        // (no power sensor) is skipped, not an error.
+        let log = match read_battery_log(path, profile.as_ref(), &open) {
+            Ok(l) => l,
+            Err(aloft_logs::LogError::NoBatteryData { reason, .. }) => {
+                skipped.push(SkippedLog { file, reason });
+                continue;
+            }
+            Err(e) => return Err(Error::LogFile(Box::new(e))),
+        };
+        if !log.has_current() {
+            skipped.push(SkippedLog {
+                file,
+                reason: "no current is logged (voltage only): nothing to fit a pack on".into(),
+            });
+            continue;
+        }
+        match analyse_with(&log, &options) {
+            Ok(r) => {
+                failsafe.low_voltage_v = r.low_voltage_failsafe_v.or(failsafe.low_voltage_v);
+                failsafe.critical_voltage_v = r
+                    .critical_voltage_failsafe_v
+                    .or(failsafe.critical_voltage_v);
+                serial = serial.or(r.pack_id.clone());
+                logs.push(r);
+            }
+            Err(e) => skipped.push(SkippedLog {
+                file,
+                reason: e.to_string(),
+            }),
+        }
+    }
+    let mut notes = Vec::new();
+    let step_r = median(
+        logs.iter()
+            .filter_map(|r| r.internal_resistance_ohm)
+            .collect(),
+    );
+    let autopilot_r = median(
+        logs.iter()
+            .filter_map(|r| r.autopilot_internal_resistance_ohm)
+            .collect(),
+    );
+    let (resistance, source) = match (
+        step_r,
+        autopilot_r,
+        base.as_ref().and_then(|b| b.internal_resistance_ohm),
+    ) {
+        (Some(r), _, _) => (Some(r), Some("current steps")),
+        (None, Some(r), _) => {
+            notes.push("no log has enough current steps: the autopilot's own resistance estimate is written".into());
+            (Some(r), Some("autopilot"))
+        }
+        (None, None, Some(r)) => {
+            notes.push("no log has enough current steps or an autopilot estimate: the --battery pack's resistance is kept".into());
+            (Some(r), Some("--battery pack"))
+        }
+        _ => (None, None),
+    };
+    let capacity = median(logs.iter().filter_map(|r| r.capacity_mah).collect());
+    let discharged: f64 = logs.iter().filter_map(|r| r.discharged_mah).sum();
+    let rated = options
+        .rated_capacity_mah
+        .or_else(|| median(logs.iter().filter_map(|r| r.rated_capacity_mah).collect()));
+    let mut answer = PackFitAnswer {
+        internal_resistance_ohm: resistance,
+        internal_resistance_source: source.map(str::to_string),
+        autopilot_internal_resistance_ohm: autopilot_r,
+        capacity_mah: capacity,
+        pack_capacity_mah: None,
+        discharged_mah: discharged,
+        equivalent_cycles: rated.map(|c| discharged / c),
+        pack: None,
+        pack_toml: None,
+        output: String::new(),
+        notes,
+        logs,
+        skipped,
+    };
+    if answer.logs.is_empty() {
+        return Ok(answer);
+    }
+    let resistance = resistance.ok_or(Error::PackKeyMissing {
+        key: "internal_resistance_ohm",
+        hint: "no log has enough current steps or an autopilot estimate; give --battery NAME to keep its pack's",
+    })?;
+    let cells = options
+        .cells_series
+        .or_else(|| answer.logs.iter().find_map(|r| r.cells_series))
+        .ok_or(Error::PackKeyMissing {
+            key: "cells_series",
+            hint: "the logs do not say it: give --cells N or --battery NAME",
+        })?;
+    let capacity_mah = capacity.or(rated).ok_or(Error::PackKeyMissing {
+        key: "capacity_mah",
+        hint: "no capacity could be estimated between rests and no rated capacity is logged: give --capacity-mah or --battery NAME",
+    })?;
+    answer.pack_capacity_mah = Some(capacity_mah);
+    let mass_kg = request
+        .mass_kg
+        .or(base.as_ref().and_then(|b| b.mass_kg))
+        .ok_or(Error::PackKeyMissing {
+            key: "mass_kg",
+            hint: "logs do not weigh packs: give --mass-kg or --battery NAME",
+        })?;
+    let nominal_v = request
+        .nominal_v
+        .or(base.as_ref().and_then(|b| b.nominal_v))
+        .unwrap_or(DEFAULT_NOMINAL_CELL_V * f64::from(cells));
+    let mut spec = base.clone().unwrap_or_else(|| aloft_planner::BatterySpec {
+        name: String::new(),
+        default: false,
+        cells_series: cells,
+        cells_parallel: 1,
+        capacity_mah,
+        nominal_v: None,
+        energy_wh: None,
+        mass_kg: None,
+        internal_resistance_ohm: None,
+        r1_ohm: None,
+        r2_ohm_a: None,
+        r3_ohm_a: None,
+        eq17_min_current_a: None,
+        eq17_max_current_a: None,
+        cutoff_cell_v: None,
+        usable_fraction: 1.0,
+        effective_capacity_fraction: None,
+        full_charge_cell_v: None,
+        ocv_soc: None,
+        ocv_cell_v: None,
+        max_current_a: None,
+    });
+    spec.name = request
+        .name
+        .clone()
+        .or(base.as_ref().map(|b| b.name.clone()))
+        .or(serial)
+        .unwrap_or_else(|| "fitted".to_string());
+    spec.default = false;
+    spec.cells_series = cells;
+    spec.capacity_mah = capacity_mah;
+    spec.nominal_v = Some(nominal_v);
+    spec.energy_wh = Some(capacity_mah / 1000.0 * nominal_v);
+    spec.mass_kg = Some(mass_kg);
+    spec.internal_resistance_ohm = Some(resistance);
+    // The fitted constant resistance replaces a current-dependent eq (17) one.
+    (spec.r1_ohm, spec.r2_ohm_a, spec.r3_ohm_a) = (None, None, None);
+    (spec.eq17_min_current_a, spec.eq17_max_current_a) = (None, None);
+    spec.cutoff_cell_v = request
+        .cutoff_cell_v
+        .or(spec.cutoff_cell_v)
+        .or(Some(DEFAULT_CUTOFF_CELL_V));
+    if let Some(u) = request.usable_fraction {
+        spec.usable_fraction = u;
+    }
+    let pack = PackFile {
+        battery: spec,
+        failsafe: (failsafe != Failsafe::default()).then_some(failsafe),
+        fitted: Some(fitted_table(&answer)),
+    };
+    let text = pack.to_toml()?;
+    // What is written must load: the same checks as --battery pack.toml.
+    let origin = request.output.as_ref().map_or_else(
+        || "the fitted pack".to_string(),
+        |p| p.display().to_string(),
+    );
+    let pack = PackFile::from_toml_str(&text, &origin)?;
+    if let Some(path) = &request.output {
+        write_file(path, &text)?;
+        answer.output = path.display().to_string();
+    }
+    answer.pack = Some(pack);
+    answer.pack_toml = Some(text);
+    finite(answer, "pack fit", || format!("logs {:?}", request.logs))
+}
+
+/// Write `text` to a temporary name beside `path`, then rename it there.
+fn write_file(path: &std::path::Path, text: &str) -> Result<(), Error> {
+    let io = |source| Error::Io {
+        origin: format!("cannot write {}", path.display()),
+        source,
+    };
+    let name = path
+        .file_name()
+        .map_or_else(|| "pack.toml".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&tmp, text).map_err(io)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        io(e)
+    })
+}
+
+/// The `[fitted]` table: the logs, steps and the autopilot's figures.
+fn fitted_table(a: &PackFitAnswer) -> toml::Table {
+    let mut t = toml::Table::new();
+    let strings =
+        |v: Vec<String>| toml::Value::Array(v.into_iter().map(toml::Value::String).collect());
+    let floats = |v: Vec<f64>| toml::Value::Array(v.into_iter().map(toml::Value::Float).collect());
+    t.insert(
+        "logs".into(),
+        strings(a.logs.iter().map(|r| r.source.clone()).collect()),
+    );
+    t.insert(
+        "steps".into(),
+        toml::Value::Integer(
+            a.logs
+                .iter()
+                .filter_map(|r| r.resistance.as_ref())
+                .map(|r| r.steps as i64)
+                .sum(),
+        ),
+    );
+    t.insert(
+        "resistance_per_log_ohm".into(),
+        floats(
+            a.logs
+                .iter()
+                .filter_map(|r| r.internal_resistance_ohm)
+                .collect(),
+        ),
+    );
+    if let Some(s) = &a.internal_resistance_source {
+        t.insert(
+            "internal_resistance_source".into(),
+            toml::Value::String(s.clone()),
+        );
+    }
+    if let Some(r) = a.autopilot_internal_resistance_ohm {
+        t.insert(
+            "autopilot_internal_resistance_ohm".into(),
+            toml::Value::Float(r),
+        );
+    }
+    if let Some(c) = a.capacity_mah {
+        t.insert("capacity_estimated_mah".into(), toml::Value::Float(c));
+    }
+    t.insert(
+        "discharged_mah".into(),
+        toml::Value::Float(a.discharged_mah),
+    );
+    if !a.skipped.is_empty() {
+        t.insert(
+            "skipped".into(),
+            strings(
+                a.skipped
+                    .iter()
+                    .map(|s| format!("{}: {}", s.file, s.reason))
+                    .collect(),
+            ),
+        );
+    }
+    t
+}
