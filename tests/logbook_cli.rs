@@ -264,6 +264,7 @@ const SCHEMA: [(&str, &[&str]); 4] = [
             "capacity_refusal",
             "imbalance_minor_min",
             "imbalance_major_min",
+            "file_path",
         ],
     ),
     (
@@ -331,7 +332,7 @@ print(json.dumps(out))
     };
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(v["user_version"], 2);
+    assert_eq!(v["user_version"], 3);
     assert_eq!(v["journal_mode"], "wal");
     let tables = v["tables"].as_object().unwrap();
     assert_eq!(tables.len(), SCHEMA.len(), "{v}");
@@ -399,4 +400,120 @@ fn logbook_served_as_the_command_line_answers() {
     ]);
     assert_eq!(code, 2);
     assert!(err.contains("none.sqlite"), "{err}");
+}
+
+/// `aloft logbook pack-file`: the pack file of a pack's logs, read again where they were; its
+/// resistance the median of the flights' (5 flugdrohne ULogs: the middle one); a log moved
+/// since is left out with a note, and with none left the answer is exit 1; "unknown" and a pack
+/// not in the logbook are exit 2.
+#[test]
+fn logbook_pack_file_from_the_packs_logs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let dir = data_dir().join("px4_flugdrohne/ulg");
+    let mut ulgs: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    ulgs.sort();
+    let mut args = vec![
+        "logbook",
+        "add",
+        "--db",
+        s(&db),
+        "--pack-label",
+        "flugdrohne-3s",
+    ];
+    args.extend(ulgs.iter().map(|p| s(p)));
+    assert_eq!(run(&args).0, 0);
+    let flights = json(&["logbook", "flights", "--db", s(&db), "--format", "json"]);
+    let mut r: Vec<f64> = flights["flights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|f| f["resistance_ohm"].as_f64())
+        .collect();
+    assert_eq!(r.len(), 5);
+    r.sort_by(f64::total_cmp);
+    let pack = tmp.path().join("pack.toml");
+    let (code, out, err) = run(&[
+        "logbook",
+        "pack-file",
+        "flugdrohne-3s",
+        "--db",
+        s(&db),
+        "-o",
+        s(&pack),
+        "--capacity-mah",
+        "2200",
+        "--mass-kg",
+        "0.19",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("from 5 logs"), "{out}");
+    let text = std::fs::read_to_string(&pack).unwrap();
+    let file: toml::Table = toml::from_str(&text).unwrap();
+    let battery = file["battery"].as_table().unwrap();
+    assert_eq!(battery["name"].as_str(), Some("flugdrohne-3s"));
+    assert_eq!(battery["cells_series"].as_integer(), Some(3));
+    let ohm = battery["internal_resistance_ohm"].as_float().unwrap();
+    assert!((ohm - r[2]).abs() < 1e-12, "{ohm} vs {r:?}");
+    // The file flies.
+    let (code, _, err) = run(&["mission", "--battery", s(&pack)]);
+    assert!(code == 0 || code == 1, "{err}");
+
+    // A log moved away after it was added.
+    let moved = tmp.path().join("moved.ulg");
+    std::fs::copy(&ulgs[0], &moved).unwrap();
+    let db2 = tmp.path().join("two.sqlite");
+    assert_eq!(
+        run(&[
+            "logbook",
+            "add",
+            "--db",
+            s(&db2),
+            "--pack-label",
+            "p",
+            s(&moved)
+        ])
+        .0,
+        0
+    );
+    std::fs::remove_file(&moved).unwrap();
+    let (code, _, err) = run(&[
+        "logbook",
+        "pack-file",
+        "p",
+        "--db",
+        s(&db2),
+        "-o",
+        s(&pack),
+        "--capacity-mah",
+        "2200",
+        "--mass-kg",
+        "0.19",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("moved.ulg: left out"), "{err}");
+    let (code, _, err) = run(&[
+        "logbook",
+        "pack-file",
+        "unknown",
+        "--db",
+        s(&db2),
+        "-o",
+        s(&pack),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run(&[
+        "logbook",
+        "pack-file",
+        "nope",
+        "--db",
+        s(&db2),
+        "-o",
+        s(&pack),
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("no such pack"), "{err}");
 }

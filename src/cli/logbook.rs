@@ -51,6 +51,38 @@ enum LogbookCommand {
     Packs(ListArgs),
     /// The files that are not flights of the logbook, with the reason.
     Skipped(ListArgs),
+    /// The pack file to fly a pack with (`aloft pack fit` over the pack's logs, read again
+    /// where they were when added; a log moved or changed since is left out, with a note).
+    /// Exit 1 when none of its logs can be used.
+    PackFile(PackFileArgs),
+}
+
+#[derive(Debug, Args)]
+struct PackFileArgs {
+    /// The pack's key (as `aloft logbook packs` lists it; not "unknown").
+    #[arg(value_name = "PACK")]
+    pack: String,
+    /// Where to write the pack file (TOML).
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// The pack's name in the file (default: its key).
+    #[arg(long, value_name = "NAME")]
+    name: Option<String>,
+    /// Cells in series, when the logs do not say.
+    #[arg(long, value_name = "N")]
+    cells: Option<u32>,
+    /// Rated capacity, mAh, when no capacity can be estimated from the logs.
+    #[arg(long, value_parser = aloft::engine::flags::finite(), value_name = "MAH")]
+    capacity_mah: Option<f64>,
+    /// The pack's mass, kg (logs do not say it).
+    #[arg(long, value_parser = aloft::engine::flags::finite(), value_name = "KG")]
+    mass_kg: Option<f64>,
+    /// CSV profile of the logs: kaist, px4, or a column-map TOML file.
+    #[arg(long, value_name = "PROFILE")]
+    profile: Option<String>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = BookFormat::Table)]
+    format: BookFormat,
 }
 
 #[derive(Debug, Args)]
@@ -147,6 +179,7 @@ pub fn run(args: LogbookArgs) -> Result<Outcome> {
             let packs = book.packs()?;
             list(a.format, "packs", &packs, |out| packs_table(out, &packs))
         }
+        LogbookCommand::PackFile(a) => pack_file(&book, a),
         LogbookCommand::Skipped(a) => {
             let skipped = book.skipped()?;
             list(a.format, "skipped", &skipped, |out| {
@@ -485,4 +518,93 @@ fn skipped_table(out: &mut impl Write, skipped: &[Skipped]) -> Result<()> {
         writeln!(out, "{}: {}", s.file_name, s.reason)?;
     }
     Ok(())
+}
+
+/// The logs of a pack that are still where they were and as they were (by content), and a note
+/// for each of the others.
+fn pack_logs(flights: &[Flight]) -> (Vec<PathBuf>, Vec<String>) {
+    let mut logs = Vec::new();
+    let mut notes = Vec::new();
+    for f in flights {
+        let Some(path) = f.file_path.as_deref().map(PathBuf::from) else {
+            notes.push(format!(
+                "{}: left out: added before the logbook kept where logs are",
+                f.file_name
+            ));
+            continue;
+        };
+        match aloft_logbook::file_sha256(&path) {
+            Ok(sha) if sha == f.file_sha256 => logs.push(path),
+            Ok(_) => notes.push(format!(
+                "{}: left out: the file has changed since it was added",
+                path.display()
+            )),
+            Err(e) => notes.push(format!("{}: left out: {e}", path.display())),
+        }
+    }
+    (logs, notes)
+}
+
+fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
+    use aloft::engine::{fit_pack, PackFitRequest};
+    if a.pack == aloft_logbook::UNKNOWN {
+        anyhow::bail!(
+            "pack \"{}\": its flights are of any pack; add logs with --pack-label to give a pack its flights",
+            aloft_logbook::UNKNOWN
+        );
+    }
+    let flights = book.flights_of_pack(&a.pack)?;
+    if flights.is_empty() {
+        anyhow::bail!(
+            "pack \"{}\": no such pack in {}",
+            a.pack,
+            book.path().display()
+        );
+    }
+    let (logs, notes) = pack_logs(&flights);
+    for n in &notes {
+        eprintln!("aloft logbook pack-file: {n}");
+    }
+    if logs.is_empty() {
+        eprintln!(
+            "aloft logbook pack-file: no log of pack \"{}\" can be read again: no pack written",
+            a.pack
+        );
+        return Ok(Outcome::Failed);
+    }
+    let request = PackFitRequest {
+        logs,
+        profile: a.profile,
+        name: Some(a.name.unwrap_or_else(|| a.pack.clone())),
+        cells_series: a.cells,
+        capacity_mah: a.capacity_mah,
+        mass_kg: a.mass_kg,
+        output: Some(a.output.clone()),
+        ..PackFitRequest::default()
+    };
+    let answer = fit_pack(&request)?;
+    for s in &answer.skipped {
+        eprintln!("aloft logbook pack-file: {}: skipped: {}", s.file, s.reason);
+    }
+    for n in &answer.notes {
+        eprintln!("aloft logbook pack-file: {n}");
+    }
+    if answer.pack.is_none() {
+        eprintln!("aloft logbook pack-file: no usable log: no pack written");
+        return Ok(Outcome::Failed);
+    }
+    let mut out = std::io::stdout().lock();
+    match a.format {
+        BookFormat::Json => output::write_json(&mut out, &answer)?,
+        BookFormat::Table => writeln!(
+            out,
+            "wrote {}: pack {} from {} logs, resistance {} mOhm, capacity {} mAh",
+            answer.output,
+            a.pack,
+            answer.logs.len(),
+            opt(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
+            opt(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
+        )?,
+    }
+    Ok(Outcome::Ok)
 }

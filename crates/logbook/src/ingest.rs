@@ -180,9 +180,14 @@ impl Logbook {
             || file.display().to_string(),
             |n| n.to_string_lossy().into_owned(),
         );
+        // Where it is, to read it again (`aloft logbook pack-file`): absolute when it can be.
+        let path = std::fs::canonicalize(file)
+            .unwrap_or_else(|_| file.to_path_buf())
+            .display()
+            .to_string();
         // Read outside the write lock: another `add` writes meanwhile.
         let facts = read_flight(file, options);
-        self.write(&sha, &name, facts, labels)
+        self.write(&sha, (&name, &path), facts, labels)
             .map_err(|e| self.sql(e))
     }
 
@@ -202,7 +207,7 @@ impl Logbook {
     fn write(
         &mut self,
         sha: &str,
-        name: &str,
+        (name, path): (&str, &str),
         facts: std::result::Result<FlightFacts, String>,
         labels: &Labels,
     ) -> rusqlite::Result<AddOutcome> {
@@ -263,9 +268,9 @@ impl Logbook {
                energy_wh, discharged_mah, max_current_a, min_voltage_v, mean_power_w,
                added_unix_s, hover_power_w, cells_series, resistance_ohm,
                autopilot_resistance_ohm, capacity_mah, capacity_refusal, imbalance_minor_min,
-               imbalance_major_min)
+               imbalance_major_min, file_path)
              VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16,
-                     ?17, ?18, ?19, ?20, ?21)",
+                     ?17, ?18, ?19, ?20, ?21, ?22)",
             params![
                 sha,
                 name,
@@ -288,6 +293,7 @@ impl Logbook {
                 f.capacity_refusal,
                 f.imbalance_minor_min,
                 f.imbalance_major_min,
+                path,
             ],
         )?;
         let flight_id = tx.last_insert_rowid();

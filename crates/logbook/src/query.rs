@@ -58,12 +58,15 @@ pub struct Flight {
     pub imbalance_major_min: Option<f64>,
     /// When it was added, Unix time, s.
     pub added_unix_s: i64,
+    /// Where the file was when added (absolute); `None` for flights added before version 3.
+    pub file_path: Option<String>,
 }
 
 const FLIGHT_COLUMNS: &str = "id, file_sha256, file_name, format, vehicle_key, pack_key,
     start_unix_s, duration_s, energy_wh, discharged_mah, max_current_a, min_voltage_v,
     mean_power_w, hover_power_w, cells_series, resistance_ohm, autopilot_resistance_ohm,
-    capacity_mah, capacity_refusal, imbalance_minor_min, imbalance_major_min, added_unix_s";
+    capacity_mah, capacity_refusal, imbalance_minor_min, imbalance_major_min, added_unix_s,
+    file_path";
 
 /// Flying order: start time where known (unknown last), then the order of adding.
 const FLYING_ORDER: &str = "ORDER BY start_unix_s IS NULL, start_unix_s, id";
@@ -93,6 +96,7 @@ impl Flight {
             imbalance_minor_min: r.get(19)?,
             imbalance_major_min: r.get(20)?,
             added_unix_s: r.get(21)?,
+            file_path: r.get(22)?,
         })
     }
 }
@@ -315,6 +319,14 @@ impl Logbook {
             rows.collect()
         };
         run().map_err(|e| self.sql(e))
+    }
+
+    /// The flights of one pack, in flying order (for its pack file).
+    ///
+    /// # Errors
+    /// The database cannot be read.
+    pub fn flights_of_pack(&self, key: &str) -> Result<Vec<Flight>> {
+        self.select_flights("WHERE pack_key = ?1", &[key])
     }
 
     /// Every vehicle's history, by key.

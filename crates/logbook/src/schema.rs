@@ -61,8 +61,13 @@ ALTER TABLE flights ADD COLUMN imbalance_major_min REAL;
 ALTER TABLE packs ADD COLUMN cells_series INTEGER;
 ";
 
+/// Version 2 to 3: where each log was when added (to read it again for a pack file).
+const V2_TO_V3: &str = "
+ALTER TABLE flights ADD COLUMN file_path TEXT;
+";
+
 /// The schema of each version after 0: `MIGRATIONS[n]` takes a version `n` file to `n + 1`.
-const MIGRATIONS: [&str; 2] = [V1, V1_TO_V2];
+const MIGRATIONS: [&str; 3] = [V1, V1_TO_V2, V2_TO_V3];
 
 /// The schema version this code writes.
 pub const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;

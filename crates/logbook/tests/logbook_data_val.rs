@@ -384,7 +384,7 @@ fn a_version_1_logbook_is_migrated_forward() {
         .query_row("PRAGMA user_version", [], |r| r.get(0))
         .unwrap();
     assert_eq!(v, SCHEMA_VERSION);
-    assert_eq!(v, 2);
+    assert_eq!(v, 3);
 }
 
 /// A file written by a newer aloft is refused, not rewritten.
