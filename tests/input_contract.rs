@@ -242,9 +242,11 @@ fn output_files_do_not_make_memory_grow_with_the_flight() {
         "hover.toml",
     );
     let (csv, mcap, svg) = (tmp("hover.csv"), tmp("hover.mcap"), tmp("hover.svg"));
-    // 170 MB of address space: the run needs 120-140 MB (most of it zstd's buffers for MCAP
-    // chunks); the code that kept every sample (250 bytes each, in a vector that doubles) needed
-    // 200-260 MB for this flight (measured) and does not fit.
+    // 185 MB of address space: the run needs 120-140 MB (most of it zstd's buffers for MCAP
+    // chunks) besides the debug binary's own mappings (measured in all: 170-172 MB with the
+    // bundled SQLite of `aloft logbook`, about 26 MiB of loaded code and data, 168-170 MB
+    // without it); the code that kept every sample (250 bytes each, in a vector that doubles)
+    // needed 200-260 MB for this flight (measured) and does not fit.
     let (code, err, _) = aloft_limited(
         &[
             "mission",
@@ -260,7 +262,7 @@ fn output_files_do_not_make_memory_grow_with_the_flight() {
             "--plot",
             &svg,
         ],
-        170_000,
+        185_000,
         Duration::from_secs(300),
     );
     assert!(code == Some(0) || code == Some(1), "{code:?}: {err}");

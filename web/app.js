@@ -1227,6 +1227,72 @@
     });
   }
 
+
+  // ---------------------------------------------------------------- logbook
+
+  // One series of a history chart: a line through its points and a dot on each, x the flight's
+  // place in the vehicle's or pack's flights (1, 2, ...).
+  function historyChart(container, label, yLabel, series) {
+    const all = series.flatMap((s) => s.values.filter(Number.isFinite));
+    const n = Math.max(1, ...series.map((s) => s.values.length));
+    if (!all.length) {
+      container.replaceChildren(el('p', { class: 'muted' }, [`no ${yLabel.split(' (')[0]} in these flights`]));
+      return;
+    }
+    const lo = Math.min(...all);
+    const hi = Math.max(...all);
+    const pad = (hi - lo) * 0.1 || Math.abs(hi) * 0.1 || 1;
+    const f = frame(container, { label, x0: 1, x1: Math.max(2, n), y0: lo - pad, y1: hi + pad, xLabel: 'flight', yLabel });
+    for (const s of series) {
+      const xs = s.values.map((_, i) => i + 1);
+      f.plot.append(svg('polyline', { points: points(xs, s.values, f.x, f.y).join(' '), class: s.cls }));
+      s.values.forEach((v, i) => {
+        if (!Number.isFinite(v)) return;
+        const dot = svg('circle', { cx: f.x(i + 1), cy: f.y(v), r: 3, class: s.cls });
+        dot.append(svg('title', {}, `flight ${i + 1}, ${s.name}: ${fmt(v, 1)}`));
+        f.plot.append(dot);
+      });
+    }
+  }
+
+  function renderLogbookVehicle(v) {
+    const drift = v.power_drift && v.power_drift.trend.change_percent != null
+      ? `; ${v.power_drift.quantity === 'hover_power_w' ? 'hover' : 'mean'} power ${v.power_drift.trend.change_percent >= 0 ? '+' : ''}${fmt(v.power_drift.trend.change_percent, 1)} % over the last ${v.power_drift.trend.n} flights`
+      : '';
+    $('#logbook-vehicle-summary').textContent = `${v.key}: ${v.flights} flights, ${fmt(v.hours, 2)} h, ${fmt(v.energy_wh, 1)} Wh${drift}`;
+    const num = (x) => (x == null ? NaN : x);
+    historyChart($('#logbook-vehicle-chart'), `power per flight of ${v.key}`, 'power (W)', [
+      { name: 'mean power', cls: 'mean-power', values: v.power.map((p) => num(p.mean_power_w)) },
+      { name: 'hover power', cls: 'hover-power', values: v.power.map((p) => num(p.hover_power_w)) },
+    ]);
+  }
+
+  function renderLogbookPack(p) {
+    const cycles = p.equivalent_cycles == null ? 'cycles n/a (no rated capacity)' : `${fmt(p.equivalent_cycles, 2)} equivalent cycles`;
+    const t = p.resistance_trend;
+    const trend = t ? `; resistance ${fmt(t.first * 1000, 1)} to ${fmt(t.last * 1000, 1)} mOhm over ${t.n} flights` : '';
+    $('#logbook-pack-summary').textContent = `${p.key}: ${p.flights} flights, ${fmt(p.discharged_mah, 0)} mAh, ${cycles}${trend}`;
+    historyChart($('#logbook-pack-chart'), `resistance per flight of ${p.key}`, 'resistance (mOhm)', [
+      { name: 'resistance', cls: 'resistance', values: p.resistance.map((r) => r.value * 1000) },
+    ]);
+  }
+
+  function fillLogbookSelect(select, items, render) {
+    select.replaceChildren(...items.map((x, i) => el('option', { value: String(i) }, [`${x.key} (${x.flights} flights)`])));
+    select.onchange = () => render(items[Number(select.value)]);
+    // The first with a key of its own (the flights of "unknown" are of any vehicle or pack).
+    const first = Math.max(0, items.findIndex((x) => x.key !== 'unknown'));
+    select.value = String(first);
+    if (items.length) render(items[first]);
+  }
+
+  async function loadLogbook() {
+    const [vehicles, packs] = await Promise.all([api('/api/logbook/vehicles'), api('/api/logbook/packs')]);
+    $('#logbook-panel').hidden = false;
+    fillLogbookSelect($('#logbook-vehicle'), vehicles.vehicles, renderLogbookVehicle);
+    fillLogbookSelect($('#logbook-pack'), packs.packs, renderLogbookPack);
+  }
+
   async function start() {
     body.dataset.state = 'loading';
     body.dataset.plans = '0';
@@ -1260,8 +1326,12 @@
         .then((info) => renderLogInfo(info, f.name))
         .catch((e) => showError(`${basename(f.name)}: ${e.message}`)),
     );
+    const logbookLoad = state.config.logbook
+      ? loadLogbook().catch((e) => showError(`logbook: ${e.message}`))
+      : Promise.resolve();
     await selectMission(first ? first.key : liveOnly ? 'none' : 'demo');
     await Promise.all(logLoads);
+    await logbookLoad;
     settle(!$('#error').textContent);
   }
 

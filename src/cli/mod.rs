@@ -8,6 +8,8 @@ mod fit;
 mod flights;
 mod live;
 mod log;
+#[cfg(feature = "logbook")]
+pub(crate) mod logbook;
 mod mission;
 mod mission_args;
 mod mission_view;
@@ -63,6 +65,10 @@ enum Command {
     Pack(pack::PackArgs),
     /// Follow a flight as it flies: the energy of the rest, its spread, and what to do.
     Live(live::LiveArgs),
+    /// The operator's logbook: flights, vehicles and packs from their own logs, in one SQLite
+    /// file.
+    #[cfg(feature = "logbook")]
+    Logbook(logbook::LogbookArgs),
     /// Fly a mission (or the built-in demo): energy per segment, battery, reserve, point of no return.
     Mission(Box<mission_args::MissionArgs>),
     /// Hover and orbit endurance, best-endurance and best-range speeds, the power curve.
@@ -112,6 +118,8 @@ pub fn main() -> ExitCode {
         Command::Fit(args) => fit::run(args),
         Command::Validate(args) => validate::run(args),
         Command::Live(args) => live::run(args),
+        #[cfg(feature = "logbook")]
+        Command::Logbook(args) => logbook::run(args),
         Command::Pack(args) => pack::run(args),
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),

@@ -8,7 +8,8 @@
 // Prints one `ok - ...` / `not ok - ...` line per check and exits 0 only when all pass.
 
 import { spawn, execFileSync } from 'node:child_process';
-import { readFileSync, readdirSync, mkdirSync, existsSync } from 'node:fs';
+import { readFileSync, readdirSync, mkdirSync, existsSync, mkdtempSync, rmSync } from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -655,6 +656,77 @@ async function main() {
     await page.context().close();
   } finally {
     doc.stop();
+  }
+
+  // --- 9: the logbook's histories (`aloft serve --logbook FILE`): a logbook written by
+  // `aloft logbook add`, its lists served as the CLI's JSON, a vehicle's and a pack's charts.
+  const bookDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-logbook-'));
+  const book = path.join(bookDir, 'logbook.sqlite');
+  const kaistDir = path.join(DATA, 'kaist_energy_drone');
+  const ulgDir = path.join(DATA, 'px4_flugdrohne/ulg');
+  const kaist = readdirSync(kaistDir).filter((f) => f.endsWith('.csv')).sort().map((f) => path.join(kaistDir, f));
+  const ulgs = readdirSync(ulgDir).filter((f) => f.endsWith('.ulg')).sort().map((f) => path.join(ulgDir, f));
+  const logbookCli = (args) => JSON.parse(execFileSync(BIN, ['logbook', ...args, '--db', book, '--format', 'json'], { encoding: 'utf8' }));
+  logbookCli(['add', ...kaist, '--vehicle-label', 'kaist-m600']);
+  logbookCli(['add', ...ulgs, '--pack-label', 'flugdrohne-3s']);
+  const lb = await serve(['--logbook', book]);
+  try {
+    const page = await openPage(lb.url);
+    for (const kind of ['flights', 'vehicles', 'packs']) {
+      await check(`GET /api/logbook/${kind} equals aloft logbook ${kind} --format json`, async () => {
+        const served = await page.evaluate((k) => fetch(`/api/logbook/${k}`).then((r) => r.json()), kind);
+        const cli = logbookCli([kind]);
+        assert(JSON.stringify(served) === JSON.stringify(cli), `${JSON.stringify(served).slice(0, 300)} vs ${JSON.stringify(cli).slice(0, 300)}`);
+      });
+    }
+    const vehicles = logbookCli(['vehicles']).vehicles;
+    const packs = logbookCli(['packs']).packs;
+    await check(`the logbook panel lists the ${vehicles.length} vehicles and ${packs.length} packs`, async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])');
+      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent));
+      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent));
+      assert(v.length === vehicles.length && p.length === packs.length, `${v} / ${p}`);
+    });
+    for (const v of vehicles) {
+      const hover = v.power.filter((x) => x.hover_power_w != null).length;
+      const mean = v.power.filter((x) => x.mean_power_w != null).length;
+      await check(`vehicle ${v.key}: ${mean} mean and ${hover} hover powers charted`, async () => {
+        await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(v)));
+        const got = await page.evaluate(() => [
+          document.querySelectorAll('#logbook-vehicle-chart circle.mean-power').length,
+          document.querySelectorAll('#logbook-vehicle-chart circle.hover-power').length,
+          document.querySelector('#logbook-vehicle-summary').textContent,
+        ]);
+        assert(got[0] === mean && got[1] === hover, JSON.stringify(got));
+        assert(got[2].startsWith(`${v.key}: ${v.flights} flights`), got[2]);
+      });
+    }
+    const pack = packs.find((p) => p.key === 'flugdrohne-3s');
+    await check(`pack flugdrohne-3s: its ${pack.resistance.length} resistances charted in mOhm`, async () => {
+      await page.selectOption('#logbook-pack', String(packs.indexOf(pack)));
+      const cys = await page.$$eval('#logbook-pack-chart circle.resistance', (cs) => cs.map((c) => c.querySelector('title').textContent));
+      assert(cys.length === pack.resistance.length, `${cys.length}`);
+      const first = `flight 1, resistance: ${(pack.resistance[0].value * 1000).toFixed(1)}`;
+      assert(cys[0] === first, `${cys[0]} vs ${first}`);
+      const summary = await page.textContent('#logbook-pack-summary');
+      assert(summary.includes(`over ${pack.resistance_trend.n} flights`), summary);
+    });
+    await page.context().close();
+  } finally {
+    lb.stop();
+    rmSync(bookDir, { recursive: true, force: true });
+  }
+  const nobook = await serve([]);
+  try {
+    const page = await openPage(nobook.url);
+    await check('without --logbook: no panel, and /api/logbook/vehicles is 404', async () => {
+      assert(await page.$eval('#logbook-panel', (e) => e.hidden), 'panel shown');
+      const status = await refusing(() => page.evaluate(() => fetch('/api/logbook/vehicles').then((r) => r.status)));
+      assert(status === 404, `${status}`);
+    });
+    await page.context().close();
+  } finally {
+    nobook.stop();
   }
 
   // --- 7: no page errors anywhere

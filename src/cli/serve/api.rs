@@ -34,6 +34,7 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
         "files": files,
         "live": shared.live.is_some(),
         "max_upload_bytes": shared.max_upload,
+        "logbook": shared.logbook.is_some(),
     });
     if let (Some((url, attribution)), Some(c)) = (&shared.tiles, config.as_object_mut()) {
         c.insert("tiles".into(), url.as_str().into());
@@ -51,6 +52,43 @@ fn json(text: String) -> Response {
 /// engine's queue.
 pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> Response {
     json(shared.vehicles.clone())
+}
+
+/// `GET /api/logbook/KIND`: the list of the logbook given with `--logbook` (404 without one),
+/// read on the engine's queue.
+pub(super) async fn logbook(
+    State(shared): State<Arc<Shared>>,
+    axum::extract::Path(kind): axum::extract::Path<String>,
+) -> Response {
+    let Some(db) = shared.logbook.clone() else {
+        return error(
+            StatusCode::NOT_FOUND,
+            "no logbook: start aloft serve with --logbook FILE",
+        );
+    };
+    if !["flights", "vehicles", "packs", "skipped"].contains(&kind.as_str()) {
+        return error(
+            StatusCode::NOT_FOUND,
+            &format!("/api/logbook/{kind}: not a list of the logbook (flights, vehicles, packs, skipped)"),
+        );
+    }
+    logbook_answer(&shared, db, kind).await
+}
+
+#[cfg(feature = "logbook")]
+async fn logbook_answer(shared: &Shared, db: std::path::PathBuf, kind: String) -> Response {
+    shared
+        .work
+        .run(move |_: &_| crate::cli::logbook::answer_json(&db, &kind))
+        .await
+}
+
+#[cfg(not(feature = "logbook"))]
+async fn logbook_answer(_: &Shared, _: std::path::PathBuf, _: String) -> Response {
+    error(
+        StatusCode::NOT_FOUND,
+        "this aloft is built without the logbook",
+    )
 }
 
 /// An answer, or the refusal that ends the request early (a 4xx with its JSON error): handlers

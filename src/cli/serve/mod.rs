@@ -14,6 +14,7 @@
 //! | `GET /api/files/N` | the N-th file given on the command line (a mission's text) |
 //! | `GET /api/files/N/info` | `aloft log info FILE --format json` of the N-th file, a log |
 //! | `GET /api/live` | with `--live` or `--tlog`: the updates of `aloft live --format json`, as server-sent events |
+//! | `GET /api/logbook/KIND` (`flights`, `vehicles`, `packs`, `skipped`) | with `--logbook FILE`: `aloft logbook KIND --db FILE --format json` (404 without `--logbook`) |
 //!
 //! OPTIONS are the command's flags in snake_case, as the Python package's keywords
 //! (`payload_kg=0.5`, `no_ground_effect=true`); `file` names the upload as the command line would
@@ -102,6 +103,11 @@ pub struct ServeArgs {
     /// Its battery pack (default: the vehicle's first).
     #[arg(long)]
     battery: Option<String>,
+    /// A logbook (`aloft logbook --db FILE`) whose vehicles' and packs' histories the page
+    /// charts. Only this file: a request never names a logbook.
+    #[cfg(feature = "logbook")]
+    #[arg(long, value_name = "FILE")]
+    logbook: Option<PathBuf>,
 }
 
 /// What every request shares.
@@ -122,6 +128,8 @@ struct Shared {
     work: work::Pool,
     /// `aloft vehicles --format json`, answered once.
     vehicles: String,
+    /// The logbook given with `--logbook`.
+    logbook: Option<PathBuf>,
 }
 
 pub fn run(args: ServeArgs) -> Result<Outcome> {
@@ -131,13 +139,14 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         }
     }
     let given = given::read_given(&args.files)?;
+    let logbook = logbook_of(&args)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
         .build()
         .context("starting the server's runtime")?;
-    let served = runtime.block_on(serve(args, given, uploads.path().to_path_buf()));
+    let served = runtime.block_on(serve(args, given, logbook, uploads.path().to_path_buf()));
     // Work still running for clients that have gone is not waited for; the uploads' folder is
     // removed whatever happened.
     runtime.shutdown_background();
@@ -159,7 +168,31 @@ fn uploads_folder() -> std::io::Result<tempfile::TempDir> {
     builder.tempdir()
 }
 
-async fn serve(args: ServeArgs, given: Vec<given::Given>, uploads: PathBuf) -> Result<()> {
+/// The logbook of `--logbook`: an existing file, opened once here (so that a file that is not
+/// a logbook stops the server at its start, and an old one is migrated before any request).
+#[cfg(feature = "logbook")]
+fn logbook_of(args: &ServeArgs) -> Result<Option<PathBuf>> {
+    let Some(path) = &args.logbook else {
+        return Ok(None);
+    };
+    if !path.is_file() {
+        anyhow::bail!("--logbook {}: no such file", path.display());
+    }
+    aloft_logbook::Logbook::open(path)?;
+    Ok(Some(path.clone()))
+}
+
+#[cfg(not(feature = "logbook"))]
+fn logbook_of(_: &ServeArgs) -> Result<Option<PathBuf>> {
+    Ok(None)
+}
+
+async fn serve(
+    args: ServeArgs,
+    given: Vec<given::Given>,
+    logbook: Option<PathBuf>,
+    uploads: PathBuf,
+) -> Result<()> {
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;
@@ -174,6 +207,7 @@ async fn serve(args: ServeArgs, given: Vec<given::Given>, uploads: PathBuf) -> R
         uploads,
         work: work::Pool::new(args.max_request_steps),
         vehicles: answers::vehicles_answer()?,
+        logbook,
     });
     let app = router(shared);
     let mut out = std::io::stdout().lock();
@@ -205,6 +239,7 @@ fn router(shared: Arc<Shared>) -> Router {
         .route("/api/files/{index}", get(files::given_file))
         .route("/api/files/{index}/info", get(files::given_log_info))
         .route("/api/live", get(live::events))
+        .route("/api/logbook/{kind}", get(api::logbook))
         .fallback(get(assets::asset).fallback(not_allowed))
         .method_not_allowed_fallback(not_allowed)
         .layer(middleware::from_fn_with_state(shared.clone(), guard::check))

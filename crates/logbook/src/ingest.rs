@@ -1,0 +1,308 @@
+//! Opening a logbook and adding logs to it: one transaction per file, keyed by the file's
+//! SHA-256, so adding a log twice changes nothing and a log that fails leaves no row but its
+//! `skipped` entry.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use rusqlite::{params, Connection, OptionalExtension, TransactionBehavior};
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+use crate::error::{LogbookError, Result};
+use crate::record::{read_flight, FlightFacts, ReadOptions};
+use crate::schema::{migrate, Migrated, SCHEMA_VERSION};
+
+/// How long a writer waits for another's lock before giving up (two `add`s at once both land).
+pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// The key of a vehicle or pack whose log does not identify it and that was given no label.
+pub const UNKNOWN: &str = "unknown";
+
+/// An open logbook: one SQLite file in WAL mode at [`SCHEMA_VERSION`].
+#[derive(Debug)]
+pub struct Logbook {
+    pub(crate) conn: Connection,
+    pub(crate) path: PathBuf,
+}
+
+/// Keys given on the command line for logs that do not identify their vehicle or pack.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Labels {
+    /// The vehicle of logs without a vehicle identity (`--vehicle-label`).
+    pub vehicle: Option<String>,
+    /// The pack of logs without a pack identity (`--pack-label`).
+    pub pack: Option<String>,
+}
+
+/// What adding one file did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum AddOutcome {
+    /// A new flight.
+    Added {
+        /// Its id in `flights`.
+        flight_id: i64,
+        /// The vehicle key it was filed under.
+        vehicle_key: String,
+        /// The pack key it was filed under.
+        pack_key: String,
+    },
+    /// The same file (by content) is already a flight of the logbook.
+    AlreadyPresent {
+        /// Its id in `flights`.
+        flight_id: i64,
+    },
+    /// The file is not a flight of the logbook: recorded in `skipped` (when it could be read
+    /// to hash it) with the reason.
+    Skipped {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+/// Seconds since the Unix epoch, now.
+fn now_unix_s() -> i64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_secs()).unwrap_or(i64::MAX))
+}
+
+/// The SHA-256 of a file's content, as 64 lowercase hex digits.
+///
+/// # Errors
+/// The file cannot be opened or read.
+pub fn file_sha256(path: &Path) -> std::io::Result<String> {
+    let mut file = std::fs::File::open(path)?;
+    let mut hasher = Sha256::new();
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = file.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buf[..n]);
+    }
+    Ok(hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
+}
+
+/// A key and where it came from: the log's identity, else the label, else [`UNKNOWN`].
+fn key(from_log: Option<&str>, label: Option<&str>) -> (String, &'static str) {
+    match (from_log, label) {
+        (Some(id), _) => (id.to_string(), "log"),
+        (None, Some(l)) => (l.to_string(), "label"),
+        (None, None) => (UNKNOWN.to_string(), UNKNOWN),
+    }
+}
+
+impl Logbook {
+    /// Open the logbook at `path`, creating it (not its folder) when missing, and migrate it to
+    /// [`SCHEMA_VERSION`].
+    ///
+    /// # Errors
+    /// The folder is missing; the file is not a SQLite database or cannot be written; its
+    /// schema is newer than this code's.
+    pub fn open(path: &Path) -> Result<Self> {
+        let folder = match path.parent() {
+            Some(p) if p.as_os_str().is_empty() => Path::new("."),
+            Some(p) => p,
+            None => Path::new("."),
+        };
+        if !folder.is_dir() {
+            return Err(LogbookError::FolderMissing {
+                folder: folder.to_path_buf(),
+            });
+        }
+        let sql = |source| LogbookError::Sqlite {
+            path: path.to_path_buf(),
+            source,
+        };
+        let mut conn = Connection::open(path).map_err(sql)?;
+        conn.busy_timeout(BUSY_TIMEOUT).map_err(sql)?;
+        conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0))
+            .map_err(sql)?;
+        conn.execute_batch("PRAGMA foreign_keys = ON")
+            .map_err(sql)?;
+        match migrate(&mut conn).map_err(sql)? {
+            Migrated::Current => Ok(Self {
+                conn,
+                path: path.to_path_buf(),
+            }),
+            Migrated::TooNew(found) => Err(LogbookError::SchemaTooNew {
+                path: path.to_path_buf(),
+                found,
+                supported: SCHEMA_VERSION,
+            }),
+        }
+    }
+
+    /// The database file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    pub(crate) fn sql(&self, source: rusqlite::Error) -> LogbookError {
+        LogbookError::Sqlite {
+            path: self.path.clone(),
+            source,
+        }
+    }
+
+    /// Add the log at `file`: a new flight, one already there (same content), or skipped with
+    /// the reason (recorded in `skipped` when the file could be hashed; a file that cannot be
+    /// read at all is only reported).
+    ///
+    /// # Errors
+    /// The database cannot be written (a log's own faults are [`AddOutcome::Skipped`]).
+    pub fn add(
+        &mut self,
+        file: &Path,
+        labels: &Labels,
+        options: &ReadOptions,
+    ) -> Result<AddOutcome> {
+        let sha = match file_sha256(file) {
+            Ok(s) => s,
+            Err(e) => {
+                return Ok(AddOutcome::Skipped {
+                    reason: format!("cannot read the file: {e}"),
+                })
+            }
+        };
+        if let Some(flight_id) = self.flight_of(&sha)? {
+            return Ok(AddOutcome::AlreadyPresent { flight_id });
+        }
+        let name = file.file_name().map_or_else(
+            || file.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        // Where it is, to read it again (`aloft logbook pack-file`): absolute when it can be.
+        let path = std::fs::canonicalize(file)
+            .unwrap_or_else(|_| file.to_path_buf())
+            .display()
+            .to_string();
+        // Read outside the write lock: another `add` writes meanwhile.
+        let facts = read_flight(file, options);
+        self.write(&sha, (&name, &path), facts, labels)
+            .map_err(|e| self.sql(e))
+    }
+
+    /// The flight with this file hash.
+    fn flight_of(&self, sha: &str) -> Result<Option<i64>> {
+        self.conn
+            .query_row(
+                "SELECT id FROM flights WHERE file_sha256 = ?1",
+                [sha],
+                |r| r.get(0),
+            )
+            .optional()
+            .map_err(|e| self.sql(e))
+    }
+
+    /// Write one file's row (its flight, or its `skipped` entry) in one transaction.
+    fn write(
+        &mut self,
+        sha: &str,
+        (name, path): (&str, &str),
+        facts: std::result::Result<FlightFacts, String>,
+        labels: &Labels,
+    ) -> rusqlite::Result<AddOutcome> {
+        let now = now_unix_s();
+        let tx = self
+            .conn
+            .transaction_with_behavior(TransactionBehavior::Immediate)?;
+        // Another process may have added the same file since it was looked up.
+        let present: Option<i64> = tx
+            .query_row(
+                "SELECT id FROM flights WHERE file_sha256 = ?1",
+                [sha],
+                |r| r.get(0),
+            )
+            .optional()?;
+        if let Some(flight_id) = present {
+            return Ok(AddOutcome::AlreadyPresent { flight_id });
+        }
+        let f = match facts {
+            Ok(f) => f,
+            Err(reason) => {
+                tx.execute(
+                    "INSERT INTO skipped (file_sha256, file_name, reason, added_unix_s)
+                     VALUES (?1, ?2, ?3, ?4)
+                     ON CONFLICT(file_sha256) DO UPDATE SET
+                       file_name = excluded.file_name, reason = excluded.reason",
+                    params![sha, name, reason, now],
+                )?;
+                tx.commit()?;
+                return Ok(AddOutcome::Skipped { reason });
+            }
+        };
+        let (vehicle_key, vehicle_source) = key(f.vehicle_id.as_deref(), labels.vehicle.as_deref());
+        let (pack_key, pack_source) = key(f.pack_id.as_deref(), labels.pack.as_deref());
+        tx.execute(
+            "INSERT OR IGNORE INTO vehicles (key, key_source, first_added_unix_s)
+             VALUES (?1, ?2, ?3)",
+            params![vehicle_key, vehicle_source, now],
+        )?;
+        tx.execute(
+            "INSERT OR IGNORE INTO packs (key, key_source, first_added_unix_s)
+             VALUES (?1, ?2, ?3)",
+            params![pack_key, pack_source, now],
+        )?;
+        if pack_key != UNKNOWN {
+            // The pack's rating and cells: the first log that states them.
+            tx.execute(
+                "UPDATE packs SET
+                   rated_capacity_mah = COALESCE(rated_capacity_mah, ?2),
+                   cells_series = COALESCE(cells_series, ?3)
+                 WHERE key = ?1",
+                params![pack_key, f.rated_capacity_mah, f.cells_series],
+            )?;
+        }
+        tx.execute(
+            "INSERT INTO flights (
+               file_sha256, file_name, format, vehicle_key, pack_key, start_unix_s, duration_s,
+               energy_wh, discharged_mah, max_current_a, min_voltage_v, mean_power_w,
+               added_unix_s, hover_power_w, cells_series, resistance_ohm,
+               autopilot_resistance_ohm, capacity_mah, capacity_refusal, imbalance_minor_min,
+               imbalance_major_min, file_path)
+             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16,
+                     ?17, ?18, ?19, ?20, ?21, ?22)",
+            params![
+                sha,
+                name,
+                f.format,
+                vehicle_key,
+                pack_key,
+                f.start_unix_s,
+                f.duration_s,
+                f.energy_wh,
+                f.discharged_mah,
+                f.max_current_a,
+                f.min_voltage_v,
+                f.mean_power_w,
+                now,
+                f.hover_power_w,
+                f.cells_series,
+                f.resistance_ohm,
+                f.autopilot_resistance_ohm,
+                f.capacity_mah,
+                f.capacity_refusal,
+                f.imbalance_minor_min,
+                f.imbalance_major_min,
+                path,
+            ],
+        )?;
+        let flight_id = tx.last_insert_rowid();
+        tx.execute("DELETE FROM skipped WHERE file_sha256 = ?1", [sha])?;
+        tx.commit()?;
+        Ok(AddOutcome::Added {
+            flight_id,
+            vehicle_key,
+            pack_key,
+        })
+    }
+}

@@ -1,0 +1,610 @@
+//! `aloft logbook`: the operator's flights, vehicles and packs in one SQLite file
+//! (`aloft_logbook`). This module parses the arguments, finds the file and renders the answers;
+//! the schema, the ingest and the queries are the logbook crate's.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use serde::Serialize;
+
+use aloft_logbook::{
+    AddOutcome, Flight, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
+};
+
+use super::output::{self, fixed, Row};
+use super::Outcome;
+
+/// Output format of the logbook's answers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
+pub enum BookFormat {
+    /// Aligned text for a terminal.
+    #[default]
+    Table,
+    /// JSON: `{"flights": [...]}`, `{"vehicles": [...]}`, `{"packs": [...]}`.
+    Json,
+}
+
+#[derive(Debug, Args)]
+pub struct LogbookArgs {
+    /// The logbook file. Default: $ALOFT_LOGBOOK, else $XDG_DATA_HOME/aloft/logbook.sqlite
+    /// (~/.local/share/aloft/logbook.sqlite), whose folder is created; the folder of a file
+    /// given here or in ALOFT_LOGBOOK must exist.
+    #[arg(long, global = true, value_name = "FILE")]
+    db: Option<PathBuf>,
+    #[command(subcommand)]
+    command: LogbookCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum LogbookCommand {
+    /// Add flight logs (CSV, MCAP, PX4 ULog, ArduPilot DataFlash): each file once, by content.
+    /// Exit 0 when at least one is added or already there, 1 when every one is skipped.
+    Add(AddArgs),
+    /// The flights, in flying order.
+    Flights(ListArgs),
+    /// Per vehicle: flights, hours, energy, the power of each flight and its drift.
+    Vehicles(ListArgs),
+    /// Per pack: flights, equivalent cycles, discharged charge, resistance trend, capacity
+    /// estimates, minutes of cell imbalance.
+    Packs(ListArgs),
+    /// The files that are not flights of the logbook, with the reason.
+    Skipped(ListArgs),
+    /// The pack file to fly a pack with (`aloft pack fit` over the pack's logs, read again
+    /// where they were when added; a log moved or changed since is left out, with a note).
+    /// Exit 1 when none of its logs can be used.
+    PackFile(PackFileArgs),
+}
+
+#[derive(Debug, Args)]
+struct PackFileArgs {
+    /// The pack's key (as `aloft logbook packs` lists it; not "unknown").
+    #[arg(value_name = "PACK")]
+    pack: String,
+    /// Where to write the pack file (TOML).
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// The pack's name in the file (default: its key).
+    #[arg(long, value_name = "NAME")]
+    name: Option<String>,
+    /// Cells in series, when the logs do not say.
+    #[arg(long, value_name = "N")]
+    cells: Option<u32>,
+    /// Rated capacity, mAh, when no capacity can be estimated from the logs.
+    #[arg(long, value_parser = aloft::engine::flags::finite(), value_name = "MAH")]
+    capacity_mah: Option<f64>,
+    /// The pack's mass, kg (logs do not say it).
+    #[arg(long, value_parser = aloft::engine::flags::finite(), value_name = "KG")]
+    mass_kg: Option<f64>,
+    /// CSV profile of the logs: kaist, px4, or a column-map TOML file.
+    #[arg(long, value_name = "PROFILE")]
+    profile: Option<String>,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = BookFormat::Table)]
+    format: BookFormat,
+}
+
+#[derive(Debug, Args)]
+struct AddArgs {
+    /// The logs.
+    #[arg(required = true, value_name = "LOG")]
+    logs: Vec<PathBuf>,
+    /// The vehicle of logs that do not identify theirs (PX4 sys_uuid, ArduPilot
+    /// BRD_SERIAL_NUM); without it they are filed under "unknown".
+    #[arg(long, value_name = "LABEL", value_parser = label)]
+    vehicle_label: Option<String>,
+    /// The pack of logs that do not identify theirs (a smart pack's serial, BATT_SERIAL_NUM);
+    /// without it they are filed under "unknown".
+    #[arg(long, value_name = "LABEL", value_parser = label)]
+    pack_label: Option<String>,
+    /// CSV profile: kaist, px4, or a column-map TOML file. Default: recognised from the file.
+    #[arg(long, value_name = "PROFILE")]
+    profile: Option<String>,
+    /// PX4 ULog / ArduPilot DataFlash: the battery instance to read (0: the first).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    battery_instance: u8,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = BookFormat::Table)]
+    format: BookFormat,
+}
+
+#[derive(Debug, Args)]
+struct ListArgs {
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = BookFormat::Table)]
+    format: BookFormat,
+}
+
+/// A label: not empty, not "unknown" (the key of logs without one), at most 200 characters.
+fn label(s: &str) -> Result<String, String> {
+    let t = s.trim();
+    if t.is_empty() || t.len() > 200 || t == aloft_logbook::UNKNOWN {
+        return Err(format!(
+            "'{s}' is not a label: 1 to 200 characters, not \"{}\"",
+            aloft_logbook::UNKNOWN
+        ));
+    }
+    Ok(t.to_string())
+}
+
+/// The logbook file and whether its folder may be created (only the default's).
+fn db_path(given: Option<PathBuf>) -> Result<(PathBuf, bool)> {
+    if let Some(p) = given {
+        return Ok((p, false));
+    }
+    if let Some(p) = std::env::var_os("ALOFT_LOGBOOK").filter(|p| !p.is_empty()) {
+        return Ok((PathBuf::from(p), false));
+    }
+    let data = std::env::var_os("XDG_DATA_HOME")
+        .filter(|p| !p.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| {
+            std::env::var_os("HOME")
+                .filter(|p| !p.is_empty())
+                .map(|h| Path::new(&h).join(".local/share"))
+        })
+        .context("no logbook file: give --db FILE or set ALOFT_LOGBOOK (neither XDG_DATA_HOME nor HOME is set)")?;
+    Ok((data.join("aloft").join("logbook.sqlite"), true))
+}
+
+fn open(given: Option<PathBuf>) -> Result<Logbook> {
+    let (path, create_folder) = db_path(given)?;
+    if create_folder {
+        if let Some(folder) = path.parent() {
+            std::fs::create_dir_all(folder)
+                .with_context(|| format!("{}: cannot create the folder", folder.display()))?;
+        }
+    }
+    Ok(Logbook::open(&path)?)
+}
+
+pub fn run(args: LogbookArgs) -> Result<Outcome> {
+    let mut book = open(args.db)?;
+    match args.command {
+        LogbookCommand::Add(a) => add(&mut book, a),
+        LogbookCommand::Flights(a) => {
+            let flights = book.flights()?;
+            list(a.format, "flights", &flights, |out| {
+                flights_table(out, &flights)
+            })
+        }
+        LogbookCommand::Vehicles(a) => {
+            let vehicles = book.vehicles()?;
+            list(a.format, "vehicles", &vehicles, |out| {
+                vehicles_table(out, &vehicles)
+            })
+        }
+        LogbookCommand::Packs(a) => {
+            let packs = book.packs()?;
+            list(a.format, "packs", &packs, |out| packs_table(out, &packs))
+        }
+        LogbookCommand::PackFile(a) => pack_file(&book, a),
+        LogbookCommand::Skipped(a) => {
+            let skipped = book.skipped()?;
+            list(a.format, "skipped", &skipped, |out| {
+                skipped_table(out, &skipped)
+            })
+        }
+    }
+}
+
+/// Print a list as `{"<key>": [...]}` or as its table.
+fn list<T: Serialize>(
+    format: BookFormat,
+    key: &str,
+    items: &[T],
+    table: impl FnOnce(&mut std::io::StdoutLock<'static>) -> Result<()>,
+) -> Result<Outcome> {
+    let mut out = std::io::stdout().lock();
+    match format {
+        BookFormat::Json => output::write_json(&mut out, &Keyed(key, items))?,
+        BookFormat::Table => table(&mut out)?,
+    }
+    Ok(Outcome::Ok)
+}
+
+/// The JSON answer of `aloft logbook KIND --format json` (KIND: `flights`, `vehicles`, `packs`,
+/// `skipped`) from the logbook at `db`, or the command line's message (the page's
+/// `/api/logbook/KIND`).
+#[cfg(feature = "serve")]
+pub(crate) fn answer_json(db: &Path, kind: &str) -> Result<String, String> {
+    let text = |e: &dyn std::fmt::Display| e.to_string();
+    let book = Logbook::open(db).map_err(|e| text(&e))?;
+    let json = match kind {
+        "flights" => serde_json::to_string(&Keyed(kind, &book.flights().map_err(|e| text(&e))?)),
+        "vehicles" => serde_json::to_string(&Keyed(kind, &book.vehicles().map_err(|e| text(&e))?)),
+        "packs" => serde_json::to_string(&Keyed(kind, &book.packs().map_err(|e| text(&e))?)),
+        "skipped" => serde_json::to_string(&Keyed(kind, &book.skipped().map_err(|e| text(&e))?)),
+        _ => {
+            return Err(format!(
+                "{kind}: not a list of the logbook (flights, vehicles, packs, skipped)"
+            ))
+        }
+    };
+    json.map_err(|e| text(&e))
+}
+
+/// `{"<key>": [...]}`, each item's fields in their declared order.
+struct Keyed<'a, T>(&'a str, &'a [T]);
+
+impl<T: Serialize> Serialize for Keyed<'_, T> {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(Some(1))?;
+        map.serialize_entry(self.0, self.1)?;
+        map.end()
+    }
+}
+
+/// One file's outcome, as `add --format json` lists it.
+#[derive(Debug, Serialize)]
+struct FileOutcome {
+    file: String,
+    #[serde(flatten)]
+    outcome: AddOutcome,
+}
+
+/// The answer of `add --format json`.
+#[derive(Debug, Serialize)]
+struct AddAnswer {
+    files: Vec<FileOutcome>,
+    added: usize,
+    already_present: usize,
+    skipped: usize,
+}
+
+fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
+    if let Some(p) = &a.profile {
+        aloft::engine::check_profile(p)?;
+    }
+    let labels = Labels {
+        vehicle: a.vehicle_label,
+        pack: a.pack_label,
+    };
+    let options = ReadOptions {
+        profile: a.profile,
+        battery_instance: a.battery_instance,
+    };
+    let mut files = Vec::new();
+    let mut out = std::io::stdout().lock();
+    for log in &a.logs {
+        let outcome = book.add(log, &labels, &options)?;
+        let file = log.display().to_string();
+        if a.format == BookFormat::Table {
+            writeln!(out, "{}", add_line(&file, &outcome))?;
+        }
+        files.push(FileOutcome { file, outcome });
+    }
+    let count = |f: fn(&AddOutcome) -> bool| files.iter().filter(|o| f(&o.outcome)).count();
+    let answer = AddAnswer {
+        added: count(|o| matches!(o, AddOutcome::Added { .. })),
+        already_present: count(|o| matches!(o, AddOutcome::AlreadyPresent { .. })),
+        skipped: count(|o| matches!(o, AddOutcome::Skipped { .. })),
+        files,
+    };
+    match a.format {
+        BookFormat::Json => output::write_json(&mut out, &answer)?,
+        BookFormat::Table => writeln!(
+            out,
+            "{} added, {} already in the logbook, {} skipped ({})",
+            answer.added,
+            answer.already_present,
+            answer.skipped,
+            book.path().display()
+        )?,
+    }
+    Ok(if answer.skipped == answer.files.len() {
+        Outcome::Failed
+    } else {
+        Outcome::Ok
+    })
+}
+
+fn add_line(file: &str, o: &AddOutcome) -> String {
+    match o {
+        AddOutcome::Added {
+            flight_id,
+            vehicle_key,
+            pack_key,
+        } => format!("added: {file} (flight {flight_id}, vehicle {vehicle_key}, pack {pack_key})"),
+        AddOutcome::AlreadyPresent { flight_id } => {
+            format!("already in the logbook: {file} (flight {flight_id})")
+        }
+        AddOutcome::Skipped { reason } => format!("skipped: {file} ({reason})"),
+    }
+}
+
+/// An optional figure with `decimals`, `-` when absent.
+fn opt(v: Option<f64>, decimals: usize) -> String {
+    v.map_or_else(|| "-".to_string(), |v| fixed(v, decimals))
+}
+
+/// Rows as aligned columns under a header (text left, numbers right).
+fn write_columns(out: &mut impl Write, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
+    let mut widths: Vec<usize> = header.iter().map(|h| h.len()).collect();
+    for r in rows {
+        for (w, c) in widths.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: Vec<&str>| -> String {
+        let parts: Vec<String> = cells
+            .iter()
+            .zip(&widths)
+            .enumerate()
+            .map(|(i, (c, w))| {
+                if i < 4 {
+                    format!("{c:<w$}")
+                } else {
+                    format!("{c:>w$}")
+                }
+            })
+            .collect();
+        parts.join("  ").trim_end().to_string()
+    };
+    writeln!(out, "{}", line(header.to_vec()))?;
+    for r in rows {
+        writeln!(out, "{}", line(r.iter().map(String::as_str).collect()))?;
+    }
+    Ok(())
+}
+
+fn flights_table(out: &mut impl Write, flights: &[Flight]) -> Result<()> {
+    if flights.is_empty() {
+        writeln!(out, "no flights in the logbook")?;
+        return Ok(());
+    }
+    let rows: Vec<Vec<String>> = flights
+        .iter()
+        .map(|f| {
+            vec![
+                f.id.to_string(),
+                f.file_name.clone(),
+                f.vehicle_key.clone(),
+                f.pack_key.clone(),
+                fixed(f.duration_s / 60.0, 1),
+                fixed(f.energy_wh, 1),
+                opt(f.discharged_mah, 0),
+                opt(f.mean_power_w, 0),
+                opt(f.hover_power_w, 0),
+                opt(f.resistance_ohm.map(|r| r * 1000.0), 1),
+            ]
+        })
+        .collect();
+    write_columns(
+        out,
+        &[
+            "id", "file", "vehicle", "pack", "min", "Wh", "mAh", "mean W", "hover W", "R mOhm",
+        ],
+        &rows,
+    )
+}
+
+/// A titled block of label and value lines, both left-aligned (the values are words and
+/// figures with their units).
+fn write_block(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> Result<()> {
+    writeln!(out, "{title}")?;
+    let lw = rows.iter().map(|r| r.label.len()).max().unwrap_or(0);
+    for r in rows {
+        let line = format!("  {:<lw$}  {} {}", r.label, r.value, r.unit);
+        writeln!(out, "{}", line.trim_end())?;
+    }
+    Ok(())
+}
+
+fn vehicles_table(out: &mut impl Write, vehicles: &[VehicleSummary]) -> Result<()> {
+    if vehicles.is_empty() {
+        writeln!(out, "no vehicles in the logbook")?;
+    }
+    for (i, v) in vehicles.iter().enumerate() {
+        if i > 0 {
+            writeln!(out)?;
+        }
+        let mut rows = vec![
+            Row::new("flights", v.flights.to_string(), ""),
+            Row::num("flight time", v.hours, 2, "h"),
+            Row::num("energy", v.energy_wh, 1, "Wh"),
+            Row::num("charge", v.discharged_mah, 0, "mAh"),
+            Row::new("packs", v.packs.join(", "), ""),
+        ];
+        if let Some(d) = &v.power_drift {
+            let what = if d.quantity == "hover_power_w" {
+                "hover power"
+            } else {
+                "mean power"
+            };
+            let change = d
+                .trend
+                .change_percent
+                .map_or_else(|| "n/a".to_string(), |c| format!("{c:+.1} %"));
+            rows.push(Row::new(
+                "power drift",
+                format!(
+                    "{what} {change} over the last {} flights ({:.0} W to {:.0} W)",
+                    d.trend.n, d.trend.first, d.trend.last
+                ),
+                "",
+            ));
+        }
+        write_block(out, &format!("vehicle {} ({})", v.key, v.key_source), &rows)?;
+    }
+    Ok(())
+}
+
+fn packs_table(out: &mut impl Write, packs: &[PackSummary]) -> Result<()> {
+    if packs.is_empty() {
+        writeln!(out, "no packs in the logbook")?;
+    }
+    for (i, p) in packs.iter().enumerate() {
+        if i > 0 {
+            writeln!(out)?;
+        }
+        let mut rows = vec![
+            Row::new("flights", p.flights.to_string(), ""),
+            Row::num("flight time", p.hours, 2, "h"),
+            Row::num("discharged", p.discharged_mah, 0, "mAh"),
+            Row::num("energy", p.energy_wh, 1, "Wh"),
+        ];
+        match (p.equivalent_cycles, p.rated_capacity_mah) {
+            (Some(c), Some(r)) => rows.push(Row::new(
+                "equivalent cycles",
+                format!("{c:.2} (rated {r:.0} mAh)"),
+                "",
+            )),
+            _ => rows.push(Row::new(
+                "equivalent cycles",
+                "n/a: no rated capacity".into(),
+                "",
+            )),
+        }
+        if let Some(c) = p.cells_series {
+            rows.push(Row::new("cells in series", c.to_string(), ""));
+        }
+        rows.push(Row::new(
+            "resistance",
+            match &p.resistance_trend {
+                Some(t) => format!(
+                    "first {:.1} mOhm, last {:.1} mOhm, slope {} mOhm/flight, n {}",
+                    t.first * 1000.0,
+                    t.last * 1000.0,
+                    opt(t.slope_per_flight.map(|s| s * 1000.0), 2),
+                    t.n
+                ),
+                None if p.resistance.is_empty() => "n/a: no estimate".into(),
+                None => format!(
+                    "{} estimates, no trend (the flights of \"{}\" are of any pack)",
+                    p.resistance.len(),
+                    aloft_logbook::UNKNOWN
+                ),
+            },
+            "",
+        ));
+        rows.push(Row::new(
+            "capacity estimates",
+            if p.capacity.is_empty() {
+                "none".into()
+            } else {
+                p.capacity
+                    .iter()
+                    .map(|c| format!("{:.0}", c.value))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+                    + " mAh"
+            },
+            "",
+        ));
+        rows.push(Row::new(
+            "cell imbalance > 0.01 V",
+            opt(p.imbalance_minor_min, 1),
+            "min",
+        ));
+        rows.push(Row::new(
+            "cell imbalance > 0.07 V",
+            opt(p.imbalance_major_min, 1),
+            "min",
+        ));
+        rows.push(Row::new("vehicles", p.vehicles.join(", "), ""));
+        write_block(out, &format!("pack {} ({})", p.key, p.key_source), &rows)?;
+    }
+    Ok(())
+}
+
+fn skipped_table(out: &mut impl Write, skipped: &[Skipped]) -> Result<()> {
+    if skipped.is_empty() {
+        writeln!(out, "no skipped files")?;
+    }
+    for s in skipped {
+        writeln!(out, "{}: {}", s.file_name, s.reason)?;
+    }
+    Ok(())
+}
+
+/// The logs of a pack that are still where they were and as they were (by content), and a note
+/// for each of the others.
+fn pack_logs(flights: &[Flight]) -> (Vec<PathBuf>, Vec<String>) {
+    let mut logs = Vec::new();
+    let mut notes = Vec::new();
+    for f in flights {
+        let Some(path) = f.file_path.as_deref().map(PathBuf::from) else {
+            notes.push(format!(
+                "{}: left out: added before the logbook kept where logs are",
+                f.file_name
+            ));
+            continue;
+        };
+        match aloft_logbook::file_sha256(&path) {
+            Ok(sha) if sha == f.file_sha256 => logs.push(path),
+            Ok(_) => notes.push(format!(
+                "{}: left out: the file has changed since it was added",
+                path.display()
+            )),
+            Err(e) => notes.push(format!("{}: left out: {e}", path.display())),
+        }
+    }
+    (logs, notes)
+}
+
+fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
+    use aloft::engine::{fit_pack, PackFitRequest};
+    if a.pack == aloft_logbook::UNKNOWN {
+        anyhow::bail!(
+            "pack \"{}\": its flights are of any pack; add logs with --pack-label to give a pack its flights",
+            aloft_logbook::UNKNOWN
+        );
+    }
+    let flights = book.flights_of_pack(&a.pack)?;
+    if flights.is_empty() {
+        anyhow::bail!(
+            "pack \"{}\": no such pack in {}",
+            a.pack,
+            book.path().display()
+        );
+    }
+    let (logs, notes) = pack_logs(&flights);
+    for n in &notes {
+        eprintln!("aloft logbook pack-file: {n}");
+    }
+    if logs.is_empty() {
+        eprintln!(
+            "aloft logbook pack-file: no log of pack \"{}\" can be read again: no pack written",
+            a.pack
+        );
+        return Ok(Outcome::Failed);
+    }
+    let request = PackFitRequest {
+        logs,
+        profile: a.profile,
+        name: Some(a.name.unwrap_or_else(|| a.pack.clone())),
+        cells_series: a.cells,
+        capacity_mah: a.capacity_mah,
+        mass_kg: a.mass_kg,
+        output: Some(a.output.clone()),
+        ..PackFitRequest::default()
+    };
+    let answer = fit_pack(&request)?;
+    for s in &answer.skipped {
+        eprintln!("aloft logbook pack-file: {}: skipped: {}", s.file, s.reason);
+    }
+    for n in &answer.notes {
+        eprintln!("aloft logbook pack-file: {n}");
+    }
+    if answer.pack.is_none() {
+        eprintln!("aloft logbook pack-file: no usable log: no pack written");
+        return Ok(Outcome::Failed);
+    }
+    let mut out = std::io::stdout().lock();
+    match a.format {
+        BookFormat::Json => output::write_json(&mut out, &answer)?,
+        BookFormat::Table => writeln!(
+            out,
+            "wrote {}: pack {} from {} logs, resistance {} mOhm, capacity {} mAh",
+            answer.output,
+            a.pack,
+            answer.logs.len(),
+            opt(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
+            opt(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
+        )?,
+    }
+    Ok(Outcome::Ok)
+}
