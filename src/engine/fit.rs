@@ -15,7 +15,7 @@ use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
 use super::finite::finite;
-use super::fit_quality::{judge_fit, Envelope, FitQuality};
+use super::fit_quality::{judge_fit, Alignment, Envelope, FitQuality};
 use super::logs::{FlightLogs, SkippedLog};
 use super::vehicles::Vehicle;
 use crate::error::Error;
@@ -243,7 +243,15 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         max_speed_mps: a.max_speed_mps,
         max_climb_rate_mps: a.max_climb_rate_mps,
     });
-    let (quality, quality_reasons) = judge_fit(power.nrmse, &logs, &samples, envelope);
+    let alignments: Vec<Alignment> = logs
+        .iter()
+        .map(|l| Alignment {
+            file: &l.file,
+            lag_s: l.lag_s,
+            correlation: l.lag_correlation,
+        })
+        .collect();
+    let (quality, quality_reasons) = judge_fit(power.nrmse, &alignments, &samples, envelope);
     let vehicle_toml =
         fitted_vehicle_toml(template.file(), &power, drag.as_ref(), &logs, &vehicle)?;
     if let Some(path) = &request.output {

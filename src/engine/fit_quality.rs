@@ -18,8 +18,6 @@ use serde::Serialize;
 
 use aloft_power::FitSample;
 
-use super::fit::LogFitReport;
-
 /// The verdict of a fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -30,6 +28,17 @@ pub enum FitQuality {
     Usable,
     /// Not to be trusted: see the reasons.
     Poor,
+}
+
+/// How one log of a fit was aligned.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Alignment<'a> {
+    /// The log.
+    pub file: &'a str,
+    /// Lag of power behind motion applied, s.
+    pub lag_s: f64,
+    /// Correlation of power with tilt at that lag (`None` when the lag was given).
+    pub correlation: Option<f64>,
 }
 
 /// What the fit covered of the vehicle's envelope, where the vehicle has one.
@@ -44,7 +53,7 @@ pub struct Envelope {
 /// The verdict and why, from the fit's NRMSE (a fraction), its logs and the samples it used.
 pub fn judge_fit(
     nrmse: f64,
-    logs: &[LogFitReport],
+    logs: &[Alignment<'_>],
     samples: &[FitSample],
     envelope: Option<Envelope>,
 ) -> (FitQuality, Vec<String>) {
@@ -67,8 +76,8 @@ pub fn judge_fit(
         ),
     );
     for l in logs {
-        let name = l.file.rsplit('/').next().unwrap_or(&l.file);
-        if let Some(c) = l.lag_correlation {
+        let name = l.file.rsplit('/').next().unwrap_or(l.file);
+        if let Some(c) = l.correlation {
             if c < 0.3 {
                 say(
                     FitQuality::Poor,
@@ -150,14 +159,11 @@ mod tests {
             .collect()
     }
 
-    fn log(lag_s: f64, c: Option<f64>) -> LogFitReport {
-        LogFitReport {
-            file: "a/b.ulg".into(),
+    fn log(lag_s: f64, c: Option<f64>) -> Alignment<'static> {
+        Alignment {
+            file: "a/b.ulg",
             lag_s,
-            lag_correlation: c,
-            samples: 1000,
-            skipped: 0,
-            pack: None,
+            correlation: c,
         }
     }
 

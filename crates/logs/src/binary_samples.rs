@@ -23,7 +23,7 @@ pub struct BinaryOptions {
     /// Longest interval of a topic across which values are interpolated, s.
     pub max_bracket_s: f64,
     /// Collect every battery record with its details (cells, resistance, counters), the
-    /// battery parameters and the identities, for [`crate::battery_log`] (off: the samples
+    /// battery parameters and the identities, for [`crate::battery_records`] (off: the samples
     /// only).
     pub battery_details: bool,
 }
@@ -44,9 +44,9 @@ impl Default for BinaryOptions {
 /// does not count as power data.
 pub const MIN_BATTERY_COVERAGE: f64 = 0.5;
 
-/// Largest battery capacity a log's parameters may give, mA h (10,000 A h, the end of the CSV
-/// charge range): a larger or non-finite one is a corrupt parameter and is not read.
-pub const MAX_BATTERY_CAPACITY_MAH: f64 = 1e7;
+/// Largest battery capacity a log's parameters may give (a larger or non-finite one is a
+/// corrupt parameter and is not read); its home is [`crate::battery_records`].
+pub use crate::battery_records::MAX_BATTERY_CAPACITY_MAH;
 
 /// A capacity parameter in mA h as A h, when it is positive and at most
 /// [`MAX_BATTERY_CAPACITY_MAH`] (an infinite one made the answer of `log info` not finite).
@@ -117,7 +117,7 @@ pub struct BinarySummary {
     pub warnings: Vec<String>,
     /// The battery records in detail, when [`BinaryOptions::battery_details`] is set.
     #[serde(skip)]
-    pub(crate) battery_details: Option<crate::battery_log::BatteryDetails>,
+    pub(crate) battery_details: Option<crate::battery_records::BatteryDetails>,
     #[serde(skip)]
     pub(crate) rho_sum: f64,
     #[serde(skip)]

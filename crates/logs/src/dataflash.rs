@@ -477,7 +477,7 @@ impl DataflashDecoder {
                         crate::binary_samples::capacity_ah(v).or(s.battery_capacity_ah);
                 }
                 if let Some(d) = &mut s.battery_details {
-                    if crate::battery_log::is_battery_parameter(&name) && v.is_finite() {
+                    if crate::battery_records::is_battery_parameter(&name) && v.is_finite() {
                         d.parameters.insert(name, v);
                     }
                 }
@@ -659,7 +659,7 @@ impl DataflashDecoder {
         }
         if let Some(d) = &mut s.battery_details {
             let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
-            d.samples.push(crate::battery_log::BatterySample {
+            d.samples.push(crate::battery_records::BatterySample {
                 time_s: t,
                 voltage_v: v,
                 current_a: Some(i),
@@ -697,7 +697,7 @@ impl DataflashDecoder {
         let cells: Vec<f64> = (1..=12)
             .filter_map(|k| f.num(p, &format!("V{k}")))
             .map(|mv| mv * 1e-3)
-            .filter(|v| crate::battery_log::valid_cell(*v))
+            .filter(|v| crate::battery_records::valid_cell(*v))
             .collect();
         if let Some(last) = d.samples.last_mut() {
             if last.cell_v.is_empty() {

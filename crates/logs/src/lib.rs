@@ -37,6 +37,7 @@
 #![deny(clippy::float_cmp)]
 
 pub mod battery_log;
+pub mod battery_records;
 pub mod binary;
 mod binary_samples;
 pub mod bytes;
@@ -64,9 +65,8 @@ pub mod synth;
 pub mod telemetry;
 pub mod ulog;
 
-pub use battery_log::{
-    read_battery_log, read_dataflash_battery, read_ulog_battery, BatteryLog, BatterySample,
-};
+pub use battery_log::{read_battery_log, read_dataflash_battery, read_ulog_battery};
+pub use battery_records::{BatteryLog, BatterySample};
 pub use binary::{
     read_dataflash, read_ulog, BinaryLog, BinaryOptions, BinarySamples, BinarySummary,
 };

@@ -222,13 +222,13 @@ struct Sub {
     timestamp: Option<Loc>,
     topic: Option<Topic>,
     locs: Vec<Option<Loc>>,
-    /// `battery_status` fields read for [`crate::battery_log`].
+    /// `battery_status` fields read for [`crate::battery_records`].
     battery: Option<Box<BatteryLocs>>,
     /// `time_utc_usec` of a GPS topic (`vehicle_gps_position`, `sensor_gps`).
     utc: Option<Loc>,
 }
 
-/// Where the `battery_status` fields of [`crate::battery_log`] lie in a data record.
+/// Where the `battery_status` fields of [`crate::battery_records`] lie in a data record.
 #[derive(Debug, Clone, Default)]
 struct BatteryLocs {
     voltage: Option<Loc>,
@@ -545,7 +545,7 @@ impl UlogDecoder {
             _ => return Err(format!("parameter '{key}' of unknown type")),
         };
         if let (Some(name), Some(d)) = (key.split_once(' ').map(|k| k.1), &mut s.battery_details) {
-            if crate::battery_log::is_battery_parameter(name) && v.is_finite() {
+            if crate::battery_records::is_battery_parameter(name) && v.is_finite() {
                 d.parameters.insert(name.to_string(), v);
             }
         }
@@ -837,7 +837,7 @@ fn info(b: &[u8], s: &mut BinarySummary) {
         return;
     };
     if key.starts_with("char[") && key.ends_with(" sys_uuid") {
-        let text = crate::battery_log::text_id(value);
+        let text = crate::battery_records::text_id(value);
         if let (Some(d), Some(t)) = (&mut s.battery_details, text) {
             d.vehicle_id = Some(t);
         }
@@ -869,7 +869,7 @@ fn battery_details(sub: &Sub, payload: &[u8], instance: u8, s: &mut BinarySummar
         .cells
         .iter()
         .filter_map(|c| c.prim.read(payload, c.offset))
-        .filter(|v| crate::battery_log::valid_cell(*v))
+        .filter(|v| crate::battery_records::valid_cell(*v))
         .collect();
     if let Some(n) = read(l.cell_count).filter(|n| *n >= 1.0 && *n <= 64.0) {
         d.cells_logged = Some(n as u32);
@@ -878,7 +878,7 @@ fn battery_details(sub: &Sub, payload: &[u8], instance: u8, s: &mut BinarySummar
         let id = if count > 1 {
             payload
                 .get(loc.offset..loc.offset + count)
-                .and_then(crate::battery_log::text_id)
+                .and_then(crate::battery_records::text_id)
         } else {
             read(Some(loc))
                 .filter(|v| *v >= 1.0)
@@ -898,7 +898,7 @@ fn battery_details(sub: &Sub, payload: &[u8], instance: u8, s: &mut BinarySummar
     if let Some(r) = r_cell {
         d.per_cell_resistance.push((d.samples.len(), r));
     }
-    d.samples.push(crate::battery_log::BatterySample {
+    d.samples.push(crate::battery_records::BatterySample {
         time_s: t,
         voltage_v: volt,
         current_a: read(l.current).filter(|i| i.is_finite() && *i >= 0.0),
