@@ -33,11 +33,7 @@ pub struct EnduranceArgs {
 }
 
 pub fn run(mut args: EnduranceArgs) -> Result<Outcome> {
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.flags.vehicle)?,
-        args.flags.battery.as_deref(),
-    )?;
-    args.flags.battery = flying.battery.clone();
+    let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let options = args.flags.options();
     if let Some(sweep) = &args.flags.payload_sweep {

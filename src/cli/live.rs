@@ -10,7 +10,7 @@ use clap::{Args, ValueEnum};
 use aloft::engine::flags::{LiveFlags, LiveTask};
 use aloft::engine::{
     follow_live, replay_live, Error, LiveCheck, LiveCheckpoint, LiveRecorder, LiveSummary,
-    LiveUpdate, Vehicle,
+    LiveUpdate,
 };
 
 use super::Outcome;
@@ -39,11 +39,7 @@ pub struct LiveArgs {
 }
 
 pub fn run(mut args: LiveArgs) -> Result<Outcome> {
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.flags.vehicle)?,
-        args.flags.battery.as_deref(),
-    )?;
-    args.flags.battery = flying.battery.clone();
+    let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let task = args.flags.request()?;
     let stdout = std::io::stdout();

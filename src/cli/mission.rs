@@ -6,7 +6,7 @@ use std::io::Write;
 
 use anyhow::{bail, Context, Result};
 
-use aloft::engine::{plan_mission_with, Mission, MissionReport, Plan, Sample, Vehicle};
+use aloft::engine::{plan_mission_with, Mission, MissionReport, Plan, Sample};
 
 use super::mission_args::MissionArgs;
 use super::mission_view::{
@@ -24,11 +24,7 @@ pub fn run(mut args: MissionArgs) -> Result<Outcome> {
     if args.format == Format::Csv {
         bail!("aloft mission writes table or json; use --timeseries for a CSV of samples");
     }
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.flags.vehicle)?,
-        args.flags.battery.as_deref(),
-    )?;
-    args.flags.battery = flying.battery.clone();
+    let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let options = flying.with_failsafes(args.flags.options());
     let vehicle = flying.vehicle;
     let mission = Mission::load(args.mission.as_deref())?;

@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::flags::PlanFlags;
-use aloft::engine::{answers, plan_to_fly, FlyPlan, Mission, PlanFigures, Vehicle};
+use aloft::engine::{answers, plan_to_fly, FlyPlan, Mission, PlanFigures};
 
 use super::mission_view::mmss;
 use super::output;
@@ -37,11 +37,8 @@ pub fn run(mut args: PlanArgs) -> Result<Outcome> {
     if args.format == Format::Csv {
         bail!("aloft plan writes table or json");
     }
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.flags.mission.vehicle)?,
-        args.flags.mission.battery.as_deref(),
-    )?;
-    args.flags.mission.battery = flying.battery.clone();
+    let flying =
+        aloft::engine::load_flying(&args.flags.mission.vehicle, &mut args.flags.mission.battery)?;
     let vehicle = flying.vehicle;
     let mission = Mission::load(args.mission.as_deref())?;
     let request = args.flags.request()?;

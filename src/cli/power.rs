@@ -7,8 +7,7 @@ use anyhow::{bail, Result};
 use clap::Args;
 
 use aloft::engine::{
-    power_csv_file, power_point, power_values, FlightStateDeg, PowerAnswer, PowerQuery, Vehicle,
-    POWER_KEYS,
+    power_csv_file, power_point, power_values, FlightStateDeg, PowerAnswer, PowerQuery, POWER_KEYS,
 };
 
 use super::output;
@@ -68,11 +67,7 @@ impl PowerArgs {
 }
 
 pub fn run(mut args: PowerArgs) -> Result<Outcome> {
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.model.vehicle)?,
-        args.model.battery.as_deref(),
-    )?;
-    args.model.battery = flying.battery.clone();
+    let flying = aloft::engine::load_flying(&args.model.vehicle, &mut args.model.battery)?;
     let vehicle = flying.vehicle;
     if let Some(path) = &args.input {
         if matches!(args.format, Some(Format::Json | Format::Table)) {

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 
 use aloft::engine::flags::ValidateFlags;
-use aloft::engine::{validate_logs, PowerSeries, ValidateReport, Vehicle};
+use aloft::engine::{validate_logs, PowerSeries, ValidateReport};
 
 use super::flights::file_name;
 use super::output;
@@ -28,11 +28,7 @@ pub struct ValidateArgs {
 }
 
 pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
-    let flying = aloft::engine::fly_with_battery(
-        Vehicle::load(&args.flags.vehicle)?,
-        args.flags.battery.as_deref(),
-    )?;
-    args.flags.battery = flying.battery.clone();
+    let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let request = args.flags.request(args.plot.is_some());
     let answer = validate_logs(&vehicle, &request)?;

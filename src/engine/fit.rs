@@ -149,37 +149,10 @@ pub struct FitAnswer {
 /// cannot identify, an output that cannot be written.
 pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
     let mut vehicle = template.power_model()?.vehicle().clone();
-    // Each log on its own: one that cannot be used is skipped with its reason.
-    let mut flights = Vec::new();
-    let mut skipped_logs = Vec::new();
-    for (path, loaded) in request.logs.logs.iter().zip(request.logs.load_each()?) {
-        match loaded {
-            Ok(flight) => flights.push(flight),
-            Err(e) => skipped_logs.push(SkippedLog {
-                file: path.display().to_string(),
-                reason: e.to_string(),
-            }),
-        }
-    }
-    if flights.is_empty() {
-        return Err(Error::NoUsableLog {
-            reasons: skipped_logs
-                .iter()
-                .map(|s| s.reason.clone())
-                .collect::<Vec<_>>()
-                .join("; "),
-        });
-    }
-    // The logs' own air: the constants are fitted in it and written for the template's density
-    // (ISA sea level unless the template says otherwise), term by term as the model carries
-    // density (`aloft_power::VehicleParams::in_air`).
+    let (flights, skipped_logs) = usable_logs(&request.logs)?;
+    // The logs' own air: the constants are fitted in it and written for the template's density.
     let reference_density = vehicle.air_density_kg_m3();
-    let densities: Vec<f64> = flights
-        .iter()
-        .filter_map(|(f, _)| f.air_density_kg_m3)
-        .collect();
-    let log_density =
-        (!densities.is_empty()).then(|| densities.iter().sum::<f64>() / densities.len() as f64);
+    let (log_density, with_air) = logs_air(&flights);
     if let Some(rho) = log_density {
         vehicle = aloft_power::Vehicle::new(vehicle.params().in_air(rho))?;
     }
@@ -221,7 +194,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         power.vehicle = power.vehicle.in_air(reference_density);
         notes.push(format!(
             "fitted in the logs' own air, {rho:.4} kg/m^3 (the mean of the logs' own, PX4 vehicle_air_data or ArduPilot BARO, over {} of {} logs), and written for {reference_density:.4} kg/m^3: kappa1 x {:.4}, drag x {:.4} (the fitted values above are the logs' air's)",
-            densities.len(),
+            with_air,
             flights.len(),
             (rho / reference_density).sqrt(),
             reference_density / rho
@@ -283,6 +256,47 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         "fit",
         || format!("logs {:?}", request.logs.logs),
     )
+}
+
+/// A log aligned for the fit, with its samples.
+type Flight = (crate::identify::AlignedFlight, aloft_logs::Log);
+
+/// The logs that can be used, aligned, and those that cannot, each with its reason.
+///
+/// # Errors
+/// [`Error::NoUsableLog`] when no log can be used; what every log shares (a profile).
+fn usable_logs(logs: &FlightLogs) -> Result<(Vec<Flight>, Vec<SkippedLog>), Error> {
+    let mut flights = Vec::new();
+    let mut skipped = Vec::new();
+    for (path, loaded) in logs.logs.iter().zip(logs.load_each()?) {
+        match loaded {
+            Ok(flight) => flights.push(flight),
+            Err(e) => skipped.push(SkippedLog {
+                file: path.display().to_string(),
+                reason: e.to_string(),
+            }),
+        }
+    }
+    if flights.is_empty() {
+        let reasons: Vec<&str> = skipped.iter().map(|s| s.reason.as_str()).collect();
+        return Err(Error::NoUsableLog {
+            reasons: reasons.join("; "),
+        });
+    }
+    Ok((flights, skipped))
+}
+
+/// The mean of the air densities the logs carry (PX4
+/// `vehicle_air_data`, ArduPilot `BARO`), kg/m^3, and how many logs carry one. The constants are
+/// fitted in that air and carried back to the template's density term by term
+/// (`aloft_power::VehicleParams::in_air`).
+fn logs_air(flights: &[Flight]) -> (Option<f64>, usize) {
+    let densities: Vec<f64> = flights
+        .iter()
+        .filter_map(|(f, _)| f.air_density_kg_m3)
+        .collect();
+    let n = densities.len();
+    ((n > 0).then(|| densities.iter().sum::<f64>() / n as f64), n)
 }
 
 /// Pack resistance of one log, when it has voltage and current.

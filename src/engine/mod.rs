@@ -17,7 +17,7 @@
 //! | propulsion | [`hover`], [`hover_sweep`], [`RotorRequest`] → [`rotor_response`] | [`HoverResult`], [`HoverSweep`], [`RotorAnswer`] | `propulsion.rs` |
 //! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
 //! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `fit.rs`, `validate.rs` |
-//! | packs | [`PackFitRequest`] → [`fit_pack`] (logs → a pack file); a `--battery` value → [`fly_with_battery`] (a pack name, or a [`PackFile`] flown, for every command that flies) | [`PackFitAnswer`], [`FlyingPack`] | `pack_fit.rs`, `pack_file.rs` |
+//! | packs | [`PackFitRequest`] → [`fit_pack`] (logs → a pack file); a `--battery` value → [`fly_with_battery`] (the command line: [`load_flying`]) (a pack name, or a [`PackFile`] flown, for every command that flies) | [`PackFitAnswer`], [`FlyingPack`] | `pack_fit.rs`, `pack_file.rs` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `estimator.rs` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `scenarios.rs`, `scenario_stats.rs` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
@@ -129,7 +129,7 @@ pub use mission_map::{
 };
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
-pub use pack_file::{fly_with_battery, is_pack_file, Failsafe, FlyingPack, PackFile};
+pub use pack_file::{fly_with_battery, is_pack_file, load_flying, Failsafe, FlyingPack, PackFile};
 pub use pack_fit::{
     fit_pack, PackFitAnswer, PackFitRequest, DEFAULT_CUTOFF_CELL_V, DEFAULT_NOMINAL_CELL_V,
 };

@@ -141,6 +141,21 @@ impl FlyingPack {
 /// # Errors
 /// As [`PackFile::load`], or a vehicle that does not accept the pack.
 pub fn fly_with_battery(vehicle: Vehicle, battery: Option<&str>) -> Result<FlyingPack, Error> {
+    fly_pack(vehicle, battery)
+}
+
+/// The command line's `--vehicle NAME|FILE` and `--battery NAME|pack.toml`: the vehicle loaded
+/// and flown with the pack ([`fly_with_battery`]), and `battery` set to the pack's name.
+///
+/// # Errors
+/// As [`Vehicle::load`] and [`fly_with_battery`].
+pub fn load_flying(vehicle: &str, battery: &mut Option<String>) -> Result<FlyingPack, Error> {
+    let flying = fly_pack(Vehicle::load(vehicle)?, battery.as_deref())?;
+    battery.clone_from(&flying.battery);
+    Ok(flying)
+}
+
+fn fly_pack(vehicle: Vehicle, battery: Option<&str>) -> Result<FlyingPack, Error> {
     let Some(path) = battery.filter(|b| is_pack_file(b)) else {
         return Ok(FlyingPack {
             vehicle,
