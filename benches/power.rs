@@ -103,10 +103,7 @@ fn bench_fit(c: &mut Criterion) {
             let pitch = -(truth.vehicle().drag().force_n(v) / w).atan() + 0.05 * s;
             let state = FlightState::new(v, 0.3 * s, pitch, if i % 7 == 0 { 2.0 * s } else { 0.0 });
             let p = truth.evaluate(&state).expect("valid").electrical_w;
-            FitSample {
-                state,
-                measured_power_w: p * (1.0 + 0.01 * s),
-            }
+            FitSample::new(state, p * (1.0 + 0.01 * s))
         })
         .collect();
     let start = Vehicle::new(VehicleParams {

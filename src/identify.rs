@@ -269,10 +269,7 @@ fn pair_with_power(
         match interpolate(&power.times_s, &power.power_w, t + lag_s) {
             Some(p) if p > 0.0 => {
                 times_s.push(t);
-                samples.push(FitSample {
-                    state: *state,
-                    measured_power_w: p,
-                });
+                samples.push(FitSample::new(*state, p));
             }
             _ => unpaired += 1,
         }
@@ -315,6 +312,7 @@ pub fn force_samples(log: &Log) -> Vec<aloft_power::ForceSample> {
                 roll_rad: att.roll_rad,
                 pitch_rad: att.pitch_rad,
                 yaw_rad: att.yaw_rad,
+                mass_ratio: 1.0,
             })
         })
         .collect()

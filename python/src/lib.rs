@@ -217,17 +217,17 @@ fn log_info_json(
 
 /// `aloft fit --format json` as text (the vehicle file written only when `output` is given).
 #[pyfunction]
-#[pyo3(signature = (logs, vehicle_template, options=None))]
+#[pyo3(signature = (logs, vehicle_template=None, options=None))]
 fn fit_json(
     py: Python<'_>,
     logs: Vec<PathBuf>,
-    vehicle_template: String,
+    vehicle_template: Option<String>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let positional = [
-        ("log", options::paths(&logs)),
-        ("vehicle_template", options::text(&vehicle_template)),
-    ];
+    let mut positional = vec![("log", options::paths(&logs))];
+    if let Some(t) = &vehicle_template {
+        positional.push(("vehicle_template", options::text(t)));
+    }
     let flags: FitFlags = options::parse("fit", &positional, options)?;
     py.detach(|| answers::fit_answer(&flags))
         .map_err(engine_error)

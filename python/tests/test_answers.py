@@ -239,3 +239,24 @@ def test_live_refuses_bad_options_and_links(data):
         aloft.live(log, "dji-m100", every=0)
     with pytest.raises(aloft.AloftError, match="live"):
         aloft.live(log, "dji-m100", speed="fast")
+
+
+def test_fit_of_an_own_vehicle_equals_cli(cli, data, tmp_path):
+    """Without a template: the owner's flags, a per-log payload; the missing flag is named."""
+    logs = sorted((data / "px4_flugdrohne" / "ulg").glob("*.ulg"))
+    with_payload = [str(logs[0])] + [f"{p}:payload_kg=0.3" for p in logs[1:]]
+    owner = {"mass_kg": 1.2, "rotor_diameter_m": 0.254, "battery_capacity_mah": 5000}
+    cli_toml, py_toml = tmp_path / "quad.toml", tmp_path / "py" / "quad.toml"
+    py_toml.parent.mkdir()
+    args = ["fit"]
+    for p in with_payload:
+        args += ["--log", p]
+    expected = cli.json(*args, "--mass-kg", "1.2", "--rotor-diameter-m", "0.254",
+                        "--battery-capacity-mah", "5000", "-o", str(cli_toml))
+    got = aloft.fit(with_payload, output=py_toml, **owner)
+    assert (got.pop("output"), expected.pop("output")) == (str(py_toml), str(cli_toml))
+    assert got == expected
+    assert [s["file"] for s in got["skipped_logs"]] == [str(logs[3])]  # log_65
+    assert py_toml.read_text() == cli_toml.read_text()
+    with pytest.raises(aloft.AloftError, match="--mass-kg"):
+        aloft.fit(logs, rotor_diameter_m=0.254)

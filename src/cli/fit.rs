@@ -7,7 +7,7 @@ use anyhow::Result;
 use clap::Args;
 
 use aloft::engine::flags::FitFlags;
-use aloft::engine::{fit_logs, FitAnswer, FitQuality, FitRequest, Vehicle};
+use aloft::engine::{fit_logs, FitAnswer, FitQuality, FitRequest};
 
 use super::flights::file_name;
 use super::output::{self, Row};
@@ -26,7 +26,7 @@ pub struct FitArgs {
 }
 
 pub fn run(args: FitArgs) -> Result<Outcome> {
-    let template = Vehicle::load(&args.flags.vehicle_template)?;
+    let template = args.flags.template()?;
     let request = args.flags.request()?;
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new_spinner();

@@ -267,7 +267,7 @@ pub fn log_info_answer_as(path: &Path, name: &str, flags: &LogInfoFlags) -> Resu
 /// # Errors
 /// As [`fit_logs`].
 pub fn fit_answer(flags: &FitFlags) -> Result<String, Error> {
-    let template = Vehicle::load(&flags.vehicle_template)?;
+    let template = flags.template()?;
     json_text(&fit_logs(&template, &flags.request()?)?)
 }
 

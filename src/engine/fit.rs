@@ -17,6 +17,7 @@ use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 use super::finite::finite;
 use super::fit_quality::{judge_fit, Alignment, Envelope, FitQuality};
 use super::logs::{FlightLogs, SkippedLog};
+use super::own_vehicle::{complete_vehicle, Completed, OwnVehicle};
 use super::vehicles::Vehicle;
 use crate::error::Error;
 use crate::identify::force_samples;
@@ -38,6 +39,11 @@ pub struct FitRequest {
     pub output: Option<PathBuf>,
     /// Called at each Gauss-Newton iteration.
     pub progress: Option<FitProgress>,
+    /// What the owner states of the vehicle that the logs do not record.
+    pub own: OwnVehicle,
+    /// The template is the generic one (`aloft vehicles template`): its mass, rotor size and
+    /// capacity are guesses that never stand in the written vehicle.
+    pub generic_template: bool,
 }
 
 impl Default for FitRequest {
@@ -48,6 +54,8 @@ impl Default for FitRequest {
             no_drag: false,
             output: None,
             progress: None,
+            own: OwnVehicle::default(),
+            generic_template: false,
         }
     }
 }
@@ -148,8 +156,19 @@ pub struct FitAnswer {
 /// [`Error::NoUsableLog`] when no log can be used; a template without `[power]`, a fit the data
 /// cannot identify, an output that cannot be written.
 pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
-    let mut vehicle = template.power_model()?.vehicle().clone();
+    // A template without the model to fit is refused before any log is read.
+    template.power_model()?;
     let (flights, skipped_logs) = usable_logs(&request.logs)?;
+    let (used, completed) = starting_vehicle(template, request, &skipped_logs)?;
+    let generic_name = request
+        .generic_template
+        .then(|| completed.file.name.clone());
+    let template = Vehicle::from_file(completed.file)?;
+    let template = &template;
+    let mut vehicle = template.power_model()?.vehicle().clone();
+    let mass_ratios: Vec<f64> = (0..used.logs.len())
+        .map(|i| 1.0 + used.payload_kg(i) / vehicle.mass_kg())
+        .collect();
     // The logs' own air: the constants are fitted in it and written for the template's density.
     let reference_density = vehicle.air_density_kg_m3();
     let (log_density, with_air) = logs_air(&flights);
@@ -159,9 +178,18 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     let mut logs = Vec::new();
     let mut samples: Vec<FitSample> = Vec::new();
     let mut forces: Vec<ForceSample> = Vec::new();
-    for (flight, log) in &flights {
-        samples.extend_from_slice(&flight.samples);
-        forces.extend(force_samples(log));
+    for ((flight, log), &mass_ratio) in flights.iter().zip(&mass_ratios) {
+        samples.extend(
+            flight
+                .samples
+                .iter()
+                .map(|s| FitSample { mass_ratio, ..*s }),
+        );
+        forces.extend(
+            force_samples(log)
+                .into_iter()
+                .map(|f| ForceSample { mass_ratio, ..f }),
+        );
         logs.push(LogFitReport {
             file: flight.source.clone(),
             lag_s: flight.lag_s,
@@ -171,7 +199,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             pack: pack_fit(log),
         });
     }
-    let mut notes = Vec::new();
+    let mut notes = completed.notes;
     let mut kept = Vec::new();
     let (drag, mut drag_fitted) = drag_fit(request, &forces, &mut notes, &mut kept, &mut vehicle)?;
     let drag_body_axes = if drag.is_some() {
@@ -188,7 +216,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     let bounded = fit_power_model_bounded(&vehicle, &samples, &options)?;
     let mut power = bounded.fit;
     kept.extend(bounded.kept);
-    let efficiency_relative_sd = efficiency_spread(&power, &flights)?;
+    let efficiency_relative_sd = efficiency_spread(&power, &flights, &mass_ratios)?;
     power.vehicle.efficiency_relative_sd = efficiency_relative_sd;
     if let Some(rho) = log_density {
         power.vehicle = power.vehicle.in_air(reference_density);
@@ -225,8 +253,15 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         })
         .collect();
     let (quality, quality_reasons) = judge_fit(power.nrmse, &alignments, &samples, envelope);
-    let vehicle_toml =
-        fitted_vehicle_toml(template.file(), &power, drag.as_ref(), &logs, &vehicle)?;
+    let vehicle_toml = fitted_vehicle_toml(
+        template.file(),
+        generic_name.as_deref(),
+        &power,
+        drag.as_ref(),
+        &logs,
+        &vehicle,
+        &notes,
+    )?;
     if let Some(path) = &request.output {
         std::fs::write(path, &vehicle_toml).map_err(|source| Error::Io {
             origin: format!("cannot write {}", path.display()),
@@ -256,6 +291,31 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         "fit",
         || format!("logs {:?}", request.logs.logs),
     )
+}
+
+/// The vehicle the fit starts from and writes: the template completed from the usable logs'
+/// parameters and pack and the owner's flags ([`complete_vehicle`]); from the generic template
+/// it is named after its file (`-o quad.toml`: `quad`). And the usable logs.
+fn starting_vehicle(
+    template: &Vehicle,
+    request: &FitRequest,
+    skipped: &[SkippedLog],
+) -> Result<(FlightLogs, Completed), Error> {
+    let used = request
+        .logs
+        .retain_files(|p| !skipped.iter().any(|s| s.file == p.display().to_string()));
+    let mut base = template.file().clone();
+    if request.generic_template {
+        base.name = request
+            .output
+            .as_ref()
+            .and_then(|p| p.file_stem())
+            .and_then(|s| s.to_str())
+            .unwrap_or("my-quad")
+            .to_string();
+    }
+    let completed = complete_vehicle(&base, request.generic_template, &request.own, &used)?;
+    Ok((used, completed))
 }
 
 /// A log aligned for the fit, with its samples.
@@ -459,14 +519,17 @@ fn body_axis_fit(
 /// days cannot show. `None` with fewer than two logs.
 fn efficiency_spread(
     power: &PowerFit,
-    flights: &[(crate::identify::AlignedFlight, aloft_logs::Log)],
+    flights: &[Flight],
+    mass_ratios: &[f64],
 ) -> Result<Option<f64>, Error> {
     if flights.len() < 2 {
         return Ok(None);
     }
-    let model = aloft_power::PowerModel::new(aloft_power::Vehicle::new(power.vehicle.clone())?);
+    let vehicle = aloft_power::Vehicle::new(power.vehicle.clone())?;
     let mut logs = Vec::with_capacity(flights.len());
-    for (f, _) in flights {
+    for ((f, _), r) in flights.iter().zip(mass_ratios) {
+        // Each flight at its own mass.
+        let model = aloft_power::PowerModel::new(vehicle.with_mass(vehicle.mass_kg() * r)?);
         let predicted = crate::identify::predict(&model, f)?;
         let measured: Vec<f64> = f.samples.iter().map(|s| s.measured_power_w).collect();
         let ratio = aloft_core::trapezoid(&f.times_s, &predicted)
@@ -488,20 +551,31 @@ fn efficiency_spread(
 /// a comment header.
 fn fitted_vehicle_toml(
     template: &VehicleFile,
+    generic_name: Option<&str>,
     fit: &PowerFit,
     drag: Option<&DragFit>,
     logs: &[LogFitReport],
     vehicle: &aloft_power::Vehicle,
+    notes: &[String],
 ) -> Result<String, Error> {
     let mut fitted = template.clone();
-    fitted.name = format!("{}-fitted", template.name);
-    fitted.description = format!(
-        "{} (fitted by aloft fit from {} log(s), RMSE {:.1} W, NRMSE {:.2} %)",
-        template.description,
+    let fitted_by = format!(
+        "fitted by aloft fit from {} log(s), RMSE {:.1} W, NRMSE {:.2} %",
         logs.len(),
         fit.rmse_w,
         100.0 * fit.nrmse
     );
+    match generic_name {
+        // The generic template's name and words are not the owner's vehicle.
+        Some(name) => {
+            fitted.name = name.to_string();
+            fitted.description = format!("A multirotor {fitted_by}");
+        }
+        None => {
+            fitted.name = format!("{}-fitted", template.name);
+            fitted.description = format!("{} ({fitted_by})", template.description);
+        }
+    }
     fitted.power = Some(fit.vehicle.clone());
     let mut text = String::new();
     text.push_str(
@@ -524,6 +598,9 @@ fn fitted_vehicle_toml(
             "# Log {}: lag {:.2} s, {} samples\n",
             l.file, l.lag_s, l.samples
         ));
+    }
+    for n in notes {
+        text.push_str(&format!("# Note: {n}\n"));
     }
     let body = toml::to_string(&fitted).map_err(|e| Error::VehicleFormat {
         origin: fitted.name.clone(),

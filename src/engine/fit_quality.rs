@@ -152,9 +152,11 @@ mod tests {
 
     fn samples(n: usize, speed: f64, climb: f64) -> Vec<FitSample> {
         (0..n)
-            .map(|k| FitSample {
-                state: FlightState::new(speed * k as f64 / n as f64, 0.0, 0.0, climb),
-                measured_power_w: 100.0,
+            .map(|k| {
+                FitSample::new(
+                    FlightState::new(speed * k as f64 / n as f64, 0.0, 0.0, climb),
+                    100.0,
+                )
             })
             .collect()
     }

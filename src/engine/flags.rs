@@ -22,13 +22,15 @@ use super::air::AirInput;
 use super::fit::{fit_parameter, FitRequest};
 use super::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
 use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
-use super::logs::{FlightLogs, LogReadOptions};
+use super::logs::{FlightLogs, LogArg, LogReadOptions};
 use super::mission_file::Mission;
 use super::mission_options::{GustSpec, MissionOptions};
+use super::own_vehicle::OwnVehicle;
 use super::payload_sweep::PayloadSweep;
 use super::power::PowerModelQuery;
 use super::scenarios::{ScenarioOptions, WorkBounds, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
 use super::validate::ValidateRequest;
+use super::vehicles::Vehicle;
 use super::EnduranceOptions;
 use crate::error::Error;
 use crate::vehicle::DEFAULT_VEHICLE;
@@ -41,6 +43,12 @@ pub fn finite() -> impl TypedValueParser<Value = f64> {
         Ok(_) => Err("not a finite number".to_string()),
         Err(_) => Err("not a number".to_string()),
     })
+}
+
+/// A flight log as `--log` takes it: `FILE`, or `FILE:payload_kg=KG` for the payload that flight
+/// carried beyond the request's (a file whose whole name exists is that file).
+fn log_arg() -> impl TypedValueParser<Value = LogArg> {
+    StringValueParser::new().try_map(|text: String| LogArg::parse(&text))
 }
 
 /// A spread: a finite number from 0 to `max`.
@@ -496,9 +504,12 @@ pub struct LogInfoFlags {
 /// them.
 #[derive(Debug, Clone, Args)]
 pub struct FlightLogFlags {
-    /// Flight logs (CSV, MCAP, PX4 ULog or ArduPilot DataFlash).
-    #[arg(long, required = true, num_args = 1.., value_name = "FILE")]
-    pub log: Vec<PathBuf>,
+    /// Flight logs (CSV, MCAP, PX4 ULog or ArduPilot DataFlash); `FILE:payload_kg=KG` for a
+    /// flight that carried a payload beyond the others (its take-off mass is the vehicle's plus
+    /// KG).
+    #[arg(long, required = true, num_args = 1.., value_name = "FILE[:payload_kg=KG]",
+        value_parser = log_arg())]
+    pub log: Vec<LogArg>,
     /// Log layout: kaist, px4 or a column-map TOML (default: detected).
     #[arg(long, value_name = "PROFILE")]
     pub profile: Option<String>,
@@ -521,7 +532,8 @@ impl FlightLogFlags {
     /// The engine's description of the logs.
     pub fn logs(&self) -> FlightLogs {
         FlightLogs {
-            logs: self.log.clone(),
+            logs: self.log.iter().map(|l| l.path.clone()).collect(),
+            payloads_kg: self.log.iter().map(|l| l.payload_kg).collect(),
             profile: self.profile.clone(),
             aoa: self.aoa,
             lag_s: self.lag,
@@ -537,9 +549,25 @@ pub struct FitFlags {
     /// The flight logs.
     #[command(flatten)]
     pub logs: FlightLogFlags,
-    /// Vehicle to start from (its [power] table): built-in name or TOML file.
+    /// Vehicle to start from: built-in name or TOML file (default: the generic template of
+    /// `aloft vehicles template`; then --mass-kg and --rotor-diameter-m are needed).
     #[arg(long, value_name = "NAME|FILE")]
-    pub vehicle_template: String,
+    pub vehicle_template: Option<String>,
+    /// Take-off mass of the flights without payload (airframe and pack), kg.
+    #[arg(value_parser = finite(), long, value_name = "KG")]
+    pub mass_kg: Option<f64>,
+    /// Propeller diameter, m (10 in = 0.254 m).
+    #[arg(value_parser = finite(), long, value_name = "M")]
+    pub rotor_diameter_m: Option<f64>,
+    /// The pack's rated capacity, mA h (when the logs' BAT1_CAPACITY / BATT_CAPACITY is unset).
+    #[arg(value_parser = finite(), long, value_name = "MAH")]
+    pub battery_capacity_mah: Option<f64>,
+    /// The pack's mass, kg (default: estimated from its energy at 150 Wh/kg).
+    #[arg(value_parser = finite(), long, value_name = "KG")]
+    pub battery_mass_kg: Option<f64>,
+    /// Largest take-off mass, kg (default: the template's, else 1.5 times the heaviest flight).
+    #[arg(value_parser = finite(), long, value_name = "KG")]
+    pub max_takeoff_mass_kg: Option<f64>,
     /// Where to write the fitted vehicle TOML.
     #[arg(short = 'o', long, value_name = "TOML")]
     pub output: Option<PathBuf>,
@@ -570,7 +598,26 @@ impl FitFlags {
             no_drag: self.no_drag,
             output: self.output.clone(),
             progress: None,
+            own: OwnVehicle {
+                mass_kg: self.mass_kg,
+                rotor_diameter_m: self.rotor_diameter_m,
+                battery_capacity_mah: self.battery_capacity_mah,
+                battery_mass_kg: self.battery_mass_kg,
+                max_takeoff_mass_kg: self.max_takeoff_mass_kg,
+            },
+            generic_template: self.vehicle_template.is_none(),
         })
+    }
+
+    /// The vehicle the fit starts from: `--vehicle-template`, else the generic template.
+    ///
+    /// # Errors
+    /// A template that cannot be loaded.
+    pub fn template(&self) -> Result<Vehicle, Error> {
+        match &self.vehicle_template {
+            Some(name) => Vehicle::load(name),
+            None => Vehicle::from_toml(crate::vehicle::VEHICLE_TEMPLATE, "the vehicle template"),
+        }
     }
 }
 

@@ -70,9 +70,10 @@ pub fn file_keywords<T: FlagGroup>() -> Vec<String> {
         .filter(|a| !a.is_hide_set())
         .filter(|a| {
             a.get_value_names().is_some_and(|names| {
-                names
-                    .iter()
-                    .any(|n| n.split('|').any(|word| FILE_VALUE_WORDS.contains(&word)))
+                names.iter().any(|n| {
+                    n.split(['|', '['])
+                        .any(|word| FILE_VALUE_WORDS.contains(&word))
+                })
             })
         })
         .filter_map(keyword_of)

@@ -564,11 +564,61 @@ pub fn convert_log(
     )
 }
 
+/// A flight log as given: its file and the payload that flight carried beyond the request's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogArg {
+    /// The file.
+    pub path: PathBuf,
+    /// Payload, kg (0: none beyond the request's).
+    pub payload_kg: f64,
+}
+
+impl LogArg {
+    /// `FILE` or `FILE:payload_kg=KG` (KG finite, 0 to 1000). A file whose whole name exists is
+    /// that file, whatever it holds.
+    ///
+    /// # Errors
+    /// The message of a payload that is not a number of kilograms, or a key other than
+    /// `payload_kg`.
+    pub fn parse(text: &str) -> Result<Self, String> {
+        const KEY: &str = ":payload_kg=";
+        let whole = || Self {
+            path: PathBuf::from(text),
+            payload_kg: 0.0,
+        };
+        if Path::new(text).exists() {
+            return Ok(whole());
+        }
+        let Some((file, value)) = text.rsplit_once(KEY) else {
+            if let Some((_, rest)) = text.rsplit_once(':') {
+                if let Some((key, _)) = rest.split_once('=') {
+                    return Err(format!(
+                        "'{key}' is not a per-log option (expected FILE:payload_kg=KG)"
+                    ));
+                }
+            }
+            return Ok(whole());
+        };
+        match value.trim().parse::<f64>() {
+            Ok(kg) if kg.is_finite() && (0.0..=1000.0).contains(&kg) => Ok(Self {
+                path: PathBuf::from(file),
+                payload_kg: kg,
+            }),
+            _ => Err(format!(
+                "payload_kg '{value}' of {file} is not a payload in kg from 0 to 1000"
+            )),
+        }
+    }
+}
+
 /// The flight logs a fit or a validation reads, and how to align power with motion in them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlightLogs {
     /// The log files (CSV or MCAP).
     pub logs: Vec<PathBuf>,
+    /// Per log, in `logs`' order, the payload that flight carried beyond the request's, kg
+    /// (`--log FILE:payload_kg=KG`); a log past its end carried none.
+    pub payloads_kg: Vec<f64>,
     /// CSV profile: `kaist`, `px4` or a column-map TOML; `None`: recognised from the file.
     pub profile: Option<String>,
     /// Angle-of-attack model for the logged states.
@@ -585,6 +635,7 @@ impl Default for FlightLogs {
     fn default() -> Self {
         Self {
             logs: Vec::new(),
+            payloads_kg: Vec::new(),
             profile: None,
             aoa: AoaModel::Geometric,
             lag_s: None,
@@ -595,6 +646,27 @@ impl Default for FlightLogs {
 }
 
 impl FlightLogs {
+    /// The payload the `index`-th log's flight carried beyond the request's, kg.
+    pub fn payload_kg(&self, index: usize) -> f64 {
+        self.payloads_kg.get(index).copied().unwrap_or(0.0)
+    }
+
+    /// These logs with only the files `keep` keeps (each with its payload).
+    pub(crate) fn retain_files(&self, keep: impl Fn(&Path) -> bool) -> Self {
+        let (logs, payloads_kg) = self
+            .logs
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| keep(p))
+            .map(|(i, p)| (p.clone(), self.payload_kg(i)))
+            .unzip();
+        Self {
+            logs,
+            payloads_kg,
+            ..self.clone()
+        }
+    }
+
     /// The profile and reading options every log is opened with.
     fn open_options(&self) -> Result<(Option<Profile>, OpenOptions), Error> {
         let profile = self.profile.as_deref().map(Profile::resolve).transpose()?;

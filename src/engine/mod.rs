@@ -71,6 +71,7 @@ mod mission_file;
 mod mission_map;
 mod mission_options;
 mod mission_outputs;
+mod own_vehicle;
 mod pack_file;
 mod pack_fit;
 mod payload_sweep;
@@ -116,8 +117,8 @@ pub use live::{
     LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
 };
 pub use logs::{
-    check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogChannel, LogInfo,
-    LogReadOptions, LogTime, LogTopic, SkippedLog, TopicCount,
+    check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,
+    LogInfo, LogReadOptions, LogTime, LogTopic, SkippedLog, TopicCount,
 };
 pub use loiter::LoiterSummary;
 pub use mission::{
@@ -129,6 +130,7 @@ pub use mission_map::{
 };
 pub use mission_options::{GustSpec, MissionOptions};
 pub use mission_outputs::{MissionOutputs, PLOT_SAMPLES};
+pub use own_vehicle::{OwnVehicle, LIPO_WH_PER_KG};
 pub use pack_file::{fly_with_battery, is_pack_file, load_flying, Failsafe, FlyingPack, PackFile};
 pub use pack_fit::{
     fit_pack, PackFitAnswer, PackFitRequest, DEFAULT_CUTOFF_CELL_V, DEFAULT_NOMINAL_CELL_V,

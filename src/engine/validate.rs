@@ -88,12 +88,14 @@ pub fn validate_logs(
     let flights = request.logs.load()?;
     let mut results = Vec::with_capacity(flights.len());
     let mut series = Vec::new();
-    for (f, _) in &flights {
-        // Each flight in its own air: the given day, else the log's, else the vehicle file's.
+    for (i, (f, _)) in flights.iter().enumerate() {
+        // Each flight in its own air (the given day, else the log's, else the vehicle file's)
+        // and at its own mass (the request's payload and the log's own, `FILE:payload_kg=KG`).
         let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
+        let payload_kg = request.payload_kg + request.logs.payload_kg(i);
         let (model, _) = vehicle
             .in_air(air.air_density_kg_m3)?
-            .power_model_with(request.battery.as_deref(), request.payload_kg)?;
+            .power_model_with(request.battery.as_deref(), payload_kg)?;
         let mut result = validate_flight(&model, f, request.calibrate_first_s)?;
         result.density_source = air.density_source;
         results.push(result);

@@ -38,11 +38,37 @@ use serde::Serialize;
 /// a unit slip, not a pack.
 pub const MAX_BATTERY_CAPACITY_MAH: f64 = 1e7;
 
-/// Battery and vehicle parameters read from a log into [`BatteryLog::parameters`]: every PX4
-/// parameter starting `BAT` and every ArduPilot parameter starting `BATT_` (instance 1: the
-/// first battery), and `BRD_SERIAL_NUM`.
-pub fn is_battery_parameter(name: &str) -> bool {
-    name.starts_with("BAT") || name == "BRD_SERIAL_NUM"
+/// The autopilot's flight-envelope parameters a log's [`BatteryLog::parameters`] keeps besides
+/// the battery's: what a vehicle file's `[airframe]` holds (PX4 in SI units, ArduPilot in
+/// centidegrees and cm/s), and the rotor count.
+pub const ENVELOPE_PARAMETERS: [&str; 20] = [
+    "MPC_TILTMAX_AIR",
+    "MPC_XY_VEL_MAX",
+    "MPC_XY_CRUISE",
+    "MPC_Z_VEL_MAX_UP",
+    "MPC_Z_VEL_MAX_DN",
+    "MPC_ACC_HOR",
+    "MPC_ACC_UP_MAX",
+    "MPC_YAWRAUTO_MAX",
+    "RTL_RETURN_ALT",
+    "CA_ROTOR_COUNT",
+    "ANGLE_MAX",
+    "WPNAV_SPEED",
+    "WPNAV_SPEED_UP",
+    "WPNAV_SPEED_DN",
+    "WPNAV_ACCEL",
+    "WPNAV_ACCEL_Z",
+    "PILOT_SPEED_UP",
+    "PILOT_SPEED_DN",
+    "ATC_RATE_Y_MAX",
+    "RTL_ALT",
+];
+
+/// Parameters read from a log into [`BatteryLog::parameters`]: every PX4 parameter starting
+/// `BAT` and every ArduPilot parameter starting `BATT_` (instance 1: the first battery),
+/// `BRD_SERIAL_NUM`, and the [`ENVELOPE_PARAMETERS`].
+pub fn is_kept_parameter(name: &str) -> bool {
+    name.starts_with("BAT") || name == "BRD_SERIAL_NUM" || ENVELOPE_PARAMETERS.contains(&name)
 }
 
 /// One battery record of a log.
@@ -105,7 +131,7 @@ pub struct BatteryLog {
     /// A smart pack's state of health (PX4 `state_of_health`, full-charge / design capacity,
     /// last non-zero value), percent.
     pub state_of_health_percent: Option<f64>,
-    /// Battery and vehicle parameters read ([`is_battery_parameter`]), by name.
+    /// Battery and vehicle parameters read ([`is_kept_parameter`]), by name.
     pub parameters: BTreeMap<String, f64>,
     /// Wall-clock time of the first battery record (GPS time, UTC), s since 1970; `None` when
     /// the log has none.

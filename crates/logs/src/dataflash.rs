@@ -477,7 +477,7 @@ impl DataflashDecoder {
                         crate::binary_samples::capacity_ah(v).or(s.battery_capacity_ah);
                 }
                 if let Some(d) = &mut s.battery_details {
-                    if crate::battery_records::is_battery_parameter(&name) && v.is_finite() {
+                    if crate::battery_records::is_kept_parameter(&name) && v.is_finite() {
                         d.parameters.insert(name, v);
                     }
                 }

@@ -545,7 +545,7 @@ impl UlogDecoder {
             _ => return Err(format!("parameter '{key}' of unknown type")),
         };
         if let (Some(name), Some(d)) = (key.split_once(' ').map(|k| k.1), &mut s.battery_details) {
-            if crate::battery_records::is_battery_parameter(name) && v.is_finite() {
+            if crate::battery_records::is_kept_parameter(name) && v.is_finite() {
                 d.parameters.insert(name.to_string(), v);
             }
         }

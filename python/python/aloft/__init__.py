@@ -266,17 +266,23 @@ def log_info(path: PathLike, **options: Any) -> Dict[str, Any]:
 
 
 def fit(
-    logs: Union[PathLike, Sequence[PathLike]], vehicle_template: str, **options: Any
+    logs: Union[PathLike, Sequence[PathLike]],
+    vehicle_template: Optional[str] = None,
+    **options: Any,
 ) -> Dict[str, Any]:
-    """Fit the power model of a vehicle to flight logs: ``aloft fit --format json``.
+    """Fit a vehicle to flight logs: ``aloft fit --format json``.
 
     Args:
-        logs: One log or a list of logs (``--log``).
-        vehicle_template: The vehicle to start from, built-in name or TOML path.
-        **options: ``free`` (list or comma-separated text, default ``["k"]``), ``no_drag``,
-            ``output`` (write the fitted vehicle TOML there; the CLI requires it, here it is
-            optional), ``profile``, ``aoa``, ``lag``, ``max_lag`` (default 10),
-            ``battery_instance``.
+        logs: One log or a list of logs (``--log``); ``"FILE:payload_kg=0.5"`` for a flight
+            that carried a payload.
+        vehicle_template: The vehicle to start from, built-in name or TOML path (default: the
+            generic template, which needs ``mass_kg`` and ``rotor_diameter_m``).
+        **options: ``mass_kg`` (take-off mass without payload), ``rotor_diameter_m``,
+            ``battery_capacity_mah`` (when the logs' capacity parameter is unset),
+            ``battery_mass_kg``, ``max_takeoff_mass_kg``, ``free`` (list or comma-separated
+            text, default ``["k"]``), ``no_drag``, ``output`` (write the fitted vehicle TOML
+            there; the CLI requires it, here it is optional), ``profile``, ``aoa``, ``lag``,
+            ``max_lag`` (default 10), ``battery_instance``.
     """
     return json.loads(_native.fit_json(_paths(logs), vehicle_template, options))
 

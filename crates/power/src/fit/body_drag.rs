@@ -81,8 +81,8 @@ fn axis_rows(
         }
         let a = s.acc_enu_mps2;
         let d = [
-            (gravity_mps2 + a[2]) * t.x / t.z - a[0],
-            (gravity_mps2 + a[2]) * t.y / t.z - a[1],
+            s.mass_ratio * ((gravity_mps2 + a[2]) * t.x / t.z - a[0]),
+            s.mass_ratio * ((gravity_mps2 + a[2]) * t.y / t.z - a[1]),
         ];
         let (se, ce) = s.yaw_rad.sin_cos();
         let axes = [[se, ce], [ce, -se]];
@@ -198,6 +198,7 @@ mod tests {
                     roll_rad: roll,
                     pitch_rad: pitch,
                     yaw_rad: yaw,
+                    mass_ratio: 1.0,
                 }
             })
             .collect()

@@ -461,10 +461,7 @@ mod tests {
                     0.5 * (0.2 * t).sin(),
                 );
                 let p = model.evaluate(&state).unwrap().electrical_w;
-                FitSample {
-                    state,
-                    measured_power_w: p * (1.0 + 0.01 * (1.7 * t).sin()),
-                }
+                FitSample::new(state, p * (1.0 + 0.01 * (1.7 * t).sin()))
             })
             .collect()
     }
@@ -532,6 +529,7 @@ mod tests {
                     roll_rad: 0.0,
                     pitch_rad: pitch,
                     yaw_rad: std::f64::consts::FRAC_PI_2,
+                    mass_ratio: 1.0,
                 }
             })
             .collect()

@@ -32,6 +32,10 @@ pub struct ForceSample {
     pub pitch_rad: f64,
     /// Yaw (heading clockwise from north), rad.
     pub yaw_rad: f64,
+    /// The sample's mass over the one the fit is for (1: that mass): the drag force is the mass
+    /// times the force balance's acceleration, so a heavier flight's drag per unit of the fit's
+    /// mass is this many times its own.
+    pub mass_ratio: f64,
 }
 
 /// Result of [`fit_drag`].
@@ -72,8 +76,9 @@ pub(crate) fn force_rows(
             continue;
         }
         let a = s.acc_enu_mps2;
-        let d_per_m =
-            (gravity_mps2 + a[2]) * (t.x * e[0] + t.y * e[1]) / t.z - (a[0] * e[0] + a[1] * e[1]);
+        let d_per_m = s.mass_ratio
+            * ((gravity_mps2 + a[2]) * (t.x * e[0] + t.y * e[1]) / t.z
+                - (a[0] * e[0] + a[1] * e[1]));
         if d_per_m.is_finite() {
             rows.push((speed, d_per_m));
         }
@@ -194,6 +199,7 @@ mod tests {
                 roll_rad: roll,
                 pitch_rad: pitch,
                 yaw_rad: yaw,
+                mass_ratio: 1.0,
             });
         }
         let fit = fit_drag(m, g, &samples, 0.5, 5.0).unwrap();
@@ -211,6 +217,7 @@ mod tests {
             roll_rad: 0.0,
             pitch_rad: 0.0,
             yaw_rad: 0.0,
+            mass_ratio: 1.0,
         };
         let e = fit_drag(3.0, 9.8, &vec![s; 100], 0.5, 5.0).unwrap_err();
         assert!(matches!(e, FitError::NoForwardFlight { .. }), "{e}");

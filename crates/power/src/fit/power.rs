@@ -59,6 +59,22 @@ pub struct FitSample {
     pub state: FlightState,
     /// Measured electrical power, W.
     pub measured_power_w: f64,
+    /// The sample's take-off mass over the template's (1: the template's mass). A flight that
+    /// carried a payload flies at `mass_ratio` > 1: its thrust scales with the mass, `vh` with its
+    /// square root (eq 10) and the profile power `kappa1 T^1.5` with its 1.5th power, so the
+    /// lumped constants stay those of the template's mass (module docs).
+    pub mass_ratio: f64,
+}
+
+impl FitSample {
+    /// A sample of a flight at the template's mass.
+    pub fn new(state: FlightState, measured_power_w: f64) -> Self {
+        Self {
+            state,
+            measured_power_w,
+            mass_ratio: 1.0,
+        }
+    }
 }
 
 /// A lumped constant of the fit (see the module docs).
@@ -229,6 +245,11 @@ struct Pre {
     /// 1 with the paper's AoA (eq 11 adds drag work), 0 with the geometric one (drag work is in
     /// `T Vn` through the attitude).
     drag_weight: f64,
+    /// Take-off mass over the template's ([`FitSample::mass_ratio`]), and its square root and
+    /// 1.5th power.
+    mass_ratio: f64,
+    sqrt_mass_ratio: f64,
+    mass_ratio_15: f64,
 }
 
 /// Full lumped parameter vector in [`FitParameter::ALL`] order.
@@ -236,15 +257,19 @@ type Lumped = [f64; 6];
 
 fn model_and_gradient(p: &Lumped, s: &Pre, want_gradient: bool) -> Option<(f64, Lumped)> {
     let [k, vh, kp, d1, d2, d3] = *p;
-    let a = s.vn / vh;
-    let b = s.vp / vh;
+    // This sample's mass: K and the climb work scale with it, vh with its square root, the
+    // profile power with its 1.5th power; drag does not depend on mass.
+    let (r, sqrt_r, r15) = (s.mass_ratio, s.sqrt_mass_ratio, s.mass_ratio_15);
+    let vh_s = vh * sqrt_r;
+    let a = s.vn / vh_s;
+    let b = s.vp / vh_s;
     let x = solve_normalised(a, b)?;
     let v = s.v;
-    let induced = vh * x + s.vn;
-    let power = k * s.inv_c * induced
-        + kp * s.inv_c15
+    let induced = vh_s * x + s.vn;
+    let power = k * r * s.inv_c * induced
+        + kp * r15 * s.inv_c15
         + s.drag_weight * s.v2 * (d1 + v * (d2 + v * d3))
-        + k * s.vz;
+        + k * r * s.vz;
     if !want_gradient {
         return Some((power, [0.0; 6]));
     }
@@ -255,9 +280,9 @@ fn model_and_gradient(p: &Lumped, s: &Pre, want_gradient: bool) -> Option<(f64, 
     let dx_da = -(2.0 * x * x * sx) / g_x;
     let dx_db = -(2.0 * x * x * b) / g_x;
     let grad = [
-        s.inv_c * induced + s.vz,
-        k * s.inv_c * (x - a * dx_da - b * dx_db),
-        s.inv_c15,
+        r * (s.inv_c * induced + s.vz),
+        k * r * s.inv_c * (x - a * dx_da - b * dx_db) * sqrt_r,
+        r15 * s.inv_c15,
         s.drag_weight * s.v2,
         s.drag_weight * s.v2 * v,
         s.drag_weight * s.v2 * v * v,
@@ -406,6 +431,13 @@ fn precompute_sample(index: usize, s: &FitSample) -> Result<Pre, FitError> {
             ),
         });
     }
+    let r = s.mass_ratio;
+    if !(r.is_finite() && r > 0.0) {
+        return Err(FitError::BadSample {
+            index,
+            message: format!("mass_ratio must be finite and positive, got {r}"),
+        });
+    }
     let st = s.state;
     let v = st.airspeed_mps;
     Ok(Pre {
@@ -421,6 +453,9 @@ fn precompute_sample(index: usize, s: &FitSample) -> Result<Pre, FitError> {
             AoaModel::Paper => 1.0,
             AoaModel::Geometric => 0.0,
         },
+        mass_ratio: r,
+        sqrt_mass_ratio: r.sqrt(),
+        mass_ratio_15: r * r.sqrt(),
     })
 }
 
@@ -827,12 +862,55 @@ mod tests {
                 ..FlightState::new(v, roll, pitch, climb)
             };
             let p = model.evaluate(&state).unwrap().electrical_w;
-            out.push(FitSample {
-                state,
-                measured_power_w: p + noise_w * 2.0 * rand(),
-            });
+            out.push(FitSample::new(state, p + noise_w * 2.0 * rand()));
         }
         out
+    }
+
+    /// Flights at two masses (the template's and 1.4 times it, a payload): with each sample's
+    /// `mass_ratio` the fit lands on the truth (eq 10's `vh ~ sqrt(m)`, eq 12's `T^1.5`); one
+    /// mass for all, it cannot.
+    #[test]
+    fn per_sample_mass_recovers_the_truth_where_one_mass_cannot() {
+        let truth = m100_with_efficiency(0.7);
+        let heavy = truth.with_mass(1.4 * truth.mass_kg()).unwrap();
+        let light_data = flights(&truth, 0.0);
+        let heavy_data = flights(&heavy, 0.0);
+        let mut data: Vec<FitSample> = light_data.iter().step_by(2).copied().collect();
+        data.extend(heavy_data.iter().step_by(2).map(|s| FitSample {
+            mass_ratio: 1.4,
+            ..*s
+        }));
+        let start = m100_with_efficiency(0.9);
+        let fit = fit_power_model(&start, &data, &FitOptions::known_geometry()).unwrap();
+        assert!(
+            (fit.vehicle.efficiency - 0.7).abs() < 1e-6,
+            "{:?}",
+            fit.vehicle
+        );
+        assert!((fit.vehicle.kappa1_w_per_n1_5 - 0.275).abs() < 1e-5);
+        assert!(fit.rmse_w < 1e-6, "{}", fit.rmse_w);
+        let one_mass: Vec<FitSample> = data
+            .iter()
+            .map(|s| FitSample {
+                mass_ratio: 1.0,
+                ..*s
+            })
+            .collect();
+        // One mass for all: the profile constant runs negative (refused) or the residual stays.
+        if let Ok(blind) = fit_power_model(&start, &one_mass, &FitOptions::known_geometry()) {
+            assert!(
+                blind.rmse_w > 10.0,
+                "one mass fits too well: {}",
+                blind.rmse_w
+            );
+        }
+        let bad = FitSample {
+            mass_ratio: 0.0,
+            ..data[0]
+        };
+        let e = fit_power_model(&start, &[bad; 100], &FitOptions::known_geometry()).unwrap_err();
+        assert!(e.to_string().contains("mass_ratio"), "{e}");
     }
 
     #[test]

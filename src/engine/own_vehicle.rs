@@ -1,0 +1,452 @@
+//! The vehicle a fit writes: the template completed into a vehicle that flies, from what the logs
+//! record and what the owner states.
+//!
+//! - **Envelope** (`[airframe]`): the autopilot's own limits, read from each log's parameters
+//!   ([`aloft_logs::battery_records::ENVELOPE_PARAMETERS`]): PX4 `MPC_TILTMAX_AIR`,
+//!   `MPC_XY_VEL_MAX`, `MPC_XY_CRUISE`, `MPC_Z_VEL_MAX_UP`, `MPC_Z_VEL_MAX_DN`, `MPC_ACC_HOR`,
+//!   `MPC_ACC_UP_MAX`, `MPC_YAWRAUTO_MAX`, `RTL_RETURN_ALT`; ArduPilot `ANGLE_MAX` (cdeg),
+//!   `WPNAV_SPEED` (cm/s: the speed limit and the cruise speed), `WPNAV_SPEED_UP`,
+//!   `WPNAV_SPEED_DN`, `WPNAV_ACCEL`, `WPNAV_ACCEL_Z`, `ATC_RATE_Y_MAX`, `RTL_ALT` (cm). Where the
+//!   logs disagree the most cautious value is written (the smallest) and said. A limit no log
+//!   sets keeps the template's.
+//! - **Rotors**: PX4 `CA_ROTOR_COUNT`, else the template's; the diameter is `--rotor-diameter-m`.
+//! - **Mass**: `--mass-kg` is the take-off mass of a flight without payload (airframe + pack);
+//!   the airframe is that less the pack. A flight given as `FILE:payload_kg=KG` flew KG heavier.
+//!   The maximum take-off mass is `--max-takeoff-mass-kg`, else the template's when it is the
+//!   owner's, else 1.5 times the heaviest flight (a guess, said).
+//! - **Pack** (`[[battery]]`): `aloft pack fit` on the same logs
+//!   ([`super::pack_fit::fit_pack`]): the measured resistance, the cells the logs give (else the
+//!   highest voltage logged over 4.35 V a cell, rounded up), the capacity from the autopilot's
+//!   parameter (PX4 `BAT1_CAPACITY`, ArduPilot `BATT_CAPACITY`) or `--battery-capacity-mah`,
+//!   the mass from `--battery-mass-kg` or estimated at [`LIPO_WH_PER_KG`].
+//!
+//! A value neither the logs nor the flags give is asked for by the flag that gives it
+//! ([`Error::MissingValue`]). The template is the owner's file (`--vehicle-template`), whose
+//! values stand where logs and flags are silent; or the generic one (`aloft vehicles template`),
+//! whose guesses never stand for the mass, the rotor size or the capacity.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use aloft_logs::{read_battery_log, OpenOptions, Profile};
+
+use super::logs::FlightLogs;
+use super::pack_fit::{fit_pack, PackFitRequest};
+use crate::error::Error;
+use crate::vehicle::VehicleFile;
+
+/// Specific energy of a LiPo pack used to estimate its mass when it is not given, W h/kg (the
+/// middle of 130-180 W h/kg for hobby LiPo packs).
+pub const LIPO_WH_PER_KG: f64 = 150.0;
+
+/// The highest cell voltage a LiPo (or LiHV) cell reaches, V: a pack's cell count is at least its
+/// highest logged voltage over this.
+const MAX_CELL_V: f64 = 4.35;
+
+/// What the owner states of a vehicle the logs do not record (`aloft fit`'s flags).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OwnVehicle {
+    /// Take-off mass of the flights without payload (airframe + pack), kg.
+    pub mass_kg: Option<f64>,
+    /// Propeller diameter, m.
+    pub rotor_diameter_m: Option<f64>,
+    /// The pack's rated capacity, mA h (when the autopilot's parameter is unset).
+    pub battery_capacity_mah: Option<f64>,
+    /// The pack's mass, kg.
+    pub battery_mass_kg: Option<f64>,
+    /// The largest take-off mass, kg.
+    pub max_takeoff_mass_kg: Option<f64>,
+}
+
+/// The completed vehicle file, and notes on where its values came from.
+pub(crate) struct Completed {
+    /// The vehicle file (its `[power]` the template's, with the mass and rotors set).
+    pub file: VehicleFile,
+    /// One line per value taken, guessed or chosen between logs.
+    pub notes: Vec<String>,
+}
+
+/// One envelope key of `[airframe]`, the parameters that give it and their scale to the key's
+/// unit.
+struct EnvelopeKey {
+    key: &'static str,
+    sources: &'static [(&'static str, f64)],
+}
+
+const ENVELOPE: [EnvelopeKey; 9] = [
+    EnvelopeKey {
+        key: "max_tilt_deg",
+        sources: &[("MPC_TILTMAX_AIR", 1.0), ("ANGLE_MAX", 0.01)],
+    },
+    EnvelopeKey {
+        key: "max_speed_mps",
+        sources: &[("MPC_XY_VEL_MAX", 1.0), ("WPNAV_SPEED", 0.01)],
+    },
+    EnvelopeKey {
+        key: "cruise_speed_mps",
+        sources: &[("MPC_XY_CRUISE", 1.0), ("WPNAV_SPEED", 0.01)],
+    },
+    EnvelopeKey {
+        key: "max_climb_rate_mps",
+        sources: &[("MPC_Z_VEL_MAX_UP", 1.0), ("WPNAV_SPEED_UP", 0.01)],
+    },
+    EnvelopeKey {
+        key: "max_descent_rate_mps",
+        sources: &[("MPC_Z_VEL_MAX_DN", 1.0), ("WPNAV_SPEED_DN", 0.01)],
+    },
+    EnvelopeKey {
+        key: "acceleration_mps2",
+        sources: &[("MPC_ACC_HOR", 1.0), ("WPNAV_ACCEL", 0.01)],
+    },
+    EnvelopeKey {
+        key: "vertical_acceleration_mps2",
+        sources: &[("MPC_ACC_UP_MAX", 1.0), ("WPNAV_ACCEL_Z", 0.01)],
+    },
+    EnvelopeKey {
+        key: "yaw_rate_deg_s",
+        sources: &[("MPC_YAWRAUTO_MAX", 1.0), ("ATC_RATE_Y_MAX", 1.0)],
+    },
+    EnvelopeKey {
+        key: "rtl_altitude_m",
+        sources: &[("RTL_RETURN_ALT", 1.0), ("RTL_ALT", 0.01)],
+    },
+];
+
+/// One log's kept parameters, with its file.
+type LogParameters = (String, BTreeMap<String, f64>);
+
+/// Each log's parameters (those [`aloft_logs::battery_records::is_kept_parameter`] keeps),
+/// with the file; a log whose battery records cannot be read gives none.
+fn log_parameters(logs: &FlightLogs) -> Result<Vec<LogParameters>, Error> {
+    let profile = logs.profile.as_deref().map(Profile::resolve).transpose()?;
+    let mut open = OpenOptions::default();
+    open.binary.battery_instance = logs.battery_instance;
+    Ok(logs
+        .logs
+        .iter()
+        .filter_map(|path| {
+            let log = read_battery_log(path, profile.as_ref(), &open).ok()?;
+            Some((path.display().to_string(), log.parameters))
+        })
+        .collect())
+}
+
+/// The value of one envelope key over the logs: each log's first source that is set (positive),
+/// scaled; the smallest over the logs, with a note when they disagree.
+fn envelope_value(
+    key: &EnvelopeKey,
+    params: &[LogParameters],
+    notes: &mut Vec<String>,
+) -> Option<f64> {
+    let values: Vec<(f64, &'static str)> = params
+        .iter()
+        .filter_map(|(_, p)| {
+            key.sources.iter().find_map(|(name, scale)| {
+                let v = p.get(*name)? * scale;
+                (v.is_finite() && v > 0.0).then_some((v, *name))
+            })
+        })
+        .collect();
+    let (min, name) = values.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0))?;
+    let max = values.iter().map(|v| v.0).fold(min, f64::max);
+    if max > min {
+        notes.push(format!(
+            "the logs disagree on {name} ({min} to {max}): {} = {min} written, the most cautious",
+            key.key
+        ));
+    }
+    Some(min)
+}
+
+/// Set the airframe key `key` to `value`.
+fn set_envelope(a: &mut aloft_planner::AirframeSpec, key: &str, value: f64) {
+    match key {
+        "max_tilt_deg" => a.max_tilt_deg = value,
+        "max_speed_mps" => a.max_speed_mps = value,
+        "cruise_speed_mps" => a.cruise_speed_mps = Some(value),
+        "max_climb_rate_mps" => a.max_climb_rate_mps = value,
+        "max_descent_rate_mps" => a.max_descent_rate_mps = value,
+        "acceleration_mps2" => a.acceleration_mps2 = value,
+        "vertical_acceleration_mps2" => a.vertical_acceleration_mps2 = value,
+        "yaw_rate_deg_s" => a.yaw_rate_deg_s = value,
+        "rtl_altitude_m" => a.rtl_altitude_m = Some(value),
+        _ => {}
+    }
+}
+
+/// The template completed from the logs and the owner's flags (module docs). `generic`: the
+/// template is `aloft vehicles template`, whose mass, rotor size and capacity are guesses that
+/// never stand. An owner's template that cannot be completed (no capacity for a pack it lacks)
+/// is written with its own tables, and a note says why.
+///
+/// # Errors
+/// From the generic template, [`Error::MissingValue`] naming the flag of a value neither the logs
+/// nor the flags give; values the vehicle file refuses.
+pub(crate) fn complete_vehicle(
+    template: &VehicleFile,
+    generic: bool,
+    own: &OwnVehicle,
+    logs: &FlightLogs,
+) -> Result<Completed, Error> {
+    match completed(template, generic, own, logs) {
+        // The owner's template stands as it is where a value is missing, said.
+        Err(e @ Error::MissingValue { .. }) if !generic => Ok(Completed {
+            file: template.clone(),
+            notes: vec![format!(
+                "the template's tables are written as they are, not completed from the logs: {e}"
+            )],
+        }),
+        other => other,
+    }
+}
+
+/// [`complete_vehicle`], every missing value an error.
+fn completed(
+    template: &VehicleFile,
+    generic: bool,
+    own: &OwnVehicle,
+    logs: &FlightLogs,
+) -> Result<Completed, Error> {
+    let mut notes = Vec::new();
+    let mut file = template.clone();
+    let params = log_parameters(logs)?;
+    let mut power = file.power.clone().ok_or(Error::MissingTable {
+        vehicle: template.name.clone(),
+        table: "power",
+        needed_for: "the four-term power model",
+    })?;
+    // Rotors: the autopilot's count, the owner's diameter.
+    if let Some(n) = params
+        .iter()
+        .find_map(|(_, p)| p.get("CA_ROTOR_COUNT").copied())
+        .filter(|n| (1.0..=16.0).contains(n))
+    {
+        power.rotor_count = n as u32;
+    }
+    match own.rotor_diameter_m {
+        Some(d) => power.rotor_radius_m = d / 2.0,
+        None if generic => {
+            return Err(Error::MissingValue {
+                flag: "--rotor-diameter-m",
+                hint: "logs do not record the propellers: give their diameter in metres (10 in = 0.254 m), or --vehicle-template FILE with your [power] rotor_radius_m",
+            })
+        }
+        None => {}
+    }
+    if generic && own.mass_kg.is_none() {
+        return Err(missing_mass());
+    }
+    // The pack, from the same logs.
+    let template_pack = (!generic)
+        .then(|| {
+            file.batteries
+                .iter()
+                .find(|b| b.default)
+                .or(file.batteries.first())
+        })
+        .flatten()
+        .cloned();
+    let pack = own_pack(own, logs, template, template_pack.as_ref(), &mut notes)?;
+    let pack_kg = pack.mass_kg.unwrap_or(0.0);
+    // The mass of a flight without payload.
+    let takeoff_kg = match (own.mass_kg, generic) {
+        (Some(m), _) => m,
+        (None, true) => return Err(missing_mass()),
+        (None, false) => match (&file.airframe, &template_pack) {
+            (Some(a), Some(b)) => a.mass_kg + b.mass_kg.unwrap_or(0.0),
+            _ => power.mass_kg,
+        },
+    };
+    if !(takeoff_kg.is_finite() && takeoff_kg > pack_kg) {
+        return Err(Error::InvalidInput {
+            name: "mass_kg",
+            value: takeoff_kg,
+            unit: "kg",
+            expected: "a take-off mass above the pack's mass",
+        });
+    }
+    power.mass_kg = takeoff_kg;
+    let mut airframe = file.airframe.clone().unwrap_or_else(|| {
+        let generic_file = crate::vehicle::VehicleFile::from_toml_str(
+            crate::vehicle::VEHICLE_TEMPLATE,
+            "the vehicle template",
+        )
+        .ok()
+        .and_then(|f| f.airframe);
+        generic_file.expect("the built-in vehicle template has an [airframe]")
+    });
+    airframe.mass_kg = round6(takeoff_kg - pack_kg);
+    let heaviest = takeoff_kg
+        + (0..logs.logs.len())
+            .map(|i| logs.payload_kg(i))
+            .fold(0.0, f64::max);
+    airframe.max_takeoff_mass_kg = match own.max_takeoff_mass_kg {
+        Some(m) => m,
+        None if !generic && template.airframe.is_some() => {
+            airframe.max_takeoff_mass_kg.max(heaviest)
+        }
+        None => {
+            let guess = round6(1.5 * heaviest);
+            notes.push(format!(
+                "max_takeoff_mass_kg {guess:.3} kg is a guess, 1.5 times the heaviest flight ({heaviest:.3} kg): give --max-takeoff-mass-kg"
+            ));
+            guess
+        }
+    };
+    for key in &ENVELOPE {
+        if let Some(v) = envelope_value(key, &params, &mut notes) {
+            set_envelope(&mut airframe, key.key, v);
+        }
+    }
+    file.power = Some(power);
+    file.airframe = Some(airframe);
+    // The fitted pack in place of the template's default (its other packs kept), or alone.
+    match file
+        .batteries
+        .iter()
+        .position(|b| Some(&b.name) == template_pack.as_ref().map(|t| &t.name))
+    {
+        Some(i) if !generic => {
+            for b in &mut file.batteries {
+                b.default = false;
+            }
+            file.batteries[i] = pack;
+        }
+        _ => file.batteries = vec![pack],
+    }
+    Ok(Completed { file, notes })
+}
+
+/// `x` to a millionth (a written value reads as it was meant: 11.1 V, not 11.100000000000001).
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+/// The take-off mass, which no log records.
+fn missing_mass() -> Error {
+    Error::MissingValue {
+        flag: "--mass-kg",
+        hint: "logs do not weigh the vehicle: give the take-off mass of a flight without payload (with its pack), kg, or --vehicle-template FILE with your [airframe] and [[battery]]",
+    }
+}
+
+/// The pack of the logs ([`fit_pack`]), its missing keys from the flags, else the template's
+/// pack when the template is the owner's.
+fn own_pack(
+    own: &OwnVehicle,
+    logs: &FlightLogs,
+    template: &VehicleFile,
+    template_pack: Option<&aloft_planner::BatterySpec>,
+    notes: &mut Vec<String>,
+) -> Result<aloft_planner::BatterySpec, Error> {
+    let mass_kg = own
+        .battery_mass_kg
+        .or(template_pack.and_then(|b| b.mass_kg));
+    let request = PackFitRequest {
+        logs: logs.logs.clone(),
+        profile: logs.profile.clone(),
+        battery_instance: logs.battery_instance,
+        capacity_mah: own
+            .battery_capacity_mah
+            .or(template_pack.map(|b| b.capacity_mah)),
+        // The mass is set below (it may be estimated from the fitted energy).
+        mass_kg: Some(mass_kg.unwrap_or(1.0)),
+        name: template_pack.map(|b| b.name.clone()),
+        ..PackFitRequest::default()
+    };
+    let answer = match fit_pack(&request) {
+        // The logs do not say the cells: from the highest voltage they record.
+        Err(Error::PackKeyMissing {
+            key: "cells_series",
+            ..
+        }) => fit_pack(&PackFitRequest {
+            cells_series: cells_from_voltage(logs),
+            ..request
+        }),
+        other => other,
+    };
+    let answer = match answer {
+        Err(Error::PackKeyMissing {
+            key: "capacity_mah",
+            ..
+        }) => {
+            return Err(Error::MissingValue {
+                flag: "--battery-capacity-mah",
+                hint: "the autopilot's capacity parameter (PX4 BAT1_CAPACITY, ArduPilot BATT_CAPACITY) is unset in the logs: give the pack's rated capacity, mA h",
+            })
+        }
+        other => other,
+    };
+    // What the logs cannot fit: the owner's pack stands, said; the generic one never does.
+    let keep_template = |reason: String, notes: &mut Vec<String>| {
+        match template_pack {
+        Some(b) => {
+            notes.push(format!(
+                "the pack is the template's {} as it is: {reason}",
+                b.name
+            ));
+            Ok(b.clone())
+        }
+        None => Err(Error::MissingValue {
+            flag: "--vehicle-template",
+            hint: "the logs cannot fit a pack (no battery current, or no current steps): give a vehicle file with your [[battery]]",
+        }),
+    }
+    };
+    let answer = match answer {
+        Ok(a) => a,
+        Err(e) => return keep_template(e.to_string(), notes),
+    };
+    let Some(pack) = answer.pack else {
+        return keep_template("no log has battery current".into(), notes);
+    };
+    let mut spec = pack.battery;
+    spec.mass_kg = Some(mass_kg.unwrap_or_else(|| {
+        let energy = spec.energy_wh.unwrap_or(0.0);
+        let mass = energy / LIPO_WH_PER_KG;
+        notes.push(format!(
+            "the pack's mass, {mass:.3} kg, is estimated from its {energy:.1} Wh at {LIPO_WH_PER_KG} Wh/kg: give --battery-mass-kg"
+        ));
+        mass
+    }));
+    spec.mass_kg = spec.mass_kg.map(round6);
+    spec.nominal_v = spec.nominal_v.map(round6);
+    spec.energy_wh = spec.energy_wh.map(round6);
+    spec.default = true;
+    if spec.name == "fitted" {
+        spec.name = format!("{}-pack", template.name);
+    }
+    notes.extend(answer.notes);
+    if let Some(r) = answer.internal_resistance_ohm {
+        notes.push(format!(
+            "pack resistance {:.4} ohm measured from {} over {} log(s) (aloft pack fit)",
+            r,
+            answer
+                .internal_resistance_source
+                .as_deref()
+                .unwrap_or("the logs"),
+            answer.logs.len()
+        ));
+    }
+    Ok(spec)
+}
+
+/// Cells in series from the highest voltage any log records, when the logs' parameters do not
+/// say: at least that voltage over [`MAX_CELL_V`], rounded up.
+fn cells_from_voltage(logs: &FlightLogs) -> Option<u32> {
+    let profile = logs
+        .profile
+        .as_deref()
+        .map(Profile::resolve)
+        .transpose()
+        .ok()?;
+    let open = OpenOptions::default();
+    let max_v = logs
+        .logs
+        .iter()
+        .filter_map(|p: &PathBuf| read_battery_log(p, profile.as_ref(), &open).ok())
+        .flat_map(|l| l.samples.into_iter().map(|s| s.voltage_v))
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold(0.0, f64::max);
+    (max_v > 0.0).then(|| (max_v / MAX_CELL_V).ceil().max(1.0) as u32)
+}
