@@ -174,7 +174,7 @@ fn render(out: &mut impl Write, r: &FitAnswer) -> Result<()> {
     let v = &p.vehicle;
     writeln!(
         out,
-        "\nFitted vehicle -> {}: mass {} kg (template), efficiency {:.4}, rotor radius {:.4} m, kappa1 {:.4}, mu {:.4} {:.5} {:.6}",
+        "\nFitted vehicle -> {}: take-off mass {} kg without payload, efficiency {:.4}, rotor radius {:.4} m, kappa1 {:.4}, mu {:.4} {:.5} {:.6}",
         r.output, v.mass_kg, v.efficiency, v.rotor_radius_m, v.kappa1_w_per_n1_5, v.mu1_n_s_per_m, v.mu2_n_s2_per_m2, v.mu3_n_s3_per_m3
     )?;
     writeln!(out, "\nQuality: {}", quality_word(r.quality))?;

@@ -175,30 +175,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     if let Some(rho) = log_density {
         vehicle = aloft_power::Vehicle::new(vehicle.params().in_air(rho))?;
     }
-    let mut logs = Vec::new();
-    let mut samples: Vec<FitSample> = Vec::new();
-    let mut forces: Vec<ForceSample> = Vec::new();
-    for ((flight, log), &mass_ratio) in flights.iter().zip(&mass_ratios) {
-        samples.extend(
-            flight
-                .samples
-                .iter()
-                .map(|s| FitSample { mass_ratio, ..*s }),
-        );
-        forces.extend(
-            force_samples(log)
-                .into_iter()
-                .map(|f| ForceSample { mass_ratio, ..f }),
-        );
-        logs.push(LogFitReport {
-            file: flight.source.clone(),
-            lag_s: flight.lag_s,
-            lag_correlation: flight.lag_correlation,
-            samples: flight.samples.len(),
-            skipped: flight.skipped,
-            pack: pack_fit(log),
-        });
-    }
+    let (logs, samples, forces) = fit_inputs(&flights, &mass_ratios);
     let mut notes = completed.notes;
     let mut kept = Vec::new();
     let (drag, mut drag_fitted) = drag_fit(request, &forces, &mut notes, &mut kept, &mut vehicle)?;
@@ -207,12 +184,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     } else {
         None
     };
-    let mut options = FitOptions::known_geometry();
-    options.free = request.free.clone();
-    if let Some(p) = &request.progress {
-        let p = p.clone();
-        options.progress = Some(Arc::new(move |i, cost| p(i, cost)));
-    }
+    let options = power_fit_options(request);
     let bounded = fit_power_model_bounded(&vehicle, &samples, &options)?;
     let mut power = bounded.fit;
     kept.extend(bounded.kept);
@@ -240,19 +212,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
             k.name, k.value, k.unit, k.reason
         )
     }));
-    let envelope = template.file().airframe.as_ref().map(|a| Envelope {
-        max_speed_mps: a.max_speed_mps,
-        max_climb_rate_mps: a.max_climb_rate_mps,
-    });
-    let alignments: Vec<Alignment> = logs
-        .iter()
-        .map(|l| Alignment {
-            file: &l.file,
-            lag_s: l.lag_s,
-            correlation: l.lag_correlation,
-        })
-        .collect();
-    let (quality, quality_reasons) = judge_fit(power.nrmse, &alignments, &samples, envelope);
+    let (quality, quality_reasons) = verdict(template, &power, &logs, &samples);
     let vehicle_toml = fitted_vehicle_toml(
         template.file(),
         generic_name.as_deref(),
@@ -291,6 +251,72 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         "fit",
         || format!("logs {:?}", request.logs.logs),
     )
+}
+
+/// Each log's report, and the samples of every log for the power fit and the force balance,
+/// each at its flight's mass ratio.
+fn fit_inputs(
+    flights: &[Flight],
+    mass_ratios: &[f64],
+) -> (Vec<LogFitReport>, Vec<FitSample>, Vec<ForceSample>) {
+    let mut logs = Vec::new();
+    let mut samples: Vec<FitSample> = Vec::new();
+    let mut forces: Vec<ForceSample> = Vec::new();
+    for ((flight, log), &mass_ratio) in flights.iter().zip(mass_ratios) {
+        samples.extend(
+            flight
+                .samples
+                .iter()
+                .map(|s| FitSample { mass_ratio, ..*s }),
+        );
+        forces.extend(
+            force_samples(log)
+                .into_iter()
+                .map(|f| ForceSample { mass_ratio, ..f }),
+        );
+        logs.push(LogFitReport {
+            file: flight.source.clone(),
+            lag_s: flight.lag_s,
+            lag_correlation: flight.lag_correlation,
+            samples: flight.samples.len(),
+            skipped: flight.skipped,
+            pack: pack_fit(log),
+        });
+    }
+    (logs, samples, forces)
+}
+
+/// The power fit's options: known geometry, the request's free constants and progress.
+fn power_fit_options(request: &FitRequest) -> FitOptions {
+    let mut options = FitOptions::known_geometry();
+    options.free = request.free.clone();
+    if let Some(p) = &request.progress {
+        let p = p.clone();
+        options.progress = Some(Arc::new(move |i, cost| p(i, cost)));
+    }
+    options
+}
+
+/// How good the fit is ([`judge_fit`]), against the written vehicle's envelope.
+fn verdict(
+    vehicle: &Vehicle,
+    power: &PowerFit,
+    logs: &[LogFitReport],
+    samples: &[FitSample],
+) -> (FitQuality, Vec<String>) {
+    let envelope = vehicle.file().airframe.as_ref().map(|a| Envelope {
+        max_speed_mps: a.max_speed_mps,
+        max_climb_rate_mps: a.max_climb_rate_mps,
+    });
+    let alignments: Vec<Alignment> = logs
+        .iter()
+        .map(|l| Alignment {
+            file: &l.file,
+            lag_s: l.lag_s,
+            correlation: l.lag_correlation,
+        })
+        .collect();
+    judge_fit(power.nrmse, &alignments, samples, envelope)
 }
 
 /// The vehicle the fit starts from and writes: the template completed from the usable logs'

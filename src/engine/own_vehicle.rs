@@ -215,24 +215,7 @@ fn completed(
         table: "power",
         needed_for: "the four-term power model",
     })?;
-    // Rotors: the autopilot's count, the owner's diameter.
-    if let Some(n) = params
-        .iter()
-        .find_map(|(_, p)| p.get("CA_ROTOR_COUNT").copied())
-        .filter(|n| (1.0..=16.0).contains(n))
-    {
-        power.rotor_count = n as u32;
-    }
-    match own.rotor_diameter_m {
-        Some(d) => power.rotor_radius_m = d / 2.0,
-        None if generic => {
-            return Err(Error::MissingValue {
-                flag: "--rotor-diameter-m",
-                hint: "logs do not record the propellers: give their diameter in metres (10 in = 0.254 m), or --vehicle-template FILE with your [power] rotor_radius_m",
-            })
-        }
-        None => {}
-    }
+    set_rotors(&mut power, &params, own, generic)?;
     if generic && own.mass_kg.is_none() {
         return Err(missing_mass());
     }
@@ -276,11 +259,63 @@ fn completed(
         generic_file.expect("the built-in vehicle template has an [airframe]")
     });
     airframe.mass_kg = round6(takeoff_kg - pack_kg);
+    airframe.max_takeoff_mass_kg = max_takeoff_mass(
+        &airframe, takeoff_kg, own, generic, template, logs, &mut notes,
+    );
+    for key in &ENVELOPE {
+        if let Some(v) = envelope_value(key, &params, &mut notes) {
+            set_envelope(&mut airframe, key.key, v);
+        }
+    }
+    file.power = Some(power);
+    file.airframe = Some(airframe);
+    place_pack(&mut file, pack, template_pack.as_ref(), generic);
+    Ok(Completed { file, notes })
+}
+
+/// The rotors: the autopilot's count (PX4 `CA_ROTOR_COUNT`), the owner's diameter.
+fn set_rotors(
+    power: &mut aloft_power::VehicleParams,
+    params: &[LogParameters],
+    own: &OwnVehicle,
+    generic: bool,
+) -> Result<(), Error> {
+    if let Some(n) = params
+        .iter()
+        .find_map(|(_, p)| p.get("CA_ROTOR_COUNT").copied())
+        .filter(|n| (1.0..=16.0).contains(n))
+    {
+        power.rotor_count = n as u32;
+    }
+    match own.rotor_diameter_m {
+        Some(d) => power.rotor_radius_m = d / 2.0,
+        None if generic => {
+            return Err(Error::MissingValue {
+                flag: "--rotor-diameter-m",
+                hint: "logs do not record the propellers: give their diameter in metres (10 in = 0.254 m), or --vehicle-template FILE with your [power] rotor_radius_m",
+            })
+        }
+        None => {}
+    }
+    Ok(())
+}
+
+/// The largest take-off mass: the owner's, else the owner's template's (at least the heaviest
+/// flight), else 1.5 times the heaviest flight, said as a guess.
+fn max_takeoff_mass(
+    airframe: &aloft_planner::AirframeSpec,
+    takeoff_kg: f64,
+    own: &OwnVehicle,
+    generic: bool,
+    template: &VehicleFile,
+    logs: &FlightLogs,
+    notes: &mut Vec<String>,
+) -> f64 {
     let heaviest = takeoff_kg
         + (0..logs.logs.len())
             .map(|i| logs.payload_kg(i))
             .fold(0.0, f64::max);
-    airframe.max_takeoff_mass_kg = match own.max_takeoff_mass_kg {
+    match own.max_takeoff_mass_kg {
         Some(m) => m,
         None if !generic && template.airframe.is_some() => {
             airframe.max_takeoff_mass_kg.max(heaviest)
@@ -292,20 +327,22 @@ fn completed(
             ));
             guess
         }
-    };
-    for key in &ENVELOPE {
-        if let Some(v) = envelope_value(key, &params, &mut notes) {
-            set_envelope(&mut airframe, key.key, v);
-        }
     }
-    file.power = Some(power);
-    file.airframe = Some(airframe);
-    // The fitted pack in place of the template's default (its other packs kept), or alone.
-    match file
+}
+
+/// The fitted pack in place of the owner's template's default (its other packs kept), else
+/// alone.
+fn place_pack(
+    file: &mut VehicleFile,
+    pack: aloft_planner::BatterySpec,
+    template_pack: Option<&aloft_planner::BatterySpec>,
+    generic: bool,
+) {
+    let at = file
         .batteries
         .iter()
-        .position(|b| Some(&b.name) == template_pack.as_ref().map(|t| &t.name))
-    {
+        .position(|b| Some(&b.name) == template_pack.map(|t| &t.name));
+    match at {
         Some(i) if !generic => {
             for b in &mut file.batteries {
                 b.default = false;
@@ -314,7 +351,6 @@ fn completed(
         }
         _ => file.batteries = vec![pack],
     }
-    Ok(Completed { file, notes })
 }
 
 /// `x` to a millionth (a written value reads as it was meant: 11.1 V, not 11.100000000000001).

@@ -168,10 +168,9 @@ mod tests {
         (roll, pitch)
     }
 
-    #[test]
-    fn recovers_the_m100_drag_from_a_synthetic_force_balance() {
-        let (m, g) = (3.29, 9.8066);
-        let mu = [0.1816, -0.02326, 0.004045];
+    /// Level and accelerated flight of a vehicle of mass `m` with drag `mu` (eq 6), every
+    /// direction and heading, its attitude from the force balance `m a = T + m g + D`.
+    fn synthetic(m: f64, g: f64, mu: [f64; 3]) -> Vec<ForceSample> {
         let mut samples = Vec::new();
         for i in 0..2000 {
             let speed = 1.0 + 13.0 * f64::from(i % 200) / 200.0;
@@ -202,11 +201,37 @@ mod tests {
                 mass_ratio: 1.0,
             });
         }
+        samples
+    }
+
+    #[test]
+    fn recovers_the_m100_drag_from_a_synthetic_force_balance() {
+        let (m, g) = (3.29, 9.8066);
+        let mu = [0.1816, -0.02326, 0.004045];
+        let samples = synthetic(m, g, mu);
         let fit = fit_drag(m, g, &samples, 0.5, 5.0).unwrap();
         for (got, want) in fit.mu_n.iter().zip(mu) {
             assert!((got - want).abs() < 1e-9, "{fit:?}");
         }
         let _ = ned_to_enu(&V3::zeros());
+    }
+
+    /// Flights 1.5 times heavier, each sample's `mass_ratio` saying so: the drag of the fit's
+    /// mass is recovered; without the ratio it reads 1/1.5 of it.
+    #[test]
+    fn a_heavier_flight_is_scaled_by_its_mass_ratio() {
+        let (m, g) = (3.29, 9.8066);
+        let mu = [0.1816, -0.02326, 0.004045];
+        let mut samples = synthetic(1.5 * m, g, mu);
+        let blind = fit_drag(m, g, &samples, 0.5, 5.0).unwrap();
+        assert!((blind.mu_n[0] * 1.5 - mu[0]).abs() < 1e-9, "{blind:?}");
+        for s in &mut samples {
+            s.mass_ratio = 1.5;
+        }
+        let fit = fit_drag(m, g, &samples, 0.5, 5.0).unwrap();
+        for (got, want) in fit.mu_n.iter().zip(mu) {
+            assert!((got - want).abs() < 1e-9, "{fit:?}");
+        }
     }
 
     #[test]
