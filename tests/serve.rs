@@ -456,3 +456,309 @@ fn no_request_takes_the_server_down() {
     }
     assert_eq!(server.get("/api/vehicles").0, 200);
 }
+
+/// A vehicle file of the user's in the scratch folder as `file`: `aloft vehicles template`,
+/// named `name` inside.
+fn template_vehicle(file: &str, name: &str) -> String {
+    let text = common::ok_stdout(&["vehicles", "template"]);
+    let text = text.replacen("name = \"my-quad\"", &format!("name = \"{name}\""), 1);
+    assert!(text.contains(&format!("name = \"{name}\"")));
+    let path = common::scratch("serve-vehicles", file);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// JSON text, parsed.
+fn parsed(text: &str) -> serde_json::Value {
+    serde_json::from_str(text).unwrap_or_else(|e| panic!("{e}: {text}"))
+}
+
+/// The keys of a JSON object, sorted.
+fn keys(v: &serde_json::Value) -> Vec<String> {
+    let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+    k.sort();
+    k
+}
+
+/// `aloft serve --vehicle FILE...` (issue 35 item 5): the vehicle files given (with `--vehicle`
+/// and positionally) are in `/api/vehicles` after the built-ins, as `aloft vehicles` lists one;
+/// the first `--vehicle` is the default of the page (`/api/config`) and of requests that name
+/// none; a request names a given vehicle by its own name or the name it was given with, and is
+/// answered as the command line with that file.
+#[test]
+fn vehicles_given_are_listed_and_flown_as_the_command_line_flies_them() {
+    let quad = template_vehicle("my-quad.toml", "my-quad");
+    let m600 = std::fs::read_to_string(common::fixture("vehicles", "dji-m600.toml")).unwrap();
+    let m600 = m600.replacen("name = \"dji-m600\"", "name = \"my-m600\"", 1);
+    let m600_path = common::scratch("serve-vehicles", "my-m600.toml");
+    std::fs::write(&m600_path, m600).unwrap();
+    let m600_path = m600_path.display().to_string();
+    let server = Server::start(&[&m600_path, "--vehicle", &quad, "dji-inspire1"]);
+    let config = parsed(&server.get("/api/config").1);
+    assert_eq!(config["default_vehicle"], "my-quad");
+    let kinds: Vec<&str> = config["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["kind"].as_str().unwrap())
+        .collect();
+    assert_eq!(kinds, ["vehicle", "vehicle"]);
+    // The list: the built-ins as `aloft vehicles` lists them, then the files given.
+    let (code, body) = server.get("/api/vehicles");
+    assert_eq!(code, 200, "{body}");
+    let listed = parsed(&body);
+    let listed = listed.as_array().unwrap();
+    let builtins = parsed(&cli(&["vehicles", "--format", "json"]));
+    let builtins = builtins.as_array().unwrap();
+    assert_eq!(&listed[..builtins.len()], builtins.as_slice());
+    let names: Vec<&str> = listed[builtins.len()..]
+        .iter()
+        .map(|v| v["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["my-m600", "my-quad"]);
+    let mine = &listed[builtins.len() + 1];
+    // The shape of a built-in's entry (the template has no [source], which is left out).
+    let mut shape = keys(&builtins[0]);
+    shape.retain(|k| k != "source");
+    assert_eq!(keys(mine), shape);
+    assert_eq!(mine["batteries"], serde_json::json!(["3S-5000"]));
+    assert_eq!(mine["models"], serde_json::json!(["power"]));
+    let endurance = parsed(&cli(&["endurance", "--vehicle", &quad, "--format", "json"]));
+    assert_eq!(mine["takeoff_mass_kg"], endurance["takeoff_mass_kg"]);
+    // Flown by its own name, by the name it was given with, and by default: the command line's
+    // answer with the file, the same options.
+    let expected = parsed(&cli(&[
+        "mission",
+        "--vehicle",
+        &quad,
+        "--payload-kg",
+        "0.1",
+        "--wind-speed",
+        "3",
+        "--wind-from",
+        "90",
+        "--format",
+        "json",
+    ]));
+    assert_eq!(expected["vehicle"], "my-quad");
+    let options = "payload_kg=0.1&wind_speed=3&wind_from=90";
+    for vehicle in [Some("my-quad"), Some(quad.as_str()), None] {
+        let query = match vehicle {
+            Some(v) => format!("vehicle={}&{options}", encoded(v)),
+            None => options.to_string(),
+        };
+        let (code, body) = server.request("POST", &format!("/api/mission?{query}"), None, b"");
+        assert_eq!(code, 200, "{vehicle:?}: {body}");
+        assert_eq!(parsed(&body), expected, "{vehicle:?}");
+    }
+    // The positional file by its own name, the built-in given with --vehicle by its name.
+    let (code, body) = server.get("/api/endurance?vehicle=my-m600&payload_kg=1");
+    assert_eq!(code, 200, "{body}");
+    let expected = cli(&[
+        "endurance",
+        "--vehicle",
+        &m600_path,
+        "--payload-kg",
+        "1",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(parsed(&body), parsed(&expected));
+    let (code, body) = server.request("POST", "/api/mission?vehicle=dji-inspire1", None, b"");
+    assert_eq!(code, 200, "{body}");
+    let expected = cli(&["mission", "--vehicle", "dji-inspire1", "--format", "json"]);
+    assert_eq!(parsed(&body), parsed(&expected));
+    // Bad input at start: exit 2, one line naming the file.
+    let bad = common::scratch("serve-vehicles", "bad-vehicle.toml");
+    std::fs::write(&bad, "name = 3\n").unwrap();
+    let bad = bad.display().to_string();
+    for file in [bad.as_str(), "/no/such/vehicle.toml"] {
+        let (code, _, err) = common::run(&["serve", "--listen", "127.0.0.1:0", "--vehicle", file]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(file) && err.lines().count() == 1, "{err}");
+    }
+    // A mission taken by --vehicle from the files after it says so.
+    let demo = common::fixture("missions", "demo-survey.toml");
+    let demo = demo.display().to_string();
+    let (code, _, err) = common::run(&[
+        "serve",
+        "--listen",
+        "127.0.0.1:0",
+        "--vehicle",
+        &quad,
+        &demo,
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("a mission, not a vehicle file"), "{err}");
+}
+
+/// `POST /api/vehicles` (a vehicle file dropped on the page): kept under its own name, answered
+/// with its entry, then flown by that name as the command line flies the file; a bad file is
+/// 422 with the command line's message, a body past 256 KiB 413, a name that is a built-in's or
+/// a given vehicle's 422 naming the clash, a page of another origin 403; the same name again
+/// replaces the vehicle; past 32 vehicles sent the oldest is forgotten.
+#[test]
+fn a_vehicle_file_sent_is_kept_and_flown_by_its_name() {
+    let quad = template_vehicle("my-quad.toml", "my-quad");
+    let sent = template_vehicle("sent.toml", "sent-quad");
+    let server = Server::start(&["--vehicle", &quad]);
+    let text = std::fs::read(&sent).unwrap();
+    let (code, body) = server.request("POST", "/api/vehicles?file=sent.toml", None, &text);
+    assert_eq!(code, 200, "{body}");
+    let entry = parsed(&body);
+    assert_eq!(entry["name"], "sent-quad");
+    let listed = parsed(&server.get("/api/vehicles").1);
+    let listed = listed.as_array().unwrap();
+    assert_eq!(listed.last().unwrap(), &entry);
+    assert_eq!(
+        listed.iter().filter(|v| v["name"] == "sent-quad").count(),
+        1
+    );
+    // Flown by its name as the command line flies the file.
+    let expected = cli(&[
+        "mission",
+        "--vehicle",
+        &sent,
+        "--reserve-percent",
+        "25",
+        "--format",
+        "json",
+    ]);
+    let (code, body) = server.request(
+        "POST",
+        "/api/mission?vehicle=sent-quad&reserve_percent=25",
+        None,
+        b"",
+    );
+    assert_eq!(code, 200, "{body}");
+    assert_eq!(parsed(&body), parsed(&expected));
+    let (code, body) = server.get("/api/endurance?vehicle=sent-quad");
+    assert_eq!(code, 200, "{body}");
+    let expected = cli(&["endurance", "--vehicle", &sent, "--format", "json"]);
+    assert_eq!(parsed(&body), parsed(&expected));
+    for route in ["/api/map", "/api/plan"] {
+        let (code, body) = server.request("POST", &format!("{route}?vehicle=sent-quad"), None, b"");
+        assert_eq!(code, 200, "{route}: {body}");
+    }
+    // A bad file: 422, the command line's one line (the file named as it was sent).
+    let bad = common::scratch("serve-vehicles", "typo.toml");
+    let typo =
+        String::from_utf8(text.clone())
+            .unwrap()
+            .replacen("max_tilt_deg", "max_tilt_degs", 1);
+    std::fs::write(&bad, &typo).unwrap();
+    let bad = bad.display().to_string();
+    let out = aloft(&["endurance", "--vehicle", &bad, "--format", "json"]);
+    let (code, body) = server.request(
+        "POST",
+        &format!("/api/vehicles?file={}", encoded(&bad)),
+        None,
+        typo.as_bytes(),
+    );
+    assert_refused_alike(&out, (code, &body), "typo.toml");
+    assert!(!parsed(&body)["error"].as_str().unwrap().contains('\n'));
+    let (code, body) = server.request("POST", "/api/vehicles?file=x.toml", None, &[0xff, 0xfe]);
+    assert_eq!(code, 422, "{body}");
+    assert!(body.contains("x.toml: not UTF-8 text"), "{body}");
+    // Past the limit.
+    let mut big = text.clone();
+    big.extend(std::iter::repeat_n(b'#', 300 << 10));
+    let (code, body) = server.request("POST", "/api/vehicles?file=big.toml", None, &big);
+    assert_eq!(code, 413, "{body}");
+    assert!(body.contains("256 KiB"), "{body}");
+    // A name of a built-in or of a vehicle given: 422 naming the clash; nothing kept.
+    let text_named = |name: &str| {
+        String::from_utf8(text.clone()).unwrap().replacen(
+            "name = \"sent-quad\"",
+            &format!("name = \"{name}\""),
+            1,
+        )
+    };
+    for (name, clash) in [
+        ("dji-m100", "is a built-in vehicle's"),
+        ("my-quad", "given to aloft serve on its command line"),
+        (quad.as_str(), "given to aloft serve on its command line"),
+    ] {
+        let (code, body) = server.request(
+            "POST",
+            "/api/vehicles?file=clash.toml",
+            None,
+            text_named(&name.replace('\\', "\\\\")).as_bytes(),
+        );
+        assert_eq!(code, 422, "{name}: {body}");
+        assert!(
+            body.contains(clash) && body.contains("clash.toml"),
+            "{body}"
+        );
+    }
+    let (code, body) = server.get("/api/endurance?vehicle=dji-m100");
+    assert_eq!((code, body), (200, cli(&["endurance", "--format", "json"])));
+    // An option it does not take; a page of another origin.
+    let (code, body) = server.request("POST", "/api/vehicles?payload_kg=1", None, &text);
+    assert_eq!(code, 400, "{body}");
+    let evil = text_named("evil-quad");
+    let a = server.send(
+        "POST",
+        "/api/vehicles?file=evil.toml",
+        &["Origin: http://evil.example"],
+        evil.as_bytes(),
+    );
+    assert_eq!(a.status, 403, "{}", a.body);
+    let (code, _) = server.request("POST", "/api/mission?vehicle=evil-quad", None, b"");
+    assert_eq!(code, 400);
+    // The same name again replaces it (here a heavier airframe).
+    let heavier =
+        String::from_utf8(text.clone())
+            .unwrap()
+            .replacen("mass_kg = 0.95", "mass_kg = 1.05", 1);
+    assert_ne!(heavier.as_bytes(), text.as_slice());
+    let (code, body) = server.request(
+        "POST",
+        "/api/vehicles?file=sent.toml",
+        None,
+        heavier.as_bytes(),
+    );
+    assert_eq!(code, 200, "{body}");
+    let mass = parsed(&body)["takeoff_mass_kg"].as_f64().unwrap();
+    let before = entry["takeoff_mass_kg"].as_f64().unwrap();
+    // 0.1 kg heavier, to the rounding of sums of decimals.
+    assert!((mass - before - 0.1).abs() < 1e-9, "{mass} {before}");
+    let listed = parsed(&server.get("/api/vehicles").1);
+    let sent_names = |listed: &serde_json::Value| -> Vec<String> {
+        listed
+            .as_array()
+            .unwrap()
+            .iter()
+            .skip(builtin_and_given())
+            .map(|v| v["name"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(sent_names(&listed), ["sent-quad"]);
+    // Past 32 vehicles sent, the oldest is forgotten.
+    for k in 0..32 {
+        let (code, body) = server.request(
+            "POST",
+            &format!("/api/vehicles?file=v{k}.toml"),
+            None,
+            text_named(&format!("v{k}")).as_bytes(),
+        );
+        assert_eq!(code, 200, "v{k}: {body}");
+    }
+    let names = sent_names(&parsed(&server.get("/api/vehicles").1));
+    let expected: Vec<String> = (0..32).map(|k| format!("v{k}")).collect();
+    assert_eq!(names, expected);
+    let (code, body) = server.request("POST", "/api/mission?vehicle=sent-quad", None, b"");
+    assert_eq!(code, 400, "{body}");
+    assert!(body.contains("sent-quad"), "{body}");
+    let (code, body) = server.request("POST", "/api/mission?vehicle=v31", None, b"");
+    assert_eq!(code, 200, "{body}");
+}
+
+/// The built-ins and the one vehicle given in [`a_vehicle_file_sent_is_kept_and_flown_by_its_name`].
+fn builtin_and_given() -> usize {
+    parsed(&cli(&["vehicles", "--format", "json"]))
+        .as_array()
+        .unwrap()
+        .len()
+        + 1
+}

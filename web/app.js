@@ -3,6 +3,12 @@
   'use strict';
 
   const MISSION_EXT = /\.(plan|waypoints|toml|json|txt)$/i;
+  // A `.toml` with a vehicle's table (`[power]`, `[airframe]`, `[propulsion]`, `[[battery]]`)
+  // and no mission segment (`[[segment]]`) is a vehicle file: sent to POST /api/vehicles. Any
+  // other `.toml` is a mission (a file is never both: each format refuses the other's keys).
+  const VEHICLE_TABLE = /^[ \t]*\[\[?[ \t]*(power|airframe|propulsion|battery)[ \t]*\]\]?/m;
+  const MISSION_TABLE = /^[ \t]*\[\[[ \t]*segment[ \t]*\]\]/m;
+  const VEHICLE_LIMIT = 256 * 1024;
   const SVG_NS = 'http://www.w3.org/2000/svg';
 
   const $ = (sel) => document.querySelector(sel);
@@ -633,7 +639,9 @@
   }
 
   async function updateSweep(mission) {
-    const vehicle = mission.vehicle;
+    // The vehicle chosen in the list (a given file may be listed under the name it was given
+    // with, its own name being a built-in's), else the answer's.
+    const vehicle = $('#vehicle').value || mission.vehicle;
     const battery = mission.battery;
     const key = `${vehicle}|${battery}`;
     if (state.sweepKey === key) return;
@@ -988,11 +996,45 @@
 
   // ---------------------------------------------------------------- vehicles
 
+  // The server's vehicles (built-in, given, sent), its default (the first --vehicle) chosen.
   function fillVehicles() {
     const select = $('#vehicle');
-    for (const v of state.vehicles) {
-      select.append(el('option', { value: v.name, text: v.name, title: v.description }));
+    select.replaceChildren(...state.vehicles.map((v) => el('option', { value: v.name, text: v.name, title: v.description })));
+    const chosen = state.config.default_vehicle;
+    if (chosen && state.vehicles.some((v) => v.name === chosen)) select.value = chosen;
+  }
+
+  // A vehicle file sent to the server: kept there under its own name, added to the list (in
+  // place of one of that name sent before), chosen, and the mission re-planned with it.
+  async function uploadVehicle(file, text) {
+    if (file.size > VEHICLE_LIMIT) {
+      showError(`${file.name}: ${file.size} bytes is more than the server accepts for a vehicle file (${VEHICLE_LIMIT})`);
+      settle(false);
+      return;
     }
+    let entry;
+    try {
+      entry = await api(`/api/vehicles?file=${encodeURIComponent(file.name)}`, {
+        method: 'POST',
+        body: text,
+        headers: { 'Content-Type': 'text/plain' },
+      });
+    } catch (e) {
+      // The server's message names the file.
+      showError(e.message);
+      settle(false);
+      return;
+    }
+    state.vehicles = state.vehicles.filter((v) => v.name !== entry.name).concat([entry]);
+    for (const key of [...state.sweepCache.keys()]) {
+      if (key.startsWith(`${entry.name}|`)) state.sweepCache.delete(key);
+    }
+    state.sweepKey = null;
+    fillVehicles();
+    $('#vehicle').value = entry.name;
+    $('#battery').value = '';
+    syncBatteries(null);
+    await replan();
   }
 
   // The battery list follows the chosen vehicle (or the answer's vehicle when on the default).
@@ -1065,6 +1107,10 @@
             continue;
           }
           const text = await file.text();
+          if (/\.toml$/i.test(file.name) && VEHICLE_TABLE.test(text) && !MISSION_TABLE.test(text)) {
+            await uploadVehicle(file, text);
+            continue;
+          }
           state.uploads += 1;
           const entry = { key: `upload:${state.uploads}`, label: `${file.name} (opened)`, name: file.name, text };
           addMission(entry);

@@ -19,6 +19,7 @@ use super::{
     list_vehicles, log_info, mission_map, payload_sweep, plan_mission, plan_mission_with,
     plan_scenarios, plan_to_fly, power_curve, replay_live, validate_logs, EnduranceWithUncertainty,
     FlyPlan, LiveUpdate, Mission, MissionOutputs, MissionWithUncertainty, SortieMap, Vehicle,
+    VehicleEntry,
 };
 use crate::error::Error;
 
@@ -44,14 +45,26 @@ pub fn mission_answer(path: Option<&Path>, flags: &MissionScenarioFlags) -> Resu
 /// # Errors
 /// As [`plan_mission`] and [`plan_scenarios`].
 pub fn mission_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Result<String, Error> {
+    mission_answer_with(&Vehicle::load(&flags.mission.vehicle)?, m, flags)
+}
+
+/// [`mission_answer_for`] of a vehicle already loaded (`aloft serve`'s, read at its start or
+/// sent to it), in place of the flags' `vehicle`.
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_answer_with(
+    v: &Vehicle,
+    m: &Mission,
+    flags: &MissionScenarioFlags,
+) -> Result<String, Error> {
     let opts = flags.mission.options();
-    let v = Vehicle::load(&flags.mission.vehicle)?;
-    let plan = plan_mission(&v, m, &opts)?;
+    let plan = plan_mission(v, m, &opts)?;
     match flags.scenarios.options(false) {
         None => plan.to_json(),
         Some(sc) => MissionWithUncertainty {
             summary: plan.summary(),
-            uncertainty: &plan_scenarios(&v, m, &opts, &sc)?,
+            uncertainty: &plan_scenarios(v, m, &opts, &sc)?,
         }
         .to_json(),
     }
@@ -77,16 +90,27 @@ pub fn mission_map_answer(
 /// # Errors
 /// As [`plan_mission`] and [`plan_scenarios`].
 pub fn mission_map_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Result<String, Error> {
+    mission_map_answer_with(&Vehicle::load(&flags.mission.vehicle)?, m, flags)
+}
+
+/// [`mission_map_answer_for`] of a vehicle already loaded, in place of the flags' `vehicle`.
+///
+/// # Errors
+/// As [`plan_mission`] and [`plan_scenarios`].
+pub fn mission_map_answer_with(
+    v: &Vehicle,
+    m: &Mission,
+    flags: &MissionScenarioFlags,
+) -> Result<String, Error> {
     let opts = flags.mission.options();
-    let v = Vehicle::load(&flags.mission.vehicle)?;
     let outputs = MissionOutputs {
         plot: true,
         ..MissionOutputs::default()
     };
-    let plan = plan_mission_with(&v, m, &opts, &outputs)?;
+    let plan = plan_mission_with(v, m, &opts, &outputs)?;
     let fan = match flags.scenarios.options(true) {
         None => None,
-        Some(sc) => plan_scenarios(&v, m, &opts, &sc)?.soc_fan,
+        Some(sc) => plan_scenarios(v, m, &opts, &sc)?.soc_fan,
     };
     // Compact: the page's, not a reader's (a long route is thousands of points).
     serde_json::to_string(&mission_map(&plan, m, fan)).map_err(|e| Error::OptionsFormat {
@@ -104,9 +128,16 @@ pub fn mission_map_answer_for(m: &Mission, flags: &MissionScenarioFlags) -> Resu
 /// # Errors
 /// As [`plan_to_fly`] (but [`Error::NoPlan`], which is an answer) and [`PlanFlags::request`].
 pub fn plan_answer_for(m: &Mission, flags: &PlanFlags) -> Result<String, Error> {
-    let v = Vehicle::load(&flags.mission.vehicle)?;
+    plan_answer_with(&Vehicle::load(&flags.mission.vehicle)?, m, flags)
+}
+
+/// [`plan_answer_for`] of a vehicle already loaded, in place of the flags' `vehicle`.
+///
+/// # Errors
+/// As [`plan_answer_for`].
+pub fn plan_answer_with(v: &Vehicle, m: &Mission, flags: &PlanFlags) -> Result<String, Error> {
     let request = flags.request()?;
-    let plan = match plan_to_fly(&v, m, &request) {
+    let plan = match plan_to_fly(v, m, &request) {
         Ok(plan) => plan,
         Err(Error::NoPlan { reason }) => return Ok(no_plan_answer(&reason)),
         Err(e) => return Err(e),
@@ -121,7 +152,7 @@ pub fn plan_answer_for(m: &Mission, flags: &PlanFlags) -> Result<String, Error> 
                 text,
             })
             .collect(),
-        maps: fly_plan_map(&v, &plan, &request)?,
+        maps: fly_plan_map(v, &plan, &request)?,
         plan: &plan,
     };
     serde_json::to_string(&answer).map_err(|e| Error::OptionsFormat {
@@ -206,20 +237,27 @@ pub fn plan_answer(
 /// # Errors
 /// As [`endurance`] and the sweeps.
 pub fn endurance_answer(flags: &EnduranceFlags) -> Result<String, Error> {
+    endurance_answer_with(&Vehicle::load(&flags.vehicle)?, flags)
+}
+
+/// [`endurance_answer`] of a vehicle already loaded, in place of the flags' `vehicle`.
+///
+/// # Errors
+/// As [`endurance`] and the sweeps.
+pub fn endurance_answer_with(v: &Vehicle, flags: &EnduranceFlags) -> Result<String, Error> {
     let opts = flags.options();
-    let v = Vehicle::load(&flags.vehicle)?;
     if let Some(sweep) = &flags.payload_sweep {
-        return json_text(&payload_sweep(&v, &opts, sweep)?);
+        return json_text(&payload_sweep(v, &opts, sweep)?);
     }
     if let Some(step) = flags.sweep_speed {
-        return json_text(&power_curve(&v, &opts, step)?);
+        return json_text(&power_curve(v, &opts, step)?);
     }
-    let summary = endurance(&v, &opts)?;
+    let summary = endurance(v, &opts)?;
     match flags.scenarios.options(false) {
         None => summary.to_json(),
         Some(sc) => json_text(&EnduranceWithUncertainty {
             summary: &summary,
-            uncertainty: &endurance_scenarios(&v, &opts, &sc)?,
+            uncertainty: &endurance_scenarios(v, &opts, &sc)?,
         }),
     }
 }
@@ -229,7 +267,27 @@ pub fn endurance_answer(flags: &EnduranceFlags) -> Result<String, Error> {
 /// # Errors
 /// A built-in vehicle file that does not read (a defect, tested against).
 pub fn vehicles_answer() -> Result<String, Error> {
-    json_text(&list_vehicles()?)
+    vehicles_answer_of(&list_vehicles()?)
+}
+
+/// `aloft vehicles --format json` of a list of entries ([`list_vehicles`] and the vehicles
+/// `aloft serve` was given or sent: [`Vehicle::entry`]).
+///
+/// # Errors
+/// None in practice (finite numbers serialise).
+pub fn vehicles_answer_of(entries: &[VehicleEntry]) -> Result<String, Error> {
+    json_text(&entries)
+}
+
+/// One vehicle's entry as `aloft vehicles --format json` lists it ([`Vehicle::entry`]), listed
+/// under `name`.
+///
+/// # Errors
+/// As [`Vehicle::entry`].
+pub fn vehicle_answer(v: &Vehicle, name: &str) -> Result<String, Error> {
+    let mut entry = v.entry()?;
+    entry.name = name.to_string();
+    json_text(&entry)
 }
 
 /// `aloft vehicles calibrate SPEC -o OUTPUT --format json`: the vehicle file of a spec sheet,

@@ -8,7 +8,7 @@
 //!
 //! | concern | requests | answer | file |
 //! |---|---|---|---|
-//! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`]; [`Vehicle::takeoff_mass`] (the one mass every command flies) | [`Vehicle`], [`TakeoffMass`], [`list_vehicles`] | `vehicles.rs` |
+//! | vehicles | [`Vehicle::load`], [`Vehicle::builtin`], [`Vehicle::from_toml`]; [`Vehicle::takeoff_mass`] (the one mass every command flies) | [`Vehicle`], [`TakeoffMass`], [`list_vehicles`], one vehicle's entry of that list: [`Vehicle::entry`] | `vehicles.rs` |
 //! | calibrate | [`SpecSheet`] → [`calibrate_spec`]; a vehicle file → [`calibrate_hover`] | [`SpecCalibration`], [`HoverCalibration`] | `calibrate.rs` |
 //! | missions | [`Mission::load`] (aloft TOML or JSON, QGroundControl `.plan`, `.waypoints`, recognised from the content) + [`MissionOptions`] → [`plan_mission`] | [`Plan`] ([`MissionSummary`] with the [`RouteFigures`], samples, files) | `mission.rs`, `summary.rs`, `mission_outputs.rs`, `wind.rs` |
 //! | replay of a log | [`ReplayRequest`] → [`replay_log`] | [`ReplayAnswer`] | `replay.rs` |
@@ -24,7 +24,7 @@
 //! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `mission_map.rs` |
 //! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `fly_plan.rs`, `sorties.rs`, `plan_files.rs`, `survey_angle.rs` |
 //! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `plan_map.rs` |
-//! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
+//! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
 //! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
 //!

@@ -472,11 +472,12 @@ fn check_payload(payload_kg: f64) -> Result<(), Error> {
     }
 }
 
-/// One built-in vehicle as `aloft vehicles` lists it.
+/// One vehicle as `aloft vehicles` lists it (and `aloft serve` lists the vehicles given to it
+/// or dropped on its page: [`Vehicle::entry`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct VehicleEntry {
     /// Name on the command line.
-    pub name: &'static str,
+    pub name: String,
     /// One line about the vehicle and its source.
     pub description: String,
     /// The mass every command flies it at without payload, kg: airframe + default pack, or for
@@ -491,6 +492,36 @@ pub struct VehicleEntry {
     pub source: Option<VehicleSource>,
 }
 
+impl Vehicle {
+    /// The vehicle as `aloft vehicles` lists one, under its own name.
+    ///
+    /// # Errors
+    /// A vehicle without a default take-off mass (an airframe without `[[battery]]`, a default
+    /// pack above the airframe's limit, no table that gives a mass): no command can fly it.
+    pub fn entry(&self) -> Result<VehicleEntry, Error> {
+        entry_of(&self.file)
+    }
+}
+
+/// The entry of a vehicle file (see [`Vehicle::entry`]).
+fn entry_of(f: &VehicleFile) -> Result<VehicleEntry, Error> {
+    let mut models = Vec::new();
+    if f.power.is_some() {
+        models.push("power");
+    }
+    if f.propulsion.is_some() {
+        models.push("propulsion");
+    }
+    Ok(VehicleEntry {
+        name: f.name.clone(),
+        takeoff_mass_kg: default_takeoff_mass(f)?.total_kg,
+        batteries: f.battery_names().iter().map(|s| s.to_string()).collect(),
+        source: f.source.clone(),
+        description: f.description.clone(),
+        models,
+    })
+}
+
 /// The built-in vehicles, the default first.
 ///
 /// # Errors
@@ -498,24 +529,7 @@ pub struct VehicleEntry {
 pub fn list_vehicles() -> Result<Vec<VehicleEntry>, Error> {
     BUILTIN_VEHICLES
         .iter()
-        .map(|b| {
-            let f = VehicleFile::builtin(b.name)?;
-            let mut models = Vec::new();
-            if f.power.is_some() {
-                models.push("power");
-            }
-            if f.propulsion.is_some() {
-                models.push("propulsion");
-            }
-            Ok(VehicleEntry {
-                name: b.name,
-                takeoff_mass_kg: default_takeoff_mass(&f)?.total_kg,
-                batteries: f.battery_names().iter().map(|s| s.to_string()).collect(),
-                source: f.source.clone(),
-                description: f.description,
-                models,
-            })
-        })
+        .map(|b| entry_of(&VehicleFile::builtin(b.name)?))
         .collect()
 }
 

@@ -8,7 +8,7 @@
 // Prints one `ok - ...` / `not ok - ...` line per check and exits 0 only when all pass.
 
 import { spawn, execFileSync } from 'node:child_process';
-import { readFileSync, readdirSync, mkdirSync, existsSync, mkdtempSync, rmSync } from 'node:fs';
+import { readFileSync, readdirSync, mkdirSync, existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -727,6 +727,85 @@ async function main() {
     await page.context().close();
   } finally {
     nobook.stop();
+  }
+
+  // --- 10: your own vehicles: a vehicle file given with --vehicle (`aloft vehicles template`)
+  // listed and chosen, the page's answers the command line's with that file; a vehicle file
+  // dropped on the page (a built-in's file, renamed) added, chosen and flown.
+  const vehDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-vehicles-'));
+  const myQuad = path.join(vehDir, 'my-quad.toml');
+  writeFileSync(myQuad, execFileSync(BIN, ['vehicles', 'template'], { encoding: 'utf8' }));
+  const inspire = readFileSync(path.join(repo, 'fixtures/vehicles/dji-inspire1.toml'), 'utf8');
+  const dropped = path.join(vehDir, 'dropped-inspire.toml');
+  writeFileSync(dropped, inspire.replace('name = "dji-inspire1"', 'name = "dropped-inspire"'));
+  const own = await serve(['--vehicle', myQuad]);
+  try {
+    const page = await openPage(own.url);
+    const summary = () => page.$eval('#summary', (e) => ({ f: e.dataset.feasible, e: e.dataset.energyWh, text: e.textContent }));
+    const chosen = () => page.$eval('#vehicle', (s) => s.value);
+    const listed = () => page.$$eval('#vehicle option', (os) => os.map((o) => o.value));
+    await check('--vehicle my-quad.toml (aloft vehicles template): in the vehicle list and chosen by default', async () => {
+      const names = await listed();
+      assert(names.includes('my-quad') && names.includes('dji-m100'), names.join(','));
+      assert((await chosen()) === 'my-quad', `chosen ${await chosen()}`);
+    });
+    await check('the demo flown with my-quad: the page shows aloft mission --vehicle my-quad.toml', async () => {
+      const cli = cliMission(null, ['--vehicle', myQuad]);
+      assert(cli.status <= 1 && cli.json.vehicle === 'my-quad', JSON.stringify(cli).slice(0, 200));
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const s = await summary();
+      assert(s.f === String(cli.json.feasible) && s.e === String(cli.json.energy_wh), JSON.stringify(s));
+      assert(s.text.includes('my-quad'), s.text);
+    });
+    await check("my-quad's packs in the battery list, its payload sweep drawn", async () => {
+      const packs = await page.$$eval('#battery option', (os) => os.map((o) => o.value).filter((v) => v));
+      assert(packs.join(',') === '3S-5000', packs.join(','));
+      await page.waitForFunction(() => document.querySelector('#sweep-title').textContent.startsWith('my-quad'), null, { timeout: 10000 });
+      assert(await page.$('#sweep svg polyline.sweep-hover'), 'no sweep');
+    });
+    const missionsBefore = await page.$$eval('#mission-select option', (os) => os.length);
+    await check('a dropped vehicle file (dji-inspire1 renamed) is listed, chosen, and the page shows aloft mission --vehicle dropped-inspire.toml', async () => {
+      const before = await plans(page);
+      await dropFiles(page, [{ name: path.basename(dropped), bytes: readFileSync(dropped) }]);
+      await waitReady(page, before);
+      assert((await listed()).includes('dropped-inspire'), (await listed()).join(','));
+      assert((await chosen()) === 'dropped-inspire', `chosen ${await chosen()}`);
+      const cli = cliMission(null, ['--vehicle', dropped]);
+      assert(cli.status <= 1 && cli.json.vehicle === 'dropped-inspire', JSON.stringify(cli).slice(0, 200));
+      compareRows(await pageRows(page), expectedRows(cli.json));
+      const s = await summary();
+      assert(s.f === String(cli.json.feasible) && s.e === String(cli.json.energy_wh), JSON.stringify(s));
+      const mine = cliMission(null, ['--vehicle', myQuad]);
+      assert(s.e !== String(mine.json.energy_wh), 'the same energy as my-quad');
+      const missions = await page.$$eval('#mission-select option', (os) => os.length);
+      assert(missions === missionsBefore, `${missions} missions: taken as a mission`);
+      const served = await page.evaluate(() => fetch('/api/vehicles').then((r) => r.json()));
+      assert(served.some((v) => v.name === 'dropped-inspire' && v.batteries.length > 0), 'not in /api/vehicles');
+    });
+    await check('a dropped mission .toml stays a mission, flown with the chosen vehicle', async () => {
+      const before = await plans(page);
+      await dropFiles(page, [{ name: 'demo-copy.toml', bytes: readFileSync(DEMO) }]);
+      await waitReady(page, before);
+      const label = await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent);
+      assert(label.includes('demo-copy.toml'), label);
+      assert((await chosen()) === 'dropped-inspire', `chosen ${await chosen()}`);
+      compareRows(await pageRows(page), expectedRows(cliMission(DEMO, ['--vehicle', dropped]).json));
+    });
+    await check("a dropped vehicle file named as a built-in is refused with the server's message", async () => {
+      const clash = readFileSync(myQuad, 'utf8').replace('name = "my-quad"', 'name = "dji-m100"');
+      const names = await listed();
+      await refusing(async () => {
+        await dropFiles(page, [{ name: 'clash.toml', bytes: Buffer.from(clash) }]);
+        await page.waitForSelector('#error:not([hidden])', { timeout: 10000 });
+      });
+      const shown = await page.$eval('#error', (e) => e.textContent);
+      assert(shown.includes('clash.toml') && shown.includes("'dji-m100' is a built-in vehicle's"), shown);
+      assert((await listed()).join(',') === names.join(','), 'the list changed');
+    });
+    await page.context().close();
+  } finally {
+    own.stop();
+    rmSync(vehDir, { recursive: true, force: true });
   }
 
   // --- 7: no page errors anywhere

@@ -12,7 +12,7 @@ use axum::routing::{post, MethodRouter};
 
 use aloft::engine::answers;
 use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
-use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission};
+use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission, Vehicle};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT};
 use super::given::Names;
@@ -35,6 +35,7 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
         "live": shared.live.is_some(),
         "max_upload_bytes": shared.max_upload,
         "logbook": shared.logbook.is_some(),
+        "default_vehicle": shared.vehicles.default_name(),
     });
     if let (Some((url, attribution)), Some(c)) = (&shared.tiles, config.as_object_mut()) {
         c.insert("tiles".into(), url.as_str().into());
@@ -46,12 +47,6 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
 /// A JSON answer.
 fn json(text: String) -> Response {
     (StatusCode::OK, [(header::CONTENT_TYPE, json_type())], text).into_response()
-}
-
-/// `GET /api/vehicles`: answered at start (it depends on nothing a request gives), off the
-/// engine's queue.
-pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> Response {
-    json(shared.vehicles.clone())
 }
 
 /// `GET /api/logbook/KIND`: the list of the logbook given with `--logbook` (404 without one),
@@ -100,11 +95,13 @@ pub(super) async fn endurance(
     State(shared): State<Arc<Shared>>,
     Query(query): QueryPairs,
 ) -> Answered {
-    let mut flags: EnduranceFlags = flags("GET /api/endurance", &query, &shared)?;
+    let request = "GET /api/endurance";
+    let mut flags: EnduranceFlags = flags(request, &query, &shared)?;
+    let vehicle = shared.vehicles.vehicle(request, &flags.vehicle)?;
     let work = shared.clone();
     let job = move |cancel: &_| {
         work.work.bound(&mut flags.scenarios, cancel);
-        answers::endurance_answer(&flags).map_err(engine_message)
+        answers::endurance_answer_with(&vehicle, &flags).map_err(engine_message)
     };
     Ok(shared.work.run(job).await)
 }
@@ -114,11 +111,18 @@ pub(super) async fn endurance(
 pub(super) trait MissionRequest: FlagGroup + Send + 'static {
     /// Bound the request's work within the pool's, with the cancellation flag of its client.
     fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>);
+
+    /// The vehicle flown: its name in the server's list (see [`flags`]).
+    fn vehicle(&self) -> &str;
 }
 
 impl MissionRequest for MissionScenarioFlags {
     fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) {
         pool.bound(&mut self.scenarios, cancel);
+    }
+
+    fn vehicle(&self) -> &str {
+        &self.mission.vehicle
     }
 }
 
@@ -129,15 +133,20 @@ impl MissionRequest for PlanFlags {
     fn bound(&mut self, _: &Pool, cancel: &Arc<AtomicBool>) {
         self.bounds.cancel = Some(cancel.clone());
     }
+
+    fn vehicle(&self) -> &str {
+        &self.mission.vehicle
+    }
 }
 
-/// How a mission request is answered: `aloft mission`'s JSON, the page's map, `aloft plan`'s.
-type MissionAnswer<T> = fn(&Mission, &T) -> Result<String, aloft::Error>;
+/// How a mission request is answered, with the vehicle flown: `aloft mission`'s JSON, the
+/// page's map, `aloft plan`'s.
+type MissionAnswer<T> = fn(&Vehicle, &Mission, &T) -> Result<String, aloft::Error>;
 
 /// The route of a mission request (`POST PATH?file=NAME&OPTIONS`, the body a mission file, the
-/// demo when empty): `/api/mission` answers with `answers::mission_answer_for`, `/api/map` (the
-/// page's map of the same plan) with `answers::mission_map_answer_for`, both with the options
-/// of `aloft mission`; `/api/plan` with `answers::plan_answer_for` and those of `aloft plan`.
+/// demo when empty): `/api/mission` answers with `answers::mission_answer_with`, `/api/map` (the
+/// page's map of the same plan) with `answers::mission_map_answer_with`, both with the options
+/// of `aloft mission`; `/api/plan` with `answers::plan_answer_with` and those of `aloft plan`.
 pub(super) fn planned_route<T: MissionRequest>(
     request: &'static str,
     answer: MissionAnswer<T>,
@@ -162,13 +171,14 @@ async fn planned<T: MissionRequest>(
     let limit_name = "the limit on mission files";
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
     let mut flags: T = flags(request, &query, &shared)?;
+    let vehicle = shared.vehicles.vehicle(request, flags.vehicle())?;
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
     let job = move |cancel: &_| {
         flags.bound(&work.work, cancel);
         mission_of(&body, &origin)
-            .and_then(|m| answer(&m, &flags))
+            .and_then(|m| answer(&vehicle, &m, &flags))
             .map_err(engine_message)
     };
     Ok(shared.work.run(job).await)
@@ -188,8 +198,9 @@ fn mission_of(body: &[u8], origin: &str) -> Result<Mission, aloft::Error> {
 }
 
 /// The query's options (all but `file`) as the command's flag group, the options that name a
-/// file resolved to the files given to the server ([`Names`]); or a 400 naming the option and
-/// the `request`.
+/// file resolved to the files given to the server ([`Names`]), a `vehicle` to its name in the
+/// server's list (the server's default vehicle when the command flies one and the query names
+/// none); or a 400 naming the option and the `request`.
 pub(super) fn flags<T: FlagGroup>(
     request: &str,
     query: &[(String, String)],
@@ -197,10 +208,17 @@ pub(super) fn flags<T: FlagGroup>(
 ) -> Result<T, Refused> {
     let bad = |m: String| Refused::from(error(StatusCode::BAD_REQUEST, &m));
     let file_options = file_keywords::<T>();
-    let names = Names(&shared.files);
+    let names = Names {
+        files: &shared.files,
+        vehicles: &shared.vehicles,
+    };
+    let vehicle = "vehicle".to_string();
+    let default = (vehicle.clone(), shared.vehicles.default_name().to_string());
+    let named = query.iter().any(|(k, _)| *k == vehicle);
+    let default = (file_options.contains(&vehicle) && !named).then_some(&default);
     // Each key's values, in order: one is a value (or a switch), several are a list.
     let mut values: Vec<(&String, Vec<String>)> = Vec::new();
-    for (k, v) in query.iter().filter(|(k, _)| k != "file") {
+    for (k, v) in query.iter().filter(|(k, _)| k != "file").chain(default) {
         let v = match file_options.contains(k) {
             true => names.resolve(request, k, v).map_err(bad)?,
             false => v.clone(),

@@ -8,6 +8,7 @@
 //! |---|---|
 //! | a mission (`/api/mission`, `/api/map`, `/api/plan`) | [`MISSION_LIMIT`]: the command line's limit on whole-file inputs, as the text is held and parsed whole |
 //! | a log (`/api/log/info`) | `--max-upload-mb` (256 MiB by default): streamed to a file, never held |
+//! | a vehicle file (`POST /api/vehicles`) | [`VEHICLE_LIMIT`]: held and parsed whole, and kept (parsed) in memory |
 
 use axum::body::{Body, Bytes};
 use axum::http::{header, HeaderMap, StatusCode};
@@ -19,6 +20,10 @@ use super::{error, Refused};
 
 /// Largest mission body, bytes.
 pub(super) const MISSION_LIMIT: usize = aloft::engine::MAX_INPUT_BYTES as usize;
+
+/// Largest vehicle file body, bytes: the built-in files are 2-5 KiB, and a vehicle sent is kept
+/// in memory (at most [`super::vehicles::MAX_SENT`] of them).
+pub(super) const VEHICLE_LIMIT: usize = 256 << 10;
 
 /// 413 when the body's declared length is over `limit` bytes (`what` names the limit).
 pub(super) fn within_declared(
@@ -36,14 +41,15 @@ pub(super) fn within_declared(
     }
 }
 
-/// 413 naming the limit.
+/// 413 naming the limit (in MiB, or KiB below one).
 pub(super) fn too_large(limit: usize, what: &str) -> Response {
+    let size = match limit < 1 << 20 {
+        true => format!("{} KiB", limit.div_ceil(1 << 10)),
+        false => format!("{} MiB", limit.div_ceil(1 << 20)),
+    };
     error(
         StatusCode::PAYLOAD_TOO_LARGE,
-        &format!(
-            "the body is larger than the limit ({} MiB, {what})",
-            limit.div_ceil(1 << 20)
-        ),
+        &format!("the body is larger than the limit ({size}, {what})"),
     )
 }
 

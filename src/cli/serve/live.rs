@@ -34,9 +34,10 @@ pub(super) struct Feed {
     last: Arc<Mutex<Option<(&'static str, String)>>>,
 }
 
-/// Start following the flight of `--live` / `--tlog`, if one is given: its source opened here
-/// (a bad address or file is bad input, before the server starts), followed on a thread.
-pub(super) fn start(args: &ServeArgs) -> Result<Option<Feed>> {
+/// Start following the flight of `--live` / `--tlog`, if one is given, with `vehicle` (the
+/// first `--vehicle`, read at start): its source opened here (a bad address or file is bad
+/// input, before the server starts), followed on a thread.
+pub(super) fn start(args: &ServeArgs, vehicle: Arc<Vehicle>) -> Result<Option<Feed>> {
     let mut given: Vec<(String, Keyword)> = Vec::new();
     let one = |k: &str, v: String| (k.to_string(), Keyword::One(v.into()));
     match (&args.live, &args.tlog) {
@@ -45,10 +46,8 @@ pub(super) fn start(args: &ServeArgs) -> Result<Option<Feed>> {
         (None, None) => return Ok(None),
     }
     given.extend(args.speed.clone().map(|s| one("speed", s)));
-    given.push(one("vehicle", args.vehicle.clone()));
     given.extend(args.battery.clone().map(|b| one("battery", b)));
     let flags: LiveFlags = parse(&given)?;
-    let vehicle = Vehicle::load(&flags.vehicle)?;
     let LiveTask::Follow { source, request } = flags.request()? else {
         anyhow::bail!("--live/--tlog: not a flight to follow");
     };

@@ -4,8 +4,9 @@
 //! | request | answer |
 //! |---|---|
 //! | `GET /` | the page (its files built into the binary: [`assets`]) |
-//! | `GET /api/config` | the files given on the command line, the tile layer, whether a flight is followed |
-//! | `GET /api/vehicles` | `aloft vehicles --format json` |
+//! | `GET /api/config` | the files given on the command line, the default vehicle (`default_vehicle`: the first `--vehicle`), the tile layer, whether a flight is followed |
+//! | `GET /api/vehicles` | `aloft vehicles --format json`, then the entries of the vehicle files given (`--vehicle FILE...` and positionally) and sent ([`vehicles`]) |
+//! | `POST /api/vehicles?file=NAME` (body: a vehicle file, at most 256 KiB) | the vehicle kept in memory under its own name (no built-in's nor given vehicle's: 422), answered with its entry of `/api/vehicles`; at most 32 kept, the oldest forgotten |
 //! | `GET /api/endurance?OPTIONS` | `aloft endurance OPTIONS --format json` |
 //! | `POST /api/mission?file=NAME&OPTIONS` (body: the mission file; empty: the built-in demo) | `aloft mission NAME OPTIONS --format json` |
 //! | `POST /api/map?file=NAME&OPTIONS` (as `/api/mission`) | the route, point of no return and state of charge over time that the page draws ([`aloft::engine::MissionMap`]) |
@@ -19,8 +20,9 @@
 //! OPTIONS are the command's flags in snake_case, as the Python package's keywords
 //! (`payload_kg=0.5`, `no_ground_effect=true`); `file` names the upload as the command line would
 //! be given it (its name in the answer). An option that names a file (`vehicle`, `wind_field`,
-//! `profile`) names a built-in or a file given on the command line, never another file of the
-//! server ([`files`]). Every answer is the engine's ([`aloft::engine::answers`]), so it is the
+//! `profile`) names a built-in or a file given on the command line (a vehicle also one sent to
+//! `POST /api/vehicles`), never another file of the server ([`given`]); a request that names no
+//! vehicle flies the server's default (the first `--vehicle`, else dji-m100). Every answer is the engine's ([`aloft::engine::answers`]), so it is the
 //! command line's text; an infeasible mission is an answer (200), and so is a mission no plan
 //! keeps the reserve for (`{"feasible": false, "reason": ...}`, as `aloft plan` answers it).
 //!
@@ -41,6 +43,7 @@ mod files;
 mod given;
 mod guard;
 mod live;
+mod vehicles;
 mod work;
 
 use std::io::Write;
@@ -97,9 +100,12 @@ pub struct ServeArgs {
     /// Playback speed of `--tlog`: `max` or times its own time (as `aloft live --speed`).
     #[arg(long, value_name = "X|max", requires = "tlog")]
     speed: Option<String>,
-    /// The vehicle followed by `--live` / `--tlog`: a built-in name or a vehicle TOML file.
-    #[arg(long, default_value = DEFAULT_VEHICLE, value_name = "NAME|FILE")]
-    vehicle: String,
+    /// Vehicles for the page's list and for requests to name (`vehicle=NAME`): built-in names or
+    /// vehicle TOML files, each file read once at start. The first is the page's and the
+    /// requests' default, and the vehicle followed by `--live` / `--tlog` (default: dji-m100).
+    /// Takes several values: give missions and logs before it.
+    #[arg(long, value_name = "NAME|FILE", num_args = 1..)]
+    vehicle: Vec<String>,
     /// Its battery pack (default: the vehicle's first).
     #[arg(long)]
     battery: Option<String>,
@@ -126,8 +132,8 @@ struct Shared {
     uploads: PathBuf,
     /// The engine's work: permits and bounds.
     work: work::Pool,
-    /// `aloft vehicles --format json`, answered once.
-    vehicles: String,
+    /// The vehicles a request may fly: built-in, given, sent.
+    vehicles: vehicles::Fleet,
     /// The logbook given with `--logbook`.
     logbook: Option<PathBuf>,
 }
@@ -138,7 +144,10 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
             anyhow::bail!("--tiles '{t}': the URL template needs {{z}}, {{x}} and {{y}}");
         }
     }
-    let given = given::read_given(&args.files)?;
+    let mut given = given::read_given(&args.files)?;
+    given.extend(given::read_vehicles(&args.vehicle, &given)?);
+    let default = args.vehicle.first().map_or(DEFAULT_VEHICLE, String::as_str);
+    let fleet = vehicles::Fleet::new(&given, default)?;
     let logbook = logbook_of(&args)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -146,7 +155,12 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         .enable_all()
         .build()
         .context("starting the server's runtime")?;
-    let served = runtime.block_on(serve(args, given, logbook, uploads.path().to_path_buf()));
+    let state = AtStart {
+        files: given,
+        vehicles: fleet,
+        logbook,
+    };
+    let served = runtime.block_on(serve(args, state, uploads.path().to_path_buf()));
     // Work still running for clients that have gone is not waited for; the uploads' folder is
     // removed whatever happened.
     runtime.shutdown_background();
@@ -187,27 +201,29 @@ fn logbook_of(_: &ServeArgs) -> Result<Option<PathBuf>> {
     Ok(None)
 }
 
-async fn serve(
-    args: ServeArgs,
-    given: Vec<given::Given>,
+/// What the command line gave, read at start.
+struct AtStart {
+    files: Vec<given::Given>,
+    vehicles: vehicles::Fleet,
     logbook: Option<PathBuf>,
-    uploads: PathBuf,
-) -> Result<()> {
+}
+
+async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> {
     let listener = tokio::net::TcpListener::bind(args.listen)
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;
     let local = listener.local_addr()?;
-    let live = live::start(&args)?;
+    let live = live::start(&args, given.vehicles.default_vehicle())?;
     let shared = Arc::new(Shared {
         hosts: guard::Hosts::new(local),
-        files: given,
+        files: given.files,
         tiles: args.tiles.zip(args.attribution),
         live,
         max_upload: args.max_upload_mb.saturating_mul(1 << 20),
         uploads,
         work: work::Pool::new(args.max_request_steps),
-        vehicles: answers::vehicles_answer()?,
-        logbook,
+        vehicles: given.vehicles,
+        logbook: given.logbook,
     });
     let app = router(shared);
     let mut out = std::io::stdout().lock();
@@ -221,19 +237,19 @@ async fn serve(
 fn router(shared: Arc<Shared>) -> Router {
     Router::new()
         .route("/api/config", get(api::config))
-        .route("/api/vehicles", get(api::vehicles))
+        .route("/api/vehicles", get(vehicles::list).post(vehicles::send))
         .route("/api/endurance", get(api::endurance))
         .route(
             "/api/mission",
-            api::planned_route("POST /api/mission", answers::mission_answer_for),
+            api::planned_route("POST /api/mission", answers::mission_answer_with),
         )
         .route(
             "/api/map",
-            api::planned_route("POST /api/map", answers::mission_map_answer_for),
+            api::planned_route("POST /api/map", answers::mission_map_answer_with),
         )
         .route(
             "/api/plan",
-            api::planned_route("POST /api/plan", answers::plan_answer_for),
+            api::planned_route("POST /api/plan", answers::plan_answer_with),
         )
         .route("/api/log/info", post(files::log_info))
         .route("/api/files/{index}", get(files::given_file))
