@@ -233,6 +233,12 @@ fn per_log_payload_is_checked() {
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(needle), "{err}");
     }
+    // A file whose whole name exists is that file, whatever its name holds.
+    let odd = scratch("own-vehicle", "odd:payload_kg=2.ulg");
+    std::fs::copy(&log, &odd).unwrap();
+    let (code, v, err) = fit(&[odd.display().to_string()], &OWNER, &out);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(v["logs"][0]["file"].as_str(), odd.to_str());
 }
 
 /// PX4's own hover-thrust estimate of a log (`hover_thrust_estimate.hover_thrust`, median of the

@@ -122,6 +122,23 @@ fn summary_rows(j: &LogInfo) -> Vec<Row<'static>> {
     if let Some(p) = j.max_power_w {
         rows.push(Row::num("max power", p, 1, "W"));
     }
+    // What a ULog or DataFlash log says of its vehicle (what `aloft fit` reads, or asks for).
+    if let Some(b) = &j.log {
+        rows.push(match b.battery_cells {
+            Some(n) => Row::new("pack cells (params)", n.to_string(), ""),
+            None => Row::new("pack cells (params)", "not set".into(), ""),
+        });
+        rows.push(match b.battery_capacity_ah {
+            Some(c) => Row::num("pack capacity (params)", 1000.0 * c, 0, "mAh"),
+            None => Row::new("pack capacity (params)", "not set".into(), ""),
+        });
+        if let Some(rho) = b.air_density_kg_m3 {
+            rows.push(Row::num("air density (mean)", rho, 3, "kg/m^3"));
+        }
+        if let Some(t) = b.in_air_s {
+            rows.push(Row::num("time in the air", t, 1, "s"));
+        }
+    }
     if let Some(l) = &j.lag {
         rows.push(Row::new(
             "power lag behind ground speed",

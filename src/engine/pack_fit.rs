@@ -121,30 +121,7 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// source gives ([`Error::PackKeyMissing`]), a pack the planner refuses, an output that cannot be
 /// written.
 pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
-    let profile = request
-        .profile
-        .as_deref()
-        .map(Profile::resolve)
-        .transpose()?;
-    let mut open = OpenOptions::default();
-    open.binary.battery_instance = request.battery_instance;
-    let base = match (&request.vehicle, &request.battery) {
-        (Some(v), Some(b)) => Some(
-            v.file()
-                .batteries
-                .iter()
-                .find(|s| s.name.eq_ignore_ascii_case(b))
-                .cloned()
-                .ok_or_else(|| {
-                    // The vehicle's own message lists its packs.
-                    v.battery(Some(b)).err().unwrap_or(Error::PackKeyMissing {
-                        key: "name",
-                        hint: "no such pack",
-                    })
-                })?,
-        ),
-        _ => None,
-    };
+    let base = base_pack(request)?;
     let options = PackOptions {
         rated_capacity_mah: request
             .capacity_mah
@@ -153,167 +130,19 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
             .cells_series
             .or(base.as_ref().map(|b| b.cells_series)),
     };
-    let mut logs = Vec::new();
-    let mut skipped = Vec::new();
-    let mut failsafe = Failsafe::default();
-    let mut serial = None;
-    for path in &request.logs {
-        let file = path.display().to_string();
-        // The log reader's error names the file. A log that reads but holds no battery record
-        // (no power sensor) is skipped, not an error.
-        let log = match read_battery_log(path, profile.as_ref(), &open) {
-            Ok(l) => l,
-            Err(aloft_logs::LogError::NoBatteryData { reason, .. }) => {
-                skipped.push(SkippedLog { file, reason });
-                continue;
-            }
-            Err(e) => return Err(Error::LogFile(Box::new(e))),
-        };
-        if !log.has_current() {
-            skipped.push(SkippedLog {
-                file,
-                reason: "no current is logged (voltage only): nothing to fit a pack on".into(),
-            });
-            continue;
-        }
-        match analyse_with(&log, &options) {
-            Ok(r) => {
-                failsafe.low_voltage_v = r.low_voltage_failsafe_v.or(failsafe.low_voltage_v);
-                failsafe.critical_voltage_v = r
-                    .critical_voltage_failsafe_v
-                    .or(failsafe.critical_voltage_v);
-                serial = serial.or(r.pack_id.clone());
-                logs.push(r);
-            }
-            Err(e) => skipped.push(SkippedLog {
-                file,
-                reason: e.to_string(),
-            }),
-        }
-    }
-    let mut notes = Vec::new();
-    let step_r = median(
-        logs.iter()
-            .filter_map(|r| r.internal_resistance_ohm)
-            .collect(),
-    );
-    let autopilot_r = median(
-        logs.iter()
-            .filter_map(|r| r.autopilot_internal_resistance_ohm)
-            .collect(),
-    );
-    let (resistance, source) = match (
-        step_r,
-        autopilot_r,
-        base.as_ref().and_then(|b| b.internal_resistance_ohm),
-    ) {
-        (Some(r), _, _) => (Some(r), Some("current steps")),
-        (None, Some(r), _) => {
-            notes.push("no log has enough current steps: the autopilot's own resistance estimate is written".into());
-            (Some(r), Some("autopilot"))
-        }
-        (None, None, Some(r)) => {
-            notes.push("no log has enough current steps or an autopilot estimate: the --battery pack's resistance is kept".into());
-            (Some(r), Some("--battery pack"))
-        }
-        _ => (None, None),
-    };
-    let capacity = median(logs.iter().filter_map(|r| r.capacity_mah).collect());
-    let discharged: f64 = logs.iter().filter_map(|r| r.discharged_mah).sum();
-    let rated = options
-        .rated_capacity_mah
-        .or_else(|| median(logs.iter().filter_map(|r| r.rated_capacity_mah).collect()));
-    let mut answer = PackFitAnswer {
-        internal_resistance_ohm: resistance,
-        internal_resistance_source: source.map(str::to_string),
-        autopilot_internal_resistance_ohm: autopilot_r,
-        capacity_mah: capacity,
-        pack_capacity_mah: None,
-        discharged_mah: discharged,
-        equivalent_cycles: rated.map(|c| discharged / c),
-        pack: None,
-        pack_toml: None,
-        output: String::new(),
-        notes,
-        logs,
-        skipped,
-    };
+    let analysed = analyse_logs(request, &options)?;
+    let mut answer = combine(analysed.logs, analysed.skipped, &options, base.as_ref());
     if answer.logs.is_empty() {
         return Ok(answer);
     }
-    let resistance = resistance.ok_or(Error::PackKeyMissing {
-        key: "internal_resistance_ohm",
-        hint: "no log has enough current steps or an autopilot estimate; give --battery NAME to keep its pack's",
-    })?;
-    let cells = options
-        .cells_series
-        .or_else(|| answer.logs.iter().find_map(|r| r.cells_series))
-        .ok_or(Error::PackKeyMissing {
-            key: "cells_series",
-            hint: "the logs do not say it: give --cells N or --battery NAME",
-        })?;
-    let capacity_mah = capacity.or(rated).ok_or(Error::PackKeyMissing {
-        key: "capacity_mah",
-        hint: "no capacity could be estimated between rests and no rated capacity is logged: give --capacity-mah or --battery NAME",
-    })?;
-    answer.pack_capacity_mah = Some(capacity_mah);
-    let mass_kg = request
-        .mass_kg
-        .or(base.as_ref().and_then(|b| b.mass_kg))
-        .ok_or(Error::PackKeyMissing {
-            key: "mass_kg",
-            hint: "logs do not weigh packs: give --mass-kg or --battery NAME",
-        })?;
-    let nominal_v = request
-        .nominal_v
-        .or(base.as_ref().and_then(|b| b.nominal_v))
-        .unwrap_or(DEFAULT_NOMINAL_CELL_V * f64::from(cells));
-    let mut spec = base.clone().unwrap_or_else(|| aloft_planner::BatterySpec {
-        name: String::new(),
-        default: false,
-        cells_series: cells,
-        cells_parallel: 1,
-        capacity_mah,
-        nominal_v: None,
-        energy_wh: None,
-        mass_kg: None,
-        internal_resistance_ohm: None,
-        r1_ohm: None,
-        r2_ohm_a: None,
-        r3_ohm_a: None,
-        eq17_min_current_a: None,
-        eq17_max_current_a: None,
-        cutoff_cell_v: None,
-        usable_fraction: 1.0,
-        effective_capacity_fraction: None,
-        full_charge_cell_v: None,
-        ocv_soc: None,
-        ocv_cell_v: None,
-        max_current_a: None,
-    });
-    spec.name = request
-        .name
-        .clone()
-        .or(base.as_ref().map(|b| b.name.clone()))
-        .or(serial)
-        .unwrap_or_else(|| "fitted".to_string());
-    spec.default = false;
-    spec.cells_series = cells;
-    spec.capacity_mah = capacity_mah;
-    spec.nominal_v = Some(nominal_v);
-    spec.energy_wh = Some(capacity_mah / 1000.0 * nominal_v);
-    spec.mass_kg = Some(mass_kg);
-    spec.internal_resistance_ohm = Some(resistance);
-    // The fitted constant resistance replaces a current-dependent eq (17) one.
-    (spec.r1_ohm, spec.r2_ohm_a, spec.r3_ohm_a) = (None, None, None);
-    (spec.eq17_min_current_a, spec.eq17_max_current_a) = (None, None);
-    spec.cutoff_cell_v = request
-        .cutoff_cell_v
-        .or(spec.cutoff_cell_v)
-        .or(Some(DEFAULT_CUTOFF_CELL_V));
-    if let Some(u) = request.usable_fraction {
-        spec.usable_fraction = u;
-    }
+    let spec = pack_spec(
+        request,
+        &mut answer,
+        &options,
+        base.as_ref(),
+        analysed.serial,
+    )?;
+    let failsafe = analysed.failsafe;
     let pack = PackFile {
         battery: spec,
         failsafe: (failsafe != Failsafe::default()).then_some(failsafe),
@@ -333,6 +162,226 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
     answer.pack = Some(pack);
     answer.pack_toml = Some(text);
     finite(answer, "pack fit", || format!("logs {:?}", request.logs))
+}
+
+/// The `--battery` pack of the request's vehicle, which gives the keys the logs cannot.
+///
+/// # Errors
+/// A pack the vehicle does not have (its message lists its packs).
+fn base_pack(request: &PackFitRequest) -> Result<Option<aloft_planner::BatterySpec>, Error> {
+    let (Some(v), Some(b)) = (&request.vehicle, &request.battery) else {
+        return Ok(None);
+    };
+    v.file()
+        .batteries
+        .iter()
+        .find(|s| s.name.eq_ignore_ascii_case(b))
+        .cloned()
+        .map(Some)
+        .ok_or_else(|| {
+            v.battery(Some(b)).err().unwrap_or(Error::PackKeyMissing {
+                key: "name",
+                hint: "no such pack",
+            })
+        })
+}
+
+/// The logs analysed one by one, the skipped ones with their reasons, and what they say of the
+/// pack besides (the failsafes, the last log's; the first serial logged).
+struct Analysed {
+    logs: Vec<PackReport>,
+    skipped: Vec<SkippedLog>,
+    failsafe: Failsafe,
+    serial: Option<String>,
+}
+
+/// Read and analyse each log: one that reads but holds no battery record (no power sensor) or
+/// no current is skipped, not an error.
+///
+/// # Errors
+/// A log that cannot be read ([`Error::LogFile`], naming it); a profile that cannot be read.
+fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analysed, Error> {
+    let profile = request
+        .profile
+        .as_deref()
+        .map(Profile::resolve)
+        .transpose()?;
+    let mut open = OpenOptions::default();
+    open.binary.battery_instance = request.battery_instance;
+    let mut out = Analysed {
+        logs: Vec::new(),
+        skipped: Vec::new(),
+        failsafe: Failsafe::default(),
+        serial: None,
+    };
+    for path in &request.logs {
+        let file = path.display().to_string();
+        let log = match read_battery_log(path, profile.as_ref(), &open) {
+            Ok(l) => l,
+            Err(aloft_logs::LogError::NoBatteryData { reason, .. }) => {
+                out.skipped.push(SkippedLog { file, reason });
+                continue;
+            }
+            Err(e) => return Err(Error::LogFile(Box::new(e))),
+        };
+        if !log.has_current() {
+            out.skipped.push(SkippedLog {
+                file,
+                reason: "no current is logged (voltage only): nothing to fit a pack on".into(),
+            });
+            continue;
+        }
+        match analyse_with(&log, options) {
+            Ok(r) => {
+                let f = &mut out.failsafe;
+                f.low_voltage_v = r.low_voltage_failsafe_v.or(f.low_voltage_v);
+                f.critical_voltage_v = r.critical_voltage_failsafe_v.or(f.critical_voltage_v);
+                out.serial = out.serial.or(r.pack_id.clone());
+                out.logs.push(r);
+            }
+            Err(e) => out.skipped.push(SkippedLog {
+                file,
+                reason: e.to_string(),
+            }),
+        }
+    }
+    Ok(out)
+}
+
+/// The flights combined (module docs): the resistance and where it comes from, the capacity
+/// estimated between rests, the charge drawn and the equivalent cycles.
+fn combine(
+    logs: Vec<PackReport>,
+    skipped: Vec<SkippedLog>,
+    options: &PackOptions,
+    base: Option<&aloft_planner::BatterySpec>,
+) -> PackFitAnswer {
+    let mut notes = Vec::new();
+    let step_r = median(
+        logs.iter()
+            .filter_map(|r| r.internal_resistance_ohm)
+            .collect(),
+    );
+    let autopilot_r = median(
+        logs.iter()
+            .filter_map(|r| r.autopilot_internal_resistance_ohm)
+            .collect(),
+    );
+    let (resistance, source) = match (
+        step_r,
+        autopilot_r,
+        base.and_then(|b| b.internal_resistance_ohm),
+    ) {
+        (Some(r), _, _) => (Some(r), Some("current steps")),
+        (None, Some(r), _) => {
+            notes.push("no log has enough current steps: the autopilot's own resistance estimate is written".into());
+            (Some(r), Some("autopilot"))
+        }
+        (None, None, Some(r)) => {
+            notes.push("no log has enough current steps or an autopilot estimate: the --battery pack's resistance is kept".into());
+            (Some(r), Some("--battery pack"))
+        }
+        _ => (None, None),
+    };
+    let capacity = median(logs.iter().filter_map(|r| r.capacity_mah).collect());
+    let discharged: f64 = logs.iter().filter_map(|r| r.discharged_mah).sum();
+    let rated = options
+        .rated_capacity_mah
+        .or_else(|| median(logs.iter().filter_map(|r| r.rated_capacity_mah).collect()));
+    PackFitAnswer {
+        internal_resistance_ohm: resistance,
+        internal_resistance_source: source.map(str::to_string),
+        autopilot_internal_resistance_ohm: autopilot_r,
+        capacity_mah: capacity,
+        pack_capacity_mah: None,
+        discharged_mah: discharged,
+        equivalent_cycles: rated.map(|c| discharged / c),
+        pack: None,
+        pack_toml: None,
+        output: String::new(),
+        notes,
+        logs,
+        skipped,
+    }
+}
+
+/// The pack's `[battery]` keys from the combined flights, the flags, the `--battery` pack and
+/// the documented defaults (module docs); sets the answer's capacity.
+///
+/// # Errors
+/// [`Error::PackKeyMissing`] for a key no source gives.
+fn pack_spec(
+    request: &PackFitRequest,
+    answer: &mut PackFitAnswer,
+    options: &PackOptions,
+    base: Option<&aloft_planner::BatterySpec>,
+    serial: Option<String>,
+) -> Result<aloft_planner::BatterySpec, Error> {
+    let resistance = answer.internal_resistance_ohm.ok_or(Error::PackKeyMissing {
+        key: "internal_resistance_ohm",
+        hint: "no log has enough current steps or an autopilot estimate; give --battery NAME to keep its pack's",
+    })?;
+    let cells = options
+        .cells_series
+        .or_else(|| answer.logs.iter().find_map(|r| r.cells_series))
+        .ok_or(Error::PackKeyMissing {
+            key: "cells_series",
+            hint: "the logs do not say it: give --cells N or --battery NAME",
+        })?;
+    let rated = options.rated_capacity_mah.or_else(|| {
+        median(
+            answer
+                .logs
+                .iter()
+                .filter_map(|r| r.rated_capacity_mah)
+                .collect(),
+        )
+    });
+    let capacity_mah = answer
+        .capacity_mah
+        .or(rated)
+        .ok_or(Error::PackKeyMissing {
+            key: "capacity_mah",
+            hint: "no capacity could be estimated between rests and no rated capacity is logged: give --capacity-mah or --battery NAME",
+        })?;
+    answer.pack_capacity_mah = Some(capacity_mah);
+    let mass_kg =
+        request
+            .mass_kg
+            .or(base.and_then(|b| b.mass_kg))
+            .ok_or(Error::PackKeyMissing {
+                key: "mass_kg",
+                hint: "logs do not weigh packs: give --mass-kg or --battery NAME",
+            })?;
+    let nominal_v = request
+        .nominal_v
+        .or(base.and_then(|b| b.nominal_v))
+        .unwrap_or(DEFAULT_NOMINAL_CELL_V * f64::from(cells));
+    let mut spec = base.cloned().unwrap_or_default();
+    spec.name = request
+        .name
+        .clone()
+        .or(base.map(|b| b.name.clone()))
+        .or(serial)
+        .unwrap_or_else(|| "fitted".to_string());
+    spec.default = false;
+    spec.cells_series = cells;
+    spec.capacity_mah = capacity_mah;
+    spec.nominal_v = Some(nominal_v);
+    spec.energy_wh = Some(capacity_mah / 1000.0 * nominal_v);
+    spec.mass_kg = Some(mass_kg);
+    spec.internal_resistance_ohm = Some(resistance);
+    // The fitted constant resistance replaces a current-dependent eq (17) one.
+    (spec.r1_ohm, spec.r2_ohm_a, spec.r3_ohm_a) = (None, None, None);
+    (spec.eq17_min_current_a, spec.eq17_max_current_a) = (None, None);
+    spec.cutoff_cell_v = request
+        .cutoff_cell_v
+        .or(spec.cutoff_cell_v)
+        .or(Some(DEFAULT_CUTOFF_CELL_V));
+    if let Some(u) = request.usable_fraction {
+        spec.usable_fraction = u;
+    }
+    Ok(spec)
 }
 
 /// Write `text` to a temporary name beside `path`, then rename it there.
