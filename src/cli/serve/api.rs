@@ -14,7 +14,7 @@ use aloft::engine::answers;
 use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
 use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission, Vehicle};
 
-use super::body::{read_whole, within_declared, MISSION_LIMIT};
+use super::body::{read_whole, within_declared, MISSION_LIMIT, VEHICLE_LIMIT};
 use super::given::Names;
 use super::work::Pool;
 use super::{engine_message, error, json_type, Refused, Shared};
@@ -249,4 +249,35 @@ pub(super) fn file_name(query: &[(String, String)], default: &str) -> String {
         .iter()
         .find(|(k, _)| k == "file")
         .map_or_else(|| default.to_string(), |(_, v)| v.clone())
+}
+
+/// `GET /api/vehicles`: the list (off the engine's queue: it depends on nothing a request
+/// gives, and is small).
+pub(super) async fn vehicles(State(shared): State<Arc<Shared>>) -> axum::response::Response {
+    super::answer(answers::vehicles_answer_of(&shared.vehicles.entries()).map_err(engine_message))
+}
+
+/// `POST /api/vehicles?file=NAME` (body: a vehicle file, at most [`VEHICLE_LIMIT`]): the
+/// vehicle kept under its own name, answered with its entry in the list.
+pub(super) async fn send_vehicle(
+    State(shared): State<Arc<Shared>>,
+    headers: HeaderMap,
+    Query(query): QueryPairs,
+    body: Body,
+) -> Answered {
+    let request = "POST /api/vehicles";
+    let limit_name = "the limit on vehicle files";
+    within_declared(&headers, VEHICLE_LIMIT, limit_name)?;
+    if let Some((k, _)) = query.iter().find(|(k, _)| k != "file") {
+        return Err(error(
+            StatusCode::BAD_REQUEST,
+            &format!("unknown option '{k}' of {request} (known: file)"),
+        )
+        .into());
+    }
+    let body = read_whole(body, VEHICLE_LIMIT, limit_name).await?;
+    let origin = file_name(&query, "upload.toml");
+    let work = shared.clone();
+    let job = move |_: &_| work.vehicles.keep(&body, &origin);
+    Ok(shared.work.run(job).await)
 }

@@ -199,3 +199,14 @@ fn refusal(request: &str, key: &str, value: &str, what: &str, known: &[String]) 
          request names no other file of the server); known: {known}"
     )
 }
+
+/// The vehicle files among the files given, each with the name it was given with.
+pub(super) fn vehicles_of(files: &[Given]) -> Vec<(String, Arc<Vehicle>)> {
+    files
+        .iter()
+        .filter_map(|g| match &g.content {
+            Content::Vehicle(v) => Some((g.name.clone(), v.clone())),
+            _ => None,
+        })
+        .collect()
+}

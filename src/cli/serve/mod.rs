@@ -147,7 +147,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
     let mut given = given::read_given(&args.files)?;
     given.extend(given::read_vehicles(&args.vehicle, &given)?);
     let default = args.vehicle.first().map_or(DEFAULT_VEHICLE, String::as_str);
-    let fleet = vehicles::Fleet::new(&given, default)?;
+    let fleet = vehicles::Fleet::new(&given::vehicles_of(&given), default)?;
     let logbook = logbook_of(&args)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -237,7 +237,7 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
 fn router(shared: Arc<Shared>) -> Router {
     Router::new()
         .route("/api/config", get(api::config))
-        .route("/api/vehicles", get(vehicles::list).post(vehicles::send))
+        .route("/api/vehicles", get(api::vehicles).post(api::send_vehicle))
         .route("/api/endurance", get(api::endurance))
         .route(
             "/api/mission",

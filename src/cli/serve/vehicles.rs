@@ -17,16 +17,11 @@ use std::collections::VecDeque;
 use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, Result};
-use axum::body::Body;
-use axum::extract::{Query, State};
-use axum::http::{HeaderMap, StatusCode};
+use axum::http::StatusCode;
 
 use aloft::engine::{answers, builtin_names, list_vehicles, Vehicle, VehicleEntry};
 
-use super::api::{file_name, Answered, QueryPairs};
-use super::body::{read_whole, within_declared, VEHICLE_LIMIT};
-use super::given::{Content, Given};
-use super::{engine_message, error, Refused, Shared};
+use super::{engine_message, error, Refused};
 
 /// Most vehicles sent to `POST /api/vehicles` kept at once: past it the oldest is forgotten.
 pub(super) const MAX_SENT: usize = 32;
@@ -71,12 +66,12 @@ pub(super) struct Fleet {
 }
 
 impl Fleet {
-    /// The built-ins and the vehicle files among `files`; `default` (the first `--vehicle`, a
+    /// The built-ins and the vehicle files given (each with the name it was given with); `default` (the first `--vehicle`, a
     /// built-in's name or a given file's name) is the vehicle of requests that name none.
     ///
     /// # Errors
     /// A vehicle file that no command can fly (no default take-off mass), named.
-    pub(super) fn new(files: &[Given], default: &str) -> Result<Self> {
+    pub(super) fn new(files: &[(String, Arc<Vehicle>)], default: &str) -> Result<Self> {
         let builtins = list_vehicles()?
             .into_iter()
             .map(|entry| {
@@ -93,19 +88,16 @@ impl Fleet {
             given: Vec::new(),
             sent: Mutex::new(VecDeque::new()),
         };
-        for g in files {
-            let Content::Vehicle(vehicle) = &g.content else {
-                continue;
-            };
+        for (given_as, vehicle) in files {
             let mut entry = vehicle
                 .entry()
-                .with_context(|| format!("vehicle file {}", g.name))?;
+                .with_context(|| format!("vehicle file {given_as}"))?;
             if fleet.listed(vehicle.name()).is_some() {
-                entry.name.clone_from(&g.name);
+                entry.name.clone_from(given_as);
             }
             fleet.given.push(Listed {
                 entry,
-                given_as: Some(g.name.clone()),
+                given_as: Some(given_as.clone()),
                 vehicle: vehicle.clone(),
             });
         }
@@ -183,7 +175,7 @@ impl Fleet {
 
     /// Keep a vehicle sent (its file's text, `origin` naming it in messages): its entry's JSON,
     /// or the message of a 422.
-    fn keep(&self, text: &[u8], origin: &str) -> Result<String, String> {
+    pub(super) fn keep(&self, text: &[u8], origin: &str) -> Result<String, String> {
         let text = std::str::from_utf8(text).map_err(|_| {
             engine_message(aloft::Error::VehicleFormat {
                 origin: origin.to_string(),
@@ -234,35 +226,4 @@ impl Fleet {
         }
         Ok(())
     }
-}
-
-/// `GET /api/vehicles`: the list (off the engine's queue: it depends on nothing a request
-/// gives, and is small).
-pub(super) async fn list(State(shared): State<Arc<Shared>>) -> axum::response::Response {
-    super::answer(answers::vehicles_answer_of(&shared.vehicles.entries()).map_err(engine_message))
-}
-
-/// `POST /api/vehicles?file=NAME` (body: a vehicle file, at most [`VEHICLE_LIMIT`]): the
-/// vehicle kept under its own name, answered with its entry in the list.
-pub(super) async fn send(
-    State(shared): State<Arc<Shared>>,
-    headers: HeaderMap,
-    Query(query): QueryPairs,
-    body: Body,
-) -> Answered {
-    let request = "POST /api/vehicles";
-    let limit_name = "the limit on vehicle files";
-    within_declared(&headers, VEHICLE_LIMIT, limit_name)?;
-    if let Some((k, _)) = query.iter().find(|(k, _)| k != "file") {
-        return Err(error(
-            StatusCode::BAD_REQUEST,
-            &format!("unknown option '{k}' of {request} (known: file)"),
-        )
-        .into());
-    }
-    let body = read_whole(body, VEHICLE_LIMIT, limit_name).await?;
-    let origin = file_name(&query, "upload.toml");
-    let work = shared.clone();
-    let job = move |_: &_| work.vehicles.keep(&body, &origin);
-    Ok(shared.work.run(job).await)
 }
