@@ -240,62 +240,7 @@ impl Logbook {
                 return Ok(AddOutcome::Skipped { reason });
             }
         };
-        let (vehicle_key, vehicle_source) = key(f.vehicle_id.as_deref(), labels.vehicle.as_deref());
-        let (pack_key, pack_source) = key(f.pack_id.as_deref(), labels.pack.as_deref());
-        tx.execute(
-            "INSERT OR IGNORE INTO vehicles (key, key_source, first_added_unix_s)
-             VALUES (?1, ?2, ?3)",
-            params![vehicle_key, vehicle_source, now],
-        )?;
-        tx.execute(
-            "INSERT OR IGNORE INTO packs (key, key_source, first_added_unix_s)
-             VALUES (?1, ?2, ?3)",
-            params![pack_key, pack_source, now],
-        )?;
-        if pack_key != UNKNOWN {
-            // The pack's rating and cells: the first log that states them.
-            tx.execute(
-                "UPDATE packs SET
-                   rated_capacity_mah = COALESCE(rated_capacity_mah, ?2),
-                   cells_series = COALESCE(cells_series, ?3)
-                 WHERE key = ?1",
-                params![pack_key, f.rated_capacity_mah, f.cells_series],
-            )?;
-        }
-        tx.execute(
-            "INSERT INTO flights (
-               file_sha256, file_name, format, vehicle_key, pack_key, start_unix_s, duration_s,
-               energy_wh, discharged_mah, max_current_a, min_voltage_v, mean_power_w,
-               added_unix_s, hover_power_w, cells_series, resistance_ohm,
-               autopilot_resistance_ohm, capacity_mah, capacity_refusal, imbalance_minor_min,
-               imbalance_major_min, file_path)
-             VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16,
-                     ?17, ?18, ?19, ?20, ?21, ?22)",
-            params![
-                sha,
-                name,
-                f.format,
-                vehicle_key,
-                pack_key,
-                f.start_unix_s,
-                f.duration_s,
-                f.energy_wh,
-                f.discharged_mah,
-                f.max_current_a,
-                f.min_voltage_v,
-                f.mean_power_w,
-                now,
-                f.hover_power_w,
-                f.cells_series,
-                f.resistance_ohm,
-                f.autopilot_resistance_ohm,
-                f.capacity_mah,
-                f.capacity_refusal,
-                f.imbalance_minor_min,
-                f.imbalance_major_min,
-                path,
-            ],
-        )?;
+        let (vehicle_key, pack_key) = insert_flight(&tx, sha, (name, path), &f, labels, now)?;
         let flight_id = tx.last_insert_rowid();
         tx.execute("DELETE FROM skipped WHERE file_sha256 = ?1", [sha])?;
         tx.commit()?;
@@ -305,4 +250,73 @@ impl Logbook {
             pack_key,
         })
     }
+}
+
+/// The flight's row, with its vehicle and pack (each added when new, the pack's rating and cells
+/// from the first log that states them); its vehicle and pack keys.
+fn insert_flight(
+    tx: &rusqlite::Transaction<'_>,
+    sha: &str,
+    (name, path): (&str, &str),
+    f: &FlightFacts,
+    labels: &Labels,
+    now: i64,
+) -> rusqlite::Result<(String, String)> {
+    let (vehicle_key, vehicle_source) = key(f.vehicle_id.as_deref(), labels.vehicle.as_deref());
+    let (pack_key, pack_source) = key(f.pack_id.as_deref(), labels.pack.as_deref());
+    tx.execute(
+        "INSERT OR IGNORE INTO vehicles (key, key_source, first_added_unix_s)
+         VALUES (?1, ?2, ?3)",
+        params![vehicle_key, vehicle_source, now],
+    )?;
+    tx.execute(
+        "INSERT OR IGNORE INTO packs (key, key_source, first_added_unix_s)
+         VALUES (?1, ?2, ?3)",
+        params![pack_key, pack_source, now],
+    )?;
+    if pack_key != UNKNOWN {
+        // The pack's rating and cells: the first log that states them.
+        tx.execute(
+            "UPDATE packs SET
+               rated_capacity_mah = COALESCE(rated_capacity_mah, ?2),
+               cells_series = COALESCE(cells_series, ?3)
+             WHERE key = ?1",
+            params![pack_key, f.rated_capacity_mah, f.cells_series],
+        )?;
+    }
+    tx.execute(
+        "INSERT INTO flights (
+           file_sha256, file_name, format, vehicle_key, pack_key, start_unix_s, duration_s,
+           energy_wh, discharged_mah, max_current_a, min_voltage_v, mean_power_w,
+           added_unix_s, hover_power_w, cells_series, resistance_ohm,
+           autopilot_resistance_ohm, capacity_mah, capacity_refusal, imbalance_minor_min,
+           imbalance_major_min, file_path)
+         VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, ?15, ?16,
+                 ?17, ?18, ?19, ?20, ?21, ?22)",
+        params![
+            sha,
+            name,
+            f.format,
+            vehicle_key,
+            pack_key,
+            f.start_unix_s,
+            f.duration_s,
+            f.energy_wh,
+            f.discharged_mah,
+            f.max_current_a,
+            f.min_voltage_v,
+            f.mean_power_w,
+            now,
+            f.hover_power_w,
+            f.cells_series,
+            f.resistance_ohm,
+            f.autopilot_resistance_ohm,
+            f.capacity_mah,
+            f.capacity_refusal,
+            f.imbalance_minor_min,
+            f.imbalance_major_min,
+            path,
+        ],
+    )?;
+    Ok((vehicle_key, pack_key))
 }
