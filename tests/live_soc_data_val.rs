@@ -362,3 +362,26 @@ fn data_val_live_every_update_is_in_its_physical_range() {
     // 5 PX4 flights, 7 ULog/DataFlash logs, 5 telemetry logs, 2 KAIST flights.
     assert_eq!(checked, 19);
 }
+
+/// Before the pack has said anything (no report, no rested voltage, no power measured) the
+/// update on the ground gives no state of charge: `log_66` starts 0.1 s before its first
+/// `battery_status` record, and its first update said 100 % (the assumed full pack, shown as the
+/// vehicle's) where PX4 reports 69 % a moment later. The note says what is assumed.
+#[test]
+fn data_val_no_state_of_charge_is_shown_before_the_pack_says_one() {
+    let vehicle = px4_vehicle("log_66_2023-6-21-08-44-02");
+    let log = data_dir().join("px4_flugdrohne/ulg/log_66_2023-6-21-08-44-02.ulg");
+    let log = log.display().to_string();
+    let v = updates(&["--replay", &log], &vehicle, &["--every", "5"]);
+    let first = &v[0];
+    assert_eq!(first["power_available"], false, "{first}");
+    assert!(first.get("soc").is_none(), "{first}");
+    assert!(
+        first["note"].as_str().unwrap_or("").contains("full pack"),
+        "{first}"
+    );
+    // From the first battery record on, every update has one.
+    for u in v.iter().filter(|u| u["power_available"] == true) {
+        assert!(u["soc"].is_number(), "{u}");
+    }
+}
