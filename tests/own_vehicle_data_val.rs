@@ -233,6 +233,27 @@ fn per_log_payload_is_checked() {
         assert_eq!(code, 2, "{err}");
         assert!(err.contains(needle), "{err}");
     }
+    // The owner's values in their ranges, named (before any log is read).
+    for (flag, value) in [
+        ("--mass-kg", "0"),
+        ("--rotor-diameter-m", "-0.254"),
+        ("--battery-capacity-mah", "1e9"),
+        ("--battery-mass-kg", "0"),
+        ("--max-takeoff-mass-kg", "nan"),
+    ] {
+        // The owner's flags with this one's value in place (or added), as `--flag=value`.
+        let mut args: Vec<String> = OWNER
+            .chunks(2)
+            .filter(|kv| kv[0] != flag)
+            .map(|kv| format!("{}={}", kv[0], kv[1]))
+            .collect();
+        args.push(format!("{flag}={value}"));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = fit(std::slice::from_ref(&log), &args, &out);
+        assert_eq!(code, 2, "{flag} {value}: {err}");
+        assert!(err.contains(flag), "{err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
     // A file whose whole name exists is that file, whatever its name holds.
     let odd = scratch("own-vehicle", "odd:payload_kg=2.ulg");
     std::fs::copy(&log, &odd).unwrap();

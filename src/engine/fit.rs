@@ -158,6 +158,7 @@ pub struct FitAnswer {
 pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, Error> {
     // A template without the model to fit is refused before any log is read.
     template.power_model()?;
+    request.own.check()?;
     let (flights, skipped_logs) = usable_logs(&request.logs)?;
     let (used, completed) = starting_vehicle(template, request, &skipped_logs)?;
     let generic_name = request

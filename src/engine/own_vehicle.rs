@@ -200,6 +200,44 @@ pub(crate) fn complete_vehicle(
     }
 }
 
+impl OwnVehicle {
+    /// Each value given is in its range: a mass or diameter positive (a rotor at most 5 m, a
+    /// mass at most 1000 kg), a capacity positive up to the logs' own limit.
+    ///
+    /// # Errors
+    /// [`Error::InvalidInput`] naming the flag.
+    pub fn check(&self) -> Result<(), Error> {
+        let checks: [(&'static str, Option<f64>, &'static str, f64); 5] = [
+            ("--mass-kg", self.mass_kg, "kg", 1000.0),
+            ("--rotor-diameter-m", self.rotor_diameter_m, "m", 5.0),
+            (
+                "--battery-capacity-mah",
+                self.battery_capacity_mah,
+                "mAh",
+                aloft_logs::battery_records::MAX_BATTERY_CAPACITY_MAH,
+            ),
+            ("--battery-mass-kg", self.battery_mass_kg, "kg", 1000.0),
+            (
+                "--max-takeoff-mass-kg",
+                self.max_takeoff_mass_kg,
+                "kg",
+                1000.0,
+            ),
+        ];
+        for (name, value, unit, max) in checks {
+            if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0 && *v <= max)) {
+                return Err(Error::InvalidInput {
+                    name,
+                    value: v,
+                    unit,
+                    expected: "a positive value within its physical range (a rotor up to 5 m, a mass up to 1000 kg)",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
 /// [`complete_vehicle`], every missing value an error.
 fn completed(
     template: &VehicleFile,
@@ -258,6 +296,12 @@ fn completed(
         .and_then(|f| f.airframe);
         generic_file.expect("the built-in vehicle template has an [airframe]")
     });
+    if file.airframe.is_none() {
+        notes.push(
+            "the [airframe] keys no log parameter sets (rotor_height_m, and any limit below) are the generic template's: check them"
+                .to_string(),
+        );
+    }
     airframe.mass_kg = round6(takeoff_kg - pack_kg);
     airframe.max_takeoff_mass_kg = max_takeoff_mass(
         &airframe, takeoff_kg, own, generic, template, logs, &mut notes,
