@@ -11,23 +11,8 @@ use serde_json::Value;
 
 fn fit(logs: &[std::path::PathBuf], template: &str, tag: &str) -> (i32, Value, String) {
     let out = scratch("fit-quality", &format!("{tag}.toml"));
-    let mut args: Vec<String> = vec!["fit".into()];
-    for l in logs {
-        args.push("--log".into());
-        args.push(l.display().to_string());
-    }
-    args.extend([
-        "--vehicle-template".into(),
-        template.into(),
-        "-o".into(),
-        out.display().to_string(),
-        "--format".into(),
-        "json".into(),
-    ]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (code, stdout, stderr) = run(&args);
-    let json = serde_json::from_str(&stdout).unwrap_or(Value::Null);
-    (code, json, stderr)
+    let logs: Vec<String> = logs.iter().map(|l| l.display().to_string()).collect();
+    common::fit_json(&logs, &["--vehicle-template", template], &out)
 }
 
 fn template(name: &str) -> String {

@@ -12,7 +12,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{data_dir, run, scratch};
+use common::{data_dir, fit_json as fit, run, scratch};
 use serde_json::Value;
 
 /// The flags a 1.2 kg quadrotor on 10 in propellers with a 5000 mAh pack is given (the
@@ -36,29 +36,6 @@ fn usable() -> Vec<PathBuf> {
         .into_iter()
         .filter(|p| !p.to_string_lossy().contains("log_65"))
         .collect()
-}
-
-/// `aloft fit --log L... EXTRA -o OUT --format json`: exit code, JSON, stderr.
-fn fit(logs: &[String], extra: &[&str], out: &Path) -> (i32, Value, String) {
-    let mut args: Vec<String> = vec!["fit".into()];
-    for l in logs {
-        args.push("--log".into());
-        args.push(l.clone());
-    }
-    args.extend(extra.iter().map(|s| s.to_string()));
-    args.extend([
-        "-o".into(),
-        out.display().to_string(),
-        "--format".into(),
-        "json".into(),
-    ]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    let (code, stdout, stderr) = run(&args);
-    (
-        code,
-        serde_json::from_str(&stdout).unwrap_or(Value::Null),
-        stderr,
-    )
 }
 
 fn strings(paths: &[PathBuf]) -> Vec<String> {

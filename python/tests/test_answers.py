@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
 
 import numpy as np
 import pandas as pd
@@ -258,5 +259,13 @@ def test_fit_of_an_own_vehicle_equals_cli(cli, data, tmp_path):
     assert got == expected
     assert [s["file"] for s in got["skipped_logs"]] == [str(logs[3])]  # log_65
     assert py_toml.read_text() == cli_toml.read_text()
+    # The file read back by Python's own TOML reader: the envelope is the logs' PX4 parameters
+    # (MPC_TILTMAX_AIR 45, the smaller MPC_XY_VEL_MAX 12), the pack 3S at the stated capacity.
+    written = tomllib.loads(py_toml.read_text())
+    assert written["airframe"]["max_tilt_deg"] == 45.0
+    assert written["airframe"]["max_speed_mps"] == 12.0
+    assert written["battery"][0]["cells_series"] == 3
+    assert written["battery"][0]["capacity_mah"] == 5000.0
+    assert written["airframe"]["mass_kg"] + written["battery"][0]["mass_kg"] == pytest.approx(1.2)
     with pytest.raises(aloft.AloftError, match="--mass-kg"):
         aloft.fit(logs, rotor_diameter_m=0.254)

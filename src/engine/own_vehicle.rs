@@ -26,7 +26,6 @@
 //! whose guesses never stand for the mass, the rotor size or the capacity.
 
 use std::collections::BTreeMap;
-use std::path::PathBuf;
 
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
 
@@ -112,12 +111,17 @@ const ENVELOPE: [EnvelopeKey; 9] = [
     },
 ];
 
-/// One log's kept parameters, with its file.
-type LogParameters = (String, BTreeMap<String, f64>);
+/// What one log says of its vehicle: its kept parameters and the highest pack voltage it
+/// records, V (0 when none).
+struct LogFacts {
+    parameters: BTreeMap<String, f64>,
+    max_voltage_v: f64,
+}
 
-/// Each log's parameters (those [`aloft_logs::battery_records::is_kept_parameter`] keeps),
-/// with the file; a log whose battery records cannot be read gives none.
-fn log_parameters(logs: &FlightLogs) -> Result<Vec<LogParameters>, Error> {
+/// Each log's [`LogFacts`] (the parameters those
+/// [`aloft_logs::battery_records::is_kept_parameter`] keeps), read once; a log whose battery
+/// records cannot be read gives none.
+fn log_facts(logs: &FlightLogs) -> Result<Vec<LogFacts>, Error> {
     let profile = logs.profile.as_deref().map(Profile::resolve).transpose()?;
     let mut open = OpenOptions::default();
     open.binary.battery_instance = logs.battery_instance;
@@ -126,21 +130,27 @@ fn log_parameters(logs: &FlightLogs) -> Result<Vec<LogParameters>, Error> {
         .iter()
         .filter_map(|path| {
             let log = read_battery_log(path, profile.as_ref(), &open).ok()?;
-            Some((path.display().to_string(), log.parameters))
+            let max_voltage_v = log
+                .samples
+                .iter()
+                .map(|s| s.voltage_v)
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .fold(0.0, f64::max);
+            Some(LogFacts {
+                parameters: log.parameters,
+                max_voltage_v,
+            })
         })
         .collect())
 }
 
 /// The value of one envelope key over the logs: each log's first source that is set (positive),
 /// scaled; the smallest over the logs, with a note when they disagree.
-fn envelope_value(
-    key: &EnvelopeKey,
-    params: &[LogParameters],
-    notes: &mut Vec<String>,
-) -> Option<f64> {
+fn envelope_value(key: &EnvelopeKey, params: &[LogFacts], notes: &mut Vec<String>) -> Option<f64> {
     let values: Vec<(f64, &'static str)> = params
         .iter()
-        .filter_map(|(_, p)| {
+        .filter_map(|f| {
+            let p = &f.parameters;
             key.sources.iter().find_map(|(name, scale)| {
                 let v = p.get(*name)? * scale;
                 (v.is_finite() && v > 0.0).then_some((v, *name))
@@ -247,7 +257,7 @@ fn completed(
 ) -> Result<Completed, Error> {
     let mut notes = Vec::new();
     let mut file = template.clone();
-    let params = log_parameters(logs)?;
+    let params = log_facts(logs)?;
     let mut power = file.power.clone().ok_or(Error::MissingTable {
         vehicle: template.name.clone(),
         table: "power",
@@ -267,7 +277,15 @@ fn completed(
         })
         .flatten()
         .cloned();
-    let pack = own_pack(own, logs, template, template_pack.as_ref(), &mut notes)?;
+    let cells = cells_from_voltage(&params);
+    let pack = own_pack(
+        own,
+        logs,
+        cells,
+        template,
+        template_pack.as_ref(),
+        &mut notes,
+    )?;
     let pack_kg = pack.mass_kg.unwrap_or(0.0);
     // The mass of a flight without payload.
     let takeoff_kg = match (own.mass_kg, generic) {
@@ -320,13 +338,13 @@ fn completed(
 /// The rotors: the autopilot's count (PX4 `CA_ROTOR_COUNT`), the owner's diameter.
 fn set_rotors(
     power: &mut aloft_power::VehicleParams,
-    params: &[LogParameters],
+    params: &[LogFacts],
     own: &OwnVehicle,
     generic: bool,
 ) -> Result<(), Error> {
     if let Some(n) = params
         .iter()
-        .find_map(|(_, p)| p.get("CA_ROTOR_COUNT").copied())
+        .find_map(|f| f.parameters.get("CA_ROTOR_COUNT").copied())
         .filter(|n| (1.0..=16.0).contains(n))
     {
         power.rotor_count = n as u32;
@@ -415,6 +433,7 @@ fn missing_mass() -> Error {
 fn own_pack(
     own: &OwnVehicle,
     logs: &FlightLogs,
+    cells_from_voltage: Option<u32>,
     template: &VehicleFile,
     template_pack: Option<&aloft_planner::BatterySpec>,
     notes: &mut Vec<String>,
@@ -440,7 +459,7 @@ fn own_pack(
             key: "cells_series",
             ..
         }) => fit_pack(&PackFitRequest {
-            cells_series: cells_from_voltage(logs),
+            cells_series: cells_from_voltage,
             ..request
         }),
         other => other,
@@ -513,20 +532,7 @@ fn own_pack(
 
 /// Cells in series from the highest voltage any log records, when the logs' parameters do not
 /// say: at least that voltage over [`MAX_CELL_V`], rounded up.
-fn cells_from_voltage(logs: &FlightLogs) -> Option<u32> {
-    let profile = logs
-        .profile
-        .as_deref()
-        .map(Profile::resolve)
-        .transpose()
-        .ok()?;
-    let open = OpenOptions::default();
-    let max_v = logs
-        .logs
-        .iter()
-        .filter_map(|p: &PathBuf| read_battery_log(p, profile.as_ref(), &open).ok())
-        .flat_map(|l| l.samples.into_iter().map(|s| s.voltage_v))
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold(0.0, f64::max);
+fn cells_from_voltage(logs: &[LogFacts]) -> Option<u32> {
+    let max_v = logs.iter().map(|l| l.max_voltage_v).fold(0.0, f64::max);
     (max_v > 0.0).then(|| (max_v / MAX_CELL_V).ceil().max(1.0) as u32)
 }

@@ -243,3 +243,24 @@ pub const ENDURANCE_KEYS: [&str; 6] = [
     "max_range_speed_mps",
     "max_range_m",
 ];
+
+/// `aloft fit --log L... EXTRA -o OUT --format json`: exit code, JSON (null when stdout is not
+/// JSON), stderr.
+pub fn fit_json(logs: &[String], extra: &[&str], out: &Path) -> (i32, serde_json::Value, String) {
+    let mut args: Vec<String> = vec!["fit".into()];
+    for l in logs {
+        args.push("--log".into());
+        args.push(l.clone());
+    }
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args.extend([
+        "-o".into(),
+        out.display().to_string(),
+        "--format".into(),
+        "json".into(),
+    ]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (code, stdout, stderr) = run(&args);
+    let json = serde_json::from_str(&stdout).unwrap_or(serde_json::Value::Null);
+    (code, json, stderr)
+}

@@ -307,6 +307,12 @@ impl Charge {
         (SocSource::AssumedFull, full)
     }
 
+    /// Whether the state of charge is only the full pack assumed at the start (nothing from the
+    /// pack believed: no report, no rested voltage).
+    pub(crate) fn assumed_full(&self) -> bool {
+        self.anchor().0 == SocSource::AssumedFull
+    }
+
     /// The state of charge now (0-1), with `drawn` up to now, and where it comes from.
     pub(crate) fn soc(&self, drawn: Drawn) -> (f64, SocSource) {
         let (source, a) = self.anchor();

@@ -534,10 +534,7 @@ impl<'a> LiveSession<'a> {
             // Nothing from the pack yet on the ground (no report, no rested voltage, no power
             // measured): the assumed full pack is not shown as the vehicle's state (the note
             // says what is assumed).
-            soc: (self.charge.soc(self.drawn()).1 != charge::SocSource::AssumedFull
-                || t.power_available()
-                || t.in_air())
-            .then_some(soc),
+            soc: (!self.charge.assumed_full() || t.power_available() || t.in_air()).then_some(soc),
             energy_used_wh: t.energy_used_wh(),
             power_w: t.power_w,
             power_available: t.power_available(),
