@@ -4,7 +4,7 @@
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use rusqlite::{params, Connection, OptionalExtension, TransactionBehavior};
 use serde::Serialize;
@@ -16,6 +16,24 @@ use crate::schema::{migrate, Migrated, SCHEMA_VERSION};
 
 /// How long a writer waits for another's lock before giving up (two `add`s at once both land).
 pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Switch the file to WAL, waiting up to [`BUSY_TIMEOUT`] for other connections. The switch
+/// reads the file and then takes its write lock; when two connections do so at once SQLite
+/// refuses one at once, without its busy handler (the two would otherwise wait on each other),
+/// so the refused one tries again here once the other is done.
+fn use_wal(conn: &Connection) -> rusqlite::Result<()> {
+    let deadline = Instant::now() + BUSY_TIMEOUT;
+    loop {
+        match conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0)) {
+            Err(rusqlite::Error::SqliteFailure(e, _))
+                if e.code == rusqlite::ErrorCode::DatabaseBusy && Instant::now() < deadline =>
+            {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            other => return other.map(drop),
+        }
+    }
+}
 
 /// The key of a vehicle or pack whose log does not identify it and that was given no label.
 pub const UNKNOWN: &str = "unknown";
@@ -124,8 +142,7 @@ impl Logbook {
         };
         let mut conn = Connection::open(path).map_err(sql)?;
         conn.busy_timeout(BUSY_TIMEOUT).map_err(sql)?;
-        conn.query_row("PRAGMA journal_mode = WAL", [], |r| r.get::<_, String>(0))
-            .map_err(sql)?;
+        use_wal(&conn).map_err(sql)?;
         conn.execute_batch("PRAGMA foreign_keys = ON")
             .map_err(sql)?;
         match migrate(&mut conn).map_err(sql)? {

@@ -330,6 +330,30 @@ fn two_adds_at_once_both_land() {
     assert_eq!(book.flights().unwrap().len(), files.len());
 }
 
+/// Many connections opening one new file at the same moment (as `aloft logbook add` processes
+/// started together do): each opens it, none is refused as locked. Opening switches the file to
+/// WAL, which SQLite refuses at once, without waiting, to one of two readers that both want the
+/// write lock; a CI run failed on it (one `add` of two: "database is locked").
+#[test]
+fn many_opens_of_a_new_file_at_once_all_succeed() {
+    let tmp = tempfile::tempdir().unwrap();
+    for round in 0..30 {
+        let db = tmp.path().join(format!("book{round}.sqlite"));
+        let start = std::sync::Barrier::new(6);
+        std::thread::scope(|s| {
+            for _ in 0..6 {
+                let (db, start) = (&db, &start);
+                s.spawn(move || {
+                    start.wait();
+                    if let Err(e) = Logbook::open(db) {
+                        panic!("round {round}: {e}");
+                    }
+                });
+            }
+        });
+    }
+}
+
 /// A logbook of version 1, written here by hand with a flight, opened by this code: migrated to
 /// the current version, the flight kept, the new columns empty, and adding works.
 #[test]
