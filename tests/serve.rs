@@ -496,12 +496,7 @@ fn vehicles_given_are_listed_and_flown_as_the_command_line_flies_them() {
     let server = Server::start(&[&m600_path, "--vehicle", &quad, "dji-inspire1"]);
     let config = parsed(&server.get("/api/config").1);
     assert_eq!(config["default_vehicle"], "my-quad");
-    let kinds: Vec<&str> = config["files"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f["kind"].as_str().unwrap())
-        .collect();
+    let kinds = common::strs_of(&config["files"], "kind");
     assert_eq!(kinds, ["vehicle", "vehicle"]);
     // The list: the built-ins as `aloft vehicles` lists them, then the files given.
     let (code, body) = server.get("/api/vehicles");

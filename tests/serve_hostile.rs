@@ -107,12 +107,7 @@ fn a_request_names_no_file_of_the_server() {
     assert_eq!(strip(&body), strip(&expected));
     // The page is told what was given.
     let config: serde_json::Value = serde_json::from_str(&server.get("/api/config").1).unwrap();
-    let kinds: Vec<&str> = config["files"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f["kind"].as_str().unwrap())
-        .collect();
+    let kinds = common::strs_of(&config["files"], "kind");
     assert_eq!(kinds, ["vehicle", "wind_field", "column_map"]);
 }
 

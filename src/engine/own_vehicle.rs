@@ -28,6 +28,7 @@
 use std::collections::BTreeMap;
 
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
+use aloft_planner::{AirframeSpec, BatterySpec};
 
 use super::logs::FlightLogs;
 use super::pack_fit::{fit_pack, PackFitRequest};
@@ -66,48 +67,58 @@ pub(crate) struct Completed {
 }
 
 /// One envelope key of `[airframe]`, the parameters that give it and their scale to the key's
-/// unit.
+/// unit, and how it is set.
 struct EnvelopeKey {
     key: &'static str,
     sources: &'static [(&'static str, f64)],
+    set: fn(&mut AirframeSpec, f64),
 }
 
 const ENVELOPE: [EnvelopeKey; 9] = [
     EnvelopeKey {
         key: "max_tilt_deg",
         sources: &[("MPC_TILTMAX_AIR", 1.0), ("ANGLE_MAX", 0.01)],
+        set: |a, v| a.max_tilt_deg = v,
     },
     EnvelopeKey {
         key: "max_speed_mps",
         sources: &[("MPC_XY_VEL_MAX", 1.0), ("WPNAV_SPEED", 0.01)],
+        set: |a, v| a.max_speed_mps = v,
     },
     EnvelopeKey {
         key: "cruise_speed_mps",
         sources: &[("MPC_XY_CRUISE", 1.0), ("WPNAV_SPEED", 0.01)],
+        set: |a, v| a.cruise_speed_mps = Some(v),
     },
     EnvelopeKey {
         key: "max_climb_rate_mps",
         sources: &[("MPC_Z_VEL_MAX_UP", 1.0), ("WPNAV_SPEED_UP", 0.01)],
+        set: |a, v| a.max_climb_rate_mps = v,
     },
     EnvelopeKey {
         key: "max_descent_rate_mps",
         sources: &[("MPC_Z_VEL_MAX_DN", 1.0), ("WPNAV_SPEED_DN", 0.01)],
+        set: |a, v| a.max_descent_rate_mps = v,
     },
     EnvelopeKey {
         key: "acceleration_mps2",
         sources: &[("MPC_ACC_HOR", 1.0), ("WPNAV_ACCEL", 0.01)],
+        set: |a, v| a.acceleration_mps2 = v,
     },
     EnvelopeKey {
         key: "vertical_acceleration_mps2",
         sources: &[("MPC_ACC_UP_MAX", 1.0), ("WPNAV_ACCEL_Z", 0.01)],
+        set: |a, v| a.vertical_acceleration_mps2 = v,
     },
     EnvelopeKey {
         key: "yaw_rate_deg_s",
         sources: &[("MPC_YAWRAUTO_MAX", 1.0), ("ATC_RATE_Y_MAX", 1.0)],
+        set: |a, v| a.yaw_rate_deg_s = v,
     },
     EnvelopeKey {
         key: "rtl_altitude_m",
         sources: &[("RTL_RETURN_ALT", 1.0), ("RTL_ALT", 0.01)],
+        set: |a, v| a.rtl_altitude_m = Some(v),
     },
 ];
 
@@ -166,22 +177,6 @@ fn envelope_value(key: &EnvelopeKey, params: &[LogFacts], notes: &mut Vec<String
         ));
     }
     Some(min)
-}
-
-/// Set the airframe key `key` to `value`.
-fn set_envelope(a: &mut aloft_planner::AirframeSpec, key: &str, value: f64) {
-    match key {
-        "max_tilt_deg" => a.max_tilt_deg = value,
-        "max_speed_mps" => a.max_speed_mps = value,
-        "cruise_speed_mps" => a.cruise_speed_mps = Some(value),
-        "max_climb_rate_mps" => a.max_climb_rate_mps = value,
-        "max_descent_rate_mps" => a.max_descent_rate_mps = value,
-        "acceleration_mps2" => a.acceleration_mps2 = value,
-        "vertical_acceleration_mps2" => a.vertical_acceleration_mps2 = value,
-        "yaw_rate_deg_s" => a.yaw_rate_deg_s = value,
-        "rtl_altitude_m" => a.rtl_altitude_m = Some(value),
-        _ => {}
-    }
 }
 
 /// The template completed from the logs and the owner's flags (module docs). `generic`: the
@@ -264,10 +259,6 @@ fn completed(
         needed_for: "the four-term power model",
     })?;
     set_rotors(&mut power, &params, own, generic)?;
-    if generic && own.mass_kg.is_none() {
-        return Err(missing_mass());
-    }
-    // The pack, from the same logs.
     let template_pack = (!generic)
         .then(|| {
             file.batteries
@@ -277,6 +268,16 @@ fn completed(
         })
         .flatten()
         .cloned();
+    // The mass of a flight without payload (asked before the pack's capacity).
+    let takeoff_kg = match own.mass_kg {
+        Some(m) => m,
+        None if generic => return Err(missing_mass()),
+        None => match (&file.airframe, &template_pack) {
+            (Some(a), Some(b)) => a.mass_kg + b.mass_kg.unwrap_or(0.0),
+            _ => power.mass_kg,
+        },
+    };
+    // The pack, from the same logs.
     let cells = cells_from_voltage(&params);
     let pack = own_pack(
         own,
@@ -287,15 +288,6 @@ fn completed(
         &mut notes,
     )?;
     let pack_kg = pack.mass_kg.unwrap_or(0.0);
-    // The mass of a flight without payload.
-    let takeoff_kg = match (own.mass_kg, generic) {
-        (Some(m), _) => m,
-        (None, true) => return Err(missing_mass()),
-        (None, false) => match (&file.airframe, &template_pack) {
-            (Some(a), Some(b)) => a.mass_kg + b.mass_kg.unwrap_or(0.0),
-            _ => power.mass_kg,
-        },
-    };
     if !(takeoff_kg.is_finite() && takeoff_kg > pack_kg) {
         return Err(Error::InvalidInput {
             name: "mass_kg",
@@ -326,7 +318,7 @@ fn completed(
     );
     for key in &ENVELOPE {
         if let Some(v) = envelope_value(key, &params, &mut notes) {
-            set_envelope(&mut airframe, key.key, v);
+            (key.set)(&mut airframe, v);
         }
     }
     file.power = Some(power);
@@ -365,7 +357,7 @@ fn set_rotors(
 /// The largest take-off mass: the owner's, else the owner's template's (at least the heaviest
 /// flight), else 1.5 times the heaviest flight, said as a guess.
 fn max_takeoff_mass(
-    airframe: &aloft_planner::AirframeSpec,
+    airframe: &AirframeSpec,
     takeoff_kg: f64,
     own: &OwnVehicle,
     generic: bool,
@@ -396,8 +388,8 @@ fn max_takeoff_mass(
 /// alone.
 fn place_pack(
     file: &mut VehicleFile,
-    pack: aloft_planner::BatterySpec,
-    template_pack: Option<&aloft_planner::BatterySpec>,
+    pack: BatterySpec,
+    template_pack: Option<&BatterySpec>,
     generic: bool,
 ) {
     let at = file
@@ -435,9 +427,9 @@ fn own_pack(
     logs: &FlightLogs,
     cells_from_voltage: Option<u32>,
     template: &VehicleFile,
-    template_pack: Option<&aloft_planner::BatterySpec>,
+    template_pack: Option<&BatterySpec>,
     notes: &mut Vec<String>,
-) -> Result<aloft_planner::BatterySpec, Error> {
+) -> Result<BatterySpec, Error> {
     let mass_kg = own
         .battery_mass_kg
         .or(template_pack.and_then(|b| b.mass_kg));
@@ -476,28 +468,12 @@ fn own_pack(
         }
         other => other,
     };
-    // What the logs cannot fit: the owner's pack stands, said; the generic one never does.
-    let keep_template = |reason: String, notes: &mut Vec<String>| {
-        match template_pack {
-        Some(b) => {
-            notes.push(format!(
-                "the pack is the template's {} as it is: {reason}",
-                b.name
-            ));
-            Ok(b.clone())
-        }
-        None => Err(Error::MissingValue {
-            flag: "--vehicle-template",
-            hint: "the logs cannot fit a pack (no battery current, or no current steps): give a vehicle file with your [[battery]]",
-        }),
-    }
-    };
     let answer = match answer {
         Ok(a) => a,
-        Err(e) => return keep_template(e.to_string(), notes),
+        Err(e) => return template_pack_as_is(template_pack, &e.to_string(), notes),
     };
     let Some(pack) = answer.pack else {
-        return keep_template("no log has battery current".into(), notes);
+        return template_pack_as_is(template_pack, "no log has battery current", notes);
     };
     let mut spec = pack.battery;
     spec.mass_kg = Some(mass_kg.unwrap_or_else(|| {
@@ -528,6 +504,25 @@ fn own_pack(
         ));
     }
     Ok(spec)
+}
+
+/// What the logs cannot fit: the owner's pack stands, said; the generic template's never does.
+fn template_pack_as_is(
+    template_pack: Option<&BatterySpec>,
+    reason: &str,
+    notes: &mut Vec<String>,
+) -> Result<BatterySpec, Error> {
+    let Some(b) = template_pack else {
+        return Err(Error::MissingValue {
+            flag: "--vehicle-template",
+            hint: "the logs cannot fit a pack (no battery current, or no current steps): give a vehicle file with your [[battery]]",
+        });
+    };
+    notes.push(format!(
+        "the pack is the template's {} as it is: {reason}",
+        b.name
+    ));
+    Ok(b.clone())
 }
 
 /// Cells in series from the highest voltage any log records, when the logs' parameters do not
