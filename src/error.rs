@@ -81,12 +81,11 @@ pub enum Error {
         /// The input's format.
         format: &'static str,
     },
-    /// A file that would be overwritten.
-    #[error("{path} exists: give --force to overwrite it")]
-    FileExists {
-        /// The file.
-        path: String,
-    },
+    /// An output file refused or not written by aloft's one way of writing a file
+    /// ([`aloft_core::output`]): it exists (without `force`), something aloft never replaces is
+    /// at its name (a FIFO, a device, a folder), its folder is missing, or the write failed.
+    #[error(transparent)]
+    Output(#[from] aloft_core::output::OutputError),
     /// A CSV input lacks a required column.
     #[error("{origin}: missing column '{column}' (none of the {columns} columns of its first line is named so)")]
     ColumnMissing {
@@ -535,6 +534,10 @@ impl From<aloft_planner::PlannerError> for Error {
 
 impl From<aloft_logs::LogError> for Error {
     fn from(e: aloft_logs::LogError) -> Self {
-        Error::LogFile(Box::new(e))
+        match e {
+            // An output refused or not placed says so in aloft's one way, whichever writer.
+            aloft_logs::LogError::Output(o) => Error::Output(o),
+            e => Error::LogFile(Box::new(e)),
+        }
     }
 }

@@ -18,6 +18,11 @@ fn aloft_limited(
 ) -> (Option<i32>, String, Duration) {
     let script = format!("ulimit -v {memory_kib}; exec \"$0\" \"$@\"");
     let mut child = Command::new("sh")
+        // `ulimit -v` bounds address space, a proxy for memory: one malloc arena per thread
+        // (glibc reserves 64 MiB of address space for each, used or not) would count the
+        // signal-handling thread of the command line (`src/cli/signals.rs`) as 64 MiB of
+        // memory; with one arena only the memory the run allocates counts.
+        .env("MALLOC_ARENA_MAX", "1")
         .arg("-c")
         .arg(script)
         .arg(env!("CARGO_BIN_EXE_aloft"))

@@ -25,7 +25,7 @@ fn original_and_converted(log: &Path) -> (LogInfo, LogInfo) {
         std::process::id(),
         name(log)
     ));
-    let c = convert_log(log, &options, &out).unwrap();
+    let c = convert_log(log, &options, &out, true).unwrap();
     assert_eq!(c.samples, original.samples, "{}", log.display());
     let back = log_info(&out, &options, None).unwrap();
     std::fs::remove_file(&out).unwrap();

@@ -256,7 +256,7 @@ fn the_reported_state_of_charge_reads_back() {
         s.soc = (k % 2 == 0).then_some(0.69 - 0.001 * k as f64);
     }
     let out = tmp("kaist_small_soc.mcap");
-    write_log_mcap(&out, &log).unwrap();
+    write_log_mcap(&out, &log, true).unwrap();
     let back = read_log(&out, None, &McapOptions::default()).unwrap();
     assert_eq!(back.samples.len(), log.samples.len());
     for (a, b) in log.samples.iter().zip(&back.samples) {
@@ -275,7 +275,7 @@ fn log_round_trip_file() -> (aloft_logs::Log, PathBuf) {
     )
     .unwrap();
     let out = tmp("kaist_small.mcap");
-    let summary = write_log_mcap(&out, &log).unwrap();
+    let summary = write_log_mcap(&out, &log, true).unwrap();
     assert_eq!(summary.count("/aloft/pose"), 20);
     assert_eq!(summary.count("/aloft/state"), 20);
     assert_eq!(summary.count("/aloft/battery"), 20);
@@ -418,7 +418,7 @@ fn mission() -> (Vec<MissionSample>, Vec<PathPoint>) {
 fn mission_mcap_has_all_topics_and_reads_back() {
     let (samples, path) = mission();
     let out = tmp("mission.mcap");
-    let s = write_mission_mcap(&out, &samples, &path).unwrap();
+    let s = write_mission_mcap(&out, &samples, &path, true).unwrap();
     assert_eq!(
         s.messages,
         vec![
@@ -460,7 +460,7 @@ fn mission_mcap_has_all_topics_and_reads_back() {
 fn a_mission_mcap_reads_back_one_sample_per_instant_with_its_energy() {
     let (samples, path) = mission();
     let out = tmp("mission_instants.mcap");
-    write_mission_mcap(&out, &samples, &path).unwrap();
+    write_mission_mcap(&out, &samples, &path, true).unwrap();
     let mut r = McapSamples::open(&out, McapOptions::default()).unwrap();
     let back: Vec<Sample> = r.by_ref().collect::<Result<_, _>>().unwrap();
     assert_eq!(back.len(), samples.len());
@@ -537,7 +537,7 @@ fn samples_of_one_time_read_back_as_written() {
         ..aloft_logs::Log::default()
     };
     let out = tmp("one_time.mcap");
-    write_log_mcap(&out, &log).unwrap();
+    write_log_mcap(&out, &log, true).unwrap();
     let back = read_log(&out, None, &McapOptions::default()).unwrap();
     assert_eq!(back.samples.len(), written.len());
     for (i, (a, b)) in written.iter().zip(&back.samples).enumerate() {
@@ -558,6 +558,6 @@ fn samples_of_one_time_read_back_as_written() {
 fn non_finite_mission_values_are_refused() {
     let (mut samples, path) = mission();
     samples[7].power.induced_w = f64::NAN;
-    let e = write_mission_mcap(&tmp("nan.mcap"), &samples, &path).unwrap_err();
+    let e = write_mission_mcap(&tmp("nan.mcap"), &samples, &path, true).unwrap_err();
     assert!(matches!(e, LogError::NonFinite { index: 7, .. }), "{e}");
 }

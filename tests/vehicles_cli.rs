@@ -77,7 +77,15 @@ fn calibrate_writes_a_vehicle_every_command_accepts() {
         "8",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = aloft(&["vehicles", "calibrate", spec, "-o", out.to_str().unwrap()]);
+    // The table of the same calibration, over the file written above (--force).
+    let o = aloft(&[
+        "vehicles",
+        "calibrate",
+        spec,
+        "-o",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(
         text.contains("efficiency 0.499") && text.contains("default: drag"),

@@ -52,7 +52,15 @@ pub(crate) fn aloft_error(message: impl Into<String>) -> PyErr {
 
 /// An engine error as Python sees it.
 pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
-    aloft_error(aloft::engine::error_line(&e))
+    use aloft::engine::OutputError;
+    match e {
+        // Python's word for the command line's --force.
+        aloft::Error::Output(OutputError::Exists { path }) => aloft_error(format!(
+            "{} exists: aloft keeps it (force=True replaces it)",
+            aloft::engine::shown_path(&path)
+        )),
+        e => aloft_error(aloft::engine::error_line(&e)),
+    }
 }
 
 /// `aloft mission --format json` as text.
@@ -186,12 +194,17 @@ fn vehicles_json() -> PyResult<String> {
     answers::vehicles_answer().map_err(engine_error)
 }
 
-/// `aloft vehicles calibrate SPEC -o OUTPUT --format json` as text: the vehicle file of a spec
-/// sheet, written to `output`.
+/// `aloft vehicles calibrate SPEC -o OUTPUT [--force] --format json` as text: the vehicle file
+/// of a spec sheet, written to `output` (an existing file replaced only with `force`).
 #[pyfunction]
-#[pyo3(signature = (spec, output))]
-fn calibrate_vehicle_json(py: Python<'_>, spec: PathBuf, output: PathBuf) -> PyResult<String> {
-    py.detach(|| answers::calibrate_vehicle_answer(&spec, &output))
+#[pyo3(signature = (spec, output, force=false))]
+fn calibrate_vehicle_json(
+    py: Python<'_>,
+    spec: PathBuf,
+    output: PathBuf,
+    force: bool,
+) -> PyResult<String> {
+    py.detach(|| answers::calibrate_vehicle_answer(&spec, &output, force))
         .map_err(engine_error)
 }
 

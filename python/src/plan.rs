@@ -1,10 +1,10 @@
 //! `aloft.plan`: `aloft plan MISSION -o DIR --format json`, with the texts of the files.
 //!
 //! The engine answers ([`answers::plan_answer`]: the vehicle, the request of the flags,
-//! [`plan_to_fly`](aloft::engine::plan_to_fly), [`FlyPlan::write`](aloft::engine::FlyPlan::write));
-//! what is left here is Python's words for one of the command's: an existing file is refused
-//! with "give force=True" rather than "give --force". The keywords are the flags' names in
-//! snake case (`max_speed=` for `--max-speed`), as everywhere in the package.
+//! [`plan_to_fly`](aloft::engine::plan_to_fly), [`FlyPlan::write`](aloft::engine::FlyPlan::write)).
+//! An existing file is refused with "force=True replaces it" (every function's
+//! [`engine_error`]). The keywords are the flags' names in snake case (`max_speed=` for
+//! `--max-speed`), as everywhere in the package.
 
 use std::path::PathBuf;
 
@@ -34,20 +34,11 @@ pub fn plan_json(
         ));
     }
     let given = options::given("plan", options)?;
-    let flags: PlanFlags = parse_keywords("aloft.plan", &[], &given).map_err(in_python_words)?;
+    let flags: PlanFlags = parse_keywords("aloft.plan", &[], &given).map_err(engine_error)?;
     let output = output.as_deref().map(|dir| (dir, force));
     let answer = py
         .detach(|| answers::plan_answer(path.as_deref(), &flags, output))
-        .map_err(in_python_words)?;
+        .map_err(engine_error)?;
     Ok((answer.json, answer.texts))
 }
 
-/// An engine error in Python's words (module docs).
-fn in_python_words(e: aloft::Error) -> PyErr {
-    match e {
-        aloft::Error::FileExists { path } => {
-            aloft_error(format!("{path} exists: give force=True to overwrite it"))
-        }
-        e => engine_error(e),
-    }
-}

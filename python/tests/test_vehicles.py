@@ -39,3 +39,29 @@ def test_bad_spec_raises_with_the_key(tmp_path):
     with pytest.raises(aloft.AloftError, match="rotors"):
         aloft.calibrate_vehicle(bad, tmp_path / "out.toml")
     assert not (tmp_path / "out.toml").exists()
+
+
+def test_calibrate_vehicle_keeps_an_existing_file_without_force(cli, tmp_path):
+    """aloft's one way of writing a file, from Python: an existing file is kept (the CLI's
+    message in Python's words), force=True replaces it, and a planted link is never written
+    through (force=True replaces the link itself)."""
+    out = tmp_path / "m600.toml"
+    out.write_text("the operator's own file")
+    message = cli.error("vehicles", "calibrate", SPEC, "-o", str(out))
+    assert "--force" in message
+    with pytest.raises(aloft.AloftError) as e:
+        aloft.calibrate_vehicle(SPEC, out)
+    assert str(e.value) == message.replace("--force", "force=True")
+    assert out.read_text() == "the operator's own file"
+    aloft.calibrate_vehicle(SPEC, out, force=True)
+    assert "[power]" in out.read_text()
+    victim = tmp_path / "victim.txt"
+    victim.write_text("precious")
+    link = tmp_path / "link.toml"
+    link.symlink_to(victim)
+    with pytest.raises(aloft.AloftError, match="exists"):
+        aloft.calibrate_vehicle(SPEC, link)
+    aloft.calibrate_vehicle(SPEC, link, force=True)
+    assert not link.is_symlink() and "[power]" in link.read_text()
+    assert victim.read_text() == "precious"
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".aloft-")] == []

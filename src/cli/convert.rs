@@ -9,7 +9,7 @@ use aloft::engine::convert_log;
 
 use aloft::engine::flags::LogReadFlags;
 
-use super::output::{self, Row};
+use super::output::{self, ForceFlag, Row};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -23,13 +23,20 @@ pub struct ConvertArgs {
     /// The MCAP file to write.
     #[arg(long, short = 'o', value_name = "MCAP")]
     output: PathBuf,
+    #[command(flatten)]
+    force: ForceFlag,
     /// Output format of the summary.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
 pub fn run(args: ConvertArgs) -> Result<Outcome> {
-    let json = convert_log(&args.log, &args.read.options(), &args.output)?;
+    let json = convert_log(
+        &args.log,
+        &args.read.options(),
+        &args.output,
+        args.force.force,
+    )?;
     output::print_table_or_json(args.format, &json, |out| {
         let rows: Vec<Row<'_>> = json
             .topics

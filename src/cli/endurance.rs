@@ -3,7 +3,7 @@
 //! against payload per pack (`--payload-sweep`, rendered in `payload_sweep.rs`).
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::{ArgGroup, Args};
@@ -14,8 +14,8 @@ use aloft::engine::{
     EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
-use super::output;
-use super::plot::Line;
+use super::output::{self, ForceFlag};
+use super::plot::{ChartFile, Line};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -27,12 +27,15 @@ pub struct EnduranceArgs {
     /// With --sweep-speed or --payload-sweep: also draw the curves to this SVG.
     #[arg(long, value_name = "SVG", requires = "curve")]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    force: ForceFlag,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
 pub fn run(mut args: EnduranceArgs) -> Result<Outcome> {
+    args.force.check(args.plot.as_deref())?;
     let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let options = args.flags.options();
@@ -42,7 +45,7 @@ pub fn run(mut args: EnduranceArgs) -> Result<Outcome> {
     if let Some(step) = args.flags.sweep_speed {
         let curve = power_curve(&vehicle, &options, step)?;
         if let Some(p) = &args.plot {
-            plot_sweep(p, &curve.context.vehicle, &curve.rows)
+            plot_sweep(args.force.chart(p), &curve.context.vehicle, &curve.rows)
                 .with_context(|| format!("cannot draw {}", p.display()))?;
         }
         output::print(
@@ -97,7 +100,7 @@ fn run_payload_sweep(
         e => e.into(),
     })?;
     if let Some(p) = &args.plot {
-        super::payload_sweep::plot(p, &curve)
+        super::payload_sweep::plot(args.force.chart(p), &curve)
             .with_context(|| format!("cannot draw {}", p.display()))?;
     }
     output::print(
@@ -217,13 +220,13 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
     Ok(())
 }
 
-fn plot_sweep(path: &Path, name: &str, rows: &[SweepRow]) -> Result<()> {
+fn plot_sweep(file: ChartFile<'_>, name: &str, rows: &[SweepRow]) -> Result<()> {
     use plotters::prelude::*;
     let v_max = rows.last().map(|r| r.airspeed_mps).unwrap_or(1.0).max(1.0);
     let power = rows.iter().map(|r| (r.airspeed_mps, r.power_w)).collect();
     let endurance = rows.iter().map(|r| (r.airspeed_mps, r.endurance_s / 60.0));
     super::plot::dual_lines_file(
-        path,
+        file,
         (900, 500),
         format!("{name}: power curve (level flight, still air)"),
         (0.0..v_max, "airspeed (m/s)"),

@@ -36,6 +36,8 @@ pub struct LiveArgs {
     /// Also record every update in this MCAP file for Foxglove (topic `/aloft/live`).
     #[arg(long, value_name = "FILE")]
     mcap: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    force: super::output::ForceFlag,
 }
 
 pub fn run(mut args: LiveArgs) -> Result<Outcome> {
@@ -53,7 +55,12 @@ pub fn run(mut args: LiveArgs) -> Result<Outcome> {
         drawn: 0,
         header: true,
     };
-    let mut recorder = args.mcap.as_deref().map(LiveRecorder::create).transpose()?;
+    let force = args.force.force;
+    let mut recorder = args
+        .mcap
+        .as_deref()
+        .map(|p| LiveRecorder::create(p, force))
+        .transpose()?;
     let mut emit = |u: &LiveUpdate| -> Result<(), Error> {
         if let Some(r) = &mut recorder {
             r.record(u)?;
@@ -74,7 +81,7 @@ pub fn run(mut args: LiveArgs) -> Result<Outcome> {
         LiveTask::Follow { source, request } => {
             // Ctrl-C (SIGINT) and SIGTERM end the stream: the summary is printed and the exit
             // is 0, as at the end of a log.
-            let mut source = match interrupt() {
+            let mut source = match super::signals::stop_flag() {
                 Some(stop) => source.open_until(stop)?,
                 None => source.open()?,
             };
@@ -89,28 +96,6 @@ pub fn run(mut args: LiveArgs) -> Result<Outcome> {
         r.finish()?;
     }
     Ok(Outcome::Ok)
-}
-
-/// A flag that SIGINT and SIGTERM set (a second one exits at once, with 130); `None` where the
-/// handler cannot be set (a build without the `live` feature, or one already set), so that the
-/// signal stops the process as it would otherwise.
-#[cfg(feature = "live")]
-fn interrupt() -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    let stop = std::sync::Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    let set = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::Relaxed) {
-            // 128 + SIGINT: the shell's code for a process stopped by Ctrl-C.
-            std::process::exit(130);
-        }
-    });
-    set.is_ok().then_some(stop)
-}
-
-#[cfg(not(feature = "live"))]
-fn interrupt() -> Option<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    None
 }
 
 /// How updates are shown.

@@ -65,6 +65,8 @@ struct PackFileArgs {
     /// Where to write the pack file (TOML).
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
+    #[command(flatten)]
+    force: output::ForceFlag,
     /// The pack's name in the file (default: its key).
     #[arg(long, value_name = "NAME")]
     name: Option<String>,
@@ -580,6 +582,7 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
         capacity_mah: a.capacity_mah,
         mass_kg: a.mass_kg,
         output: Some(a.output.clone()),
+        force: a.force.force,
         ..PackFitRequest::default()
     };
     let answer = fit_pack(&request)?;

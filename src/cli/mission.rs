@@ -24,6 +24,10 @@ pub fn run(mut args: MissionArgs) -> Result<Outcome> {
     if args.format == Format::Csv {
         bail!("aloft mission writes table or json; use --timeseries for a CSV of samples");
     }
+    // Every output checked before the flight is flown (the streamed ones again as they open).
+    for path in [&args.plot, &args.timeseries, &args.mcap] {
+        args.force.check(path.as_deref())?;
+    }
     let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let options = flying.with_failsafes(args.flags.options());
     let vehicle = flying.vehicle;
@@ -35,7 +39,7 @@ pub fn run(mut args: MissionArgs) -> Result<Outcome> {
             mission: &mission,
             options: &options,
             plan: &plan,
-            plot: args.plot.as_deref(),
+            plot: args.plot.as_deref().map(|p| args.force.chart(p)),
             format: args.format,
         };
         return super::scenarios::run_mission(&run, &sc);
@@ -43,7 +47,7 @@ pub fn run(mut args: MissionArgs) -> Result<Outcome> {
     if let Some(path) = &args.plot {
         let name = mission.spec().name.as_str();
         let power = |top: &Area<'_>| plot_power(top, name, plan.report(), plan.plot_samples());
-        plot_over_track(path, &plan, None, power)
+        plot_over_track(args.force.chart(path), &plan, None, power)
             .with_context(|| format!("cannot draw {}", path.display()))?;
     }
     if args.format == Format::Json {

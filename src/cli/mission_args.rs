@@ -9,6 +9,7 @@ use clap::{Args, ValueEnum};
 use aloft::engine::flags::{finite, MissionFlags, ScenarioFlags};
 use aloft::engine::MissionOutputs;
 
+use super::output::ForceFlag;
 use super::Format;
 
 #[derive(Debug, Args)]
@@ -35,6 +36,8 @@ pub struct MissionArgs {
     /// path to this MCAP file (JSON messages with schemas, for Foxglove).
     #[arg(long, value_name = "MCAP")]
     pub mcap: Option<PathBuf>,
+    #[command(flatten)]
+    pub force: ForceFlag,
     /// Replay a recorded flight instead of planning: predict its energy from the trajectory alone
     /// (velocities and accelerations through the planner's trim and power model; no power data)
     /// and print it next to the measured energy (integral of V x I over the same span).
@@ -83,6 +86,7 @@ impl MissionArgs {
             timeseries: self.timeseries.clone(),
             mcap: self.mcap.clone(),
             plot: self.plot.is_some(),
+            force: self.force.force,
         }
     }
 }

@@ -5,8 +5,6 @@
 use std::fmt::Write as _;
 use std::io::Write;
 
-use std::path::Path;
-
 use anyhow::{bail, Result};
 
 use aloft::engine::{
@@ -14,6 +12,7 @@ use aloft::engine::{
 };
 
 use super::output::Row;
+use super::plot::ChartFile;
 
 /// The warnings of a plan: the mission file's reader's, then the planner's.
 pub(super) fn plan_warnings(plan: &Plan) -> impl Iterator<Item = &String> {
@@ -231,23 +230,20 @@ pub(super) type Area<'a> =
 /// A mission's chart file: `upper` draws a chart over time in the upper half, the ground track
 /// is below it (`confident`: see [`plot_track`]).
 pub(super) fn plot_over_track(
-    path: &Path,
+    file: ChartFile<'_>,
     plan: &Plan,
     confident: Option<(f64, f64)>,
     upper: impl FnOnce(&Area<'_>) -> Result<()>,
 ) -> Result<()> {
-    use plotters::prelude::*;
     let samples = plan.plot_samples();
     if samples.is_empty() {
         bail!("no samples to plot");
     }
-    let root = SVGBackend::new(path, (1100, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (top, bottom) = root.split_vertically(400);
-    upper(&top)?;
-    plot_track(&bottom, plan.report(), samples, plan.home_m(), confident)?;
-    root.present()?;
-    Ok(())
+    super::plot::svg_file(file, (1100, 800), |root| {
+        let (top, bottom) = root.split_vertically(400);
+        upper(&top)?;
+        plot_track(&bottom, plan.report(), samples, plan.home_m(), confident)
+    })
 }
 
 /// The ground track (equal scales) with home and the point of no return; with `confident`, also

@@ -25,6 +25,7 @@ mod rotor;
 mod scenarios;
 #[cfg(feature = "serve")]
 mod serve;
+mod signals;
 mod validate;
 mod vehicles;
 
@@ -108,6 +109,15 @@ pub fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage_error(e),
     };
+    // Every command but the server (which stops on its own handling of the signals): an
+    // interrupted command leaves no file behind.
+    #[cfg(feature = "serve")]
+    let serving = matches!(cli.command, Command::Serve(_));
+    #[cfg(not(feature = "serve"))]
+    let serving = false;
+    if !serving {
+        signals::install();
+    }
     let result = match cli.command {
         Command::Power(args) => power::run(args),
         Command::Propulsion(args) => propulsion::run(args),

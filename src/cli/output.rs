@@ -4,6 +4,34 @@ use std::io::{self, StdoutLock, Write};
 
 use super::Format;
 
+/// `--force`, of every command that writes files.
+#[derive(Debug, Clone, Copy, Default, clap::Args)]
+pub struct ForceFlag {
+    /// Replace output files that exist (a regular file, or a link itself, never what it points
+    /// to; never a device, a FIFO or a folder). Without it an existing output is kept (exit 2).
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl ForceFlag {
+    /// Check, before the work, that `path` may be written (its folder exists; nothing there, or
+    /// with `--force` a regular file or a link).
+    pub fn check(self, path: Option<&std::path::Path>) -> anyhow::Result<()> {
+        if let Some(p) = path {
+            aloft::engine::check_output(p, self.force)?;
+        }
+        Ok(())
+    }
+
+    /// Where a chart goes.
+    pub fn chart(self, path: &std::path::Path) -> super::plot::ChartFile<'_> {
+        super::plot::ChartFile {
+            path,
+            force: self.force,
+        }
+    }
+}
+
 /// True when the error chain holds a broken pipe (the reader went away: exit quietly).
 pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {

@@ -48,6 +48,8 @@ pub struct PackFitArgs {
     /// The pack file to write.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
+    #[command(flatten)]
+    force: output::ForceFlag,
     /// The pack's name in the file (default: the --battery pack's, the logged serial, `fitted`).
     #[arg(long)]
     name: Option<String>,
@@ -100,6 +102,7 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         cutoff_cell_v: a.cutoff_cell_v,
         usable_fraction: a.usable_fraction,
         output: Some(a.output.clone()),
+        force: a.force.force,
     };
     let answer = fit_pack(&request)?;
     for s in &answer.skipped {

@@ -2,11 +2,12 @@
 //! per pack, CSV, and a chart with one curve per pack.
 
 use std::io::Write;
-use std::path::Path;
 
 use anyhow::Result;
 
 use aloft::engine::{PayloadCurve, PayloadRow};
+
+use super::plot::ChartFile;
 
 /// A block per pack: payload, take-off mass, hover power and endurance, best endurance and best
 /// range; the notes (where a curve stops) last.
@@ -140,10 +141,18 @@ fn csv_record(r: &PayloadRow, orbit: bool) -> Vec<String> {
 
 /// Hover endurance (min) above and best range (km) below, against payload (kg), one line per
 /// pack: the chart manufacturers print.
-pub fn plot(path: &Path, curve: &PayloadCurve) -> Result<()> {
-    use plotters::prelude::*;
-    let root = SVGBackend::new(path, (900, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
+pub fn plot(file: ChartFile<'_>, curve: &PayloadCurve) -> Result<()> {
+    super::plot::svg_file(file, (900, 800), |root| plot_on(root, curve))
+}
+
+/// [`plot`] on a picture.
+fn plot_on(
+    root: &plotters::drawing::DrawingArea<
+        plotters::prelude::SVGBackend<'_>,
+        plotters::coord::Shift,
+    >,
+    curve: &PayloadCurve,
+) -> Result<()> {
     let (top, bottom) = root.split_vertically(400);
     let (lo, hi) = curve
         .rows
@@ -187,6 +196,5 @@ pub fn plot(path: &Path, curve: &PayloadCurve) -> Result<()> {
         "best range (km)",
         series(|r| r.report.max_range_m / 1000.0),
     )?;
-    root.present()?;
     Ok(())
 }

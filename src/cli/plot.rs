@@ -76,22 +76,46 @@ pub fn dual_lines<'a, 'b>(
     Ok(chart)
 }
 
+/// Where a chart goes: its file, and whether it may replace one (`--force`).
+#[derive(Debug, Clone, Copy)]
+pub struct ChartFile<'p> {
+    pub path: &'p Path,
+    pub force: bool,
+}
+
+/// Draw a picture of `size` pixels on white with `draw`, then write it to `file` in aloft's one
+/// way ([`aloft::engine::write_output`]: never half-written, nothing replaced without
+/// `--force`, never a device or a FIFO).
+pub fn svg_file(
+    file: ChartFile<'_>,
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<()>,
+) -> Result<()> {
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        draw(&root)?;
+        root.present()?;
+    }
+    aloft::engine::write_output(file.path, text.as_bytes(), file.force)?;
+    Ok(())
+}
+
 /// A chart file of [`dual_lines`] over the whole picture (`size` in pixels), the legend at the
 /// middle right.
 pub fn dual_lines_file(
-    path: &Path,
+    file: ChartFile<'_>,
     size: (u32, u32),
     caption: String,
     x: (std::ops::Range<f64>, &str),
     left: Line<'_>,
     right: Line<'_>,
 ) -> Result<()> {
-    let root = SVGBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = dual_lines(&root, caption, x, left, right)?;
-    legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
-    root.present()?;
-    Ok(())
+    svg_file(file, size, |root| {
+        let mut chart = dual_lines(root, caption, x, left, right)?;
+        legend(&mut chart, SeriesLabelPosition::MiddleRight)
+    })
 }
 
 /// Draw `points` as a line in `style`, with `label` in the legend beside a short stroke in `key`.

@@ -10,7 +10,7 @@ use aloft::engine::{
     power_csv_file, power_point, power_values, FlightStateDeg, PowerAnswer, PowerQuery, POWER_KEYS,
 };
 
-use super::output;
+use super::output::{self, ForceFlag};
 use super::{Format, Outcome};
 use aloft::engine::flags::{finite, PowerModelFlags};
 
@@ -48,6 +48,8 @@ pub struct PowerArgs {
     /// Batch mode: write the result CSV here instead of standard output.
     #[arg(long, short = 'o', value_name = "CSV", requires = "input")]
     output: Option<PathBuf>,
+    #[command(flatten)]
+    force: ForceFlag,
 }
 
 impl PowerArgs {
@@ -76,7 +78,8 @@ pub fn run(mut args: PowerArgs) -> Result<Outcome> {
         if args.model.aoa.is_some() || args.air_direction_deg.is_some() {
             bail!("in batch mode the angle of attack is per row: add an air_direction_deg column for the geometric model");
         }
-        power_csv_file(&vehicle, &args.model.query(), path, args.output.as_deref())?;
+        let output = args.output.as_deref().map(|p| (p, args.force.force));
+        power_csv_file(&vehicle, &args.model.query(), path, output)?;
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;

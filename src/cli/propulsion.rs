@@ -11,7 +11,8 @@ use aloft::engine::{hover, hover_sweep, HoverRequest, HoverResult, SweepPoint, V
 
 use aloft::engine::flags::finite;
 
-use super::output::{self, Row};
+use super::output::{self, ForceFlag, Row};
+use super::plot::ChartFile;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -36,19 +37,22 @@ pub struct PropulsionArgs {
     /// With --sweep-takeoff-mass: also write an SVG chart of flight time and power against mass.
     #[arg(long, value_name = "SVG", requires = "sweep_takeoff_mass")]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    force: ForceFlag,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
 pub fn run(args: PropulsionArgs) -> Result<Outcome> {
+    args.force.check(args.plot.as_deref())?;
     let vehicle = Vehicle::load(&args.vehicle)?;
     if let Some(spec) = &args.sweep_takeoff_mass {
         let (from, to, step) = parse_range(spec)?;
         let sweep = hover_sweep(&vehicle, from, to, step)
             .with_context(|| format!("--sweep-takeoff-mass '{spec}'"))?;
         if let Some(path) = &args.plot {
-            plot_sweep(path, vehicle.name(), &sweep.points)
+            plot_sweep(args.force.chart(path), vehicle.name(), &sweep.points)
                 .with_context(|| format!("cannot write the plot {}", path.display()))?;
         }
         output::print(
@@ -191,7 +195,7 @@ fn write_table(out: &mut impl Write, name: &str, h: &HoverResult) -> Result<()> 
     Ok(())
 }
 
-fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Result<()> {
+fn plot_sweep(file: ChartFile<'_>, name: &str, points: &[SweepPoint]) -> Result<()> {
     use plotters::prelude::*;
     let ok: Vec<(f64, &HoverResult)> = points
         .iter()
@@ -212,7 +216,7 @@ fn plot_sweep(path: &std::path::Path, name: &str, points: &[SweepPoint]) -> Resu
         .fold(0.0, f64::max)
         * 1.1;
     super::plot::dual_lines_file(
-        path,
+        file,
         (800, 500),
         format!("{name}: flight time and power against take-off mass"),
         (x0..x1, "take-off mass (kg)"),

@@ -3,7 +3,6 @@
 //! `uncertainty` object and, for a mission, a state-of-charge fan in the chart.
 
 use std::io::Write;
-use std::path::Path;
 
 use anyhow::{Context, Result};
 
@@ -14,7 +13,7 @@ use aloft::engine::{
 
 use super::mission_view::{self, mmss};
 use super::output::{self, Row};
-use super::plot::labelled_line;
+use super::plot::{labelled_line, ChartFile};
 use super::{Format, Outcome};
 
 /// What a mission's scenarios are drawn around and rendered with.
@@ -23,7 +22,7 @@ pub struct MissionRun<'a> {
     pub mission: &'a Mission,
     pub options: &'a MissionOptions,
     pub plan: &'a Plan,
-    pub plot: Option<&'a Path>,
+    pub plot: Option<ChartFile<'a>>,
     pub format: Format,
 }
 
@@ -32,9 +31,10 @@ pub struct MissionRun<'a> {
 pub fn run_mission(run: &MissionRun<'_>, sc: &ScenarioOptions) -> Result<Outcome> {
     let u = plan_scenarios(run.vehicle, run.mission, run.options, sc)?;
     let plan = run.plan;
-    if let Some(path) = run.plot {
+    if let Some(file) = run.plot {
         let name = run.mission.spec().name.as_str();
-        plot(path, name, plan, &u).with_context(|| format!("cannot draw {}", path.display()))?;
+        plot(file, name, plan, &u)
+            .with_context(|| format!("cannot draw {}", file.path.display()))?;
     }
     if run.format == Format::Json {
         output::warn(mission_view::plan_warnings(plan));
@@ -200,13 +200,13 @@ use super::mission_view::Area;
 
 /// The state-of-charge fan over time (the plan's own line in it) and the ground track with the
 /// plan's point of no return and the one that holds with 95 % confidence.
-fn plot(path: &Path, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
+fn plot(file: ChartFile<'_>, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {
     let confident = u
         .point_of_no_return_s
         .p5
         .and_then(|t| sample_at(plan.plot_samples(), t))
         .map(|x| (x.east_m, x.north_m));
-    mission_view::plot_over_track(path, plan, confident, |top| plot_fan(top, name, plan, u))
+    mission_view::plot_over_track(file, plan, confident, |top| plot_fan(top, name, plan, u))
 }
 
 fn plot_fan(area: &Area<'_>, name: &str, plan: &Plan, u: &Uncertainty) -> Result<()> {

@@ -2,7 +2,7 @@
 //! the layout of the power seed's Table I, with the whole-flight energy error.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -11,7 +11,8 @@ use aloft::engine::flags::ValidateFlags;
 use aloft::engine::{validate_logs, PowerSeries, ValidateReport};
 
 use super::flights::file_name;
-use super::output;
+use super::output::{self, ForceFlag};
+use super::plot::ChartFile;
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -22,12 +23,15 @@ pub struct ValidateArgs {
     /// Also write an SVG of measured against predicted power, one panel per flight.
     #[arg(long, value_name = "SVG")]
     plot: Option<PathBuf>,
+    #[command(flatten)]
+    force: ForceFlag,
     /// Output format.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
 }
 
 pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
+    args.force.check(args.plot.as_deref())?;
     let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let request = args.flags.request(args.plot.is_some());
@@ -40,7 +44,7 @@ pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
         );
     }
     if let Some(path) = &args.plot {
-        plot(path, &answer.series)
+        plot(args.force.chart(path), &answer.series)
             .with_context(|| format!("cannot write the plot {}", path.display()))?;
     }
     let report = &answer.report;
@@ -163,54 +167,62 @@ fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
     Ok(())
 }
 
-fn plot(path: &Path, series: &[PowerSeries]) -> Result<()> {
-    use plotters::prelude::*;
+fn plot(file: ChartFile<'_>, series: &[PowerSeries]) -> Result<()> {
     let height = 260 * series.len().max(1) as u32;
-    let root = SVGBackend::new(path, (1000, height)).into_drawing_area();
-    root.fill(&WHITE)?;
-    for ((name, t, measured, predicted), area) in
-        series.iter().zip(root.split_evenly((series.len(), 1)))
-    {
-        if t.is_empty() {
-            continue;
+    super::plot::svg_file(file, (1000, height), |root| {
+        for (one, area) in series.iter().zip(root.split_evenly((series.len(), 1))) {
+            plot_one(&area, one)?;
         }
-        let t0 = t[0];
-        let t1 = t[t.len() - 1].max(t0 + 1.0);
-        let hi = measured
-            .iter()
-            .chain(predicted)
-            .copied()
-            .fold(0.0, f64::max)
-            * 1.05;
-        let lo = measured
-            .iter()
-            .chain(predicted)
-            .copied()
-            .fold(f64::INFINITY, f64::min)
-            * 0.95;
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!(
-                    "{}: measured and predicted electrical power",
-                    file_name(name)
-                ),
-                ("sans-serif", 16),
-            )
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(55)
-            .build_cartesian_2d(0.0..(t1 - t0), lo..hi)?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc("power (W)")
-            .draw()?;
-        for (values, color, label) in [(measured, BLUE, "measured"), (predicted, RED, "model")] {
-            let line = t.iter().zip(values).map(|(x, y)| (x - t0, *y));
-            super::plot::labelled_line(&mut chart, line, color, label, color)?;
-        }
-        super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
+        Ok(())
+    })
+}
+
+/// One log's measured and predicted power against time.
+fn plot_one(
+    area: &plotters::drawing::DrawingArea<
+        plotters::prelude::SVGBackend<'_>,
+        plotters::coord::Shift,
+    >,
+    (name, t, measured, predicted): &PowerSeries,
+) -> Result<()> {
+    use plotters::prelude::*;
+    if t.is_empty() {
+        return Ok(());
     }
-    root.present()?;
-    Ok(())
+    let t0 = t[0];
+    let t1 = t[t.len() - 1].max(t0 + 1.0);
+    let hi = measured
+        .iter()
+        .chain(predicted)
+        .copied()
+        .fold(0.0, f64::max)
+        * 1.05;
+    let lo = measured
+        .iter()
+        .chain(predicted)
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+        * 0.95;
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            format!(
+                "{}: measured and predicted electrical power",
+                file_name(name)
+            ),
+            ("sans-serif", 16),
+        )
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..(t1 - t0), lo..hi)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc("power (W)")
+        .draw()?;
+    for (values, color, label) in [(measured, BLUE, "measured"), (predicted, RED, "model")] {
+        let line = t.iter().zip(values).map(|(x, y)| (x - t0, *y));
+        super::plot::labelled_line(&mut chart, line, color, label, color)?;
+    }
+    super::plot::legend(&mut chart, SeriesLabelPosition::MiddleRight)
 }

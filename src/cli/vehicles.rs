@@ -40,6 +40,10 @@ struct CalibrateArgs {
     /// Write the vehicle file here.
     #[arg(short = 'o', long, value_name = "VEHICLE.toml")]
     output: PathBuf,
+    /// Replace an existing output (a regular file, or a link itself, never what it points to;
+    /// never a device, a FIFO or a folder). Without it an existing output is kept (exit 2).
+    #[arg(long)]
+    force: bool,
     /// Output format of the summary.
     #[arg(long, value_enum, default_value_t = Format::Table)]
     format: Format,
@@ -131,7 +135,7 @@ fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
 
 fn calibrate(args: CalibrateArgs) -> Result<Outcome> {
     let c = calibrate_spec_file(&args.spec)?;
-    c.write_vehicle_file(&args.output)?;
+    c.write_vehicle_file(&args.output, args.force)?;
     output::print(
         args.format,
         &c,

@@ -290,14 +290,15 @@ pub fn vehicle_answer(v: &Vehicle, name: &str) -> Result<String, Error> {
     json_text(&entry)
 }
 
-/// `aloft vehicles calibrate SPEC -o OUTPUT --format json`: the vehicle file of a spec sheet,
-/// written to `output`.
+/// `aloft vehicles calibrate SPEC -o OUTPUT [--force] --format json`: the vehicle file of a
+/// spec sheet, written to `output` (an existing file replaced only with `force`).
 ///
 /// # Errors
-/// As [`calibrate_spec_file`], and an `output` that cannot be written.
-pub fn calibrate_vehicle_answer(spec: &Path, output: &Path) -> Result<String, Error> {
+/// As [`calibrate_spec_file`], and an `output` that exists (without `force`) or cannot be
+/// written.
+pub fn calibrate_vehicle_answer(spec: &Path, output: &Path, force: bool) -> Result<String, Error> {
     let c = calibrate_spec_file(spec)?;
-    c.write_vehicle_file(output)?;
+    c.write_vehicle_file(output, force)?;
     json_text(&c)
 }
 

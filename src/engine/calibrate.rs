@@ -326,15 +326,13 @@ pub struct SpecCalibration {
 }
 
 impl SpecCalibration {
-    /// Write the vehicle file ([`Self::to_toml`]) to `path` (`aloft vehicles calibrate -o`).
+    /// Write the vehicle file ([`Self::to_toml`]) to `path` (`aloft vehicles calibrate -o`), in
+    /// aloft's one way ([`super::write_output`]): an existing file is replaced only with `force`.
     ///
     /// # Errors
-    /// [`Error::Io`] naming the file when it cannot be written.
-    pub fn write_vehicle_file(&self, path: &std::path::Path) -> Result<(), Error> {
-        std::fs::write(path, self.to_toml()?).map_err(|source| Error::Io {
-            origin: format!("cannot write vehicle file {}", path.display()),
-            source,
-        })
+    /// [`Error::Output`] naming the file when it exists (without `force`) or cannot be written.
+    pub fn write_vehicle_file(&self, path: &std::path::Path, force: bool) -> Result<(), Error> {
+        super::files::write_output(path, self.to_toml()?.as_bytes(), force)
     }
 
     /// The vehicle file as TOML, headed by comments that say where each part came from.

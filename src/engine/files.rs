@@ -1,11 +1,21 @@
-//! Reading the files a request names: the one place where the engine opens an input by path.
+//! The files a request names: the one place where the engine opens an input by path, and the
+//! engine's door to aloft's one way of writing a file.
 //!
 //! Inputs are regular files only: a FIFO, a device or a directory is refused before it is opened
 //! (it could block or never end). Whole-file inputs (vehicle, mission, rotor files, wind fields)
 //! are read only up to [`MAX_INPUT_BYTES`]; logs and CSV batches are streamed and have no limit.
+//!
+//! Outputs are written by [`aloft_core::output`] only ([`write_output`], [`Output`],
+//! [`OutputSet`]): an exclusive temporary file with a random name beside the target, then a
+//! rename; an existing output kept unless `force`, which replaces a regular file or a link
+//! itself, never a link's target, a device or a FIFO; a set of files all or nothing; names taken
+//! from an input's file name only ([`safe_stem`]); [`abandon_outputs`] for a program's signal
+//! handler.
 
 use std::fs::File;
 use std::path::Path;
+
+pub use aloft_core::output::{safe_stem, shown as shown_path, Output, OutputError, OutputSet};
 
 use crate::error::Error;
 
@@ -35,6 +45,33 @@ pub fn open_input_file(path: &Path, what: &str) -> Result<File, Error> {
         origin: format!("cannot open {what} {}", path.display()),
         source,
     })
+}
+
+/// Write `bytes` to the file `path` in aloft's one way ([`aloft_core::output`]): nothing
+/// replaced unless `force` (a regular file or a link itself, never a device, a FIFO or a
+/// folder), never half-written.
+///
+/// # Errors
+/// [`Error::Output`]: the file exists (without `force`), something aloft never replaces is there,
+/// its folder is missing, the write failed, or the program was interrupted.
+pub fn write_output(path: &Path, bytes: &[u8], force: bool) -> Result<(), Error> {
+    Ok(aloft_core::output::write_file(path, bytes, force)?)
+}
+
+/// Check, before long work, that `path` could be written ([`aloft_core::output::check`]): its
+/// folder exists, and nothing is there (or, with `force`, a regular file or a link).
+///
+/// # Errors
+/// [`Error::Output`] saying why not.
+pub fn check_output(path: &Path, force: bool) -> Result<(), Error> {
+    Ok(aloft_core::output::check(path, force)?)
+}
+
+/// Remove the temporary files of every output this process is writing and refuse to place any
+/// from now on (a set being placed is finished first); the number removed. For the SIGINT and
+/// SIGTERM handler of a program that exits right after.
+pub fn abandon_outputs() -> usize {
+    aloft_core::output::abandon_all()
 }
 
 /// A CSV header must name each column once: a repeated name would leave the reader to pick one

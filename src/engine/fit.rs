@@ -14,6 +14,7 @@ use aloft_power::fit::{
 use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
+use super::files::{check_output, write_output};
 use super::finite::finite;
 use super::fit_quality::{judge_fit, Alignment, Envelope, FitQuality};
 use super::logs::{FlightLogs, SkippedLog};
@@ -37,6 +38,9 @@ pub struct FitRequest {
     pub no_drag: bool,
     /// Where the fitted vehicle file is written (`None`: not written).
     pub output: Option<PathBuf>,
+    /// Replace an existing `output` (a regular file or a link itself; never a device, a FIFO or
+    /// a folder). Without it an existing file is kept and the fit refused before any log is read.
+    pub force: bool,
     /// Called at each Gauss-Newton iteration.
     pub progress: Option<FitProgress>,
     /// What the owner states of the vehicle that the logs do not record.
@@ -53,6 +57,7 @@ impl Default for FitRequest {
             free: vec![FitParameter::WeightOverEfficiency],
             no_drag: false,
             output: None,
+            force: false,
             progress: None,
             own: OwnVehicle::default(),
             generic_template: false,
@@ -159,6 +164,9 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     // A template without the model to fit is refused before any log is read.
     template.power_model()?;
     request.own.check()?;
+    if let Some(path) = &request.output {
+        check_output(path, request.force)?;
+    }
     let (flights, skipped_logs) = usable_logs(&request.logs)?;
     let (used, completed) = starting_vehicle(template, request, &skipped_logs)?;
     let generic_name = request
@@ -224,10 +232,7 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
         &notes,
     )?;
     if let Some(path) = &request.output {
-        std::fs::write(path, &vehicle_toml).map_err(|source| Error::Io {
-            origin: format!("cannot write {}", path.display()),
-            source,
-        })?;
+        write_output(path, vehicle_toml.as_bytes(), request.force)?;
     }
     finite(
         FitAnswer {

@@ -571,6 +571,10 @@ pub struct FitFlags {
     /// Where to write the fitted vehicle TOML.
     #[arg(short = 'o', long, value_name = "TOML")]
     pub output: Option<PathBuf>,
+    /// Replace an existing output (a regular file, or a link itself, never what it points to;
+    /// never a device, a FIFO or a folder). Without it an existing output is kept (exit 2).
+    #[arg(long)]
+    pub force: bool,
     /// Lumped constants to fit: k (= m g / eta), vh, profile, mu1, mu2, mu3 (comma-separated).
     /// Default: k. Drag (mu1..mu3) is fitted from the force balance when the logs carry
     /// acceleration, unless --aoa paper and mu* are listed here.
@@ -597,6 +601,7 @@ impl FitFlags {
                 .collect::<Result<Vec<_>, _>>()?,
             no_drag: self.no_drag,
             output: self.output.clone(),
+            force: self.force,
             progress: None,
             own: OwnVehicle {
                 mass_kg: self.mass_kg,

@@ -28,9 +28,10 @@ use serde::{Deserialize, Serialize};
 use aloft_missions::SourceFormat;
 use aloft_planner::{best_range_within_limits, MissionSpec, SegmentSpec, Wind};
 
+use super::files::{safe_stem, shown_path, OutputSet};
 use super::finite::finite;
 use super::mission::{plan_mission, prepare, Prepared};
-use super::mission_file::Mission;
+use super::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN};
 use super::mission_options::MissionOptions;
 use super::plan_files::PlannerSorties;
 use super::scenarios::WorkBounds;
@@ -740,8 +741,9 @@ fn sortie_answer(file: &str, plan: &SortiePlan, spec: &MissionSpec) -> FlySortie
     }
 }
 
-/// The name a plan's files are given and their extension: the input's (the built-in demo's is
-/// `demo-survey.toml`).
+/// The name a plan's files are given and their extension: the input's file name, made safe
+/// ([`safe_stem`]: never a path, never the mission's own `name`), `mission` when nothing is left
+/// of it; the built-in demo's is its fixture's, `demo-survey`.
 fn file_stem_and_extension(mission: &Mission) -> Result<(String, &'static str), Error> {
     let extension = match mission.route().source_format {
         SourceFormat::AloftToml => "toml",
@@ -749,10 +751,10 @@ fn file_stem_and_extension(mission: &Mission) -> Result<(String, &'static str), 
         SourceFormat::QgcPlan => "plan",
         SourceFormat::QgcWpl | SourceFormat::MavlinkItems => "waypoints",
     };
-    let origin = Path::new(mission.origin());
-    let stem = match origin.file_stem().and_then(|s| s.to_str()) {
-        Some(s) if origin.extension().is_some() => s.to_string(),
-        _ => mission.display_name().to_string(),
+    let stem = if mission.origin() == DEMO_ORIGIN {
+        DEMO_FILE_STEM.to_string()
+    } else {
+        safe_stem(Path::new(mission.origin())).unwrap_or_else(|| "mission".to_string())
     };
     Ok((stem, extension))
 }
@@ -772,33 +774,25 @@ fn sortie_text(mission: &Mission, plan: &SortiePlan, k: usize, n: usize) -> Resu
 }
 
 impl FlyPlan {
-    /// Write the files into `dir` (created if missing), each to a temporary name there first
-    /// and then renamed, so that none is ever half-written; an existing file is refused unless
-    /// `force`. The answer's `files` become their paths.
+    /// Write the files into `dir` (created if missing) as one set, all or nothing
+    /// ([`OutputSet`]): each to an exclusive temporary file with a random name there, then all
+    /// renamed into place; an existing file is kept unless `force` (which replaces a regular file
+    /// or a link itself, never a device or a FIFO); an error (or an interrupted program) at any
+    /// file leaves none of the set. The answer's `files` become their paths.
     ///
     /// # Errors
-    /// [`Error::Io`] naming the folder or the file; an existing file without `force`.
+    /// [`Error::Io`] naming the folder; [`Error::Output`] naming the file.
     pub fn write(&mut self, dir: &Path, force: bool) -> Result<(), Error> {
-        let io = |what: String| {
-            move |source| Error::Io {
-                origin: what,
-                source,
-            }
-        };
-        std::fs::create_dir_all(dir).map_err(io(format!("cannot create {}", dir.display())))?;
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            origin: format!("cannot create {}", shown_path(dir)),
+            source,
+        })?;
         let paths: Vec<PathBuf> = self.files.iter().map(|f| dir.join(f)).collect();
-        if !force {
-            if let Some(p) = paths.iter().find(|p| p.exists()) {
-                return Err(Error::FileExists {
-                    path: p.display().to_string(),
-                });
-            }
-        }
+        let mut set = OutputSet::new();
         for (path, text) in paths.iter().zip(&self.texts) {
-            let tmp = path.with_extension("aloft-tmp");
-            std::fs::write(&tmp, text).map_err(io(format!("cannot write {}", tmp.display())))?;
-            std::fs::rename(&tmp, path).map_err(io(format!("cannot write {}", path.display())))?;
+            set.add(path, text.as_bytes(), force)?;
         }
+        set.commit()?;
         self.files = paths.iter().map(|p| p.display().to_string()).collect();
         for (sortie, file) in self.sorties.iter_mut().zip(&self.files) {
             sortie.file.clone_from(file);

@@ -8,11 +8,12 @@ use serde::Serialize;
 use aloft_logs::sample::{Gap, NonMonotonic};
 use aloft_logs::{
     estimate_lag_s, open_log_with, resample_uniform, BinaryOptions, BinarySummary, Channel,
-    DroppedValue, InfoAccumulator, LogError, LogFormat, LogReader, McapOptions, McapTime,
-    McapWriter, OpenOptions, Profile, TimeReport,
+    DroppedValue, InfoAccumulator, LogError, LogFormat, LogReader, McapFile, McapOptions, McapTime,
+    OpenOptions, Profile, TimeReport,
 };
 use aloft_power::AoaModel;
 
+use super::files::check_output;
 use super::finite::finite;
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions, AlignedFlight};
@@ -502,18 +503,21 @@ pub struct ConvertSummary {
     pub time_notes: Option<(u64, u64)>,
 }
 
-/// Convert the log at `input` to MCAP (JSON with JSON Schemas) at `output`. The first sample is
-/// read before the output is created, so a bad input leaves no file; a failure while converting
-/// removes the half-written file.
+/// Convert the log at `input` to MCAP (JSON with JSON Schemas) at `output`, written in aloft's
+/// one way ([`McapFile`]): to a temporary file beside it, placed when the whole log is written,
+/// so a bad input or a failure while converting leaves nothing; an existing file is replaced only
+/// with `force`.
 ///
 /// # Errors
-/// A log that cannot be opened or decoded, holds no samples, or an output that cannot be
-/// written.
+/// A log that cannot be opened or decoded, holds no samples, or an output that exists (without
+/// `force`) or cannot be written.
 pub fn convert_log(
     input: &Path,
     options: &LogReadOptions,
     output: &Path,
+    force: bool,
 ) -> Result<ConvertSummary, Error> {
+    check_output(output, force)?;
     let (mut reader, _) = options.open(input)?;
     let first = match reader.next() {
         Some(s) => s?,
@@ -523,7 +527,7 @@ pub fn convert_log(
             })
         }
     };
-    let mut w = McapWriter::create(output)?;
+    let mut w = McapFile::create(output, force)?;
     if let Some(t) = reader.start_time_s().filter(|t| *t > 0.0) {
         w.set_start_ns((t * 1e9).round() as u64);
     }
@@ -536,13 +540,9 @@ pub fn convert_log(
         }
         Ok(())
     })();
-    if let Err(e) = result {
-        // Do not leave a half-written file that looks valid.
-        drop(w);
-        let _ = std::fs::remove_file(output);
-        return Err(e);
-    }
-    let summary = w.finish()?;
+    // On an error the half-written file goes with `w`: nothing is placed.
+    result?;
+    let summary = w.commit()?;
     let time = reader.time_report();
     finite(
         ConvertSummary {

@@ -16,6 +16,9 @@ pub const DEMO_MISSION: &str = include_str!("../../fixtures/missions/demo-survey
 /// Origin the CLI gives the built-in demonstration mission (its name when the file has none).
 pub const DEMO_ORIGIN: &str = "built-in demo";
 
+/// The stem of the files `aloft plan` writes for the built-in demo (its fixture's name).
+pub const DEMO_FILE_STEM: &str = "demo-survey";
+
 /// A mission to plan: the parsed mission file, where it came from, and its route figures (the
 /// file's own geometry, with what the reader of a planner file noticed).
 #[derive(Debug, Clone, PartialEq)]

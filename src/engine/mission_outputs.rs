@@ -1,15 +1,19 @@
 //! A plan's samples as files other tools read, written as the flight is flown so that memory does
 //! not grow with the flight: a CSV time series, MCAP (the samples and the planned path) that
 //! Foxglove displays, and a decimated copy for a chart.
+//!
+//! The files are written in aloft's one way ([`super::files`]): each to a temporary file beside
+//! it, placed together when the flight is flown (all or nothing); a run that fails, or a program
+//! interrupted, leaves none of them; an existing file is kept unless `force`.
 
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
 
-use aloft_logs::{Attitude, BatteryPoint, McapWriter, MissionSample, PathPoint, PowerTerms};
+use aloft_logs::{Attitude, BatteryPoint, McapFile, MissionSample, PathPoint, PowerTerms};
 use aloft_planner::trajectory::Shape;
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
+use super::files::{shown_path, Output, OutputError, OutputSet};
 use super::finite::first_non_finite;
 use crate::error::Error;
 
@@ -30,6 +34,10 @@ pub struct MissionOutputs {
     pub mcap: Option<PathBuf>,
     /// Keep a decimated copy of the samples for a chart ([`super::Plan::plot_samples`]).
     pub plot: bool,
+    /// Replace files that exist at `timeseries` and `mcap` (a regular file or a link itself;
+    /// never a device, a FIFO or a folder). Without it an existing file is kept and the run
+    /// refused before it flies.
+    pub force: bool,
 }
 
 impl MissionOutputs {
@@ -41,12 +49,11 @@ impl MissionOutputs {
 
 /// The sink the planner streams a run's samples into: one writer per output asked for.
 pub(crate) struct OutputSink {
-    csv: Option<(csv::Writer<BufWriter<File>>, PathBuf)>,
+    csv: Option<(csv::Writer<BufWriter<Output>>, PathBuf)>,
     mcap: Option<McapStream>,
     plot: Option<Decimator>,
     /// Every sample, when the plan keeps them ([`super::MissionOptions::record_samples`]).
     all: Option<Vec<Sample>>,
-    created: Vec<PathBuf>,
     /// The first failure, with the file it names (the planner only sees that the sink failed).
     failure: Option<Error>,
     /// Voltage thresholds watched: (threshold V, first sample below it as (time s, segment)).
@@ -66,47 +73,45 @@ impl OutputSink {
             mcap: None,
             plot: outputs.plot.then(Decimator::default),
             all: keep_all.then(Vec::new),
-            created: Vec::new(),
             failure: None,
             watch: Vec::new(),
         };
+        if let (Some(a), Some(b)) = (&outputs.timeseries, &outputs.mcap) {
+            if a == b {
+                return Err(OutputError::Duplicate { path: a.clone() }.into());
+            }
+        }
         if let Some(path) = &outputs.timeseries {
-            let file = File::create(path).map_err(|source| Error::Io {
-                origin: format!("cannot create {}", path.display()),
-                source,
-            })?;
-            sink.created.push(path.clone());
+            let file = Output::create(path, outputs.force)?;
             sink.csv = Some((csv::Writer::from_writer(BufWriter::new(file)), path.clone()));
         }
         if let Some(path) = &outputs.mcap {
-            let writer = McapWriter::create(path).map_err(|e| Error::Log {
-                origin: format!("cannot write {}", path.display()),
-                source: Box::new(e),
-            });
-            let writer = match writer {
-                Ok(w) => w,
-                Err(e) => {
-                    sink.discard();
-                    return Err(e);
-                }
-            };
-            sink.created.push(path.clone());
+            // On an error the time series' temporary file goes with the sink.
+            let writer = McapFile::create(path, outputs.force)?;
             sink.mcap = Some(McapStream::new(writer, path.clone(), path_points));
         }
         Ok(sink)
     }
 
-    /// Flush and close the files; the decimated samples for a chart and, when kept, all of them.
+    /// Finish the files and put them in place together; the decimated samples for a chart and,
+    /// when kept, all of them.
     pub(crate) fn finish(mut self) -> Result<(Vec<Sample>, Vec<Sample>), Error> {
-        if let Some((mut w, path)) = self.csv.take() {
-            w.flush().map_err(|source| Error::Io {
-                origin: format!("cannot write {}", path.display()),
-                source,
-            })?;
+        let mut set = OutputSet::new();
+        if let Some((w, path)) = self.csv.take() {
+            let out = w
+                .into_inner()
+                .map_err(|e| e.into_error())
+                .and_then(|b| b.into_inner().map_err(std::io::IntoInnerError::into_error))
+                .map_err(|source| Error::Io {
+                    origin: format!("cannot write {}", shown_path(&path)),
+                    source,
+                })?;
+            set.push(out)?;
         }
         if let Some(m) = self.mcap.take() {
-            m.finish()?;
+            set.push(m.finish()?)?;
         }
+        set.commit()?;
         let plot = self.plot.take().map(|d| d.samples).unwrap_or_default();
         Ok((plot, self.all.take().unwrap_or_default()))
     }
@@ -122,13 +127,11 @@ impl OutputSink {
         self.watch.iter().map(|w| w.1).collect()
     }
 
-    /// Remove the files created (after a failed run, so no half-written file looks valid).
+    /// Drop the files being written (after a failed run): their temporary files go, and nothing
+    /// is placed, so no half-written file looks valid.
     pub(crate) fn discard(&mut self) {
         self.csv = None;
         self.mcap = None;
-        for p in self.created.drain(..) {
-            let _ = std::fs::remove_file(p);
-        }
     }
 
     /// The failure that stopped the run, when the sink was the cause.
@@ -187,7 +190,7 @@ impl SampleSink for OutputSink {
 /// A mission's MCAP as it is flown: the planned path at the first sample's time, then every
 /// sample with the energy used to the end of its step.
 struct McapStream {
-    writer: McapWriter<BufWriter<File>>,
+    writer: McapFile,
     path: PathBuf,
     path_points: Vec<PathPoint>,
     index: usize,
@@ -196,11 +199,7 @@ struct McapStream {
 }
 
 impl McapStream {
-    fn new(
-        writer: McapWriter<BufWriter<File>>,
-        path: PathBuf,
-        path_points: Vec<PathPoint>,
-    ) -> Self {
+    fn new(writer: McapFile, path: PathBuf, path_points: Vec<PathPoint>) -> Self {
         Self {
             writer,
             path,
@@ -238,13 +237,14 @@ impl McapStream {
         Ok(())
     }
 
-    fn finish(self) -> Result<(), Error> {
-        let path = self.path.display().to_string();
-        self.writer.finish().map_err(|e| Error::Log {
+    /// The finished file, to be placed with the run's other files.
+    fn finish(self) -> Result<Output, Error> {
+        let path = shown_path(&self.path);
+        let (_, out) = self.writer.finish_output().map_err(|e| Error::Log {
             origin: format!("cannot write {path}"),
             source: Box::new(e),
         })?;
-        Ok(())
+        Ok(out)
     }
 }
 

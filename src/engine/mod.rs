@@ -27,6 +27,7 @@
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
 //! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag | [`crate::Error::TooMuchWork`], [`crate::Error::Cancelled`] | `scenarios.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
+//! | files written | [`write_output`], [`Output`], [`OutputSet`] (aloft's one way: exclusive temporary file, rename, nothing replaced without `force`, sets all or nothing), [`safe_stem`] (a name from an input's file name), [`abandon_outputs`] (interrupted) | the files, or [`crate::Error::Output`] | `files.rs` (`aloft_core::output`) |
 //!
 //! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
 //! else the options' wind, else the mission file's, else still air; gusts on top), the reserve
@@ -103,7 +104,10 @@ pub use endurance::{
     PowerCurve,
 };
 pub use estimator::InFlightEstimator;
-pub use files::{read_text_file, MAX_INPUT_BYTES};
+pub use files::{
+    abandon_outputs, check_output, read_text_file, safe_stem, shown_path, write_output, Output,
+    OutputError, OutputSet, MAX_INPUT_BYTES,
+};
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use fit_quality::FitQuality;
 pub use flown::PlanningSpeed;

@@ -26,6 +26,7 @@ use serde::Serialize;
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
 use aloft_packs::{analyse_with, PackOptions, PackReport};
 
+use super::files::{check_output, write_output};
 use super::finite::finite;
 use super::logs::SkippedLog;
 use super::pack_file::{Failsafe, PackFile};
@@ -67,6 +68,9 @@ pub struct PackFitRequest {
     pub usable_fraction: Option<f64>,
     /// Where to write the pack file.
     pub output: Option<PathBuf>,
+    /// Replace an existing `output` (a regular file or a link itself; never a device, a FIFO or
+    /// a folder). Without it an existing file is kept and the fit refused before any log is read.
+    pub force: bool,
 }
 
 /// What `aloft pack fit` answers.
@@ -121,6 +125,9 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// source gives ([`Error::PackKeyMissing`]), a pack the planner refuses, an output that cannot be
 /// written.
 pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
+    if let Some(path) = &request.output {
+        check_output(path, request.force)?;
+    }
     let base = base_pack(request)?;
     let options = PackOptions {
         rated_capacity_mah: request
@@ -156,7 +163,7 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
     );
     let pack = PackFile::from_toml_str(&text, &origin)?;
     if let Some(path) = &request.output {
-        write_file(path, &text)?;
+        write_output(path, text.as_bytes(), request.force)?;
         answer.output = path.display().to_string();
     }
     answer.pack = Some(pack);
@@ -382,23 +389,6 @@ fn pack_spec(
         spec.usable_fraction = u;
     }
     Ok(spec)
-}
-
-/// Write `text` to a temporary name beside `path`, then rename it there.
-fn write_file(path: &std::path::Path, text: &str) -> Result<(), Error> {
-    let io = |source| Error::Io {
-        origin: format!("cannot write {}", path.display()),
-        source,
-    };
-    let name = path
-        .file_name()
-        .map_or_else(|| "pack.toml".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&tmp, text).map_err(io)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io(e)
-    })
 }
 
 /// The `[fitted]` table: the logs, steps and the autopilot's figures.

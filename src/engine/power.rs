@@ -2,7 +2,6 @@
 //! hybrid options of the power seed, the angle-of-attack choice and the gradient; and the same
 //! for a CSV of states streamed from a file ([`power_csv_file`]).
 
-use std::fs::File;
 use std::io::{BufReader, BufWriter};
 use std::path::Path;
 
@@ -13,7 +12,7 @@ use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown,
 use aloft_power::{Term, Terms};
 
 use super::air::{vehicle_air, Air, AirInput};
-use super::files::open_input_file;
+use super::files::{open_input_file, shown_path, Output};
 use super::finite::finite;
 use super::power_batch::power_csv;
 use super::vehicles::{TakeoffMass, Vehicle};
@@ -231,32 +230,32 @@ fn aoa_input(aoa: Option<AoaModel>, air_direction_deg: Option<f64>) -> Result<Ao
 /// Stream the CSV of states at `input` through the model of `vehicle` at the query's take-off
 /// mass, terms and cutoff ([`power_model`]; the states come from the rows) into `output`, or
 /// standard output when `None`, one row at a time (see [`power_csv`]). Returns the number of
-/// rows.
+/// rows. The output file is written in aloft's one way ([`super::write_output`]): placed when
+/// every row is written (an error leaves nothing), an existing file replaced only with `force`.
 ///
 /// # Errors
-/// As [`power_model`] and [`power_csv`], and files that cannot be opened or created.
+/// As [`power_model`] and [`power_csv`], an input that cannot be opened, an output that exists
+/// (without `force`) or cannot be written.
 pub fn power_csv_file(
     vehicle: &Vehicle,
     query: &PowerModelQuery,
     input: &Path,
-    output: Option<&Path>,
+    output: Option<(&Path, bool)>,
 ) -> Result<u64, Error> {
     let model = power_model(vehicle, query)?;
     let file = open_input_file(input, "CSV of states")?;
     let reader = BufReader::with_capacity(1 << 16, file);
     let origin = input.display().to_string();
     match output {
-        Some(p) => {
-            let sink = File::create(p).map_err(|source| Error::Io {
-                origin: format!("cannot create {}", p.display()),
-                source,
+        Some((p, force)) => {
+            let mut sink = BufWriter::with_capacity(1 << 16, Output::create(p, force)?);
+            let rows = power_csv(&model, reader, &mut sink, &origin)?;
+            let out = sink.into_inner().map_err(|e| Error::Io {
+                origin: format!("cannot write {}", shown_path(p)),
+                source: e.into_error(),
             })?;
-            power_csv(
-                &model,
-                reader,
-                BufWriter::with_capacity(1 << 16, sink),
-                &origin,
-            )
+            out.commit()?;
+            Ok(rows)
         }
         None => {
             let stdout = std::io::stdout();

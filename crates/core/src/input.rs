@@ -14,28 +14,36 @@ use std::path::Path;
 /// # Errors
 /// The path cannot be examined (it does not exist, no permission).
 pub fn non_regular_kind(path: &Path) -> io::Result<Option<&'static str>> {
-    let meta = std::fs::metadata(path)?;
-    let ft = meta.file_type();
+    let ft = std::fs::metadata(path)?.file_type();
+    Ok((!ft.is_file()).then(|| kind_in_words(&ft)))
+}
+
+/// What a file system object of type `ft` is, in words: `a regular file`, `a directory`,
+/// `a FIFO (named pipe)`, `a socket`, `a device`, `a link`.
+pub fn kind_in_words(ft: &std::fs::FileType) -> &'static str {
     if ft.is_file() {
-        return Ok(None);
+        return "a regular file";
     }
     if ft.is_dir() {
-        return Ok(Some("a directory"));
+        return "a directory";
+    }
+    if ft.is_symlink() {
+        return "a link";
     }
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt;
         if ft.is_fifo() {
-            return Ok(Some("a FIFO (named pipe)"));
+            return "a FIFO (named pipe)";
         }
         if ft.is_socket() {
-            return Ok(Some("a socket"));
+            return "a socket";
         }
         if ft.is_char_device() || ft.is_block_device() {
-            return Ok(Some("a device"));
+            return "a device";
         }
     }
-    Ok(Some("not a regular file"))
+    "not a regular file"
 }
 
 /// Open `path` for reading if it is a regular file; anything else is refused before it is opened

@@ -11,9 +11,13 @@
 //!   (elevation, temperature, humidity, QNH);
 //! - [`bisect`], the bracketing of a crossing by halving;
 //! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
-//!   before it is opened, so it cannot block), with a size limit for whole-file inputs.
+//!   before it is opened, so it cannot block), with a size limit for whole-file inputs;
+//! - [`output`]: the one way aloft writes a file (a name from the input's file name only, an
+//!   exclusive temporary file beside the target, then a rename; nothing replaced without `force`,
+//!   never a device or a FIFO; sets of files all or nothing; nothing left when interrupted).
 //!
-//! The crate has no dependencies; its only I/O is the opening of input files in [`input`].
+//! Its only I/O is the opening of input files in [`input`] and the writing of outputs in
+//! [`output`]; its dependencies are `tempfile` (the exclusive temporary files) and `thiserror`.
 
 #![deny(missing_docs)]
 #![deny(clippy::float_cmp)]
@@ -22,6 +26,7 @@ pub mod atmosphere;
 pub mod bisect;
 pub mod input;
 pub mod integrate;
+pub mod output;
 
 pub use bisect::bisect;
 pub use input::{open_regular_file, read_regular_text};

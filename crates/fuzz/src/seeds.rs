@@ -185,7 +185,7 @@ pub fn mcap() -> Vec<Vec<u8>> {
             profile,
             ..LogReadOptions::default()
         };
-        if convert_log(&log, &options, &path).is_ok() {
+        if convert_log(&log, &options, &path, true).is_ok() {
             if let Ok(bytes) = std::fs::read(&path) {
                 out.extend(reencoded(&bytes));
                 out.push(bytes);
@@ -304,6 +304,7 @@ fn mission_mcap() -> Vec<Vec<u8>> {
     let path = scratch("mission-seed.mcap");
     let outputs = MissionOutputs {
         mcap: Some(path.clone()),
+        force: true,
         ..MissionOutputs::default()
     };
     let planned = Vehicle::builtin("dji-m100").and_then(|v| {

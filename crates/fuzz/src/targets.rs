@@ -373,7 +373,7 @@ fn log_csv(data: &[u8]) -> Outcome {
 /// writes, with the same number of samples.
 fn convert_and_read_back(o: &mut Outcome, path: &Path, options: &LogReadOptions) {
     let out = scratch("converted.mcap");
-    match convert_log(path, options, &out) {
+    match convert_log(path, options, &out, true) {
         Ok(c) => {
             o.json("convert", &c);
             let source = log_info(path, options, None).map(|i| (i.duration_s, i.samples));

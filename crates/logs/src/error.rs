@@ -19,6 +19,10 @@ pub enum LogError {
         /// The operating system's error.
         cause: std::io::Error,
     },
+    /// An output file that aloft's one writer refused or could not place (it exists, a link or
+    /// a FIFO is there, its folder is missing).
+    #[error(transparent)]
+    Output(#[from] aloft_core::output::OutputError),
     /// The file could not be created or written.
     #[error("cannot write {path}: {cause}")]
     WriteIo {

@@ -78,8 +78,8 @@ pub use info::{ChannelStats, InfoAccumulator, LogStats, PowerAccumulator, PowerS
 pub use lag::{estimate_lag_s, resample_uniform, LagEstimate};
 pub use mcap_read::{McapOptions, McapSamples, McapTime, TopicInfo};
 pub use mcap_write::{
-    write_log_mcap, write_mission_mcap, BatteryPoint, McapWriter, MissionSample, PathPoint,
-    PowerTerms, WriteSummary,
+    write_log_mcap, write_mission_mcap, BatteryPoint, McapFile, McapWriter, MissionSample,
+    PathPoint, PowerTerms, WriteSummary,
 };
 pub use open::{
     open_log, open_log_with, read_log, LogFormat, LogReader, OpenOptions, Profile, BUILTIN_PROFILES,

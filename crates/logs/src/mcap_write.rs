@@ -21,9 +21,11 @@
 //! The writer streams: memory is one chunk (the `mcap` crate's default, zstd-compressed).
 
 use std::collections::HashMap;
-use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
+use std::ops::{Deref, DerefMut};
 use std::path::{Path, PathBuf};
+
+use aloft_core::output::Output;
 
 use serde::Serialize;
 use serde_json::{json, Map, Value};
@@ -209,14 +211,60 @@ pub struct McapWriter<W: Write + Seek> {
     start_ns: u64,
 }
 
-impl McapWriter<BufWriter<File>> {
-    /// Create (or truncate) a file.
-    pub fn create(path: &Path) -> Result<Self> {
-        let f = File::create(path).map_err(|cause| LogError::WriteIo {
-            path: path.to_path_buf(),
-            cause,
+/// An MCAP file being written through aloft's one way of writing a file
+/// ([`aloft_core::output`]): its messages go to a temporary file beside `path`, and
+/// [`McapFile::commit`] finishes it and puts it in place. Dropped before (an error on the way, an
+/// interrupted run), it leaves nothing at `path`. It writes as a [`McapWriter`] does (it
+/// dereferences to one).
+pub struct McapFile(McapWriter<BufWriter<Output>>);
+
+impl McapFile {
+    /// Start the file `path`: refused when something is there, unless `force` (which replaces a
+    /// regular file or a link, never a device or a FIFO).
+    ///
+    /// # Errors
+    /// [`LogError::Output`] (the file is there, its folder is missing, ...); the MCAP header.
+    pub fn create(path: &Path, force: bool) -> Result<Self> {
+        let out = Output::create(path, force)?;
+        McapWriter::new(BufWriter::new(out), path).map(Self)
+    }
+
+    /// Finish the file (its summary and footer) and put it in place.
+    ///
+    /// # Errors
+    /// Writing the summary, or placing the file ([`LogError::Output`]).
+    pub fn commit(self) -> Result<WriteSummary> {
+        let (summary, out) = self.finish_output()?;
+        out.commit()?;
+        Ok(summary)
+    }
+
+    /// Finish the file (its summary and footer) without placing it: the output, to be placed
+    /// with others as one set ([`aloft_core::output::OutputSet::push`]).
+    ///
+    /// # Errors
+    /// Writing the summary or flushing the file.
+    pub fn finish_output(self) -> Result<(WriteSummary, Output)> {
+        let path = self.0.path.clone();
+        let (summary, buffered) = self.0.finish_into_inner()?;
+        let out = buffered.into_inner().map_err(|e| LogError::WriteIo {
+            path,
+            cause: e.into_error(),
         })?;
-        Self::new(BufWriter::new(f), path)
+        Ok((summary, out))
+    }
+}
+
+impl Deref for McapFile {
+    type Target = McapWriter<BufWriter<Output>>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+impl DerefMut for McapFile {
+    fn deref_mut(&mut self) -> &mut Self::Target {
+        &mut self.0
     }
 }
 
@@ -510,8 +558,20 @@ impl<W: Write + Seek> McapWriter<W> {
         self.put(TOPIC_PATH, "foxglove.PosesInFrame", ns, m)
     }
 
-    /// Write the summary and close the file.
-    pub fn finish(mut self) -> Result<WriteSummary> {
+    /// Write the summary and the footer (of an [`McapFile`]: [`McapFile::commit`], which also
+    /// puts the file in place).
+    ///
+    /// # Errors
+    /// The writer's error, naming the file.
+    pub fn finish(self) -> Result<WriteSummary> {
+        self.finish_into_inner().map(|(summary, _)| summary)
+    }
+
+    /// [`McapWriter::finish`], giving back the writer the file went to.
+    ///
+    /// # Errors
+    /// As [`McapWriter::finish`].
+    pub fn finish_into_inner(mut self) -> Result<(WriteSummary, W)> {
         self.inner.finish().map_err(|e| self.err(e))?;
         let mut messages: Vec<(String, u64)> = self
             .counts
@@ -519,7 +579,7 @@ impl<W: Write + Seek> McapWriter<W> {
             .map(|(t, n)| ((*t).to_string(), *n))
             .collect();
         messages.sort();
-        Ok(WriteSummary { messages })
+        Ok((WriteSummary { messages }, self.inner.into_inner()))
     }
 }
 
@@ -531,14 +591,15 @@ fn start_ns_of(start_time_s: f64) -> u64 {
     }
 }
 
-/// Write a whole log (e.g. for `aloft convert`), keeping its absolute start time when known.
-pub fn write_log_mcap(path: &Path, log: &Log) -> Result<WriteSummary> {
-    let mut w = McapWriter::create(path)?;
+/// Write a whole log (e.g. for `aloft convert`), keeping its absolute start time when known; an
+/// existing file at `path` is replaced only with `force` ([`McapFile::create`]).
+pub fn write_log_mcap(path: &Path, log: &Log, force: bool) -> Result<WriteSummary> {
+    let mut w = McapFile::create(path, force)?;
     w.set_start_ns(start_ns_of(log.start_time_s));
     for (i, s) in log.samples.iter().enumerate() {
         w.write_sample(i, s)?;
     }
-    w.finish()
+    w.commit()
 }
 
 /// Write a mission: its samples and the planned path (written once, at the first sample's time).
@@ -547,15 +608,16 @@ pub fn write_mission_mcap(
     path: &Path,
     samples: &[MissionSample],
     planned_path: &[PathPoint],
+    force: bool,
 ) -> Result<WriteSummary> {
-    let mut w = McapWriter::create(path)?;
+    let mut w = McapFile::create(path, force)?;
     if !planned_path.is_empty() {
         w.write_path(samples.first().map_or(0.0, |s| s.time_s), planned_path)?;
     }
     for (i, s) in samples.iter().enumerate() {
         w.write_mission_sample(i, s)?;
     }
-    w.finish()
+    w.commit()
 }
 
 /// The fields of one `aloft.VehicleState` message (each optional but the time).

@@ -237,20 +237,24 @@ def vehicles() -> List[Dict[str, Any]]:
     return json.loads(_native.vehicles_json())
 
 
-def calibrate_vehicle(spec: PathLike, output: PathLike) -> Dict[str, Any]:
+def calibrate_vehicle(spec: PathLike, output: PathLike, force: bool = False) -> Dict[str, Any]:
     """A vehicle file from a spec sheet: ``aloft vehicles calibrate SPEC -o OUTPUT --format json``.
 
     Args:
         spec: The spec sheet (TOML: ``name``, ``rotors``, ``rotor_diameter_m``,
             ``frame_mass_kg``, ``[battery]``, ``[published_hover]``; see docs/guide.md).
         output: Where to write the vehicle file; every function accepts it as ``vehicle=``.
+        force: Replace ``output`` when it exists (a regular file, or a link itself; never a
+            device, a FIFO or a folder). Without it an existing file is kept (``AloftError``).
 
     Returns:
         The calibration: ``efficiency``, ``hover_power_w``, ``max_minutes_at_unit_efficiency``,
         ``battery``, ``takeoff_mass_kg``, ``published_minutes``, ``defaults`` (the class defaults
         used, in words).
     """
-    return json.loads(_native.calibrate_vehicle_json(os.fspath(spec), os.fspath(output)))
+    return json.loads(
+        _native.calibrate_vehicle_json(os.fspath(spec), os.fspath(output), force)
+    )
 
 
 def log_info(path: PathLike, **options: Any) -> Dict[str, Any]:
@@ -281,7 +285,8 @@ def fit(
             ``battery_capacity_mah`` (when the logs' capacity parameter is unset),
             ``battery_mass_kg``, ``max_takeoff_mass_kg``, ``free`` (list or comma-separated
             text, default ``["k"]``), ``no_drag``, ``output`` (write the fitted vehicle TOML
-            there; the CLI requires it, here it is optional), ``profile``, ``aoa``, ``lag``,
+            there; the CLI requires it, here it is optional), ``force`` (replace an existing
+            ``output``; without it the file is kept and the fit refused), ``profile``, ``aoa``, ``lag``,
             ``max_lag`` (default 10), ``battery_instance``.
     """
     return json.loads(_native.fit_json(_paths(logs), vehicle_template, options))

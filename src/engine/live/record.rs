@@ -1,12 +1,10 @@
 //! `aloft live --mcap FILE`: the updates recorded for Foxglove, one `/aloft/live` message each
 //! (the JSON line as it is), streamed: memory is one chunk whatever the flight's length.
 
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use aloft_logs::mcap_write::TOPIC_LIVE;
-use aloft_logs::McapWriter;
+use aloft_logs::McapFile;
 
 use super::LiveUpdate;
 use crate::error::Error;
@@ -14,17 +12,18 @@ use crate::error::Error;
 /// An MCAP file the updates go to.
 pub struct LiveRecorder {
     path: PathBuf,
-    writer: McapWriter<BufWriter<File>>,
+    writer: McapFile,
     written: usize,
 }
 
 impl LiveRecorder {
-    /// Create `path` (replaced if it exists).
+    /// Start the file `path`, in aloft's one way ([`McapFile`]): written beside it and placed by
+    /// [`LiveRecorder::finish`]; an existing file is replaced only with `force`.
     ///
     /// # Errors
-    /// A file that cannot be created.
-    pub fn create(path: &Path) -> Result<Self, Error> {
-        let writer = McapWriter::create(path).map_err(|e| Error::LogFile(Box::new(e)))?;
+    /// A file that exists (without `force`) or cannot be created.
+    pub fn create(path: &Path, force: bool) -> Result<Self, Error> {
+        let writer = McapFile::create(path, force)?;
         Ok(Self {
             path: path.to_path_buf(),
             writer,
@@ -57,14 +56,13 @@ impl LiveRecorder {
         Ok(())
     }
 
-    /// Finish the file (its summary and index): the number of updates recorded.
+    /// Finish the file (its summary and index) and put it in place: the number of updates
+    /// recorded.
     ///
     /// # Errors
-    /// A write that fails.
+    /// A write that fails, or a file that cannot be placed.
     pub fn finish(self) -> Result<usize, Error> {
-        self.writer
-            .finish()
-            .map_err(|e| Error::LogFile(Box::new(e)))?;
+        self.writer.commit()?;
         Ok(self.written)
     }
 }
