@@ -364,3 +364,46 @@ fn plan_requests_are_refused_as_mission_requests_are() {
     assert_eq!(server.get("/api/plan").0, 405);
     assert_eq!(server.get("/api/vehicles").0, 200);
 }
+
+/// Issue 41: the files of a plan are named after the upload's file name only, made safe (the
+/// page zips them under these names): never the mission's own `name`, never a path, never
+/// markup. Before, a mission without an extension named `../escaped` was answered as
+/// `../escaped-1-of-1.toml`.
+#[test]
+fn plan_file_names_are_safe_whatever_the_upload_or_mission_is_called() {
+    let server = Server::start(&[]);
+    let mission = |name: &str| {
+        format!(
+            "name = {name:?}\ndefault_speed_mps = 8.0\n[[segment]]\nkind = \"take-off\"\naltitude_m = 20.0\nclimb_rate_mps = 2.0\n\
+             [[segment]]\nkind = \"leg\"\neast_m = 300.0\nnorth_m = 0.0\n\
+             [[segment]]\nkind = \"return\"\n[[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n"
+        )
+    };
+    for (file, inner, stem) in [
+        ("mission", "../escaped", "mission"),
+        ("../../etc/passwd", "/etc/passwd", "passwd"),
+        (
+            "<img src=x onerror=alert(1)>.toml",
+            "<b>x</b>",
+            "_img_src_x_onerror_alert_1__",
+        ),
+        ("..", "../x", "mission"),
+    ] {
+        let (code, answer) = plan(
+            &server,
+            &format!("file={}", encoded(file)),
+            mission(inner).as_bytes(),
+        );
+        assert_eq!(code, 200, "{file}: {answer}");
+        let files = array(&answer["files"]);
+        assert_eq!(files.len(), 1, "{answer}");
+        assert_eq!(
+            files[0].as_str(),
+            Some(format!("{stem}-1-of-1.toml").as_str()),
+            "{file}"
+        );
+        for s in array(&answer["sorties"]) {
+            assert_eq!(s["file"], files[0], "{file}");
+        }
+    }
+}

@@ -18,6 +18,7 @@ use tokio::io::AsyncWriteExt;
 
 use aloft::engine::answers;
 use aloft::engine::flags::LogInfoFlags;
+use aloft::engine::safe_stem;
 
 use super::api::{file_name, flags, Answered, QueryPairs};
 use super::body::{next_chunk, too_large, within_declared};
@@ -94,22 +95,33 @@ struct Upload {
     path: PathBuf,
 }
 
-/// The file name of an upload named `name` (its last path component), or the message of a 400.
-fn upload_file_name(name: &str) -> Result<&str, String> {
+/// The file name an upload named `name` is kept under: aloft's rule for a name taken from an
+/// input ([`safe_stem`]: the last path component, every character outside `A-Z a-z 0-9 . _ -`
+/// replaced, no leading dot or dash), its extension kept when it is plain letters and digits
+/// (the readers tell `.ulg`, `.bin`, `.tlog`, `.csv` by it); `upload` when nothing is left. The
+/// client's name is only ever shown (in messages), never used as a path. A NUL byte or a name
+/// over 255 bytes is the message of a 400.
+fn upload_file_name(name: &str) -> Result<String, String> {
     if name.contains('\0') {
         return Err("the upload's name holds a NUL byte".to_string());
     }
-    let base = match name.rsplit(['/', '\\']).next() {
-        Some(b) if !b.is_empty() && b != "." && b != ".." => b,
-        _ => "upload",
-    };
-    if base.len() > 255 {
+    if name.len() > 255 {
         return Err(format!(
             "the upload's file name is {} bytes long, more than the 255 a file name may have",
-            base.len()
+            name.len()
         ));
     }
-    Ok(base)
+    // Both separators: a name from a Windows browser is a path there.
+    let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
+    let stem = safe_stem(Path::new(base)).unwrap_or_else(|| "upload".to_string());
+    let extension = Path::new(base)
+        .extension()
+        .and_then(|e| e.to_str())
+        .filter(|e| e.len() <= 16 && !e.is_empty() && e.chars().all(|c| c.is_ascii_alphanumeric()));
+    Ok(match extension {
+        Some(e) => format!("{stem}.{e}"),
+        None => stem,
+    })
 }
 
 impl Upload {
@@ -129,7 +141,7 @@ impl Upload {
         // not follow one), and the private folder keeps other users out.
         tokio::fs::create_dir(&dir).await.map_err(failed)?;
         let upload = Self {
-            path: dir.join(base),
+            path: dir.join(&base),
             dir,
         };
         let mut file = tokio::fs::OpenOptions::new()
@@ -163,13 +175,21 @@ mod tests {
     use super::*;
 
     #[test]
-    fn upload_names_are_file_names() {
-        assert_eq!(upload_file_name("a/b/log.ulg"), Ok("log.ulg"));
-        assert_eq!(upload_file_name("..\\..\\x.bin"), Ok("x.bin"));
-        assert_eq!(upload_file_name(".."), Ok("upload"));
-        assert_eq!(upload_file_name("dir/"), Ok("upload"));
+    fn upload_names_are_safe_file_names() {
+        let name = |n: &str| upload_file_name(n).unwrap();
+        assert_eq!(name("a/b/log.ulg"), "log.ulg");
+        assert_eq!(name("..\\..\\x.bin"), "x.bin");
+        assert_eq!(name(".."), "upload");
+        assert_eq!(name("dir/"), "upload");
+        assert_eq!(
+            name("<img src=x onerror=alert(1)>.plan"),
+            "_img_src_x_onerror_alert_1__.plan"
+        );
+        assert_eq!(name("flight 3\n\u{202E}gol.ulg"), "flight_3__gol.ulg");
+        assert_eq!(name(".hidden.csv"), "_hidden.csv");
+        assert_eq!(name("x.t<b>"), "x");
         assert!(upload_file_name("a\0b").is_err());
         assert!(upload_file_name(&"x".repeat(256)).is_err());
-        assert_eq!(upload_file_name(&"x".repeat(255)).map(str::len), Ok(255));
+        assert_eq!(name(&"x".repeat(255)).len(), 100);
     }
 }
