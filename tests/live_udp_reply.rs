@@ -8,6 +8,10 @@
 //! `mavlink` crate's `udpin`) sent most of aloft's messages to the stray; aloft must send every
 //! one to the vehicle, and none to the stray.
 //!
+//! The same vehicle reporting 70 % left with a count of the charge drawn (BATTERY_STATUS
+//! `current_consumed`) that jumps to `INT32_MAX`, wraps to `INT32_MIN` and goes back (issue 41):
+//! no `land now` reaches it, and the updates say the count was not believed.
+//!
 //! It needs python3 with pymavlink (`.ci/run` installs it). Without it the test says so and
 //! passes, unless `ALOFT_PYMAVLINK_TESTS=require` or `CI` is set, where it fails.
 #![cfg(feature = "live")]
@@ -184,4 +188,82 @@ fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
     assert_eq!(got["others"], serde_json::json!({}), "{got}");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.trim().is_empty(), "{stderr}");
+}
+
+/// The vehicle (`wrapped-count`) reports 70 % left while its count of the charge drawn counts
+/// 14 A from 500 mA h, jumps to `INT32_MAX` mA h at 3 s, wraps to `INT32_MIN` at 5 s and goes
+/// back to 10 mA h at 7 s. Before the fix the jump made the state of charge 0 and sent the
+/// vehicle `aloft: land now`; now every update says `continue` at about 70 %, the only text the
+/// vehicle gets is `aloft: continue`, and the notes say, once each, why the count is not
+/// believed.
+#[test]
+fn live_udp_a_jumping_and_wrapping_charge_count_is_not_land_now() {
+    if !pymavlink_ready() {
+        return;
+    }
+    const SECONDS: u32 = 10;
+    let port = {
+        let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
+        probe.local_addr().expect("address").port()
+    };
+    let mut aloft = aloft_live(port);
+    std::thread::sleep(Duration::from_millis(500));
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mavlink_vehicle.py");
+    let vehicle = Command::new("python3")
+        .arg(&script)
+        .args([
+            port.to_string(),
+            SECONDS.to_string(),
+            "wrapped-count".into(),
+        ])
+        .output()
+        .expect("python3 runs");
+    let _ = aloft.kill();
+    let out = aloft.wait_with_output().expect("aloft's output");
+    assert!(
+        vehicle.status.success(),
+        "{}",
+        String::from_utf8_lossy(&vehicle.stderr)
+    );
+    let got: Value = serde_json::from_slice(&vehicle.stdout).expect("the vehicle's JSON line");
+    let updates: Vec<Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect();
+    eprintln!("the vehicle got {got}");
+    let texts: Vec<&str> = got["texts"]
+        .as_array()
+        .expect("texts")
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    assert!(!texts.is_empty(), "{got}");
+    assert!(
+        texts.iter().all(|t| t.starts_with("aloft: continue")),
+        "{texts:?}"
+    );
+    let advised = updates.iter().filter(|u| u.get("advice").is_some()).count();
+    assert!(advised >= 2 * SECONDS as usize - 4, "{updates:?}");
+    for u in &updates {
+        if let Some(advice) = u.get("advice") {
+            assert_eq!(advice, "continue", "{u}");
+        }
+        if let Some(soc) = u["soc"].as_f64() {
+            assert!(soc >= 0.68, "{u}");
+        }
+    }
+    let notes: Vec<&str> = updates
+        .iter()
+        .filter_map(|u| u["note"].as_str())
+        .filter(|n| n.contains("current_consumed"))
+        .collect();
+    eprintln!("notes: {notes:#?}");
+    for why in ["is more than the", "is negative", "went back from"] {
+        let said = notes.iter().filter(|n| n.contains(why)).count();
+        assert_eq!(said, 1, "{why}: {notes:?}");
+    }
+    assert!(
+        notes.iter().all(|n| n.contains("not believed")),
+        "{notes:?}"
+    );
 }

@@ -2,7 +2,7 @@
 """A vehicle on a UDP link, written with pymavlink (the independent MAVLink implementation), for
 tests/live_udp_reply.rs:
 
-    python3 tests/python/mavlink_vehicle.py PORT SECONDS
+    python3 tests/python/mavlink_vehicle.py PORT SECONDS [wrapped-count]
 
 From an ephemeral port of 127.0.0.1 it sends to 127.0.0.1:PORT, for SECONDS, what an armed
 ArduCopter quadrotor hovering in LOITER 20 m above its home sends (MAVLink 2, system 1,
@@ -11,6 +11,11 @@ EXTENDED_SYS_STATE and HOME_POSITION at 1 Hz. It answers a mission download (MIS
 then each MISSION_ITEM_INT asked for). Then it listens one second more and prints, as one JSON
 line, what it received from system 255 (aloft): messages by type, the NAMED_VALUE_FLOAT names,
 the STATUSTEXT texts, and messages from any other system.
+
+With `wrapped-count` it reports 70 % left (SYS_STATUS and BATTERY_STATUS) and sends
+BATTERY_STATUS at 1 Hz with a count of the charge drawn (`current_consumed`) that counts 14 A
+from 500 mAh for 3 s, then jumps to INT32_MAX for 2 s, then wraps to INT32_MIN and counts on
+for 2 s, then goes back to 10 mAh and counts on from there.
 """
 import json
 import os
@@ -26,7 +31,23 @@ UP_MM = 20_000
 PERIOD_S = 0.2
 
 
-def send_telemetry(m, k, boot_ms):
+INT32_MAX = 2**31 - 1
+INT32_MIN = -(2**31)
+
+
+def wrapped_count(t):
+    """The count of the charge drawn at t seconds, mAh: on track, jumping, wrapping, back."""
+    drawn = round(14_000 * t / 3600)
+    if t < 3:
+        return 500 + drawn
+    if t < 5:
+        return INT32_MAX
+    if t < 7:
+        return INT32_MIN + drawn
+    return 10 + drawn
+
+
+def send_telemetry(m, k, boot_ms, wrapped):
     """The k-th 0.2 s step of the hover."""
     if k % 5 == 0:
         m.mav.heartbeat_send(
@@ -36,8 +57,13 @@ def send_telemetry(m, k, boot_ms):
             5,  # LOITER
             mav.MAV_STATE_ACTIVE,
         )
-        # 22.8 V, 14 A, 80 % left.
-        m.mav.sys_status_send(0, 0, 0, 0, 22_800, 1_400, 80, 0, 0, 0, 0, 0, 0)
+        # 22.8 V, 14 A, 80 % left (70 % with the wrapped count).
+        left = 70 if wrapped else 80
+        m.mav.sys_status_send(0, 0, 0, 0, 22_800, 1_400, left, 0, 0, 0, 0, 0, 0)
+        if wrapped:
+            cells = [3_800] * 6 + [65_535] * 4
+            count = wrapped_count(k * PERIOD_S)
+            m.mav.battery_status_send(0, 0, 0, 0, cells, 1_400, count, -1, 70)
         m.mav.extended_sys_state_send(0, mav.MAV_LANDED_STATE_IN_AIR)
         m.mav.home_position_send(HOME[0], HOME[1], HOME[2], 0, 0, 0, [1, 0, 0, 0], 0, 0, 0)
     m.mav.global_position_int_send(boot_ms, HOME[0], HOME[1], HOME[2] + UP_MM, UP_MM, 0, 0, 0, 0)
@@ -60,6 +86,7 @@ def answer(m, msg):
 
 def main():
     port, seconds = int(sys.argv[1]), float(sys.argv[2])
+    wrapped = sys.argv[3:] == ["wrapped-count"]
     m = mavutil.mavlink_connection(
         f"udpout:127.0.0.1:{port}", source_system=1, source_component=1, dialect="ardupilotmega"
     )
@@ -69,7 +96,7 @@ def main():
     while time.monotonic() - start < seconds + 1.0:
         now = time.monotonic() - start
         if now < seconds and now >= k * PERIOD_S:
-            send_telemetry(m, k, 60_000 + int(now * 1000))
+            send_telemetry(m, k, 60_000 + int(now * 1000), wrapped)
             k += 1
         msg = m.recv_msg()
         if msg is None:

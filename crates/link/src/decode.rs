@@ -12,7 +12,7 @@
 //! |---|---|
 //! | HEARTBEAT | [`Event::Heartbeat`]: armed (`base_mode` safety flag), mode by name ([`mode_name`]), MAV_TYPE |
 //! | SYS_STATUS | [`Event::Sample`]: `voltage_battery` mV -> V (unless 0 or UINT16_MAX), `current_battery` cA -> A (unless -1); [`Event::Battery`]: `battery_remaining` % -> soc (unless -1) |
-//! | BATTERY_STATUS (id 0) | [`Event::Sample`]: sum of the cell voltages, current; [`Event::Battery`]: soc, `current_consumed` mAh -> A h |
+//! | BATTERY_STATUS (id 0) | [`Event::Sample`]: sum of the cell voltages, current; [`Event::Battery`]: soc, `current_consumed` mAh -> A h (unless -1; another negative count is passed on for the reader to judge) |
 //! | GLOBAL_POSITION_INT | [`Event::Origin`] at the first fix the next one confirms, then [`Event::Sample`]: position ENU from the origin (east and north on the WGS84 tangent plane, up from `relative_alt`, see below), velocity NED cm/s -> ENU m/s; fixes off the Earth or out of reach are dropped (see below) |
 //! | ATTITUDE | [`Event::Sample`]: roll, pitch, yaw (rad, yaw wrapped to (-pi, pi]) |
 //! | VFR_HUD | [`Event::Speeds`] |
@@ -398,7 +398,8 @@ impl Decoder {
         self.battery_sample(voltage_v, current_a, out);
         let battery = BatteryState {
             soc: soc(b.battery_remaining),
-            consumed_ah: (b.current_consumed >= 0).then(|| f64::from(b.current_consumed) / 1000.0),
+            // -1 is "not sent"; any other count is the reader's to believe or not.
+            consumed_ah: (b.current_consumed != -1).then(|| f64::from(b.current_consumed) / 1000.0),
         };
         if battery.soc.is_some() || battery.consumed_ah.is_some() {
             self.emit(out, Event::Battery(battery));

@@ -85,7 +85,8 @@ pub struct Heartbeat {
 pub struct BatteryState {
     /// State of charge, 0-1 (`battery_remaining` percent / 100); `None` where not sent (-1).
     pub soc: Option<f64>,
-    /// Charge drawn since the start, A h; `None` where not sent (-1).
+    /// Charge drawn since the start, A h, as sent (a negative or implausible count too: the
+    /// reader judges it); `None` where not sent (-1).
     pub consumed_ah: Option<f64>,
 }
 

@@ -14,10 +14,10 @@
 //!
 //! It is flown from the present state of charge, by the vehicle at the re-estimated efficiency,
 //! in the present wind, in [`LIVE_SCENARIOS`] scenarios that draw the model error from the
-//! estimate's own spread and the wind from its source's ([`wind_sd`]). The advice: `continue`
-//! while 95 % of the scenarios land with the reserve (the p5 reserve at landing holds), `return
-//! now` where they do not but 95 % of a direct return's do, `land now` where neither holds; on
-//! the ground, `do not take off` where the mission from the ground does not hold it.
+//! estimate's own spread and the wind from its source's ([`wind_sd`]). The answer carries the
+//! shares of the scenarios that land with the reserve, the rest's and, where the advice may need
+//! it, a direct return's: the advice is made from them, with its hysteresis, in
+//! [`super::advice`].
 
 use aloft_missions::SourceFormat;
 use aloft_planner::{geodesy::LocalFrame, HomeSpec, MissionSpec, SegmentSpec, WindSpec};
@@ -27,6 +27,7 @@ use super::super::mission_options::MissionOptions;
 use super::super::scenario_stats::Percentiles;
 use super::super::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
 use super::super::vehicles::Vehicle;
+use super::advice::Shares;
 use super::estimate::Ratio;
 use super::tracker::{wind_from_deg, Tracker, WindSource};
 use crate::error::Error;
@@ -48,9 +49,6 @@ fn wind_sd(source: Option<WindSource>) -> (f64, f64) {
     }
 }
 
-/// Share of the scenarios that must land with the reserve for a route to be flown.
-const P_HOLDS: f64 = 0.95;
-
 /// Ground speed of a return where neither the mission nor the vehicle gives one, m/s (PX4's
 /// `MPC_XY_CRUISE`; ArduPilot's `WPNAV_SPEED` is 10 m/s).
 const RETURN_SPEED_MPS: f64 = 5.0;
@@ -67,8 +65,8 @@ pub(crate) struct AheadAnswer {
     /// The rest's point of no return (p5 of the scenarios), s from now: `None` where the route
     /// can turn back everywhere.
     pub point_of_no_return_s: Option<f64>,
-    /// Whether a direct return has a point of no return at all (`false`: it is past).
-    pub advice: &'static str,
+    /// The shares of the scenarios that land with the reserve, for the advice.
+    pub shares: Shares,
 }
 
 /// The route ahead's inputs that do not change within a flight.
@@ -99,28 +97,25 @@ impl Ahead<'_> {
             return Ok(None);
         };
         let rest_u = self.fly(&vehicle, rest, t, soc, ratio)?;
-        let holds = |u: &Uncertainty| u.p_feasible >= P_HOLDS;
-        let advice = if holds(&rest_u) {
-            "continue"
-        } else if !t.in_air() {
-            // Before take-off (or after landing): the whole mission from the ground.
-            "do not take off"
-        } else if !is_return {
-            let back = self.fly(&vehicle, return_spec(t, mission), t, soc, ratio)?;
-            if holds(&back) {
-                "return now"
-            } else {
-                "land now"
+        let back = match Shares::needs_back(rest_u.p_feasible, t.in_air(), is_return) {
+            true => {
+                let back = self.fly(&vehicle, return_spec(t, mission), t, soc, ratio)?;
+                Some(back.p_feasible)
             }
-        } else {
-            "land now"
+            false => None,
+        };
+        let shares = Shares {
+            rest: rest_u.p_feasible,
+            back,
+            in_air: t.in_air(),
+            rest_is_return: is_return,
         };
         Ok(Some(AheadAnswer {
             remaining_wh: rest_u.energy_wh,
             landing_soc: rest_u.end_soc,
             duration_s: rest_u.duration_s,
             point_of_no_return_s: rest_u.point_of_no_return_s.p5,
-            advice,
+            shares,
         }))
     }
 

@@ -15,14 +15,19 @@
 //!    the charge drawn), less the charge drawn since; the update's note says so.
 //!
 //! The charge drawn between two instants is the autopilot's count (BATTERY_STATUS
-//! `current_consumed`) over the pack's capacity where both instants have it, else the energy used
-//! over the pack's rated energy.
+//! `current_consumed`) over the pack's capacity where both instants have one that is believed
+//! ([`super::count`]: not negative, within the pack, never going back, never rising faster than
+//! the measured current draws), else the energy used over the pack's rated energy.
 //!
 //! A report is not believed where it is implausible:
 //! - outside 0-1 (that report is left out);
 //! - a jump: more than [`MAX_JUMP`] from the last believed report less the charge drawn since
 //!   (left out; a fall that lasts [`JUMP_SETTLE_REPORTS`] reports, within [`SETTLE_BAND`] of
-//!   each other, is a new estimate and believed, on the ground a rise too: a pack swapped);
+//!   each other, is a new estimate and believed, on the ground a rise too: a pack swapped). A
+//!   report back within [`MAX_JUMP`] of the track the reports held before a fall that settled
+//!   (that track's report less the charge drawn since) is believed at once: the fall was the
+//!   glitch, and the state of charge follows the evidence back (the last [`MAX_FALLS`] falls
+//!   in the air are remembered);
 //! - fuller than the rested voltage allows by more than [`FULLER_THAN_RESTED`] (an autopilot that
 //!   counts from a full pack at boot, PX4 without its cell count): the reports are not believed
 //!   for the rest of the flight;
@@ -61,6 +66,9 @@ const JUMP_SETTLE_REPORTS: u32 = 5;
 
 /// How close the reports after a jump must stay to each other to be a new level (0-1).
 const SETTLE_BAND: f64 = 0.05;
+
+/// Falls that settled in the air whose track before them is remembered.
+const MAX_FALLS: usize = 4;
 
 /// How much fuller than the rested voltage says a report may be, state of charge (0-1). PX4's
 /// reports and the generic LiPo curve agree within 8 % at take-off on the three shared flights
@@ -131,6 +139,8 @@ pub(crate) struct Charge {
     first_in_air: Option<Anchor>,
     /// A jump being watched: its level and how many reports held it.
     jump: Option<(f64, u32)>,
+    /// The last believed report before each fall that settled in the air (the latest last).
+    before_falls: Vec<Anchor>,
     distrust: Option<Distrust>,
     took_off: bool,
 }
@@ -146,6 +156,7 @@ impl Charge {
             reported: None,
             first_in_air: None,
             jump: None,
+            before_falls: Vec::new(),
             distrust: None,
             took_off: false,
         }
@@ -248,14 +259,25 @@ impl Charge {
     }
 
     /// Whether `soc` continues the believed reports: within [`MAX_JUMP`] of the last one less
-    /// the charge drawn since, or a new level that lasted (a fall, or on the ground any).
+    /// the charge drawn since, back on the track before a fall that settled, or a new level that
+    /// lasted (a fall, or on the ground any).
     fn not_a_jump(&mut self, soc: f64, in_air: bool, drawn: Drawn) -> bool {
         let Some(last) = self.reported else {
             return true;
         };
-        let expected = last.soc - self.drawn_between(last.drawn, drawn);
-        if (soc - expected).abs() <= MAX_JUMP {
+        let on_track = |a: &Anchor| (soc - (a.soc - self.drawn_between(a.drawn, drawn))).abs();
+        if on_track(&last) <= MAX_JUMP {
             self.jump = None;
+            return true;
+        }
+        if let Some(k) = self
+            .before_falls
+            .iter()
+            .rposition(|a| on_track(a) <= MAX_JUMP)
+        {
+            self.before_falls.truncate(k);
+            self.jump = None;
+            self.first_in_air = None;
             return true;
         }
         let held = match self.jump {
@@ -263,13 +285,27 @@ impl Charge {
             _ => 1,
         };
         self.jump = Some((soc, held));
-        let may_settle = !in_air || soc < expected;
-        if may_settle && held >= JUMP_SETTLE_REPORTS {
-            self.jump = None;
-            self.first_in_air = None;
+        let fall = soc < last.soc - self.drawn_between(last.drawn, drawn);
+        if (!in_air || fall) && held >= JUMP_SETTLE_REPORTS {
+            self.settle(last, in_air);
             return true;
         }
         false
+    }
+
+    /// A jump from `last` settled: in the air a fall, whose track before it is remembered; on
+    /// the ground maybe another pack, so no track before it holds.
+    fn settle(&mut self, last: Anchor, in_air: bool) {
+        self.jump = None;
+        self.first_in_air = None;
+        if !in_air {
+            self.before_falls.clear();
+            return;
+        }
+        if self.before_falls.len() == MAX_FALLS {
+            self.before_falls.remove(0);
+        }
+        self.before_falls.push(last);
     }
 
     /// The believed report against the rested voltage: much fuller is not believed.
@@ -529,6 +565,28 @@ mod tests {
             c.report(0.40 - 0.001 * f64::from(k), true, used(0.0));
         }
         assert!(near(c.soc(used(0.0)).0, 0.396));
+    }
+
+    /// A fall that settled in the air (20 reports at 0 %) is believed; a report back on the
+    /// track before it (0.90 less the 2.775 W h drawn since, 5 %: 85 %) is believed at once, and
+    /// so is the track after it. A rise elsewhere is still not.
+    #[test]
+    fn a_report_back_on_its_track_after_a_fall_is_believed() {
+        let mut c = Charge::new(pack());
+        c.in_air();
+        c.report(0.90, true, used(0.0));
+        for _ in 0..20 {
+            c.report(0.0, true, used(1.0));
+        }
+        assert!(near(c.soc(used(1.0)).0, 0.0));
+        // A rise to 60 %: on no track.
+        c.report(0.60, true, used(2.775));
+        assert!(near(c.soc(used(2.775)).0, 0.0));
+        c.report(0.85, true, used(2.775));
+        assert_eq!(c.soc(used(2.775)), (0.85, SocSource::Reported));
+        c.report(0.84, true, used(3.0));
+        assert!(near(c.soc(used(3.0)).0, 0.84));
+        assert_eq!(c.note(), None);
     }
 
     /// A report fuller than the rested voltage allows (an autopilot that counts from a full

@@ -5,10 +5,12 @@
 //! - [`follow_live`]: any [`TelemetrySource`] (a MAVLink link or telemetry log through the
 //!   `aloft-link` crate, a flight log replayed as events): the events folded into the flight's
 //!   state, the state of charge from the vehicle's reports, else its rested voltage, else a full
-//!   pack ([`charge`](self::charge)), the efficiency re-estimated from measured against
+//!   pack ([`charge`](self::charge)), the charge drawn from the autopilot's count where it is
+//!   believed ([`count`](self::count)), the efficiency re-estimated from measured against
 //!   predicted power ([`estimate`](self::estimate)), the wind from the autopilot or the tilt, and
-//!   the rest of the route flown from the present state in Monte-Carlo scenarios, with the
-//!   advice ([`ahead`](self::ahead)); on a link, the answer sent back ([`replies`]).
+//!   the rest of the route flown from the present state in Monte-Carlo scenarios
+//!   ([`ahead`](self::ahead)), with the advice and its hysteresis ([`advice`](self::advice)); on
+//!   a link, the answer sent back ([`replies`]).
 //! - [`replay_live`]: the validation route (`--route log`), a flight log replayed with the rest of
 //!   the logged path as the route ahead, so each prediction is checked against the energy the
 //!   log measured from then to the end.
@@ -25,8 +27,10 @@ use super::scenario_stats::Percentiles;
 use super::vehicles::Vehicle;
 use crate::error::Error;
 
+mod advice;
 mod ahead;
 mod charge;
+mod count;
 mod estimate;
 mod record;
 mod replay;
@@ -38,8 +42,10 @@ pub use record::LiveRecorder;
 pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
 pub use sources::LiveSource;
 
+use advice::AdviceHold;
 use ahead::{Ahead, AheadAnswer};
 use charge::{Charge, Drawn};
+use count::ChargeCount;
 use tracker::Tracker;
 
 /// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
@@ -91,7 +97,8 @@ pub struct LiveUpdate {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_s: Option<f64>,
     /// What to do: `continue`, `return now` or `land now`; on the ground, `continue` or `do not
-    /// take off`.
+    /// take off`. A graver advice at once, a milder one once it has held
+    /// ([`advice`](self::advice)).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub advice: Option<&'static str>,
     /// The naive rate: mean measured power so far times the route's remaining time, Wh.
@@ -104,8 +111,9 @@ pub struct LiveUpdate {
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub link_lost: bool,
     /// Why the route ahead has no answer (the planner's message), that the efficiency was held
-    /// at 1, where the state of charge comes from when it is not the vehicle's report; several
-    /// joined by `; `.
+    /// at 1, where the state of charge comes from when it is not the vehicle's report, and once,
+    /// a step back of a telemetry log's clock or a count of the charge drawn not believed;
+    /// several joined by `; `.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
 }
@@ -313,6 +321,10 @@ pub struct LiveSession<'a> {
     ahead: Ahead<'a>,
     /// The state of charge and where it comes from.
     charge: Charge,
+    /// The autopilot's count of the charge drawn, believed or not.
+    count: ChargeCount,
+    /// The advice given, for its hysteresis.
+    advice: AdviceHold,
     eta0: f64,
     given_mission: Option<&'a Mission>,
     /// The mission learned from the source (or why it cannot be read), by the upload it came
@@ -358,7 +370,9 @@ impl<'a> LiveSession<'a> {
                 speed_mps: request.speed_mps,
                 scenarios: request.scenarios,
             },
+            count: ChargeCount::new(pack.capacity_ah()),
             charge: Charge::new(pack),
+            advice: AdviceHold::default(),
             eta0,
             given_mission: request.mission.as_ref(),
             learned: None,
@@ -368,10 +382,11 @@ impl<'a> LiveSession<'a> {
         })
     }
 
-    /// What was drawn from the pack so far: the autopilot's count and the energy used.
+    /// What was drawn from the pack so far: the autopilot's count where it is believed, and
+    /// the energy used.
     fn drawn(&self) -> Drawn {
         Drawn {
-            consumed_ah: self.tracker.battery.consumed_ah,
+            consumed_ah: self.count.believed_ah(),
             energy_wh: self.tracker.energy_used_wh(),
         }
     }
@@ -397,12 +412,16 @@ impl<'a> LiveSession<'a> {
     pub fn apply(&mut self, event: &aloft_logs::telemetry::Telemetry) {
         use aloft_logs::telemetry::Event;
         self.tracker.apply(event);
+        self.apply_count(&event.event);
         let in_air = self.tracker.in_air();
         let drawn = self.drawn();
         let c = &mut self.charge;
         match &event.event {
-            // Another flight, maybe another pack: nothing reported holds.
-            Event::Reboot => *c = Charge::new(c.pack().clone()),
+            // Another flight, maybe another pack: nothing reported holds, no advice either.
+            Event::Reboot => {
+                *c = Charge::new(c.pack().clone());
+                self.advice = AdviceHold::default();
+            }
             Event::Battery(b) => {
                 if let Some(soc) = b.soc {
                     c.report(soc, in_air, drawn);
@@ -424,18 +443,39 @@ impl<'a> LiveSession<'a> {
         }
     }
 
+    /// The autopilot's count and the current it is judged by ([`count`](self::count)); a
+    /// restart starts the count over.
+    fn apply_count(&mut self, event: &aloft_logs::telemetry::Event) {
+        use aloft_logs::telemetry::Event;
+        let now = self.tracker.now_s;
+        match event {
+            Event::Reboot => self.count = ChargeCount::new(self.charge.pack().capacity_ah()),
+            Event::Sample(s) => {
+                if let Some(i) = s.current_a {
+                    self.count.current(now, i);
+                }
+            }
+            Event::Battery(b) => {
+                if let Some(c) = b.consumed_ah {
+                    self.count.count(now, c);
+                }
+            }
+            _ => {}
+        }
+    }
+
     /// The answer now: the state of charge, the efficiency's estimate, the route ahead in
     /// scenarios and the advice. A mission learned from the link that aloft cannot read, a route
-    /// the planner refuses, and a step back of a telemetry log's clock since the last answer are
-    /// said in the update's `note`.
+    /// the planner refuses, and, once, a step back of a telemetry log's clock or a count of the
+    /// charge drawn not believed since the last answer are said in the update's `note`.
     pub fn update(&mut self) -> LiveUpdate {
         let mut update = self.answer();
-        if let Some(clock) = self.tracker.clock_note.take() {
-            update.note = Some(match update.note {
-                Some(note) => format!("{clock}; {note}"),
-                None => clock,
-            });
-        }
+        let once = [self.tracker.clock_note.take(), self.count.take_note()];
+        update.note = once
+            .into_iter()
+            .chain([update.note])
+            .flatten()
+            .reduce(|a, b| format!("{a}; {b}"));
         update
     }
 
@@ -544,7 +584,9 @@ impl<'a> LiveSession<'a> {
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
             landing_soc: answer.as_ref().and_then(|a| a.landing_soc),
             point_of_no_return_s,
-            advice: answer.as_ref().map(|a| a.advice),
+            advice: answer
+                .as_ref()
+                .map(|a| self.advice.advise(now, &a.shares).as_str()),
             naive_remaining_wh: naive,
             measured_remaining_wh: None,
             link_lost: false,

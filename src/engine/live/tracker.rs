@@ -5,7 +5,7 @@
 use aloft_core::Trapezoid;
 use aloft_logs::frame::euler_to_mat_ned_frd;
 use aloft_logs::sample::{Attitude, GeoOrigin, Sample};
-use aloft_logs::telemetry::{BatteryState, Event, Heartbeat, MissionItem, Telemetry};
+use aloft_logs::telemetry::{Event, Heartbeat, MissionItem, Telemetry};
 use aloft_power::{CubicDrag, PowerModel};
 
 use super::estimate::RatioEstimator;
@@ -79,7 +79,6 @@ pub(crate) struct Tracker {
     pub power_w: Option<f64>,
     landed: Option<bool>,
     pub heartbeat: Option<Heartbeat>,
-    pub battery: BatteryState,
     /// The mission as the vehicle holds it, and how many times one arrived (a re-upload).
     pub mission: Option<(Vec<MissionItem>, u32)>,
     pub mission_current: Option<u32>,
@@ -116,7 +115,6 @@ impl Tracker {
             power_w: None,
             landed: None,
             heartbeat: None,
-            battery: BatteryState::default(),
             mission: None,
             mission_current: None,
             wind: None,
@@ -146,11 +144,8 @@ impl Tracker {
             Event::Origin(o) => self.origin = Some(*o),
             Event::Home(h) => self.home_enu = Some(*h),
             Event::Heartbeat(h) => self.heartbeat = Some(h.clone()),
-            Event::Battery(b) => {
-                self.battery.soc = b.soc.or(self.battery.soc);
-                self.battery.consumed_ah = b.consumed_ah.or(self.battery.consumed_ah);
-            }
-            Event::Speeds { .. } => {}
+            // The charge's and the count's to judge (`super::charge`, `super::count`).
+            Event::Battery(_) | Event::Speeds { .. } => {}
             Event::MissionCurrent(seq) => self.mission_current = Some(*seq),
             Event::Mission(items) => {
                 let uploads = self.mission.as_ref().map_or(0, |(_, n)| *n) + 1;

@@ -172,6 +172,24 @@ fn battery_status_sums_cells_and_reads_consumed_charge() {
     };
     assert!(close(b.consumed_ah.unwrap(), 2.06, TOL));
     assert!(close(b.soc.unwrap(), 0.2, TOL));
+    // -1 is "not sent"; any other count is passed on as it is, a negative one too (a wrapped
+    // counter: `aloft live` judges it and says so, rather than keep the last count silently).
+    let MavMessage::BATTERY_STATUS(mut counted) = msg.clone() else {
+        unreachable!()
+    };
+    for (mah, want) in [(-1, None), (i32::MIN, Some(-2_147_483.648)), (0, Some(0.0))] {
+        counted.current_consumed = mah;
+        let ev = events(
+            &mut d,
+            1.5,
+            h(1, 1),
+            MavMessage::BATTERY_STATUS(counted.clone()),
+        );
+        let Event::Battery(b) = &ev[1].event else {
+            panic!("{ev:?}")
+        };
+        assert_eq!(b.consumed_ah, want, "{mah}");
+    }
     // A second battery is not the flight pack.
     let MavMessage::BATTERY_STATUS(mut second) = msg else {
         unreachable!()
