@@ -517,3 +517,196 @@ fn logbook_pack_file_from_the_packs_logs() {
     assert_eq!(code, 2);
     assert!(err.contains("no such pack"), "{err}");
 }
+
+/// `logbook add --db other-app.sqlite` (a SQLite file of another program): exit 2, one line
+/// naming the file and saying it is not an aloft logbook; the file's bytes as they were, no WAL
+/// or other side file made. Listing it is refused the same way.
+#[test]
+fn logbook_refuses_another_programs_sqlite_file_and_changes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("other-app.sqlite");
+    let script = "import sqlite3, sys\nc = sqlite3.connect(sys.argv[1])\nc.execute('CREATE TABLE notes (id INTEGER PRIMARY KEY, text TEXT)')\nc.execute(\"INSERT INTO notes (text) VALUES ('keep me')\")\nc.commit()\n";
+    match Command::new("python3")
+        .args(["-c", script, s(&db)])
+        .status()
+    {
+        Ok(st) => assert!(st.success()),
+        Err(e) => {
+            assert!(std::env::var_os("CI").is_none(), "python3: {e}");
+            eprintln!("skipped: no python3 ({e})");
+            return;
+        }
+    }
+    let before = std::fs::read(&db).unwrap();
+    let f = kaist();
+    for args in [
+        vec!["logbook", "add", "--db", s(&db), s(&f[0])],
+        vec!["logbook", "flights", "--db", s(&db)],
+        vec!["logbook", "packs", "--db", s(&db), "--format", "json"],
+    ] {
+        let (code, out, err) = run(&args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains("other-app.sqlite") && err.contains("not an aloft logbook"),
+            "{err}"
+        );
+        assert!(std::fs::read(&db).unwrap() == before, "{args:?}: changed");
+        let names: Vec<String> = std::fs::read_dir(tmp.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, vec!["other-app.sqlite"], "{args:?}");
+    }
+}
+
+/// A logbook with a page overwritten in the middle (the `skipped` table's): `add` is refused
+/// in one line before anything is written; `flights` and `packs` still list what SQLite reads.
+#[test]
+fn logbook_damaged_is_refused_on_add_and_still_listed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let f = kaist();
+    let cut = tmp.path().join("cut.csv");
+    std::fs::write(&cut, &std::fs::read(&f[0]).unwrap()[..1000]).unwrap();
+    let (code, _, err) = run(&[
+        "logbook",
+        "add",
+        "--db",
+        s(&db),
+        s(&f[0]),
+        s(&f[1]),
+        s(&f[2]),
+        s(&cut),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // The root page of `skipped`, by the page numbers of Python's sqlite3.
+    let o = Command::new("python3")
+        .args([
+            "-c",
+            "import sqlite3, sys\nc = sqlite3.connect(sys.argv[1])\nprint(c.execute(\"SELECT rootpage FROM sqlite_master WHERE name = 'skipped'\").fetchone()[0], c.execute('PRAGMA page_size').fetchone()[0])",
+            s(&db),
+        ])
+        .output();
+    let Ok(o) = o else {
+        assert!(std::env::var_os("CI").is_none(), "no python3");
+        return;
+    };
+    let text = String::from_utf8(o.stdout).unwrap();
+    let nums: Vec<usize> = text
+        .split_whitespace()
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let mut bytes = std::fs::read(&db).unwrap();
+    let at = (nums[0] - 1) * nums[1];
+    assert!(at > 0 && at < bytes.len() - nums[1], "{nums:?}");
+    bytes[at..at + 12].fill(0xFF);
+    std::fs::write(&db, &bytes).unwrap();
+
+    let (code, out, err) = run(&["logbook", "add", "--db", s(&db), s(&f[3])]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("book.sqlite") && err.contains("damaged"),
+        "{err}"
+    );
+    assert!(std::fs::read(&db).unwrap() == bytes, "written after all");
+    let flights = json(&["logbook", "flights", "--db", s(&db), "--format", "json"]);
+    assert_eq!(flights["flights"].as_array().unwrap().len(), 3);
+    let packs = json(&["logbook", "packs", "--db", s(&db), "--format", "json"]);
+    let n: u64 = packs["packs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["flights"].as_u64().unwrap())
+        .sum();
+    assert_eq!(n, 3);
+}
+
+/// Run aloft as another user than root (`setpriv` to nobody), where the tests run as root (root
+/// ignores file permissions); as the user itself otherwise. `None` when root cannot switch.
+fn as_unprivileged(args: &[&str]) -> Option<(i32, String, String)> {
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    let o = if root {
+        let mut c = Command::new("setpriv");
+        c.args(["--reuid=65534", "--regid=65534", "--clear-groups"])
+            .arg(env!("CARGO_BIN_EXE_aloft"))
+            .args(args)
+            .env_remove("ALOFT_LOGBOOK");
+        c.output().ok()?
+    } else {
+        aloft_env(args, &[])
+    };
+    Some((
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    ))
+}
+
+/// A logbook the user may read but not write: the file read-only in a folder they may write,
+/// and the file in a folder they may not write (where SQLite cannot make the WAL's side files).
+/// `flights`, `vehicles` and `packs` list it; `add` is refused (exit 2); the file is unchanged.
+#[cfg(unix)]
+#[test]
+fn logbook_listed_from_a_read_only_file_and_a_read_only_folder() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let f = kaist();
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    for (folder_mode, file_mode) in [(0o777, 0o444), (0o555, 0o444), (0o755, 0o644)] {
+        let dir = tmp.path().join(format!("d{folder_mode:o}-{file_mode:o}"));
+        std::fs::create_dir(&dir).unwrap();
+        let db = dir.join("book.sqlite");
+        let (code, _, err) = run(&["logbook", "add", "--db", s(&db), s(&f[0]), s(&f[10])]);
+        assert_eq!(code, 0, "{err}");
+        if !root && folder_mode == 0o755 {
+            // Owned by the user: a folder they may write; covered by the 0o555 case.
+            continue;
+        }
+        std::fs::set_permissions(&db, std::fs::Permissions::from_mode(file_mode)).unwrap();
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(folder_mode)).unwrap();
+        std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o755)).unwrap();
+        let before = std::fs::read(&db).unwrap();
+        for kind in ["flights", "vehicles", "packs"] {
+            let Some((code, out, err)) =
+                as_unprivileged(&["logbook", kind, "--db", s(&db), "--format", "json"])
+            else {
+                assert!(std::env::var_os("CI").is_none(), "cannot run as nobody");
+                eprintln!("skipped: cannot run as another user");
+                return;
+            };
+            assert_eq!(code, 0, "{folder_mode:o}/{file_mode:o} {kind}: {err}");
+            let v: Value = serde_json::from_str(&out).unwrap();
+            assert!(!v[kind].as_array().unwrap().is_empty(), "{v}");
+        }
+        let (code, _, err) =
+            as_unprivileged(&["logbook", "add", "--db", s(&db), s(&f[1])]).unwrap();
+        assert_eq!(code, 2, "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(std::fs::read(&db).unwrap() == before);
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+}
+
+/// A link planted at the logbook's path, to a file that does not exist: `add` creates nothing
+/// through it (exit 2 naming the path).
+#[cfg(unix)]
+#[test]
+fn logbook_not_created_through_a_planted_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let target = tmp.path().join("victim.sqlite");
+    let db = tmp.path().join("book.sqlite");
+    std::os::unix::fs::symlink(&target, &db).unwrap();
+    let (code, _, err) = run(&["logbook", "add", "--db", s(&db), s(&kaist()[0])]);
+    assert_eq!(code, 2, "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("book.sqlite"), "{err}");
+    assert!(!target.exists());
+}

@@ -148,7 +148,8 @@ fn db_path(given: Option<PathBuf>) -> Result<(PathBuf, bool)> {
     Ok((data.join("aloft").join("logbook.sqlite"), true))
 }
 
-fn open(given: Option<PathBuf>) -> Result<Logbook> {
+/// The logbook to add to: made when missing (the default's folder too).
+fn open_to_write(given: Option<PathBuf>) -> Result<Logbook> {
     let (path, create_folder) = db_path(given)?;
     if create_folder {
         if let Some(folder) = path.parent() {
@@ -159,29 +160,34 @@ fn open(given: Option<PathBuf>) -> Result<Logbook> {
     Ok(Logbook::open(&path)?)
 }
 
+/// The logbook to list, read-only (a file or folder the user may not write is listed).
+fn open_to_read(given: Option<PathBuf>) -> Result<Logbook> {
+    let (path, _) = db_path(given)?;
+    Ok(Logbook::open_read_only(&path)?)
+}
+
 pub fn run(args: LogbookArgs) -> Result<Outcome> {
-    let mut book = open(args.db)?;
     match args.command {
-        LogbookCommand::Add(a) => add(&mut book, a),
+        LogbookCommand::Add(a) => add(&mut open_to_write(args.db)?, a),
         LogbookCommand::Flights(a) => {
-            let flights = book.flights()?;
+            let flights = open_to_read(args.db)?.flights()?;
             list(a.format, "flights", &flights, |out| {
                 flights_table(out, &flights)
             })
         }
         LogbookCommand::Vehicles(a) => {
-            let vehicles = book.vehicles()?;
+            let vehicles = open_to_read(args.db)?.vehicles()?;
             list(a.format, "vehicles", &vehicles, |out| {
                 vehicles_table(out, &vehicles)
             })
         }
         LogbookCommand::Packs(a) => {
-            let packs = book.packs()?;
+            let packs = open_to_read(args.db)?.packs()?;
             list(a.format, "packs", &packs, |out| packs_table(out, &packs))
         }
-        LogbookCommand::PackFile(a) => pack_file(&book, a),
+        LogbookCommand::PackFile(a) => pack_file(&open_to_read(args.db)?, a),
         LogbookCommand::Skipped(a) => {
-            let skipped = book.skipped()?;
+            let skipped = open_to_read(args.db)?.skipped()?;
             list(a.format, "skipped", &skipped, |out| {
                 skipped_table(out, &skipped)
             })
@@ -210,7 +216,7 @@ fn list<T: Serialize>(
 #[cfg(feature = "serve")]
 pub(crate) fn answer_json(db: &Path, kind: &str) -> Result<String, String> {
     let text = |e: &dyn std::fmt::Display| e.to_string();
-    let book = Logbook::open(db).map_err(|e| text(&e))?;
+    let book = Logbook::open_read_only(db).map_err(|e| text(&e))?;
     let json = match kind {
         "flights" => serde_json::to_string(&Keyed(kind, &book.flights().map_err(|e| text(&e))?)),
         "vehicles" => serde_json::to_string(&Keyed(kind, &book.vehicles().map_err(|e| text(&e))?)),

@@ -11,6 +11,7 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{LogbookError, Result};
+use crate::file::{self, Identity, APPLICATION_ID};
 use crate::record::{read_flight, FlightFacts, ReadOptions};
 use crate::schema::{migrate, Migrated, SCHEMA_VERSION};
 
@@ -33,6 +34,41 @@ fn use_wal(conn: &Connection) -> rusqlite::Result<()> {
             other => return other.map(drop),
         }
     }
+}
+
+/// The folder the logbook is to be in must exist (it is not made: a typo in `--db` should not
+/// leave a folder behind).
+fn check_folder(path: &Path) -> Result<()> {
+    let folder = match path.parent() {
+        Some(p) if p.as_os_str().is_empty() => Path::new("."),
+        Some(p) => p,
+        None => Path::new("."),
+    };
+    if folder.is_dir() {
+        Ok(())
+    } else {
+        Err(LogbookError::FolderMissing {
+            folder: folder.to_path_buf(),
+        })
+    }
+}
+
+fn too_new(path: &Path, found: i64) -> LogbookError {
+    LogbookError::SchemaTooNew {
+        path: path.to_path_buf(),
+        found,
+        supported: SCHEMA_VERSION,
+    }
+}
+
+/// Mark the file as aloft's ([`APPLICATION_ID`]) where it is not yet (a logbook of before the
+/// mark, once migrated).
+fn mark(conn: &Connection) -> rusqlite::Result<()> {
+    let id: i32 = conn.query_row("PRAGMA application_id", [], |r| r.get(0))?;
+    if id != APPLICATION_ID {
+        conn.execute_batch(&format!("PRAGMA application_id = {APPLICATION_ID}"))?;
+    }
+    Ok(())
 }
 
 /// The key of a vehicle or pack whose log does not identify it and that was given no label.
@@ -119,42 +155,100 @@ fn key(from_log: Option<&str>, label: Option<&str>) -> (String, &'static str) {
 }
 
 impl Logbook {
-    /// Open the logbook at `path`, creating it (not its folder) when missing, and migrate it to
-    /// [`SCHEMA_VERSION`].
+    /// Open the logbook at `path` to add to it, creating it (not its folder) when missing, and
+    /// migrate it to [`SCHEMA_VERSION`] (see [`crate::file`] for what is refused, and why).
     ///
     /// # Errors
-    /// The folder is missing; the file is not a SQLite database or cannot be written; its
-    /// schema is newer than this code's.
+    /// The folder is missing; a link to nothing or not a regular file is at the path; the file
+    /// is not a SQLite database, is another program's ([`LogbookError::NotALogbook`], nothing
+    /// in it changed), is damaged ([`LogbookError::Damaged`]) or cannot be written; its schema is
+    /// newer than this code's.
     pub fn open(path: &Path) -> Result<Self> {
-        let folder = match path.parent() {
-            Some(p) if p.as_os_str().is_empty() => Path::new("."),
-            Some(p) => p,
-            None => Path::new("."),
-        };
-        if !folder.is_dir() {
-            return Err(LogbookError::FolderMissing {
-                folder: folder.to_path_buf(),
+        check_folder(path)?;
+        let create = !file::existing(path)?;
+        let sql = file::sql_error(path);
+        let mut conn = file::open_to_write(path, create)?;
+        conn.busy_timeout(BUSY_TIMEOUT).map_err(&sql)?;
+        match file::identify(&conn).map_err(&sql)? {
+            Identity::Foreign {
+                application_id,
+                tables,
+            } => {
+                return Err(LogbookError::NotALogbook {
+                    path: path.to_path_buf(),
+                    application_id,
+                    tables,
+                })
+            }
+            Identity::Aloft(found) if found > SCHEMA_VERSION => {
+                return Err(too_new(path, found));
+            }
+            Identity::Aloft(_) => {
+                if let Some(problem) = file::quick_check(&conn).map_err(&sql)? {
+                    return Err(LogbookError::Damaged {
+                        path: path.to_path_buf(),
+                        problem,
+                    });
+                }
+            }
+            Identity::Empty => {}
+        }
+        use_wal(&conn).map_err(&sql)?;
+        conn.execute_batch("PRAGMA foreign_keys = ON")
+            .map_err(&sql)?;
+        match migrate(&mut conn).map_err(&sql)? {
+            Migrated::Current => {}
+            Migrated::TooNew(found) => return Err(too_new(path, found)),
+        }
+        mark(&conn).map_err(&sql)?;
+        Ok(Self {
+            conn,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// Open the logbook at `path` to list it, read-only: a file or folder the user may not
+    /// write can be listed. A logbook of an older schema (or a file of zero bytes) is brought up
+    /// to date first, as [`Logbook::open`] does, where the file can be written.
+    ///
+    /// # Errors
+    /// No file at the path ([`LogbookError::NoLogbook`]: listing makes none); the file is not a
+    /// SQLite database or is another program's; its schema is newer than this code's, or older
+    /// and the file cannot be written ([`LogbookError::CannotMigrate`]).
+    pub fn open_read_only(path: &Path) -> Result<Self> {
+        check_folder(path)?;
+        if !file::existing(path)? {
+            return Err(LogbookError::NoLogbook {
+                path: path.to_path_buf(),
             });
         }
-        let sql = |source| LogbookError::Sqlite {
-            path: path.to_path_buf(),
-            source,
-        };
-        let mut conn = Connection::open(path).map_err(sql)?;
-        conn.busy_timeout(BUSY_TIMEOUT).map_err(sql)?;
-        use_wal(&conn).map_err(sql)?;
-        conn.execute_batch("PRAGMA foreign_keys = ON")
-            .map_err(sql)?;
-        match migrate(&mut conn).map_err(sql)? {
-            Migrated::Current => Ok(Self {
+        let (conn, identity) = file::open_to_read(path)?;
+        match identity {
+            Identity::Aloft(SCHEMA_VERSION) => Ok(Self {
                 conn,
                 path: path.to_path_buf(),
             }),
-            Migrated::TooNew(found) => Err(LogbookError::SchemaTooNew {
+            Identity::Aloft(found) if found > SCHEMA_VERSION => Err(too_new(path, found)),
+            Identity::Foreign {
+                application_id,
+                tables,
+            } => Err(LogbookError::NotALogbook {
                 path: path.to_path_buf(),
-                found,
-                supported: SCHEMA_VERSION,
+                application_id,
+                tables,
             }),
+            Identity::Aloft(found) => {
+                drop(conn);
+                Self::open(path).map_err(|e| match e {
+                    LogbookError::ReadOnly { .. } => LogbookError::CannotMigrate {
+                        path: path.to_path_buf(),
+                        found,
+                        supported: SCHEMA_VERSION,
+                    },
+                    e => e,
+                })
+            }
+            Identity::Empty => Self::open(path),
         }
     }
 

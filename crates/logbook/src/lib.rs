@@ -28,12 +28,14 @@
 #![deny(clippy::float_cmp)]
 
 mod error;
+pub mod file;
 mod ingest;
 mod query;
 pub mod record;
 pub mod schema;
 
 pub use error::{LogbookError, Result};
+pub use file::APPLICATION_ID;
 pub use ingest::{file_sha256, AddOutcome, Labels, Logbook, BUSY_TIMEOUT, UNKNOWN};
 pub use query::{
     trend, Flight, PackPoint, PackSummary, PowerDrift, PowerPoint, Skipped, Trend, VehicleSummary,

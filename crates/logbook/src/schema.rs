@@ -99,7 +99,11 @@ pub(crate) fn migrate(conn: &mut Connection) -> rusqlite::Result<Migrated> {
             return Ok(Migrated::Current);
         };
         tx.execute_batch(step)?;
-        tx.execute_batch(&format!("PRAGMA user_version = {}", v + 1))?;
+        tx.execute_batch(&format!(
+            "PRAGMA user_version = {}; PRAGMA application_id = {}",
+            v + 1,
+            crate::file::APPLICATION_ID
+        ))?;
         tx.commit()?;
     }
 }

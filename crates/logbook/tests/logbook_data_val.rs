@@ -411,14 +411,15 @@ fn a_version_1_logbook_is_migrated_forward() {
     assert_eq!(v, 3);
 }
 
-/// A file written by a newer aloft is refused, not rewritten.
+/// A file written by a newer aloft (marked as aloft's, at a version above this code's) is
+/// refused, not rewritten.
 #[test]
 fn a_newer_logbook_is_refused() {
     let tmp = tempfile::tempdir().unwrap();
     let db = tmp.path().join("new.sqlite");
     rusqlite::Connection::open(&db)
         .unwrap()
-        .execute_batch("PRAGMA user_version = 99")
+        .execute_batch("PRAGMA user_version = 99; PRAGMA application_id = 1634494068")
         .unwrap();
     let e = Logbook::open(&db).unwrap_err().to_string();
     assert!(
