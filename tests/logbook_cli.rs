@@ -111,10 +111,11 @@ fn logbook_json_shapes_and_exit_codes() {
         "discharged_mah",
         "resistance_ohm",
         "capacity_refusal",
-        "imbalance_minor_min",
     ] {
         assert!(f0.get(k).is_some(), "no {k}: {f0}");
     }
+    // The ULog has no cell voltages: no imbalance, and no key for it (never `null`).
+    assert!(f0.get("imbalance_minor_min").is_none(), "{f0}");
     // The ULog is filed under its own sys_uuid, not the label.
     let vehicles = json(&["logbook", "vehicles", "--db", db, "--format", "json"]);
     let keys: Vec<&str> = vehicles["vehicles"]
@@ -709,4 +710,70 @@ fn logbook_not_created_through_a_planted_link() {
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.contains("book.sqlite"), "{err}");
     assert!(!target.exists());
+}
+
+/// Paths of every `null` in a JSON value.
+fn nulls(v: &Value, at: &str, out: &mut Vec<String>) {
+    match v {
+        Value::Null => out.push(at.to_string()),
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                nulls(x, &format!("{at}[{i}]"), out);
+            }
+        }
+        Value::Object(o) => {
+            for (k, x) in o {
+                nulls(x, &format!("{at}.{k}"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Real logs that lack some figures (the KAIST CSVs have no clock, no cells, no rating; some
+/// ULogs no hover or resistance): no `null` anywhere in the JSON of `add`, `flights`,
+/// `vehicles`, `packs`; an absent figure is an absent key, a present one is there.
+#[test]
+fn logbook_json_has_no_null_where_a_figure_is_absent() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let d = data_dir();
+    let kaist = kaist();
+    let ulog = d.join("px4_flugdrohne/ulg/log_20_2023-6-7-10-52-56.ulg");
+    let bin = d.join("flight_logs/sitl_ac47_00000002.BIN");
+    let added = json(&[
+        "logbook",
+        "add",
+        "--db",
+        s(&db),
+        s(&kaist[0]),
+        s(&kaist[1]),
+        s(&ulog),
+        s(&bin),
+        "--format",
+        "json",
+    ]);
+    let mut found = Vec::new();
+    nulls(&added, "add", &mut found);
+    for kind in ["flights", "vehicles", "packs", "skipped"] {
+        let v = json(&["logbook", kind, "--db", s(&db), "--format", "json"]);
+        nulls(&v, kind, &mut found);
+    }
+    assert_eq!(found, Vec::<String>::new());
+    let v = json(&["logbook", "flights", "--db", s(&db), "--format", "json"]);
+    let by_name = |n: &str| -> Value {
+        v["flights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["file_name"] == n)
+            .cloned()
+            .unwrap()
+    };
+    // A CSV has no clock: no start; the ULog's GPS clock gives one.
+    let csv = by_name(kaist[0].file_name().unwrap().to_str().unwrap());
+    assert!(csv.get("start_unix_s").is_none(), "{csv}");
+    assert!(csv["duration_s"].as_f64().unwrap() > 0.0);
+    let u = by_name("log_20_2023-6-7-10-52-56.ulg");
+    assert!(u["start_unix_s"].as_f64().unwrap() > 1.6e9, "{u}");
 }

@@ -27,38 +27,52 @@ pub struct Flight {
     /// The pack's key.
     pub pack_key: String,
     /// Start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// First to last battery sample, s.
     pub duration_s: f64,
     /// Energy drawn, Wh.
     pub energy_wh: f64,
     /// Charge drawn, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub discharged_mah: Option<f64>,
     /// Largest current, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_current_a: Option<f64>,
     /// Lowest voltage, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub min_voltage_v: Option<f64>,
     /// Mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_power_w: Option<f64>,
     /// Mean power while hovering, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hover_power_w: Option<f64>,
     /// Cells in series.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cells_series: Option<u32>,
     /// The pack's resistance from current steps, ohm.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resistance_ohm: Option<f64>,
     /// The autopilot's estimate of the pack's resistance, ohm.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub autopilot_resistance_ohm: Option<f64>,
     /// Usable capacity between rested points, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_mah: Option<f64>,
     /// Why no capacity was estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_refusal: Option<String>,
     /// Minutes with a cell more than 0.01 V from the others.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_minor_min: Option<f64>,
     /// Minutes with a cell more than 0.07 V from the others.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_major_min: Option<f64>,
     /// When it was added, Unix time, s.
     pub added_unix_s: i64,
     /// Where the file was when added (absolute); `None` for flights added before version 3.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub file_path: Option<String>,
 }
 
@@ -122,9 +136,11 @@ pub struct Trend {
     /// Its value on the last.
     pub last: f64,
     /// Least-squares slope per flight (`None` with fewer than two flights).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub slope_per_flight: Option<f64>,
     /// Change from the line's value at the first flight to its value at the last, percent of
     /// the first (`None` with fewer than three flights).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub change_percent: Option<f64>,
 }
 
@@ -162,10 +178,13 @@ pub struct PowerPoint {
     /// The flight.
     pub flight_id: i64,
     /// Its start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// Its mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_power_w: Option<f64>,
     /// Its hover power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hover_power_w: Option<f64>,
 }
 
@@ -200,6 +219,7 @@ pub struct VehicleSummary {
     pub power: Vec<PowerPoint>,
     /// Drift of the power over the last flights (at least two with a power; none for the
     /// vehicle "unknown", whose flights are of any vehicle).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub power_drift: Option<PowerDrift>,
 }
 
@@ -209,6 +229,7 @@ pub struct PackPoint {
     /// The flight.
     pub flight_id: i64,
     /// Its start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// The value (ohm for resistance, mAh for capacity).
     pub value: f64,
@@ -222,8 +243,10 @@ pub struct PackSummary {
     /// Where the key came from: `log`, `label`, `unknown`.
     pub key_source: String,
     /// Rated capacity, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rated_capacity_mah: Option<f64>,
     /// Cells in series.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cells_series: Option<u32>,
     /// Flights.
     pub flights: usize,
@@ -234,18 +257,22 @@ pub struct PackSummary {
     /// Energy drawn, Wh.
     pub energy_wh: f64,
     /// Equivalent full cycles: discharged charge / rated charge (`None` without a rating).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub equivalent_cycles: Option<f64>,
     /// Vehicles it flew.
     pub vehicles: Vec<String>,
     /// Resistance per flight, ohm.
     pub resistance: Vec<PackPoint>,
     /// Its trend (slope in ohm per flight; none for the pack "unknown").
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resistance_trend: Option<Trend>,
     /// Capacity estimates, mAh.
     pub capacity: Vec<PackPoint>,
     /// Minutes with a cell more than 0.01 V from the others, over all flights.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_minor_min: Option<f64>,
     /// Minutes with a cell more than 0.07 V from the others, over all flights.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_major_min: Option<f64>,
 }
 
