@@ -108,6 +108,40 @@ pub enum LogbookError {
         /// The version this code reads.
         supported: i64,
     },
+    /// No vehicle or pack of that key in the logbook.
+    #[error(
+        "{}: no {kind} {key:?} in the logbook (`aloft logbook {kind}s` lists them)",
+        path.display()
+    )]
+    NoSuchKey {
+        /// The file.
+        path: PathBuf,
+        /// Vehicle or pack.
+        kind: crate::KeyKind,
+        /// The key asked for.
+        key: String,
+    },
+    /// A vehicle or pack of that key is already in the logbook.
+    #[error(
+        "{}: a {kind} {key:?} is already in the logbook: give a name not taken",
+        path.display()
+    )]
+    KeyTaken {
+        /// The file.
+        path: PathBuf,
+        /// Vehicle or pack.
+        kind: crate::KeyKind,
+        /// The key taken.
+        key: String,
+    },
+    /// A label that cannot be a key.
+    #[error("{label:?} is not a label: {reason}")]
+    BadLabel {
+        /// The label given.
+        label: String,
+        /// What a label must be.
+        reason: &'static str,
+    },
     /// The logbook's path cannot be looked at.
     #[error("{}: {source}", path.display())]
     Io {

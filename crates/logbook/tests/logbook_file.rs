@@ -109,7 +109,25 @@ fn a_sqlite_file_of_another_program_is_refused_and_not_changed() {
             "{name}: {e:?}"
         );
         assert!(std::fs::read(&db).unwrap() == before);
+        assert_eq!(side_files(&db), Vec::<PathBuf>::new(), "{name}");
     }
+}
+
+/// Listing a logbook in a folder the user may write leaves no side file behind (a read-only
+/// SQLite connection cannot remove the WAL's `-wal` and `-shm` when it closes).
+#[test]
+fn listing_leaves_no_side_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let mut book = Logbook::open(&db).unwrap();
+    book.add(&kaist()[10], &Labels::default(), &ReadOptions::default())
+        .unwrap();
+    drop(book);
+    assert_eq!(side_files(&db), Vec::<PathBuf>::new());
+    let book = Logbook::open_read_only(&db).unwrap();
+    assert_eq!(book.flights().unwrap().len(), 1);
+    drop(book);
+    assert_eq!(side_files(&db), Vec::<PathBuf>::new());
 }
 
 /// The schema of version 3, as aloft wrote it before the mark (written out here, not taken from
