@@ -10,11 +10,14 @@ use clap::{Args, Subcommand, ValueEnum};
 use serde::Serialize;
 
 use aloft_logbook::{
-    AddOutcome, Flight, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
+    AddOutcome, Flight, KeyKind, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
 };
 
 use super::output::{self, fixed, Row};
 use super::Outcome;
+
+#[path = "logbook_read.rs"]
+mod read;
 
 /// Output format of the logbook's answers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum, Default)]
@@ -39,9 +42,14 @@ pub struct LogbookArgs {
 
 #[derive(Debug, Subcommand)]
 enum LogbookCommand {
-    /// Add flight logs (CSV, MCAP, PX4 ULog, ArduPilot DataFlash): each file once, by content.
-    /// Exit 0 when at least one is added or already there, 1 when every one is skipped.
+    /// Add flight logs (CSV, MCAP, PX4 ULog, ArduPilot DataFlash, MAVLink .tlog): each file
+    /// once, by content; a second log of a flight already there (the same vehicle over the same
+    /// time) is recorded as a copy of it, counted once. Exit 0 when at least one is added or
+    /// already there, 1 when every one is skipped.
     Add(AddArgs),
+    /// Rename a vehicle or a pack (its flights follow; the packs keyed by a vehicle's name
+    /// follow the vehicle).
+    Relabel(RelabelArgs),
     /// The flights, in flying order.
     Flights(ListArgs),
     /// Per vehicle: flights, hours, energy, the power of each flight and its drift.
@@ -111,6 +119,28 @@ struct AddArgs {
     format: BookFormat,
 }
 
+/// Which name `relabel` changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum KeyArg {
+    /// A vehicle (as `aloft logbook vehicles` lists it).
+    Vehicle,
+    /// A pack (as `aloft logbook packs` lists it).
+    Pack,
+}
+
+#[derive(Debug, Args)]
+struct RelabelArgs {
+    /// A vehicle or a pack.
+    #[arg(value_enum)]
+    kind: KeyArg,
+    /// Its name now.
+    #[arg(value_name = "OLD")]
+    old: String,
+    /// Its new name: 1 to 200 characters, not "unknown" nor "unknown ..." (aloft's keys).
+    #[arg(value_name = "NEW", value_parser = label)]
+    new: String,
+}
+
 #[derive(Debug, Args)]
 struct ListArgs {
     /// Output format.
@@ -118,16 +148,9 @@ struct ListArgs {
     format: BookFormat,
 }
 
-/// A label: not empty, not "unknown" (the key of logs without one), at most 200 characters.
+/// A label ([`aloft_logbook::check_label`]).
 fn label(s: &str) -> Result<String, String> {
-    let t = s.trim();
-    if t.is_empty() || t.len() > 200 || t == aloft_logbook::UNKNOWN {
-        return Err(format!(
-            "'{s}' is not a label: 1 to 200 characters, not \"{}\"",
-            aloft_logbook::UNKNOWN
-        ));
-    }
-    Ok(t.to_string())
+    aloft_logbook::check_label(s).map_err(|e| e.to_string())
 }
 
 /// The logbook file and whether its folder may be created (only the default's).
@@ -150,7 +173,8 @@ fn db_path(given: Option<PathBuf>) -> Result<(PathBuf, bool)> {
     Ok((data.join("aloft").join("logbook.sqlite"), true))
 }
 
-fn open(given: Option<PathBuf>) -> Result<Logbook> {
+/// The logbook to add to: made when missing (the default's folder too).
+fn open_to_write(given: Option<PathBuf>) -> Result<Logbook> {
     let (path, create_folder) = db_path(given)?;
     if create_folder {
         if let Some(folder) = path.parent() {
@@ -161,29 +185,35 @@ fn open(given: Option<PathBuf>) -> Result<Logbook> {
     Ok(Logbook::open(&path)?)
 }
 
+/// The logbook to list, read-only (a file or folder the user may not write is listed).
+fn open_to_read(given: Option<PathBuf>) -> Result<Logbook> {
+    let (path, _) = db_path(given)?;
+    Ok(Logbook::open_read_only(&path)?)
+}
+
 pub fn run(args: LogbookArgs) -> Result<Outcome> {
-    let mut book = open(args.db)?;
     match args.command {
-        LogbookCommand::Add(a) => add(&mut book, a),
+        LogbookCommand::Add(a) => add(&mut open_to_write(args.db)?, a),
+        LogbookCommand::Relabel(a) => relabel(&mut open_to_write(args.db)?, a),
         LogbookCommand::Flights(a) => {
-            let flights = book.flights()?;
+            let flights = open_to_read(args.db)?.flights()?;
             list(a.format, "flights", &flights, |out| {
                 flights_table(out, &flights)
             })
         }
         LogbookCommand::Vehicles(a) => {
-            let vehicles = book.vehicles()?;
+            let vehicles = open_to_read(args.db)?.vehicles()?;
             list(a.format, "vehicles", &vehicles, |out| {
                 vehicles_table(out, &vehicles)
             })
         }
         LogbookCommand::Packs(a) => {
-            let packs = book.packs()?;
+            let packs = open_to_read(args.db)?.packs()?;
             list(a.format, "packs", &packs, |out| packs_table(out, &packs))
         }
-        LogbookCommand::PackFile(a) => pack_file(&book, a),
+        LogbookCommand::PackFile(a) => pack_file(&open_to_read(args.db)?, a),
         LogbookCommand::Skipped(a) => {
-            let skipped = book.skipped()?;
+            let skipped = open_to_read(args.db)?.skipped()?;
             list(a.format, "skipped", &skipped, |out| {
                 skipped_table(out, &skipped)
             })
@@ -212,7 +242,7 @@ fn list<T: Serialize>(
 #[cfg(feature = "serve")]
 pub(crate) fn answer_json(db: &Path, kind: &str) -> Result<String, String> {
     let text = |e: &dyn std::fmt::Display| e.to_string();
-    let book = Logbook::open(db).map_err(|e| text(&e))?;
+    let book = Logbook::open_read_only(db).map_err(|e| text(&e))?;
     let json = match kind {
         "flights" => serde_json::to_string(&Keyed(kind, &book.flights().map_err(|e| text(&e))?)),
         "vehicles" => serde_json::to_string(&Keyed(kind, &book.vehicles().map_err(|e| text(&e))?)),
@@ -252,6 +282,7 @@ struct FileOutcome {
 struct AddAnswer {
     files: Vec<FileOutcome>,
     added: usize,
+    copies: usize,
     already_present: usize,
     skipped: usize,
 }
@@ -271,7 +302,7 @@ fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
     let mut files = Vec::new();
     let mut out = std::io::stdout().lock();
     for log in &a.logs {
-        let outcome = book.add(log, &labels, &options)?;
+        let outcome = book.add_with(log, &labels, |p| read::read_log(p, &options))?;
         let file = log.display().to_string();
         if a.format == BookFormat::Table {
             writeln!(out, "{}", add_line(&file, &outcome))?;
@@ -281,6 +312,7 @@ fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
     let count = |f: fn(&AddOutcome) -> bool| files.iter().filter(|o| f(&o.outcome)).count();
     let answer = AddAnswer {
         added: count(|o| matches!(o, AddOutcome::Added { .. })),
+        copies: count(|o| matches!(o, AddOutcome::Copy { .. })),
         already_present: count(|o| matches!(o, AddOutcome::AlreadyPresent { .. })),
         skipped: count(|o| matches!(o, AddOutcome::Skipped { .. })),
         files,
@@ -289,8 +321,9 @@ fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
         BookFormat::Json => output::write_json(&mut out, &answer)?,
         BookFormat::Table => writeln!(
             out,
-            "{} added, {} already in the logbook, {} skipped ({})",
+            "{} added, {} copies, {} already in the logbook, {} skipped ({})",
             answer.added,
+            answer.copies,
             answer.already_present,
             answer.skipped,
             book.path().display()
@@ -314,7 +347,32 @@ fn add_line(file: &str, o: &AddOutcome) -> String {
             format!("already in the logbook: {file} (flight {flight_id})")
         }
         AddOutcome::Skipped { reason } => format!("skipped: {file} ({reason})"),
+        AddOutcome::Copy {
+            flight_id,
+            copy_of,
+            vehicle_key,
+            ..
+        } => format!(
+            "copy: {file} (flight {flight_id}, a copy of flight {copy_of}: vehicle {vehicle_key} over the same time; counted once)"
+        ),
     }
+}
+
+fn relabel(book: &mut Logbook, a: RelabelArgs) -> Result<Outcome> {
+    let kind = match a.kind {
+        KeyArg::Vehicle => KeyKind::Vehicle,
+        KeyArg::Pack => KeyKind::Pack,
+    };
+    let n = book.relabel(kind, &a.old, &a.new)?;
+    let flights = if n == 1 { "flight" } else { "flights" };
+    writeln!(
+        std::io::stdout().lock(),
+        "{kind} {:?} is now {:?} ({n} {flights}; {})",
+        a.old,
+        a.new,
+        book.path().display()
+    )?;
+    Ok(Outcome::Ok)
 }
 
 /// An optional figure with `decimals`, `-` when absent.
@@ -366,21 +424,32 @@ fn flights_table(out: &mut impl Write, flights: &[Flight]) -> Result<()> {
                 f.vehicle_key.clone(),
                 f.pack_key.clone(),
                 fixed(f.duration_s / 60.0, 1),
+                opt(f.air_s.map(|s| s / 60.0), 1),
                 fixed(f.energy_wh, 1),
                 opt(f.discharged_mah, 0),
                 opt(f.mean_power_w, 0),
                 opt(f.hover_power_w, 0),
                 opt(f.resistance_ohm.map(|r| r * 1000.0), 1),
+                f.copy_of.map_or_else(|| "-".to_string(), |c| c.to_string()),
             ]
         })
         .collect();
     write_columns(
         out,
         &[
-            "id", "file", "vehicle", "pack", "min", "Wh", "mAh", "mean W", "hover W", "R mOhm",
+            "id", "file", "vehicle", "pack", "min", "air min", "Wh", "mAh", "mean W", "hover W",
+            "R mOhm", "copy of",
         ],
         &rows,
-    )
+    )?;
+    let copies = flights.iter().filter(|f| f.copy_of.is_some()).count();
+    if copies > 0 {
+        writeln!(
+            out,
+            "{copies} of these logs are copies of another log of the same flight (\"copy of\"): counted once"
+        )?;
+    }
+    Ok(())
 }
 
 /// A titled block of label and value lines, both left-aligned (the values are words and
@@ -395,6 +464,14 @@ fn write_block(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> Result<()
     Ok(())
 }
 
+/// Flights, and the copies not counted among them.
+fn flights_and_copies(flights: usize, copies: usize) -> String {
+    match copies {
+        0 => flights.to_string(),
+        c => format!("{flights} (and {c} copies of them, not counted)"),
+    }
+}
+
 fn vehicles_table(out: &mut impl Write, vehicles: &[VehicleSummary]) -> Result<()> {
     if vehicles.is_empty() {
         writeln!(out, "no vehicles in the logbook")?;
@@ -404,12 +481,17 @@ fn vehicles_table(out: &mut impl Write, vehicles: &[VehicleSummary]) -> Result<(
             writeln!(out)?;
         }
         let mut rows = vec![
-            Row::new("flights", v.flights.to_string(), ""),
+            Row::new("flights", flights_and_copies(v.flights, v.copies), ""),
             Row::num("flight time", v.hours, 2, "h"),
+        ];
+        if let Some(h) = v.air_hours {
+            rows.push(Row::num("time in the air", h, 2, "h"));
+        }
+        rows.extend([
             Row::num("energy", v.energy_wh, 1, "Wh"),
             Row::num("charge", v.discharged_mah, 0, "mAh"),
             Row::new("packs", v.packs.join(", "), ""),
-        ];
+        ]);
         if let Some(d) = &v.power_drift {
             let what = if d.quantity == "hover_power_w" {
                 "hover power"
@@ -443,7 +525,7 @@ fn packs_table(out: &mut impl Write, packs: &[PackSummary]) -> Result<()> {
             writeln!(out)?;
         }
         let mut rows = vec![
-            Row::new("flights", p.flights.to_string(), ""),
+            Row::new("flights", flights_and_copies(p.flights, p.copies), ""),
             Row::num("flight time", p.hours, 2, "h"),
             Row::num("discharged", p.discharged_mah, 0, "mAh"),
             Row::num("energy", p.energy_wh, 1, "Wh"),
@@ -528,6 +610,13 @@ fn pack_logs(flights: &[Flight]) -> (Vec<PathBuf>, Vec<String>) {
     let mut logs = Vec::new();
     let mut notes = Vec::new();
     for f in flights {
+        if f.format == "tlog" {
+            notes.push(format!(
+                "{}: left out: a telemetry log (too sparse for `aloft pack fit`'s current steps and rests)",
+                f.file_name
+            ));
+            continue;
+        }
         let Some(path) = f.file_path.as_deref().map(PathBuf::from) else {
             notes.push(format!(
                 "{}: left out: added before the logbook kept where logs are",

@@ -39,6 +39,22 @@ pub enum LinkError {
         /// Bytes read.
         bytes: u64,
     },
+    /// A telemetry log in which the vehicle is never armed: no flight.
+    #[error("{name}: the vehicle is never armed in the telemetry (HEARTBEAT): no flight")]
+    NeverArmed {
+        /// The file.
+        name: String,
+    },
+    /// A telemetry log without two battery records with a voltage while the vehicle is armed
+    /// (SYS_STATUS `voltage_battery` 0, no BATTERY_STATUS cells).
+    #[error(
+        "{name}: no battery voltage in the telemetry while armed (SYS_STATUS voltage 0 or \
+         absent, no BATTERY_STATUS cells): no energy to record"
+    )]
+    NoBatteryVoltage {
+        /// The file.
+        name: String,
+    },
     /// A link address that is not one of the supported forms.
     #[error(
         "{url}: not a link address (udpin:HOST:PORT, udpout:HOST:PORT, tcpout:HOST:PORT or \

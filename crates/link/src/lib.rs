@@ -11,6 +11,8 @@
 //!   skipped and counted ([`TlogStats`]).
 //! - [`Decoder`] ([`decode`]): messages of the vehicle into [`Telemetry`] events; the mission
 //!   assembled from the mission protocol ([`mission`]).
+//! - [`read_tlog_flight`] ([`flight`]): what a telemetry log says of its flight (armed, in the
+//!   air, the energy drawn), for a logbook.
 //! - [`TlogSource`] and [`LinkSource`] ([`source`]): the two as
 //!   [`TelemetrySource`]s; a live link reads on a thread,
 //!   reports silence as [`Event::LinkLost`], answers with
@@ -40,6 +42,7 @@
 
 pub mod decode;
 pub mod error;
+pub mod flight;
 pub mod mission;
 mod modes;
 pub mod request;
@@ -52,6 +55,7 @@ pub use aloft_logs::telemetry::{
 };
 pub use decode::{Decoder, FixStats};
 pub use error::{LinkError, Result};
+pub use flight::{read_tlog_flight, TlogFlight};
 /// The `mavlink` crate aloft-link is built on (its ArduPilot dialect's message types appear in
 /// [`TlogFrame`] and [`Decoder::push`]).
 pub use mavlink;

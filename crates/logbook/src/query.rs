@@ -27,46 +27,67 @@ pub struct Flight {
     /// The pack's key.
     pub pack_key: String,
     /// Start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// First to last battery sample, s.
     pub duration_s: f64,
     /// Energy drawn, Wh.
     pub energy_wh: f64,
     /// Charge drawn, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub discharged_mah: Option<f64>,
     /// Largest current, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_current_a: Option<f64>,
     /// Lowest voltage, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub min_voltage_v: Option<f64>,
     /// Mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_power_w: Option<f64>,
     /// Mean power while hovering, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hover_power_w: Option<f64>,
     /// Cells in series.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cells_series: Option<u32>,
     /// The pack's resistance from current steps, ohm.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resistance_ohm: Option<f64>,
     /// The autopilot's estimate of the pack's resistance, ohm.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub autopilot_resistance_ohm: Option<f64>,
     /// Usable capacity between rested points, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_mah: Option<f64>,
     /// Why no capacity was estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_refusal: Option<String>,
     /// Minutes with a cell more than 0.01 V from the others.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_minor_min: Option<f64>,
     /// Minutes with a cell more than 0.07 V from the others.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_major_min: Option<f64>,
     /// When it was added, Unix time, s.
     pub added_unix_s: i64,
     /// Where the file was when added (absolute); `None` for flights added before version 3.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub file_path: Option<String>,
+    /// The flight this log is another log of (the same vehicle over the same time); `None`
+    /// for a flight of its own. A copy is listed, and counted in no sum.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub copy_of: Option<i64>,
+    /// Time in the air, s (where the log says its landed or armed state).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_s: Option<f64>,
 }
 
 const FLIGHT_COLUMNS: &str = "id, file_sha256, file_name, format, vehicle_key, pack_key,
     start_unix_s, duration_s, energy_wh, discharged_mah, max_current_a, min_voltage_v,
     mean_power_w, hover_power_w, cells_series, resistance_ohm, autopilot_resistance_ohm,
     capacity_mah, capacity_refusal, imbalance_minor_min, imbalance_major_min, added_unix_s,
-    file_path";
+    file_path, copy_of, air_s";
 
 /// Flying order: start time where known (unknown last), then the order of adding.
 const FLYING_ORDER: &str = "ORDER BY start_unix_s IS NULL, start_unix_s, id";
@@ -97,6 +118,8 @@ impl Flight {
             imbalance_major_min: r.get(20)?,
             added_unix_s: r.get(21)?,
             file_path: r.get(22)?,
+            copy_of: r.get(23)?,
+            air_s: r.get(24)?,
         })
     }
 }
@@ -122,9 +145,11 @@ pub struct Trend {
     /// Its value on the last.
     pub last: f64,
     /// Least-squares slope per flight (`None` with fewer than two flights).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub slope_per_flight: Option<f64>,
     /// Change from the line's value at the first flight to its value at the last, percent of
     /// the first (`None` with fewer than three flights).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub change_percent: Option<f64>,
 }
 
@@ -162,10 +187,13 @@ pub struct PowerPoint {
     /// The flight.
     pub flight_id: i64,
     /// Its start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// Its mean power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_power_w: Option<f64>,
     /// Its hover power, W.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub hover_power_w: Option<f64>,
 }
 
@@ -186,20 +214,26 @@ pub struct VehicleSummary {
     pub key: String,
     /// Where the key came from: `log`, `label`, `unknown`.
     pub key_source: String,
-    /// Flights.
+    /// Flights (copies not counted).
     pub flights: usize,
+    /// Logs that are copies of its flights (listed by `flights`, counted in no sum).
+    pub copies: usize,
     /// Flight time (sum of durations), h.
     pub hours: f64,
     /// Energy drawn, Wh.
     pub energy_wh: f64,
     /// Charge drawn, mAh.
     pub discharged_mah: f64,
+    /// Time in the air of the flights whose logs say it, h (`None` when none does).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub air_hours: Option<f64>,
     /// Packs flown.
     pub packs: Vec<String>,
     /// Power per flight, in flying order.
     pub power: Vec<PowerPoint>,
     /// Drift of the power over the last flights (at least two with a power; none for the
     /// vehicle "unknown", whose flights are of any vehicle).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub power_drift: Option<PowerDrift>,
 }
 
@@ -209,6 +243,7 @@ pub struct PackPoint {
     /// The flight.
     pub flight_id: i64,
     /// Its start, Unix time, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// The value (ohm for resistance, mAh for capacity).
     pub value: f64,
@@ -222,11 +257,15 @@ pub struct PackSummary {
     /// Where the key came from: `log`, `label`, `unknown`.
     pub key_source: String,
     /// Rated capacity, mAh.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rated_capacity_mah: Option<f64>,
     /// Cells in series.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cells_series: Option<u32>,
-    /// Flights.
+    /// Flights (copies not counted).
     pub flights: usize,
+    /// Logs that are copies of its flights (counted in no sum).
+    pub copies: usize,
     /// Flight time, h.
     pub hours: f64,
     /// Charge drawn over all flights, mAh.
@@ -234,18 +273,22 @@ pub struct PackSummary {
     /// Energy drawn, Wh.
     pub energy_wh: f64,
     /// Equivalent full cycles: discharged charge / rated charge (`None` without a rating).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub equivalent_cycles: Option<f64>,
     /// Vehicles it flew.
     pub vehicles: Vec<String>,
     /// Resistance per flight, ohm.
     pub resistance: Vec<PackPoint>,
     /// Its trend (slope in ohm per flight; none for the pack "unknown").
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resistance_trend: Option<Trend>,
     /// Capacity estimates, mAh.
     pub capacity: Vec<PackPoint>,
     /// Minutes with a cell more than 0.01 V from the others, over all flights.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_minor_min: Option<f64>,
     /// Minutes with a cell more than 0.07 V from the others, over all flights.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_major_min: Option<f64>,
 }
 
@@ -321,12 +364,12 @@ impl Logbook {
         run().map_err(|e| self.sql(e))
     }
 
-    /// The flights of one pack, in flying order (for its pack file).
+    /// The flights of one pack, in flying order, copies left out (for its pack file).
     ///
     /// # Errors
     /// The database cannot be read.
     pub fn flights_of_pack(&self, key: &str) -> Result<Vec<Flight>> {
-        self.select_flights("WHERE pack_key = ?1", &[key])
+        self.select_flights("WHERE pack_key = ?1 AND copy_of IS NULL", &[key])
     }
 
     /// Every vehicle's history, by key.
@@ -364,8 +407,21 @@ impl Logbook {
     }
 }
 
-/// A vehicle's sums and power history over its flights (in flying order).
-fn vehicle_summary(key: String, key_source: String, flights: &[Flight]) -> VehicleSummary {
+/// The flights of their own and the number of copies among `all`.
+fn originals(all: &[Flight]) -> (Vec<Flight>, usize) {
+    let flights: Vec<Flight> = all
+        .iter()
+        .filter(|f| f.copy_of.is_none())
+        .cloned()
+        .collect();
+    let copies = all.len() - flights.len();
+    (flights, copies)
+}
+
+/// A vehicle's sums and power history over its flights (in flying order), copies left out.
+fn vehicle_summary(key: String, key_source: String, all: &[Flight]) -> VehicleSummary {
+    let (flights, copies) = originals(all);
+    let flights = &flights[..];
     let power: Vec<PowerPoint> = flights
         .iter()
         .map(|f| PowerPoint {
@@ -393,23 +449,27 @@ fn vehicle_summary(key: String, key_source: String, flights: &[Flight]) -> Vehic
         key,
         key_source,
         flights: flights.len(),
+        copies,
         hours: flights.iter().map(|f| f.duration_s).sum::<f64>() / 3600.0,
         energy_wh: flights.iter().map(|f| f.energy_wh).sum(),
         discharged_mah: flights.iter().filter_map(|f| f.discharged_mah).sum(),
+        air_hours: sum_present(flights.iter().map(|f| f.air_s)).map(|s| s / 3600.0),
         packs: distinct(flights.iter().map(|f| &f.pack_key)),
         power,
         power_drift,
     }
 }
 
-/// A pack's sums, cycles and trends over its flights (in flying order).
+/// A pack's sums, cycles and trends over its flights (in flying order), copies left out.
 fn pack_summary(
     key: String,
     key_source: String,
     rated_capacity_mah: Option<f64>,
     cells_series: Option<u32>,
-    flights: &[Flight],
+    all: &[Flight],
 ) -> PackSummary {
+    let (flights, copies) = originals(all);
+    let flights = &flights[..];
     let points = |pick: fn(&Flight) -> Option<f64>| -> Vec<PackPoint> {
         flights
             .iter()
@@ -436,6 +496,7 @@ fn pack_summary(
         rated_capacity_mah,
         cells_series,
         flights: flights.len(),
+        copies,
         hours: flights.iter().map(|f| f.duration_s).sum::<f64>() / 3600.0,
         discharged_mah,
         energy_wh: flights.iter().map(|f| f.energy_wh).sum(),

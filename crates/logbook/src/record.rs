@@ -57,6 +57,12 @@ pub struct FlightFacts {
     pub imbalance_minor_min: Option<f64>,
     /// Minutes with a cell more than 0.07 V from the others.
     pub imbalance_major_min: Option<f64>,
+    /// Time in the air (the log's landed state, or armed and not landed), s; `None` where the
+    /// log says neither.
+    pub air_s: Option<f64>,
+    /// The pack's high voltage: the 95th percentile of its records' (a spike of a few records
+    /// aside), V: the pack's cells where its log does not state them ([`crate::cells_of`]).
+    pub high_voltage_v: Option<f64>,
 }
 
 /// Read the log at `path` into the figures of its flight: the pack's figures from its battery
@@ -67,6 +73,7 @@ pub struct FlightFacts {
 /// Why the log is not a flight of the logbook, in words (the `skipped` table's reason): it
 /// cannot be opened or decoded, or it has fewer than two battery records.
 pub fn read_flight(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
+    refuse_unread(path)?;
     read(path, options).map_err(|reason| {
         // The reason is stored beside the file's name: without the path the readers lead with.
         let prefix = format!("{}: ", path.display());
@@ -75,6 +82,79 @@ pub fn read_flight(path: &Path, options: &ReadOptions) -> Result<FlightFacts, St
             .map_or_else(|| reason.clone(), str::to_string)
     })
 }
+
+/// What the first bytes of a file say it is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogKind {
+    /// PX4 ULog, ArduPilot DataFlash or MCAP (by their magic bytes), or text (a CSV): read by
+    /// [`read_flight`].
+    Readable,
+    /// A MAVLink telemetry log (`.tlog`): a plausible timestamp (µs since 1970, years 2000 to
+    /// 2100, big-endian) and a MAVLink magic byte (`0xFE`, `0xFD`) after it. The logbook takes
+    /// its flight from a reader of MAVLink ([`crate::Logbook::add_with`]).
+    Tlog,
+    /// Anything else (binary, and none of the above).
+    Other,
+}
+
+/// Bytes of a file looked at to say what it is.
+const HEAD_LEN: usize = 4096;
+/// 2000-01-01 and 2100-01-01, µs since 1970 (a `.tlog`'s timestamps).
+const TLOG_TIME_US: std::ops::Range<u64> = 946_684_800_000_000..4_102_444_800_000_000;
+
+/// What the file at `path` is, from its first bytes (`Readable` when it cannot be read: the
+/// reader then says why).
+pub fn log_kind(path: &Path) -> LogKind {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(HEAD_LEN);
+    let read =
+        std::fs::File::open(path).and_then(|f| f.take(HEAD_LEN as u64).read_to_end(&mut head));
+    if read.is_err() || head.is_empty() {
+        return LogKind::Readable;
+    }
+    kind_of(&head)
+}
+
+/// [`log_kind`] of a file's first bytes.
+pub fn kind_of(head: &[u8]) -> LogKind {
+    const MAGIC: [&[u8]; 3] = [b"ULog", &[0xA3, 0x95], b"\x89MCAP"];
+    if MAGIC.iter().any(|m| head.starts_with(m)) {
+        return LogKind::Readable;
+    }
+    if head.len() > 8 && matches!(head[8], 0xFE | 0xFD) {
+        let t = u64::from_be_bytes(head[..8].try_into().unwrap_or_default());
+        if TLOG_TIME_US.contains(&t) {
+            return LogKind::Tlog;
+        }
+    }
+    // Text: UTF-8 (a character cut by the end of the head aside) without NUL.
+    let text = match std::str::from_utf8(head) {
+        Ok(_) => true,
+        Err(e) => e.error_len().is_none(),
+    };
+    if text && !head.contains(&0) {
+        LogKind::Readable
+    } else {
+        LogKind::Other
+    }
+}
+
+/// A file the logbook does not read, refused in words before a reader tries it.
+fn refuse_unread(path: &Path) -> Result<(), String> {
+    match log_kind(path) {
+        LogKind::Readable => Ok(()),
+        LogKind::Tlog => Err(
+            "a MAVLink telemetry log (.tlog): read by aloft's command line (aloft logbook add), \
+             not by this library alone"
+                .to_string(),
+        ),
+        LogKind::Other => Err(NOT_A_LOG.to_string()),
+    }
+}
+
+/// Why a file of no format the logbook reads is skipped.
+pub const NOT_A_LOG: &str = "not a log the logbook reads (PX4 ULog, ArduPilot DataFlash, \
+     MCAP, CSV, MAVLink .tlog)";
 
 fn read(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
     let profile = options
@@ -92,6 +172,8 @@ fn read(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
     };
     let battery = read_battery_log(path, profile.as_ref(), &open).map_err(|e| e.to_string())?;
     let r = analyse(&battery).map_err(|e| e.to_string())?;
+    let high_voltage_v = high_voltage_v(battery.samples.iter().map(|s| s.voltage_v));
+    let (hover_power_w, air_s) = motion_of(path, profile.as_ref(), &open);
     Ok(FlightFacts {
         format: r.format,
         vehicle_id: r.vehicle_id,
@@ -106,22 +188,54 @@ fn read(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
         min_voltage_v: Some(r.min_voltage_v).filter(|v| v.is_finite()),
         mean_power_w: (r.duration_s > 0.0 && r.discharged_mah.is_some())
             .then(|| r.energy_wh * 3600.0 / r.duration_s),
-        hover_power_w: hover_of(path, profile.as_ref(), &open),
+        hover_power_w,
         resistance_ohm: r.internal_resistance_ohm,
         autopilot_resistance_ohm: r.autopilot_internal_resistance_ohm,
         capacity_mah: r.capacity_mah,
         capacity_refusal: r.capacity_refused,
         imbalance_minor_min: r.imbalance_minor_min,
         imbalance_major_min: r.imbalance_major_min,
+        air_s,
+        high_voltage_v,
     })
 }
 
-/// The hover power of the log's samples (`None` when they cannot be read: the battery figures
-/// stand without it).
-fn hover_of(path: &Path, profile: Option<&Profile>, open: &OpenOptions) -> Option<f64> {
-    let mut reader = open_log_with(path, profile, open).ok()?;
-    let log = reader.read_rest(&path.display().to_string()).ok()?;
-    hover_power_w(&log.samples)
+/// The hover power and the time in the air of the log's samples (`None` when they cannot be
+/// read: the battery figures stand without them).
+fn motion_of(
+    path: &Path,
+    profile: Option<&Profile>,
+    open: &OpenOptions,
+) -> (Option<f64>, Option<f64>) {
+    let Some(log) = open_log_with(path, profile, open)
+        .ok()
+        .and_then(|mut reader| reader.read_rest(&path.display().to_string()).ok())
+    else {
+        return (None, None);
+    };
+    (hover_power_w(&log.samples), air_s(&log.samples))
+}
+
+/// The 95th percentile of the finite positive `volts`, V: the pack's high voltage, a spike of
+/// up to one record in twenty aside (one KAIST flight logs 90 V on a 12S pack of 50 V).
+pub fn high_voltage_v(volts: impl Iterator<Item = f64>) -> Option<f64> {
+    let mut v: Vec<f64> = volts.filter(|v| v.is_finite() && *v > 0.0).collect();
+    v.sort_by(f64::total_cmp);
+    let i = (v.len().checked_sub(1)? as f64 * 0.95).floor() as usize;
+    v.get(i).copied()
+}
+
+/// Time in the air: each sample the log says is not landed, weighted by the time to the next
+/// sample; `None` where no sample says the landed state.
+pub fn air_s(samples: &[Sample]) -> Option<f64> {
+    samples.iter().find(|s| s.landed.is_some())?;
+    Some(
+        samples
+            .windows(2)
+            .filter(|w| w[0].landed == Some(false))
+            .map(|w| (w[1].time_s - w[0].time_s).max(0.0))
+            .sum(),
+    )
 }
 
 /// Horizontal ground speed below which a sample is hovering, m/s.

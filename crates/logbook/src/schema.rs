@@ -66,8 +66,16 @@ const V2_TO_V3: &str = "
 ALTER TABLE flights ADD COLUMN file_path TEXT;
 ";
 
+/// Version 3 to 4: a log of a flight already in the logbook is a copy of it (counted once); the
+/// time in the air. From version 4 every file carries aloft's `application_id` (set by every
+/// migration, so versions 1 to 3 are marked as they are brought up to date).
+const V3_TO_V4: &str = "
+ALTER TABLE flights ADD COLUMN copy_of INTEGER REFERENCES flights(id);
+ALTER TABLE flights ADD COLUMN air_s REAL;
+";
+
 /// The schema of each version after 0: `MIGRATIONS[n]` takes a version `n` file to `n + 1`.
-const MIGRATIONS: [&str; 3] = [V1, V1_TO_V2, V2_TO_V3];
+const MIGRATIONS: [&str; 4] = [V1, V1_TO_V2, V2_TO_V3, V3_TO_V4];
 
 /// The schema version this code writes.
 pub const SCHEMA_VERSION: i64 = MIGRATIONS.len() as i64;
@@ -99,7 +107,11 @@ pub(crate) fn migrate(conn: &mut Connection) -> rusqlite::Result<Migrated> {
             return Ok(Migrated::Current);
         };
         tx.execute_batch(step)?;
-        tx.execute_batch(&format!("PRAGMA user_version = {}", v + 1))?;
+        tx.execute_batch(&format!(
+            "PRAGMA user_version = {}; PRAGMA application_id = {}",
+            v + 1,
+            crate::file::APPLICATION_ID
+        ))?;
         tx.commit()?;
     }
 }

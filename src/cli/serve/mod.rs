@@ -183,7 +183,8 @@ fn uploads_folder() -> std::io::Result<tempfile::TempDir> {
 }
 
 /// The logbook of `--logbook`: an existing file, opened once here (so that a file that is not
-/// a logbook stops the server at its start, and an old one is migrated before any request).
+/// a logbook stops the server at its start, and an old one is migrated before any request where
+/// it can be written); read-only, as every request reads it.
 #[cfg(feature = "logbook")]
 fn logbook_of(args: &ServeArgs) -> Result<Option<PathBuf>> {
     let Some(path) = &args.logbook else {
@@ -192,7 +193,7 @@ fn logbook_of(args: &ServeArgs) -> Result<Option<PathBuf>> {
     if !path.is_file() {
         anyhow::bail!("--logbook {}: no such file", path.display());
     }
-    aloft_logbook::Logbook::open(path)?;
+    aloft_logbook::Logbook::open_read_only(path)?;
     Ok(Some(path.clone()))
 }
 
