@@ -11,8 +11,10 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{post, MethodRouter};
 
 use aloft::engine::answers;
-use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
-use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission, Vehicle};
+use aloft::engine::flags::{EnduranceFlags, MissionFlags, MissionScenarioFlags, PlanFlags};
+use aloft::engine::{
+    file_keywords, parse_keywords, FlagGroup, Keyword, Mission, StepMeter, Vehicle,
+};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT, VEHICLE_LIMIT};
 use super::given::Names;
@@ -109,33 +111,41 @@ pub(super) async fn endurance(
 /// The options of a request with a mission as its body: a flag group whose work the server
 /// bounds ([`super::work`]).
 pub(super) trait MissionRequest: FlagGroup + Send + 'static {
-    /// Bound the request's work within the pool's, with the cancellation flag of its client.
-    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>);
+    /// Bound the request's work within the pool's, with the cancellation flag of its client:
+    /// the meter of its flights ([`StepMeter`]), whose verdict is the request's answer.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter;
 
-    /// The vehicle flown: its name in the server's list (see [`flags`]).
-    fn vehicle(&self) -> &str;
+    /// The mission's options.
+    fn mission(&mut self) -> &mut MissionFlags;
 }
 
 impl MissionRequest for MissionScenarioFlags {
-    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) {
+    /// The scenarios within the pool's bound before they fly, the mission's own flights (the
+    /// plan, its sorties) metered as they fly.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter {
         pool.bound(&mut self.scenarios, cancel);
+        let meter = pool.meter(cancel);
+        self.mission.meter = Some(meter.clone());
+        meter
     }
 
-    fn vehicle(&self) -> &str {
-        &self.mission.vehicle
+    fn mission(&mut self) -> &mut MissionFlags {
+        &mut self.mission
     }
 }
 
 impl MissionRequest for PlanFlags {
-    /// A plan has no scenarios: it flies a few candidates (the planner's own limit on each
-    /// flight, at most [`aloft::engine::MAX_SORTIES`] sorties each) and stops before its next
-    /// candidate or survey angle when its client leaves.
-    fn bound(&mut self, _: &Pool, cancel: &Arc<AtomicBool>) {
+    /// A plan has no scenarios: every flight of its search (candidates, sorties, trials, the
+    /// maps of its files) is metered, and none flies on once its client leaves.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter {
         self.bounds.cancel = Some(cancel.clone());
+        let meter = pool.meter(cancel);
+        self.mission.meter = Some(meter.clone());
+        meter
     }
 
-    fn vehicle(&self) -> &str {
-        &self.mission.vehicle
+    fn mission(&mut self) -> &mut MissionFlags {
+        &mut self.mission
     }
 }
 
@@ -171,15 +181,14 @@ async fn planned<T: MissionRequest>(
     let limit_name = "the limit on mission files";
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
     let mut flags: T = flags(request, &query, &shared)?;
-    let vehicle = shared.vehicles.vehicle(request, flags.vehicle())?;
+    let vehicle = shared.vehicles.vehicle(request, &flags.mission().vehicle)?;
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
     let job = move |cancel: &_| {
-        flags.bound(&work.work, cancel);
-        mission_of(&body, &origin)
-            .and_then(|m| answer(&vehicle, &m, &flags))
-            .map_err(engine_message)
+        let meter = flags.bound(&work.work, cancel);
+        let answered = mission_of(&body, &origin).and_then(|m| answer(&vehicle, &m, &flags));
+        meter.verdict(answered).map_err(engine_message)
     };
     Ok(shared.work.run(job).await)
 }
