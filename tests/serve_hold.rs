@@ -6,11 +6,12 @@
 mod common;
 
 use std::io::Write;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
 use common::scratch;
-use common::serve::Server;
+use common::serve::{Answer, Server};
 
 /// The command line's JSON answer (stdout without its final line break).
 fn cli(args: &[&str]) -> String {
@@ -35,6 +36,137 @@ fn long_survey(lines: usize) -> String {
     text.push_str(&return_home(8.0));
     text.push_str(&landing(1.0));
     text
+}
+
+/// A CSP's directives: each name with its sources.
+fn directives(csp: &str) -> Vec<(String, Vec<String>)> {
+    csp.split(';')
+        .filter_map(|d| {
+            let mut words = d.split_whitespace();
+            let name = words.next()?.to_ascii_lowercase();
+            Some((name, words.map(str::to_string).collect()))
+        })
+        .collect()
+}
+
+/// The sources of directive `name` (`None` when the policy does not give it).
+fn sources<'a>(policy: &'a [(String, Vec<String>)], name: &str) -> Option<&'a [String]> {
+    policy
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, s)| s.as_slice())
+}
+
+/// The policy of an answer, checked: no inline script, no plugin, no `<base>`, no framing, and
+/// the page's content type not sniffed.
+fn checked_policy(what: &str, a: &Answer) -> Vec<(String, Vec<String>)> {
+    assert_eq!(
+        a.header("x-content-type-options"),
+        Some("nosniff"),
+        "{what}: {:?}",
+        a.headers
+    );
+    let csp = a
+        .header("content-security-policy")
+        .unwrap_or_else(|| panic!("{what}: no Content-Security-Policy in {:?}", a.headers));
+    let policy = directives(csp);
+    for (name, expected) in [
+        ("default-src", "'self'"),
+        ("script-src", "'self'"),
+        ("object-src", "'none'"),
+        ("base-uri", "'none'"),
+        ("frame-ancestors", "'none'"),
+    ] {
+        assert_eq!(
+            sources(&policy, name),
+            Some([expected.to_string()].as_slice()),
+            "{what}: {name} in {csp}"
+        );
+    }
+    assert!(!csp.contains("unsafe-eval"), "{what}: {csp}");
+    policy
+}
+
+/// Finding 1 (item 2): the page ran a file's name as markup; nothing told the browser that the
+/// page runs no inline script, so any missed spot ran. Every answer, the page's files and the
+/// API's (errors too), carries a Content-Security-Policy that forbids inline script, and
+/// `nosniff`.
+#[test]
+fn every_answer_carries_a_policy_without_inline_script() {
+    let server = Server::start(&[]);
+    let evil_host = "Host: evil.example:80".to_string();
+    let cases: [(&str, &str, Vec<&str>, u16); 10] = [
+        ("GET", "/", vec![], 200),
+        ("GET", "/app.js", vec![], 200),
+        ("GET", "/style.css", vec![], 200),
+        ("GET", "/vendor/leaflet/leaflet.js", vec![], 200),
+        ("GET", "/api/config", vec![], 200),
+        ("GET", "/api/vehicles", vec![], 200),
+        ("POST", "/api/mission", vec![], 200),
+        ("GET", "/no/such.js", vec![], 404),
+        ("GET", "/api/mission", vec![], 405),
+        ("GET", "/", vec![evil_host.as_str()], 403),
+    ];
+    for (method, path, extra, status) in cases {
+        let what = format!("{method} {path} {extra:?}");
+        let a = server.send(method, path, &extra, b"");
+        assert_eq!(a.status, status, "{what}: {}", a.body);
+        let policy = checked_policy(&what, &a);
+        // No tile layer: images are the page's own (and the empty icon, a data: URL).
+        let img = sources(&policy, "img-src").unwrap_or(&[]);
+        assert!(
+            img.iter().all(|s| s == "'self'" || s == "data:"),
+            "{what}: img-src {img:?}"
+        );
+    }
+    // A tile layer's server is the one other place images come from.
+    let tiles = Server::start(&[
+        "--tiles",
+        "https://tiles.example.org/{z}/{x}/{y}.png",
+        "--attribution",
+        "example tiles",
+    ]);
+    let a = tiles.send("GET", "/", &[], b"");
+    let policy = checked_policy("GET / with --tiles", &a);
+    let img = sources(&policy, "img-src").unwrap_or(&[]);
+    assert!(
+        img.contains(&"'self'".to_string())
+            && img.contains(&"https://tiles.example.org".to_string()),
+        "img-src {img:?}"
+    );
+}
+
+/// The page's own files hold no inline script, no inline event handler, and no markup built from
+/// strings (`innerHTML` and its kin): a value reaches the page as text only.
+#[test]
+fn the_page_has_no_inline_script_and_builds_no_markup_from_strings() {
+    let web = Path::new(env!("CARGO_MANIFEST_DIR")).join("web");
+    let html = std::fs::read_to_string(web.join("index.html")).unwrap();
+    let lower = html.to_ascii_lowercase();
+    for (at, _) in lower.match_indices("<script") {
+        let tag = &lower[at..at + lower[at..].find('>').unwrap()];
+        assert!(tag.contains(" src="), "an inline script: {tag}");
+    }
+    // An attribute `on...=` inside a tag.
+    let handler = lower.split('<').skip(1).find_map(|tag| {
+        let tag = tag.split('>').next().unwrap_or("");
+        tag.split_whitespace()
+            .skip(1)
+            .find(|a| a.starts_with("on") && a.contains('='))
+            .map(str::to_string)
+    });
+    assert_eq!(handler, None, "an inline event handler in index.html");
+    let js = std::fs::read_to_string(web.join("app.js")).unwrap();
+    for sink in [
+        "innerHTML",
+        "outerHTML",
+        "insertAdjacentHTML",
+        "document.write",
+        "eval(",
+        "new Function",
+    ] {
+        assert!(!js.contains(sink), "web/app.js uses {sink}");
+    }
 }
 
 /// Finding 6 (item 4): `/api/plan` went on computing after its client left (102 s of CPU for a
@@ -117,4 +249,110 @@ fn a_plan_past_the_step_bound_is_refused_naming_it() {
             |v: &serde_json::Value| v.to_string().replace(&format!("{}/", dir.display()), "");
         assert_eq!(strip(&plan[key]), strip(&cli[key]), "{key}");
     }
+}
+
+/// The longest run of `c` in `text`.
+fn longest_run(text: &str, c: char) -> usize {
+    text.split(|x| x != c).map(str::len).max().unwrap_or(0)
+}
+
+/// Finding 11 (item 11): an error quoted a bad value whole (3,000 characters of it, back to the
+/// page that sent it). Every error quotes at most 80 characters of any value.
+#[test]
+fn errors_quote_at_most_80_characters_of_a_value() {
+    let server = Server::start(&[]);
+    let long = |c: char| c.to_string().repeat(3000);
+    let plan = b"{ not a plan".as_slice();
+    let cases: Vec<(&str, String, &[u8], char, u16)> = vec![
+        (
+            "POST",
+            format!("/api/plan?speeds={}", long('w')),
+            b"",
+            'w',
+            400,
+        ),
+        (
+            "POST",
+            format!("/api/plan?max_speed=1{}", long('0')),
+            b"",
+            '0',
+            400,
+        ),
+        (
+            "POST",
+            format!("/api/plan?overlap_m={}", long('9')),
+            b"",
+            '9',
+            400,
+        ),
+        (
+            "POST",
+            format!("/api/plan?vehicle={}", long('v')),
+            b"",
+            'v',
+            400,
+        ),
+        ("POST", format!("/api/plan?{}=1", long('k')), b"", 'k', 400),
+        (
+            "POST",
+            format!("/api/plan?file={}.plan", long('f')),
+            plan,
+            'f',
+            422,
+        ),
+        (
+            "POST",
+            format!("/api/mission?battery={}", long('b')),
+            b"",
+            'b',
+            422,
+        ),
+        (
+            "GET",
+            format!("/api/endurance?payload_kg={}", long('x')),
+            b"",
+            'x',
+            400,
+        ),
+        ("GET", format!("/{}", long('p')), b"", 'p', 404),
+        ("GET", format!("/api/files/{}", long('n')), b"", 'n', 404),
+        ("GET", format!("/api/logbook/{}", long('l')), b"", 'l', 404),
+        ("PUT", format!("/api/{}", long('m')), b"", 'm', 405),
+    ];
+    for (method, target, body, c, status) in cases {
+        let a = server.send(method, &target, &[], body);
+        let what = format!("{method} {}...", &target[..target.len().min(30)]);
+        assert_eq!(a.status, status, "{what}: {}", a.body);
+        assert!(a.body.starts_with("{\"error\""), "{what}: {}", a.body);
+        let run = longest_run(&a.body, c);
+        assert!(
+            run <= 80,
+            "{what}: {run} characters of the value quoted: {}",
+            a.body
+        );
+    }
+}
+
+/// Finding 11 (item 11): of two `Host` headers the first was checked and the request served; a
+/// proxy or cache may read the other. A request with more than one is 400.
+#[test]
+fn a_request_with_two_host_headers_is_refused() {
+    let server = Server::start(&[]);
+    let own = format!("Host: {}", server.address);
+    for second in [own.clone(), "Host: evil.example:80".to_string()] {
+        let a = server.send(
+            "GET",
+            "/api/vehicles",
+            &[own.as_str(), second.as_str()],
+            b"",
+        );
+        assert_eq!(a.status, 400, "{second}: {}", a.body);
+        assert!(a.body.contains("Host"), "{}", a.body);
+    }
+    assert_eq!(
+        server
+            .send("GET", "/api/vehicles", &[own.as_str()], b"")
+            .status,
+        200
+    );
 }

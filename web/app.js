@@ -1,4 +1,10 @@
 // The page of `aloft serve`: plain JS, no build step. Talks to the JSON API of the same server.
+//
+// Every value from a file, a request or the server goes into the page as text: elements are
+// built with `el`/`svg` (text nodes, `textContent`, attributes), Leaflet's tooltips are given
+// nodes (`tipNode`), never a string (Leaflet parses a string as markup), and the tile layer's
+// attribution is escaped (`escaped`). No markup is built from strings anywhere; the server's
+// Content-Security-Policy (no inline script) holds if a spot is ever missed.
 (function () {
   'use strict';
 
@@ -50,7 +56,8 @@
         if (v === undefined || v === null) continue;
         if (k === 'class') e.className = v;
         else if (k === 'text') e.textContent = v;
-        else if (k.startsWith('data-')) e.setAttribute(k, v);
+        // Through the CSS object model: the page's policy allows no inline style attribute.
+        else if (k === 'style') e.style.cssText = v;
         else e.setAttribute(k, v);
       }
     }
@@ -68,6 +75,46 @@
     }
     if (text !== undefined) e.textContent = text;
     return e;
+  }
+
+  // A tooltip's content: its lines as text nodes (Leaflet puts a node in as it is, where it
+  // would parse a string as markup).
+  function tipNode(...lines) {
+    const box = el('div', { class: 'tip' });
+    lines.forEach((line, k) => {
+      if (k) box.append(el('br'));
+      box.append(String(line));
+    });
+    return box;
+  }
+
+  // `text` with the characters of markup escaped, for the one place a library takes markup and
+  // no node (the tile layer's attribution).
+  function escaped(text) {
+    return String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+  }
+
+  // A name to save a file under: its last path component (whatever the server says), without
+  // control characters, `..` or a leading dot; `fallback` when nothing is left.
+  function safeFileName(name, fallback) {
+    const base = String(name === undefined || name === null ? '' : name).split(/[\\/]/).pop();
+    const clean = base
+      .replace(/[\u0000-\u001f\u007f:*?"<>|]/g, '_')
+      .replace(/\.{2,}/g, '.')
+      .replace(/^[.\s]+/, '')
+      .trim();
+    return clean || fallback;
+  }
+
+  // Names made unique in their order (`name (2).ext` for a second `name.ext`).
+  function uniqueNames(names) {
+    const seen = new Set();
+    return names.map((n) => {
+      let out = n;
+      for (let k = 2; seen.has(out); k++) out = n.replace(/(\.[^.]*)?$/, (ext) => ` (${k})${ext}`);
+      seen.add(out);
+      return out;
+    });
   }
 
   function fmt(x, digits) {
@@ -403,7 +450,8 @@
     if (geo) {
       map = L.map(container, { zoomControl: true });
       L.tileLayer(state.config.tiles, {
-        attribution: state.config.attribution || '',
+        // Leaflet puts an attribution in as markup: the operator's text is shown as text.
+        attribution: escaped(state.config.attribution || ''),
         maxZoom: 19,
       }).addTo(map);
     } else {
@@ -441,7 +489,7 @@
       const bar = L.DomUtil.create('div', 'map-legend-bar', box);
       bar.style.background = `linear-gradient(to right, ${stops.join(', ')})`;
       const labels = L.DomUtil.create('div', 'map-legend-labels', box);
-      labels.innerHTML = '<span>reserve</span><span>battery at leg end</span><span>full</span>';
+      labels.append(...['reserve', 'battery at leg end', 'full'].map((t) => el('span', { text: t })));
       return box;
     };
     return legend;
@@ -478,8 +526,8 @@
         lineJoin: 'round',
       });
       const item = seg.item !== undefined && seg.item !== null ? `item ${seg.item} · ` : '';
-      const tip = `${item}${seg.kind} (segment ${seg.index})` +
-        (ms ? `<br>${fmt(ms.energy_wh, 2)} Wh · battery ${pct(ms.end_soc)} %` : '');
+      const head = `${item}${seg.kind} (segment ${seg.index})`;
+      const tip = ms ? tipNode(head, `${fmt(ms.energy_wh, 2)} Wh · battery ${pct(ms.end_soc)} %`) : tipNode(head);
       line.bindTooltip(tip, { sticky: true });
       line.on('mouseover', () => highlight(seg.index, true));
       line.on('mouseout', () => highlight(seg.index, false));
@@ -491,7 +539,7 @@
     // home
     const home = geo ? [mapAnswer.home.latitude_deg, mapAnswer.home.longitude_deg] : [0, 0];
     L.circleMarker(home, { radius: 7, className: 'home', color: '#1f3b73', weight: 2, fillColor: '#fff', fillOpacity: 1 })
-      .bindTooltip('home')
+      .bindTooltip(tipNode('home'))
       .addTo(state.routeLayer);
     // ends of sorties
     for (const sortie of mission.sorties || []) {
@@ -499,7 +547,7 @@
       if (!latlngs || !latlngs.length) continue;
       const end = latlngs[latlngs.length - 1];
       L.circleMarker(end, { radius: 6, className: 'sortie-end', color: '#333', weight: 2, fillColor: '#ffd54f', fillOpacity: 1 })
-        .bindTooltip(`end of sortie (segment ${sortie.last_segment}): battery ${pct(sortie.end_soc)} %`)
+        .bindTooltip(tipNode(`end of sortie (segment ${sortie.last_segment}): battery ${pct(sortie.end_soc)} %`))
         .addTo(state.routeLayer);
     }
     // point of no return
@@ -507,7 +555,7 @@
     if (pnr) {
       const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
       L.circleMarker(at, { radius: 8, className: 'pnr', color: '#b00020', weight: 3, fillColor: '#fff', fillOpacity: 1 })
-        .bindTooltip(`point of no return: ${duration(pnr.time_s)} (segment ${pnr.segment})`)
+        .bindTooltip(tipNode(`point of no return: ${duration(pnr.time_s)} (segment ${pnr.segment})`))
         .addTo(state.routeLayer);
     }
     map.invalidateSize();
@@ -874,17 +922,20 @@
     return el('ul', { class: 'fly-changes' }, lines);
   }
 
-  // Each file as a download, and all of them in one zip.
+  // Each file as a download, and all of them in one zip: each saved under its base name only,
+  // whatever the server names it (no folder, no `..`: a zip's entry is extracted where it says).
   function flyDownloads(plan) {
     const link = (name, blob, cls) => {
       const url = URL.createObjectURL(blob);
       state.flyUrls.push(url);
       return el('a', { href: url, download: name, class: cls, text: name });
     };
-    const files = (plan.texts || []).map((t) => ({ name: t.file, text: t.text }));
+    const texts = plan.texts || [];
+    const names = uniqueNames(texts.map((t, k) => safeFileName(t.file, `sortie-${k + 1}-of-${texts.length}.txt`)));
+    const files = texts.map((t, k) => ({ name: names[k], text: String(t.text) }));
     const links = files.map((f) => link(f.name, new Blob([f.text], { type: 'text/plain;charset=utf-8' }), 'fly-file'));
     const stem = files.length ? files[0].name.replace(/-1-of-\d+\.[^.]+$/, '') : 'plan';
-    links.push(link(`${stem}-plan.zip`, zipStored(files), 'fly-all'));
+    links.push(link(safeFileName(`${stem}-plan.zip`, 'plan.zip'), zipStored(files), 'fly-all'));
     return el('p', { class: 'fly-downloads' }, ['Files: ', ...links.flatMap((a, k) => (k ? [' ', a] : [a]))]);
   }
 
@@ -911,7 +962,8 @@
           lineJoin: 'round',
         });
         const s = plan.sorties[k];
-        line.bindTooltip(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}<br>${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`, { sticky: true });
+        const tip = tipNode(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}`, `${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`);
+        line.bindTooltip(tip, { sticky: true });
         line.on('mouseover', () => lightSortie(k, true));
         line.on('mouseout', () => lightSortie(k, false));
         line.addTo(state.flyLayer);
@@ -921,7 +973,7 @@
       if (pnr) {
         const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
         L.circleMarker(at, { radius: 5, className: 'fly-pnr', color: colour, weight: 2, fillColor: '#fff', fillOpacity: 1 })
-          .bindTooltip(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`)
+          .bindTooltip(tipNode(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`))
           .addTo(state.flyLayer);
       }
       state.flyLines.push(lines);
@@ -1211,7 +1263,7 @@
     }
     if (!state.liveMarker) {
       state.liveMarker = L.circleMarker(at, { radius: 8, className: 'vehicle', color: '#0d47a1', weight: 3, fillColor: '#42a5f5', fillOpacity: 1 }).addTo(state.liveLayer);
-      state.liveMarker.bindTooltip('vehicle');
+      state.liveMarker.bindTooltip(tipNode('vehicle'));
     } else {
       state.liveMarker.setLatLng(at);
     }
@@ -1235,6 +1287,8 @@
       input.addEventListener('input', replanSoon);
       input.addEventListener('change', replanSoon);
     }
+    // The controls are not a form to send: Enter in a field changes nothing but the field.
+    $('#controls').addEventListener('submit', (e) => e.preventDefault());
     $('#plan-fly').addEventListener('click', () => {
       planToFly();
     });

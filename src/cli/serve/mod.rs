@@ -26,8 +26,12 @@
 //! command line's text; an infeasible mission is an answer (200), and so is a mission no plan
 //! keeps the reserve for (`{"feasible": false, "reason": ...}`, as `aloft plan` answers it).
 //!
-//! Errors, each `{"error": "..."}`: 400 for options the command does not take or a file option
-//! naming no given file, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
+//! Every answer carries a Content-Security-Policy without inline script and `nosniff`
+//! ([`policy`]).
+//!
+//! Errors, each `{"error": "..."}` quoting at most 80 characters of any value ([`quotes`]): 400
+//! for options the command does not take, a file option naming no given file or a request with
+//! two `Host` headers, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
 //! server's, a page of another origin), 404 for anything else, 405 for a method a route does
 //! not take, 408 for a body that stops
 //! arriving, 413 for a body past its limit ([`body`]), 422 for a request the engine refuses (the
@@ -43,6 +47,8 @@ mod files;
 mod given;
 mod guard;
 mod live;
+mod policy;
+mod quotes;
 mod vehicles;
 mod work;
 
@@ -136,6 +142,8 @@ struct Shared {
     vehicles: vehicles::Fleet,
     /// The logbook given with `--logbook`.
     logbook: Option<PathBuf>,
+    /// The Content-Security-Policy of every answer ([`policy`]).
+    policy: HeaderValue,
 }
 
 pub fn run(args: ServeArgs) -> Result<Outcome> {
@@ -144,6 +152,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
             anyhow::bail!("--tiles '{t}': the URL template needs {{z}}, {{x}} and {{y}}");
         }
     }
+    let policy = policy::content_policy(args.tiles.as_deref())?;
     let mut given = given::read_given(&args.files)?;
     given.extend(given::read_vehicles(&args.vehicle, &given)?);
     let default = args.vehicle.first().map_or(DEFAULT_VEHICLE, String::as_str);
@@ -159,6 +168,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         files: given,
         vehicles: fleet,
         logbook,
+        policy,
     };
     let served = runtime.block_on(serve(args, state, uploads.path().to_path_buf()));
     // Work still running for clients that have gone is not waited for; the uploads' folder is
@@ -206,6 +216,7 @@ struct AtStart {
     files: Vec<given::Given>,
     vehicles: vehicles::Fleet,
     logbook: Option<PathBuf>,
+    policy: HeaderValue,
 }
 
 async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> {
@@ -224,6 +235,7 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
         work: work::Pool::new(args.max_request_steps),
         vehicles: given.vehicles,
         logbook: given.logbook,
+        policy: given.policy,
     });
     let app = router(shared);
     let mut out = std::io::stdout().lock();
@@ -259,6 +271,11 @@ fn router(shared: Arc<Shared>) -> Router {
         .fallback(get(assets::asset).fallback(not_allowed))
         .method_not_allowed_fallback(not_allowed)
         .layer(middleware::from_fn_with_state(shared.clone(), guard::check))
+        .layer(middleware::from_fn(quotes::shortened_errors))
+        .layer(middleware::from_fn_with_state(
+            shared.clone(),
+            policy::headers,
+        ))
         .with_state(shared)
 }
 
