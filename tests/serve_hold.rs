@@ -5,13 +5,14 @@
 
 mod common;
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
-use common::scratch;
 use common::serve::{Answer, Server};
+use common::{fixture, scratch};
 
 /// The command line's JSON answer (stdout without its final line break).
 fn cli(args: &[&str]) -> String {
@@ -249,6 +250,123 @@ fn a_plan_past_the_step_bound_is_refused_naming_it() {
             |v: &serde_json::Value| v.to_string().replace(&format!("{}/", dir.display()), "");
         assert_eq!(strip(&plan[key]), strip(&cli[key]), "{key}");
     }
+}
+
+/// The M100's vehicle file, renamed `name`.
+fn renamed_m100(name: &str) -> String {
+    let text = std::fs::read_to_string(fixture("vehicles", "dji-m100.toml")).unwrap();
+    let quoted = serde_json::to_string(name).unwrap();
+    let text = text.replacen("name = \"dji-m100\"", &format!("name = {quoted}"), 1);
+    assert!(text.contains(&quoted));
+    text
+}
+
+/// The names of `GET /api/vehicles`.
+fn listed(server: &Server) -> Vec<String> {
+    let (code, body) = server.get("/api/vehicles");
+    assert_eq!(code, 200);
+    let list: serde_json::Value = serde_json::from_str(&body).unwrap();
+    common::strs_of(&list, "name")
+        .into_iter()
+        .map(str::to_string)
+        .collect()
+}
+
+/// Finding 11 (item 11): names that look like a built-in's or a given vehicle's (another case,
+/// a space before or after, U+2010 HYPHEN for `-`, a zero width space, a right-to-left override
+/// that shows `dji-m100` backwards) were kept beside it, so that the page listed two vehicles
+/// that read the same. They clash, or are refused; a vehicle sent under its own name again
+/// replaces it.
+#[test]
+fn look_alike_vehicle_names_clash_or_are_refused() {
+    let given = scratch("serve-hold", "my-quad.toml");
+    std::fs::write(&given, renamed_m100("my-quad")).unwrap();
+    let server = Server::start(&["--vehicle", given.to_str().unwrap()]);
+    let before = listed(&server);
+    assert!(before.iter().any(|n| n == "my-quad"), "{before:?}");
+    let send = |name: &str| {
+        server.request(
+            "POST",
+            "/api/vehicles?file=sent.toml",
+            None,
+            renamed_m100(name).as_bytes(),
+        )
+    };
+    for name in [
+        "DJI-M100",
+        "dji-m100 ",
+        " dji-m100",
+        "dji\u{2010}m100",
+        "dji-m\u{200B}100",
+        "\u{202E}001m-ijd",
+        "My-Quad",
+        "my-quad\u{00A0}",
+        "my\u{2010}quad",
+        "my-\u{200B}quad",
+        "quad\u{200E}",
+        "\u{FF4D}y-quad",
+    ] {
+        let (code, body) = send(name);
+        assert_eq!(code, 422, "{name:?}: {body}");
+        assert!(body.contains("sent.toml"), "{name:?}: {body}");
+    }
+    assert_eq!(listed(&server), before);
+    // Sent ones keep to the rule among themselves; the same name again replaces the vehicle.
+    assert_eq!(send("Field-Quad").0, 200);
+    let (code, body) = send("field-quad");
+    assert_eq!(code, 422, "{body}");
+    assert_eq!(send("Field-Quad").0, 200);
+    let names = listed(&server);
+    assert_eq!(names.len(), before.len() + 1, "{names:?}");
+
+    // The files given on the command line keep the same rules: a name that looks like a
+    // built-in's is listed under the name the file was given with, as the built-in's own name
+    // is; a name no vehicle may have stops the server at its start.
+    let upper = scratch("serve-hold", "upper.toml");
+    std::fs::write(&upper, renamed_m100("DJI-M100")).unwrap();
+    let server = Server::start(&["--vehicle", upper.to_str().unwrap()]);
+    let names = listed(&server);
+    assert!(
+        !names.iter().any(|n| n == "DJI-M100")
+            && names.iter().any(|n| n == upper.to_str().unwrap()),
+        "{names:?}"
+    );
+    for (file, name) in [("zwsp.toml", "my-\u{200B}quad"), ("space.toml", "my-quad ")] {
+        let path = scratch("serve-hold", file);
+        std::fs::write(&path, renamed_m100(name)).unwrap();
+        let (code, err) = start_outcome(&["--vehicle", path.to_str().unwrap()]);
+        assert_eq!(code, Some(2), "{name:?}: {err}");
+        assert!(err.contains(file) && err.lines().count() == 1, "{err}");
+    }
+}
+
+/// `aloft serve --listen 127.0.0.1:0 ARGS`: its exit code and stderr when it ends within 10 s,
+/// else `None` (a server that started) and it is stopped.
+fn start_outcome(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(["serve", "--listen", "127.0.0.1:0"])
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while started.elapsed() < Duration::from_secs(10) {
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut err = String::new();
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
+            return (status.code(), err);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    (None, "still serving after 10 s".to_string())
 }
 
 /// The longest run of `c` in `text`.
