@@ -6,7 +6,7 @@
 mod common;
 
 use std::io::{Read, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -473,4 +473,80 @@ fn a_request_with_two_host_headers_is_refused() {
             .status,
         200
     );
+}
+
+/// A pack file of the user's (a 6S 5700 mAh pack named `served`, its failsafes set).
+fn pack_file() -> PathBuf {
+    let pack = scratch("serve-hold", "served.toml");
+    std::fs::write(
+        &pack,
+        "[battery]\nname = \"served\"\ncells_series = 6\ncapacity_mah = 5700.0\nnominal_v = 22.8\n\
+         energy_wh = 129.96\nmass_kg = 0.676\ninternal_resistance_ohm = 0.04\ncutoff_cell_v = 3.0\n\
+         \n[failsafe]\nlow_voltage_v = 21.0\ncritical_voltage_v = 20.4\n",
+    )
+    .unwrap();
+    pack
+}
+
+/// Finding 10 (item 10): `serve --battery pack.toml` was ignored (the page flew the vehicle's
+/// own pack). The server's default vehicle flies the pack given, as `aloft mission --battery`
+/// does; a value that is neither one of its packs nor a pack file stops the server at its start.
+#[test]
+fn serve_battery_flies_that_pack_or_is_refused() {
+    let pack = pack_file();
+    let pack_s = pack.to_str().unwrap();
+    let server = Server::start(&["--battery", pack_s]);
+    let (code, body) = server.request("POST", "/api/mission", None, b"");
+    assert_eq!(code, 200, "{body}");
+    let answer: serde_json::Value = serde_json::from_str(&body).unwrap();
+    assert_eq!(answer["battery"], "served", "{body}");
+    assert_eq!(
+        body,
+        cli(&["mission", "--battery", pack_s, "--format", "json"])
+    );
+    let (_, endurance) = server.get("/api/endurance");
+    assert_eq!(
+        endurance,
+        cli(&["endurance", "--battery", pack_s, "--format", "json"])
+    );
+    let config: serde_json::Value = serde_json::from_str(&server.get("/api/config").1).unwrap();
+    assert_eq!(config["default_battery"], "served", "{config}");
+    let (_, vehicles) = server.get("/api/vehicles");
+    let vehicles: serde_json::Value = serde_json::from_str(&vehicles).unwrap();
+    let m100 = vehicles
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|v| v["name"] == "dji-m100")
+        .unwrap();
+    assert!(
+        m100["batteries"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|b| b == "served"),
+        "{m100}"
+    );
+    // Another vehicle asked for by name flies its own pack.
+    let (_, inspire) = server.request("POST", "/api/mission?vehicle=dji-inspire1", None, b"");
+    assert_eq!(
+        inspire,
+        cli(&["mission", "--vehicle", "dji-inspire1", "--format", "json"])
+    );
+    drop(server);
+
+    // A pack of the vehicle's, by name.
+    let server = Server::start(&["--battery", "TB48D"]);
+    let (_, body) = server.request("POST", "/api/mission", None, b"");
+    assert_eq!(
+        body,
+        cli(&["mission", "--battery", "TB48D", "--format", "json"])
+    );
+    drop(server);
+
+    for bad in ["no-such-pack", "/no/such/pack.toml"] {
+        let (code, err) = start_outcome(&["--battery", bad]);
+        assert_eq!(code, Some(2), "--battery {bad}: {err}");
+        assert!(err.contains(bad) && err.lines().count() == 1, "{err}");
+    }
 }

@@ -1097,8 +1097,11 @@
     const packs = vehicle ? vehicle.batteries : [];
     const current = select.value;
     const have = [...select.options].slice(1).map((o) => o.value);
-    if (have.join('|') !== packs.join('|')) {
-      select.replaceChildren(el('option', { value: '', text: 'default' }), ...packs.map((b) => el('option', { value: b, text: b })));
+    // The server's pack for its default vehicle (`aloft serve --battery`), else the vehicle's.
+    const own = name === state.config.default_vehicle && state.config.default_battery;
+    const label = own ? `default (${state.config.default_battery})` : 'default';
+    if (have.join('|') !== packs.join('|') || select.options[0].textContent !== label) {
+      select.replaceChildren(el('option', { value: '', text: label }), ...packs.map((b) => el('option', { value: b, text: b })));
       select.value = packs.includes(current) ? current : '';
     }
   }

@@ -18,6 +18,7 @@ use aloft::engine::{
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT, VEHICLE_LIMIT};
 use super::given::Names;
+use super::vehicles::Fleet;
 use super::work::Pool;
 use super::{engine_message, error, json_type, Refused, Shared};
 
@@ -39,6 +40,13 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
         "logbook": shared.logbook.is_some(),
         "default_vehicle": shared.vehicles.default_name(),
     });
+    let fleet = &shared.vehicles;
+    if let (Some(pack), Some(c)) = (
+        fleet.default_pack(fleet.default_name()),
+        config.as_object_mut(),
+    ) {
+        c.insert("default_battery".into(), pack.name.as_str().into());
+    }
     if let (Some((url, attribution)), Some(c)) = (&shared.tiles, config.as_object_mut()) {
         c.insert("tiles".into(), url.as_str().into());
         c.insert("attribution".into(), attribution.as_str().into());
@@ -100,6 +108,9 @@ pub(super) async fn endurance(
     let request = "GET /api/endurance";
     let mut flags: EnduranceFlags = flags(request, &query, &shared)?;
     let vehicle = shared.vehicles.vehicle(request, &flags.vehicle)?;
+    if let Some(pack) = shared.vehicles.default_pack(&flags.vehicle) {
+        flags.battery.get_or_insert_with(|| pack.name.clone());
+    }
     let work = shared.clone();
     let job = move |cancel: &_| {
         work.work.bound(&mut flags.scenarios, cancel);
@@ -182,6 +193,7 @@ async fn planned<T: MissionRequest>(
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
     let mut flags: T = flags(request, &query, &shared)?;
     let vehicle = shared.vehicles.vehicle(request, &flags.mission().vehicle)?;
+    with_default_pack(&shared.vehicles, flags.mission());
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
@@ -191,6 +203,22 @@ async fn planned<T: MissionRequest>(
         meter.verdict(answered).map_err(engine_message)
     };
     Ok(shared.work.run(job).await)
+}
+
+/// A request that flies the default vehicle and names no pack flies the pack of `--battery`,
+/// with a pack file's failsafes where the request gives none (as `aloft mission --battery FILE`).
+fn with_default_pack(fleet: &Fleet, mission: &mut MissionFlags) {
+    let Some(pack) = fleet.default_pack(&mission.vehicle) else {
+        return;
+    };
+    if mission.battery.is_some() {
+        return;
+    }
+    mission.battery = Some(pack.name.clone());
+    if let Some(f) = &pack.failsafe {
+        mission.low_voltage_v = mission.low_voltage_v.or(f.low_voltage_v);
+        mission.critical_voltage_v = mission.critical_voltage_v.or(f.critical_voltage_v);
+    }
 }
 
 /// The mission of an upload: the built-in demo when empty, else the file's text in any of the

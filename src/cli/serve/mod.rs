@@ -4,7 +4,7 @@
 //! | request | answer |
 //! |---|---|
 //! | `GET /` | the page (its files built into the binary: [`assets`]) |
-//! | `GET /api/config` | the files given on the command line, the default vehicle (`default_vehicle`: the first `--vehicle`), the tile layer, whether a flight is followed |
+//! | `GET /api/config` | the files given on the command line, the default vehicle (`default_vehicle`: the first `--vehicle`) and its pack when `--battery` gives one (`default_battery`), the tile layer, whether a flight is followed |
 //! | `GET /api/vehicles` | `aloft vehicles --format json`, then the entries of the vehicle files given (`--vehicle FILE...` and positionally) and sent ([`vehicles`]) |
 //! | `POST /api/vehicles?file=NAME` (body: a vehicle file, at most 256 KiB) | the vehicle kept in memory under its own name (no built-in's nor given vehicle's: 422), answered with its entry of `/api/vehicles`; at most 32 kept, the oldest forgotten |
 //! | `GET /api/endurance?OPTIONS` | `aloft endurance OPTIONS --format json` |
@@ -112,8 +112,11 @@ pub struct ServeArgs {
     /// Takes several values: give missions and logs before it.
     #[arg(long, value_name = "NAME|FILE", num_args = 1..)]
     vehicle: Vec<String>,
-    /// Its battery pack (default: the vehicle's first).
-    #[arg(long)]
+    /// The default vehicle's pack (the first `--vehicle`'s): one of its packs by name, or a
+    /// pack file (`aloft pack fit`, `aloft logbook pack-file`) flown as `aloft mission --battery
+    /// FILE` flies it. Requests that fly that vehicle and name no pack fly it, and so does
+    /// `--live` / `--tlog` (default: the vehicle's own default pack).
+    #[arg(long, value_name = "NAME|FILE")]
     battery: Option<String>,
     /// A logbook (`aloft logbook --db FILE`) whose vehicles' and packs' histories the page
     /// charts. Only this file: a request never names a logbook.
@@ -156,7 +159,10 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
     let mut given = given::read_given(&args.files)?;
     given.extend(given::read_vehicles(&args.vehicle, &given)?);
     let default = args.vehicle.first().map_or(DEFAULT_VEHICLE, String::as_str);
-    let fleet = vehicles::Fleet::new(&given::vehicles_of(&given), default)?;
+    let mut fleet = vehicles::Fleet::new(&given::vehicles_of(&given), default)?;
+    if let Some(battery) = &args.battery {
+        fleet.fly_default_with(battery)?;
+    }
     let logbook = logbook_of(&args)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -224,7 +230,11 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;
     let local = listener.local_addr()?;
-    let live = live::start(&args, given.vehicles.default_vehicle())?;
+    let fleet = &given.vehicles;
+    let pack = fleet
+        .default_pack(fleet.default_name())
+        .map(|p| p.name.clone());
+    let live = live::start(&args, fleet.default_vehicle(), pack)?;
     let shared = Arc::new(Shared {
         hosts: guard::Hosts::new(local),
         files: given.files,

@@ -29,7 +29,7 @@ use std::sync::{Arc, Mutex};
 use anyhow::{Context, Result};
 use axum::http::StatusCode;
 
-use aloft::engine::{answers, list_vehicles, Vehicle, VehicleEntry};
+use aloft::engine::{answers, fly_with_battery, list_vehicles, Failsafe, Vehicle, VehicleEntry};
 
 use super::{engine_message, error, Refused};
 
@@ -73,6 +73,17 @@ pub(super) struct Fleet {
     sent: Mutex<VecDeque<Listed>>,
     /// The vehicle a request flies when it names none (the first `--vehicle`).
     default: Listed,
+    /// The pack of `--battery`, flown by the default vehicle when a request names none.
+    default_pack: Option<DefaultPack>,
+}
+
+/// The pack of `aloft serve --battery`.
+#[derive(Debug, Clone)]
+pub(super) struct DefaultPack {
+    /// Its name among the default vehicle's packs.
+    pub(super) name: String,
+    /// A pack file's failsafes (the options' own come first).
+    pub(super) failsafe: Option<Failsafe>,
 }
 
 impl Fleet {
@@ -97,6 +108,7 @@ impl Fleet {
             builtins,
             given: Vec::new(),
             sent: Mutex::new(VecDeque::new()),
+            default_pack: None,
         };
         for (given_as, vehicle) in files {
             if let Some(why) = name_fault(vehicle.name()) {
@@ -165,6 +177,53 @@ impl Fleet {
     /// The name in the list of the vehicle of requests that name none.
     pub(super) fn default_name(&self) -> &str {
         self.default.name()
+    }
+
+    /// Fly the default vehicle with `battery` (`aloft serve --battery`): one of its packs by
+    /// name, or a pack file added to its packs (replacing one of the same name), as the command
+    /// line's `--battery` flies it ([`fly_with_battery`]). Requests that fly the default vehicle
+    /// and name no pack fly it ([`Self::default_pack`]); its entry in the list names it.
+    ///
+    /// # Errors
+    /// A value that is neither a pack of the vehicle's nor a pack file it can fly, named.
+    pub(super) fn fly_default_with(&mut self, battery: &str) -> Result<()> {
+        let vehicle = self.default.vehicle.as_ref().clone();
+        let flying = fly_with_battery(vehicle, Some(battery))
+            .map_err(|e| anyhow::anyhow!("--battery {battery}: {}", engine_message(e)))?;
+        let name = flying
+            .battery
+            .clone()
+            .unwrap_or_else(|| battery.to_string());
+        if let Err(e) = flying.vehicle.battery(Some(&name)) {
+            anyhow::bail!(
+                "--battery {battery}: neither a pack of {} nor a pack file: {}",
+                self.default.name(),
+                engine_message(e)
+            );
+        }
+        let listed_as = self.default.name().to_string();
+        let mut entry = flying.vehicle.entry()?;
+        entry.name.clone_from(&listed_as);
+        let vehicle = Arc::new(flying.vehicle);
+        let same = |l: &&mut Listed| l.name() == listed_as;
+        for l in self.builtins.iter_mut().chain(&mut self.given).filter(same) {
+            l.vehicle = vehicle.clone();
+            l.entry = entry.clone();
+        }
+        self.default.vehicle = vehicle;
+        self.default.entry = entry;
+        self.default_pack = Some(DefaultPack {
+            name,
+            failsafe: flying.failsafe,
+        });
+        Ok(())
+    }
+
+    /// The pack of `--battery` when `vehicle` (a name in the list) is the default vehicle.
+    pub(super) fn default_pack(&self, vehicle: &str) -> Option<&DefaultPack> {
+        self.default_pack
+            .as_ref()
+            .filter(|_| vehicle == self.default.name())
     }
 
     /// The vehicle of requests that name none, and the one `--live` / `--tlog` follow.
