@@ -1283,6 +1283,7 @@
     $('#vehicle').addEventListener('change', () => {
       syncBatteries(state.plan && state.plan.mission);
       $('#battery').value = '';
+      followInLogbook();
       replanSoon();
     });
     for (const id of ['#battery', '#payload', '#wind-speed', '#wind-from', '#reserve', '#elevation', '#temperature', '#samples']) {
@@ -1333,8 +1334,12 @@
 
   // ---------------------------------------------------------------- logbook
 
-  // One series of a history chart: a line through its points and a dot on each, x the flight's
-  // place in the vehicle's or pack's flights (1, 2, ...).
+  // The logbook's lists (`/api/logbook/vehicles`, `/api/logbook/packs`).
+  const logbook = { vehicles: [], packs: [] };
+
+  // A history chart: each series its own line through its points and a dot on each (a line never
+  // joins two series: two packs are two lines), x the flight's place in the series' own flights
+  // (1, 2, ...); a legend names the series. A series is coloured by its class, or by `colour`.
   function historyChart(container, label, yLabel, series) {
     const all = series.flatMap((s) => s.values.filter(Number.isFinite));
     const n = Math.max(1, ...series.map((s) => s.values.length));
@@ -1346,16 +1351,27 @@
     const hi = Math.max(...all);
     const pad = (hi - lo) * 0.1 || Math.abs(hi) * 0.1 || 1;
     const f = frame(container, { label, x0: 1, x1: Math.max(2, n), y0: lo - pad, y1: hi + pad, xLabel: 'flight', yLabel });
+    const paint = (e, s, fill) => {
+      if (s.colour) e.style[fill ? 'fill' : 'stroke'] = s.colour;
+      return e;
+    };
     for (const s of series) {
       const xs = s.values.map((_, i) => i + 1);
-      f.plot.append(svg('polyline', { points: points(xs, s.values, f.x, f.y).join(' '), class: s.cls }));
+      f.plot.append(paint(svg('polyline', { points: points(xs, s.values, f.x, f.y).join(' '), class: s.cls }), s, false));
       s.values.forEach((v, i) => {
         if (!Number.isFinite(v)) return;
-        const dot = svg('circle', { cx: f.x(i + 1), cy: f.y(v), r: 3, class: s.cls });
+        const dot = paint(svg('circle', { cx: f.x(i + 1), cy: f.y(v), r: 3, class: s.cls }), s, true);
         dot.append(svg('title', {}, `flight ${i + 1}, ${s.name}: ${fmt(v, 1)}`));
         f.plot.append(dot);
       });
     }
+    const legend = svg('g', { class: 'legend history-legend', transform: `translate(${f.m.l + 10}, ${f.m.t + 12})` });
+    series.forEach((s, k) => {
+      const y = k * 14;
+      legend.append(paint(svg('line', { x1: 0, x2: 16, y1: y - 3, y2: y - 3, class: s.cls }), s, false));
+      legend.append(svg('text', { x: 20, y: y + 1 }, s.name));
+    });
+    f.plot.append(legend);
   }
 
   function renderLogbookVehicle(v) {
@@ -1363,37 +1379,89 @@
       ? `; ${v.power_drift.quantity === 'hover_power_w' ? 'hover' : 'mean'} power ${v.power_drift.trend.change_percent >= 0 ? '+' : ''}${fmt(v.power_drift.trend.change_percent, 1)} % over the last ${v.power_drift.trend.n} flights`
       : '';
     $('#logbook-vehicle-summary').textContent = `${v.key}: ${v.flights} flights, ${fmt(v.hours, 2)} h, ${fmt(v.energy_wh, 1)} Wh${drift}`;
-    const num = (x) => (x == null ? NaN : x);
+    const num = (x) => (typeof x === 'number' ? x : NaN);
     historyChart($('#logbook-vehicle-chart'), `power per flight of ${v.key}`, 'power (W)', [
       { name: 'mean power', cls: 'mean-power', values: v.power.map((p) => num(p.mean_power_w)) },
       { name: 'hover power', cls: 'hover-power', values: v.power.map((p) => num(p.hover_power_w)) },
     ]);
   }
 
+  // The pack's summary, and the resistance of each pack of the chosen vehicle (and of this pack),
+  // one line each, this one drawn over the others.
   function renderLogbookPack(p) {
-    const cycles = p.equivalent_cycles == null ? 'cycles n/a (no rated capacity)' : `${fmt(p.equivalent_cycles, 2)} equivalent cycles`;
+    const cycles = typeof p.equivalent_cycles !== 'number' ? 'cycles n/a (no rated capacity)' : `${fmt(p.equivalent_cycles, 2)} equivalent cycles`;
     const t = p.resistance_trend;
     const trend = t ? `; resistance ${fmt(t.first * 1000, 1)} to ${fmt(t.last * 1000, 1)} mOhm over ${t.n} flights` : '';
     $('#logbook-pack-summary').textContent = `${p.key}: ${p.flights} flights, ${fmt(p.discharged_mah, 0)} mAh, ${cycles}${trend}`;
-    historyChart($('#logbook-pack-chart'), `resistance per flight of ${p.key}`, 'resistance (mOhm)', [
-      { name: 'resistance', cls: 'resistance', values: p.resistance.map((r) => r.value * 1000) },
-    ]);
+    const vehicle = logbook.vehicles[Number($('#logbook-vehicle').value)];
+    const keys = ((vehicle && vehicle.packs) || []).filter((k) => k !== p.key);
+    const others = logbook.packs.filter((q) => keys.includes(q.key));
+    const series = others.concat([p]).map((q, k) => ({
+      name: q.key,
+      cls: q === p ? 'resistance selected' : 'resistance other',
+      colour: q === p ? undefined : SORTIE_COLOURS[k % SORTIE_COLOURS.length],
+      values: (q.resistance || []).map((r) => r.value * 1000),
+    }));
+    historyChart($('#logbook-pack-chart'), `resistance per flight of ${p.key}`, 'resistance (mOhm)', series);
   }
 
-  function fillLogbookSelect(select, items, render) {
+  // The logbook's vehicle the page opens on: the one the page flies (its name, in any case),
+  // else the one with the latest flight, else the first with a key of its own (the flights of
+  // "unknown" are of any vehicle).
+  function openingVehicle(vehicles) {
+    const flown = String($('#vehicle').value || state.config.default_vehicle || '').trim().toLowerCase();
+    const same = vehicles.findIndex((v) => String(v.key).trim().toLowerCase() === flown);
+    if (same >= 0) return same;
+    const latest = (v) => Math.max(-Infinity, ...(v.power || []).map((p) => (typeof p.start_unix_s === 'number' ? p.start_unix_s : -Infinity)));
+    let best = -1;
+    vehicles.forEach((v, i) => {
+      if (latest(v) > (best >= 0 ? latest(vehicles[best]) : -Infinity)) best = i;
+    });
+    return best >= 0 ? best : Math.max(0, vehicles.findIndex((v) => v.key !== 'unknown'));
+  }
+
+  // The pack the panel opens on for vehicle `v`: its first pack in the logbook, else the first
+  // with a key of its own.
+  function openingPack(v, packs) {
+    const own = packs.findIndex((p) => v && (v.packs || []).includes(p.key));
+    return own >= 0 ? own : Math.max(0, packs.findIndex((p) => p.key !== 'unknown'));
+  }
+
+  function fillLogbookSelect(select, items) {
     select.replaceChildren(...items.map((x, i) => el('option', { value: String(i) }, [`${x.key} (${x.flights} flights)`])));
-    select.onchange = () => render(items[Number(select.value)]);
-    // The first with a key of its own (the flights of "unknown" are of any vehicle or pack).
-    const first = Math.max(0, items.findIndex((x) => x.key !== 'unknown'));
-    select.value = String(first);
-    if (items.length) render(items[first]);
+  }
+
+  // Show vehicle `i` of the logbook, and the pack it opens on.
+  function showLogbookVehicle(i) {
+    const v = logbook.vehicles[i];
+    $('#logbook-vehicle').value = String(i);
+    if (v) renderLogbookVehicle(v);
+    const k = openingPack(v, logbook.packs);
+    $('#logbook-pack').value = String(k);
+    if (logbook.packs[k]) renderLogbookPack(logbook.packs[k]);
+  }
+
+  // The logbook's panel follows the vehicle chosen on the page when the logbook has it.
+  function followInLogbook() {
+    if (!logbook.vehicles.length) return;
+    const flown = String($('#vehicle').value).trim().toLowerCase();
+    const i = logbook.vehicles.findIndex((v) => String(v.key).trim().toLowerCase() === flown);
+    if (i >= 0) showLogbookVehicle(i);
   }
 
   async function loadLogbook() {
     const [vehicles, packs] = await Promise.all([api('/api/logbook/vehicles'), api('/api/logbook/packs')]);
+    logbook.vehicles = vehicles.vehicles || [];
+    logbook.packs = packs.packs || [];
     $('#logbook-panel').hidden = false;
-    fillLogbookSelect($('#logbook-vehicle'), vehicles.vehicles, renderLogbookVehicle);
-    fillLogbookSelect($('#logbook-pack'), packs.packs, renderLogbookPack);
+    fillLogbookSelect($('#logbook-vehicle'), logbook.vehicles);
+    fillLogbookSelect($('#logbook-pack'), logbook.packs);
+    $('#logbook-vehicle').onchange = () => showLogbookVehicle(Number($('#logbook-vehicle').value));
+    $('#logbook-pack').onchange = () => {
+      const p = logbook.packs[Number($('#logbook-pack').value)];
+      if (p) renderLogbookPack(p);
+    };
+    showLogbookVehicle(openingVehicle(logbook.vehicles));
   }
 
   async function start() {

@@ -301,8 +301,8 @@ async function main() {
     executablePath: CHROMIUM,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
   });
-  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup.
-  const only = { markup: markupEverywhere }[process.env.ALOFT_BROWSER_ONLY];
+  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup or =logbook.
+  const only = { markup: markupEverywhere, logbook: logbookPanel }[process.env.ALOFT_BROWSER_ONLY];
   if (only) {
     await only();
     await noProblems();
@@ -680,64 +680,8 @@ async function main() {
     doc.stop();
   }
 
-  // --- 9: the logbook's histories (`aloft serve --logbook FILE`): a logbook written by
-  // `aloft logbook add`, its lists served as the CLI's JSON, a vehicle's and a pack's charts.
-  const bookDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-logbook-'));
-  const book = path.join(bookDir, 'logbook.sqlite');
-  const kaistDir = path.join(DATA, 'kaist_energy_drone');
-  const ulgDir = path.join(DATA, 'px4_flugdrohne/ulg');
-  const kaist = readdirSync(kaistDir).filter((f) => f.endsWith('.csv')).sort().map((f) => path.join(kaistDir, f));
-  const ulgs = readdirSync(ulgDir).filter((f) => f.endsWith('.ulg')).sort().map((f) => path.join(ulgDir, f));
-  const logbookCli = (args) => JSON.parse(execFileSync(BIN, ['logbook', ...args, '--db', book, '--format', 'json'], { encoding: 'utf8' }));
-  logbookCli(['add', ...kaist, '--vehicle-label', 'kaist-m600']);
-  logbookCli(['add', ...ulgs, '--pack-label', 'flugdrohne-3s']);
-  const lb = await serve(['--logbook', book]);
-  try {
-    const page = await openPage(lb.url);
-    for (const kind of ['flights', 'vehicles', 'packs']) {
-      await check(`GET /api/logbook/${kind} equals aloft logbook ${kind} --format json`, async () => {
-        const served = await page.evaluate((k) => fetch(`/api/logbook/${k}`).then((r) => r.json()), kind);
-        const cli = logbookCli([kind]);
-        assert(JSON.stringify(served) === JSON.stringify(cli), `${JSON.stringify(served).slice(0, 300)} vs ${JSON.stringify(cli).slice(0, 300)}`);
-      });
-    }
-    const vehicles = logbookCli(['vehicles']).vehicles;
-    const packs = logbookCli(['packs']).packs;
-    await check(`the logbook panel lists the ${vehicles.length} vehicles and ${packs.length} packs`, async () => {
-      await page.waitForSelector('#logbook-panel:not([hidden])');
-      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent));
-      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent));
-      assert(v.length === vehicles.length && p.length === packs.length, `${v} / ${p}`);
-    });
-    for (const v of vehicles) {
-      const hover = v.power.filter((x) => x.hover_power_w != null).length;
-      const mean = v.power.filter((x) => x.mean_power_w != null).length;
-      await check(`vehicle ${v.key}: ${mean} mean and ${hover} hover powers charted`, async () => {
-        await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(v)));
-        const got = await page.evaluate(() => [
-          document.querySelectorAll('#logbook-vehicle-chart circle.mean-power').length,
-          document.querySelectorAll('#logbook-vehicle-chart circle.hover-power').length,
-          document.querySelector('#logbook-vehicle-summary').textContent,
-        ]);
-        assert(got[0] === mean && got[1] === hover, JSON.stringify(got));
-        assert(got[2].startsWith(`${v.key}: ${v.flights} flights`), got[2]);
-      });
-    }
-    const pack = packs.find((p) => p.key === 'flugdrohne-3s');
-    await check(`pack flugdrohne-3s: its ${pack.resistance.length} resistances charted in mOhm`, async () => {
-      await page.selectOption('#logbook-pack', String(packs.indexOf(pack)));
-      const cys = await page.$$eval('#logbook-pack-chart circle.resistance', (cs) => cs.map((c) => c.querySelector('title').textContent));
-      assert(cys.length === pack.resistance.length, `${cys.length}`);
-      const first = `flight 1, resistance: ${(pack.resistance[0].value * 1000).toFixed(1)}`;
-      assert(cys[0] === first, `${cys[0]} vs ${first}`);
-      const summary = await page.textContent('#logbook-pack-summary');
-      assert(summary.includes(`over ${pack.resistance_trend.n} flights`), summary);
-    });
-    await page.context().close();
-  } finally {
-    lb.stop();
-    rmSync(bookDir, { recursive: true, force: true });
-  }
+  // --- 9: the logbook's histories
+  await logbookPanel();
   const nobook = await serve([]);
   try {
     const page = await openPage(nobook.url);
@@ -841,6 +785,110 @@ async function noProblems() {
   await check(`no page error, console error nor dialog in any test (${expectedRefusals} expected 4xx answers logged by Chromium while refusals were tested)`, async () => {
     assert(pageProblems.length === 0 && dialogs.length === 0, pageProblems.concat(dialogs).join('\n'));
   });
+}
+
+// --- 9: the logbook's histories (`aloft serve --logbook FILE`): a logbook written by `aloft
+// logbook add`, its lists served as the CLI's JSON; the panel opens on the vehicle the page flies
+// (else the one with the latest flight); a vehicle's powers with a legend; the resistance of each
+// pack of a vehicle its own line (the flugdrohne's logs filed under two packs).
+async function logbookPanel() {
+  const bookDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-logbook-'));
+  const book = path.join(bookDir, 'logbook.sqlite');
+  const kaistDir = path.join(DATA, 'kaist_energy_drone');
+  const ulgDir = path.join(DATA, 'px4_flugdrohne/ulg');
+  const kaist = readdirSync(kaistDir).filter((f) => f.endsWith('.csv')).sort().map((f) => path.join(kaistDir, f));
+  const ulgs = readdirSync(ulgDir).filter((f) => f.endsWith('.ulg')).sort().map((f) => path.join(ulgDir, f));
+  const logbookCli = (args) => JSON.parse(execFileSync(BIN, ['logbook', ...args, '--db', book, '--format', 'json'], { encoding: 'utf8' }));
+  logbookCli(['add', ...kaist, '--vehicle-label', 'kaist-m600']);
+  logbookCli(['add', ...ulgs.slice(0, 2), '--pack-label', 'flugdrohne-3s-a']);
+  logbookCli(['add', ...ulgs.slice(2), '--pack-label', 'flugdrohne-3s-b']);
+  // The page flies a vehicle file named as the logbook's kaist-m600 (the M600's, renamed).
+  const m600 = path.join(bookDir, 'kaist-m600.toml');
+  writeFileSync(m600, readFileSync(path.join(repo, 'fixtures/vehicles/dji-m600.toml'), 'utf8').replace('name = "dji-m600"', 'name = "kaist-m600"'));
+  const vehicles = logbookCli(['vehicles']).vehicles;
+  const packs = logbookCli(['packs']).packs;
+  const lb = await serve(['--logbook', book, '--vehicle', m600]);
+  try {
+    const page = await openPage(lb.url);
+    for (const kind of ['flights', 'vehicles', 'packs']) {
+      await check(`GET /api/logbook/${kind} equals aloft logbook ${kind} --format json`, async () => {
+        const served = await page.evaluate((k) => fetch(`/api/logbook/${k}`).then((r) => r.json()), kind);
+        const cli = logbookCli([kind]);
+        assert(JSON.stringify(served) === JSON.stringify(cli), `${JSON.stringify(served).slice(0, 300)} vs ${JSON.stringify(cli).slice(0, 300)}`);
+      });
+    }
+    await check(`the logbook panel lists the ${vehicles.length} vehicles and ${packs.length} packs`, async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])');
+      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent));
+      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent));
+      assert(v.length === vehicles.length && p.length === packs.length, `${v} / ${p}`);
+    });
+    await check('the logbook panel opens on the vehicle the page flies (kaist-m600), not the first listed', async () => {
+      const at = vehicles.findIndex((v) => v.key === 'kaist-m600');
+      assert(at > 0, `kaist-m600 is vehicle ${at} of the logbook`);
+      assert((await page.$eval('#vehicle', (s) => s.value)) === 'kaist-m600', 'the page does not fly kaist-m600');
+      const shown = await page.$eval('#logbook-vehicle', (s) => s.value);
+      assert(shown === String(at), `vehicle ${shown} shown`);
+      const summary = await page.textContent('#logbook-vehicle-summary');
+      assert(summary.startsWith('kaist-m600: '), summary);
+    });
+    for (const v of vehicles) {
+      const hover = v.power.filter((x) => typeof x.hover_power_w === 'number').length;
+      const mean = v.power.filter((x) => typeof x.mean_power_w === 'number').length;
+      await check(`vehicle ${v.key}: ${mean} mean and ${hover} hover powers charted, with a legend`, async () => {
+        await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(v)));
+        const got = await page.evaluate(() => [
+          document.querySelectorAll('#logbook-vehicle-chart circle.mean-power').length,
+          document.querySelectorAll('#logbook-vehicle-chart circle.hover-power').length,
+          document.querySelector('#logbook-vehicle-summary').textContent,
+          [...document.querySelectorAll('#logbook-vehicle-chart g.legend text')].map((t) => t.textContent).join(','),
+        ]);
+        assert(got[0] === mean && got[1] === hover, JSON.stringify(got));
+        assert(got[2].startsWith(`${v.key}: ${v.flights} flights`), got[2]);
+        if (mean + hover > 0) assert(got[3] === 'mean power,hover power', `legend: ${got[3]}`);
+      });
+    }
+    const flugdrohne = vehicles.find((v) => v.packs.includes('flugdrohne-3s-a'));
+    const own = packs.filter((p) => flugdrohne.packs.includes(p.key) && p.resistance.length > 0);
+    await check(`vehicle ${flugdrohne.key}: the resistance of each of its ${own.length} packs its own line, never one line through both`, async () => {
+      assert(own.length === 2, `${own.length} packs with a resistance`);
+      await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(flugdrohne)));
+      const lines = await page.$$eval('#logbook-pack-chart polyline.resistance', (ps) => ps.map((p) => p.getAttribute('points').trim().split(/\s+/).filter(Boolean).length));
+      assert(lines.length === own.length, `${lines.length} lines: ${lines}`);
+      assert(lines.slice().sort().join(',') === own.map((p) => p.resistance.length).sort().join(','), `${lines} vs ${own.map((p) => p.resistance.length)}`);
+      const legend = await page.$$eval('#logbook-pack-chart g.legend text', (ts) => ts.map((t) => t.textContent).sort().join(','));
+      assert(legend === own.map((p) => p.key).sort().join(','), legend);
+    });
+    const pack = packs.find((p) => p.key === 'flugdrohne-3s-b');
+    await check(`pack flugdrohne-3s-b: its ${pack.resistance.length} resistances charted in mOhm, drawn over the other pack`, async () => {
+      await page.selectOption('#logbook-pack', String(packs.indexOf(pack)));
+      const cys = await page.$$eval('#logbook-pack-chart circle.resistance.selected', (cs) => cs.map((c) => c.querySelector('title').textContent));
+      assert(cys.length === pack.resistance.length, `${cys.length}`);
+      const first = `flight 1, flugdrohne-3s-b: ${(pack.resistance[0].value * 1000).toFixed(1)}`;
+      assert(cys[0] === first, `${cys[0]} vs ${first}`);
+      const summary = await page.textContent('#logbook-pack-summary');
+      assert(summary.includes(`over ${pack.resistance_trend.n} flights`), summary);
+    });
+    await page.context().close();
+  } finally {
+    lb.stop();
+  }
+  // A page flying a vehicle the logbook does not know: the vehicle with the latest flight.
+  const latest = (v) => Math.max(-Infinity, ...v.power.map((p) => (typeof p.start_unix_s === 'number' ? p.start_unix_s : -Infinity)));
+  const newest = vehicles.reduce((b, v) => (latest(v) > latest(b) ? v : b), vehicles[0]);
+  const other = await serve(['--logbook', book]);
+  try {
+    const page = await openPage(other.url);
+    await check(`flying dji-m100, which the logbook does not know: the panel opens on the vehicle of the latest flight (${newest.key})`, async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])');
+      const shown = await page.$eval('#logbook-vehicle', (s) => s.value);
+      assert(shown === String(vehicles.indexOf(newest)), `vehicle ${shown} shown`);
+    });
+    await page.context().close();
+  } finally {
+    other.stop();
+    rmSync(bookDir, { recursive: true, force: true });
+  }
 }
 
 // ------------------------------------------------------------------ markup in names (issue 41)
