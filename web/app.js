@@ -1247,6 +1247,8 @@
       row('Remaining', `${fmt(u.remaining_wh.p5, 1)} / ${fmt(u.remaining_wh.p50, 1)} / ${fmt(u.remaining_wh.p95, 1)} Wh (p5/p50/p95)`);
     }
     if (u.advice) row('Advice', u.advice, u.advice === 'continue' ? 'good' : 'bad');
+    // What aloft live does not believe, or assumes (the state of charge's source), as it says it.
+    if (u.note) row('Note', u.note, 'note');
     panel.querySelector('.live-body').replaceChildren(el('dl', { class: 'summary' }, rows));
   }
 
