@@ -47,6 +47,14 @@ pub enum Error {
         /// The most scenarios within the bound.
         max_samples: u64,
     },
+    /// A request whose flights (a mission's, a plan's candidates, sorties and trials) would fly
+    /// more planner steps than its caller allows ([`StepMeter`](crate::engine::StepMeter),
+    /// `aloft serve --max-request-steps`).
+    #[error("the request would fly more than {max_steps} planner steps, more work than one request may ask for: give a longer time step (time_step) or a shorter mission")]
+    RequestTooLong {
+        /// The bound on the steps of all the request's flights.
+        max_steps: u64,
+    },
     /// A value of the day's air outside its range (`--elevation-m`, `--temperature-c`,
     /// `--humidity-percent`, `--qnh-hpa`).
     #[error("{name} = {} {unit} is outside the air aloft flies in: expected {expected}", aloft_core::Num::of(.value))]

@@ -1,4 +1,10 @@
 // The page of `aloft serve`: plain JS, no build step. Talks to the JSON API of the same server.
+//
+// Every value from a file, a request or the server goes into the page as text: elements are
+// built with `el`/`svg` (text nodes, `textContent`, attributes), Leaflet's tooltips are given
+// nodes (`tipNode`), never a string (Leaflet parses a string as markup), and the tile layer's
+// attribution is escaped (`escaped`). No markup is built from strings anywhere; the server's
+// Content-Security-Policy (no inline script) holds if a spot is ever missed.
 (function () {
   'use strict';
 
@@ -50,7 +56,8 @@
         if (v === undefined || v === null) continue;
         if (k === 'class') e.className = v;
         else if (k === 'text') e.textContent = v;
-        else if (k.startsWith('data-')) e.setAttribute(k, v);
+        // Through the CSS object model: the page's policy allows no inline style attribute.
+        else if (k === 'style') e.style.cssText = v;
         else e.setAttribute(k, v);
       }
     }
@@ -68,6 +75,46 @@
     }
     if (text !== undefined) e.textContent = text;
     return e;
+  }
+
+  // A tooltip's content: its lines as text nodes (Leaflet puts a node in as it is, where it
+  // would parse a string as markup).
+  function tipNode(...lines) {
+    const box = el('div', { class: 'tip' });
+    lines.forEach((line, k) => {
+      if (k) box.append(el('br'));
+      box.append(String(line));
+    });
+    return box;
+  }
+
+  // `text` with the characters of markup escaped, for the one place a library takes markup and
+  // no node (the tile layer's attribution).
+  function escaped(text) {
+    return String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+  }
+
+  // A name to save a file under: its last path component (whatever the server says), without
+  // control characters, `..` or a leading dot; `fallback` when nothing is left.
+  function safeFileName(name, fallback) {
+    const base = String(name === undefined || name === null ? '' : name).split(/[\\/]/).pop();
+    const clean = base
+      .replace(/[\u0000-\u001f\u007f:*?"<>|]/g, '_')
+      .replace(/\.{2,}/g, '.')
+      .replace(/^[.\s]+/, '')
+      .trim();
+    return clean || fallback;
+  }
+
+  // Names made unique in their order (`name (2).ext` for a second `name.ext`).
+  function uniqueNames(names) {
+    const seen = new Set();
+    return names.map((n) => {
+      let out = n;
+      for (let k = 2; seen.has(out); k++) out = n.replace(/(\.[^.]*)?$/, (ext) => ` (${k})${ext}`);
+      seen.add(out);
+      return out;
+    });
   }
 
   function fmt(x, digits) {
@@ -403,7 +450,8 @@
     if (geo) {
       map = L.map(container, { zoomControl: true });
       L.tileLayer(state.config.tiles, {
-        attribution: state.config.attribution || '',
+        // Leaflet puts an attribution in as markup: the operator's text is shown as text.
+        attribution: escaped(state.config.attribution || ''),
         maxZoom: 19,
       }).addTo(map);
     } else {
@@ -441,7 +489,7 @@
       const bar = L.DomUtil.create('div', 'map-legend-bar', box);
       bar.style.background = `linear-gradient(to right, ${stops.join(', ')})`;
       const labels = L.DomUtil.create('div', 'map-legend-labels', box);
-      labels.innerHTML = '<span>reserve</span><span>battery at leg end</span><span>full</span>';
+      labels.append(...['reserve', 'battery at leg end', 'full'].map((t) => el('span', { text: t })));
       return box;
     };
     return legend;
@@ -478,8 +526,8 @@
         lineJoin: 'round',
       });
       const item = seg.item !== undefined && seg.item !== null ? `item ${seg.item} · ` : '';
-      const tip = `${item}${seg.kind} (segment ${seg.index})` +
-        (ms ? `<br>${fmt(ms.energy_wh, 2)} Wh · battery ${pct(ms.end_soc)} %` : '');
+      const head = `${item}${seg.kind} (segment ${seg.index})`;
+      const tip = ms ? tipNode(head, `${fmt(ms.energy_wh, 2)} Wh · battery ${pct(ms.end_soc)} %`) : tipNode(head);
       line.bindTooltip(tip, { sticky: true });
       line.on('mouseover', () => highlight(seg.index, true));
       line.on('mouseout', () => highlight(seg.index, false));
@@ -491,7 +539,7 @@
     // home
     const home = geo ? [mapAnswer.home.latitude_deg, mapAnswer.home.longitude_deg] : [0, 0];
     L.circleMarker(home, { radius: 7, className: 'home', color: '#1f3b73', weight: 2, fillColor: '#fff', fillOpacity: 1 })
-      .bindTooltip('home')
+      .bindTooltip(tipNode('home'))
       .addTo(state.routeLayer);
     // ends of sorties
     for (const sortie of mission.sorties || []) {
@@ -499,7 +547,7 @@
       if (!latlngs || !latlngs.length) continue;
       const end = latlngs[latlngs.length - 1];
       L.circleMarker(end, { radius: 6, className: 'sortie-end', color: '#333', weight: 2, fillColor: '#ffd54f', fillOpacity: 1 })
-        .bindTooltip(`end of sortie (segment ${sortie.last_segment}): battery ${pct(sortie.end_soc)} %`)
+        .bindTooltip(tipNode(`end of sortie (segment ${sortie.last_segment}): battery ${pct(sortie.end_soc)} %`))
         .addTo(state.routeLayer);
     }
     // point of no return
@@ -507,7 +555,7 @@
     if (pnr) {
       const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
       L.circleMarker(at, { radius: 8, className: 'pnr', color: '#b00020', weight: 3, fillColor: '#fff', fillOpacity: 1 })
-        .bindTooltip(`point of no return: ${duration(pnr.time_s)} (segment ${pnr.segment})`)
+        .bindTooltip(tipNode(`point of no return: ${duration(pnr.time_s)} (segment ${pnr.segment})`))
         .addTo(state.routeLayer);
     }
     map.invalidateSize();
@@ -874,17 +922,20 @@
     return el('ul', { class: 'fly-changes' }, lines);
   }
 
-  // Each file as a download, and all of them in one zip.
+  // Each file as a download, and all of them in one zip: each saved under its base name only,
+  // whatever the server names it (no folder, no `..`: a zip's entry is extracted where it says).
   function flyDownloads(plan) {
     const link = (name, blob, cls) => {
       const url = URL.createObjectURL(blob);
       state.flyUrls.push(url);
       return el('a', { href: url, download: name, class: cls, text: name });
     };
-    const files = (plan.texts || []).map((t) => ({ name: t.file, text: t.text }));
+    const texts = plan.texts || [];
+    const names = uniqueNames(texts.map((t, k) => safeFileName(t.file, `sortie-${k + 1}-of-${texts.length}.txt`)));
+    const files = texts.map((t, k) => ({ name: names[k], text: String(t.text) }));
     const links = files.map((f) => link(f.name, new Blob([f.text], { type: 'text/plain;charset=utf-8' }), 'fly-file'));
     const stem = files.length ? files[0].name.replace(/-1-of-\d+\.[^.]+$/, '') : 'plan';
-    links.push(link(`${stem}-plan.zip`, zipStored(files), 'fly-all'));
+    links.push(link(safeFileName(`${stem}-plan.zip`, 'plan.zip'), zipStored(files), 'fly-all'));
     return el('p', { class: 'fly-downloads' }, ['Files: ', ...links.flatMap((a, k) => (k ? [' ', a] : [a]))]);
   }
 
@@ -911,7 +962,8 @@
           lineJoin: 'round',
         });
         const s = plan.sorties[k];
-        line.bindTooltip(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}<br>${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`, { sticky: true });
+        const tip = tipNode(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}`, `${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`);
+        line.bindTooltip(tip, { sticky: true });
         line.on('mouseover', () => lightSortie(k, true));
         line.on('mouseout', () => lightSortie(k, false));
         line.addTo(state.flyLayer);
@@ -921,7 +973,7 @@
       if (pnr) {
         const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
         L.circleMarker(at, { radius: 5, className: 'fly-pnr', color: colour, weight: 2, fillColor: '#fff', fillOpacity: 1 })
-          .bindTooltip(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`)
+          .bindTooltip(tipNode(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`))
           .addTo(state.flyLayer);
       }
       state.flyLines.push(lines);
@@ -1045,8 +1097,11 @@
     const packs = vehicle ? vehicle.batteries : [];
     const current = select.value;
     const have = [...select.options].slice(1).map((o) => o.value);
-    if (have.join('|') !== packs.join('|')) {
-      select.replaceChildren(el('option', { value: '', text: 'default' }), ...packs.map((b) => el('option', { value: b, text: b })));
+    // The server's pack for its default vehicle (`aloft serve --battery`), else the vehicle's.
+    const own = name === state.config.default_vehicle && state.config.default_battery;
+    const label = own ? `default (${state.config.default_battery})` : 'default';
+    if (have.join('|') !== packs.join('|') || select.options[0].textContent !== label) {
+      select.replaceChildren(el('option', { value: '', text: label }), ...packs.map((b) => el('option', { value: b, text: b })));
       select.value = packs.includes(current) ? current : '';
     }
   }
@@ -1192,6 +1247,8 @@
       row('Remaining', `${fmt(u.remaining_wh.p5, 1)} / ${fmt(u.remaining_wh.p50, 1)} / ${fmt(u.remaining_wh.p95, 1)} Wh (p5/p50/p95)`);
     }
     if (u.advice) row('Advice', u.advice, u.advice === 'continue' ? 'good' : 'bad');
+    // What aloft live does not believe, or assumes (the state of charge's source), as it says it.
+    if (u.note) row('Note', u.note, 'note');
     panel.querySelector('.live-body').replaceChildren(el('dl', { class: 'summary' }, rows));
   }
 
@@ -1211,7 +1268,7 @@
     }
     if (!state.liveMarker) {
       state.liveMarker = L.circleMarker(at, { radius: 8, className: 'vehicle', color: '#0d47a1', weight: 3, fillColor: '#42a5f5', fillOpacity: 1 }).addTo(state.liveLayer);
-      state.liveMarker.bindTooltip('vehicle');
+      state.liveMarker.bindTooltip(tipNode('vehicle'));
     } else {
       state.liveMarker.setLatLng(at);
     }
@@ -1228,6 +1285,7 @@
     $('#vehicle').addEventListener('change', () => {
       syncBatteries(state.plan && state.plan.mission);
       $('#battery').value = '';
+      followInLogbook();
       replanSoon();
     });
     for (const id of ['#battery', '#payload', '#wind-speed', '#wind-from', '#reserve', '#elevation', '#temperature', '#samples']) {
@@ -1235,6 +1293,8 @@
       input.addEventListener('input', replanSoon);
       input.addEventListener('change', replanSoon);
     }
+    // The controls are not a form to send: Enter in a field changes nothing but the field.
+    $('#controls').addEventListener('submit', (e) => e.preventDefault());
     $('#plan-fly').addEventListener('click', () => {
       planToFly();
     });
@@ -1276,8 +1336,12 @@
 
   // ---------------------------------------------------------------- logbook
 
-  // One series of a history chart: a line through its points and a dot on each, x the flight's
-  // place in the vehicle's or pack's flights (1, 2, ...).
+  // The logbook's lists (`/api/logbook/vehicles`, `/api/logbook/packs`).
+  const logbook = { vehicles: [], packs: [] };
+
+  // A history chart: each series its own line through its points and a dot on each (a line never
+  // joins two series: two packs are two lines), x the flight's place in the series' own flights
+  // (1, 2, ...); a legend names the series. A series is coloured by its class, or by `colour`.
   function historyChart(container, label, yLabel, series) {
     const all = series.flatMap((s) => s.values.filter(Number.isFinite));
     const n = Math.max(1, ...series.map((s) => s.values.length));
@@ -1289,16 +1353,27 @@
     const hi = Math.max(...all);
     const pad = (hi - lo) * 0.1 || Math.abs(hi) * 0.1 || 1;
     const f = frame(container, { label, x0: 1, x1: Math.max(2, n), y0: lo - pad, y1: hi + pad, xLabel: 'flight', yLabel });
+    const paint = (e, s, fill) => {
+      if (s.colour) e.style[fill ? 'fill' : 'stroke'] = s.colour;
+      return e;
+    };
     for (const s of series) {
       const xs = s.values.map((_, i) => i + 1);
-      f.plot.append(svg('polyline', { points: points(xs, s.values, f.x, f.y).join(' '), class: s.cls }));
+      f.plot.append(paint(svg('polyline', { points: points(xs, s.values, f.x, f.y).join(' '), class: s.cls }), s, false));
       s.values.forEach((v, i) => {
         if (!Number.isFinite(v)) return;
-        const dot = svg('circle', { cx: f.x(i + 1), cy: f.y(v), r: 3, class: s.cls });
+        const dot = paint(svg('circle', { cx: f.x(i + 1), cy: f.y(v), r: 3, class: s.cls }), s, true);
         dot.append(svg('title', {}, `flight ${i + 1}, ${s.name}: ${fmt(v, 1)}`));
         f.plot.append(dot);
       });
     }
+    const legend = svg('g', { class: 'legend history-legend', transform: `translate(${f.m.l + 10}, ${f.m.t + 12})` });
+    series.forEach((s, k) => {
+      const y = k * 14;
+      legend.append(paint(svg('line', { x1: 0, x2: 16, y1: y - 3, y2: y - 3, class: s.cls }), s, false));
+      legend.append(svg('text', { x: 20, y: y + 1 }, s.name));
+    });
+    f.plot.append(legend);
   }
 
   function renderLogbookVehicle(v) {
@@ -1306,37 +1381,89 @@
       ? `; ${v.power_drift.quantity === 'hover_power_w' ? 'hover' : 'mean'} power ${v.power_drift.trend.change_percent >= 0 ? '+' : ''}${fmt(v.power_drift.trend.change_percent, 1)} % over the last ${v.power_drift.trend.n} flights`
       : '';
     $('#logbook-vehicle-summary').textContent = `${v.key}: ${v.flights} flights, ${fmt(v.hours, 2)} h, ${fmt(v.energy_wh, 1)} Wh${drift}`;
-    const num = (x) => (x == null ? NaN : x);
+    const num = (x) => (typeof x === 'number' ? x : NaN);
     historyChart($('#logbook-vehicle-chart'), `power per flight of ${v.key}`, 'power (W)', [
       { name: 'mean power', cls: 'mean-power', values: v.power.map((p) => num(p.mean_power_w)) },
       { name: 'hover power', cls: 'hover-power', values: v.power.map((p) => num(p.hover_power_w)) },
     ]);
   }
 
+  // The pack's summary, and the resistance of each pack of the chosen vehicle (and of this pack),
+  // one line each, this one drawn over the others.
   function renderLogbookPack(p) {
-    const cycles = p.equivalent_cycles == null ? 'cycles n/a (no rated capacity)' : `${fmt(p.equivalent_cycles, 2)} equivalent cycles`;
+    const cycles = typeof p.equivalent_cycles !== 'number' ? 'cycles n/a (no rated capacity)' : `${fmt(p.equivalent_cycles, 2)} equivalent cycles`;
     const t = p.resistance_trend;
     const trend = t ? `; resistance ${fmt(t.first * 1000, 1)} to ${fmt(t.last * 1000, 1)} mOhm over ${t.n} flights` : '';
     $('#logbook-pack-summary').textContent = `${p.key}: ${p.flights} flights, ${fmt(p.discharged_mah, 0)} mAh, ${cycles}${trend}`;
-    historyChart($('#logbook-pack-chart'), `resistance per flight of ${p.key}`, 'resistance (mOhm)', [
-      { name: 'resistance', cls: 'resistance', values: p.resistance.map((r) => r.value * 1000) },
-    ]);
+    const vehicle = logbook.vehicles[Number($('#logbook-vehicle').value)];
+    const keys = ((vehicle && vehicle.packs) || []).filter((k) => k !== p.key);
+    const others = logbook.packs.filter((q) => keys.includes(q.key));
+    const series = others.concat([p]).map((q, k) => ({
+      name: q.key,
+      cls: q === p ? 'resistance selected' : 'resistance other',
+      colour: q === p ? undefined : SORTIE_COLOURS[k % SORTIE_COLOURS.length],
+      values: (q.resistance || []).map((r) => r.value * 1000),
+    }));
+    historyChart($('#logbook-pack-chart'), `resistance per flight of ${p.key}`, 'resistance (mOhm)', series);
   }
 
-  function fillLogbookSelect(select, items, render) {
+  // The logbook's vehicle the page opens on: the one the page flies (its name, in any case),
+  // else the one with the latest flight, else the first with a key of its own (the flights of
+  // "unknown" are of any vehicle).
+  function openingVehicle(vehicles) {
+    const flown = String($('#vehicle').value || state.config.default_vehicle || '').trim().toLowerCase();
+    const same = vehicles.findIndex((v) => String(v.key).trim().toLowerCase() === flown);
+    if (same >= 0) return same;
+    const latest = (v) => Math.max(-Infinity, ...(v.power || []).map((p) => (typeof p.start_unix_s === 'number' ? p.start_unix_s : -Infinity)));
+    let best = -1;
+    vehicles.forEach((v, i) => {
+      if (latest(v) > (best >= 0 ? latest(vehicles[best]) : -Infinity)) best = i;
+    });
+    return best >= 0 ? best : Math.max(0, vehicles.findIndex((v) => v.key !== 'unknown'));
+  }
+
+  // The pack the panel opens on for vehicle `v`: its first pack in the logbook, else the first
+  // with a key of its own.
+  function openingPack(v, packs) {
+    const own = packs.findIndex((p) => v && (v.packs || []).includes(p.key));
+    return own >= 0 ? own : Math.max(0, packs.findIndex((p) => p.key !== 'unknown'));
+  }
+
+  function fillLogbookSelect(select, items) {
     select.replaceChildren(...items.map((x, i) => el('option', { value: String(i) }, [`${x.key} (${x.flights} flights)`])));
-    select.onchange = () => render(items[Number(select.value)]);
-    // The first with a key of its own (the flights of "unknown" are of any vehicle or pack).
-    const first = Math.max(0, items.findIndex((x) => x.key !== 'unknown'));
-    select.value = String(first);
-    if (items.length) render(items[first]);
+  }
+
+  // Show vehicle `i` of the logbook, and the pack it opens on.
+  function showLogbookVehicle(i) {
+    const v = logbook.vehicles[i];
+    $('#logbook-vehicle').value = String(i);
+    if (v) renderLogbookVehicle(v);
+    const k = openingPack(v, logbook.packs);
+    $('#logbook-pack').value = String(k);
+    if (logbook.packs[k]) renderLogbookPack(logbook.packs[k]);
+  }
+
+  // The logbook's panel follows the vehicle chosen on the page when the logbook has it.
+  function followInLogbook() {
+    if (!logbook.vehicles.length) return;
+    const flown = String($('#vehicle').value).trim().toLowerCase();
+    const i = logbook.vehicles.findIndex((v) => String(v.key).trim().toLowerCase() === flown);
+    if (i >= 0) showLogbookVehicle(i);
   }
 
   async function loadLogbook() {
     const [vehicles, packs] = await Promise.all([api('/api/logbook/vehicles'), api('/api/logbook/packs')]);
+    logbook.vehicles = vehicles.vehicles || [];
+    logbook.packs = packs.packs || [];
     $('#logbook-panel').hidden = false;
-    fillLogbookSelect($('#logbook-vehicle'), vehicles.vehicles, renderLogbookVehicle);
-    fillLogbookSelect($('#logbook-pack'), packs.packs, renderLogbookPack);
+    fillLogbookSelect($('#logbook-vehicle'), logbook.vehicles);
+    fillLogbookSelect($('#logbook-pack'), logbook.packs);
+    $('#logbook-vehicle').onchange = () => showLogbookVehicle(Number($('#logbook-vehicle').value));
+    $('#logbook-pack').onchange = () => {
+      const p = logbook.packs[Number($('#logbook-pack').value)];
+      if (p) renderLogbookPack(p);
+    };
+    showLogbookVehicle(openingVehicle(logbook.vehicles));
   }
 
   async function start() {

@@ -29,6 +29,7 @@ use super::own_vehicle::OwnVehicle;
 use super::payload_sweep::PayloadSweep;
 use super::power::PowerModelQuery;
 use super::scenarios::{ScenarioOptions, WorkBounds, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
+use super::step_meter::StepMeter;
 use super::validate::ValidateRequest;
 use super::vehicles::Vehicle;
 use super::EnduranceOptions;
@@ -281,6 +282,9 @@ pub struct MissionFlags {
     /// The autopilot's critical-voltage failsafe, pack volts (ArduPilot BATT_CRT_VOLT).
     #[arg(value_parser = finite(), long, value_name = "V")]
     pub critical_voltage_v: Option<f64>,
+    /// The request's budget of planner steps, set by a caller that serves others (no flag).
+    #[arg(skip)]
+    pub meter: Option<StepMeter>,
 }
 
 impl MissionFlags {
@@ -307,6 +311,7 @@ impl MissionFlags {
             air: self.air.input(),
             low_voltage_v: self.low_voltage_v,
             critical_voltage_v: self.critical_voltage_v,
+            meter: self.meter.clone(),
         }
     }
 }

@@ -7,6 +7,8 @@ use aloft_planner::{
     PlannerError, SampleSink, SegmentSpec, Wind,
 };
 
+use super::step_meter::StepMeter;
+
 /// Descent rate of the landing after a return home that aloft adds (a loiter's, a sortie's), m/s
 /// (or the airframe's limit if lower): an autopilot's gentle landing.
 const LANDING_RATE_MPS: f64 = 1.0;
@@ -21,6 +23,9 @@ pub(super) struct Flight<'a> {
     pub(super) wind: &'a Wind,
     /// The planner's options.
     pub(super) options: PlanOptions,
+    /// The request's budget of steps, when its caller bounds it: each flight flies within what
+    /// is left and is counted ([`StepMeter`]).
+    pub(super) meter: Option<StepMeter>,
 }
 
 impl Flight<'_> {
@@ -53,14 +58,9 @@ impl Flight<'_> {
         compiled: &Compiled,
         sink: &mut dyn SampleSink,
     ) -> Result<MissionReport, PlannerError> {
-        aloft_planner::plan_into(
-            self.aircraft,
-            self.pack,
-            compiled,
-            self.wind,
-            &self.options,
-            sink,
-        )
+        self.metered(|options| {
+            aloft_planner::plan_into(self.aircraft, self.pack, compiled, self.wind, options, sink)
+        })
     }
 
     /// Fly a compiled mission, keeping the samples when the options ask.
@@ -68,7 +68,24 @@ impl Flight<'_> {
     /// # Errors
     /// As [`aloft_planner::plan`].
     pub(super) fn fly(&self, compiled: &Compiled) -> Result<MissionReport, PlannerError> {
-        aloft_planner::plan(self.aircraft, self.pack, compiled, self.wind, &self.options)
+        self.metered(|options| {
+            aloft_planner::plan(self.aircraft, self.pack, compiled, self.wind, options)
+        })
+    }
+
+    /// A flight with the planner's options, within the request's budget and counted in it when
+    /// there is one.
+    fn metered(
+        &self,
+        fly: impl FnOnce(&PlanOptions) -> Result<MissionReport, PlannerError>,
+    ) -> Result<MissionReport, PlannerError> {
+        let Some(meter) = &self.meter else {
+            return fly(&self.options);
+        };
+        let options = meter.within(&self.options);
+        let flown = fly(&options);
+        meter.count(&flown, &options, self.options.max_samples);
+        flown
     }
 
     /// Compile and fly `spec` (take-off payload `payload_kg` when given) for its report alone:

@@ -86,7 +86,8 @@ pub struct FlyPlanRequest {
     /// at every [`ANGLE_STEP_DEG`](super::ANGLE_STEP_DEG) degrees and along and across the wind).
     pub keep_angle: bool,
     /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
-    /// candidate, angle or sortie once cancelled (its steps are the planner's own to bound).
+    /// candidate, angle or sortie once cancelled (its steps, and its flights once cancelled, are
+    /// bounded by the options' [`StepMeter`](super::StepMeter) when the caller gives one).
     pub bounds: WorkBounds,
 }
 

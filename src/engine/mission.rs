@@ -383,6 +383,7 @@ pub(super) fn prepare<'a>(
         pack,
         wind,
         options: planner_options(options, mission.spec())?,
+        meter: options.meter.clone(),
     };
     let flown = flown_mission(&flight, mission, vehicle, (options, options.payload_kg))
         .map_err(in_mission)?;

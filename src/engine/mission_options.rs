@@ -9,6 +9,7 @@ use aloft_planner::{CornerMode, WindSpec};
 use aloft_power::AoaModel;
 
 use super::air::AirInput;
+use super::step_meter::StepMeter;
 use crate::error::Error;
 
 /// Options of [`plan_mission`]: the options of `aloft mission` (JSON keys as the field names;
@@ -58,6 +59,11 @@ pub struct MissionOptions {
     pub low_voltage_v: Option<f64>,
     /// The autopilot's critical-voltage failsafe, pack volts (as `low_voltage_v`).
     pub critical_voltage_v: Option<f64>,
+    /// The budget of planner steps of the request these options are part of, when its caller
+    /// bounds its work (`aloft serve`; not in the JSON; default none: unbounded, as the planner's
+    /// own limit on one flight allows).
+    #[serde(skip)]
+    pub meter: Option<StepMeter>,
 }
 
 impl Default for MissionOptions {
@@ -80,6 +86,7 @@ impl Default for MissionOptions {
             rtl_altitude_m: None,
             corners: None,
             air: AirInput::default(),
+            meter: None,
         }
     }
 }

@@ -720,6 +720,8 @@ impl<'a> MissionScenarios<'a> {
             pack: &pack,
             wind: &winds.nominal,
             options: plan_options,
+            // The scenarios are bounded before they fly (`WorkBounds`).
+            meter: None,
         };
         // A loiter until the reserve is resolved once, in the plan's conditions: the scenarios
         // fly the loiter the operator is told to fly.
@@ -751,6 +753,7 @@ impl<'a> MissionScenarios<'a> {
             pack: &self.pack,
             wind: &self.winds.nominal,
             options: self.options,
+            meter: None,
         };
         let compiled = plan
             .compile(&self.spec, self.payload_kg)
@@ -783,6 +786,7 @@ impl<'a> MissionScenarios<'a> {
             pack: &pack,
             wind: &wind,
             options: self.options,
+            meter: None,
         };
         let report = flight
             .compile(&self.spec, payload_kg)

@@ -206,9 +206,24 @@ async function refusing(fn) {
 }
 let browser;
 
+// Dialogs any page opened (an `alert` of injected markup): none is expected.
+const dialogs = [];
+
 async function openPage(url, viewport = { width: 1400, height: 900 }) {
-  const context = await browser.newContext({ viewport });
+  const context = await browser.newContext({ viewport, acceptDownloads: true });
+  // Every Content-Security-Policy violation of the page, kept where a check can read it (the
+  // listener is installed by the browser, so the page's policy does not apply to it).
+  await context.addInitScript(() => {
+    window.__violations = [];
+    document.addEventListener('securitypolicyviolation', (e) => {
+      window.__violations.push(`${e.violatedDirective} ${e.blockedURI} ${e.sample || ''}`.trim());
+    });
+  });
   const page = await context.newPage();
+  page.on('dialog', (d) => {
+    dialogs.push(`${url}: ${d.type()} ${d.message()}`);
+    d.dismiss().catch(() => {});
+  });
   page.on('pageerror', (e) => pageProblems.push(`pageerror at ${url}: ${e.message}`));
   page.on('console', (m) => {
     if (m.type() !== 'error') return;
@@ -286,6 +301,13 @@ async function main() {
     executablePath: CHROMIUM,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
   });
+  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup or =logbook.
+  const only = { markup: markupEverywhere, logbook: logbookPanel }[process.env.ALOFT_BROWSER_ONLY];
+  if (only) {
+    await only();
+    await noProblems();
+    return;
+  }
 
   // --- 1, 2: every shared mission and the demo against the CLI. `aloft serve` refuses to start
   // with a mission it cannot fly, so the accepted ones are given on its command line (picked in
@@ -658,64 +680,8 @@ async function main() {
     doc.stop();
   }
 
-  // --- 9: the logbook's histories (`aloft serve --logbook FILE`): a logbook written by
-  // `aloft logbook add`, its lists served as the CLI's JSON, a vehicle's and a pack's charts.
-  const bookDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-logbook-'));
-  const book = path.join(bookDir, 'logbook.sqlite');
-  const kaistDir = path.join(DATA, 'kaist_energy_drone');
-  const ulgDir = path.join(DATA, 'px4_flugdrohne/ulg');
-  const kaist = readdirSync(kaistDir).filter((f) => f.endsWith('.csv')).sort().map((f) => path.join(kaistDir, f));
-  const ulgs = readdirSync(ulgDir).filter((f) => f.endsWith('.ulg')).sort().map((f) => path.join(ulgDir, f));
-  const logbookCli = (args) => JSON.parse(execFileSync(BIN, ['logbook', ...args, '--db', book, '--format', 'json'], { encoding: 'utf8' }));
-  logbookCli(['add', ...kaist, '--vehicle-label', 'kaist-m600']);
-  logbookCli(['add', ...ulgs, '--pack-label', 'flugdrohne-3s']);
-  const lb = await serve(['--logbook', book]);
-  try {
-    const page = await openPage(lb.url);
-    for (const kind of ['flights', 'vehicles', 'packs']) {
-      await check(`GET /api/logbook/${kind} equals aloft logbook ${kind} --format json`, async () => {
-        const served = await page.evaluate((k) => fetch(`/api/logbook/${k}`).then((r) => r.json()), kind);
-        const cli = logbookCli([kind]);
-        assert(JSON.stringify(served) === JSON.stringify(cli), `${JSON.stringify(served).slice(0, 300)} vs ${JSON.stringify(cli).slice(0, 300)}`);
-      });
-    }
-    const vehicles = logbookCli(['vehicles']).vehicles;
-    const packs = logbookCli(['packs']).packs;
-    await check(`the logbook panel lists the ${vehicles.length} vehicles and ${packs.length} packs`, async () => {
-      await page.waitForSelector('#logbook-panel:not([hidden])');
-      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent));
-      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent));
-      assert(v.length === vehicles.length && p.length === packs.length, `${v} / ${p}`);
-    });
-    for (const v of vehicles) {
-      const hover = v.power.filter((x) => x.hover_power_w != null).length;
-      const mean = v.power.filter((x) => x.mean_power_w != null).length;
-      await check(`vehicle ${v.key}: ${mean} mean and ${hover} hover powers charted`, async () => {
-        await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(v)));
-        const got = await page.evaluate(() => [
-          document.querySelectorAll('#logbook-vehicle-chart circle.mean-power').length,
-          document.querySelectorAll('#logbook-vehicle-chart circle.hover-power').length,
-          document.querySelector('#logbook-vehicle-summary').textContent,
-        ]);
-        assert(got[0] === mean && got[1] === hover, JSON.stringify(got));
-        assert(got[2].startsWith(`${v.key}: ${v.flights} flights`), got[2]);
-      });
-    }
-    const pack = packs.find((p) => p.key === 'flugdrohne-3s');
-    await check(`pack flugdrohne-3s: its ${pack.resistance.length} resistances charted in mOhm`, async () => {
-      await page.selectOption('#logbook-pack', String(packs.indexOf(pack)));
-      const cys = await page.$$eval('#logbook-pack-chart circle.resistance', (cs) => cs.map((c) => c.querySelector('title').textContent));
-      assert(cys.length === pack.resistance.length, `${cys.length}`);
-      const first = `flight 1, resistance: ${(pack.resistance[0].value * 1000).toFixed(1)}`;
-      assert(cys[0] === first, `${cys[0]} vs ${first}`);
-      const summary = await page.textContent('#logbook-pack-summary');
-      assert(summary.includes(`over ${pack.resistance_trend.n} flights`), summary);
-    });
-    await page.context().close();
-  } finally {
-    lb.stop();
-    rmSync(bookDir, { recursive: true, force: true });
-  }
+  // --- 9: the logbook's histories
+  await logbookPanel();
   const nobook = await serve([]);
   try {
     const page = await openPage(nobook.url);
@@ -808,10 +774,328 @@ async function main() {
     rmSync(vehDir, { recursive: true, force: true });
   }
 
+  // --- 11: markup in every name, on every panel (issue 41)
+  await markupEverywhere();
+
   // --- 7: no page errors anywhere
-  await check(`no page error and no console error in any test (${expectedRefusals} expected 4xx answers logged by Chromium while refusals were tested)`, async () => {
-    assert(pageProblems.length === 0, pageProblems.join('\n'));
+  await noProblems();
+}
+
+async function noProblems() {
+  await check(`no page error, console error nor dialog in any test (${expectedRefusals} expected 4xx answers logged by Chromium while refusals were tested)`, async () => {
+    assert(pageProblems.length === 0 && dialogs.length === 0, pageProblems.concat(dialogs).join('\n'));
   });
+}
+
+// --- 9: the logbook's histories (`aloft serve --logbook FILE`): a logbook written by `aloft
+// logbook add`, its lists served as the CLI's JSON; the panel opens on the vehicle the page flies
+// (else the one with the latest flight); a vehicle's powers with a legend; the resistance of each
+// pack of a vehicle its own line (the flugdrohne's logs filed under two packs).
+async function logbookPanel() {
+  const bookDir = mkdtempSync(path.join(os.tmpdir(), 'aloft-logbook-'));
+  const book = path.join(bookDir, 'logbook.sqlite');
+  const kaistDir = path.join(DATA, 'kaist_energy_drone');
+  const ulgDir = path.join(DATA, 'px4_flugdrohne/ulg');
+  const kaist = readdirSync(kaistDir).filter((f) => f.endsWith('.csv')).sort().map((f) => path.join(kaistDir, f));
+  const ulgs = readdirSync(ulgDir).filter((f) => f.endsWith('.ulg')).sort().map((f) => path.join(ulgDir, f));
+  const logbookCli = (args) => JSON.parse(execFileSync(BIN, ['logbook', ...args, '--db', book, '--format', 'json'], { encoding: 'utf8' }));
+  logbookCli(['add', ...kaist, '--vehicle-label', 'kaist-m600']);
+  logbookCli(['add', ...ulgs.slice(0, 2), '--pack-label', 'flugdrohne-3s-a']);
+  logbookCli(['add', ...ulgs.slice(2), '--pack-label', 'flugdrohne-3s-b']);
+  // The page flies a vehicle file named as the logbook's kaist-m600 (the M600's, renamed).
+  const m600 = path.join(bookDir, 'kaist-m600.toml');
+  writeFileSync(m600, readFileSync(path.join(repo, 'fixtures/vehicles/dji-m600.toml'), 'utf8').replace('name = "dji-m600"', 'name = "kaist-m600"'));
+  const vehicles = logbookCli(['vehicles']).vehicles;
+  const packs = logbookCli(['packs']).packs;
+  const lb = await serve(['--logbook', book, '--vehicle', m600]);
+  try {
+    const page = await openPage(lb.url);
+    for (const kind of ['flights', 'vehicles', 'packs']) {
+      await check(`GET /api/logbook/${kind} equals aloft logbook ${kind} --format json`, async () => {
+        const served = await page.evaluate((k) => fetch(`/api/logbook/${k}`).then((r) => r.json()), kind);
+        const cli = logbookCli([kind]);
+        assert(JSON.stringify(served) === JSON.stringify(cli), `${JSON.stringify(served).slice(0, 300)} vs ${JSON.stringify(cli).slice(0, 300)}`);
+      });
+    }
+    await check(`the logbook panel lists the ${vehicles.length} vehicles and ${packs.length} packs`, async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])');
+      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent));
+      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent));
+      assert(v.length === vehicles.length && p.length === packs.length, `${v} / ${p}`);
+    });
+    await check('the logbook panel opens on the vehicle the page flies (kaist-m600), not the first listed', async () => {
+      const at = vehicles.findIndex((v) => v.key === 'kaist-m600');
+      assert(at > 0, `kaist-m600 is vehicle ${at} of the logbook`);
+      assert((await page.$eval('#vehicle', (s) => s.value)) === 'kaist-m600', 'the page does not fly kaist-m600');
+      const shown = await page.$eval('#logbook-vehicle', (s) => s.value);
+      assert(shown === String(at), `vehicle ${shown} shown`);
+      const summary = await page.textContent('#logbook-vehicle-summary');
+      assert(summary.startsWith('kaist-m600: '), summary);
+    });
+    for (const v of vehicles) {
+      const hover = v.power.filter((x) => typeof x.hover_power_w === 'number').length;
+      const mean = v.power.filter((x) => typeof x.mean_power_w === 'number').length;
+      await check(`vehicle ${v.key}: ${mean} mean and ${hover} hover powers charted, with a legend`, async () => {
+        await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(v)));
+        const got = await page.evaluate(() => [
+          document.querySelectorAll('#logbook-vehicle-chart circle.mean-power').length,
+          document.querySelectorAll('#logbook-vehicle-chart circle.hover-power').length,
+          document.querySelector('#logbook-vehicle-summary').textContent,
+          [...document.querySelectorAll('#logbook-vehicle-chart g.legend text')].map((t) => t.textContent).join(','),
+        ]);
+        assert(got[0] === mean && got[1] === hover, JSON.stringify(got));
+        assert(got[2].startsWith(`${v.key}: ${v.flights} flights`), got[2]);
+        if (mean + hover > 0) assert(got[3] === 'mean power,hover power', `legend: ${got[3]}`);
+      });
+    }
+    const flugdrohne = vehicles.find((v) => v.packs.includes('flugdrohne-3s-a'));
+    const own = packs.filter((p) => flugdrohne.packs.includes(p.key) && p.resistance.length > 0);
+    await check(`vehicle ${flugdrohne.key}: the resistance of each of its ${own.length} packs its own line, never one line through both`, async () => {
+      assert(own.length === 2, `${own.length} packs with a resistance`);
+      await page.selectOption('#logbook-vehicle', String(vehicles.indexOf(flugdrohne)));
+      const lines = await page.$$eval('#logbook-pack-chart polyline.resistance', (ps) => ps.map((p) => p.getAttribute('points').trim().split(/\s+/).filter(Boolean).length));
+      assert(lines.length === own.length, `${lines.length} lines: ${lines}`);
+      assert(lines.slice().sort().join(',') === own.map((p) => p.resistance.length).sort().join(','), `${lines} vs ${own.map((p) => p.resistance.length)}`);
+      const legend = await page.$$eval('#logbook-pack-chart g.legend text', (ts) => ts.map((t) => t.textContent).sort().join(','));
+      assert(legend === own.map((p) => p.key).sort().join(','), legend);
+    });
+    const pack = packs.find((p) => p.key === 'flugdrohne-3s-b');
+    await check(`pack flugdrohne-3s-b: its ${pack.resistance.length} resistances charted in mOhm, drawn over the other pack`, async () => {
+      await page.selectOption('#logbook-pack', String(packs.indexOf(pack)));
+      const cys = await page.$$eval('#logbook-pack-chart circle.resistance.selected', (cs) => cs.map((c) => c.querySelector('title').textContent));
+      assert(cys.length === pack.resistance.length, `${cys.length}`);
+      const first = `flight 1, flugdrohne-3s-b: ${(pack.resistance[0].value * 1000).toFixed(1)}`;
+      assert(cys[0] === first, `${cys[0]} vs ${first}`);
+      const summary = await page.textContent('#logbook-pack-summary');
+      assert(summary.includes(`over ${pack.resistance_trend.n} flights`), summary);
+    });
+    await page.context().close();
+  } finally {
+    lb.stop();
+  }
+  // A page flying a vehicle the logbook does not know: the vehicle with the latest flight.
+  const latest = (v) => Math.max(-Infinity, ...v.power.map((p) => (typeof p.start_unix_s === 'number' ? p.start_unix_s : -Infinity)));
+  const newest = vehicles.reduce((b, v) => (latest(v) > latest(b) ? v : b), vehicles[0]);
+  const other = await serve(['--logbook', book]);
+  try {
+    const page = await openPage(other.url);
+    await check(`flying dji-m100, which the logbook does not know: the panel opens on the vehicle of the latest flight (${newest.key})`, async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])');
+      const shown = await page.$eval('#logbook-vehicle', (s) => s.value);
+      assert(shown === String(vehicles.indexOf(newest)), `vehicle ${shown} shown`);
+    });
+    await page.context().close();
+  } finally {
+    other.stop();
+    rmSync(bookDir, { recursive: true, force: true });
+  }
+}
+
+// ------------------------------------------------------------------ markup in names (issue 41)
+
+// Markup that runs script when it is parsed as HTML (an image that fails to load): `tag` says
+// where it came from, in `window.__pwned` if it ever runs.
+const evil = (tag) => `<img src=x onerror=window.__pwned='${tag}'>`;
+
+// What ran in the page: `window.__pwned` and the policy's violations.
+async function pwned(page) {
+  return page.evaluate(() => ({ pwned: window.__pwned, violations: window.__violations || [] }));
+}
+
+async function assertClean(page, where) {
+  await page.waitForTimeout(200); // an image's error event comes after its failed load
+  const p = await pwned(page);
+  assert(p.pwned === undefined, `${where}: markup ran (window.__pwned = ${p.pwned})`);
+  assert(p.violations.length === 0, `${where}: policy violations: ${p.violations.join(' | ')}`);
+  assert(dialogs.length === 0, `${where}: dialogs ${dialogs.join(' | ')}`);
+}
+
+// Move the mouse onto the middle of an SVG path of the map (a real hover: Leaflet opens its
+// tooltip), and the tooltips' text then.
+async function hoverPath(page, selector) {
+  const at = await page.$eval(selector, (p) => {
+    const q = p.getPointAtLength(p.getTotalLength() / 2);
+    const m = p.getScreenCTM();
+    return { x: q.x * m.a + q.y * m.c + m.e, y: q.x * m.b + q.y * m.d + m.f };
+  });
+  await page.mouse.move(at.x, at.y);
+  await page.waitForTimeout(150);
+  return page.$eval('#map', (m) => [...m.querySelectorAll('.leaflet-tooltip')].map((t) => t.textContent).join(' | '));
+}
+
+// Files whose names and contents carry markup, on every panel: the page shows each as text and
+// no script runs (issue 41: a mission file's name ran in a sortie's tooltip).
+async function markupEverywhere() {
+  const dir = mkdtempSync(path.join(os.tmpdir(), 'aloft-markup-'));
+  const demo = readFileSync(DEMO, 'utf8');
+  const missionName = evil('mission-name');
+  const givenMission = path.join(dir, `${evil('given-mission')}.toml`);
+  writeFileSync(givenMission, demo.replace('name = "demo-survey"', `name = "${missionName}"`).replace(/^description = .*$/m, `description = "${evil('description')}"`));
+  const givenLog = path.join(dir, `${evil('given-log')}.ulg`);
+  writeFileSync(givenLog, readFileSync(path.join(DATA, 'flight_logs/pyulog_sample_log_small.ulg')));
+  // A logbook whose vehicle, pack and file carry markup.
+  const book = path.join(dir, 'logbook.sqlite');
+  const ulg = readdirSync(path.join(DATA, 'px4_flugdrohne/ulg')).filter((f) => f.endsWith('.ulg')).sort()[0];
+  const bookLog = path.join(dir, `${evil('logbook-file')}.ulg`);
+  writeFileSync(bookLog, readFileSync(path.join(DATA, 'px4_flugdrohne/ulg', ulg)));
+  execFileSync(BIN, ['logbook', 'add', bookLog, '--vehicle-label', evil('logbook-vehicle'), '--pack-label', evil('logbook-pack'), '--db', book], { stdio: 'ignore' });
+  const server = await serve([givenMission, givenLog, '--logbook', book, '--tiles', '/vendor/leaflet/images/layers.png?{z}/{x}/{y}', '--attribution', evil('attribution')]);
+  try {
+    const page = await openPage(server.url);
+    await check('markup: a given mission whose file name and name carry markup is listed and summarised as text', async () => {
+      const label = await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent);
+      assert(label === path.basename(givenMission), label);
+      const summary = await page.$eval('#summary', (e) => e.textContent);
+      assert(summary.includes(missionName), summary);
+      assert((await page.$$('#summary img, #mission-select img')).length === 0, 'an image element was made');
+      for (const k of [1, 3]) await hoverPath(page, `#map path.seg >> nth=${k}`);
+      await hoverPath(page, '#map path.home');
+      await assertClean(page, 'the given mission');
+    });
+    await check('markup: a given log whose file name carries markup is shown as text', async () => {
+      await page.waitForSelector('#log .log-card', { timeout: 10000 });
+      const text = await page.$eval('#log .log-card', (c) => c.textContent);
+      assert(text.includes(path.basename(givenLog)), text);
+      await assertClean(page, 'the given log');
+    });
+    await check('markup: the logbook panel shows vehicle and pack keys with markup as text', async () => {
+      await page.waitForSelector('#logbook-panel:not([hidden])', { timeout: 10000 });
+      const v = await page.$$eval('#logbook-vehicle option', (os) => os.map((o) => o.textContent).join(' | '));
+      const p = await page.$$eval('#logbook-pack option', (os) => os.map((o) => o.textContent).join(' | '));
+      // (The log names its vehicle: the label is the pack's only.)
+      assert(p.includes(evil('logbook-pack')), `${v} / ${p}`);
+      const summaries = await page.$eval('#logbook-panel', (e) => e.textContent);
+      assert(summaries.includes(evil('logbook-pack')), summaries);
+      assert((await page.$$('#logbook-panel img')).length === 0, 'an image element was made');
+      await assertClean(page, 'the logbook');
+    });
+    const dropped = `${evil('dropped-plan')}.plan`;
+    await check('markup: a dropped .plan named with markup is drawn on the tiles, its attribution (markup too) as text', async () => {
+      const before = await plans(page);
+      await dropFiles(page, [{ name: dropped, bytes: readFileSync(PLAN_MISSION) }]);
+      await waitReady(page, before);
+      const label = await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent);
+      assert(label === `${dropped} (opened)`, label);
+      await page.waitForSelector('#map .leaflet-control-attribution', { timeout: 10000 });
+      const attribution = await page.$eval('#map .leaflet-control-attribution', (e) => e.textContent);
+      assert(attribution.includes(evil('attribution')), attribution);
+      await hoverPath(page, '#map path.seg >> nth=2');
+      await assertClean(page, 'the dropped plan');
+    });
+    await check('markup: plan to fly names each sortie as the server does, as text, in the table and in the tooltips', async () => {
+      const before = await plans(page);
+      await setOptions(page, { reserve: '70', 'wind-speed': '8', 'wind-from': '0' });
+      await waitReady(page, before);
+      const [answer] = await Promise.all([
+        page.waitForResponse((r) => r.url().includes('/api/plan?'), { timeout: 60000 }).then((r) => r.json()),
+        page.click('#plan-fly'),
+      ]);
+      await page.waitForSelector('#fly[data-state="ready"] table.fly-sorties tbody tr', { timeout: 60000 });
+      const names = answer.sorties.map((s) => s.file);
+      assert(names.length >= 2, `${names.length} sorties`);
+      const cells = await page.$$eval('#fly table.fly-sorties td.file', (tds) => tds.map((td) => td.textContent));
+      assert(cells.join('\n') === names.join('\n'), `${cells} vs ${names}`);
+      for (let k = 1; k <= names.length; k++) {
+        const tip = await hoverPath(page, `#map path.fly-route.fly-sortie-${k}`);
+        assert(tip.includes(`sortie ${k} (${names[k - 1]})`), `sortie ${k}: ${tip}`);
+      }
+      if (await page.$('#map path.fly-pnr')) await hoverPath(page, '#map path.fly-pnr');
+      assert((await page.$$('#map img:not(.leaflet-tile), #fly img')).length === 0, 'an image element was made');
+      await assertClean(page, 'the plan to fly');
+    });
+    await check('markup: a dropped vehicle file whose file name and name carry markup is listed and flown as text', async () => {
+      const name = evil('vehicle-name');
+      const text = readFileSync(path.join(repo, 'fixtures/vehicles/dji-inspire1.toml'), 'utf8').replace('name = "dji-inspire1"', `name = "${name}"`);
+      const before = await plans(page);
+      await dropFiles(page, [{ name: `${evil('vehicle-file')}.toml`, bytes: Buffer.from(text) }]);
+      await waitReady(page, before);
+      const options = await page.$$eval('#vehicle option', (os) => os.map((o) => o.textContent));
+      assert(options.includes(name), options.join(' | '));
+      const summary = await page.$eval('#summary', (e) => e.textContent);
+      assert(summary.includes(name), summary);
+      await page.waitForFunction((n) => document.querySelector('#sweep-title').textContent.includes(n), name, { timeout: 20000 });
+      await assertClean(page, 'the dropped vehicle');
+    });
+    await check('markup: a dropped log named with markup, and a file the server cannot read, are shown as text', async () => {
+      const name = `${evil('dropped-log')}.ulg`;
+      await dropFiles(page, [{ name, bytes: readFileSync(path.join(DATA, 'flight_logs/pyulog_sample_log_small.ulg')) }]);
+      await page.waitForFunction((n) => [...document.querySelectorAll('#log .log-card')].some((c) => c.textContent.includes(n)), name, { timeout: 20000 });
+      const bad = `${evil('bad-file')}.bin`;
+      await refusing(async () => {
+        await dropFiles(page, [{ name: bad, bytes: Buffer.from('not a flight log at all\n') }]);
+        await page.waitForFunction((n) => !document.querySelector('#error').hidden && document.querySelector('#error').textContent.includes(n), bad, { timeout: 20000 });
+      });
+      const badPlan = `${evil('bad-mission')}.toml`;
+      await refusing(async () => {
+        const before = await plans(page);
+        await dropFiles(page, [{ name: badPlan, bytes: Buffer.from(`name = "${evil('bad-mission-name')}"\n[[segment]]\nkind = "nonsense"\n`) }]);
+        await waitReady(page, before);
+      });
+      const shown = await page.$eval('#error', (e) => e.textContent);
+      assert(shown.includes(badPlan), shown);
+      assert((await page.$$('#log img, #error img')).length === 0, 'an image element was made');
+      await assertClean(page, 'the dropped log and the refusals');
+    });
+    await check("markup: the plan's zip holds base names only, whatever names the server gives", async () => {
+      // Back to the dropped plan (the last mission dropped was refused), flown by the M100.
+      let before = await plans(page);
+      await page.selectOption('#mission-select', { label: `${dropped} (opened)` });
+      await waitReady(page, before);
+      before = await plans(page);
+      await page.selectOption('#vehicle', 'dji-m100');
+      await waitReady(page, before);
+      const hostile = ['../../escaped-1-of-3.plan', '..\\..\\escaped-2-of-3.plan', '/etc/cron.d/escaped-3-of-3.plan', '..'];
+      await page.route('**/api/plan?**', async (route) => {
+        const response = await route.fetch();
+        const plan = await response.json().catch(() => ({}));
+        const name = (_, k) => hostile[k % hostile.length];
+        if (Array.isArray(plan.texts)) {
+          plan.texts.forEach((t, k) => (t.file = name(t, k)));
+          plan.sorties.forEach((s, k) => (s.file = name(s, k)));
+          (plan.maps || []).forEach((m, k) => (m.file = name(m, k)));
+          plan.files = plan.files.map(name);
+        }
+        await route.fulfill({ response, json: plan });
+      });
+      await page.click('#plan-fly');
+      await page.waitForSelector('#fly[data-state="ready"] a.fly-all', { timeout: 60000 });
+      const links = await page.$$eval('#fly a.fly-file', (as) => as.map((a) => a.getAttribute('download')));
+      for (const l of links) assert(l && !/[\/\\]/.test(l) && !l.includes('..') && !l.startsWith('.'), `link ${l}`);
+      const [zip] = await Promise.all([page.waitForEvent('download'), page.click('#fly a.fly-all')]);
+      const zipPath = path.join(dir, 'plan.zip');
+      await zip.saveAs(zipPath);
+      const listed = JSON.parse(execFileSync('python3', ['-c', 'import json,sys,zipfile; z=zipfile.ZipFile(sys.argv[1]); print(json.dumps({"bad": z.testzip(), "names": z.namelist()}))', zipPath], { encoding: 'utf8' }));
+      assert(listed.bad === null && listed.names.length === links.length, JSON.stringify(listed));
+      for (const n of listed.names) assert(n && !/[\/\\]/.test(n) && !n.includes('..') && !n.startsWith('.'), `zip entry ${n}`);
+      assert(new Set(listed.names).size === listed.names.length, `names repeat: ${listed.names}`);
+      await page.unroute('**/api/plan?**');
+      await assertClean(page, 'the zip');
+    });
+    await page.context().close();
+  } finally {
+    server.stop();
+  }
+  // The live panel: a followed telemetry log named with markup, at 4 times its speed (its first
+  // 18 s carry a note: where the state of charge comes from).
+  const tlog = path.join(dir, `${evil('tlog')}.tlog`);
+  writeFileSync(tlog, readFileSync(TLOG));
+  const lines = execFileSync(BIN, ['live', '--tlog', tlog, '--speed', 'max', '--format', 'json'], { encoding: 'utf8', maxBuffer: 1 << 26 }).trim().split('\n');
+  const note = lines.map((l) => JSON.parse(l)).find((u) => typeof u.note === 'string').note;
+  const live = await serve(['--tlog', tlog, '--speed', '4']);
+  try {
+    const page = await openPage(live.url);
+    await check("markup: a followed telemetry log named with markup: the live panel shows its updates and aloft live's note as text, nothing runs", async () => {
+      await page.waitForFunction(() => document.querySelector('#live') && document.querySelector('#live').dataset.mode, null, { timeout: 20000 });
+      await page.waitForFunction((n) => [...document.querySelectorAll('#live dd')].some((d) => d.textContent === n), note, { timeout: 20000 });
+      await page.waitForSelector('#map path.vehicle', { timeout: 10000 });
+      await hoverPath(page, '#map path.vehicle');
+      await assertClean(page, 'the live panel');
+    });
+    await page.context().close();
+  } finally {
+    live.stop();
+    rmSync(dir, { recursive: true, force: true });
+  }
 }
 
 try {

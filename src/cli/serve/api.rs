@@ -11,11 +11,14 @@ use axum::response::{IntoResponse, Response};
 use axum::routing::{post, MethodRouter};
 
 use aloft::engine::answers;
-use aloft::engine::flags::{EnduranceFlags, MissionScenarioFlags, PlanFlags};
-use aloft::engine::{file_keywords, parse_keywords, FlagGroup, Keyword, Mission, Vehicle};
+use aloft::engine::flags::{EnduranceFlags, MissionFlags, MissionScenarioFlags, PlanFlags};
+use aloft::engine::{
+    file_keywords, parse_keywords, FlagGroup, Keyword, Mission, StepMeter, Vehicle,
+};
 
 use super::body::{read_whole, within_declared, MISSION_LIMIT, VEHICLE_LIMIT};
 use super::given::Names;
+use super::vehicles::Fleet;
 use super::work::Pool;
 use super::{engine_message, error, json_type, Refused, Shared};
 
@@ -37,6 +40,13 @@ pub(super) async fn config(State(shared): State<Arc<Shared>>) -> Response {
         "logbook": shared.logbook.is_some(),
         "default_vehicle": shared.vehicles.default_name(),
     });
+    let fleet = &shared.vehicles;
+    if let (Some(pack), Some(c)) = (
+        fleet.default_pack(fleet.default_name()),
+        config.as_object_mut(),
+    ) {
+        c.insert("default_battery".into(), pack.name.as_str().into());
+    }
     if let (Some((url, attribution)), Some(c)) = (&shared.tiles, config.as_object_mut()) {
         c.insert("tiles".into(), url.as_str().into());
         c.insert("attribution".into(), attribution.as_str().into());
@@ -98,6 +108,9 @@ pub(super) async fn endurance(
     let request = "GET /api/endurance";
     let mut flags: EnduranceFlags = flags(request, &query, &shared)?;
     let vehicle = shared.vehicles.vehicle(request, &flags.vehicle)?;
+    if let Some(pack) = shared.vehicles.default_pack(&flags.vehicle) {
+        flags.battery.get_or_insert_with(|| pack.name.clone());
+    }
     let work = shared.clone();
     let job = move |cancel: &_| {
         work.work.bound(&mut flags.scenarios, cancel);
@@ -109,33 +122,41 @@ pub(super) async fn endurance(
 /// The options of a request with a mission as its body: a flag group whose work the server
 /// bounds ([`super::work`]).
 pub(super) trait MissionRequest: FlagGroup + Send + 'static {
-    /// Bound the request's work within the pool's, with the cancellation flag of its client.
-    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>);
+    /// Bound the request's work within the pool's, with the cancellation flag of its client:
+    /// the meter of its flights ([`StepMeter`]), whose verdict is the request's answer.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter;
 
-    /// The vehicle flown: its name in the server's list (see [`flags`]).
-    fn vehicle(&self) -> &str;
+    /// The mission's options.
+    fn mission(&mut self) -> &mut MissionFlags;
 }
 
 impl MissionRequest for MissionScenarioFlags {
-    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) {
+    /// The scenarios within the pool's bound before they fly, the mission's own flights (the
+    /// plan, its sorties) metered as they fly.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter {
         pool.bound(&mut self.scenarios, cancel);
+        let meter = pool.meter(cancel);
+        self.mission.meter = Some(meter.clone());
+        meter
     }
 
-    fn vehicle(&self) -> &str {
-        &self.mission.vehicle
+    fn mission(&mut self) -> &mut MissionFlags {
+        &mut self.mission
     }
 }
 
 impl MissionRequest for PlanFlags {
-    /// A plan has no scenarios: it flies a few candidates (the planner's own limit on each
-    /// flight, at most [`aloft::engine::MAX_SORTIES`] sorties each) and stops before its next
-    /// candidate or survey angle when its client leaves.
-    fn bound(&mut self, _: &Pool, cancel: &Arc<AtomicBool>) {
+    /// A plan has no scenarios: every flight of its search (candidates, sorties, trials, the
+    /// maps of its files) is metered, and none flies on once its client leaves.
+    fn bound(&mut self, pool: &Pool, cancel: &Arc<AtomicBool>) -> StepMeter {
         self.bounds.cancel = Some(cancel.clone());
+        let meter = pool.meter(cancel);
+        self.mission.meter = Some(meter.clone());
+        meter
     }
 
-    fn vehicle(&self) -> &str {
-        &self.mission.vehicle
+    fn mission(&mut self) -> &mut MissionFlags {
+        &mut self.mission
     }
 }
 
@@ -171,17 +192,33 @@ async fn planned<T: MissionRequest>(
     let limit_name = "the limit on mission files";
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
     let mut flags: T = flags(request, &query, &shared)?;
-    let vehicle = shared.vehicles.vehicle(request, flags.vehicle())?;
+    let vehicle = shared.vehicles.vehicle(request, &flags.mission().vehicle)?;
+    with_default_pack(&shared.vehicles, flags.mission());
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();
     let job = move |cancel: &_| {
-        flags.bound(&work.work, cancel);
-        mission_of(&body, &origin)
-            .and_then(|m| answer(&vehicle, &m, &flags))
-            .map_err(engine_message)
+        let meter = flags.bound(&work.work, cancel);
+        let answered = mission_of(&body, &origin).and_then(|m| answer(&vehicle, &m, &flags));
+        meter.verdict(answered).map_err(engine_message)
     };
     Ok(shared.work.run(job).await)
+}
+
+/// A request that flies the default vehicle and names no pack flies the pack of `--battery`,
+/// with a pack file's failsafes where the request gives none (as `aloft mission --battery FILE`).
+fn with_default_pack(fleet: &Fleet, mission: &mut MissionFlags) {
+    let Some(pack) = fleet.default_pack(&mission.vehicle) else {
+        return;
+    };
+    if mission.battery.is_some() {
+        return;
+    }
+    mission.battery = Some(pack.name.clone());
+    if let Some(f) = &pack.failsafe {
+        mission.low_voltage_v = mission.low_voltage_v.or(f.low_voltage_v);
+        mission.critical_voltage_v = mission.critical_voltage_v.or(f.critical_voltage_v);
+    }
 }
 
 /// The mission of an upload: the built-in demo when empty, else the file's text in any of the

@@ -1,7 +1,8 @@
 //! Who may ask: the checks every request passes before it is routed.
 //!
-//! - **`Host`** (and the authority of an absolute-form target, `GET http://h/ HTTP/1.1`) must
-//!   name this server: the address it listens on; on loopback also `localhost`; listening on every
+//! - **`Host`**, exactly one (a request with two is 400: a proxy or a cache in front may read the
+//!   other one than this server does), and the authority of an absolute-form target
+//!   (`GET http://h/ HTTP/1.1`), must name this server: the address it listens on; on loopback also `localhost`; listening on every
 //!   interface (`0.0.0.0`, `[::]`), the address the connection came in on, the machine's name and
 //!   `NAME.local`, with the port. Anything else is a page elsewhere that reached the server
 //!   through DNS rebinding: 403.
@@ -127,10 +128,20 @@ pub(super) async fn check(
     next: Next,
 ) -> Response {
     let local = request.extensions().get::<LocalAddr>().map(|l| l.0);
+    if let Some(why) = malformed(request.headers()) {
+        return error(StatusCode::BAD_REQUEST, &why);
+    }
     match refusal(&shared.hosts, request.headers(), request.uri(), local) {
         Some(why) => error(StatusCode::FORBIDDEN, &why),
         None => next.run(request).await,
     }
+}
+
+/// Why a request's head cannot be read as one request (400), if it cannot: more than one
+/// `Host`.
+fn malformed(headers: &HeaderMap) -> Option<String> {
+    let hosts = headers.get_all(header::HOST).iter().count();
+    (hosts > 1).then(|| format!("the request has {hosts} Host headers: give one"))
 }
 
 /// Why a request is refused, if it is.

@@ -35,9 +35,14 @@ pub(super) struct Feed {
 }
 
 /// Start following the flight of `--live` / `--tlog`, if one is given, with `vehicle` (the
-/// first `--vehicle`, read at start): its source opened here (a bad address or file is bad
+/// first `--vehicle`, read at start) and `battery` (the pack of `--battery`, by its name among
+/// the vehicle's packs): its source opened here (a bad address or file is bad
 /// input, before the server starts), followed on a thread.
-pub(super) fn start(args: &ServeArgs, vehicle: Arc<Vehicle>) -> Result<Option<Feed>> {
+pub(super) fn start(
+    args: &ServeArgs,
+    vehicle: Arc<Vehicle>,
+    battery: Option<String>,
+) -> Result<Option<Feed>> {
     let mut given: Vec<(String, Keyword)> = Vec::new();
     let one = |k: &str, v: String| (k.to_string(), Keyword::One(v.into()));
     match (&args.live, &args.tlog) {
@@ -46,7 +51,7 @@ pub(super) fn start(args: &ServeArgs, vehicle: Arc<Vehicle>) -> Result<Option<Fe
         (None, None) => return Ok(None),
     }
     given.extend(args.speed.clone().map(|s| one("speed", s)));
-    given.extend(args.battery.clone().map(|b| one("battery", b)));
+    given.extend(battery.map(|b| one("battery", b)));
     let flags: LiveFlags = parse(&given)?;
     let LiveTask::Follow { source, request } = flags.request()? else {
         anyhow::bail!("--live/--tlog: not a flight to follow");

@@ -4,7 +4,7 @@
 //! | request | answer |
 //! |---|---|
 //! | `GET /` | the page (its files built into the binary: [`assets`]) |
-//! | `GET /api/config` | the files given on the command line, the default vehicle (`default_vehicle`: the first `--vehicle`), the tile layer, whether a flight is followed |
+//! | `GET /api/config` | the files given on the command line, the default vehicle (`default_vehicle`: the first `--vehicle`) and its pack when `--battery` gives one (`default_battery`), the tile layer, whether a flight is followed |
 //! | `GET /api/vehicles` | `aloft vehicles --format json`, then the entries of the vehicle files given (`--vehicle FILE...` and positionally) and sent ([`vehicles`]) |
 //! | `POST /api/vehicles?file=NAME` (body: a vehicle file, at most 256 KiB) | the vehicle kept in memory under its own name (no built-in's nor given vehicle's: 422), answered with its entry of `/api/vehicles`; at most 32 kept, the oldest forgotten |
 //! | `GET /api/endurance?OPTIONS` | `aloft endurance OPTIONS --format json` |
@@ -26,8 +26,12 @@
 //! command line's text; an infeasible mission is an answer (200), and so is a mission no plan
 //! keeps the reserve for (`{"feasible": false, "reason": ...}`, as `aloft plan` answers it).
 //!
-//! Errors, each `{"error": "..."}`: 400 for options the command does not take or a file option
-//! naming no given file, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
+//! Every answer carries a Content-Security-Policy without inline script and `nosniff`
+//! ([`policy`]).
+//!
+//! Errors, each `{"error": "..."}` quoting at most 80 characters of any value ([`quotes`]): 400
+//! for options the command does not take, a file option naming no given file or a request with
+//! two `Host` headers, 403 for a request from elsewhere ([`guard`]: a `Host` that is not this
 //! server's, a page of another origin), 404 for anything else, 405 for a method a route does
 //! not take, 408 for a body that stops
 //! arriving, 413 for a body past its limit ([`body`]), 422 for a request the engine refuses (the
@@ -43,6 +47,8 @@ mod files;
 mod given;
 mod guard;
 mod live;
+mod policy;
+mod quotes;
 mod vehicles;
 mod work;
 
@@ -106,8 +112,11 @@ pub struct ServeArgs {
     /// Takes several values: give missions and logs before it.
     #[arg(long, value_name = "NAME|FILE", num_args = 1..)]
     vehicle: Vec<String>,
-    /// Its battery pack (default: the vehicle's first).
-    #[arg(long)]
+    /// The default vehicle's pack (the first `--vehicle`'s): one of its packs by name, or a
+    /// pack file (`aloft pack fit`, `aloft logbook pack-file`) flown as `aloft mission --battery
+    /// FILE` flies it. Requests that fly that vehicle and name no pack fly it, and so does
+    /// `--live` / `--tlog` (default: the vehicle's own default pack).
+    #[arg(long, value_name = "NAME|FILE")]
     battery: Option<String>,
     /// A logbook (`aloft logbook --db FILE`) whose vehicles' and packs' histories the page
     /// charts. Only this file: a request never names a logbook.
@@ -136,6 +145,8 @@ struct Shared {
     vehicles: vehicles::Fleet,
     /// The logbook given with `--logbook`.
     logbook: Option<PathBuf>,
+    /// The Content-Security-Policy of every answer ([`policy`]).
+    policy: HeaderValue,
 }
 
 pub fn run(args: ServeArgs) -> Result<Outcome> {
@@ -144,10 +155,14 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
             anyhow::bail!("--tiles '{t}': the URL template needs {{z}}, {{x}} and {{y}}");
         }
     }
+    let policy = policy::content_policy(args.tiles.as_deref())?;
     let mut given = given::read_given(&args.files)?;
     given.extend(given::read_vehicles(&args.vehicle, &given)?);
     let default = args.vehicle.first().map_or(DEFAULT_VEHICLE, String::as_str);
-    let fleet = vehicles::Fleet::new(&given::vehicles_of(&given), default)?;
+    let mut fleet = vehicles::Fleet::new(&given::vehicles_of(&given), default)?;
+    if let Some(battery) = &args.battery {
+        fleet.fly_default_with(battery)?;
+    }
     let logbook = logbook_of(&args)?;
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -159,6 +174,7 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         files: given,
         vehicles: fleet,
         logbook,
+        policy,
     };
     let served = runtime.block_on(serve(args, state, uploads.path().to_path_buf()));
     // Work still running for clients that have gone is not waited for; the uploads' folder is
@@ -207,6 +223,7 @@ struct AtStart {
     files: Vec<given::Given>,
     vehicles: vehicles::Fleet,
     logbook: Option<PathBuf>,
+    policy: HeaderValue,
 }
 
 async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> {
@@ -214,7 +231,11 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
         .await
         .with_context(|| format!("--listen {}: cannot listen there", args.listen))?;
     let local = listener.local_addr()?;
-    let live = live::start(&args, given.vehicles.default_vehicle())?;
+    let fleet = &given.vehicles;
+    let pack = fleet
+        .default_pack(fleet.default_name())
+        .map(|p| p.name.clone());
+    let live = live::start(&args, fleet.default_vehicle(), pack)?;
     let shared = Arc::new(Shared {
         hosts: guard::Hosts::new(local),
         files: given.files,
@@ -225,6 +246,7 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
         work: work::Pool::new(args.max_request_steps),
         vehicles: given.vehicles,
         logbook: given.logbook,
+        policy: given.policy,
     });
     let app = router(shared);
     let mut out = std::io::stdout().lock();
@@ -260,6 +282,11 @@ fn router(shared: Arc<Shared>) -> Router {
         .fallback(get(assets::asset).fallback(not_allowed))
         .method_not_allowed_fallback(not_allowed)
         .layer(middleware::from_fn_with_state(shared.clone(), guard::check))
+        .layer(middleware::from_fn(quotes::shortened_errors))
+        .layer(middleware::from_fn_with_state(
+            shared.clone(),
+            policy::headers,
+        ))
         .with_state(shared)
 }
 

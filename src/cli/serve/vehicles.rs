@@ -4,11 +4,21 @@
 //! - the built-ins, under their names;
 //! - the vehicle files given on the command line (positionally or with `--vehicle`), read once
 //!   at start: under their own name (the file's `name`), or, when a built-in or an earlier file
-//!   has it, under the name the file was given with; a request may name them by either;
+//!   has it or one that looks the same ([`looks_like`]), under the name the file was given with;
+//!   a request may name them by either. A name no vehicle may have ([`name_fault`]) stops the
+//!   server at its start;
 //! - the vehicle files sent to `POST /api/vehicles` (a file dropped on the page), kept in memory
-//!   under their own name, which may be no built-in's and no given file's (422 naming the clash).
-//!   Sending a file of a name already sent replaces that vehicle; past [`MAX_SENT`] vehicles
-//!   the oldest is forgotten (a request that names it is then 400, as any unknown name).
+//!   under their own name, which may be no built-in's and no given file's, nor look like one,
+//!   nor look like another sent's without being it (422 naming the clash); a name no vehicle may
+//!   have is refused alike. Sending a file of a name already sent replaces that vehicle; past
+//!   [`MAX_SENT`] vehicles the oldest is forgotten (a request that names it is then 400, as any
+//!   unknown name).
+//!
+//! Two names look the same when they differ only by case, by their spaces, by a dash for a
+//! hyphen (U+2010 HYPHEN and its kin), or by a full-width letter for its ASCII one; a name is
+//! refused when it is empty, long, starts or ends with a space, or holds a control character or
+//! an invisible one (a zero width space, a right-to-left override and the other format
+//! characters), which would make two names that read the same in the list.
 //!
 //! A vehicle is flown from memory ([`Vehicle`], read once): no request reads a file, and no name
 //! a request gives is a path ([`super::given::Names`]).
@@ -19,7 +29,7 @@ use std::sync::{Arc, Mutex};
 use anyhow::{Context, Result};
 use axum::http::StatusCode;
 
-use aloft::engine::{answers, builtin_names, list_vehicles, Vehicle, VehicleEntry};
+use aloft::engine::{answers, fly_with_battery, list_vehicles, Failsafe, Vehicle, VehicleEntry};
 
 use super::{engine_message, error, Refused};
 
@@ -63,6 +73,17 @@ pub(super) struct Fleet {
     sent: Mutex<VecDeque<Listed>>,
     /// The vehicle a request flies when it names none (the first `--vehicle`).
     default: Listed,
+    /// The pack of `--battery`, flown by the default vehicle when a request names none.
+    default_pack: Option<DefaultPack>,
+}
+
+/// The pack of `aloft serve --battery`.
+#[derive(Debug, Clone)]
+pub(super) struct DefaultPack {
+    /// Its name among the default vehicle's packs.
+    pub(super) name: String,
+    /// A pack file's failsafes (the options' own come first).
+    pub(super) failsafe: Option<Failsafe>,
 }
 
 impl Fleet {
@@ -87,12 +108,16 @@ impl Fleet {
             builtins,
             given: Vec::new(),
             sent: Mutex::new(VecDeque::new()),
+            default_pack: None,
         };
         for (given_as, vehicle) in files {
+            if let Some(why) = name_fault(vehicle.name()) {
+                anyhow::bail!("vehicle file {given_as}: its name {why}");
+            }
             let mut entry = vehicle
                 .entry()
                 .with_context(|| format!("vehicle file {given_as}"))?;
-            if fleet.listed(vehicle.name()).is_some() {
+            if fleet.listed_like(vehicle.name()).is_some() {
                 entry.name.clone_from(given_as);
             }
             fleet.given.push(Listed {
@@ -107,12 +132,14 @@ impl Fleet {
         Ok(fleet)
     }
 
-    /// The vehicle listed under `name` (by its name in the list only).
-    fn listed(&self, name: &str) -> Option<&Listed> {
-        self.builtins
-            .iter()
-            .chain(&self.given)
-            .find(|l| l.name() == name)
+    /// The built-in or given vehicle whose name in the list, own name or given name looks like
+    /// `name` ([`looks_like`]).
+    fn listed_like(&self, name: &str) -> Option<&Listed> {
+        self.builtins.iter().chain(&self.given).find(|l| {
+            looks_like(l.name(), name)
+                || looks_like(l.vehicle.name(), name)
+                || l.given_as.as_deref().is_some_and(|g| looks_like(g, name))
+        })
     }
 
     /// The vehicle a request's `vehicle=value` names: a built-in, a given file (by its name in
@@ -152,6 +179,53 @@ impl Fleet {
         self.default.name()
     }
 
+    /// Fly the default vehicle with `battery` (`aloft serve --battery`): one of its packs by
+    /// name, or a pack file added to its packs (replacing one of the same name), as the command
+    /// line's `--battery` flies it ([`fly_with_battery`]). Requests that fly the default vehicle
+    /// and name no pack fly it ([`Self::default_pack`]); its entry in the list names it.
+    ///
+    /// # Errors
+    /// A value that is neither a pack of the vehicle's nor a pack file it can fly, named.
+    pub(super) fn fly_default_with(&mut self, battery: &str) -> Result<()> {
+        let vehicle = self.default.vehicle.as_ref().clone();
+        let flying = fly_with_battery(vehicle, Some(battery))
+            .map_err(|e| anyhow::anyhow!("--battery {battery}: {}", engine_message(e)))?;
+        let name = flying
+            .battery
+            .clone()
+            .unwrap_or_else(|| battery.to_string());
+        if let Err(e) = flying.vehicle.battery(Some(&name)) {
+            anyhow::bail!(
+                "--battery {battery}: neither a pack of {} nor a pack file: {}",
+                self.default.name(),
+                engine_message(e)
+            );
+        }
+        let listed_as = self.default.name().to_string();
+        let mut entry = flying.vehicle.entry()?;
+        entry.name.clone_from(&listed_as);
+        let vehicle = Arc::new(flying.vehicle);
+        let same = |l: &&mut Listed| l.name() == listed_as;
+        for l in self.builtins.iter_mut().chain(&mut self.given).filter(same) {
+            l.vehicle = vehicle.clone();
+            l.entry = entry.clone();
+        }
+        self.default.vehicle = vehicle;
+        self.default.entry = entry;
+        self.default_pack = Some(DefaultPack {
+            name,
+            failsafe: flying.failsafe,
+        });
+        Ok(())
+    }
+
+    /// The pack of `--battery` when `vehicle` (a name in the list) is the default vehicle.
+    pub(super) fn default_pack(&self, vehicle: &str) -> Option<&DefaultPack> {
+        self.default_pack
+            .as_ref()
+            .filter(|_| vehicle == self.default.name())
+    }
+
     /// The vehicle of requests that name none, and the one `--live` / `--tlog` follow.
     pub(super) fn default_vehicle(&self) -> Arc<Vehicle> {
         self.default.vehicle.clone()
@@ -188,6 +262,16 @@ impl Fleet {
         let entry = vehicle.entry().map_err(engine_message)?;
         let answer = answers::vehicle_answer(&vehicle, &name).map_err(engine_message)?;
         let mut sent = self.sent.lock().map_err(|_| "the vehicles' list failed")?;
+        if let Some(other) = sent
+            .iter()
+            .find(|l| l.name() != name && looks_like(l.name(), &name))
+        {
+            return Err(format!(
+                "vehicle file {origin}: its name '{name}' looks like that of a vehicle sent \
+                 before, '{}': give yours a name of its own (`name` in the file)",
+                other.name()
+            ));
+        }
         sent.retain(|l| l.name() != name);
         if sent.len() == MAX_SENT {
             sent.pop_front();
@@ -200,30 +284,156 @@ impl Fleet {
         Ok(answer)
     }
 
-    /// A vehicle sent has a name of its own: not a built-in's nor a given file's (any name a
-    /// request may give it), non-empty, short, on one line.
+    /// A vehicle sent has a name of its own: one a vehicle may have ([`name_fault`]), not a
+    /// built-in's nor a given file's (any name a request may give it), nor one that looks like
+    /// them ([`looks_like`]).
     fn check_name(&self, name: &str, origin: &str) -> Result<(), String> {
         let bad = |why: &str| Err(format!("vehicle file {origin}: its name {why}"));
-        if name.trim().is_empty() {
-            return bad("is empty");
+        if let Some(why) = name_fault(name) {
+            return bad(&why);
         }
-        if name.len() > MAX_NAME_BYTES {
-            return bad(&format!("is longer than {MAX_NAME_BYTES} bytes"));
+        let Some(taken) = self.listed_like(name) else {
+            return Ok(());
+        };
+        let whose = match taken.given_as {
+            None => "a built-in vehicle's",
+            Some(_) => "a vehicle's given to aloft serve on its command line",
+        };
+        let taken = taken.name();
+        match taken == name {
+            true => bad(&format!(
+                "'{name}' is {whose}: give yours a name of its own (`name` in the file)"
+            )),
+            false => bad(&format!(
+                "'{name}' looks like '{taken}', {whose}: give yours a name of its own (`name` \
+                 in the file)"
+            )),
         }
-        if name.chars().any(char::is_control) {
-            return bad("holds a control character");
+    }
+}
+
+/// Why `name` cannot name a vehicle of the list, if it cannot (module docs): empty, longer than
+/// [`MAX_NAME_BYTES`], a space at either end, a control or an invisible character.
+fn name_fault(name: &str) -> Option<String> {
+    if name.trim().is_empty() {
+        return Some("is empty".to_string());
+    }
+    if name.len() > MAX_NAME_BYTES {
+        return Some(format!("is longer than {MAX_NAME_BYTES} bytes"));
+    }
+    if name.trim() != name {
+        return Some("starts or ends with a space".to_string());
+    }
+    if name.chars().any(char::is_control) {
+        return Some("holds a control character".to_string());
+    }
+    if let Some(c) = name.chars().find(|c| invisible(*c)) {
+        return Some(format!(
+            "holds an invisible character (U+{:04X}), which makes it read as another",
+            u32::from(c)
+        ));
+    }
+    None
+}
+
+/// Characters that show nothing (or turn the text around) where they stand: Unicode's format
+/// characters (zero width spaces and joiners, direction marks, embeddings, overrides and
+/// isolates, the byte order mark, tags), variation selectors and the fillers that render blank.
+fn invisible(c: char) -> bool {
+    matches!(
+        u32::from(c),
+        0x00AD
+            | 0x034F
+            | 0x061C
+            | 0x115F..=0x1160
+            | 0x17B4..=0x17B5
+            | 0x180B..=0x180F
+            | 0x200B..=0x200F
+            | 0x202A..=0x202E
+            | 0x2060..=0x206F
+            | 0x3164
+            | 0xFE00..=0xFE0F
+            | 0xFEFF
+            | 0xFFA0
+            | 0xFFF0..=0xFFFB
+            | 0x1D173..=0x1D17A
+            | 0xE0000..=0xE0FFF
+    )
+}
+
+/// Whether two names read the same in the list: equal once each is folded ([`folded`]).
+fn looks_like(a: &str, b: &str) -> bool {
+    folded(a) == folded(b)
+}
+
+/// A name as it reads: lower case; every dash and hyphen (U+2010-U+2015, U+2212, U+FE58,
+/// U+FE63) as `-`; full-width ASCII (U+FF01-U+FF5E) as ASCII; each run of spaces (any Unicode
+/// white space) as one, none at the ends; invisible characters left out.
+fn folded(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    let mut space = false;
+    for c in name.chars().filter(|c| !invisible(*c)) {
+        let c = match u32::from(c) {
+            0x2010..=0x2015 | 0x2212 | 0xFE58 | 0xFE63 => '-',
+            0xFF01..=0xFF5E => char::from_u32(u32::from(c) - 0xFEE0).unwrap_or(c),
+            _ => c,
+        };
+        if c.is_whitespace() {
+            space = !out.is_empty();
+            continue;
         }
-        if builtin_names().contains(&name) {
-            return bad(&format!(
-                "'{name}' is a built-in vehicle's: give yours a name of its own (`name` in the file)"
-            ));
+        if space {
+            out.push(' ');
+            space = false;
         }
-        if self.given.iter().any(|l| l.answers_to(name)) {
-            return bad(&format!(
-                "'{name}' is a vehicle's given to aloft serve on its command line: give yours \
-                 a name of its own (`name` in the file)"
-            ));
+        out.extend(c.to_lowercase());
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_that_read_the_same_fold_to_one() {
+        for (a, b) in [
+            ("dji-m100", "DJI-M100"),
+            ("dji-m100", "dji\u{2010}m100"),
+            ("dji-m100", "dji\u{2212}m100"),
+            ("my quad", "my\u{00A0}\u{00A0}quad"),
+            ("my-quad", "\u{FF4D}y-quad"),
+            ("my-quad", "my-\u{200B}quad"),
+        ] {
+            assert!(looks_like(a, b), "{a:?} {b:?}");
         }
-        Ok(())
+        for (a, b) in [
+            ("dji-m100", "dji-m600"),
+            ("my-quad", "my_quad"),
+            ("quad", "quads"),
+        ] {
+            assert!(!looks_like(a, b), "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn names_that_hide_what_they_are_are_refused() {
+        for bad in [
+            "",
+            "  ",
+            "quad ",
+            " quad",
+            "quad\u{00A0}",
+            "qu\u{200B}ad",
+            "\u{202E}dauq",
+            "quad\u{FE0F}",
+            "a\tb",
+        ] {
+            assert!(name_fault(bad).is_some(), "{bad:?}");
+        }
+        for good in ["my quad", "Quad-7 (2024)", "квадрокоптер", "<b>x</b>"] {
+            assert_eq!(name_fault(good), None, "{good:?}");
+        }
+        assert!(name_fault(&"x".repeat(101)).is_some());
     }
 }

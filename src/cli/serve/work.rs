@@ -7,11 +7,14 @@
 //! - **How much**: a request's scenarios fly at most `--max-request-steps` planner steps in all
 //!   (samples x the flight's steps; 422 beyond, naming the most samples that fit), on at most one
 //!   thread per core whatever `threads` asks (the answer does not depend on it; each thread holds
-//!   its own state, so the threads bound the memory too). One flight is bounded by the planner's
-//!   own limit of ten million steps.
+//!   its own state, so the threads bound the memory too). The flights of its mission, or of its
+//!   plan to fly (`/api/plan`: candidates, sorties, trials, the maps of its files), fly at most
+//!   `--max-request-steps` more, metered as they fly ([`StepMeter`]: 422 once a flight would
+//!   pass it, naming the bound). One flight is bounded by the planner's own limit of ten million
+//!   steps.
 //! - **For whom**: when the client goes away (its connection closes), the request's future is
-//!   dropped, which cancels its work: the scenarios stop before their next flight, a plan to
-//!   fly (`/api/plan`) before its next candidate or survey angle.
+//!   dropped, which cancels its work: the scenarios stop before their next flight, a mission or
+//!   a plan to fly within the flight it is flying (no flight starts after).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -21,7 +24,7 @@ use axum::response::{IntoResponse, Response};
 use tokio::sync::Semaphore;
 
 use aloft::engine::flags::ScenarioFlags;
-use aloft::engine::WorkBounds;
+use aloft::engine::{StepMeter, WorkBounds};
 
 use super::{answer, error};
 
@@ -64,6 +67,14 @@ impl Pool {
             max_steps: Some(self.max_steps),
             cancel: Some(cancel.clone()),
         };
+    }
+
+    /// The meter of a request's flights: at most the pool's steps, stopped by `cancel`.
+    pub(super) fn meter(&self, cancel: &Arc<AtomicBool>) -> StepMeter {
+        StepMeter::new(WorkBounds {
+            max_steps: Some(self.max_steps),
+            cancel: Some(cancel.clone()),
+        })
     }
 
     /// Run `work` on the blocking pool with a permit (503 without one) and a cancellation flag
