@@ -7,7 +7,8 @@
 //! - A command is a line of a fenced code block that starts with `aloft ` or `$ aloft ` (or the
 //!   quick start's `cargo run --release -- `, which runs the same program), continued over lines
 //!   that end with a backslash. Blocks of other programs (`cargo test`, `pip`, the fuzz runner's
-//!   `cargo run -p aloft-fuzz`) are not run.
+//!   `cargo run -p aloft-fuzz`) are not run, but for the few tools a document uses to prepare a
+//!   file for the next command (`head`, `cp`, `mkdir`, `printf`: [`PREPARING`]), which run too.
 //! - A command runs in `sh` (so its variables, globs and comments behave as in a terminal) with
 //!   the `aloft` under test first on `PATH`. Lines of the form `NAME=value` in a block set a
 //!   variable for the commands after them in that document.
@@ -60,6 +61,22 @@ fn blocks(text: &str) -> Vec<(usize, Vec<&str>)> {
     out
 }
 
+/// The tools a document may use to prepare a file for the next aloft command (a truncated copy
+/// of a log, a folder): run as they are written.
+const PREPARING: [&str; 4] = ["head ", "cp ", "mkdir ", "printf "];
+
+/// The command a line runs: an aloft command (`aloft ...`), or a [`PREPARING`] tool's.
+fn runnable(line: &str) -> Option<String> {
+    if let Some(rest) = aloft_command(line) {
+        return Some(format!("aloft {rest}"));
+    }
+    let line = line.strip_prefix("$ ").unwrap_or(line);
+    PREPARING
+        .iter()
+        .any(|tool| line.starts_with(tool))
+        .then(|| line.to_string())
+}
+
 /// The program the command line runs, when it is aloft.
 fn aloft_command(line: &str) -> Option<&str> {
     let line = line.strip_prefix("$ ").unwrap_or(line);
@@ -98,13 +115,12 @@ fn commands(text: &str) -> (Vec<(usize, String)>, Vec<DocCommand>) {
                 k += 1;
                 continue;
             }
-            let Some(rest) = aloft_command(line) else {
+            let Some(mut text) = runnable(line) else {
                 k += 1;
                 continue;
             };
             let console = line.starts_with("$ ");
             let start = k;
-            let mut text = format!("aloft {rest}");
             while text.trim_end().ends_with('\\') && k + 1 < lines.len() {
                 k += 1;
                 text = format!("{}\n{}", text.trim_end(), lines[k]);

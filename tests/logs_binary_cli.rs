@@ -58,6 +58,8 @@ fn data_val_no_battery_data_is_an_answer_for_info_and_an_error_for_fit_and_valid
         // A fit skips a log it cannot use (issue 35); with no other it is a failed check
         // (exit 1) that says why, and writes no vehicle.
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("nobat-fit.toml");
+        // A file of an earlier run is kept without --force: start without it.
+        let _ = std::fs::remove_file(&out);
         let o = common::aloft(&[
             "fit",
             "--log",
@@ -92,6 +94,8 @@ fn data_val_converted_ulog_and_dataflash_open_in_the_python_mcap_reader() {
         ("sitl_ac47_00000002.BIN", 405),
     ] {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}.mcap"));
+        // A file of an earlier run is kept without --force: start without it.
+        let _ = std::fs::remove_file(&out);
         let j = ok_json(&[
             "convert",
             &shared(name),

@@ -28,6 +28,10 @@ fn aloft_limited(args: &[&str]) -> Output {
     let mut cmd = Command::new("sh");
     cmd.arg("-c")
         .arg(format!("ulimit -v {MEMORY_KIB}; exec \"$0\" \"$@\""))
+        // `ulimit -v` bounds address space, a proxy for memory: with one malloc arena only, the
+        // signal-handling thread of the command line (`src/cli/signals.rs`) does not count its
+        // arena's 64 MiB reservation as memory (glibc reserves one per thread).
+        .env("MALLOC_ARENA_MAX", "1")
         .arg(env!("CARGO_BIN_EXE_aloft"))
         .args(args)
         .stdin(Stdio::null());
