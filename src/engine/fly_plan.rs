@@ -34,10 +34,10 @@ use super::mission::{plan_mission, prepare, Prepared};
 use super::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN};
 use super::mission_options::MissionOptions;
 use super::plan_files::PlannerSorties;
-use super::scenarios::WorkBounds;
 use super::sorties::{
     segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
 };
+use super::step_meter::WorkBounds;
 use super::survey_angle::{turned_to_wind, unturnable, AngleChange};
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;

@@ -25,7 +25,7 @@
 //! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `fly_plan.rs`, `sorties.rs`, `plan_files.rs`, `survey_angle.rs` |
 //! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `plan_map.rs` |
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
-//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag; a [`StepMeter`] in [`MissionOptions`]: the steps of every flight of a mission or a plan | [`crate::Error::TooMuchWork`], [`crate::Error::RequestTooLong`], [`crate::Error::Cancelled`] | `scenarios.rs`, `step_meter.rs` |
+//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag; a [`StepMeter`] in [`MissionOptions`]: the steps of every flight of a mission or a plan | [`crate::Error::TooMuchWork`], [`crate::Error::RequestTooLong`], [`crate::Error::Cancelled`] | `step_meter.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `wind.rs`, `logs.rs` |
 //! | files written | [`write_output`], [`Output`], [`OutputSet`] (aloft's one way: exclusive temporary file, rename, nothing replaced without `force`, sets all or nothing), [`safe_stem`] (a name from an input's file name), [`abandon_outputs`] (interrupted) | the files, or [`crate::Error::Output`] | `files.rs` (`aloft_core::output`) |
 //!
@@ -158,11 +158,10 @@ pub use scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
-    Uncertainty, WithUncertainty, WorkBounds, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS,
-    MAX_SCENARIOS,
+    Uncertainty, WithUncertainty, DEFAULT_POWER_SD_PERCENT, DEFAULT_SCENARIOS, MAX_SCENARIOS,
 };
 pub use sorties::{SortieSummary, MAX_SORTIES};
-pub use step_meter::StepMeter;
+pub use step_meter::{StepMeter, WorkBounds};
 pub use summary::{
     mission_summary, FailsafeTime, MissionSummary, PointOfNoReturnSummary, SegmentSummary,
 };

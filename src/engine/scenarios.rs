@@ -64,8 +64,6 @@
 //!   that falls among the scenarios without one is omitted.
 
 use std::borrow::Cow;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
 
@@ -84,6 +82,7 @@ use super::mission_options::MissionOptions;
 use super::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };
+use super::step_meter::WorkBounds;
 use super::summary::reason;
 use super::vehicles::Vehicle;
 use super::wind::mission_wind;
@@ -135,60 +134,6 @@ pub struct ScenarioOptions {
     /// JSON; default: no bound, never cancelled).
     #[serde(skip)]
     pub bounds: WorkBounds,
-}
-
-/// What one request's scenarios may spend: a caller that answers others (`aloft serve`) bounds
-/// the work of each request and stops the work whose answer nobody waits for any more.
-#[derive(Debug, Clone, Default)]
-pub struct WorkBounds {
-    /// Most planner steps (samples of the flight's time grid) over all the scenarios of a
-    /// mission, checked before any is flown from the plan's duration and time step
-    /// ([`Error::TooMuchWork`]); `None`: no bound.
-    pub max_steps: Option<u64>,
-    /// Set by the caller when the answer is no longer wanted: the scenarios stop before their
-    /// next flight with [`Error::Cancelled`].
-    pub cancel: Option<Arc<AtomicBool>>,
-}
-
-impl WorkBounds {
-    /// Whether the caller has given up on the answer.
-    pub(super) fn cancelled(&self) -> bool {
-        self.cancel
-            .as_ref()
-            .is_some_and(|c| c.load(Ordering::Relaxed))
-    }
-
-    /// `samples` flights of about `steps_per_flight` steps each, against [`Self::max_steps`].
-    ///
-    /// # Errors
-    /// [`Error::TooMuchWork`] beyond the bound.
-    fn check(&self, samples: u32, steps_per_flight: u64) -> Result<(), Error> {
-        let Some(max_steps) = self.max_steps else {
-            return Ok(());
-        };
-        let steps = steps_per_flight.max(1);
-        if u64::from(samples).saturating_mul(steps) <= max_steps {
-            return Ok(());
-        }
-        Err(Error::TooMuchWork {
-            samples,
-            steps_per_flight: steps,
-            max_steps,
-            max_samples: max_steps / steps,
-        })
-    }
-}
-
-/// The same bounds: the same step bound and the same cancellation flag (or none).
-impl PartialEq for WorkBounds {
-    fn eq(&self, other: &Self) -> bool {
-        let same_flag = match (&self.cancel, &other.cancel) {
-            (None, None) => true,
-            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-            _ => false,
-        };
-        self.max_steps == other.max_steps && same_flag
-    }
 }
 
 impl Default for ScenarioOptions {

@@ -21,7 +21,7 @@ use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::Wind;
 
 use super::mission_file::Mission;
-use super::scenarios::WorkBounds;
+use super::step_meter::WorkBounds;
 use crate::error::Error;
 
 /// The step of the candidate angles, deg.

@@ -18,10 +18,14 @@
 //! folder the reader may not write makes likely, not certain.
 
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use rusqlite::{Connection, OpenFlags};
 
 use crate::error::{LogbookError, Result};
+
+/// How long a writer waits for another's lock before giving up (two `add`s at once both land).
+pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// The logbook's mark in the SQLite header (`PRAGMA application_id`): the ASCII of "alft",
 /// big-endian, 0x616C6674 = 1634494068.
@@ -154,7 +158,7 @@ pub(crate) fn open_to_read(path: &Path) -> Result<(Connection, Identity)> {
         | OpenFlags::SQLITE_OPEN_NO_MUTEX;
     let open = |query: &str| -> rusqlite::Result<(Connection, Identity)> {
         let conn = Connection::open_with_flags(format!("{}?{query}", uri(path)), flags)?;
-        conn.busy_timeout(crate::ingest::BUSY_TIMEOUT)?;
+        conn.busy_timeout(BUSY_TIMEOUT)?;
         let identity = identify(&conn)?;
         Ok((conn, identity))
     };

@@ -11,12 +11,9 @@ use serde::Serialize;
 use sha2::{Digest, Sha256};
 
 use crate::error::{LogbookError, Result};
-use crate::file::{self, Identity, APPLICATION_ID};
+use crate::file::{self, Identity, APPLICATION_ID, BUSY_TIMEOUT};
 use crate::record::{read_flight, FlightFacts, ReadOptions};
 use crate::schema::{migrate, Migrated, SCHEMA_VERSION};
-
-/// How long a writer waits for another's lock before giving up (two `add`s at once both land).
-pub const BUSY_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// Switch the file to WAL, waiting up to [`BUSY_TIMEOUT`] for other connections. The switch
 /// reads the file and then takes its write lock; when two connections do so at once SQLite

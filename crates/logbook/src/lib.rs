@@ -43,10 +43,10 @@ mod relabel;
 pub mod schema;
 
 pub use error::{LogbookError, Result};
-pub use file::APPLICATION_ID;
+pub use file::{APPLICATION_ID, BUSY_TIMEOUT};
 pub use ingest::{
     cells_from_voltage, cells_of, check_label, derived_pack_key, file_sha256, AddOutcome, Labels,
-    Logbook, BUSY_TIMEOUT, MAX_CELL_V, MIN_FLOWN_CELL_V, MIN_RATED_CAPACITY_MAH, UNKNOWN,
+    Logbook, MAX_CELL_V, MIN_FLOWN_CELL_V, MIN_RATED_CAPACITY_MAH, UNKNOWN,
 };
 pub use query::{
     trend, Flight, PackPoint, PackSummary, PowerDrift, PowerPoint, Skipped, Trend, VehicleSummary,
