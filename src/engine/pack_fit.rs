@@ -220,8 +220,8 @@ struct Analysed {
     skipped: Vec<SkippedLog>,
     failsafe: Failsafe,
     serial: Option<String>,
-    /// What the logs' readers noted (a capacity parameter no pack has, ...), each after its
-    /// log's name.
+    /// What the logs' readers noted (a capacity parameter no pack has), each after its log's
+    /// name.
     notes: Vec<String>,
 }
 
@@ -255,11 +255,12 @@ fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analy
             }
             Err(e) => return Err(Error::LogFile(Box::new(e))),
         };
-        let name = path
-            .file_name()
-            .map_or(file.clone(), |n| n.to_string_lossy().into_owned());
-        out.notes
-            .extend(log.warnings.iter().map(|w| format!("{name}: {w}")));
+        if let Some(note) = &log.capacity_note {
+            let name = path
+                .file_name()
+                .map_or(file.clone(), |n| n.to_string_lossy().into_owned());
+            out.notes.push(format!("{name}: {note}"));
+        }
         if !log.has_current() {
             out.skipped.push(SkippedLog {
                 file,

@@ -151,6 +151,11 @@ pub struct BatteryLog {
     pub samples: Vec<BatterySample>,
     /// What was left out or looked wrong while reading.
     pub warnings: Vec<String>,
+    /// Why the logged capacity parameter is not the pack's, when it is set but outside
+    /// [`MIN_BATTERY_CAPACITY_MAH`]..[`MAX_BATTERY_CAPACITY_MAH`] (a `BAT1_CAPACITY` of 1e-38):
+    /// [`Self::rated_capacity_mah`] is then unset.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capacity_note: Option<String>,
 }
 
 impl BatteryLog {
@@ -210,7 +215,7 @@ impl BatteryDetails {
         mut self,
         source: &str,
         format: &str,
-        mut warnings: Vec<String>,
+        warnings: Vec<String>,
     ) -> BatteryLog {
         let param = |k: &str| self.parameters.get(k).copied();
         let cells = self
@@ -240,14 +245,16 @@ impl BatteryDetails {
         };
         let rated = logged.and_then(plausible_capacity_mah);
         // A value that is set (PX4's unset is -1, ArduPilot's 0) but no pack's is said.
-        if let Some(c) = logged.filter(|c| rated.is_none() && (c.is_nan() || *c > 0.0)) {
-            // Parameters are logged as f32: shown as logged (1e-38, not 9.999999350456404e-39).
-            let shown = (c as f32).to_string().parse().unwrap_or(c);
-            warnings.push(format!(
-                "{key} = {} mA h is not a pack's capacity (from 10 mA h to 1e7 mA h): taken as unset",
-                aloft_core::Num(shown)
-            ));
-        }
+        let capacity_note = logged
+            .filter(|c| rated.is_none() && (c.is_nan() || *c > 0.0))
+            .map(|c| {
+                // Parameters are logged as f32: shown as logged (1e-38, not 9.9999993e-39).
+                let shown = (c as f32).to_string().parse().unwrap_or(c);
+                format!(
+                    "{key} = {} mA h is not a pack's capacity (from 10 mA h to 1e7 mA h): taken as unset",
+                    aloft_core::Num(shown)
+                )
+            });
         let fraction = |v: Option<f64>| v.filter(|v| v.is_finite() && *v > 0.0 && *v < 1.0);
         let vehicle_id = self.vehicle_id.clone().or_else(|| {
             param("BRD_SERIAL_NUM")
@@ -281,6 +288,7 @@ impl BatteryDetails {
             start_unix_s,
             samples: self.samples,
             warnings,
+            capacity_note,
         }
     }
 }
