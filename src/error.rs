@@ -93,8 +93,8 @@ pub enum Error {
         /// The thinnest air flown, kg/m^3.
         min_density_kg_m3: f64,
     },
-    /// No log of a fit could be used (`aloft fit` exits 1).
-    #[error("no log can be used for the fit: {reasons}")]
+    /// No log of a fit or a validation could be used (`aloft fit` and `aloft validate` exit 1).
+    #[error("no log can be used: {reasons}")]
     NoUsableLog {
         /// Each log's reason, `; `-separated.
         reasons: String,
