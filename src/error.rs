@@ -68,8 +68,41 @@ pub enum Error {
         /// The range, in words.
         expected: &'static str,
     },
-    /// No log of a fit could be used (`aloft fit` exits 1).
-    #[error("no log can be used for the fit: {reasons}")]
+    /// A day's air that cannot exist: its water vapour pressure at or above a tenth of the air's
+    /// pressure (air at 100 % humidity near its boiling point).
+    #[error("the air of {} m, {} C, {} % humidity and QNH {} hPa cannot exist: its water vapour pressure, {:.0} Pa, is at least a tenth of the air's pressure, {:.0} Pa", aloft_core::Num(round2(*.elevation_m)), aloft_core::Num(round2(*.temperature_c)), aloft_core::Num(round2(*.humidity_percent)), aloft_core::Num(round2(*.qnh_hpa)), .vapour_pa, .pressure_pa)]
+    AirVapour {
+        /// Elevation, m.
+        elevation_m: f64,
+        /// Air temperature, C.
+        temperature_c: f64,
+        /// Relative humidity, percent.
+        humidity_percent: f64,
+        /// QNH, hPa.
+        qnh_hpa: f64,
+        /// The water vapour's partial pressure, Pa.
+        vapour_pa: f64,
+        /// The air's pressure, Pa.
+        pressure_pa: f64,
+    },
+    /// A day's air thinner than the thinnest the atmosphere answers for (ISA's at 11 km).
+    #[error("the air of {} m, {} C, {} % humidity and QNH {} hPa would have a density of {:.3} kg/m^3, below {:.4} kg/m^3 (ISA's at 11 km, the thinnest air aloft flies in)", aloft_core::Num(round2(*.elevation_m)), aloft_core::Num(round2(*.temperature_c)), aloft_core::Num(round2(*.humidity_percent)), aloft_core::Num(round2(*.qnh_hpa)), .density_kg_m3, .min_density_kg_m3)]
+    AirTooThin {
+        /// Elevation, m.
+        elevation_m: f64,
+        /// Air temperature, C.
+        temperature_c: f64,
+        /// Relative humidity, percent.
+        humidity_percent: f64,
+        /// QNH, hPa.
+        qnh_hpa: f64,
+        /// The density of that air, kg/m^3.
+        density_kg_m3: f64,
+        /// The thinnest air flown, kg/m^3.
+        min_density_kg_m3: f64,
+    },
+    /// No log of a fit or a validation could be used (`aloft fit` and `aloft validate` exit 1).
+    #[error("no log can be used: {reasons}")]
     NoUsableLog {
         /// Each log's reason, `; `-separated.
         reasons: String,
@@ -221,6 +254,31 @@ pub enum Error {
         shared: usize,
         /// The grid's step, in words with its unit.
         step: String,
+    },
+    /// A log whose own landed state keeps it on the ground throughout (`aloft fit` and `aloft
+    /// validate` skip it).
+    #[error("{origin}: never flew: its landed state keeps it on the ground for all of its {duration_s:.1} s")]
+    NeverFlew {
+        /// File.
+        origin: String,
+        /// From its first record to its last, s.
+        duration_s: f64,
+    },
+    /// A log in the air at no second where its motion and its power are both logged.
+    #[error("{origin}: in the air at no time where both its motion and its power are logged: nothing to validate")]
+    NoAirborneTime {
+        /// File.
+        origin: String,
+    },
+    /// Power and motion that overlap too briefly for the lag search's window.
+    #[error("{origin}: power and motion overlap for {overlap_s:.1} s, too short to search the lag of power behind motion within +-{} s (the search needs {} s): give the lag with --lag S, or a smaller window with --max-lag S", aloft_core::Num::of(.max_lag_s), aloft_core::Num(2.0 * *.max_lag_s))]
+    TooShortForLag {
+        /// File.
+        origin: String,
+        /// The span power and motion share, s.
+        overlap_s: f64,
+        /// The search window, s.
+        max_lag_s: f64,
     },
     /// A log with no decodable samples.
     #[error("{origin}: the log holds no decodable samples")]
@@ -548,4 +606,10 @@ impl From<aloft_logs::LogError> for Error {
             e => Error::LogFile(Box::new(e)),
         }
     }
+}
+
+/// `x` to two decimals, as a message shows a day's figure (ISA's -56.5 C at 11 km, not
+/// -56.49999999999997).
+fn round2(x: f64) -> f64 {
+    (x * 100.0).round() / 100.0
 }

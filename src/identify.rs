@@ -12,7 +12,9 @@
 //! # Ground time
 //! Logs that include take-off and landing have stretches on the ground with the motors idle or off.
 //! Samples whose measured power is below `idle_power_fraction` (default 0.25) of the flight's median
-//! are left out and counted ([`AlignedFlight::idle`]); energies are compared over the rest.
+//! are left out of a fit and counted ([`AlignedFlight::idle`]). `aloft validate` keeps them all
+//! and compares over the log's airborne time instead ([`validate_flight`]: the seconds `aloft
+//! mission --replay` books, so that one flight has one measured energy).
 //!
 //! # Flight state from a log
 //! Air-relative velocity = ground velocity - wind when the log carries wind, otherwise the ground
@@ -249,14 +251,25 @@ fn estimate_lag(
         .iter()
         .filter_map(|&t| interpolate(mt, &motion.tilt_rad, t))
         .collect();
-    aloft_logs::estimate_lag_s(&p, &m, dt, max_lag_s).map_err(|e| Error::Log {
-        origin: log.source.clone(),
-        source: Box::new(e),
+    aloft_logs::estimate_lag_s(&p, &m, dt, max_lag_s).map_err(|e| match e {
+        // A window the series are too short for: said with the overlap, not as a bad setting.
+        aloft_logs::LogError::InvalidArgument {
+            name: "max_lag_s", ..
+        } if max_lag_s.is_finite() && max_lag_s >= 0.0 => Error::TooShortForLag {
+            origin: log.source.clone(),
+            overlap_s: p.len() as f64 * dt,
+            max_lag_s,
+        },
+        e => Error::Log {
+            origin: log.source.clone(),
+            source: Box::new(e),
+        },
     })
 }
 
-/// Each flight state with the power at its time plus the lag, where that power is positive;
-/// and how many states had none.
+/// Each flight state with the power at its time plus the lag, where there is one and it is not
+/// negative (a motor stopped in the air draws 0 W, which is measured, not missing); and how many
+/// states had none.
 fn pair_with_power(
     power: &PowerSeries,
     motion: &MotionSeries,
@@ -267,7 +280,7 @@ fn pair_with_power(
     let mut unpaired = 0;
     for (&t, state) in motion.times_s.iter().zip(&motion.states) {
         match interpolate(&power.times_s, &power.power_w, t + lag_s) {
-            Some(p) if p > 0.0 => {
+            Some(p) if p >= 0.0 => {
                 times_s.push(t);
                 samples.push(FitSample::new(*state, p));
             }
@@ -277,20 +290,29 @@ fn pair_with_power(
     (times_s, samples, unpaired)
 }
 
-/// The samples at or above `idle_power_fraction` of the median power, and how many were below.
+/// The samples at or above `idle_power_fraction` of the median power (and above 0 W), and how
+/// many were below; a fraction of 0 keeps every sample (`aloft validate`, whose ground time is
+/// the log's airborne spans).
 fn drop_idle(
     times_s: Vec<f64>,
     samples: Vec<FitSample>,
     idle_power_fraction: f64,
 ) -> (Vec<f64>, Vec<FitSample>, usize) {
-    let mut sorted: Vec<f64> = samples.iter().map(|s| s.measured_power_w).collect();
+    // The median of the powers drawn (a stopped motor's 0 W is idle, not part of the flight's
+    // power).
+    let mut sorted: Vec<f64> = samples
+        .iter()
+        .map(|s| s.measured_power_w)
+        .filter(|p| *p > 0.0)
+        .collect();
     sorted.sort_by(f64::total_cmp);
     let threshold = idle_power_fraction * sorted.get(sorted.len() / 2).copied().unwrap_or(0.0);
+    let keep = |p: f64| idle_power_fraction <= 0.0 || (p > 0.0 && p >= threshold);
     let before = samples.len();
     let (times_s, samples): (Vec<f64>, Vec<FitSample>) = times_s
         .into_iter()
         .zip(samples)
-        .filter(|(_, s)| s.measured_power_w >= threshold)
+        .filter(|(_, s)| keep(s.measured_power_w))
         .unzip();
     let idle = before - samples.len();
     (times_s, samples, idle)
@@ -372,18 +394,33 @@ pub struct Calibration {
     pub best_constant_rmse_w: f64,
 }
 
+/// Longest stretch of a span without a validated sample that the comparison bridges, s: a
+/// 10 Hz log's samples are 0.1 s apart, and at touch-down the motors stop (no power to pair)
+/// a second or two before the autopilot's land detector says landed; a longer hole, where the
+/// log has no velocity or attitude to pair with its power, is left out of the seconds compared.
+pub const MAX_BRIDGE_S: f64 = 3.0;
+
 /// Validation of the model on one flight.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlightValidation {
     /// The log file.
     pub file: String,
-    /// Duration of the aligned samples, s.
+    /// The airborne time compared, s: the airborne time where the log has samples to compare
+    /// (no hole longer than [`MAX_BRIDGE_S`]).
     pub duration_s: f64,
+    /// The airborne time within the span where motion and power are logged, s (what `aloft
+    /// mission --replay` books as `airborne_s`).
+    pub airborne_s: f64,
     /// Lag of power behind motion used, s.
     pub lag_s: f64,
-    /// Measured energy over the aligned samples (integral of V x I), Wh.
+    /// Correlation of power with tilt at that lag (absent when the lag was given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag_correlation: Option<f64>,
+    /// Measured energy over the airborne time compared (integral of V x I), Wh: the same as
+    /// `aloft mission --replay`'s `measured_airborne_energy_wh`.
     pub measured_energy_wh: f64,
-    /// Model energy over the same samples, Wh.
+    /// Model energy over the same time (the model's power at the logged attitude of each sample,
+    /// linear between samples), Wh.
     pub predicted_energy_wh: f64,
     /// `(predicted - measured) / measured`, percent.
     pub energy_error_percent: f64,
@@ -403,6 +440,11 @@ pub struct FlightValidation {
     pub air_density_kg_m3: f64,
     /// Where it came from (`given`, `log`, `isa`, `vehicle_file`).
     pub density_source: crate::engine::AirSource,
+    /// The verdict on this flight: `good`, `usable` or `poor` (the fit's rules, and `poor`
+    /// where the model loses to a constant at the flight's mean power).
+    pub quality: crate::engine::FitQuality,
+    /// Why, one reason a line.
+    pub quality_reasons: Vec<String>,
 }
 
 /// Airspeed bands of the Table I layout, centred on the paper's hover, 2, 4, 6, 8 m/s.
@@ -445,13 +487,83 @@ pub fn predict(model: &PowerModel, flight: &AlignedFlight) -> Result<Vec<f64>, E
         .collect()
 }
 
-/// Validate `model` on `flight`, optionally re-estimating the efficiency from its first
-/// `calibrate_first_s` seconds (as a ground station would in flight).
+/// The samples of `flight` inside `spans` (motion time).
+fn within(flight: &AlignedFlight, spans: &[(f64, f64)]) -> AlignedFlight {
+    let inside = |t: f64| spans.iter().any(|(a, b)| t >= *a && t <= *b);
+    let (times_s, samples) = flight
+        .times_s
+        .iter()
+        .zip(&flight.samples)
+        .filter(|(t, _)| inside(**t))
+        .map(|(t, s)| (*t, *s))
+        .unzip();
+    AlignedFlight {
+        times_s,
+        samples,
+        source: flight.source.clone(),
+        ..*flight
+    }
+}
+
+/// The parts of `spans` that `times` (sorted) cover: each span cut to within
+/// `MAX_BRIDGE_S / 2` of a sample, so that a hole longer than [`MAX_BRIDGE_S`] is left out.
+fn covered(spans: &[(f64, f64)], times: &[f64]) -> Vec<(f64, f64)> {
+    let h = 0.5 * MAX_BRIDGE_S;
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for &(a, b) in spans {
+        let mut current: Option<(f64, f64)> = None;
+        for &t in times.iter().filter(|t| **t >= a - h && **t <= b + h) {
+            let (lo, hi) = ((t - h).max(a), (t + h).min(b));
+            current = match current {
+                Some((s, e)) if lo <= e => Some((s, e.max(hi))),
+                Some(done) => {
+                    out.push(done);
+                    Some((lo, hi))
+                }
+                None => Some((lo, hi)),
+            };
+        }
+        out.extend(current.filter(|(s, e)| e > s));
+    }
+    out
+}
+
+/// Integral of the piecewise-linear `values(times)` over `[a, b]`, each end value held beyond
+/// the samples (a span may start a sample before the first with an attitude), J for W.
+fn held_integral(times: &[f64], values: &[f64], a: f64, b: f64) -> f64 {
+    let at = |t: f64| {
+        interpolate(times, values, t).unwrap_or(if t < times[0] {
+            values[0]
+        } else {
+            values[values.len() - 1]
+        })
+    };
+    let mut ts = vec![a];
+    let mut vs = vec![at(a)];
+    for (&t, &v) in times.iter().zip(values) {
+        if t > a && t < b {
+            ts.push(t);
+            vs.push(v);
+        }
+    }
+    ts.push(b);
+    vs.push(at(b));
+    aloft_core::trapezoid(&ts, &vs)
+}
+
+/// Validate `model` on `flight` over its airborne `spans` (motion time), where its samples
+/// cover them ([`MAX_BRIDGE_S`]): the model's energy there against `measured_wh(a, b)`, the
+/// energy measured from `a` to `b` (Wh); optionally re-estimating the efficiency from the
+/// first `calibrate_first_s` seconds (as a ground station would in flight). The verdict is
+/// left at `good` without reasons for the caller to judge ([`crate::engine::FitQuality`]).
 pub fn validate_flight(
     model: &PowerModel,
     flight: &AlignedFlight,
     calibrate_first_s: Option<f64>,
+    spans: &[(f64, f64)],
+    measured_wh: &dyn Fn(f64, f64) -> f64,
 ) -> Result<FlightValidation, Error> {
+    let flight = &within(flight, spans);
     let measured: Vec<f64> = flight.samples.iter().map(|s| s.measured_power_w).collect();
     if measured.len() < 2 {
         return Err(Error::NoMotion {
@@ -460,8 +572,12 @@ pub fn validate_flight(
     }
     let predicted = predict(model, flight)?;
     let t = &flight.times_s;
-    let measured_energy_wh = trapezoid_wh(t, &measured);
-    let predicted_energy_wh = trapezoid_wh(t, &predicted);
+    let compared = covered(spans, t);
+    let measured_energy_wh: f64 = compared.iter().map(|(a, b)| measured_wh(*a, *b)).sum();
+    let predicted_energy_wh = compared
+        .iter()
+        .map(|(a, b)| held_integral(t, &predicted, *a, *b) / 3600.0)
+        .sum::<f64>();
     let mean = measured.iter().sum::<f64>() / measured.len() as f64;
     let constant = vec![mean; measured.len()];
     let table_i = ablation_rows(model, flight, &measured)?;
@@ -471,8 +587,10 @@ pub fn validate_flight(
     };
     Ok(FlightValidation {
         file: flight.source.clone(),
-        duration_s: t[t.len() - 1] - t[0],
+        duration_s: compared.iter().map(|(a, b)| b - a).sum(),
+        airborne_s: spans.iter().map(|(a, b)| b - a).sum(),
         lag_s: flight.lag_s,
+        lag_correlation: flight.lag_correlation,
         measured_energy_wh,
         predicted_energy_wh,
         energy_error_percent: 100.0 * (predicted_energy_wh / measured_energy_wh - 1.0),
@@ -483,6 +601,8 @@ pub fn validate_flight(
         calibration,
         air_density_kg_m3: model.vehicle().air_density_kg_m3(),
         density_source: crate::engine::AirSource::VehicleFile,
+        quality: crate::engine::FitQuality::Good,
+        quality_reasons: Vec::new(),
     })
 }
 

@@ -200,3 +200,113 @@ fn absurd_air_is_exit_2_naming_the_value_and_its_range() {
         }
     }
 }
+
+/// Saturation vapour pressure over water, Pa, by Buck's equation (1981), not the Vaisala fit
+/// aloft uses: `6.1121 exp((18.678 - t/234.5) (t / (257.14 + t)))` hPa, `t` in C.
+fn buck_vapour_pa(t_c: f64) -> f64 {
+    611.21 * ((18.678 - t_c / 234.5) * (t_c / (257.14 + t_c))).exp()
+}
+
+/// ISA station pressure at `h_m` for a sea-level pressure `p0_pa` (troposphere law), Pa.
+fn isa_pressure_pa(h_m: f64, p0_pa: f64) -> f64 {
+    p0_pa * (1.0 - 0.0065 * h_m / 288.15).powf(9.80665 / (287.053 * 0.0065))
+}
+
+/// Issue 41 item 6: air that cannot exist was flown (11,000 m at 60 C, 100 % humidity, QNH
+/// 850 hPa: water vapour pressure above the air's own, density 0.119 kg/m^3). A vapour pressure
+/// at or above a tenth of the air's pressure, or a density below ISA's at 11 km
+/// (0.3639 kg/m^3), is exit 2 with one line naming the combination; the hot and humid days that
+/// exist still fly. Expectations from Buck's vapour pressure and the ISA pressure law, here.
+#[test]
+fn air_that_cannot_exist_is_exit_2_naming_the_combination() {
+    // The issue's case: the vapour pressure is above the air's.
+    let e = buck_vapour_pa(60.0);
+    let p = isa_pressure_pa(11_000.0, 85_000.0);
+    assert!(e > p, "{e} {p}");
+    // Dry air at 11 km and 60 C: p / (Rd T) = 0.237 kg/m^3, below ISA's 0.3639 there.
+    let rho_dry = isa_pressure_pa(11_000.0, 101_325.0) / (287.053 * 333.15);
+    assert!(rho_dry < 0.3639, "{rho_dry}");
+    for (flags, needles) in [
+        (
+            &[
+                "--elevation-m",
+                "11000",
+                "--temperature-c",
+                "60",
+                "--humidity-percent",
+                "100",
+                "--qnh-hpa",
+                "850",
+            ][..],
+            &["vapour pressure", "11000 m", "60 C", "100 %", "850 hPa"][..],
+        ),
+        (
+            &["--elevation-m", "11000", "--temperature-c", "60"][..],
+            &["density", "0.3639", "11000 m", "60 C"][..],
+        ),
+    ] {
+        for command in [
+            vec!["mission"],
+            vec!["endurance"],
+            vec!["power", "--airspeed", "0"],
+        ] {
+            let mut args = command.clone();
+            args.extend(flags);
+            let (code, out, err) = run(&args);
+            assert_eq!(code, 2, "{args:?}: {out}");
+            assert_eq!(err.trim().lines().count(), 1, "{err}");
+            for n in needles {
+                assert!(err.contains(n), "{args:?}: {err} lacks {n}");
+            }
+        }
+    }
+    // The same through the keywords of Python and the page.
+    use aloft::engine::{answers, flags::EnduranceFlags, parse_keywords, Keyword};
+    let kw = |k: &str, v: &str| (k.to_string(), Keyword::One(v.into()));
+    let flags: EnduranceFlags = parse_keywords(
+        "aloft.endurance",
+        &[],
+        &[
+            kw("elevation_m", "11000"),
+            kw("temperature_c", "60"),
+            kw("humidity_percent", "100"),
+            kw("qnh_hpa", "850"),
+        ],
+    )
+    .unwrap();
+    let err = answers::endurance_answer(&flags).unwrap_err().to_string();
+    assert!(err.contains("vapour pressure"), "{err}");
+    // Days that exist: sea level at 40 C and 100 % (vapour 7.4 kPa, 7 % of the air's pressure),
+    // ISA at 11 km itself (0.3639 kg/m^3), and 3000 m at 45 C and 100 % (9.6 kPa of 70.1 kPa,
+    // 13.7 %: refused by the tenth) against 35 C (5.6 kPa, 8 %: flown).
+    assert!(buck_vapour_pa(40.0) < 0.1 * 101_325.0);
+    assert!(buck_vapour_pa(35.0) < 0.1 * isa_pressure_pa(3000.0, 101_325.0));
+    assert!(buck_vapour_pa(45.0) > 0.1 * isa_pressure_pa(3000.0, 101_325.0));
+    for flags in [
+        &["--temperature-c", "40", "--humidity-percent", "100"][..],
+        &["--elevation-m", "11000"][..],
+        &[
+            "--elevation-m",
+            "3000",
+            "--temperature-c",
+            "35",
+            "--humidity-percent",
+            "100",
+        ][..],
+    ] {
+        let mut args = vec!["endurance"];
+        args.extend(flags);
+        json(&args);
+    }
+    let (code, _, err) = run(&[
+        "endurance",
+        "--elevation-m",
+        "3000",
+        "--temperature-c",
+        "45",
+        "--humidity-percent",
+        "100",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("vapour pressure"), "{err}");
+}

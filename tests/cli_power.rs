@@ -460,13 +460,19 @@ fn fit_and_validate_reject_bad_input() {
             fit("kaist_small.csv", "dji-m100", &["--free", "k,drag"]),
             "drag",
         ),
-        (
-            ["validate", "--log", &none, "--vehicle", "dji-m100"]
-                .map(String::from)
-                .to_vec(),
-            "none.csv",
-        ),
     ];
+    // validate decides as fit does (issue 41): a log it cannot use is skipped with its reason;
+    // with no other, a failed check (exit 1) that names it.
+    let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
+        .args(["validate", "--log", &none, "--vehicle", "dji-m100"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.starts_with("NO VALIDATION") && said.contains("none.csv"),
+        "{said}"
+    );
     for (args, needle) in cases {
         let o = Command::new(env!("CARGO_BIN_EXE_aloft"))
             .args(&args)

@@ -3,7 +3,7 @@
 //! read back by the Python `mcap` reader.
 
 mod common;
-use common::{ok_json, refused};
+use common::ok_json;
 
 use std::path::Path;
 
@@ -53,10 +53,12 @@ fn data_val_no_battery_data_is_an_answer_for_info_and_an_error_for_fit_and_valid
                 .any(|w| w.as_str().unwrap().contains("no battery data")),
             "{name}: {w:?}"
         );
-        let err = refused(&["validate", "--log", &shared(name), "--vehicle", "dji-m100"]);
-        assert!(err.contains("no battery data"), "{err}");
-        // A fit skips a log it cannot use (issue 35); with no other it is a failed check
-        // (exit 1) that says why, and writes no vehicle.
+        // A fit skips a log it cannot use (issue 35), and validate decides as fit does (issue
+        // 41); with no other it is a failed check (exit 1) that says why, and a fit writes no
+        // vehicle.
+        let o = common::aloft(&["validate", "--log", &shared(name), "--vehicle", "dji-m100"]);
+        assert_eq!(o.status.code(), Some(1), "{name}");
+        assert!(common::stdout(&o).contains("no battery data"), "{name}");
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("nobat-fit.toml");
         // A file of an earlier run is kept without --force: start without it.
         let _ = std::fs::remove_file(&out);

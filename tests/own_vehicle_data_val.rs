@@ -347,3 +347,57 @@ fn data_val_leave_one_out_with_per_flight_masses() {
     // The claim of docs/validation.md: the flights' own masses beat one mass for all.
     assert!(mean_abs(2) < mean_abs(0), "{rows:?}");
 }
+
+/// Issue 41 items 6 and 11: the owner's capacity below 10 mA h is refused with its range (a pack
+/// that small is a unit slip); a subnormal `max_speed` (1e-310 m/s) in the written vehicle's
+/// `[airframe]` or given to `aloft plan --max-speed` is refused naming it, and nothing is written.
+#[test]
+fn data_val_a_tiny_capacity_or_a_subnormal_speed_is_refused() {
+    let log = usable()[0].display().to_string();
+    let out = scratch("own-vehicle", "tiny.toml");
+    for value in ["5", "1e-38"] {
+        let mut args: Vec<String> = OWNER
+            .chunks(2)
+            .filter(|kv| kv[0] != "--battery-capacity-mah")
+            .map(|kv| format!("{}={}", kv[0], kv[1]))
+            .collect();
+        args.push(format!("--battery-capacity-mah={value}"));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = fit(std::slice::from_ref(&log), &args, &out);
+        assert_eq!(code, 2, "{value}: {err}");
+        assert!(
+            err.contains("--battery-capacity-mah") && err.contains("10"),
+            "{err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+    assert!(!out.exists());
+    let vehicle = scratch("own-vehicle", "subnormal.toml");
+    let (code, _, err) = fit(std::slice::from_ref(&log), &OWNER, &vehicle);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(&vehicle).unwrap();
+    let mut file: toml::Table = text.parse().unwrap();
+    file["airframe"]["max_speed_mps"] = toml::Value::Float(1e-310);
+    assert!(file["airframe"]["max_speed_mps"]
+        .as_float()
+        .unwrap()
+        .is_subnormal());
+    std::fs::write(&vehicle, toml::to_string(&file).unwrap()).unwrap();
+    let (code, _, err) = run(&["endurance", "--vehicle", vehicle.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("max_speed_mps"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    let plan = data_dir().join("missions/kasperg3_uas_test_plan.plan");
+    let folder = scratch("own-vehicle", "subnormal-plan");
+    let (code, _, err) = run(&[
+        "plan",
+        plan.to_str().unwrap(),
+        "--max-speed",
+        "1e-310",
+        "-o",
+        folder.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("max_speed"), "{err}");
+    assert!(std::fs::read_dir(&folder).map_or(true, |mut d| d.next().is_none()));
+}

@@ -7,9 +7,9 @@ use anyhow::Result;
 use clap::Args;
 
 use aloft::engine::flags::FitFlags;
-use aloft::engine::{fit_logs, FitAnswer, FitQuality, FitRequest};
+use aloft::engine::{fit_logs, FitAnswer, FitRequest};
 
-use super::flights::file_name;
+use super::flights::{escaped, file_name, quality_word};
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -54,19 +54,20 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
         Err(aloft::Error::NoUsableLog { reasons }) => {
             let mut out = std::io::stdout().lock();
             match args.format {
-                Format::Json => writeln!(
-                    out,
-                    "{}",
-                    serde_json::json!({ "quality": null, "reason": reasons })
-                )?,
-                _ => writeln!(out, "NO FIT: no log can be used: {reasons}")?,
+                // No fit, no verdict: the reason alone (never `"quality": null`).
+                Format::Json => writeln!(out, "{}", serde_json::json!({ "reason": reasons }))?,
+                _ => writeln!(out, "NO FIT: no log can be used: {}", escaped(&reasons))?,
             }
             return Ok(Outcome::Failed);
         }
         Err(e) => return Err(e.into()),
     };
     for s in &answer.skipped_logs {
-        eprintln!("aloft fit: skipped {}: {}", file_name(&s.file), s.reason);
+        eprintln!(
+            "aloft fit: skipped {}: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        );
     }
     for l in &answer.logs {
         eprintln!(
@@ -88,15 +89,6 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
         |out| render(out, &answer),
     )?;
     Ok(Outcome::Ok)
-}
-
-/// The verdict as the table prints it.
-fn quality_word(q: FitQuality) -> &'static str {
-    match q {
-        FitQuality::Good => "good",
-        FitQuality::Usable => "usable",
-        FitQuality::Poor => "poor",
-    }
 }
 
 /// The fitted constants: name, value, standard error and unit.
@@ -175,14 +167,19 @@ fn render(out: &mut impl Write, r: &FitAnswer) -> Result<()> {
     writeln!(
         out,
         "\nFitted vehicle -> {}: take-off mass {} kg without payload, efficiency {:.4}, rotor radius {:.4} m, kappa1 {:.4}, mu {:.4} {:.5} {:.6}",
-        r.output, v.mass_kg, v.efficiency, v.rotor_radius_m, v.kappa1_w_per_n1_5, v.mu1_n_s_per_m, v.mu2_n_s2_per_m2, v.mu3_n_s3_per_m3
+        escaped(&r.output), v.mass_kg, v.efficiency, v.rotor_radius_m, v.kappa1_w_per_n1_5, v.mu1_n_s_per_m, v.mu2_n_s2_per_m2, v.mu3_n_s3_per_m3
     )?;
     writeln!(out, "\nQuality: {}", quality_word(r.quality))?;
     for reason in &r.quality_reasons {
-        writeln!(out, "  {reason}")?;
+        writeln!(out, "  {}", escaped(reason))?;
     }
     for s in &r.skipped_logs {
-        writeln!(out, "Skipped {}: {}", file_name(&s.file), s.reason)?;
+        writeln!(
+            out,
+            "Skipped {}: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        )?;
     }
     Ok(())
 }

@@ -10,7 +10,7 @@ use clap::{Args, Subcommand};
 use aloft::engine::flags::finite;
 use aloft::engine::{fit_pack, PackFitAnswer, PackFitRequest, Vehicle, DEFAULT_VEHICLE};
 
-use super::flights::file_name;
+use super::flights::{escaped, file_name};
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -109,11 +109,11 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         eprintln!(
             "aloft pack fit: {}: skipped: {}",
             file_name(&s.file),
-            s.reason
+            escaped(&s.reason)
         );
     }
     for n in &answer.notes {
-        eprintln!("aloft pack fit: {n}");
+        eprintln!("aloft pack fit: {}", escaped(n));
     }
     if answer.pack.is_none() {
         eprintln!("aloft pack fit: no usable log: no pack written");
@@ -168,9 +168,9 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
                 "min",
             ),
         ];
-        output::write_table(out, file_name(&r.source), &rows)?;
+        output::write_table(out, &file_name(&r.source), &rows)?;
         if let Some(why) = &r.capacity_refused {
-            writeln!(out, "  capacity: {why}")?;
+            writeln!(out, "  capacity: {}", escaped(why))?;
         }
     }
     let rows = vec![
@@ -188,6 +188,10 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
         Row::num("discharged over the logs", a.discharged_mah, 0, "mAh"),
         Row::new("equivalent full cycles", opt(a.equivalent_cycles, 2), ""),
     ];
-    output::write_table(out, &format!("pack written to {}", a.output), &rows)?;
+    output::write_table(
+        out,
+        &format!("pack written to {}", escaped(&a.output)),
+        &rows,
+    )?;
     Ok(())
 }

@@ -10,7 +10,7 @@ use clap::Args;
 use aloft::engine::flags::ValidateFlags;
 use aloft::engine::{validate_logs, PowerSeries, ValidateReport};
 
-use super::flights::file_name;
+use super::flights::{escaped, file_name, quality_word};
 use super::output::{self, ForceFlag};
 use super::plot::ChartFile;
 use super::{Format, Outcome};
@@ -35,7 +35,30 @@ pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
     let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
     let request = args.flags.request(args.plot.is_some());
-    let answer = validate_logs(&vehicle, &request)?;
+    let answer = match validate_logs(&vehicle, &request) {
+        Ok(a) => a,
+        // No log can be used: a failed check (exit 1) that says why, as `aloft fit`.
+        Err(aloft::Error::NoUsableLog { reasons }) => {
+            let mut out = std::io::stdout().lock();
+            match args.format {
+                Format::Json => writeln!(out, "{}", serde_json::json!({ "reason": reasons }))?,
+                _ => writeln!(
+                    out,
+                    "NO VALIDATION: no log can be used: {}",
+                    escaped(&reasons)
+                )?,
+            }
+            return Ok(Outcome::Failed);
+        }
+        Err(e) => return Err(e.into()),
+    };
+    for s in &answer.report.skipped_logs {
+        eprintln!(
+            "aloft validate: skipped {}: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        );
+    }
     for f in &answer.report.flights {
         eprintln!(
             "aloft validate: {}: power lags motion by {:.2} s",
@@ -70,6 +93,7 @@ fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
         "calibrated_energy_error_percent",
         "calibrated_rmse_w",
         "best_constant_rmse_w",
+        "quality",
     ];
     let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
     let records = report.flights.iter().map(|f| {
@@ -86,6 +110,7 @@ fn write_csv(out: impl Write, report: &ValidateReport) -> Result<()> {
             opt(c.map(|c| c.energy_error_percent)),
             opt(c.map(|c| c.rmse_w)),
             opt(c.map(|c| c.best_constant_rmse_w)),
+            quality_word(f.quality).to_string(),
         ]
     });
     output::write_csv(out, &header, records)
@@ -101,13 +126,13 @@ fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
     )?;
     writeln!(
         out,
-        "  {:<40} {:>6} {:>6} {:>9} {:>9} {:>7} {:>7} {:>8}",
-        "flight", "min", "lag s", "meas Wh", "pred Wh", "err %", "NRMSE%", "const %"
+        "  {:<40} {:>6} {:>6} {:>9} {:>9} {:>7} {:>7} {:>8} {:>7}",
+        "flight", "min", "lag s", "meas Wh", "pred Wh", "err %", "NRMSE%", "const %", "quality"
     )?;
     for f in &r.flights {
         writeln!(
             out,
-            "  {:<40} {:>6.1} {:>6.2} {:>9.1} {:>9.1} {:>+7.2} {:>7.2} {:>8.2}",
+            "  {:<40} {:>6.1} {:>6.2} {:>9.1} {:>9.1} {:>+7.2} {:>7.2} {:>8.2} {:>7}",
             file_name(&f.file),
             f.duration_s / 60.0,
             f.lag_s,
@@ -115,7 +140,8 @@ fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
             f.predicted_energy_wh,
             f.energy_error_percent,
             f.nrmse_percent,
-            f.baseline_nrmse_percent
+            f.baseline_nrmse_percent,
+            quality_word(f.quality)
         )?;
     }
     if r.flights.iter().any(|f| f.calibration.is_some()) {
@@ -163,6 +189,18 @@ fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
             }
         }
         writeln!(out)?;
+    }
+    writeln!(out, "\nQuality: {}", quality_word(r.quality))?;
+    for reason in &r.quality_reasons {
+        writeln!(out, "  {}", escaped(reason))?;
+    }
+    for s in &r.skipped_logs {
+        writeln!(
+            out,
+            "Skipped {}: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        )?;
     }
     Ok(())
 }

@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 
 use aloft_core::atmosphere::{
     air_density_kg_m3, density_altitude_m, isa_temperature_k, pressure_at_elevation_pa,
-    ELEVATION_RANGE_M, ISA_SEA_LEVEL_PRESSURE_PA, QNH_RANGE_HPA, TEMPERATURE_RANGE_C,
+    saturation_vapour_pressure_pa, thinnest_density_kg_m3, ELEVATION_RANGE_M,
+    ISA_SEA_LEVEL_PRESSURE_PA, MAX_VAPOUR_FRACTION, QNH_RANGE_HPA, TEMPERATURE_RANGE_C,
     ZERO_CELSIUS_K,
 };
 use aloft_core::ISA_SEA_LEVEL_DENSITY_KG_M3;
@@ -46,10 +47,12 @@ pub struct AirInput {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub humidity_percent: Option<f64>,
     /// The day's QNH (altimeter setting), hPa (850 to 1100; default ISA's 1013.25).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub qnh_hpa: Option<f64>,
     /// A density known outright, kg/m^3 (0.3 to 2): it overrides everything above (a caller
     /// that decided the air once and flies again in it, as `aloft live` planning the route
     /// ahead). No command-line flag.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub air_density_kg_m3: Option<f64>,
 }
 
@@ -270,6 +273,16 @@ pub fn resolve_air(
     let pressure_pa = pressure_at_elevation_pa(elevation_m, sea_level_pa);
     let humidity = input.humidity_percent.unwrap_or(0.0);
     let rho = air_density_kg_m3(pressure_pa, temperature_k, humidity / 100.0);
+    check_exists(
+        DayAir {
+            elevation_m,
+            temperature_c: temperature_k - ZERO_CELSIUS_K,
+            humidity_percent: humidity,
+            qnh_hpa: sea_level_pa / 100.0,
+        },
+        pressure_pa,
+        rho,
+    )?;
     let density_source = if input.is_empty() {
         AirSource::MissionHome
     } else {
@@ -286,6 +299,47 @@ pub fn resolve_air(
         humidity_percent: Some(humidity),
         density_altitude_m: rounded_density_altitude_m(rho),
     })
+}
+
+/// The figures of a day's air, each within its own range.
+struct DayAir {
+    elevation_m: f64,
+    temperature_c: f64,
+    humidity_percent: f64,
+    qnh_hpa: f64,
+}
+
+/// A day whose figures are each in range may still combine into air that cannot exist: water
+/// vapour at or above [`MAX_VAPOUR_FRACTION`] of the air's pressure `pressure_pa`, or a density
+/// `rho` below [`thinnest_density_kg_m3`] (ISA's at 11 km).
+///
+/// # Errors
+/// [`Error::AirVapour`] and [`Error::AirTooThin`], naming the combination.
+fn check_exists(day: DayAir, pressure_pa: f64, rho: f64) -> Result<(), Error> {
+    let vapour_pa = day.humidity_percent / 100.0 * saturation_vapour_pressure_pa(day.temperature_c);
+    if vapour_pa >= MAX_VAPOUR_FRACTION * pressure_pa {
+        return Err(Error::AirVapour {
+            elevation_m: day.elevation_m,
+            temperature_c: day.temperature_c,
+            humidity_percent: day.humidity_percent,
+            qnh_hpa: day.qnh_hpa,
+            vapour_pa,
+            pressure_pa,
+        });
+    }
+    // ISA's own 11 km is the limit itself: a relative 1e-9 for its rounding.
+    let min = thinnest_density_kg_m3();
+    if rho < min * (1.0 - 1e-9) {
+        return Err(Error::AirTooThin {
+            elevation_m: day.elevation_m,
+            temperature_c: day.temperature_c,
+            humidity_percent: day.humidity_percent,
+            qnh_hpa: day.qnh_hpa,
+            density_kg_m3: rho,
+            min_density_kg_m3: min,
+        });
+    }
+    Ok(())
 }
 
 /// The density altitude of `rho` to the nearest 0.1 m (the halving's resolution), never -0.
@@ -375,6 +429,34 @@ mod tests {
         let own = resolve_air(&AirInput::default(), None, &thin).unwrap();
         assert_eq!(own.density_source, AirSource::VehicleFile);
         assert!((own.air_density_kg_m3 - 1.1).abs() < 1e-12);
+    }
+
+    /// Issue 41: values each in range that combine into air that cannot exist are refused
+    /// naming the combination; ISA's own 11 km is flown.
+    #[test]
+    fn air_that_cannot_exist_is_refused_naming_the_combination() {
+        let day = |h: f64, t: Option<f64>, rh: Option<f64>, qnh: Option<f64>| AirInput {
+            elevation_m: Some(h),
+            temperature_c: t,
+            humidity_percent: rh,
+            qnh_hpa: qnh,
+            air_density_kg_m3: None,
+        };
+        let steam = resolve_air(
+            &day(11_000.0, Some(60.0), Some(100.0), Some(850.0)),
+            None,
+            &m100(),
+        );
+        assert!(matches!(steam, Err(Error::AirVapour { .. })), "{steam:?}");
+        let thin = resolve_air(&day(11_000.0, Some(60.0), None, None), None, &m100());
+        assert!(matches!(thin, Err(Error::AirTooThin { .. })), "{thin:?}");
+        let e = thin.unwrap_err().to_string();
+        assert!(
+            e.contains("11000 m, 60 C, 0 % humidity and QNH 1013.25 hPa"),
+            "{e}"
+        );
+        let top = resolve_air(&day(11_000.0, None, None, None), None, &m100()).unwrap();
+        assert!((top.air_density_kg_m3 - 0.3639).abs() < 1e-4);
     }
 
     /// Out-of-range values are refused naming the value and its range.

@@ -167,7 +167,9 @@ pub fn fit_logs(template: &Vehicle, request: &FitRequest) -> Result<FitAnswer, E
     if let Some(path) = &request.output {
         check_output(path, request.force)?;
     }
-    let (flights, skipped_logs) = usable_logs(&request.logs)?;
+    let (flights, skipped_logs) = request
+        .logs
+        .usable(crate::identify::AlignOptions::default().idle_power_fraction)?;
     let (used, completed) = starting_vehicle(template, request, &skipped_logs)?;
     let generic_name = request
         .generic_template
@@ -333,9 +335,7 @@ fn starting_vehicle(
     request: &FitRequest,
     skipped: &[SkippedLog],
 ) -> Result<(FlightLogs, Completed), Error> {
-    let used = request
-        .logs
-        .retain_files(|p| !skipped.iter().any(|s| s.file == p.display().to_string()));
+    let used = request.logs.without(skipped);
     let mut base = template.file().clone();
     if request.generic_template {
         base.name = request
@@ -352,31 +352,6 @@ fn starting_vehicle(
 
 /// A log aligned for the fit, with its samples.
 type Flight = (crate::identify::AlignedFlight, aloft_logs::Log);
-
-/// The logs that can be used, aligned, and those that cannot, each with its reason.
-///
-/// # Errors
-/// [`Error::NoUsableLog`] when no log can be used; what every log shares (a profile).
-fn usable_logs(logs: &FlightLogs) -> Result<(Vec<Flight>, Vec<SkippedLog>), Error> {
-    let mut flights = Vec::new();
-    let mut skipped = Vec::new();
-    for (path, loaded) in logs.logs.iter().zip(logs.load_each()?) {
-        match loaded {
-            Ok(flight) => flights.push(flight),
-            Err(e) => skipped.push(SkippedLog {
-                file: path.display().to_string(),
-                reason: e.to_string(),
-            }),
-        }
-    }
-    if flights.is_empty() {
-        let reasons: Vec<&str> = skipped.iter().map(|s| s.reason.as_str()).collect();
-        return Err(Error::NoUsableLog {
-            reasons: reasons.join("; "),
-        });
-    }
-    Ok((flights, skipped))
-}
 
 /// The mean of the air densities the logs carry (PX4
 /// `vehicle_air_data`, ArduPilot `BARO`), kg/m^3, and how many logs carry one. The constants are

@@ -13,6 +13,13 @@
 //! The thresholds are stated, not tuned: the NRMSE bands are the paper's own accuracy; the
 //! alignment bands are where a lag estimate from a correlation that weak is as likely wrong as
 //! right (the flugdrohne log aligned at -2.6 s with correlation 0.28, issue 35).
+//!
+//! `aloft validate` judges each flight by the same rules ([`judge_flight`]: the NRMSE, the
+//! alignment, the samples) and one more: a model whose NRMSE is above that of a constant at the
+//! flight's own mean power explains none of the flight's changes of power, and is `poor` ("the
+//! model loses to a constant at the flight's mean power"); so is a flight compared over less
+//! than 90 % of its time in the air (the rest of its log has no velocity or attitude to pair
+//! with its power). The whole validation is its worst flight.
 
 use serde::Serialize;
 
@@ -50,41 +57,49 @@ pub struct Envelope {
     pub max_climb_rate_mps: f64,
 }
 
-/// The verdict and why, from the fit's NRMSE (a fraction), its logs and the samples it used.
-pub fn judge_fit(
-    nrmse: f64,
-    logs: &[Alignment<'_>],
-    samples: &[FitSample],
-    envelope: Option<Envelope>,
-) -> (FitQuality, Vec<String>) {
-    let mut verdict = FitQuality::Good;
-    let mut reasons = Vec::new();
-    let mut say = |q: FitQuality, reason: String| {
-        verdict = verdict.max(q);
-        reasons.push(reason);
-    };
-    let pct = 100.0 * nrmse;
-    let q = match pct {
-        p if p <= 10.0 => FitQuality::Good,
-        p if p <= 20.0 => FitQuality::Usable,
-        _ => FitQuality::Poor,
-    };
-    say(
-        q,
-        format!(
-            "NRMSE {pct:.1} % (good at most 10 %, usable at most 20 %, the power seed's 7-18 %)"
-        ),
-    );
-    for l in logs {
+/// The verdicts of a judgement and their reasons; the worst decides.
+#[derive(Debug, Default)]
+struct Verdict {
+    worst: Option<FitQuality>,
+    reasons: Vec<String>,
+}
+
+impl Verdict {
+    fn say(&mut self, q: FitQuality, reason: String) {
+        self.worst = Some(self.worst.map_or(q, |w| w.max(q)));
+        self.reasons.push(reason);
+    }
+
+    fn done(self) -> (FitQuality, Vec<String>) {
+        (self.worst.unwrap_or(FitQuality::Good), self.reasons)
+    }
+
+    /// The NRMSE rule, `pct` in percent.
+    fn nrmse(&mut self, pct: f64) {
+        let q = match pct {
+            p if p <= 10.0 => FitQuality::Good,
+            p if p <= 20.0 => FitQuality::Usable,
+            _ => FitQuality::Poor,
+        };
+        self.say(
+            q,
+            format!(
+                "NRMSE {pct:.1} % (good at most 10 %, usable at most 20 %, the power seed's 7-18 %)"
+            ),
+        );
+    }
+
+    /// The alignment rules of one log: its correlation and a lead of power over motion.
+    fn alignment(&mut self, l: &Alignment<'_>) {
         let name = l.file.rsplit('/').next().unwrap_or(l.file);
         if let Some(c) = l.correlation {
             if c < 0.3 {
-                say(
+                self.say(
                     FitQuality::Poor,
                     format!("{name}: aligned at {:.2} s with correlation {c:.2} (below 0.3: the lag is a guess)", l.lag_s),
                 );
             } else if c < 0.5 {
-                say(
+                self.say(
                     FitQuality::Usable,
                     format!(
                         "{name}: aligned at {:.2} s with correlation {c:.2} (below 0.5)",
@@ -94,7 +109,7 @@ pub fn judge_fit(
             }
         }
         if l.lag_s < -0.5 {
-            say(
+            self.say(
                 FitQuality::Usable,
                 format!(
                     "{name}: power leads motion by {:.2} s (suspect: check the log's clocks)",
@@ -103,37 +118,55 @@ pub fn judge_fit(
             );
         }
     }
-    let n = samples.len();
-    if n < 100 {
-        say(FitQuality::Poor, format!("{n} samples (fewer than 100)"));
-    } else if n < 500 {
-        say(FitQuality::Usable, format!("{n} samples (fewer than 500)"));
+
+    /// The samples rule.
+    fn samples(&mut self, n: usize) {
+        if n < 100 {
+            self.say(FitQuality::Poor, format!("{n} samples (fewer than 100)"));
+        } else if n < 500 {
+            self.say(FitQuality::Usable, format!("{n} samples (fewer than 500)"));
+        }
     }
+}
+
+/// The verdict and why, from the fit's NRMSE (a fraction), its logs and the samples it used.
+pub fn judge_fit(
+    nrmse: f64,
+    logs: &[Alignment<'_>],
+    samples: &[FitSample],
+    envelope: Option<Envelope>,
+) -> (FitQuality, Vec<String>) {
+    let mut v = Verdict::default();
+    v.nrmse(100.0 * nrmse);
+    for l in logs {
+        v.alignment(l);
+    }
+    v.samples(samples.len());
     let p95 = |f: &dyn Fn(&FitSample) -> f64| {
-        let mut v: Vec<f64> = samples.iter().map(f).filter(|x| x.is_finite()).collect();
-        v.sort_by(f64::total_cmp);
-        v.get(((v.len() as f64 - 1.0) * 0.95).round().max(0.0) as usize)
+        let mut x: Vec<f64> = samples.iter().map(f).filter(|x| x.is_finite()).collect();
+        x.sort_by(f64::total_cmp);
+        x.get(((x.len() as f64 - 1.0) * 0.95).round().max(0.0) as usize)
             .copied()
     };
     let speed = p95(&|s| s.state.airspeed_mps);
     let climb = p95(&|s| s.state.climb_rate_mps.abs());
     match (envelope, speed) {
-        (Some(e), Some(v)) if v < 0.7 * e.max_speed_mps => say(
+        (Some(e), Some(s)) if s < 0.7 * e.max_speed_mps => v.say(
             FitQuality::Usable,
             format!(
-                "drag fitted up to {v:.1} m/s (95 % of the samples), used up to {:.1} m/s (the vehicle's max_speed_mps)",
+                "drag fitted up to {s:.1} m/s (95 % of the samples), used up to {:.1} m/s (the vehicle's max_speed_mps)",
                 e.max_speed_mps
             ),
         ),
-        (None, Some(v)) => say(
+        (None, Some(s)) => v.say(
             FitQuality::Good,
-            format!("samples up to {v:.1} m/s airspeed (95 %)"),
+            format!("samples up to {s:.1} m/s airspeed (95 %)"),
         ),
         _ => {}
     }
     if let (Some(e), Some(c)) = (envelope, climb) {
         if c < 0.5 * e.max_climb_rate_mps {
-            say(
+            v.say(
                 FitQuality::Usable,
                 format!(
                     "climb fitted up to {c:.1} m/s (95 %), flown up to {:.1} m/s (max_climb_rate_mps)",
@@ -142,7 +175,54 @@ pub fn judge_fit(
             );
         }
     }
-    (verdict, reasons)
+    v.done()
+}
+
+/// What [`judge_flight`] judges of one validated flight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlightJudged<'a> {
+    /// How the flight's log was aligned.
+    pub alignment: Alignment<'a>,
+    /// NRMSE of the model, percent.
+    pub nrmse_percent: f64,
+    /// NRMSE of a constant at the flight's mean power, percent.
+    pub constant_nrmse_percent: f64,
+    /// Samples compared.
+    pub samples: usize,
+    /// The airborne time compared (where the log has samples to compare), s.
+    pub compared_s: f64,
+    /// The airborne time, s.
+    pub airborne_s: f64,
+}
+
+/// The verdict on one flight of `aloft validate` and why: the fit's rules for the NRMSE, the
+/// alignment and the samples, and `poor` where the model loses to a constant at the flight's
+/// mean power (see the module docs).
+pub fn judge_flight(f: &FlightJudged<'_>) -> (FitQuality, Vec<String>) {
+    let mut v = Verdict::default();
+    v.nrmse(f.nrmse_percent);
+    if f.nrmse_percent > f.constant_nrmse_percent {
+        v.say(
+            FitQuality::Poor,
+            format!(
+                "the model loses to a constant at the flight's mean power (NRMSE {:.1} % against {:.1} %)",
+                f.nrmse_percent, f.constant_nrmse_percent
+            ),
+        );
+    }
+    // A flight compared over a small part of its time in the air says little of the rest.
+    if f.compared_s < 0.9 * f.airborne_s {
+        v.say(
+            FitQuality::Poor,
+            format!(
+                "compared over {:.1} s of its {:.1} s in the air: the rest has no velocity or attitude to pair with its power",
+                f.compared_s, f.airborne_s
+            ),
+        );
+    }
+    v.alignment(&f.alignment);
+    v.samples(f.samples);
+    v.done()
 }
 
 #[cfg(test)]
@@ -224,5 +304,32 @@ mod tests {
             Some(ENVELOPE),
         );
         assert_eq!(few.0, FitQuality::Poor);
+    }
+
+    /// A validated flight: good within the NRMSE band, poor where a constant at its mean power
+    /// does better, and the fit's alignment rule (a lead of power beyond 0.5 s).
+    #[test]
+    fn a_flight_that_loses_to_a_constant_is_poor() {
+        let flight = |nrmse, constant, lag_s| FlightJudged {
+            alignment: log(lag_s, Some(0.8)),
+            nrmse_percent: nrmse,
+            constant_nrmse_percent: constant,
+            samples: 1000,
+            compared_s: 60.0,
+            airborne_s: 60.0,
+        };
+        assert_eq!(judge_flight(&flight(8.0, 20.0, 0.1)).0, FitQuality::Good);
+        let (q, why) = judge_flight(&flight(8.0, 7.0, 0.1));
+        assert_eq!(q, FitQuality::Poor);
+        assert!(
+            why.iter().any(|r| r.contains("loses to a constant")),
+            "{why:?}"
+        );
+        let (q, why) = judge_flight(&flight(8.0, 20.0, -0.6));
+        assert_eq!(q, FitQuality::Usable);
+        assert!(
+            why.iter().any(|r| r.contains("leads motion by 0.60 s")),
+            "{why:?}"
+        );
     }
 }

@@ -790,12 +790,16 @@ impl PlanFlags {
                 expected: "from 0 to 1000 m",
             });
         }
-        if let Some(v) = self.max_speed.filter(|v| !(*v > 0.0 && *v <= 100.0)) {
+        // A subnormal speed (1e-310 m/s) is above 0 but no speed: refused as one.
+        if let Some(v) = self
+            .max_speed
+            .filter(|v| !(v.is_normal() && *v > 0.0 && *v <= 100.0))
+        {
             return Err(Error::InvalidInput {
                 name: "max_speed",
                 value: v,
                 unit: "m/s",
-                expected: "a ground speed above 0 and at most 100 m/s",
+                expected: "a ground speed above 0 and at most 100 m/s (not subnormal)",
             });
         }
         if let Some(v) = self

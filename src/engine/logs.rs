@@ -709,18 +709,57 @@ impl FlightLogs {
 
     /// Read every log, align power with motion, and set the angle-of-attack model.
     pub(crate) fn load(&self) -> Result<Vec<(AlignedFlight, aloft_logs::Log)>, Error> {
-        self.load_each()?.into_iter().collect()
+        self.load_each(AlignOptions::default().idle_power_fraction)?
+            .into_iter()
+            .collect()
+    }
+
+    /// The logs that can be used, read and aligned, and those that cannot, each with its reason
+    /// (the one rule of `aloft fit` and `aloft validate`: a log that cannot be read, never flew
+    /// ([`super::replay::check_flew`]) or cannot be aligned is left out and said). Samples below
+    /// `idle_power_fraction` of a flight's median power are left out as on the ground
+    /// ([`AlignOptions::idle_power_fraction`]; 0 keeps them all).
+    ///
+    /// # Errors
+    /// [`Error::NoUsableLog`] when no log can be used; what every log shares (a profile).
+    pub(crate) fn usable(
+        &self,
+        idle_power_fraction: f64,
+    ) -> Result<(Vec<Loaded>, Vec<SkippedLog>), Error> {
+        let mut flights = Vec::new();
+        let mut skipped = Vec::new();
+        for (path, loaded) in self.logs.iter().zip(self.load_each(idle_power_fraction)?) {
+            match loaded {
+                Ok(flight) => flights.push(flight),
+                Err(e) => skipped.push(SkippedLog {
+                    file: path.display().to_string(),
+                    reason: e.to_string(),
+                }),
+            }
+        }
+        if flights.is_empty() {
+            let reasons: Vec<&str> = skipped.iter().map(|s| s.reason.as_str()).collect();
+            return Err(Error::NoUsableLog {
+                reasons: reasons.join("; "),
+            });
+        }
+        Ok((flights, skipped))
+    }
+
+    /// These logs without the ones `skipped` names (each kept log with its payload).
+    pub(crate) fn without(&self, skipped: &[SkippedLog]) -> Self {
+        self.retain_files(|p| !skipped.iter().any(|s| s.file == p.display().to_string()))
     }
 
     /// [`Self::load`], each log on its own: a log that cannot be read or aligned is its error,
     /// and the others are read all the same (a fit skips it). The error of the whole is only for
     /// what every log shares (a profile that cannot be read).
-    pub(crate) fn load_each(&self) -> Result<Vec<LoadedLog>, Error> {
+    pub(crate) fn load_each(&self, idle_power_fraction: f64) -> Result<Vec<LoadedLog>, Error> {
         let (profile, open) = self.open_options()?;
         let align = AlignOptions {
             max_lag_s: self.max_lag_s,
             lag_s: self.lag_s,
-            ..AlignOptions::default()
+            idle_power_fraction,
         };
         Ok(self
             .logs
@@ -745,6 +784,8 @@ impl FlightLogs {
             }
             .into());
         }
+        // A log that never left the ground is said so, before its lag is searched for.
+        super::replay::check_flew(&log)?;
         let mut flight = align_flight(&log, align)?;
         flight.air_density_kg_m3 = reader
             .binary_summary()
@@ -768,8 +809,11 @@ pub struct SkippedLog {
     pub reason: String,
 }
 
+/// A log read and aligned: its flight and its samples.
+pub(crate) type Loaded = (AlignedFlight, aloft_logs::Log);
+
 /// One log of [`FlightLogs::load_each`]: aligned with its samples, or why not.
-pub(crate) type LoadedLog = Result<(AlignedFlight, aloft_logs::Log), Error>;
+pub(crate) type LoadedLog = Result<Loaded, Error>;
 
 #[cfg(test)]
 mod tests {

@@ -207,20 +207,27 @@ pub(crate) fn complete_vehicle(
 
 impl OwnVehicle {
     /// Each value given is in its range: a mass or diameter positive (a rotor at most 5 m, a
-    /// mass at most 1000 kg), a capacity positive up to the logs' own limit.
+    /// mass at most 1000 kg), a capacity a pack has (10 to 1e7 mA h, the logs' own range).
     ///
     /// # Errors
     /// [`Error::InvalidInput`] naming the flag.
     pub fn check(&self) -> Result<(), Error> {
-        let checks: [(&'static str, Option<f64>, &'static str, f64); 5] = [
+        // A pack below 10 mA h is a unit slip: its own range, named.
+        let (min_mah, max_mah) = aloft_core::BATTERY_CAPACITY_RANGE_MAH;
+        if let Some(v) = self
+            .battery_capacity_mah
+            .filter(|v| !(min_mah..=max_mah).contains(v))
+        {
+            return Err(Error::InvalidInput {
+                name: "--battery-capacity-mah",
+                value: v,
+                unit: "mAh",
+                expected: "a pack's capacity, from 10 to 1e7 mA h",
+            });
+        }
+        let checks: [(&'static str, Option<f64>, &'static str, f64); 4] = [
             ("--mass-kg", self.mass_kg, "kg", 1000.0),
             ("--rotor-diameter-m", self.rotor_diameter_m, "m", 5.0),
-            (
-                "--battery-capacity-mah",
-                self.battery_capacity_mah,
-                "mAh",
-                aloft_logs::battery_records::MAX_BATTERY_CAPACITY_MAH,
-            ),
             ("--battery-mass-kg", self.battery_mass_kg, "kg", 1000.0),
             (
                 "--max-takeoff-mass-kg",

@@ -81,22 +81,30 @@ pub struct PackFitAnswer {
     /// Logs left out.
     pub skipped: Vec<SkippedLog>,
     /// The pack's internal resistance written, Ω.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub internal_resistance_ohm: Option<f64>,
     /// Where it came from: `current steps`, `autopilot`, `--battery pack`.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub internal_resistance_source: Option<String>,
     /// The autopilot's own estimate over the flights (median), Ω.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub autopilot_internal_resistance_ohm: Option<f64>,
     /// Capacity estimated between rests (median over the flights), mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_mah: Option<f64>,
     /// Capacity written, mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pack_capacity_mah: Option<f64>,
     /// Charge drawn over all the logs, mA h.
     pub discharged_mah: f64,
     /// Discharged charge / rated charge over all the logs.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub equivalent_cycles: Option<f64>,
     /// The pack written (none when no log was usable).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pack: Option<PackFile>,
     /// Its TOML text.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pack_toml: Option<String>,
     /// The file written (empty when none).
     pub output: String,
@@ -125,6 +133,7 @@ fn median(mut v: Vec<f64>) -> Option<f64> {
 /// source gives ([`Error::PackKeyMissing`]), a pack the planner refuses, an output that cannot be
 /// written.
 pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
+    check_capacity(request.capacity_mah)?;
     if let Some(path) = &request.output {
         check_output(path, request.force)?;
     }
@@ -139,6 +148,7 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
     };
     let analysed = analyse_logs(request, &options)?;
     let mut answer = combine(analysed.logs, analysed.skipped, &options, base.as_ref());
+    answer.notes.extend(analysed.notes);
     if answer.logs.is_empty() {
         return Ok(answer);
     }
@@ -171,6 +181,23 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
     finite(answer, "pack fit", || format!("logs {:?}", request.logs))
 }
 
+/// A given capacity is a pack's: from 10 to 1e7 mA h (below, a unit slip).
+///
+/// # Errors
+/// [`Error::InvalidInput`] naming `--capacity-mah`, its value and its range.
+fn check_capacity(capacity_mah: Option<f64>) -> Result<(), Error> {
+    let (min, max) = aloft_core::BATTERY_CAPACITY_RANGE_MAH;
+    match capacity_mah.filter(|c| !(min..=max).contains(c)) {
+        Some(c) => Err(Error::InvalidInput {
+            name: "--capacity-mah",
+            value: c,
+            unit: "mA h",
+            expected: "a pack's capacity, from 10 to 1e7 mA h",
+        }),
+        None => Ok(()),
+    }
+}
+
 /// The `--battery` pack of the request's vehicle, which gives the keys the logs cannot.
 ///
 /// # Errors
@@ -200,6 +227,9 @@ struct Analysed {
     skipped: Vec<SkippedLog>,
     failsafe: Failsafe,
     serial: Option<String>,
+    /// What the logs' readers noted (a capacity parameter no pack has), each after its log's
+    /// name.
+    notes: Vec<String>,
 }
 
 /// Read and analyse each log: one that reads but holds no battery record (no power sensor) or
@@ -220,6 +250,7 @@ fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analy
         skipped: Vec::new(),
         failsafe: Failsafe::default(),
         serial: None,
+        notes: Vec::new(),
     };
     for path in &request.logs {
         let file = path.display().to_string();
@@ -231,6 +262,12 @@ fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analy
             }
             Err(e) => return Err(Error::LogFile(Box::new(e))),
         };
+        if let Some(note) = &log.capacity_note {
+            let name = path
+                .file_name()
+                .map_or(file.clone(), |n| n.to_string_lossy().into_owned());
+            out.notes.push(format!("{name}: {note}"));
+        }
         if !log.has_current() {
             out.skipped.push(SkippedLog {
                 file,

@@ -205,7 +205,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
     // The flight in its own air: the given day, else the log's, else the vehicle file's.
     let air = log_air(&request.air, log_density, vehicle)?;
     let vehicle = &vehicle.in_air(air.air_density_kg_m3)?;
-    let flown = replay_aircraft(vehicle, request)?;
+    let flown = replay_aircraft(vehicle, request.battery.as_deref(), request.payload_kg)?;
     let powered = flown.aircraft.at_mass(flown.mass_kg, request.aoa)?;
     let path = request.log.display().to_string();
     let trajectory = trajectory(&log, request, &path)?;
@@ -217,9 +217,7 @@ pub fn replay_log(vehicle: &Vehicle, request: &ReplayRequest) -> Result<ReplayAn
         origin: path.clone(),
         source: Box::new(e),
     })?;
-    // A vehicle that cannot hover at this mass has no idle threshold (power is then not used).
-    let hover_w = powered.level_power_w([0.0; 2], [0.0, 1.0]).ok();
-    let ground = ground_time(&log, hover_w);
+    let ground = ground_time(&log, hover_power_w(&powered));
     let mut notes = Vec::new();
     let measured = measured_series(&log, request, &mut notes)?;
     let window = compared_window(&trajectory.times, measured.as_ref(), &path)?;
@@ -311,8 +309,12 @@ fn answer(
 /// The aircraft at its replay mass: airframe + pack (the one named, else the default) +
 /// payload, as a planned mission flies, or a `[power]`-only vehicle at its table's mass + payload
 /// (that mass already is the whole vehicle: naming a pack for it is an error).
-fn replay_aircraft(vehicle: &Vehicle, request: &ReplayRequest) -> Result<Flown, Error> {
-    let mass = vehicle.takeoff_mass(request.battery.as_deref(), request.payload_kg)?;
+fn replay_aircraft(
+    vehicle: &Vehicle,
+    battery: Option<&str>,
+    payload_kg: f64,
+) -> Result<Flown, Error> {
+    let mass = vehicle.takeoff_mass(battery, payload_kg)?;
     let aircraft = if vehicle.file().airframe.is_some() {
         vehicle.aircraft()?.clone()
     } else {
@@ -351,18 +353,9 @@ fn read_replay_log(request: &ReplayRequest) -> Result<(Log, Option<f64>), Error>
 
 /// The samples with a velocity, strictly increasing in time, with their accelerations.
 fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajectory, Error> {
-    let mut times = Vec::new();
-    let mut vels = Vec::new();
-    let mut rows = Vec::new();
-    for s in &log.samples {
-        let Some(v) = s.vel_enu_mps else { continue };
-        if !s.time_s.is_finite() || times.last().is_some_and(|&t| s.time_s <= t) {
-            continue;
-        }
-        times.push(s.time_s);
-        vels.push(v);
-        rows.push(s);
-    }
+    let rows = trajectory_rows(log);
+    let times: Vec<f64> = rows.iter().map(|s| s.time_s).collect();
+    let vels: Vec<[f64; 3]> = rows.iter().filter_map(|s| s.vel_enu_mps).collect();
     if times.len() < 2 {
         return Err(Error::NothingToReplay {
             origin: path.to_string(),
@@ -396,6 +389,108 @@ fn trajectory(log: &Log, request: &ReplayRequest, path: &str) -> Result<Trajecto
         })
         .collect();
     Ok(Trajectory { times, points })
+}
+
+/// The samples of a log a trajectory is made of: those with a velocity, strictly increasing in
+/// time.
+fn trajectory_rows(log: &Log) -> Vec<&aloft_logs::Sample> {
+    let mut rows: Vec<&aloft_logs::Sample> = Vec::new();
+    for s in &log.samples {
+        if s.vel_enu_mps.is_none()
+            || !s.time_s.is_finite()
+            || rows.last().is_some_and(|r| s.time_s <= r.time_s)
+        {
+            continue;
+        }
+        rows.push(s);
+    }
+    rows
+}
+
+/// The power of `powered` in a hover, W, the scale of the idle threshold of the ground time
+/// ([`ground_time`]); `None` for a vehicle that cannot hover at its mass (power is then not
+/// used to tell the ground).
+fn hover_power_w(powered: &aloft_planner::Powered<'_>) -> Option<f64> {
+    powered.level_power_w([0.0; 2], [0.0, 1.0]).ok()
+}
+
+/// Whether a log flew, the one rule of `aloft fit` and `aloft validate` (through
+/// [`super::logs::FlightLogs::usable`]): a log whose own landed state (PX4
+/// `vehicle_land_detected`, ArduPilot's arming and landing) keeps it on the ground from its first
+/// record to its last never flew. A log without a landed state is not judged here (nothing in
+/// it tells a hover from the ground without a model of the vehicle).
+///
+/// # Errors
+/// [`Error::NeverFlew`] with the log's span.
+pub(crate) fn check_flew(log: &Log) -> Result<(), Error> {
+    let ground = ground_time(log, None);
+    if ground.airborne.is_empty() && ground.logged_points > 0 {
+        return Err(Error::NeverFlew {
+            origin: log.source.clone(),
+            duration_s: ground.last_s - ground.first_s,
+        });
+    }
+    Ok(())
+}
+
+/// The airborne seconds of a logged flight that `aloft mission --replay` books and `aloft
+/// validate` compares, and the energy measured over them: the airborne spans of the ground time
+/// (the log's landed state, else detected with the idle threshold of `vehicle`'s hover power at
+/// the take-off mass of `battery` and `payload_kg`), within the span where the log has a
+/// velocity and a power `lag_s` later; the measured energy is the power's integral over each
+/// span shifted by the lag. One function for both commands, so that one flight has one measured
+/// energy.
+///
+/// # Errors
+/// A pack the vehicle does not have, a log without a trajectory or a power that overlaps it.
+pub(crate) fn compared_airborne(
+    vehicle: &Vehicle,
+    (battery, payload_kg, aoa): (Option<&str>, f64, AoaModel),
+    log: &Log,
+    lag_s: f64,
+) -> Result<AirborneTime, Error> {
+    let flown = replay_aircraft(vehicle, battery, payload_kg)?;
+    let powered = flown.aircraft.at_mass(flown.mass_kg, aoa)?;
+    let times: Vec<f64> = trajectory_rows(log).iter().map(|s| s.time_s).collect();
+    if times.len() < 2 {
+        return Err(Error::NothingToReplay {
+            origin: log.source.clone(),
+        });
+    }
+    let (ptimes, power_w) = power_samples(log);
+    let measured = Measured {
+        times: ptimes,
+        power_w,
+        lag_s,
+    };
+    let window = compared_window(&times, Some(&measured), &log.source)?;
+    let ground = ground_time(log, hover_power_w(&powered));
+    let spans: Vec<(f64, f64)> = stretches(&ground, window)
+        .into_iter()
+        .filter(|st| st.airborne)
+        .map(|st| (st.start_s, st.end_s))
+        .collect();
+    Ok(AirborneTime { spans, measured })
+}
+
+/// The airborne time of a logged flight ([`compared_airborne`]) and its measured power.
+pub(crate) struct AirborneTime {
+    /// Airborne spans within the span where motion and power are both logged, s (motion time).
+    pub spans: Vec<(f64, f64)>,
+    measured: Measured,
+}
+
+impl AirborneTime {
+    /// The measured energy from `a` to `b` (motion time, within the spans), Wh: the integral
+    /// `aloft mission --replay` books.
+    pub fn measured_wh(&self, a: f64, b: f64) -> f64 {
+        measured_wh(&self.measured, a, b)
+    }
+}
+
+/// The measured energy from `a` to `b` (trajectory time; the power `lag_s` later), Wh.
+fn measured_wh(m: &Measured, a: f64, b: f64) -> f64 {
+    window_integral(&m.times, &m.power_w, a + m.lag_s, b + m.lag_s) / 3600.0
 }
 
 /// The ground time of the log: its own landed state where it has one, else detected from height,
@@ -588,7 +683,7 @@ fn book(
             books.predicted_ground_wh += idle.or(idle_w).unwrap_or(0.0) * (e - s) / 3600.0;
         }
         if let (Some(mb), Some(m)) = (books.measured.as_mut(), measured) {
-            let wh = window_integral(&m.times, &m.power_w, s + m.lag_s, e + m.lag_s) / 3600.0;
+            let wh = measured_wh(m, s, e);
             if st.airborne {
                 mb.air_wh += wh;
             } else {

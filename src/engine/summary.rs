@@ -74,9 +74,11 @@ pub struct FailsafeTime {
     pub kind: String,
     /// The threshold, pack volts.
     pub voltage_v: f64,
-    /// Time from take-off when the voltage first falls below it, s (`null`: never).
+    /// Time from take-off when the voltage first falls below it, s (absent: never).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_s: Option<f64>,
-    /// The segment it falls in, from 1 (`null`: never).
+    /// The segment it falls in, from 1 (absent: never).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub segment: Option<usize>,
     /// The operator's mission item of that segment, when the mission came from a planner file.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -6,10 +6,14 @@ use serde::Serialize;
 
 use super::air::{log_air, AirInput};
 use super::finite::finite;
-use super::logs::FlightLogs;
+use super::fit_quality::{judge_flight, Alignment, FitQuality, FlightJudged};
+use super::logs::{FlightLogs, SkippedLog};
+use super::replay::compared_airborne;
 use super::vehicles::Vehicle;
 use crate::error::Error;
-use crate::identify::{predict, validate_flight, AblationRow, FlightValidation, AIRSPEED_BANDS};
+use crate::identify::{
+    predict, validate_flight, AblationRow, AlignedFlight, FlightValidation, AIRSPEED_BANDS,
+};
 
 /// A validation request (the options of `aloft validate`).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -56,6 +60,13 @@ pub struct ValidateReport {
     /// That mass and what it is made of, in words (not part of the JSON).
     #[serde(skip)]
     pub mass: String,
+    /// The verdict on the whole: its worst flight's (`good`, `usable`, `poor`).
+    pub quality: FitQuality,
+    /// Why: each flight's reasons after its file name.
+    pub quality_reasons: Vec<String>,
+    /// The logs left out (one that never flew, one too short to align, ...), with their
+    /// reasons: the rule of `aloft fit`.
+    pub skipped_logs: Vec<SkippedLog>,
     /// Per flight.
     pub flights: Vec<FlightValidation>,
     /// Mean NRMSE over the flights, per dropped term and airspeed band (Table I layout).
@@ -75,41 +86,57 @@ pub struct ValidateAnswer {
 }
 
 /// Validate `vehicle`'s power model, at the take-off mass of the request's pack and payload
-/// ([`Vehicle::takeoff_mass`]), on the request's logs.
+/// ([`Vehicle::takeoff_mass`]), on the request's logs: each over its airborne time, the seconds
+/// `aloft mission --replay` books ([`compared_airborne`]), with a verdict per flight and on the
+/// whole ([`judge_flight`]). A log that cannot be used (one that never flew, one too short to
+/// align) is left out with its reason, as `aloft fit` does ([`FlightLogs::usable`]).
 ///
 /// # Errors
-/// Unreadable logs, logs without power or motion, a vehicle without `[power]`, a take-off mass
+/// [`Error::NoUsableLog`] when no log can be used; a vehicle without `[power]`, a take-off mass
 /// the vehicle refuses, a calibration window that does not fit a flight.
 pub fn validate_logs(
     vehicle: &Vehicle,
     request: &ValidateRequest,
 ) -> Result<ValidateAnswer, Error> {
     let (_, mass) = vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
-    let flights = request.logs.load()?;
+    // Every paired sample is kept: the airborne spans are the flight's ground time here, not
+    // the idle power the fit leaves out.
+    let (flights, mut skipped_logs) = request.logs.usable(0.0)?;
+    let used = request.logs.without(&skipped_logs);
     let mut results = Vec::with_capacity(flights.len());
     let mut series = Vec::new();
-    for (i, (f, _)) in flights.iter().enumerate() {
-        // Each flight in its own air (the given day, else the log's, else the vehicle file's)
-        // and at its own mass (the request's payload and the log's own, `FILE:payload_kg=KG`).
-        let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
-        let payload_kg = request.payload_kg + request.logs.payload_kg(i);
-        let (model, _) = vehicle
-            .in_air(air.air_density_kg_m3)?
-            .power_model_with(request.battery.as_deref(), payload_kg)?;
-        let mut result = validate_flight(&model, f, request.calibrate_first_s)?;
-        result.density_source = air.density_source;
-        results.push(result);
+    for (i, (f, log)) in flights.iter().enumerate() {
+        let payload_kg = request.payload_kg + used.payload_kg(i);
+        let Some(result) = validate_one(vehicle, request, (f, log), payload_kg)? else {
+            skipped_logs.push(SkippedLog {
+                file: f.source.clone(),
+                reason: Error::NoAirborneTime {
+                    origin: f.source.clone(),
+                }
+                .to_string(),
+            });
+            continue;
+        };
         if request.series {
-            let predicted = predict(&model, f)?;
-            let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
-            series.push((f.source.clone(), f.times_s.clone(), measured, predicted));
+            series.push(power_series(vehicle, request, f, payload_kg)?);
         }
+        results.push(result);
+    }
+    if results.is_empty() {
+        let reasons: Vec<&str> = skipped_logs.iter().map(|s| s.reason.as_str()).collect();
+        return Err(Error::NoUsableLog {
+            reasons: reasons.join("; "),
+        });
     }
     let table_i = mean_table_i(&results);
+    let (quality, quality_reasons) = overall(&results);
     let report = ValidateReport {
         vehicle: vehicle.name().to_string(),
         takeoff_mass_kg: mass.total_kg,
         mass: mass.describe(),
+        quality,
+        quality_reasons,
+        skipped_logs,
         flights: results,
         table_i,
     };
@@ -117,6 +144,86 @@ pub fn validate_logs(
         format!("logs {:?}", request.logs.logs)
     })?;
     Ok(ValidateAnswer { report, series })
+}
+
+/// One flight validated in its own air (the given day, else the log's, else the vehicle
+/// file's) and at its own mass (the request's payload and the log's own,
+/// `FILE:payload_kg=KG`), over its airborne time, with its verdict; `None` when it has no
+/// airborne time where motion and power are logged.
+fn validate_one(
+    vehicle: &Vehicle,
+    request: &ValidateRequest,
+    (f, log): (&AlignedFlight, &aloft_logs::Log),
+    payload_kg: f64,
+) -> Result<Option<FlightValidation>, Error> {
+    let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
+    let in_air = vehicle.in_air(air.air_density_kg_m3)?;
+    let (model, _) = in_air.power_model_with(request.battery.as_deref(), payload_kg)?;
+    let flown = (request.battery.as_deref(), payload_kg, request.logs.aoa);
+    let airborne = compared_airborne(&in_air, flown, log, f.lag_s)?;
+    if airborne.spans.is_empty() {
+        return Ok(None);
+    }
+    let measured_wh = |a: f64, b: f64| airborne.measured_wh(a, b);
+    let mut result = validate_flight(
+        &model,
+        f,
+        request.calibrate_first_s,
+        &airborne.spans,
+        &measured_wh,
+    )?;
+    result.density_source = air.density_source;
+    (result.quality, result.quality_reasons) = judge_flight(&FlightJudged {
+        alignment: Alignment {
+            file: &result.file,
+            lag_s: result.lag_s,
+            correlation: result.lag_correlation,
+        },
+        nrmse_percent: result.nrmse_percent,
+        constant_nrmse_percent: result.baseline_nrmse_percent,
+        samples: result.samples,
+        compared_s: result.duration_s,
+        airborne_s: result.airborne_s,
+    });
+    Ok(Some(result))
+}
+
+/// The measured and predicted power of a flight, for the plot.
+fn power_series(
+    vehicle: &Vehicle,
+    request: &ValidateRequest,
+    f: &AlignedFlight,
+    payload_kg: f64,
+) -> Result<PowerSeries, Error> {
+    let air = log_air(&request.air, f.air_density_kg_m3, vehicle)?;
+    let (model, _) = vehicle
+        .in_air(air.air_density_kg_m3)?
+        .power_model_with(request.battery.as_deref(), payload_kg)?;
+    let predicted = predict(&model, f)?;
+    let measured = f.samples.iter().map(|s| s.measured_power_w).collect();
+    Ok((f.source.clone(), f.times_s.clone(), measured, predicted))
+}
+
+/// The verdict on the whole: the worst flight's, and every flight's reasons after its name.
+fn overall(results: &[FlightValidation]) -> (FitQuality, Vec<String>) {
+    let quality = results
+        .iter()
+        .map(|f| f.quality)
+        .max()
+        .unwrap_or(FitQuality::Good);
+    let mut reasons = Vec::new();
+    for f in results {
+        let name = f.file.rsplit('/').next().unwrap_or(&f.file);
+        for r in &f.quality_reasons {
+            // The alignment's reasons already start with the file's name.
+            if r.starts_with(&format!("{name}: ")) {
+                reasons.push(r.clone());
+            } else {
+                reasons.push(format!("{name}: {r}"));
+            }
+        }
+    }
+    (quality, reasons)
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {

@@ -264,3 +264,71 @@ pub fn fit_json(logs: &[String], extra: &[&str], out: &Path) -> (i32, serde_json
     let json = serde_json::from_str(&stdout).unwrap_or(serde_json::Value::Null);
     (code, json, stderr)
 }
+
+/// The first `until_s` seconds of a flugdrohne log's per-topic CSV tables (`px4_flugdrohne/csv`,
+/// the log named by its `stem`), written under a scratch folder as the tables of a log named
+/// `name` (its parameters whole), and that log's prefix for `--log`: a real log cut short, e.g.
+/// before its take-off (a log that never flew).
+pub fn px4_tables_until(stem: &str, until_s: f64, tag: &str, name: &str) -> PathBuf {
+    let src = data_dir().join("px4_flugdrohne/csv");
+    let prefix = scratch(tag, name);
+    let mut first_us: Option<i64> = None;
+    // The log's clock starts at its earliest table row (all tables share the boot clock).
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        let file = p.file_name().unwrap().to_string_lossy().into_owned();
+        if file.starts_with(&format!("{stem}_")) && !file.ends_with("_params.csv") {
+            let text = std::fs::read_to_string(&p).unwrap();
+            if let Some(t) = text.lines().nth(1).and_then(|l| l.split(',').next()) {
+                let t: i64 = t.parse().unwrap();
+                first_us = Some(first_us.map_or(t, |f| f.min(t)));
+            }
+        }
+    }
+    let end_us = first_us.unwrap() + (until_s * 1e6) as i64;
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        let file = p.file_name().unwrap().to_string_lossy().into_owned();
+        let Some(rest) = file.strip_prefix(&format!("{stem}_")) else {
+            continue;
+        };
+        let text = std::fs::read_to_string(&p).unwrap();
+        let kept: Vec<&str> = text
+            .lines()
+            .enumerate()
+            .filter(|(i, l)| {
+                *i == 0
+                    || rest == "params.csv"
+                    || l.split(',').next().unwrap().parse::<i64>().unwrap() < end_us
+            })
+            .map(|(_, l)| l)
+            .collect();
+        let out = prefix.with_file_name(format!("{name}_{rest}"));
+        std::fs::write(out, kept.join("\n") + "\n").unwrap();
+    }
+    prefix
+}
+
+/// The paths of every `null` in a JSON answer (the contract: a value that does not exist is
+/// left out, never `null`).
+pub fn nulls(v: &serde_json::Value) -> Vec<String> {
+    fn walk(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Null => out.push(at),
+            serde_json::Value::Array(a) => {
+                for (i, x) in a.iter().enumerate() {
+                    walk(x, format!("{at}[{i}]"), out);
+                }
+            }
+            serde_json::Value::Object(o) => {
+                for (k, x) in o {
+                    walk(x, format!("{at}.{k}"), out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(v, String::new(), &mut out);
+    out
+}

@@ -53,6 +53,20 @@ pub const TEMPERATURE_RANGE_C: (f64, f64) = (-60.0, 60.0);
 /// pressures ever recorded (870 and 1084 hPa) with a margin.
 pub const QNH_RANGE_HPA: (f64, f64) = (850.0, 1_100.0);
 
+/// The largest share of the air's pressure its water vapour may have. Air at 100 % humidity
+/// near its boiling point would be mostly steam: at 11,000 m, 60 C and QNH 850 hPa the
+/// saturation vapour pressure (19.9 kPa) is above the air's own pressure (19.0 kPa). On
+/// Earth's surface the vapour is at most about 4 % of the air (a 35 C day at 100 % humidity,
+/// 5.6 kPa); a tenth leaves room for the hottest days that exist and refuses air that cannot.
+pub const MAX_VAPOUR_FRACTION: f64 = 0.1;
+
+/// The thinnest air the atmosphere answers for: ISA's density at the top of its troposphere
+/// (11 km, -56.5 C), 0.3639 kg/m^3, kg/m^3. A day's combination that gives thinner air (a hot
+/// day at 11 km) is outside the model's troposphere.
+pub fn thinnest_density_kg_m3() -> f64 {
+    isa_density_kg_m3(ELEVATION_RANGE_M.1)
+}
+
 /// The exponent `g0 / (Rd L)` of the ISA pressure law (5.2559).
 fn pressure_exponent() -> f64 {
     crate::STANDARD_GRAVITY_MPS2 / (DRY_AIR_GAS_CONSTANT_J_PER_KG_K * ISA_LAPSE_RATE_K_PER_M)
@@ -168,6 +182,19 @@ mod tests {
             let low = pressure_at_elevation_pa(h, 99_000.0);
             assert!((low / isa_pressure_pa(h) - 99_000.0 / 101_325.0).abs() < 1e-12);
         }
+    }
+
+    /// ISA at 11 km is 0.3639 kg/m^3 (US Standard Atmosphere 1976, Table I: 3.6392e-1); the
+    /// issue's impossible day (11,000 m, 60 C, QNH 850 hPa) has a saturation vapour pressure
+    /// above its air's pressure.
+    #[test]
+    fn paper_val_the_thinnest_air_and_the_impossible_day() {
+        assert!((thinnest_density_kg_m3() - 0.36392).abs() < 2e-4);
+        let p = pressure_at_elevation_pa(11_000.0, 85_000.0);
+        assert!(saturation_vapour_pressure_pa(60.0) > p, "{p}");
+        assert!(
+            saturation_vapour_pressure_pa(35.0) < MAX_VAPOUR_FRACTION * ISA_SEA_LEVEL_PRESSURE_PA
+        );
     }
 
     /// The density altitude of ISA's own density at an elevation is that elevation (0.1 m).

@@ -43,6 +43,11 @@ pub const ISA_SEA_LEVEL_DENSITY_KG_M3: f64 = 1.225;
 /// Seconds per hour: joules to watt-hours, ampere-seconds to ampere-hours.
 pub const SECONDS_PER_HOUR: f64 = 3600.0;
 
+/// The capacities a battery pack may have, mA h: from 10 mA h (below it a value is a unit slip
+/// or an unset parameter, such as a logged `BAT1_CAPACITY` of 1e-38; the smallest flying packs
+/// hold tens of mA h) to 1e7 mA h (10,000 A h: beyond it a unit slip, not a pack).
+pub const BATTERY_CAPACITY_RANGE_MAH: (f64, f64) = (10.0, 1e7);
+
 /// A number as an error message shows it: as written for ordinary magnitudes, in scientific
 /// notation when it is huge or tiny (`1e308`, not 309 digits), `NaN` and `inf` as such.
 ///

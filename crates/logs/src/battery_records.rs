@@ -36,7 +36,18 @@ use serde::Serialize;
 
 /// Largest battery capacity a log's parameters may give, mA h (10,000 A h): beyond it a value is
 /// a unit slip, not a pack.
-pub const MAX_BATTERY_CAPACITY_MAH: f64 = 1e7;
+pub const MAX_BATTERY_CAPACITY_MAH: f64 = aloft_core::BATTERY_CAPACITY_RANGE_MAH.1;
+/// Smallest battery capacity a log's parameters may give, mA h: below it (PX4's unset -1, a
+/// `BAT1_CAPACITY` of 1e-38) the capacity is unset.
+pub const MIN_BATTERY_CAPACITY_MAH: f64 = aloft_core::BATTERY_CAPACITY_RANGE_MAH.0;
+
+/// A logged capacity parameter, mA h, when it is a pack's (from [`MIN_BATTERY_CAPACITY_MAH`] to
+/// [`MAX_BATTERY_CAPACITY_MAH`]).
+pub(crate) fn plausible_capacity_mah(mah: f64) -> Option<f64> {
+    (MIN_BATTERY_CAPACITY_MAH..=MAX_BATTERY_CAPACITY_MAH)
+        .contains(&mah)
+        .then_some(mah)
+}
 
 /// The autopilot's flight-envelope parameters a log's [`BatteryLog::parameters`] keeps besides
 /// the battery's: what a vehicle file's `[airframe]` holds (PX4 in SI units, ArduPilot in
@@ -140,6 +151,11 @@ pub struct BatteryLog {
     pub samples: Vec<BatterySample>,
     /// What was left out or looked wrong while reading.
     pub warnings: Vec<String>,
+    /// Why the logged capacity parameter is not the pack's, when it is set but outside
+    /// [`MIN_BATTERY_CAPACITY_MAH`]..[`MAX_BATTERY_CAPACITY_MAH`] (a `BAT1_CAPACITY` of 1e-38):
+    /// [`Self::rated_capacity_mah`] is then unset.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capacity_note: Option<String>,
 }
 
 impl BatteryLog {
@@ -223,8 +239,22 @@ impl BatteryDetails {
             }
         }
         let positive = |v: Option<f64>| v.filter(|v| v.is_finite() && *v > 0.0);
-        let rated = positive(param("BAT1_CAPACITY").or_else(|| param("BATT_CAPACITY")))
-            .filter(|c| *c <= MAX_BATTERY_CAPACITY_MAH);
+        let (key, logged) = match param("BAT1_CAPACITY") {
+            Some(c) => ("BAT1_CAPACITY", Some(c)),
+            None => ("BATT_CAPACITY", param("BATT_CAPACITY")),
+        };
+        let rated = logged.and_then(plausible_capacity_mah);
+        // A value that is set (PX4's unset is -1, ArduPilot's 0) but no pack's is said.
+        let capacity_note = logged
+            .filter(|c| rated.is_none() && (c.is_nan() || *c > 0.0))
+            .map(|c| {
+                // Parameters are logged as f32: shown as logged (1e-38, not 9.9999993e-39).
+                let shown = (c as f32).to_string().parse().unwrap_or(c);
+                format!(
+                    "{key} = {} mA h is not a pack's capacity (from 10 mA h to 1e7 mA h): taken as unset",
+                    aloft_core::Num(shown)
+                )
+            });
         let fraction = |v: Option<f64>| v.filter(|v| v.is_finite() && *v > 0.0 && *v < 1.0);
         let vehicle_id = self.vehicle_id.clone().or_else(|| {
             param("BRD_SERIAL_NUM")
@@ -258,6 +288,7 @@ impl BatteryDetails {
             start_unix_s,
             samples: self.samples,
             warnings,
+            capacity_note,
         }
     }
 }

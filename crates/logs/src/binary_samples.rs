@@ -48,10 +48,11 @@ pub const MIN_BATTERY_COVERAGE: f64 = 0.5;
 /// corrupt parameter and is not read); its home is [`crate::battery_records`].
 pub use crate::battery_records::MAX_BATTERY_CAPACITY_MAH;
 
-/// A capacity parameter in mA h as A h, when it is positive and at most
-/// [`MAX_BATTERY_CAPACITY_MAH`] (an infinite one made the answer of `log info` not finite).
+/// A capacity parameter in mA h as A h, when it is a pack's: from
+/// [`crate::battery_records::MIN_BATTERY_CAPACITY_MAH`] (a `BAT1_CAPACITY` of 1e-38 is unset)
+/// to [`MAX_BATTERY_CAPACITY_MAH`] (an infinite one made the answer of `log info` not finite).
 pub(crate) fn capacity_ah(mah: f64) -> Option<f64> {
-    (mah > 0.0 && mah <= MAX_BATTERY_CAPACITY_MAH).then_some(mah / 1000.0)
+    crate::battery_records::plausible_capacity_mah(mah).map(|c| c / 1000.0)
 }
 
 /// After a record that cannot be valid at `from`: skip byte by byte to the next offset where a

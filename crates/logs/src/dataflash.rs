@@ -1013,6 +1013,10 @@ mod tests {
             (f32::INFINITY, None),
             (f32::NAN, None),
             (-1.0, None),
+            // Issue 41: a capacity no pack has (below 10 mA h) is unset.
+            (1e-38, None),
+            (9.0, None),
+            (10.0, Some(0.01)),
             (5000.0, Some(5.0)),
         ] {
             let mut b = dataflash_fmt_of_fmt();

@@ -108,17 +108,20 @@ pub fn capacity_between_rests(
     let load_from = pts.iter().position(|p| !rested(p));
     let load_to = pts.iter().rposition(|p| !rested(p));
     let (Some(a), Some(b)) = (load_from, load_to) else {
-        // Never loaded: a log at rest throughout has no discharge to count.
-        return Err(PackError::SocDropTooSmall {
-            soc_before: 0.0,
-            soc_after: 0.0,
-            drop: 0.0,
-            min_drop: MIN_SOC_DROP,
-        });
+        // Never loaded: a log at rest throughout has no discharge to count; its last (most
+        // relaxed) voltage says the state of charge it rests at.
+        return Err(never_loaded(last.1, cells_series, limit_a));
     };
-    if a == 0 || pts[a].0 - first.0 < REST_HOLD_S {
+    if a == 0 {
         return Err(PackError::NoRestBefore {
             current_a: first.2,
+            limit_a,
+            hold_s: REST_HOLD_S,
+        });
+    }
+    if pts[a].0 - first.0 < REST_HOLD_S {
+        return Err(PackError::RestBeforeTooShort {
+            rested_s: pts[a].0 - first.0,
             limit_a,
             hold_s: REST_HOLD_S,
         });
@@ -162,6 +165,23 @@ pub fn capacity_between_rests(
         rest_before_v: v1,
         rest_after_v: v2,
     })
+}
+
+/// Why a log that never drew the rest limit has no capacity: with the cells known, the state of
+/// charge its rested voltage `voltage_v` reads on the typical LiPo curve.
+fn never_loaded(voltage_v: f64, cells_series: Option<u32>, limit_a: f64) -> PackError {
+    match cells_series.filter(|n| *n > 0) {
+        Some(n) => {
+            let cell_v = voltage_v / f64::from(n);
+            PackError::NeverLoaded {
+                limit_a,
+                voltage_v,
+                cell_v,
+                soc: OcvCurve::typical_lipo().soc_at(cell_v),
+            }
+        }
+        None => PackError::NeverLoadedCellsUnknown { limit_a },
+    }
 }
 
 /// The drop of charge the pack or the autopilot reported over the log, mA h, and where it came
@@ -240,6 +260,44 @@ mod tests {
         let e = capacity_between_rests(&v, Some(4), Some(5000.0)).unwrap_err();
         assert!(
             e.to_string().starts_with("no rest before the flight"),
+            "{e}"
+        );
+    }
+
+    /// Issue 41: a pack at rest throughout was said to fall "from 0.000 to 0.000"; a 3S pack
+    /// resting at 12.3 V (4.10 V a cell) is about 88 % on the typical LiPo curve (4.08 V 85 %,
+    /// 4.11 V 90 %).
+    #[test]
+    fn a_pack_never_loaded_says_the_state_of_charge_it_rests_at() {
+        let v: Vec<BatterySample> = (0..20).map(|k| s(k as f64 * 0.1, 12.3, 0.0)).collect();
+        let e = capacity_between_rests(&v, Some(3), Some(5000.0)).unwrap_err();
+        let PackError::NeverLoaded { soc, cell_v, .. } = e else {
+            panic!("{e}")
+        };
+        assert!((cell_v - 4.1).abs() < 1e-12);
+        assert!((0.85..=0.90).contains(&soc), "{soc}");
+        assert!(e.to_string().contains("state of charge 0.8"), "{e}");
+        let e = capacity_between_rests(&v, None, None).unwrap_err();
+        assert!(
+            matches!(e, PackError::NeverLoadedCellsUnknown { .. }),
+            "{e}"
+        );
+    }
+
+    /// A rest at the start that is too short says how long it was, not that the current was
+    /// above the limit (it was not).
+    #[test]
+    fn a_short_rest_before_says_how_long_it_was() {
+        let mut v: Vec<BatterySample> = (0..=50).map(|k| s(k as f64 * 0.2, 12.3, 0.0)).collect();
+        v.extend((51..=300).map(|k| s(k as f64 * 0.2, 11.5, 20.0)));
+        let e = capacity_between_rests(&v, Some(3), Some(5000.0)).unwrap_err();
+        assert!(
+            matches!(e, PackError::RestBeforeTooShort { rested_s, .. } if (rested_s - 10.2).abs() < 1e-9),
+            "{e}"
+        );
+        assert!(
+            e.to_string()
+                .contains("below the rest limit of 0.25 A for only 10.2 s"),
             "{e}"
         );
     }

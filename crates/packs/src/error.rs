@@ -19,8 +19,8 @@ pub enum PackError {
     /// The number of cells in series is unknown, so no rested voltage reads as a state of charge.
     #[error("the number of cells in series is unknown: a rested voltage cannot be read on the per-cell OCV curve")]
     CellsUnknown,
-    /// The log does not start with a rest.
-    #[error("no rest before the flight: the current is {current_a:.2} A at the first record, above the rest limit of {limit_a:.2} A, and never held below it for {hold_s:.0} s before the discharge")]
+    /// The log does not start with a rest: its first record draws the rest limit or more.
+    #[error("no rest before the flight: the current is {current_a:.2} A at the first record, above the rest limit of {limit_a:.2} A (a rest must hold {hold_s:.0} s before the discharge)")]
     NoRestBefore {
         /// The current at the first record, A.
         current_a: f64,
@@ -28,6 +28,35 @@ pub enum PackError {
         limit_a: f64,
         /// How long a rest must hold, s.
         hold_s: f64,
+    },
+    /// The log starts at rest, but the rest ends before it has held long enough.
+    #[error("no rest before the flight: the current is below the rest limit of {limit_a:.2} A for only {rested_s:.1} s from the first record (a rest must hold {hold_s:.0} s)")]
+    RestBeforeTooShort {
+        /// From the first record to the first one above the limit, s.
+        rested_s: f64,
+        /// The rest limit, A.
+        limit_a: f64,
+        /// How long a rest must hold, s.
+        hold_s: f64,
+    },
+    /// The current never reaches the rest limit: no discharge to measure; the state of charge
+    /// the pack rests at, read on the typical LiPo curve.
+    #[error("the pack was never loaded (the current stays below the rest limit of {limit_a:.2} A): no discharge to measure a capacity; it rests at {voltage_v:.2} V ({cell_v:.3} V a cell), state of charge {soc:.2} on the typical LiPo curve")]
+    NeverLoaded {
+        /// The rest limit, A.
+        limit_a: f64,
+        /// The pack's last (most relaxed) voltage, V.
+        voltage_v: f64,
+        /// That voltage per cell, V.
+        cell_v: f64,
+        /// The state of charge it reads, 0-1.
+        soc: f64,
+    },
+    /// The current never reaches the rest limit, and the cells are unknown.
+    #[error("the pack was never loaded (the current stays below the rest limit of {limit_a:.2} A): no discharge to measure a capacity")]
+    NeverLoadedCellsUnknown {
+        /// The rest limit, A.
+        limit_a: f64,
     },
     /// The log does not end with a rest.
     #[error("no rest after the flight: the log ends {tail_s:.1} s after the last current above the rest limit of {limit_a:.2} A (a rest must hold {hold_s:.0} s)")]

@@ -39,7 +39,8 @@ pub struct PackOptions {
     pub cells_series: Option<u32>,
 }
 
-/// Everything one log says about its pack. Keys carry their units.
+/// Everything one log says about its pack. Keys carry their units; what a log does not give is
+/// left out of the JSON (never `null`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PackReport {
     /// The log.
@@ -47,14 +48,19 @@ pub struct PackReport {
     /// Its container (`ulog`, `dataflash`, `csv`, `mcap`).
     pub format: String,
     /// The vehicle's identity, when logged.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub vehicle_id: Option<String>,
     /// The pack's identity, when logged.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub pack_id: Option<String>,
     /// Wall-clock start, s since 1970 (UTC), when logged.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub start_unix_s: Option<f64>,
     /// Cells in series.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cells_series: Option<u32>,
     /// Rated capacity, mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub rated_capacity_mah: Option<f64>,
     /// Battery records.
     pub records: usize,
@@ -67,42 +73,61 @@ pub struct PackReport {
     /// Highest terminal voltage, V.
     pub max_voltage_v: f64,
     /// Largest current, A.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub max_current_a: Option<f64>,
     /// Charge drawn, ∫I dt (the coulomb count), mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub discharged_mah: Option<f64>,
     /// The drop of charge the pack or autopilot reported over the log, mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub reported_drop_mah: Option<f64>,
     /// Where [`Self::reported_drop_mah`] comes from.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub reported_drop_source: Option<String>,
     /// Coulomb count / reported drop.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub coulomb_to_reported_ratio: Option<f64>,
     /// Discharged charge / rated charge.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub equivalent_cycles: Option<f64>,
     /// The pack's internal resistance from current steps (median), Ω.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub internal_resistance_ohm: Option<f64>,
     /// The resistance estimate in full.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub resistance: Option<ResistanceEstimate>,
     /// The autopilot's own resistance estimate of the whole pack (median of its log), Ω.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub autopilot_internal_resistance_ohm: Option<f64>,
     /// Capacity between two rests, mA h.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_mah: Option<f64>,
     /// The capacity estimate in full.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity: Option<CapacityEstimate>,
     /// Why there is no capacity, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub capacity_refused: Option<String>,
     /// Time with a cell spread above 0.01 V, min.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_minor_min: Option<f64>,
     /// Time with a cell spread above 0.07 V, min.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub imbalance_major_min: Option<f64>,
     /// Cell balance in full.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cell_balance: Option<CellBalance>,
     /// A smart pack's cycle count.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub cycle_count: Option<u32>,
     /// A smart pack's state of health, percent.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub state_of_health_percent: Option<f64>,
     /// ArduPilot's low-voltage failsafe, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub low_voltage_failsafe_v: Option<f64>,
     /// ArduPilot's critical-voltage failsafe, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub critical_voltage_failsafe_v: Option<f64>,
 }
 
@@ -234,17 +259,21 @@ mod tests {
         assert!((r.equivalent_cycles.unwrap() - 0.5).abs() < 1e-12);
         assert!((r.energy_wh - 6.0).abs() < 1e-9);
         let j = serde_json::to_value(&r).unwrap();
+        for k in ["discharged_mah", "equivalent_cycles", "energy_wh"] {
+            assert!(j[k].is_number(), "{k} missing");
+        }
+        // What the log does not give is left out, never null (issue 41): a constant current
+        // has no steps, no rests, no cells and no autopilot estimate.
         for k in [
             "internal_resistance_ohm",
             "capacity_mah",
             "autopilot_internal_resistance_ohm",
-            "discharged_mah",
-            "equivalent_cycles",
             "imbalance_minor_min",
             "imbalance_major_min",
         ] {
-            assert!(j.get(k).is_some(), "{k} missing");
+            assert!(j.get(k).is_none(), "{k}: {}", j[k]);
         }
+        assert!(!j.to_string().contains("null"), "{j}");
     }
 
     #[test]

@@ -281,7 +281,18 @@ impl Pack {
         if spec.cells_series == 0 {
             return Err(bad("cells_series", 0.0, "", "at least one cell"));
         }
-        let capacity_ah = pos("capacity_mah", spec.capacity_mah, "mA h")? / 1000.0;
+        // A pack holds at least 10 mA h: below it the value is a unit slip or an unset
+        // parameter (a logged BAT1_CAPACITY of 1e-38 made a pack that flew 0.0 min).
+        let (min_mah, max_mah) = aloft_core::BATTERY_CAPACITY_RANGE_MAH;
+        if !(min_mah..=max_mah).contains(&spec.capacity_mah) {
+            return Err(bad(
+                "capacity_mah",
+                spec.capacity_mah,
+                "mA h",
+                "a capacity from 10 to 1e7 mA h (a smaller pack is a unit slip)",
+            ));
+        }
+        let capacity_ah = spec.capacity_mah / 1000.0;
         let nominal_v = pos("nominal_v", need("nominal_v", spec.nominal_v)?, "V")?;
         let energy_wh = pos("energy_wh", need("energy_wh", spec.energy_wh)?, "W h")?;
         let mass_kg = pos("mass_kg", need("mass_kg", spec.mass_kg)?, "kg")?;

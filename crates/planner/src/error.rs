@@ -169,19 +169,20 @@ pub enum PlannerError {
     },
 }
 
-/// Reject NaN, infinities and values that are zero or negative.
+/// Reject NaN, infinities, values that are zero or negative, and subnormal ones (below
+/// 2.2e-308: no physical quantity in its SI unit, and a divisor that overflows to infinity).
 pub(crate) fn positive(
     name: &'static str,
     value: f64,
     unit: &'static str,
 ) -> Result<f64, PlannerError> {
-    let ok = value.is_finite() && value > 0.0;
+    let ok = value.is_normal() && value > 0.0;
     Ok(aloft_core::parameter(
         name,
         value,
         unit,
         ok,
-        "a positive finite number",
+        "a positive finite number (not subnormal)",
     )?)
 }
 
