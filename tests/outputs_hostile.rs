@@ -230,6 +230,8 @@ fn assert_refused(w: &Writer, (code, out, err): &(i32, String, String), out_path
     assert_eq!(err.lines().count(), 1, "{}: {err}", w.name);
     let name = out_path.file_name().unwrap().to_string_lossy();
     assert!(err.contains(name.as_ref()), "{}: {err}", w.name);
+    // Never a file of aloft's own (a temporary name) in what the user reads.
+    assert!(!err.contains(".aloft-"), "{}: {err}", w.name);
 }
 
 #[test]
@@ -550,4 +552,39 @@ fn an_interrupted_plan_leaves_the_whole_set_or_nothing() {
         }
     }
     assert!(interrupted > 0, "no run was interrupted");
+}
+
+/// A log's file name is written into the fitted vehicle's comment header: a newline in it stays
+/// in its comment line (escaped), so the name cannot add keys to the file (before, a log named
+/// "x\nmass_kg = 99.0\n#.csv" wrote `mass_kg = 99.0` as a line of the vehicle file).
+#[cfg(unix)]
+#[test]
+fn fit_writes_a_log_name_with_a_newline_as_one_comment_line() {
+    let d = folder("fit-name");
+    let log = d.join("x\nmass_kg = 99.0\n#.csv");
+    std::fs::copy(kaist_log(), &log).unwrap();
+    let out = d.join("fitted.toml");
+    let template = s(&fixture("vehicles", "kaist-template.toml"));
+    let args = strings(&[
+        "fit",
+        "--profile",
+        "kaist",
+        "--log",
+        &s(&log),
+        "--vehicle-template",
+        &template,
+        "-o",
+        &s(&out),
+    ]);
+    let (code, _, err) = run_within(&args, LIMIT);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.lines().all(|l| !l.starts_with("mass_kg = 99")),
+        "{text}"
+    );
+    let comment = text.lines().find(|l| l.starts_with("# Log ")).unwrap();
+    assert!(comment.contains("x\\nmass_kg = 99.0\\n#.csv"), "{comment}");
+    let table: toml::Table = text.parse().unwrap();
+    assert!(!table.contains_key("mass_kg"), "{table:?}");
 }

@@ -25,28 +25,9 @@ pub fn file_name(p: &str) -> Cow<'_, str> {
     )
 }
 
-/// `text` with its control characters (a newline, an escape sequence) and the bidirectional
-/// overrides (U+202A-U+202E, U+2066-U+2069, which reorder what follows them on a terminal)
-/// written as Rust escapes (`\n`, `\u{1b}`), the rest as it is: a message or a table row
-/// that quotes a file name or a reason stays one line and shows what is there.
-pub fn escaped(text: &str) -> Cow<'_, str> {
-    let hidden = |c: char| {
-        c.is_control()
-            || ('\u{202a}'..='\u{202e}').contains(&c)
-            || ('\u{2066}'..='\u{2069}').contains(&c)
-    };
-    if !text.chars().any(hidden) {
-        return Cow::Borrowed(text);
-    }
-    Cow::Owned(
-        text.chars()
-            .map(|c| match c {
-                c if hidden(c) => c.escape_default().to_string(),
-                c => c.to_string(),
-            })
-            .collect(),
-    )
-}
+/// `text` with its control characters and bidirectional overrides escaped (aloft's one rule:
+/// [`aloft::engine::escaped`]).
+pub use aloft::engine::escaped;
 
 #[cfg(test)]
 mod tests {

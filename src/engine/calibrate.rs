@@ -416,18 +416,13 @@ pub fn calibrate_spec_file(path: &std::path::Path) -> Result<SpecCalibration, Er
     calibrate_spec(&SpecSheet::from_toml(&text, &origin)?, &origin)
 }
 
-/// Text for a TOML comment: anything that would end the comment line (a control character or a
-/// line separator from a name in the spec) becomes a space.
+/// Text for a TOML comment: anything that would end the comment line or reorder it (a control
+/// character, a bidirectional override) escaped ([`super::escaped`]), the line separators of
+/// Unicode too.
 fn comment_text(text: &str) -> String {
-    text.chars()
-        .map(|c| {
-            if c.is_control() || matches!(c, '\u{2028}' | '\u{2029}' | '\u{85}') {
-                ' '
-            } else {
-                c
-            }
-        })
-        .collect()
+    super::escaped(text)
+        .replace('\u{2028}', "\\u{2028}")
+        .replace('\u{2029}', "\\u{2029}")
 }
 
 /// `x` to 9 decimals: figures written to a file without binary noise (22.2, not 22.200000000000003).

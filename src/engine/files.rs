@@ -15,7 +15,9 @@
 use std::fs::File;
 use std::path::Path;
 
-pub use aloft_core::output::{safe_stem, shown as shown_path, Output, OutputError, OutputSet};
+pub use aloft_core::output::{
+    escaped, safe_stem, shown as shown_path, Output, OutputError, OutputSet,
+};
 
 use crate::error::Error;
 

@@ -14,7 +14,7 @@ use aloft_power::fit::{
 use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
-use super::files::{check_output, write_output};
+use super::files::{check_output, escaped, write_output};
 use super::finite::finite;
 use super::fit_quality::{judge_fit, Alignment, Envelope, FitQuality};
 use super::logs::{FlightLogs, SkippedLog};
@@ -603,11 +603,14 @@ fn fitted_vehicle_toml(
     for l in logs {
         text.push_str(&format!(
             "# Log {}: lag {:.2} s, {} samples\n",
-            l.file, l.lag_s, l.samples
+            escaped(&l.file),
+            l.lag_s,
+            l.samples
         ));
     }
     for n in notes {
-        text.push_str(&format!("# Note: {n}\n"));
+        // A note may quote a file name: one comment line whatever it holds.
+        text.push_str(&format!("# Note: {}\n", escaped(n)));
     }
     let body = toml::to_string(&fitted).map_err(|e| Error::VehicleFormat {
         origin: fitted.name.clone(),

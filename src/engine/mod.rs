@@ -106,8 +106,8 @@ pub use endurance::{
 };
 pub use estimator::InFlightEstimator;
 pub use files::{
-    abandon_outputs, check_output, read_text_file, safe_stem, shown_path, write_output, Output,
-    OutputError, OutputSet, MAX_INPUT_BYTES,
+    abandon_outputs, check_output, escaped, read_text_file, safe_stem, shown_path, write_output,
+    Output, OutputError, OutputSet, MAX_INPUT_BYTES,
 };
 pub use fit::{fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport};
 pub use fit_quality::FitQuality;

@@ -100,22 +100,39 @@ impl OutputError {
     }
 }
 
-/// A path as messages show it: control characters (a newline in a file name) escaped, so that a
-/// message stays on one line.
-pub fn shown(path: &Path) -> String {
-    let text = path.display().to_string();
-    if !text.chars().any(char::is_control) {
-        return text;
+/// `text` with its control characters (a newline, an escape sequence) and the bidirectional
+/// overrides (U+202A-U+202E, U+2066-U+2069, which reorder what follows them on a terminal)
+/// written as Rust escapes (`\n`, `\u{1b}`), the rest as it is: a message, a table row or a
+/// comment line of a written file that quotes a file name or a reason stays one line and shows
+/// what is there.
+///
+/// ```
+/// use aloft_core::output::escaped;
+/// assert_eq!(escaped("flight 3.ulg"), "flight 3.ulg");
+/// assert_eq!(escaped("x\nmass_kg = 99"), "x\\nmass_kg = 99");
+/// ```
+pub fn escaped(text: &str) -> std::borrow::Cow<'_, str> {
+    let hidden = |c: char| {
+        c.is_control()
+            || ('\u{202a}'..='\u{202e}').contains(&c)
+            || ('\u{2066}'..='\u{2069}').contains(&c)
+    };
+    if !text.chars().any(hidden) {
+        return std::borrow::Cow::Borrowed(text);
     }
-    text.chars()
-        .map(|c| {
-            if c.is_control() {
-                c.escape_default().to_string()
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
+    std::borrow::Cow::Owned(
+        text.chars()
+            .map(|c| match c {
+                c if hidden(c) => c.escape_default().to_string(),
+                c => c.to_string(),
+            })
+            .collect(),
+    )
+}
+
+/// A path as messages show it ([`escaped`]), so that a message stays on one line.
+pub fn shown(path: &Path) -> String {
+    escaped(&path.display().to_string()).into_owned()
 }
 
 /// The stem of an output name taken from an input's file name (`survey.plan` gives `survey`),
