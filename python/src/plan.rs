@@ -41,4 +41,3 @@ pub fn plan_json(
         .map_err(engine_error)?;
     Ok((answer.json, answer.texts))
 }
-
