@@ -17,8 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
-use common::{data_dir, fixture, scratch};
+use common::{data_dir, fixture, scratch, survey_lines};
 
 /// A new empty folder of this test's own.
 fn folder(name: &str) -> PathBuf {
@@ -366,21 +365,6 @@ fn an_output_in_a_missing_folder_is_refused_naming_it() {
 
 // ---------------------------------------------------------------------------------------------
 // aloft plan: names, links, sets, interrupts.
-
-/// Survey lines 1 km long, 40 m apart, at 8 m/s (several packs of an M100 for 40 lines).
-fn survey_lines(name: &str, lines: usize) -> String {
-    let mut text = format!("name = {name:?}\ndefault_speed_mps = 8.0\n");
-    text.push_str(&take_off(40.0, 3.0));
-    for k in 0..lines {
-        let east = if k % 2 == 0 { 1000.0 } else { 0.0 };
-        let north = 40.0 * k as f64;
-        text.push_str(&leg(east, north, 8.0));
-        text.push_str(&leg(east, north + 40.0, 8.0));
-    }
-    text.push_str(&return_home(8.0));
-    text.push_str(&landing(1.0));
-    text
-}
 
 fn plan(mission: &Path, out: &Path, extra: &[&str]) -> (i32, String, String) {
     let mut args = strings(&["plan", &s(mission), "-o", &s(out)]);

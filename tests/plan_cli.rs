@@ -9,24 +9,8 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use aloft_planner::mission_toml::{landing, leg, return_home, take_off};
-use common::{aloft, run, scratch};
+use common::{aloft, run, scratch, survey_lines};
 use serde_json::Value;
-
-/// Survey lines 1 km long, 40 m apart, at 8 m/s: about 16 minutes of an M100's TB47D at 20 %
-/// reserve per 10 lines in still air.
-fn survey_lines(lines: usize) -> String {
-    let mut text = String::from("name = \"lines\"\ndefault_speed_mps = 8.0\n");
-    text.push_str(&take_off(40.0, 3.0));
-    for k in 0..lines {
-        let east = if k % 2 == 0 { 1000.0 } else { 0.0 };
-        let north = 40.0 * k as f64;
-        text.push_str(&leg(east, north, 8.0));
-        text.push_str(&leg(east, north + 40.0, 8.0));
-    }
-    text.push_str(&return_home(8.0));
-    text.push_str(&landing(1.0));
-    text
-}
 
 fn write_mission(name: &str, text: &str) -> PathBuf {
     let path = scratch("plan", name);
@@ -71,7 +55,7 @@ fn f(v: &Value) -> f64 {
 /// reserve (it turns home inside a leg); the plan needs no more than the mission as given.
 #[test]
 fn each_file_flies_its_sortie_and_keeps_the_reserve() {
-    let mission = write_mission("lines.toml", &survey_lines(24));
+    let mission = write_mission("lines.toml", &survey_lines("lines", 24));
     for wind in [
         vec![],
         vec!["--wind-speed", "6", "--wind-from", "90"],
@@ -123,7 +107,7 @@ fn each_file_flies_its_sortie_and_keeps_the_reserve() {
 /// home; the last ends with the mission's way down.
 #[test]
 fn the_sorties_resume_where_the_last_turned_home_less_the_overlap() {
-    let mission = write_mission("overlap.toml", &survey_lines(24));
+    let mission = write_mission("overlap.toml", &survey_lines("lines", 24));
     for overlap in ["0", "30"] {
         let (answer, _) = plan(&mission, &["--overlap-m", overlap, "--speeds", "keep"]);
         let files: Vec<&str> = answer["files"]
@@ -169,7 +153,7 @@ fn the_sorties_resume_where_the_last_turned_home_less_the_overlap() {
 /// with `energy`, none with `keep`; no leg is given more than `--max-speed`.
 #[test]
 fn speeds_follow_the_choice_and_the_cap() {
-    let mut text = survey_lines(4);
+    let mut text = survey_lines("lines", 4);
     // The second leg without a speed of its own: it flies the planning speed.
     text = text.replacen("ground_speed_mps = 8.0\n", "", 2);
     let mission = write_mission("speeds.toml", &text);
@@ -200,7 +184,7 @@ fn speeds_follow_the_choice_and_the_cap() {
 /// no pack can fly out and back is exit 1 with the reason and no file.
 #[test]
 fn bad_input_and_no_plan_are_refused() {
-    let mission = write_mission("bad.toml", &survey_lines(4));
+    let mission = write_mission("bad.toml", &survey_lines("lines", 4));
     let m = mission.display().to_string();
     let dir = scratch("plan", "bad-out").display().to_string();
     let _ = std::fs::remove_dir_all(&dir);
@@ -276,7 +260,8 @@ fn bad_input_and_no_plan_are_refused() {
 fn a_cancelled_plan_stops() {
     use std::sync::atomic::AtomicBool;
     use std::sync::Arc;
-    let mission = aloft::engine::Mission::from_text(&survey_lines(24), "lines.toml").unwrap();
+    let mission =
+        aloft::engine::Mission::from_text(&survey_lines("lines", 24), "lines.toml").unwrap();
     let vehicle = aloft::engine::Vehicle::builtin("dji-m100").unwrap();
     let mut request = aloft::engine::FlyPlanRequest::default();
     let plan = aloft::engine::plan_to_fly(&vehicle, &mission, &request).unwrap();

@@ -9,7 +9,7 @@ use clap::Args;
 use aloft::engine::flags::FitFlags;
 use aloft::engine::{fit_logs, FitAnswer, FitRequest};
 
-use super::flights::{escaped, file_name, quality_word};
+use super::flights::{escaped, file_name, write_verdict};
 use super::output::{self, Row};
 use super::{Format, Outcome};
 
@@ -169,17 +169,10 @@ fn render(out: &mut impl Write, r: &FitAnswer) -> Result<()> {
         "\nFitted vehicle -> {}: take-off mass {} kg without payload, efficiency {:.4}, rotor radius {:.4} m, kappa1 {:.4}, mu {:.4} {:.5} {:.6}",
         escaped(&r.output), v.mass_kg, v.efficiency, v.rotor_radius_m, v.kappa1_w_per_n1_5, v.mu1_n_s_per_m, v.mu2_n_s2_per_m2, v.mu3_n_s3_per_m3
     )?;
-    writeln!(out, "\nQuality: {}", quality_word(r.quality))?;
-    for reason in &r.quality_reasons {
-        writeln!(out, "  {}", escaped(reason))?;
-    }
-    for s in &r.skipped_logs {
-        writeln!(
-            out,
-            "Skipped {}: {}",
-            file_name(&s.file),
-            escaped(&s.reason)
-        )?;
-    }
-    Ok(())
+    Ok(write_verdict(
+        out,
+        r.quality,
+        &r.quality_reasons,
+        &r.skipped_logs,
+    )?)
 }

@@ -3,7 +3,7 @@
 use std::borrow::Cow;
 use std::path::Path;
 
-use aloft::engine::FitQuality;
+use aloft::engine::{FitQuality, SkippedLog};
 
 /// A verdict as the tables print it.
 pub fn quality_word(q: FitQuality) -> &'static str {
@@ -23,6 +23,29 @@ pub fn file_name(p: &str) -> Cow<'_, str> {
             .and_then(|n| n.to_str())
             .unwrap_or(p),
     )
+}
+
+/// The verdict of a fit or a validation, its reasons, and the logs left out with theirs (the
+/// table's last lines of `aloft fit` and `aloft validate`).
+pub fn write_verdict(
+    out: &mut impl std::io::Write,
+    quality: FitQuality,
+    reasons: &[String],
+    skipped: &[SkippedLog],
+) -> std::io::Result<()> {
+    writeln!(out, "\nQuality: {}", quality_word(quality))?;
+    for reason in reasons {
+        writeln!(out, "  {}", escaped(reason))?;
+    }
+    for s in skipped {
+        writeln!(
+            out,
+            "Skipped {}: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        )?;
+    }
+    Ok(())
 }
 
 /// `text` with its control characters and bidirectional overrides escaped (aloft's one rule:

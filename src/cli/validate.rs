@@ -10,7 +10,7 @@ use clap::Args;
 use aloft::engine::flags::ValidateFlags;
 use aloft::engine::{validate_logs, PowerSeries, ValidateReport};
 
-use super::flights::{escaped, file_name, quality_word};
+use super::flights::{escaped, file_name, quality_word, write_verdict};
 use super::output::{self, ForceFlag};
 use super::plot::ChartFile;
 use super::{Format, Outcome};
@@ -190,19 +190,12 @@ fn render(out: &mut impl Write, r: &ValidateReport) -> Result<()> {
         }
         writeln!(out)?;
     }
-    writeln!(out, "\nQuality: {}", quality_word(r.quality))?;
-    for reason in &r.quality_reasons {
-        writeln!(out, "  {}", escaped(reason))?;
-    }
-    for s in &r.skipped_logs {
-        writeln!(
-            out,
-            "Skipped {}: {}",
-            file_name(&s.file),
-            escaped(&s.reason)
-        )?;
-    }
-    Ok(())
+    Ok(write_verdict(
+        out,
+        r.quality,
+        &r.quality_reasons,
+        &r.skipped_logs,
+    )?)
 }
 
 fn plot(file: ChartFile<'_>, series: &[PowerSeries]) -> Result<()> {
