@@ -35,23 +35,23 @@ LOG = "fixtures/logs/kaist_small.csv"
 ZERO = np.zeros(1)
 
 # (command, the Python function with its positional arguments, flags only the CLI has (output
-# formats and files, the replay of a log, the flight state of `power`), flags Python takes as
+# formats and files and --force to replace them, the replay of a log, the flight state of `power`), flags Python takes as
 # positional arguments)
 CASES = [
     (("mission",), lambda **o: aloft.mission(None, **o),
      {"format", "timeseries", "plot", "mcap", "replay", "profile", "lag", "acceleration",
-      "acceleration_window"}, set()),
-    (("endurance",), lambda **o: aloft.endurance(**o), {"format", "plot"}, set()),
+      "acceleration_window", "force"}, set()),
+    (("endurance",), lambda **o: aloft.endurance(**o), {"format", "plot", "force"}, set()),
     (("log", "info"), lambda **o: aloft.log_info(LOG, **o), {"format"}, set()),
     (("fit",), lambda **o: aloft.fit(LOG, "dji-m100", **o), {"format"},
      {"log", "vehicle_template"}),
-    (("validate",), lambda **o: aloft.validate(LOG, "dji-m100", **o), {"format", "plot"},
+    (("validate",), lambda **o: aloft.validate(LOG, "dji-m100", **o), {"format", "plot", "force"},
      {"log", "vehicle"}),
     # aloft.power names its keywords in its signature (checked below); the engine's parser is
     # reached through the native function.
     (("power",), lambda **o: _native.power(ZERO, ZERO, ZERO, ZERO, None, o),
      {"format", "airspeed", "roll", "pitch", "climb_rate", "air_direction_deg", "gradient",
-      "input", "output"}, set()),
+      "input", "output", "force"}, set()),
 ]
 
 
@@ -69,7 +69,7 @@ def test_the_mission_series_takes_the_mission_flags(cli):
     scenario = {"samples", "seed", "wind_speed_sd", "wind_from_sd", "payload_sd_kg",
                 "capacity_sd_percent", "power_sd_percent", "threads"}
     mission_only = {"format", "timeseries", "plot", "mcap", "replay", "profile", "lag",
-                    "acceleration", "acceleration_window"}
+                    "acceleration", "acceleration_window", "force"}
     expected = cli_flags(cli, "mission") - mission_only - scenario
     assert python_options(lambda **o: aloft.timeseries(None, **o)) == expected
 
