@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """A vehicle on a UDP link, written with pymavlink (the independent MAVLink implementation), for
-tests/live_udp_reply.rs:
+tests/it/live_udp_reply.rs:
 
     python3 tests/python/mavlink_vehicle.py PORT SECONDS [wrapped-count]
 

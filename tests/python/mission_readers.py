@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Mission files read by readers that are not aloft, for tests/missions_writers.rs:
+"""Mission files read by readers that are not aloft, for tests/it/missions_writers.rs:
 
     python3 tests/python/mission_readers.py mavsdk --autopilot px4|ardupilot FILE.plan...
     python3 tests/python/mission_readers.py mavwp FILE.waypoints...

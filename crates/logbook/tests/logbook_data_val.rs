@@ -3,7 +3,7 @@
 //! `BRD_SERIAL_NUM`, read here by a few lines of byte search (not aloft's decoders); two adds
 //! at once; a version 1 file written by hand and opened by this code.
 
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 
 use std::collections::BTreeSet;

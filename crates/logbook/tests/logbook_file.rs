@@ -3,7 +3,7 @@
 //! the mark) recognised by its tables and migrated, a damaged one refused before any write and
 //! still listed where SQLite can read it, no file created through a link planted at its path.
 
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 
 use std::path::{Path, PathBuf};

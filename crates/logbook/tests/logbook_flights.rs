@@ -3,7 +3,7 @@
 //! counted once; a pack the log does not name is keyed by its vehicle, cells and rated
 //! capacity, not one `unknown` for all; `relabel` renames a pack or a vehicle.
 
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 
 use std::path::{Path, PathBuf};

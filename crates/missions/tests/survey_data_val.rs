@@ -20,7 +20,7 @@ use serde_json::Value;
 const TOLERANCE_DEG: f64 = 1e-7;
 
 /// The shared data folder, as the root's tests find it.
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 use data::data_dir;
 

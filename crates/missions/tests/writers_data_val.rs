@@ -16,7 +16,7 @@ use std::path::PathBuf;
 
 use aloft_missions::{import, write_like_source, Imported, ItemOrigin, MissionItem, SourceFormat};
 
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 use data::data_dir;
 

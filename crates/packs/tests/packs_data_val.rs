@@ -3,7 +3,7 @@
 //! ArduCopter SITL log's `BAT.Res`. Expected values come from the data and closed forms: the
 //! note's figures were computed with a small Python script independent of aloft.
 
-#[path = "../../../tests/common/data.rs"]
+#[path = "../../../tests/it/common/data.rs"]
 mod data;
 use data::data_dir;
 

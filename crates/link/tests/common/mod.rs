@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use aloft_link::mavlink::Message;
 use aloft_link::{Telemetry, TlogFrame, TlogReader, TlogSource, TlogStats};
 
-#[path = "../../../../tests/common/data.rs"]
+#[path = "../../../../tests/it/common/data.rs"]
 mod data;
 pub use data::data_dir;
 

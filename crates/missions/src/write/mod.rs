@@ -5,7 +5,7 @@
 //! Sans-I/O like the readers: they return the text; writing it to a file (a temporary name in
 //! the same folder, then a rename) is the caller's job. What they write is read back by aloft's
 //! readers, by MAVSDK's QGroundControl importer and by pymavlink's `mavwp` (the tests
-//! `tests/missions_writers.rs` and `crates/missions/tests/writers_data_val.rs`).
+//! `tests/it/missions_writers.rs` and `crates/missions/tests/writers_data_val.rs`).
 //!
 //! Sources of the rules: the project's research notes `research/writing-plans.md` (section 1a:
 //! what QGroundControl's loader and MAVSDK's importer require of a `.plan`; 1e: surveys; 5: the

@@ -1,0 +1,423 @@
+//! Every mission file aloft writes is read by readers that are not aloft, and they find the items
+//! aloft wrote.
+//!
+//! The files: each shared mission file aloft reads (`ALOFT_DATA_DIR/missions`, `.plan`,
+//! `.waypoints` and `.txt`: 10 of the 12), written by `aloft_missions` in both formats: in its
+//! own with `write_like_source`, and in the other with `write_plan` (an ArduPilot header,
+//! `hoverSpeed` 10 m/s, ArduPilot's default waypoint speed) or `write_waypoints` (the items
+//! flattened). The readers (`tests/python/mission_readers.py`):
+//!
+//! - `.plan`: MAVSDK's own QGroundControl importer (PyPI `mavsdk` 4.1.0, the native binding;
+//!   `MissionRaw.import_qgroundcontrol_mission`), with a pymavlink vehicle on UDP loopback so
+//!   that MAVSDK has a system, once as PX4 and once as ArduPilot (for which the importer puts the
+//!   plan's home first). What it gives is MISSION_ITEM_INT, compared exactly with aloft's items
+//!   encoded as MAVSDK encodes a `.plan`'s values (`mission_import.cpp`): p1-p4 and z as `float`
+//!   (`null` as NaN), x and y as `round(value * 1e7)` (`null` as 0), but in frame 2 (MISSION) as
+//!   the `float` truncated to an integer.
+//! - `.waypoints`: pymavlink's `mavwp.MAVWPLoader().load()`, compared exactly with the values
+//!   aloft wrote (`NaN` in P1-P4; 0 for an unset position of an item that has none).
+//!
+//! aloft reads the files of the other format too (the ArduPilot ones give the same segments).
+//!
+//! It needs python3 with `mavsdk` 4.1.0 and `pymavlink` 2.4.50 (`.ci/run` installs them; locally
+//! `python3 -m pip install mavsdk==4.1.0 pymavlink==2.4.50`). Without them the tests say so and
+//! pass, unless `ALOFT_PYMAVLINK_TESTS=require` or `CI` is set, where they fail. Only loopback
+//! addresses are used; the script is killed if it outlives its time.
+
+use crate::common;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use aloft_missions::{
+    import, write_like_source, write_plan, write_waypoints, Home, Imported, MissionEntry,
+    MissionItem, PlanHeader, SourceFormat,
+};
+use serde_json::{json, Value};
+
+/// Longest run of the script, s (MAVSDK finds the vehicle in milliseconds).
+const SCRIPT_S: u64 = 120;
+
+/// The header of a `.plan` written from a `.waypoints` file: ArduPilot, a quadrotor, planned at
+/// ArduPilot's default waypoint speed (what aloft plans a `.waypoints` file at).
+const ARDUPILOT: PlanHeader = PlanHeader {
+    firmware_type: Some(3),
+    vehicle_type: Some(2),
+    cruise_speed_mps: None,
+    hover_speed_mps: Some(10.0),
+    global_plan_altitude_mode: None,
+};
+
+/// Whether python3 can import `modules`; where it cannot, the test fails when it is required
+/// (`ALOFT_PYMAVLINK_TESTS=require` or `CI`), else it says so and is skipped.
+fn python_ready(modules: &str) -> bool {
+    if common::python_has(modules) {
+        return true;
+    }
+    let required = std::env::var("ALOFT_PYMAVLINK_TESTS").is_ok_and(|v| v == "require")
+        || std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false");
+    assert!(
+        !required,
+        "ALOFT_PYMAVLINK_TESTS=require or CI is set, but python3 cannot import {modules} \
+         (python3 -m pip install mavsdk==4.1.0 pymavlink==2.4.50)"
+    );
+    eprintln!("skipped: this test needs python3 with {modules} (mavsdk 4.1.0, pymavlink 2.4.50)");
+    false
+}
+
+/// A child process killed (and reaped) when dropped.
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `mission_readers.py args`, which must succeed within [`SCRIPT_S`]: its JSON answer.
+fn readers(args: &[String]) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mission_readers.py");
+    let child = Command::new("python3")
+        .arg(script)
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("python3 runs");
+    let mut child = Killed(child);
+    let drain = |mut r: Box<dyn Read + Send>| {
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            let _ = r.read_to_end(&mut v);
+            v
+        })
+    };
+    let out = drain(Box::new(child.0.stdout.take().unwrap()));
+    let err = drain(Box::new(child.0.stderr.take().unwrap()));
+    let start = Instant::now();
+    let status = loop {
+        if let Some(s) = child.0.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(SCRIPT_S),
+            "mission_readers.py {args:?} still runs after {SCRIPT_S} s"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let (out, err) = (out.join().unwrap(), err.join().unwrap());
+    assert!(
+        status.success(),
+        "mission_readers.py {args:?}: {status}\n{}",
+        String::from_utf8_lossy(&err)
+    );
+    serde_json::from_slice(&out).expect("the script's JSON")
+}
+
+/// A file written, with the home and the items aloft wrote in it (surveys flattened).
+struct Written {
+    path: PathBuf,
+    home: Option<Home>,
+    items: Vec<MissionItem>,
+}
+
+/// The shared mission files aloft reads, by name.
+fn shared_missions() -> Vec<(String, Imported)> {
+    let files = common::files("missions", |n| {
+        n.ends_with(".plan") || n.ends_with(".waypoints") || n.ends_with(".txt")
+    });
+    let read: Vec<(String, Imported)> = files
+        .iter()
+        .filter_map(|p| {
+            let i = import(&std::fs::read_to_string(p).unwrap()).ok()?;
+            Some((p.file_name()?.to_string_lossy().into_owned(), i))
+        })
+        .collect();
+    assert_eq!(read.len(), 10, "10 of the 12 shared missions are read");
+    read
+}
+
+/// The home of a file written in the other format: the file's own, else where aloft put it.
+fn home_of(i: &Imported) -> Home {
+    i.home.unwrap_or(Home {
+        latitude_deg: i.spec.home.latitude_deg.unwrap(),
+        longitude_deg: i.spec.home.longitude_deg.unwrap(),
+        altitude_amsl_m: None,
+    })
+}
+
+fn entries(items: &[MissionItem]) -> Vec<MissionEntry> {
+    items.iter().map(|x| MissionEntry::Item(*x)).collect()
+}
+
+/// Every shared mission written as `.plan` (`plan`) or `.waypoints`, each with what it holds.
+fn write_all(tag: &str, plan: bool) -> Vec<Written> {
+    let mut written = Vec::new();
+    for (name, i) in shared_missions() {
+        let own = (i.format == SourceFormat::QgcPlan) == plan;
+        let stem = Path::new(&name).file_stem().unwrap().to_string_lossy();
+        let (text, path, home) = if own {
+            let path = common::scratch(tag, &name);
+            (write_like_source(&i).unwrap(), path, i.home)
+        } else if plan {
+            let path = common::scratch(tag, &format!("{stem}.from-waypoints.plan"));
+            let home = home_of(&i);
+            let text = write_plan(&ARDUPILOT, &home, &entries(&i.items)).unwrap();
+            check_same_flight(&name, &i, &text);
+            (text, path, Some(home))
+        } else {
+            let path = common::scratch(tag, &format!("{stem}.from-plan.waypoints"));
+            let home = home_of(&i);
+            let text = write_waypoints(&home, &entries(&i.items)).unwrap();
+            check_same_flight(&name, &i, &text);
+            (text, path, Some(home))
+        };
+        std::fs::write(&path, text).unwrap();
+        written.push(Written {
+            path,
+            home,
+            items: i.items.clone(),
+        });
+    }
+    written
+}
+
+/// aloft reads a file written in the other format; an ArduPilot file with a home row flies the
+/// same segments (the item numbers of a file without one start at 0, not 1).
+fn check_same_flight(name: &str, source: &Imported, text: &str) {
+    let other = import(text).unwrap_or_else(|e| panic!("{name} in the other format: {e}"));
+    let ardupilot = source.format != SourceFormat::QgcPlan
+        || source.plan.as_ref().unwrap().header.firmware_type == Some(3);
+    if ardupilot && source.home.is_some() {
+        assert_eq!(other.spec.segments, source.spec.segments, "{name}");
+    }
+}
+
+/// A number as C's `float` holds it, as JSON; NaN as null.
+fn float32(v: f64) -> Value {
+    if v.is_nan() {
+        Value::Null
+    } else {
+        json!(f64::from(v as f32))
+    }
+}
+
+/// x or y as MAVSDK's importer encodes a `.plan` value (`set_int32`): `null` 0; in frame 2 the
+/// `float` truncated; else degrees x 1e7, rounded half away from zero.
+fn int32(v: f64, frame: u32) -> Value {
+    if v.is_nan() {
+        json!(0)
+    } else if frame == 2 {
+        json!(v as f32 as i32)
+    } else {
+        json!((v * 1e7).round() as i32)
+    }
+}
+
+/// The items MAVSDK's importer should give for a written `.plan`, for `autopilot`.
+fn mavsdk_expected(w: &Written, ardupilot: bool) -> Vec<Value> {
+    let mut out: Vec<Value> = w
+        .items
+        .iter()
+        .enumerate()
+        .map(|(k, x)| {
+            let p = &x.params;
+            json!({
+                "seq": 0, "frame": x.frame, "command": x.command,
+                "current": u8::from(k == 0), "autocontinue": 1,
+                "params": [float32(p[0]), float32(p[1]), float32(p[2]), float32(p[3])],
+                "x": int32(p[4], x.frame), "y": int32(p[5], x.frame), "z": float32(p[6]),
+            })
+        })
+        .collect();
+    if ardupilot {
+        // The plan's home, in MAV_FRAME_GLOBAL_INT (5); a null altitude is NaN, as every
+        // `null` float.
+        let h = w.home.unwrap();
+        let home = json!({
+            "seq": 0, "frame": 5, "command": 16, "current": 0, "autocontinue": 1,
+            "params": [0.0, 0.0, 0.0, 0.0],
+            "x": int32(h.latitude_deg, 5), "y": int32(h.longitude_deg, 5),
+            "z": float32(h.altitude_amsl_m.unwrap_or(f64::NAN)),
+        });
+        out.insert(0, home);
+    }
+    for (k, item) in out.iter_mut().enumerate() {
+        item["seq"] = json!(k);
+    }
+    out
+}
+
+/// The rows pymavlink should read from a written `.waypoints` file: as written.
+fn mavwp_expected(w: &Written) -> Vec<Value> {
+    let mut out = Vec::new();
+    if let Some(h) = w.home {
+        out.push(json!({
+            "seq": 0, "frame": 0, "command": 16, "current": 1, "autocontinue": 1,
+            "params": [0.0, 0.0, 0.0, 0.0],
+            "x": h.latitude_deg, "y": h.longitude_deg, "z": h.altitude_amsl_m.unwrap(),
+        }));
+    }
+    for x in &w.items {
+        let p = &x.params;
+        let param = |v: f64| if v.is_nan() { Value::Null } else { json!(v) };
+        // Unset coordinates of an item without a position are written 0.
+        let coordinate = |v: f64| json!(if v.is_nan() { 0.0 } else { v });
+        out.push(json!({
+            "seq": out.len(), "frame": x.frame, "command": x.command, "current": 0,
+            "autocontinue": 1,
+            "params": [param(p[0]), param(p[1]), param(p[2]), param(p[3])],
+            "x": coordinate(p[4]), "y": coordinate(p[5]), "z": coordinate(p[6]),
+        }));
+    }
+    out
+}
+
+/// Each file's items as `reader` gave them against `expected`; the number of items compared.
+fn compare(
+    answer: &Value,
+    written: &[Written],
+    expected: impl Fn(&Written) -> Vec<Value>,
+) -> usize {
+    let mut compared = 0;
+    for w in written {
+        let path = w.path.display().to_string();
+        let got = answer["files"][&path]
+            .as_array()
+            .unwrap_or_else(|| panic!("{path}: {}", answer["files"][&path]));
+        let want = expected(w);
+        assert_eq!(got.len(), want.len(), "{path}: item count");
+        for (g, e) in got.iter().zip(&want) {
+            assert_eq!(g, e, "{path}: item {}", e["seq"]);
+        }
+        compared += got.len();
+    }
+    compared
+}
+
+fn paths(written: &[Written]) -> Vec<String> {
+    written
+        .iter()
+        .map(|w| w.path.display().to_string())
+        .collect()
+}
+
+#[test]
+fn mavsdk_imports_every_plan_aloft_writes_with_the_items_aloft_wrote() {
+    if !python_ready("mavsdk, pymavlink") {
+        return;
+    }
+    let written = write_all("writers-plan", true);
+    assert_eq!(written.len(), 10);
+    let mut compared = 0;
+    for autopilot in ["px4", "ardupilot"] {
+        let mut args = vec!["mavsdk".into(), "--autopilot".into(), autopilot.into()];
+        args.extend(paths(&written));
+        let answer = readers(&args);
+        assert!(
+            answer["reader"]
+                .as_str()
+                .unwrap()
+                .starts_with("mavsdk 4.1.0"),
+            "{}",
+            answer["reader"]
+        );
+        let ardupilot = autopilot == "ardupilot";
+        compared += compare(&answer, &written, |w| mavsdk_expected(w, ardupilot));
+    }
+    println!(
+        "MAVSDK 4.1.0 imported {} written .plan files as PX4 and as ArduPilot: {compared} items \
+         as aloft wrote them",
+        written.len()
+    );
+    // 128 items in the files and 10 homes (ArduPilot).
+    assert_eq!(compared, 2 * 128 + 10);
+}
+
+#[test]
+fn pymavlink_loads_every_waypoints_file_aloft_writes_with_the_rows_aloft_wrote() {
+    if !python_ready("pymavlink") {
+        return;
+    }
+    let written = write_all("writers-wpl", false);
+    assert_eq!(written.len(), 10);
+    let mut args = vec!["mavwp".to_string()];
+    args.extend(paths(&written));
+    let answer = readers(&args);
+    assert_eq!(answer["reader"], "pymavlink 2.4.50 mavwp");
+    let compared = compare(&answer, &written, mavwp_expected);
+    println!(
+        "pymavlink mavwp loaded {} written .waypoints files: {compared} rows as aloft wrote them",
+        written.len()
+    );
+    // 128 items and 9 home rows (one file has none).
+    assert_eq!(compared, 128 + 9);
+}
+
+/// The files of `aloft plan` (sorties cut inside legs, resumed, the camera restored and
+/// stopped, speeds written): the shared survey split into `.plan` files and an ArduPilot file
+/// into `.waypoints` files, each read by MAVSDK's importer or pymavlink's loader with the items
+/// aloft reads from it.
+#[test]
+fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
+    if !python_ready("mavsdk, pymavlink") {
+        return;
+    }
+    let sorties = |name: &str, extra: &[&str]| -> Vec<Written> {
+        let input = common::files("missions", |n| n == name);
+        let input = input.first().unwrap().display().to_string();
+        let dir = common::scratch("writers-sorties", &format!("{name}{}", extra.join("")));
+        let _ = std::fs::remove_dir_all(&dir);
+        let d = dir.display().to_string();
+        let mut args = vec!["plan", input.as_str(), "-o", d.as_str(), "--format", "json"];
+        args.extend_from_slice(extra);
+        let answer = common::ok_json(&args);
+        let files = answer["files"].as_array().unwrap();
+        files
+            .iter()
+            .map(|f| {
+                let path = PathBuf::from(f.as_str().unwrap());
+                let i = import(&std::fs::read_to_string(&path).unwrap()).unwrap();
+                Written {
+                    path,
+                    home: i.home,
+                    items: i.items,
+                }
+            })
+            .collect()
+    };
+    let words = |text: &'static str| text.split(' ').collect::<Vec<&str>>();
+    let plans = sorties(
+        "neilvaltec_test.plan",
+        &words("--reserve-percent 70 --wind-speed 8 --wind-from 0"),
+    );
+    assert!(plans.len() >= 2);
+    // One pack with its own speeds: the survey turned and written as its complex item.
+    let mut plans = plans;
+    plans.extend(sorties(
+        "neilvaltec_test.plan",
+        &words("--speeds keep --wind-speed 8 --wind-from 0"),
+    ));
+    let mut args = vec!["mavsdk".into(), "--autopilot".into(), "px4".into()];
+    args.extend(paths(&plans));
+    let compared = compare(&readers(&args), &plans, |w| mavsdk_expected(w, false));
+    // A reserve of 88 % cuts it into three sorties (at its home altitude, 584 m: at 90 % one
+    // orbit cannot be flown out and back on one pack in that air).
+    let waypoints = sorties(
+        "ardupilot_copter_loiterturns_mission.txt",
+        &["--reserve-percent", "88"],
+    );
+    assert!(waypoints.len() >= 2);
+    let mut args = vec!["mavwp".into()];
+    args.extend(paths(&waypoints));
+    let rows = compare(&readers(&args), &waypoints, mavwp_expected);
+    eprintln!(
+        "{} sortie .plan files, {compared} items; {} .waypoints files, {rows} rows",
+        plans.len(),
+        waypoints.len()
+    );
+}
