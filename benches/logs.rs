@@ -18,7 +18,7 @@ use aloft_logs::{
     read_dataflash, read_ulog, BinaryOptions, ColumnMap, CsvSamples, McapOptions, McapSamples,
 };
 
-#[path = "../tests/common/ros2.rs"]
+#[path = "../tests/it/common/ros2.rs"]
 mod ros2;
 use ros2::{battery_state, message_header, pose_stamped, ros2_channel};
 
