@@ -10,16 +10,16 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::flags::{
-    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags, PlanFlags,
-    ValidateFlags,
-};
 use super::{
     calibrate_spec_file, endurance, endurance_scenarios, fit_logs, fly_plan_map, follow_live,
     list_vehicles, log_info, mission_map, payload_sweep, plan_mission, plan_mission_with,
     plan_scenarios, plan_to_fly, power_curve, replay_live, validate_logs, EnduranceWithUncertainty,
     FlyPlan, LiveUpdate, Mission, MissionOutputs, MissionWithUncertainty, SortieMap, Vehicle,
     VehicleEntry,
+};
+use crate::engine::flags::{
+    EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags, PlanFlags,
+    ValidateFlags,
 };
 use crate::error::Error;
 

@@ -5,7 +5,7 @@
 //! need or exclude each other) and the mapping from what was given to the engine's request
 //! (precedence included). The `aloft` command line flattens these groups into its subcommands;
 //! the Python package parses its keyword arguments with the very same groups
-//! ([`super::keywords`]), so an option's name, default and range are written once. Python's
+//! ([`crate::engine::keywords`]), so an option's name, default and range are written once. Python's
 //! keyword is the flag's long name in snake_case (`--payload-kg` is `payload_kg=`).
 //!
 //! What only one front end has (output formats, files to write, progress) stays with it.
@@ -18,22 +18,24 @@ use clap::Args;
 use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
-use super::air::AirInput;
-use super::fit::{fit_parameter, FitRequest};
-use super::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
-use super::live::{LiveReplayRequest, LiveRequest, LiveSource};
-use super::logs::{FlightLogs, LogArg, LogReadOptions};
-use super::mission_file::Mission;
-use super::mission_options::{GustSpec, MissionOptions};
-use super::own_vehicle::OwnVehicle;
-use super::payload_sweep::PayloadSweep;
-use super::power::PowerModelQuery;
-use super::scenarios::{ScenarioOptions, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS};
-use super::step_meter::StepMeter;
-use super::step_meter::WorkBounds;
-use super::validate::ValidateRequest;
-use super::vehicles::Vehicle;
 use super::EnduranceOptions;
+use crate::engine::conditions::air::AirInput;
+use crate::engine::identification::fit::{fit_parameter, FitRequest};
+use crate::engine::identification::own_vehicle::OwnVehicle;
+use crate::engine::identification::validate::ValidateRequest;
+use crate::engine::live::{LiveReplayRequest, LiveRequest, LiveSource};
+use crate::engine::logs::{FlightLogs, LogArg, LogReadOptions};
+use crate::engine::missions::mission_file::Mission;
+use crate::engine::missions::mission_options::{GustSpec, MissionOptions};
+use crate::engine::performance::payload_sweep::PayloadSweep;
+use crate::engine::performance::power::PowerModelQuery;
+use crate::engine::plan_to_fly::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
+use crate::engine::step_meter::StepMeter;
+use crate::engine::step_meter::WorkBounds;
+use crate::engine::uncertainty::scenarios::{
+    ScenarioOptions, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS,
+};
+use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 use crate::vehicle::DEFAULT_VEHICLE;
 

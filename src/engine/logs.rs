@@ -5,16 +5,18 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use aloft_logs::ground::IDLE_FRACTION_OF_HOVER;
 use aloft_logs::sample::{Gap, NonMonotonic};
 use aloft_logs::{
     estimate_lag_s, open_log_with, resample_uniform, BinaryOptions, BinarySummary, Channel,
     DroppedValue, InfoAccumulator, LogError, LogFormat, LogReader, McapFile, McapOptions, McapTime,
     OpenOptions, Profile, TimeReport,
 };
+use aloft_logs::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Log};
 use aloft_power::AoaModel;
 
-use super::files::check_output;
-use super::finite::finite;
+use crate::engine::files::check_output;
+use crate::engine::finite::finite;
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions, AlignedFlight};
 
@@ -716,7 +718,7 @@ impl FlightLogs {
 
     /// The logs that can be used, read and aligned, and those that cannot, each with its reason
     /// (the one rule of `aloft fit` and `aloft validate`: a log that cannot be read, never flew
-    /// ([`super::replay::check_flew`]) or cannot be aligned is left out and said). Samples below
+    /// ([`check_flew`]) or cannot be aligned is left out and said). Samples below
     /// `idle_power_fraction` of a flight's median power are left out as on the ground
     /// ([`AlignOptions::idle_power_fraction`]; 0 keeps them all).
     ///
@@ -785,7 +787,7 @@ impl FlightLogs {
             .into());
         }
         // A log that never left the ground is said so, before its lag is searched for.
-        super::replay::check_flew(&log)?;
+        check_flew(&log)?;
         let mut flight = align_flight(&log, align)?;
         flight.air_density_kg_m3 = reader
             .binary_summary()
@@ -814,6 +816,41 @@ pub(crate) type Loaded = (AlignedFlight, aloft_logs::Log);
 
 /// One log of [`FlightLogs::load_each`]: aligned with its samples, or why not.
 pub(crate) type LoadedLog = Result<Loaded, Error>;
+
+/// Whether a log flew, the one rule of `aloft fit` and `aloft validate` (through
+/// [`crate::engine::logs::FlightLogs::usable`]): a log whose own landed state (PX4
+/// `vehicle_land_detected`, ArduPilot's arming and landing) keeps it on the ground from its first
+/// record to its last never flew. A log without a landed state is not judged here (nothing in
+/// it tells a hover from the ground without a model of the vehicle).
+///
+/// # Errors
+/// [`Error::NeverFlew`] with the log's span.
+pub(crate) fn check_flew(log: &Log) -> Result<(), Error> {
+    let ground = ground_time(log, None);
+    if ground.airborne.is_empty() && ground.logged_points > 0 {
+        return Err(Error::NeverFlew {
+            origin: log.source.clone(),
+            duration_s: ground.last_s - ground.first_s,
+        });
+    }
+    Ok(())
+}
+
+/// The ground time of the log: its own landed state where it has one, else detected from height,
+/// speed and power, with a power under [`IDLE_FRACTION_OF_HOVER`] of the model's hover power
+/// `hover_w` counting as idle ([`aloft_logs::ground`]).
+pub(crate) fn ground_time(log: &Log, hover_w: Option<f64>) -> GroundReport {
+    let mut detector = GroundDetector::new(GroundOptions {
+        idle_max_w: hover_w
+            .filter(|w| w.is_finite() && *w > 0.0)
+            .map(|w| IDLE_FRACTION_OF_HOVER * w),
+        ..GroundOptions::default()
+    });
+    for s in &log.samples {
+        detector.push(&GroundPoint::from(s));
+    }
+    detector.finish()
+}
 
 #[cfg(test)]
 mod tests {

@@ -22,14 +22,14 @@
 use aloft_missions::SourceFormat;
 use aloft_planner::{geodesy::LocalFrame, HomeSpec, MissionSpec, SegmentSpec, WindSpec};
 
-use super::super::mission_file::Mission;
-use super::super::mission_options::MissionOptions;
-use super::super::scenario_stats::Percentiles;
-use super::super::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
-use super::super::vehicles::Vehicle;
 use super::advice::Shares;
 use super::estimate::Ratio;
 use super::tracker::{wind_from_deg, Tracker, WindSource};
+use crate::engine::missions::mission_file::Mission;
+use crate::engine::missions::mission_options::MissionOptions;
+use crate::engine::uncertainty::scenario_stats::Percentiles;
+use crate::engine::uncertainty::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
+use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 
 /// Scenarios per update (the figure: one update with them within 100 ms on 2 cores).
@@ -154,7 +154,7 @@ impl Ahead<'_> {
             time_step_s: Some(LIVE_TIME_STEP_S),
             speed_mps: self.speed_mps,
             // The air the flight was decided to fly in (the vehicle is in it already).
-            air: crate::engine::AirInput::of_density(vehicle.air_density_kg_m3()),
+            air: crate::engine::conditions::air::AirInput::of_density(vehicle.air_density_kg_m3()),
             ..MissionOptions::default()
         };
         let sc = ScenarioOptions {

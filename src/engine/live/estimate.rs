@@ -62,7 +62,7 @@ pub(crate) fn prior_sd(model: &aloft_power::PowerModel) -> f64 {
         .vehicle()
         .params()
         .efficiency_relative_sd
-        .unwrap_or(super::super::scenarios::DEFAULT_POWER_SD_PERCENT / 100.0)
+        .unwrap_or(crate::engine::uncertainty::scenarios::DEFAULT_POWER_SD_PERCENT / 100.0)
 }
 
 /// The ratio of the rest and its spread.

@@ -20,11 +20,11 @@ use serde::Serialize;
 use aloft_logs::frame::enu_to_geodetic;
 use aloft_logs::telemetry::{Reply, TelemetrySource};
 
-use super::air::AirInput;
-use super::finite::finite;
-use super::mission_file::Mission;
-use super::scenario_stats::Percentiles;
-use super::vehicles::Vehicle;
+use crate::engine::conditions::air::AirInput;
+use crate::engine::finite::finite;
+use crate::engine::missions::mission_file::Mission;
+use crate::engine::uncertainty::scenario_stats::Percentiles;
+use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 
 mod advice;
@@ -32,6 +32,7 @@ mod ahead;
 mod charge;
 mod count;
 mod estimate;
+pub(crate) mod estimator;
 mod record;
 mod replay;
 mod sources;
@@ -218,7 +219,7 @@ pub fn follow_live(
         .mission
         .as_ref()
         .and_then(|m| m.spec().home.altitude_amsl_m);
-    let air = super::air::resolve_air(&request.air, home_amsl_m, vehicle)?;
+    let air = crate::engine::conditions::air::resolve_air(&request.air, home_amsl_m, vehicle)?;
     let vehicle = &vehicle.in_air(air.air_density_kg_m3)?;
     let mut follower = LiveSession::new(vehicle, request)?;
     let mut updates = 0;

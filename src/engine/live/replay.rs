@@ -21,12 +21,12 @@
 
 use serde::Serialize;
 
-use super::super::finite::finite;
-use super::super::logs::FlightLogs;
-use super::super::scenario_stats::Percentiles;
-use super::super::vehicles::Vehicle;
 use super::estimate::RatioEstimator;
 use super::LiveUpdate;
+use crate::engine::finite::finite;
+use crate::engine::logs::FlightLogs;
+use crate::engine::uncertainty::scenario_stats::Percentiles;
+use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 use crate::identify::{predict, AlignedFlight};
 
@@ -46,7 +46,7 @@ pub struct LiveReplayRequest {
     pub every_s: f64,
     /// The day's air (default: the log's own density where it has one, else the vehicle
     /// file's).
-    pub air: crate::engine::AirInput,
+    pub air: crate::engine::conditions::air::AirInput,
 }
 
 /// The end of a validation replay: how the predictions did against the measured rest.
@@ -97,7 +97,8 @@ pub fn replay_live(
     let mut flights = request.logs.load()?;
     let (flight, _) = flights.swap_remove(0);
     // The flight in its own air: the given day, else the log's, else the vehicle file's.
-    let air = super::super::air::log_air(&request.air, flight.air_density_kg_m3, vehicle)?;
+    let air =
+        crate::engine::conditions::air::log_air(&request.air, flight.air_density_kg_m3, vehicle)?;
     let (model, _) = vehicle
         .in_air(air.air_density_kg_m3)?
         .power_model_with(request.battery.as_deref(), request.payload_kg)?;

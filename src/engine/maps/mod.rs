@@ -1,0 +1,5 @@
+//! The page's maps (`aloft serve`): a mission's route, its samples and its state-of-charge fan
+//! as map layers, and a plan to fly's sorties on the same map.
+
+pub(crate) mod mission_map;
+pub(crate) mod plan_map;

@@ -1,0 +1,830 @@
+//! Plans to fly (`aloft plan`): the missions aloft would fly for an operator's mission, one per
+//! battery, at the speeds the wind favours.
+//!
+//! The steps, each candidate flown by the planner that answers `aloft mission`:
+//!
+//! 1. **As given**: the mission with its own speeds, split into sorties at whole items as
+//!    `aloft mission` splits it, flown from the files that split gives (each ending with a return
+//!    to launch, as every file does: a mission that ends in the air is priced with its autopilot's
+//!    return rather than `aloft mission`'s generic way home). `as_given` in the answer; where
+//!    that split has no files that keep the reserve, the figures of `aloft mission`.
+//! 2. **Speeds for the wind** ([`SpeedChoice`]): each leg at the ground speed that costs least
+//!    energy per metre along its course in the wind at its height
+//!    ([`aloft_planner::best_range_within_limits`]: within the vehicle's speed and its steady
+//!    envelope), at most `max_speed_mps`, rounded to 0.1 m/s. A speed the operator set on a leg
+//!    is kept unless [`SpeedChoice::Energy`]; [`SpeedChoice::Keep`] changes none.
+//! 3. **Sorties cut inside legs** ([`crate::engine::missions::sorties`], steps 4 and 5): each pack used to the
+//!    reserve, the next sortie resuming `overlap_m` back along the route.
+//! 4. **The best**: of the candidates (the mission's own speeds and the wind's, each cut inside
+//!    legs, and the as-given split), the one with the fewest batteries, then the least energy; so
+//!    the plan never needs more batteries or energy than the mission as given.
+//! 5. **Files**, one per sortie in the input's format ([`FlyPlan::files`]), each a complete
+//!    mission that `aloft mission` flies in the same conditions to the sortie's answer.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use aloft_missions::SourceFormat;
+use aloft_planner::{best_range_within_limits, MissionSpec, SegmentSpec, Wind};
+
+use crate::engine::files::{safe_stem, shown_path, OutputSet};
+use crate::engine::finite::finite;
+use crate::engine::missions::day::mission_wind;
+use crate::engine::missions::mission::{plan_mission, prepare, Prepared};
+use crate::engine::missions::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN};
+use crate::engine::missions::mission_options::MissionOptions;
+use crate::engine::missions::sorties::{
+    segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
+};
+use crate::engine::plan_to_fly::plan_files::PlannerSorties;
+use crate::engine::plan_to_fly::survey_angle::{turned_to_wind, unturnable, AngleChange};
+use crate::engine::step_meter::WorkBounds;
+use crate::engine::vehicles::vehicle::Vehicle;
+use crate::error::Error;
+
+/// How far back along the route a sortie resumes by default, m: a frame of a survey camera at
+/// the usual 10-30 m trigger distance, so that the last images of one sortie and the first of the
+/// next overlap (QGroundControl issue #4254 asks for a few waypoints back).
+pub const DEFAULT_OVERLAP_M: f64 = 10.0;
+
+/// The camera's shortest time between photos when neither the request nor the file gives one,
+/// s: a conservative interval for a survey camera that does not state its own (give
+/// `--camera-interval-s` for yours), so that no photo is skipped.
+pub const DEFAULT_CAMERA_INTERVAL_S: f64 = 2.0;
+
+/// Which legs get the wind's speed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpeedChoice {
+    /// Legs without a speed of their own (they fly the planning speed, which is no per-leg
+    /// choice); a speed the operator set is kept.
+    #[default]
+    Wind,
+    /// Every leg, the operator's speeds too.
+    Energy,
+    /// No leg: every speed as it is.
+    Keep,
+}
+
+/// What `aloft plan` is asked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlyPlanRequest {
+    /// The mission's options (as `aloft mission`'s).
+    pub options: MissionOptions,
+    /// How far back along the route a sortie resumes, m.
+    pub overlap_m: f64,
+    /// Which legs get the wind's speed.
+    pub speeds: SpeedChoice,
+    /// Highest ground speed a leg is given, m/s (the vehicle's own limits apply anyway).
+    pub max_speed_mps: Option<f64>,
+    /// The camera's shortest time between photos, s (default: a `.plan` survey's
+    /// `CameraCalc.MinTriggerInterval`, else [`DEFAULT_CAMERA_INTERVAL_S`]).
+    pub camera_interval_s: Option<f64>,
+    /// Keep the grid angle of every survey (else each QGroundControl survey is turned to the
+    /// wind where that saves energy and covers its polygon as before, its transects drawn again
+    /// at every [`ANGLE_STEP_DEG`](crate::engine::plan_to_fly::survey_angle::ANGLE_STEP_DEG) degrees and along and across the wind).
+    pub keep_angle: bool,
+    /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
+    /// candidate, angle or sortie once cancelled (its steps, and its flights once cancelled, are
+    /// bounded by the options' [`StepMeter`](crate::engine::step_meter::StepMeter) when the caller gives one).
+    pub bounds: WorkBounds,
+}
+
+impl Default for FlyPlanRequest {
+    fn default() -> Self {
+        Self {
+            options: MissionOptions::default(),
+            overlap_m: DEFAULT_OVERLAP_M,
+            speeds: SpeedChoice::default(),
+            max_speed_mps: None,
+            camera_interval_s: None,
+            keep_angle: false,
+            bounds: WorkBounds::default(),
+        }
+    }
+}
+
+/// The figures of a way of flying the mission.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct PlanFigures {
+    /// Packs it takes.
+    pub batteries: u32,
+    /// Energy of all its flights, Wh.
+    pub energy_wh: f64,
+    /// Flight time of all its flights, s.
+    pub duration_s: f64,
+}
+
+/// One sortie of the plan: one file, one pack.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlySortie {
+    /// Its file's name.
+    pub file: String,
+    /// The first item of the input it flies (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_item: Option<u32>,
+    /// The last item of the input it flies, whole or in part.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub last_item: Option<u32>,
+    /// Where it turns home inside a leg: the fraction of that leg flown (absent: at an item).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ends_inside_leg_fraction: Option<f64>,
+    /// Electrical energy drawn from its pack, Wh.
+    pub energy_wh: f64,
+    /// Flight time, take-off to landing, s.
+    pub duration_s: f64,
+    /// State of charge of its pack at landing.
+    pub end_soc: f64,
+    /// Its point of no return, s after take-off (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_of_no_return_s: Option<f64>,
+}
+
+/// A leg given another speed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedChange {
+    /// The leg's item (from a planner file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub item: Option<u32>,
+    /// The leg, from 1.
+    pub segment: usize,
+    /// Its ground speed as given (absent: the planning speed), m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub from_mps: Option<f64>,
+    /// Its ground speed in the plan, m/s.
+    pub to_mps: f64,
+}
+
+/// What changed from the mission as given.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PlanChanges {
+    /// Legs given another speed.
+    pub speeds: Vec<SpeedChange>,
+    /// Whether the sorties end inside legs (else at items, as given).
+    pub cut_inside_legs: bool,
+    /// Surveys given another grid angle.
+    #[serde(default)]
+    pub angles: Vec<AngleChange>,
+}
+
+/// The answer of `aloft plan`: the plan beside the mission as given, its sorties and files.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlyPlan {
+    /// The files, in flight order (their paths once written, else their names).
+    pub files: Vec<String>,
+    /// Packs the plan takes.
+    pub batteries: u32,
+    /// Energy of all its flights, Wh.
+    pub energy_wh: f64,
+    /// Flight time of all its flights, s.
+    pub duration_s: f64,
+    /// The air flown in (flattened: `air_density_kg_m3`, `density_source`, ...).
+    #[serde(flatten)]
+    pub air: crate::engine::conditions::air::Air,
+    /// The sorties, one per file.
+    pub sorties: Vec<FlySortie>,
+    /// The mission as given, split at whole items as `aloft mission` splits it and flown from
+    /// the files of that split (module step 1; absent when it cannot be split so).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub as_given: Option<PlanFigures>,
+    /// What changed.
+    pub changes: PlanChanges,
+    /// What the plan could not do, and why (a survey it could not draw again).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+    /// The files' texts, in flight order (not in the JSON: written by [`FlyPlan::write`]).
+    #[serde(skip)]
+    pub texts: Vec<String>,
+}
+
+/// Plan the missions to fly for `mission` with `vehicle` (module steps 1-5).
+///
+/// # Errors
+/// As [`plan_mission`]; [`Error::NoPlan`] when no way of cutting the route keeps the reserve (a
+/// leg a full pack cannot fly out and back); a mission format aloft cannot write yet.
+pub fn plan_to_fly(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+) -> Result<FlyPlan, Error> {
+    let options = &request.options;
+    // The air once: every candidate flies the vehicle in it (and finds it so when it decides
+    // the air again from its own file).
+    let (vehicle, air) = crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;
+    let vehicle = &vehicle;
+    let request = &FlyPlanRequest {
+        options: MissionOptions {
+            air: crate::engine::conditions::air::AirInput::of_density(air.air_density_kg_m3),
+            ..options.clone()
+        },
+        ..request.clone()
+    };
+    let options = &request.options;
+    let (wind, _) = mission_wind(options, mission, vehicle)?;
+    // The mission as given is planned while its surveys are turned (two threads).
+    let (planned, turned) = std::thread::scope(|scope| {
+        let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind));
+        let turned = match request.keep_angle {
+            true => Ok(None),
+            false => turned_to_wind(
+                mission,
+                &wind,
+                &|m| energy_wh(vehicle, m, request, &wind),
+                &request.bounds,
+            ),
+        };
+        let planned = planned.join().unwrap_or_else(|_| {
+            Err(Error::NoPlan {
+                reason: "the plan's flight failed".into(),
+            })
+        });
+        (planned, turned)
+    });
+    let (best, given) = planned?;
+    let turned = turned?;
+    // The surveys turned to the wind, when that needs fewer batteries or less energy.
+    let (best, angles) = match turned {
+        Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind) {
+            Ok((t, _))
+                if (t.figures.batteries, t.figures.energy_wh)
+                    < (best.figures.batteries, best.figures.energy_wh) =>
+            {
+                (t, angles)
+            }
+            _ => (best, Vec::new()),
+        },
+        None => (best, Vec::new()),
+    };
+    let as_given = match given {
+        Some(figures) => Some(figures),
+        None => as_given_figures(vehicle, mission, options)?,
+    };
+    let mut plan = answer(mission, &best, as_given)?;
+    plan.air = air;
+    plan.changes.angles = angles;
+    if !request.keep_angle {
+        plan.notes = unturnable(mission);
+    }
+    finite(plan, "plan", || {
+        format!(
+            "plan of mission {} with {}",
+            mission.origin(),
+            vehicle.name()
+        )
+    })
+}
+
+/// The best candidate of `mission` (module steps 2-4) and the figures of the mission as given,
+/// flown from its files, when it has them.
+fn plan_for(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+    wind: &Wind,
+) -> Result<(Flown, Option<PlanFigures>), Error> {
+    let options = &request.options;
+    let aircraft = vehicle.aircraft()?;
+    let battery = vehicle.battery(options.battery.as_deref())?;
+    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
+    // The take-off payload the request gives is the candidates' own (each is compiled again).
+    if let Some(payload_kg) = options.payload_kg {
+        prepared.spec.payload_kg = payload_kg;
+    }
+    let candidates = candidates((vehicle, mission), &prepared, wind, request)?;
+    let cx = Context {
+        vehicle,
+        mission,
+        options,
+        prepared: &prepared,
+        bounds: &request.bounds,
+    };
+    best_candidate(&cx, candidates)
+}
+
+/// The mission as given: its batteries and the energy and time of its sorties (or its one
+/// flight).
+fn as_given_figures(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+) -> Result<Option<PlanFigures>, Error> {
+    let plan = plan_mission(vehicle, mission, options)?;
+    let summary = plan.summary();
+    let Some(batteries) = summary.batteries_required else {
+        return Ok(None);
+    };
+    let (energy_wh, duration_s) = match summary.sorties.is_empty() {
+        true => (summary.energy_wh, summary.duration_s),
+        false => summary
+            .sorties
+            .iter()
+            .fold((0.0, 0.0), |(e, t), s| (e + s.energy_wh, t + s.duration_s)),
+    };
+    Ok(Some(PlanFigures {
+        batteries,
+        energy_wh,
+        duration_s,
+    }))
+}
+
+/// A way of flying the mission: its spec, how it is cut and the speeds changed; `as_given` for
+/// the mission as given split at whole items.
+struct Candidate {
+    spec: MissionSpec,
+    split: SplitOptions,
+    speeds: Vec<SpeedChange>,
+    as_given: bool,
+}
+
+/// The candidates of module step 4.
+fn candidates(
+    (vehicle, mission): (&Vehicle, &Mission),
+    prepared: &Prepared<'_>,
+    wind: &Wind,
+    request: &FlyPlanRequest,
+) -> Result<Vec<Candidate>, Error> {
+    let inside = SplitOptions {
+        inside_legs: true,
+        overlap_m: request.overlap_m,
+    };
+    let mut out = vec![
+        Candidate {
+            spec: prepared.spec.clone(),
+            split: inside,
+            speeds: Vec::new(),
+            as_given: false,
+        },
+        Candidate {
+            spec: prepared.spec.clone(),
+            split: SplitOptions::default(),
+            speeds: Vec::new(),
+            as_given: true,
+        },
+    ];
+    if request.speeds != SpeedChoice::Keep {
+        let (spec, speeds) = speeds_for_wind((vehicle, mission), prepared, wind, request)?;
+        if !speeds.is_empty() {
+            out.push(Candidate {
+                spec,
+                split: inside,
+                speeds,
+                as_given: false,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// The spec with its legs at the wind's speeds (module step 2), and the legs changed.
+pub(in crate::engine) fn speeds_for_wind(
+    (vehicle, mission): (&Vehicle, &Mission),
+    prepared: &Prepared<'_>,
+    wind: &Wind,
+    request: &FlyPlanRequest,
+) -> Result<(MissionSpec, Vec<SpeedChange>), Error> {
+    let flight = &prepared.flight;
+    let payload = prepared
+        .compiled
+        .payloads_kg()
+        .first()
+        .copied()
+        .unwrap_or(0.0);
+    let mass = vehicle.takeoff_mass_with(flight.pack, payload)?;
+    let powered = flight
+        .aircraft
+        .at_mass(mass.total_kg, request.options.aoa)?;
+    let mut spec = prepared.spec.clone();
+    // A planner file's speeds are flown at most at what the vehicle holds within its tilt limit
+    // in still air (as `aloft mission` flies them): a faster choice would be written and not flown.
+    let tilt_mps = spec
+        .clamp_speeds
+        .then(|| flight.aircraft.tilt_limited_speed_mps(mass.total_kg));
+    let max_mps = match (request.max_speed_mps, tilt_mps) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
+    let triggers = camera_triggers_m(mission);
+    let interval_s = camera_interval_s(mission, request);
+    let mut changes = Vec::new();
+    for (i, segment) in spec.segments.iter_mut().enumerate() {
+        let SegmentSpec::Leg {
+            ground_speed_mps,
+            item,
+            ..
+        } = segment
+        else {
+            continue;
+        };
+        if request.speeds == SpeedChoice::Wind && ground_speed_mps.is_some() {
+            continue;
+        }
+        let start = if i == 0 {
+            prepared.compiled.home_m()
+        } else {
+            ends[i - 1]
+        };
+        // A leg flown with the camera triggering every D m: at most D per camera interval.
+        let camera_mps = triggers
+            .get(i)
+            .filter(|d| **d > 0.0)
+            .map(|d| d / interval_s);
+        let max_mps = match (max_mps, camera_mps) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+        let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), max_mps) else {
+            continue;
+        };
+        if ground_speed_mps.is_some_and(|g| (g - v).abs() < 0.05) {
+            continue;
+        }
+        changes.push(SpeedChange {
+            item: *item,
+            segment: i + 1,
+            from_mps: *ground_speed_mps,
+            to_mps: v,
+        });
+        *ground_speed_mps = Some(v);
+    }
+    Ok((spec, changes))
+}
+
+/// The camera trigger distance in force on each segment of a planner file's mission, m (0: the
+/// camera off; empty for aloft's own formats): the last DO_SET_CAM_TRIGG_DIST (206) flown before
+/// the item that made the segment.
+fn camera_triggers_m(mission: &Mission) -> Vec<f64> {
+    let Some(imported) = mission.kept() else {
+        return Vec::new();
+    };
+    let mut out = vec![0.0; imported.spec.segments.len()];
+    let mut in_force = 0.0;
+    for f in &imported.flown {
+        for s in f.segments.clone() {
+            if let Some(slot) = out.get_mut(s) {
+                *slot = in_force;
+            }
+        }
+        let item = &imported.items[f.item];
+        if item.command == 206 && item.params[0].is_finite() {
+            in_force = item.params[0].max(0.0);
+        }
+    }
+    out
+}
+
+/// The camera's shortest time between photos, s: the request's, else the longest
+/// `CameraCalc.MinTriggerInterval` of a `.plan`'s surveys, else [`DEFAULT_CAMERA_INTERVAL_S`].
+fn camera_interval_s(mission: &Mission, request: &FlyPlanRequest) -> f64 {
+    let of_file = mission.kept().and_then(|k| {
+        k.surveys
+            .iter()
+            .filter_map(|s| s.survey.as_ref().ok()?.params().min_trigger_interval_s)
+            .filter(|t| *t > 0.0)
+            .reduce(f64::max)
+    });
+    request
+        .camera_interval_s
+        .or(of_file)
+        .unwrap_or(DEFAULT_CAMERA_INTERVAL_S)
+}
+
+/// The ground speed of least energy per metre along the leg from `a` to `b` in the wind at its
+/// middle, at most the vehicle's speed and `max_mps`, rounded down to 0.1 m/s; `None` for a leg without a horizontal course
+/// (shorter than 1 m) or without headway.
+fn leg_speed_mps(
+    powered: &aloft_planner::Powered<'_>,
+    wind: &Wind,
+    (a, b): ([f64; 3], [f64; 3]),
+    max_mps: Option<f64>,
+) -> Option<f64> {
+    let (de, dn) = (b[0] - a[0], b[1] - a[1]);
+    let length_m = de.hypot(dn);
+    if length_m < 1.0 {
+        return None;
+    }
+    let course = [de / length_m, dn / length_m];
+    let middle = [0, 1, 2].map(|k| 0.5 * (a[k] + b[k]));
+    let w = wind.mean_at(middle)?;
+    let best = best_range_within_limits(powered, course, [w[0], w[1]]).ok()?;
+    // The vehicle's speed bounds its ground speed too (the planner holds a leg's ground speed at
+    // it), whatever a tail wind would allow.
+    let vehicle_mps = powered.aircraft().airframe().max_speed_mps();
+    let v = best
+        .ground_speed_mps
+        .min(vehicle_mps)
+        .min(max_mps.unwrap_or(f64::INFINITY));
+    let rounded = (v * 10.0).floor() / 10.0;
+    (rounded > 0.0).then_some(rounded)
+}
+
+/// A candidate cut into sorties, with its figures and its files' texts.
+struct Flown {
+    candidate: Candidate,
+    plans: Vec<SortiePlan>,
+    figures: PlanFigures,
+    texts: Vec<String>,
+}
+
+/// What the candidates are flown for.
+struct Context<'a> {
+    vehicle: &'a Vehicle,
+    mission: &'a Mission,
+    options: &'a MissionOptions,
+    prepared: &'a Prepared<'a>,
+    bounds: &'a WorkBounds,
+}
+
+/// The best candidate (module step 4), and the figures of the mission as given split at whole
+/// items, flown from its files, when it has them.
+///
+/// # Errors
+/// [`Error::NoPlan`] when none can be cut into sorties that keep the reserve.
+fn best_candidate(
+    cx: &Context<'_>,
+    candidates: Vec<Candidate>,
+) -> Result<(Flown, Option<PlanFigures>), Error> {
+    let mut best: Option<Flown> = None;
+    let mut given: Option<PlanFigures> = None;
+    // Why the first candidate (the route cut inside legs, as given) has no plan.
+    let mut why: Option<String> = None;
+    if cx.bounds.cancelled() {
+        return Err(Error::Cancelled);
+    }
+    // The candidates fly at once, one thread each (a handful); the answer is taken in their
+    // order, so it does not depend on which finishes first.
+    let flown: Vec<Result<Flown, String>> = std::thread::scope(|scope| {
+        let running: Vec<_> = candidates
+            .into_iter()
+            .map(|c| scope.spawn(move || fly_candidate(cx, c)))
+            .collect();
+        running
+            .into_iter()
+            .map(|r| {
+                r.join()
+                    .unwrap_or_else(|_| Err("a candidate's flight failed".to_string()))
+            })
+            .collect()
+    });
+    if cx.bounds.cancelled() {
+        return Err(Error::Cancelled);
+    }
+    for result in flown {
+        match result {
+            Ok(flown) => {
+                if flown.candidate.as_given {
+                    given = Some(flown.figures);
+                }
+                let better = best.as_ref().is_none_or(|b| {
+                    (flown.figures.batteries, flown.figures.energy_wh)
+                        < (b.figures.batteries, b.figures.energy_wh)
+                });
+                if better {
+                    best = Some(flown);
+                }
+            }
+            Err(e) => {
+                why.get_or_insert(e);
+            }
+        }
+    }
+    let best = best.ok_or_else(|| Error::NoPlan {
+        reason: why.unwrap_or_default(),
+    })?;
+    Ok((best, given))
+}
+
+/// A candidate cut into sorties, each flown from its own file's mission (the file aloft writes,
+/// read back as `aloft mission` reads it), and the files' texts.
+fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String> {
+    let flight = &cx.prepared.flight;
+    let compiled = flight
+        .compile(&candidate.spec, None)
+        .map_err(|e| e.to_string())?;
+    let route = Route::of(&candidate.spec, &compiled)?;
+    let maker = Maker::of(cx, &route, &candidate);
+    let mut plans = sortie_plans(flight, &route, candidate.split, maker.as_dyn())?;
+    let n = plans.len();
+    let mut texts = Vec::with_capacity(n);
+    for (k, plan) in plans.iter_mut().enumerate() {
+        plan.spec = maker.as_dyn().sortie(plan.start, plan.end)?;
+        plan.report = flight
+            .trial(&plan.spec, None)
+            .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
+        if !plan.report.feasible {
+            return Err(format!(
+                "sortie {} of {n} misses the reserve once written",
+                k + 1
+            ));
+        }
+        texts.push(maker.text(cx.mission, plan, (k + 1, n))?);
+    }
+    Ok(Flown {
+        figures: figures(&plans),
+        candidate,
+        plans,
+        texts,
+    })
+}
+
+/// Who makes the sorties' missions and files: aloft's own segments (TOML, JSON) or the items of a
+/// planner file.
+enum Maker<'a> {
+    Spec(SpecSorties<'a, 'a>),
+    Planner(PlannerSorties<'a>),
+}
+
+impl<'a> Maker<'a> {
+    fn of(cx: &'a Context<'a>, route: &'a Route<'a>, candidate: &'a Candidate) -> Self {
+        match cx.mission.kept() {
+            Some(kept) => Maker::Planner(PlannerSorties {
+                route,
+                kept,
+                spec: &candidate.spec,
+                speeds_changed: !candidate.speeds.is_empty(),
+                vehicle: cx.vehicle,
+                options: cx.options,
+                flight: &cx.prepared.flight,
+            }),
+            None => Maker::Spec(SpecSorties {
+                route,
+                flight: &cx.prepared.flight,
+            }),
+        }
+    }
+
+    fn as_dyn(&self) -> &dyn SortieMaker {
+        match self {
+            Maker::Spec(m) => m,
+            Maker::Planner(m) => m,
+        }
+    }
+
+    /// The file of sortie `k` of `n`.
+    fn text(
+        &self,
+        mission: &Mission,
+        plan: &SortiePlan,
+        (k, n): (usize, usize),
+    ) -> Result<String, String> {
+        match self {
+            Maker::Spec(_) => sortie_text(mission, plan, k, n).map_err(|e| e.to_string()),
+            Maker::Planner(m) => m.text(plan.start, plan.end),
+        }
+    }
+}
+
+/// The figures of a set of sorties.
+fn figures(plans: &[SortiePlan]) -> PlanFigures {
+    PlanFigures {
+        batteries: u32::try_from(plans.len()).unwrap_or(u32::MAX),
+        energy_wh: plans.iter().map(|p| p.report.energy_wh).sum(),
+        duration_s: plans.iter().map(|p| p.report.duration_s).sum(),
+    }
+}
+
+/// The answer of the best candidate: its sorties named as files in the input's format.
+fn answer(
+    mission: &Mission,
+    best: &Flown,
+    as_given: Option<PlanFigures>,
+) -> Result<FlyPlan, Error> {
+    let (stem, extension) = file_stem_and_extension(mission)?;
+    let n = best.plans.len();
+    let mut files = Vec::with_capacity(n);
+    let mut texts = Vec::with_capacity(n);
+    let mut sorties = Vec::with_capacity(n);
+    for (k, plan) in best.plans.iter().enumerate() {
+        let file = format!("{stem}-{}-of-{n}.{extension}", k + 1);
+        sorties.push(sortie_answer(&file, plan, &best.candidate.spec));
+        files.push(file);
+    }
+    texts.extend(best.texts.iter().cloned());
+    Ok(FlyPlan {
+        files,
+        batteries: best.figures.batteries,
+        energy_wh: best.figures.energy_wh,
+        duration_s: best.figures.duration_s,
+        air: crate::engine::conditions::air::Air::sea_level(),
+        sorties,
+        as_given,
+        changes: PlanChanges {
+            speeds: best.candidate.speeds.clone(),
+            angles: Vec::new(),
+            cut_inside_legs: best.candidate.split.inside_legs
+                && best
+                    .plans
+                    .iter()
+                    .any(|p| p.end.is_some_and(|c| c.fraction < 1.0)),
+        },
+        notes: Vec::new(),
+        texts,
+    })
+}
+
+/// One sortie's answer.
+fn sortie_answer(file: &str, plan: &SortiePlan, spec: &MissionSpec) -> FlySortie {
+    let items = || {
+        spec.segments[plan.route.clone()]
+            .iter()
+            .filter_map(SegmentSpec::item)
+    };
+    FlySortie {
+        file: file.to_string(),
+        first_item: items().next(),
+        last_item: items().next_back(),
+        ends_inside_leg_fraction: plan.end.filter(|c| c.fraction < 1.0).map(|c| c.fraction),
+        energy_wh: plan.report.energy_wh,
+        duration_s: plan.report.duration_s,
+        end_soc: plan.report.end_soc,
+        point_of_no_return_s: plan.report.point_of_no_return.map(|p| p.time_s),
+    }
+}
+
+/// The name a plan's files are given and their extension: the input's file name, made safe
+/// ([`safe_stem`]: never a path, never the mission's own `name`), `mission` when nothing is left
+/// of it; the built-in demo's is its fixture's, `demo-survey`.
+fn file_stem_and_extension(mission: &Mission) -> Result<(String, &'static str), Error> {
+    let extension = match mission.route().source_format {
+        SourceFormat::AloftToml => "toml",
+        SourceFormat::AloftJson => "json",
+        SourceFormat::QgcPlan => "plan",
+        SourceFormat::QgcWpl | SourceFormat::MavlinkItems => "waypoints",
+    };
+    let stem = if mission.origin() == DEMO_ORIGIN {
+        DEMO_FILE_STEM.to_string()
+    } else {
+        safe_stem(Path::new(mission.origin())).unwrap_or_else(|| "mission".to_string())
+    };
+    Ok((stem, extension))
+}
+
+/// The text of sortie `k` of `n`: its mission in the input's format, named so.
+fn sortie_text(mission: &Mission, plan: &SortiePlan, k: usize, n: usize) -> Result<String, Error> {
+    let mut spec = plan.spec.clone();
+    spec.name = format!("{} ({k} of {n})", mission.display_name());
+    let text = match mission.route().source_format {
+        SourceFormat::AloftJson => serde_json::to_string_pretty(&spec).map_err(|e| e.to_string()),
+        _ => toml::to_string(&spec).map_err(|e| e.to_string()),
+    };
+    text.map_err(|message| Error::OptionsFormat {
+        what: "plan file",
+        message,
+    })
+}
+
+impl FlyPlan {
+    /// Write the files into `dir` (created if missing) as one set, all or nothing
+    /// ([`OutputSet`]): each to an exclusive temporary file with a random name there, then all
+    /// renamed into place; an existing file is kept unless `force` (which replaces a regular file
+    /// or a link itself, never a device or a FIFO); an error (or an interrupted program) at any
+    /// file leaves none of the set. The answer's `files` become their paths.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the folder; [`Error::Output`] naming the file.
+    pub fn write(&mut self, dir: &Path, force: bool) -> Result<(), Error> {
+        std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+            origin: format!("cannot create {}", shown_path(dir)),
+            source,
+        })?;
+        let paths: Vec<PathBuf> = self.files.iter().map(|f| dir.join(f)).collect();
+        let mut set = OutputSet::new();
+        for (path, text) in paths.iter().zip(&self.texts) {
+            set.add(path, text.as_bytes(), force)?;
+        }
+        set.commit()?;
+        self.files = paths.iter().map(|p| p.display().to_string()).collect();
+        for (sortie, file) in self.sorties.iter_mut().zip(&self.files) {
+            sortie.file.clone_from(file);
+        }
+        Ok(())
+    }
+}
+
+/// The energy of `mission` flown whole with the legs' speeds for the wind, Wh; `None` when it
+/// cannot be flown.
+fn energy_wh(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+    wind: &Wind,
+) -> Option<f64> {
+    let options = &request.options;
+    let aircraft = vehicle.aircraft().ok()?;
+    let battery = vehicle.battery(options.battery.as_deref()).ok()?;
+    let mut prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind)).ok()?;
+    if let Some(payload_kg) = options.payload_kg {
+        prepared.spec.payload_kg = payload_kg;
+    }
+    let spec = match request.speeds {
+        SpeedChoice::Keep => prepared.spec.clone(),
+        _ => {
+            speeds_for_wind((vehicle, mission), &prepared, wind, request)
+                .ok()?
+                .0
+        }
+    };
+    let report = prepared.flight.trial(&spec, None).ok()?;
+    Some(report.energy_wh)
+}
