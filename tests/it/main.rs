@@ -1,6 +1,8 @@
 //! aloft's integration tests, one binary: a module per area (each was its own test binary, and
 //! linked the whole crate; one link instead of 62). `cargo test --test it NAME::` runs one area,
-//! e.g. `cargo test --test it serve_hostile::`. `common` holds the helpers they share.
+//! e.g. `cargo test --test it serve_hostile::`. `common` holds the helpers they share. One test
+//! keeps a binary of its own: `tests/power_streaming.rs` measures its own process's peak memory,
+//! which other tests running beside it in one process would raise.
 
 mod common;
 
@@ -50,7 +52,6 @@ mod planner_checks;
 mod planner_cli;
 mod planner_envelope;
 mod power_paper_val;
-mod power_streaming;
 mod propulsion_data_val;
 mod propulsion_paper_val;
 mod replay_data_val;
