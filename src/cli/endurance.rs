@@ -11,10 +11,10 @@ use clap::{ArgGroup, Args};
 use aloft::engine::flags::EnduranceFlags;
 use aloft::engine::{
     endurance, endurance_scenarios, payload_sweep, power_curve, EnduranceOptions, EnduranceSummary,
-    EnduranceWithUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
+    EnduranceUncertainty, Error, PayloadSweep, PowerCurve, SweepRow, Vehicle,
 };
 
-use super::output::{self, ForceFlag};
+use super::output::{self, percentiles, ForceFlag, Row};
 use super::plot::{ChartFile, Line};
 use super::{Format, Outcome};
 
@@ -64,24 +64,14 @@ pub fn run(mut args: EnduranceArgs) -> Result<Outcome> {
         Some(sc) => Some(endurance_scenarios(&vehicle, &options, &sc)?),
         None => None,
     };
-    let mut out = std::io::stdout().lock();
-    match (args.format, &uncertainty) {
-        (Format::Json, None) => output::write_json(&mut out, &summary)?,
-        (Format::Json, Some(u)) => output::write_json(
-            &mut out,
-            &EnduranceWithUncertainty {
-                summary: &summary,
-                uncertainty: u,
-            },
-        )?,
-        (Format::Csv | Format::Table, _) => {
-            write_table(&mut out, &summary, args.flags.reserve_percent)?;
-            if let Some(u) = &uncertainty {
-                writeln!(out)?;
-                super::scenarios::write_endurance_lines(&mut out, u)?;
-            }
+    let answer = output::MaybeUncertain::new(&summary, uncertainty.as_ref());
+    output::print_table_or_json(args.format, &answer, |out| {
+        write_table(out, &summary, args.flags.reserve_percent)?;
+        match &uncertainty {
+            Some(u) => write_uncertainty(out, u),
+            None => Ok(()),
         }
-    }
+    })?;
     Ok(Outcome::Ok)
 }
 
@@ -217,6 +207,50 @@ fn write_table(out: &mut impl Write, s: &EnduranceSummary, reserve_percent: f64)
     for n in &s.context.notes {
         writeln!(out, "  note: {n}")?;
     }
+    Ok(())
+}
+
+/// The endurance table's lines for the scenarios (`--samples N`), after a blank line.
+fn write_uncertainty(out: &mut impl Write, u: &EnduranceUncertainty) -> Result<()> {
+    let s = &u.spreads;
+    writeln!(
+        out,
+        "\nScenarios: {} (seed {}; wind speed sd {} m/s, wind direction sd {} deg, payload sd {} kg, capacity sd {} %, power sd {} %); the vehicle can fly {:.1} % of them.",
+        u.samples,
+        u.seed,
+        s.wind_speed_sd_mps,
+        s.wind_from_sd_deg,
+        s.payload_sd_kg,
+        s.capacity_sd_percent,
+        s.power_sd_percent,
+        u.p_feasible * 100.0
+    )?;
+    let min = |t: f64| format!("{:.1}", t / 60.0);
+    let mut rows = vec![
+        Row::new(
+            "hover endurance",
+            percentiles(u.hover_endurance_s, &min),
+            "min",
+        ),
+        Row::new(
+            "best endurance",
+            percentiles(u.max_endurance_s, &min),
+            "min",
+        ),
+        Row::new(
+            "best range",
+            percentiles(u.max_range_m, &|m| format!("{:.2}", m / 1000.0)),
+            "km",
+        ),
+    ];
+    if u.orbit_endurance_s.is_some() {
+        rows.push(Row::new(
+            "orbit endurance",
+            percentiles(u.orbit_endurance_s, &min),
+            "min",
+        ));
+    }
+    output::write_table(out, "Uncertainty (5th percentile / median / 95th)", &rows)?;
     Ok(())
 }
 

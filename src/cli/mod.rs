@@ -12,6 +12,7 @@ mod log;
 pub(crate) mod logbook;
 mod mission;
 mod mission_args;
+mod mission_chart;
 mod mission_view;
 mod output;
 mod pack;
@@ -22,7 +23,6 @@ mod power;
 mod propulsion;
 mod replay;
 mod rotor;
-mod scenarios;
 #[cfg(feature = "serve")]
 mod serve;
 mod signals;

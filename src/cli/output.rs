@@ -72,6 +72,20 @@ pub fn fixed(value: f64, decimals: usize) -> String {
     format!("{value:.decimals$}")
 }
 
+/// Minutes and seconds, `m:ss`.
+pub fn mmss(t_s: f64) -> String {
+    let s = t_s.max(0.0).round() as u64;
+    format!("{}:{:02}", s / 60, s % 60)
+}
+
+/// A band of scenarios in one cell, `p5 / median / p95`, each shown by `show`; `-` when no
+/// scenario gave the figure.
+pub fn percentiles(p: Option<aloft::engine::Percentiles>, show: &dyn Fn(f64) -> String) -> String {
+    p.map_or("-".to_string(), |p| {
+        format!("{} / {} / {}", show(p.p5), show(p.p50), show(p.p95))
+    })
+}
+
 /// Write rows as an aligned two-column table with units.
 pub fn write_table(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> io::Result<()> {
     writeln!(out, "{title}")?;
@@ -134,6 +148,32 @@ pub fn print_table_or_json<T: serde::Serialize>(
     match format {
         Format::Json => write_json(&mut out, answer),
         Format::Table | Format::Csv => table(&mut out),
+    }
+}
+
+/// An answer as JSON, with its `uncertainty` when scenarios were drawn (`--samples N`): the
+/// answer's own keys either way, as the engine's [`WithUncertainty`] writes them.
+///
+/// [`WithUncertainty`]: aloft::engine::WithUncertainty
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+pub enum MaybeUncertain<'a, A, U> {
+    /// No scenarios: the answer alone.
+    Sure(&'a A),
+    /// The answer and its scenarios.
+    Uncertain(aloft::engine::WithUncertainty<'a, A, U>),
+}
+
+impl<'a, A, U> MaybeUncertain<'a, A, U> {
+    /// The answer `summary`, with `uncertainty` when there is one.
+    pub fn new(summary: &'a A, uncertainty: Option<&'a U>) -> Self {
+        match uncertainty {
+            None => Self::Sure(summary),
+            Some(uncertainty) => Self::Uncertain(aloft::engine::WithUncertainty {
+                summary,
+                uncertainty,
+            }),
+        }
     }
 }
 

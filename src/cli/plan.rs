@@ -10,8 +10,7 @@ use clap::Args;
 use aloft::engine::flags::PlanFlags;
 use aloft::engine::{answers, plan_to_fly, FlyPlan, Mission, PlanFigures};
 
-use super::mission_view::mmss;
-use super::output;
+use super::output::{self, mmss};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
