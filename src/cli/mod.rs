@@ -4,6 +4,7 @@
 
 mod convert;
 mod endurance;
+mod endurance_view;
 mod fit;
 mod flights;
 mod live;
@@ -20,6 +21,7 @@ mod payload_sweep;
 mod plan;
 mod plot;
 mod power;
+mod power_curve;
 mod propulsion;
 mod replay;
 mod rotor;
