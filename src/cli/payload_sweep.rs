@@ -115,12 +115,7 @@ fn write_csv(out: impl Write, curve: &PayloadCurve) -> Result<()> {
     if orbit {
         header.extend(["orbit_power_w", "orbit_endurance_s"]);
     }
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(&header)?;
-    for r in &curve.rows {
-        w.write_record(csv_record(r, orbit))?;
-    }
-    w.flush()?;
+    output::write_csv(out, &header, curve.rows.iter().map(|r| csv_record(r, orbit)))?;
     for n in &curve.notes {
         eprintln!("aloft: note: {n}");
     }
