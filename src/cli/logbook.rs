@@ -13,7 +13,7 @@ use aloft_logbook::{
     AddOutcome, Flight, KeyKind, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
 };
 
-use super::output::{self, fixed, Row};
+use super::output::{self, fixed, fixed_or_dash, Row};
 use super::Outcome;
 
 #[path = "logbook_read.rs"]
@@ -375,11 +375,6 @@ fn relabel(book: &mut Logbook, a: RelabelArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-/// An optional figure with `decimals`, `-` when absent.
-fn opt(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "-".to_string(), |v| fixed(v, decimals))
-}
-
 /// Rows as aligned columns under a header (text left, numbers right).
 fn write_columns(out: &mut impl Write, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
     let mut widths: Vec<usize> = header.iter().map(|h| h.len()).collect();
@@ -424,12 +419,12 @@ fn flights_table(out: &mut impl Write, flights: &[Flight]) -> Result<()> {
                 f.vehicle_key.clone(),
                 f.pack_key.clone(),
                 fixed(f.duration_s / 60.0, 1),
-                opt(f.air_s.map(|s| s / 60.0), 1),
+                fixed_or_dash(f.air_s.map(|s| s / 60.0), 1),
                 fixed(f.energy_wh, 1),
-                opt(f.discharged_mah, 0),
-                opt(f.mean_power_w, 0),
-                opt(f.hover_power_w, 0),
-                opt(f.resistance_ohm.map(|r| r * 1000.0), 1),
+                fixed_or_dash(f.discharged_mah, 0),
+                fixed_or_dash(f.mean_power_w, 0),
+                fixed_or_dash(f.hover_power_w, 0),
+                fixed_or_dash(f.resistance_ohm.map(|r| r * 1000.0), 1),
                 f.copy_of.map_or_else(|| "-".to_string(), |c| c.to_string()),
             ]
         })
@@ -568,7 +563,7 @@ fn pack_block(p: &PackSummary) -> (String, Vec<Row<'static>>) {
                 "first {:.1} mOhm, last {:.1} mOhm, slope {} mOhm/flight, n {}",
                 t.first * 1000.0,
                 t.last * 1000.0,
-                opt(t.slope_per_flight.map(|s| s * 1000.0), 2),
+                fixed_or_dash(t.slope_per_flight.map(|s| s * 1000.0), 2),
                 t.n
             ),
             None if p.resistance.is_empty() => "n/a: no estimate".into(),
@@ -596,12 +591,12 @@ fn pack_block(p: &PackSummary) -> (String, Vec<Row<'static>>) {
     ));
     rows.push(Row::new(
         "cell imbalance > 0.01 V",
-        opt(p.imbalance_minor_min, 1),
+        fixed_or_dash(p.imbalance_minor_min, 1),
         "min",
     ));
     rows.push(Row::new(
         "cell imbalance > 0.07 V",
-        opt(p.imbalance_major_min, 1),
+        fixed_or_dash(p.imbalance_major_min, 1),
         "min",
     ));
     rows.push(Row::new("vehicles", p.vehicles.join(", "), ""));
@@ -708,8 +703,8 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
             answer.output,
             a.pack,
             answer.logs.len(),
-            opt(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
-            opt(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
+            fixed_or_dash(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
+            fixed_or_dash(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
         )?,
     }
     Ok(Outcome::Ok)

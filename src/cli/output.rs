@@ -72,6 +72,11 @@ pub fn fixed(value: f64, decimals: usize) -> String {
     format!("{value:.decimals$}")
 }
 
+/// An optional number with `decimals` digits after the point, `-` when absent.
+pub fn fixed_or_dash(value: Option<f64>, decimals: usize) -> String {
+    value.map_or_else(|| "-".to_string(), |v| fixed(v, decimals))
+}
+
 /// Minutes and seconds, `m:ss`.
 pub fn mmss(t_s: f64) -> String {
     let s = t_s.max(0.0).round() as u64;

@@ -11,7 +11,7 @@ use aloft::engine::flags::finite;
 use aloft::engine::{fit_pack, PackFitAnswer, PackFitRequest, Vehicle, DEFAULT_VEHICLE};
 
 use super::flights::{escaped, file_name};
-use super::output::{self, Row};
+use super::output::{self, fixed_or_dash, Row};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -123,10 +123,6 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-fn opt(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "-".to_string(), |v| output::fixed(v, decimals))
-}
-
 fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
     for r in &a.logs {
         let rows = vec![
@@ -135,13 +131,17 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
             Row::num("lowest voltage", r.min_voltage_v, 2, "V"),
             Row::new(
                 "discharged (coulomb count)",
-                opt(r.discharged_mah, 0),
+                fixed_or_dash(r.discharged_mah, 0),
                 "mAh",
             ),
-            Row::new("reported drop", opt(r.reported_drop_mah, 0), "mAh"),
+            Row::new(
+                "reported drop",
+                fixed_or_dash(r.reported_drop_mah, 0),
+                "mAh",
+            ),
             Row::new(
                 "internal resistance (steps)",
-                opt(r.internal_resistance_ohm, 4),
+                fixed_or_dash(r.internal_resistance_ohm, 4),
                 "ohm",
             ),
             Row::new(
@@ -153,18 +153,22 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
             ),
             Row::new(
                 "autopilot's resistance",
-                opt(r.autopilot_internal_resistance_ohm, 4),
+                fixed_or_dash(r.autopilot_internal_resistance_ohm, 4),
                 "ohm",
             ),
-            Row::new("capacity between rests", opt(r.capacity_mah, 0), "mAh"),
+            Row::new(
+                "capacity between rests",
+                fixed_or_dash(r.capacity_mah, 0),
+                "mAh",
+            ),
             Row::new(
                 "cell imbalance > 0.01 V",
-                opt(r.imbalance_minor_min, 1),
+                fixed_or_dash(r.imbalance_minor_min, 1),
                 "min",
             ),
             Row::new(
                 "cell imbalance > 0.07 V",
-                opt(r.imbalance_major_min, 1),
+                fixed_or_dash(r.imbalance_major_min, 1),
                 "min",
             ),
         ];
@@ -176,17 +180,25 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
     let rows = vec![
         Row::new(
             "internal resistance",
-            opt(a.internal_resistance_ohm, 4),
+            fixed_or_dash(a.internal_resistance_ohm, 4),
             "ohm",
         ),
         Row::new(
             "autopilot's resistance",
-            opt(a.autopilot_internal_resistance_ohm, 4),
+            fixed_or_dash(a.autopilot_internal_resistance_ohm, 4),
             "ohm",
         ),
-        Row::new("capacity written", opt(a.pack_capacity_mah, 0), "mAh"),
+        Row::new(
+            "capacity written",
+            fixed_or_dash(a.pack_capacity_mah, 0),
+            "mAh",
+        ),
         Row::num("discharged over the logs", a.discharged_mah, 0, "mAh"),
-        Row::new("equivalent full cycles", opt(a.equivalent_cycles, 2), ""),
+        Row::new(
+            "equivalent full cycles",
+            fixed_or_dash(a.equivalent_cycles, 2),
+            "",
+        ),
     ];
     output::write_table(
         out,

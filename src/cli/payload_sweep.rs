@@ -115,7 +115,11 @@ fn write_csv(out: impl Write, curve: &PayloadCurve) -> Result<()> {
     if orbit {
         header.extend(["orbit_power_w", "orbit_endurance_s"]);
     }
-    output::write_csv(out, &header, curve.rows.iter().map(|r| csv_record(r, orbit)))?;
+    output::write_csv(
+        out,
+        &header,
+        curve.rows.iter().map(|r| csv_record(r, orbit)),
+    )?;
     for n in &curve.notes {
         eprintln!("aloft: note: {n}");
     }
