@@ -589,14 +589,16 @@ fn pack_block(p: &PackSummary) -> (String, Vec<Row<'static>>) {
         },
         "",
     ));
-    rows.push(Row::new(
+    rows.push(Row::opt(
         "cell imbalance > 0.01 V",
-        fixed_or_dash(p.imbalance_minor_min, 1),
+        p.imbalance_minor_min,
+        1,
         "min",
     ));
-    rows.push(Row::new(
+    rows.push(Row::opt(
         "cell imbalance > 0.07 V",
-        fixed_or_dash(p.imbalance_major_min, 1),
+        p.imbalance_major_min,
+        1,
         "min",
     ));
     rows.push(Row::new("vehicles", p.vehicles.join(", "), ""));

@@ -59,6 +59,11 @@ impl<'a> Row<'a> {
     pub fn num(label: &'a str, value: f64, decimals: usize, unit: &'a str) -> Self {
         Self::new(label, fixed(value, decimals), unit)
     }
+
+    /// A row of a number that may be absent (`-`), shown with `decimals` digits after the point.
+    pub fn opt(label: &'a str, value: Option<f64>, decimals: usize, unit: &'a str) -> Self {
+        Self::new(label, fixed_or_dash(value, decimals), unit)
+    }
 }
 
 /// Rows of numbers from a table of label, value, decimals and unit.

@@ -11,7 +11,7 @@ use aloft::engine::flags::finite;
 use aloft::engine::{fit_pack, PackFitAnswer, PackFitRequest, Vehicle, DEFAULT_VEHICLE};
 
 use super::flights::{escaped, file_name};
-use super::output::{self, fixed_or_dash, Row};
+use super::output::{self, Row};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -129,19 +129,12 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
             Row::num("duration", r.duration_s, 1, "s"),
             Row::num("energy", r.energy_wh, 2, "Wh"),
             Row::num("lowest voltage", r.min_voltage_v, 2, "V"),
-            Row::new(
-                "discharged (coulomb count)",
-                fixed_or_dash(r.discharged_mah, 0),
-                "mAh",
-            ),
-            Row::new(
-                "reported drop",
-                fixed_or_dash(r.reported_drop_mah, 0),
-                "mAh",
-            ),
-            Row::new(
+            Row::opt("discharged (coulomb count)", r.discharged_mah, 0, "mAh"),
+            Row::opt("reported drop", r.reported_drop_mah, 0, "mAh"),
+            Row::opt(
                 "internal resistance (steps)",
-                fixed_or_dash(r.internal_resistance_ohm, 4),
+                r.internal_resistance_ohm,
+                4,
                 "ohm",
             ),
             Row::new(
@@ -151,26 +144,15 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
                     .map_or("-".into(), |e| e.steps.to_string()),
                 "",
             ),
-            Row::new(
+            Row::opt(
                 "autopilot's resistance",
-                fixed_or_dash(r.autopilot_internal_resistance_ohm, 4),
+                r.autopilot_internal_resistance_ohm,
+                4,
                 "ohm",
             ),
-            Row::new(
-                "capacity between rests",
-                fixed_or_dash(r.capacity_mah, 0),
-                "mAh",
-            ),
-            Row::new(
-                "cell imbalance > 0.01 V",
-                fixed_or_dash(r.imbalance_minor_min, 1),
-                "min",
-            ),
-            Row::new(
-                "cell imbalance > 0.07 V",
-                fixed_or_dash(r.imbalance_major_min, 1),
-                "min",
-            ),
+            Row::opt("capacity between rests", r.capacity_mah, 0, "mAh"),
+            Row::opt("cell imbalance > 0.01 V", r.imbalance_minor_min, 1, "min"),
+            Row::opt("cell imbalance > 0.07 V", r.imbalance_major_min, 1, "min"),
         ];
         output::write_table(out, &file_name(&r.source), &rows)?;
         if let Some(why) = &r.capacity_refused {
@@ -178,27 +160,16 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
         }
     }
     let rows = vec![
-        Row::new(
-            "internal resistance",
-            fixed_or_dash(a.internal_resistance_ohm, 4),
-            "ohm",
-        ),
-        Row::new(
+        Row::opt("internal resistance", a.internal_resistance_ohm, 4, "ohm"),
+        Row::opt(
             "autopilot's resistance",
-            fixed_or_dash(a.autopilot_internal_resistance_ohm, 4),
+            a.autopilot_internal_resistance_ohm,
+            4,
             "ohm",
         ),
-        Row::new(
-            "capacity written",
-            fixed_or_dash(a.pack_capacity_mah, 0),
-            "mAh",
-        ),
+        Row::opt("capacity written", a.pack_capacity_mah, 0, "mAh"),
         Row::num("discharged over the logs", a.discharged_mah, 0, "mAh"),
-        Row::new(
-            "equivalent full cycles",
-            fixed_or_dash(a.equivalent_cycles, 2),
-            "",
-        ),
+        Row::opt("equivalent full cycles", a.equivalent_cycles, 2, ""),
     ];
     output::write_table(
         out,
