@@ -19,14 +19,15 @@ pub fn print(
     reserve_percent: f64,
     format: Format,
 ) -> Result<()> {
-    let answer = MaybeUncertain::new(summary, scenarios);
-    output::print_table_or_json(format, &answer, |out| {
-        write_table(out, summary, reserve_percent)?;
-        match scenarios {
-            Some(u) => write_uncertainty(out, u),
-            None => Ok(()),
-        }
-    })
+    let mut out = std::io::stdout().lock();
+    if format == Format::Json {
+        return output::write_json(&mut out, &MaybeUncertain::new(summary, scenarios));
+    }
+    write_table(&mut out, summary, reserve_percent)?;
+    match scenarios {
+        Some(u) => write_uncertainty(&mut out, u),
+        None => Ok(()),
+    }
 }
 
 /// The endurance figures under a title of the vehicle, pack, mass, wind, reserve and air; the

@@ -34,8 +34,14 @@ impl MissionView<'_> {
         if format == Format::Json {
             output::warn(plan_warnings(self.plan));
         }
-        let answer = MaybeUncertain::new(self.plan.summary(), self.scenarios);
-        output::print_table_or_json(format, &answer, |out| self.write_table(out))
+        let mut out = std::io::stdout().lock();
+        match format {
+            Format::Json => {
+                let answer = MaybeUncertain::new(self.plan.summary(), self.scenarios);
+                output::write_json(&mut out, &answer)
+            }
+            Format::Table | Format::Csv => self.write_table(&mut out),
+        }
     }
 
     /// The mission as a reader sees it: header (and the scenarios' verdict), summary, the

@@ -1,8 +1,7 @@
-//! Small rendering helpers shared by the subcommands.
+//! The shared writers every answer's renderer writes with (below the renderers, which pick the
+//! format): JSON, CSV, aligned tables and their cells; `--force`; a broken pipe.
 
-use std::io::{self, StdoutLock, Write};
-
-use super::Format;
+use std::io::{self, Write};
 
 /// `--force`, of every command that writes files.
 #[derive(Debug, Clone, Copy, Default, clap::Args)]
@@ -130,35 +129,6 @@ pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow
     })?;
     writeln!(out)?;
     Ok(())
-}
-
-/// Print an answer on stdout in `format`: JSON from the answer itself, CSV and the table by the
-/// command's own writers.
-pub fn print<T: serde::Serialize>(
-    format: Format,
-    answer: &T,
-    csv: impl FnOnce(StdoutLock<'static>) -> anyhow::Result<()>,
-    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let mut out = io::stdout().lock();
-    match format {
-        Format::Json => write_json(&mut out, answer),
-        Format::Csv => csv(out),
-        Format::Table => table(&mut out),
-    }
-}
-
-/// [`print`] for an answer without a CSV of its own: `--format csv` prints the table.
-pub fn print_table_or_json<T: serde::Serialize>(
-    format: Format,
-    answer: &T,
-    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let mut out = io::stdout().lock();
-    match format {
-        Format::Json => write_json(&mut out, answer),
-        Format::Table | Format::Csv => table(&mut out),
-    }
 }
 
 /// An answer as JSON, with its `uncertainty` when scenarios were drawn (`--samples N`): the

@@ -119,7 +119,11 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         eprintln!("aloft pack fit: no usable log: no pack written");
         return Ok(Outcome::Failed);
     }
-    output::print_table_or_json(a.format, &answer, |out| render(out, &answer))?;
+    let mut out = std::io::stdout().lock();
+    match a.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Table | Format::Csv => render(&mut out, &answer)?,
+    }
     Ok(Outcome::Ok)
 }
 

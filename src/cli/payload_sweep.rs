@@ -16,12 +16,12 @@ pub fn render(curve: &PayloadCurve, chart: Option<ChartFile<'_>>, format: Format
     if let Some(file) = chart {
         plot(file, curve).with_context(|| format!("cannot draw {}", file.path.display()))?;
     }
-    output::print(
-        format,
-        curve,
-        |out| write_csv(out, curve),
-        |out| write_table(out, curve),
-    )
+    let mut out = std::io::stdout().lock();
+    match format {
+        Format::Json => output::write_json(&mut out, curve),
+        Format::Csv => write_csv(out, curve),
+        Format::Table => write_table(&mut out, curve),
+    }
 }
 
 /// A block per pack: payload, take-off mass, hover power and endurance, best endurance and best

@@ -23,12 +23,12 @@ pub fn render(
         plot(file, &curve.context.vehicle, &curve.rows)
             .with_context(|| format!("cannot draw {}", file.path.display()))?;
     }
-    output::print(
-        format,
-        curve,
-        |out| write_csv(out, &curve.rows),
-        |out| write_table(out, curve, course_deg),
-    )
+    let mut out = std::io::stdout().lock();
+    match format {
+        Format::Json => output::write_json(&mut out, curve),
+        Format::Csv => write_csv(out, &curve.rows),
+        Format::Table => write_table(&mut out, curve, course_deg),
+    }
 }
 
 /// One header and one row per airspeed (every number at full precision; empty where there is
