@@ -183,3 +183,51 @@ pub fn write_csv_value(out: impl Write, value: &impl serde::Serialize) -> anyhow
     w.flush()?;
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(serde::Serialize)]
+    struct Answer {
+        energy_wh: f64,
+    }
+
+    #[derive(serde::Serialize)]
+    struct Spread {
+        p5: f64,
+    }
+
+    /// Without scenarios the JSON is the answer's own; with them, its keys then `uncertainty`
+    /// (the keys `aloft mission --samples` and the C ABI promise).
+    #[test]
+    fn maybe_uncertain_is_the_answer_alone_or_the_answer_then_its_uncertainty() {
+        let (a, u) = (Answer { energy_wh: 1.5 }, Spread { p5: 0.25 });
+        let sure = MaybeUncertain::<Answer, Spread>::new(&a, None);
+        assert_eq!(
+            serde_json::to_string(&sure).unwrap(),
+            r#"{"energy_wh":1.5}"#
+        );
+        let uncertain = MaybeUncertain::new(&a, Some(&u));
+        assert_eq!(
+            serde_json::to_string(&uncertain).unwrap(),
+            r#"{"energy_wh":1.5,"uncertainty":{"p5":0.25}}"#
+        );
+    }
+
+    #[test]
+    fn cells_round_as_tables_show_them() {
+        assert_eq!(mmss(59.6), "1:00");
+        assert_eq!(mmss(-3.0), "0:00");
+        assert_eq!(mmss(3725.0), "62:05");
+        assert_eq!(fixed_or_dash(None, 2), "-");
+        assert_eq!(fixed_or_dash(Some(0.16), 1), "0.2");
+        let p = aloft::engine::Percentiles {
+            p5: 1.0,
+            p50: 2.0,
+            p95: 3.5,
+        };
+        assert_eq!(percentiles(Some(p), &|x| fixed(x, 1)), "1.0 / 2.0 / 3.5");
+        assert_eq!(percentiles(None, &|x| fixed(x, 1)), "-");
+    }
+}
