@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::Args;
 
-use aloft::engine::convert_log;
+use aloft::engine::{convert_log, ConvertSummary};
 
 use aloft::engine::flags::LogReadFlags;
 
@@ -37,23 +37,30 @@ pub fn run(args: ConvertArgs) -> Result<Outcome> {
         &args.output,
         args.force.force,
     )?;
-    output::print_table_or_json(args.format, &json, |out| {
-        let rows: Vec<Row<'_>> = json
-            .topics
-            .iter()
-            .map(|t| Row::new(&t.topic, t.messages.to_string(), "messages"))
-            .collect();
-        let title = format!(
-            "{} -> {} ({} samples)",
-            json.input, json.output, json.samples
-        );
-        output::write_table(out, &title, &rows)?;
-        Ok(())
-    })?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &json)?,
+        Format::Table | Format::Csv => write_table(&mut out, &json)?,
+    }
     if let Some((gaps, backwards)) = json.time_notes {
         eprintln!(
             "aloft: note: the input's time base has {gaps} gap(s) and {backwards} non-monotonic step(s); they are kept as they are"
         );
     }
     Ok(Outcome::Ok)
+}
+
+/// The topics written and their messages, under the input, the output and the samples.
+fn write_table(out: &mut impl std::io::Write, json: &ConvertSummary) -> Result<()> {
+    let rows: Vec<Row<'_>> = json
+        .topics
+        .iter()
+        .map(|t| Row::new(&t.topic, t.messages.to_string(), "messages"))
+        .collect();
+    let title = format!(
+        "{} -> {} ({} samples)",
+        json.input, json.output, json.samples
+    );
+    output::write_table(out, &title, &rows)?;
+    Ok(())
 }

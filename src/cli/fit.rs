@@ -82,12 +82,12 @@ pub fn run(args: FitArgs) -> Result<Outcome> {
     for n in &answer.notes {
         eprintln!("aloft fit: {n}");
     }
-    output::print(
-        args.format,
-        &answer,
-        |out| write_csv(out, &answer),
-        |out| render(out, &answer),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Csv => write_csv(out, &answer)?,
+        Format::Table => render(&mut out, &answer)?,
+    }
     Ok(Outcome::Ok)
 }
 

@@ -13,6 +13,7 @@ use aloft::engine::{
     LiveUpdate,
 };
 
+use super::output::{fixed, fixed_or_dash, percentiles};
 use super::Outcome;
 
 /// Output of `aloft live`.
@@ -142,24 +143,9 @@ impl View {
     }
 }
 
-/// A value with `digits` decimals, or `-`.
-fn opt(x: Option<f64>, digits: usize) -> String {
-    x.map_or_else(|| "-".to_string(), |v| format!("{v:.digits$}"))
-}
-
 /// `p5 / p50 / p95` of a band, scaled, or `-`.
 fn band(b: Option<aloft::engine::Percentiles>, scale: f64, digits: usize) -> String {
-    b.map_or_else(
-        || "-".to_string(),
-        |b| {
-            format!(
-                "{:.digits$} / {:.digits$} / {:.digits$}",
-                scale * b.p5,
-                scale * b.p50,
-                scale * b.p95
-            )
-        },
-    )
+    percentiles(b, &|x| fixed(scale * x, digits))
 }
 
 /// The status panel of one update.
@@ -186,16 +172,16 @@ fn panel(u: &LiveUpdate) -> Vec<String> {
         format!("aloft live · t {:.1} s · {mode}{item} · {state}", u.time_s),
         format!(
             "battery   {} %   used {:.2} Wh   power {} W   eta {:.4}",
-            opt(u.soc.map(|s| 100.0 * s), 1),
+            fixed_or_dash(u.soc.map(|s| 100.0 * s), 1),
             u.energy_used_wh,
-            opt(u.power_w, 0),
+            fixed_or_dash(u.power_w, 0),
             u.efficiency
         ),
         format!("wind      {wind}"),
         format!(
             "ahead     {} Wh (p5 / p50 / p95); naive {} Wh",
             band(u.remaining_wh, 1.0, 2),
-            opt(u.naive_remaining_wh, 2)
+            fixed_or_dash(u.naive_remaining_wh, 2)
         ),
         format!(
             "landing   {} % state of charge",
@@ -225,15 +211,15 @@ fn follow_row(u: &LiveUpdate) -> String {
         u.mode.as_deref().unwrap_or("-"),
         u.mission_item.map_or_else(|| "-".to_string(), |i| i.to_string()),
         if u.in_air { "yes" } else { "no" },
-        opt(u.soc.map(|s| 100.0 * s), 1),
+        fixed_or_dash(u.soc.map(|s| 100.0 * s), 1),
         u.energy_used_wh,
-        opt(u.power_w, 0),
+        fixed_or_dash(u.power_w, 0),
         u.efficiency,
-        opt(u.wind_mps, 1),
-        opt(u.wind_from_deg, 0),
+        fixed_or_dash(u.wind_mps, 1),
+        fixed_or_dash(u.wind_from_deg, 0),
         band(u.remaining_wh, 1.0, 2),
         landing,
-        opt(u.point_of_no_return_s, 0),
+        fixed_or_dash(u.point_of_no_return_s, 0),
         u.advice.unwrap_or("-"),
         if u.link_lost { " (link lost)" } else { "" }
     )
@@ -249,11 +235,11 @@ fn row(u: &LiveUpdate) -> String {
         "{:>8.1} {:>9.2} {:>8} {:>7.4} {:>29} {:>9} {:>9}",
         u.time_s,
         u.energy_used_wh,
-        opt(u.power_w, 2),
+        fixed_or_dash(u.power_w, 2),
         u.efficiency,
         band(u.remaining_wh, 1.0, 2),
-        opt(u.naive_remaining_wh, 2),
-        opt(u.measured_remaining_wh, 2)
+        fixed_or_dash(u.naive_remaining_wh, 2),
+        fixed_or_dash(u.measured_remaining_wh, 2)
     )
 }
 

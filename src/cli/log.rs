@@ -59,7 +59,11 @@ fn info(args: InfoArgs) -> Result<Outcome> {
     if args.format == Format::Json {
         output::warn(&info.warnings);
     }
-    output::print_table_or_json(args.format, &info, |out| write_table(out, &info))?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &info)?,
+        Format::Table | Format::Csv => write_table(&mut out, &info)?,
+    }
     Ok(Outcome::Ok)
 }
 

@@ -13,7 +13,7 @@ use aloft_logbook::{
     AddOutcome, Flight, KeyKind, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
 };
 
-use super::output::{self, fixed, Row};
+use super::output::{self, fixed, fixed_or_dash, Row};
 use super::Outcome;
 
 #[path = "logbook_read.rs"]
@@ -375,11 +375,6 @@ fn relabel(book: &mut Logbook, a: RelabelArgs) -> Result<Outcome> {
     Ok(Outcome::Ok)
 }
 
-/// An optional figure with `decimals`, `-` when absent.
-fn opt(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "-".to_string(), |v| fixed(v, decimals))
-}
-
 /// Rows as aligned columns under a header (text left, numbers right).
 fn write_columns(out: &mut impl Write, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
     let mut widths: Vec<usize> = header.iter().map(|h| h.len()).collect();
@@ -424,12 +419,12 @@ fn flights_table(out: &mut impl Write, flights: &[Flight]) -> Result<()> {
                 f.vehicle_key.clone(),
                 f.pack_key.clone(),
                 fixed(f.duration_s / 60.0, 1),
-                opt(f.air_s.map(|s| s / 60.0), 1),
+                fixed_or_dash(f.air_s.map(|s| s / 60.0), 1),
                 fixed(f.energy_wh, 1),
-                opt(f.discharged_mah, 0),
-                opt(f.mean_power_w, 0),
-                opt(f.hover_power_w, 0),
-                opt(f.resistance_ohm.map(|r| r * 1000.0), 1),
+                fixed_or_dash(f.discharged_mah, 0),
+                fixed_or_dash(f.mean_power_w, 0),
+                fixed_or_dash(f.hover_power_w, 0),
+                fixed_or_dash(f.resistance_ohm.map(|r| r * 1000.0), 1),
                 f.copy_of.map_or_else(|| "-".to_string(), |c| c.to_string()),
             ]
         })
@@ -472,126 +467,142 @@ fn flights_and_copies(flights: usize, copies: usize) -> String {
     }
 }
 
-fn vehicles_table(out: &mut impl Write, vehicles: &[VehicleSummary]) -> Result<()> {
-    if vehicles.is_empty() {
-        writeln!(out, "no vehicles in the logbook")?;
+/// One block per item (its title and rows, by `block`), a blank line between them; `none` when
+/// there is no item.
+fn write_blocks<T>(
+    out: &mut impl Write,
+    items: &[T],
+    none: &str,
+    block: impl Fn(&T) -> (String, Vec<Row<'static>>),
+) -> Result<()> {
+    if items.is_empty() {
+        writeln!(out, "{none}")?;
     }
-    for (i, v) in vehicles.iter().enumerate() {
+    for (i, item) in items.iter().enumerate() {
         if i > 0 {
             writeln!(out)?;
         }
-        let mut rows = vec![
-            Row::new("flights", flights_and_copies(v.flights, v.copies), ""),
-            Row::num("flight time", v.hours, 2, "h"),
-        ];
-        if let Some(h) = v.air_hours {
-            rows.push(Row::num("time in the air", h, 2, "h"));
-        }
-        rows.extend([
-            Row::num("energy", v.energy_wh, 1, "Wh"),
-            Row::num("charge", v.discharged_mah, 0, "mAh"),
-            Row::new("packs", v.packs.join(", "), ""),
-        ]);
-        if let Some(d) = &v.power_drift {
-            let what = if d.quantity == "hover_power_w" {
-                "hover power"
-            } else {
-                "mean power"
-            };
-            let change = d
-                .trend
-                .change_percent
-                .map_or_else(|| "n/a".to_string(), |c| format!("{c:+.1} %"));
-            rows.push(Row::new(
-                "power drift",
-                format!(
-                    "{what} {change} over the last {} flights ({:.0} W to {:.0} W)",
-                    d.trend.n, d.trend.first, d.trend.last
-                ),
-                "",
-            ));
-        }
-        write_block(out, &format!("vehicle {} ({})", v.key, v.key_source), &rows)?;
+        let (title, rows) = block(item);
+        write_block(out, &title, &rows)?;
     }
     Ok(())
 }
 
+fn vehicles_table(out: &mut impl Write, vehicles: &[VehicleSummary]) -> Result<()> {
+    write_blocks(out, vehicles, "no vehicles in the logbook", vehicle_block)
+}
+
+/// A vehicle's block: flights, time, energy, packs and the drift of its power.
+fn vehicle_block(v: &VehicleSummary) -> (String, Vec<Row<'static>>) {
+    let mut rows = vec![
+        Row::new("flights", flights_and_copies(v.flights, v.copies), ""),
+        Row::num("flight time", v.hours, 2, "h"),
+    ];
+    if let Some(h) = v.air_hours {
+        rows.push(Row::num("time in the air", h, 2, "h"));
+    }
+    rows.extend([
+        Row::num("energy", v.energy_wh, 1, "Wh"),
+        Row::num("charge", v.discharged_mah, 0, "mAh"),
+        Row::new("packs", v.packs.join(", "), ""),
+    ]);
+    if let Some(d) = &v.power_drift {
+        let what = if d.quantity == "hover_power_w" {
+            "hover power"
+        } else {
+            "mean power"
+        };
+        let change = d
+            .trend
+            .change_percent
+            .map_or_else(|| "n/a".to_string(), |c| format!("{c:+.1} %"));
+        rows.push(Row::new(
+            "power drift",
+            format!(
+                "{what} {change} over the last {} flights ({:.0} W to {:.0} W)",
+                d.trend.n, d.trend.first, d.trend.last
+            ),
+            "",
+        ));
+    }
+    (format!("vehicle {} ({})", v.key, v.key_source), rows)
+}
+
 fn packs_table(out: &mut impl Write, packs: &[PackSummary]) -> Result<()> {
-    if packs.is_empty() {
-        writeln!(out, "no packs in the logbook")?;
-    }
-    for (i, p) in packs.iter().enumerate() {
-        if i > 0 {
-            writeln!(out)?;
-        }
-        let mut rows = vec![
-            Row::new("flights", flights_and_copies(p.flights, p.copies), ""),
-            Row::num("flight time", p.hours, 2, "h"),
-            Row::num("discharged", p.discharged_mah, 0, "mAh"),
-            Row::num("energy", p.energy_wh, 1, "Wh"),
-        ];
-        match (p.equivalent_cycles, p.rated_capacity_mah) {
-            (Some(c), Some(r)) => rows.push(Row::new(
-                "equivalent cycles",
-                format!("{c:.2} (rated {r:.0} mAh)"),
-                "",
-            )),
-            _ => rows.push(Row::new(
-                "equivalent cycles",
-                "n/a: no rated capacity".into(),
-                "",
-            )),
-        }
-        if let Some(c) = p.cells_series {
-            rows.push(Row::new("cells in series", c.to_string(), ""));
-        }
-        rows.push(Row::new(
-            "resistance",
-            match &p.resistance_trend {
-                Some(t) => format!(
-                    "first {:.1} mOhm, last {:.1} mOhm, slope {} mOhm/flight, n {}",
-                    t.first * 1000.0,
-                    t.last * 1000.0,
-                    opt(t.slope_per_flight.map(|s| s * 1000.0), 2),
-                    t.n
-                ),
-                None if p.resistance.is_empty() => "n/a: no estimate".into(),
-                None => format!(
-                    "{} estimates, no trend (the flights of \"{}\" are of any pack)",
-                    p.resistance.len(),
-                    aloft_logbook::UNKNOWN
-                ),
-            },
+    write_blocks(out, packs, "no packs in the logbook", pack_block)
+}
+
+/// A pack's block: flights, time, charge, cycles, cells, resistance, capacity, imbalance and
+/// the vehicles it flew.
+fn pack_block(p: &PackSummary) -> (String, Vec<Row<'static>>) {
+    let mut rows = vec![
+        Row::new("flights", flights_and_copies(p.flights, p.copies), ""),
+        Row::num("flight time", p.hours, 2, "h"),
+        Row::num("discharged", p.discharged_mah, 0, "mAh"),
+        Row::num("energy", p.energy_wh, 1, "Wh"),
+    ];
+    match (p.equivalent_cycles, p.rated_capacity_mah) {
+        (Some(c), Some(r)) => rows.push(Row::new(
+            "equivalent cycles",
+            format!("{c:.2} (rated {r:.0} mAh)"),
             "",
-        ));
-        rows.push(Row::new(
-            "capacity estimates",
-            if p.capacity.is_empty() {
-                "none".into()
-            } else {
-                p.capacity
-                    .iter()
-                    .map(|c| format!("{:.0}", c.value))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-                    + " mAh"
-            },
+        )),
+        _ => rows.push(Row::new(
+            "equivalent cycles",
+            "n/a: no rated capacity".into(),
             "",
-        ));
-        rows.push(Row::new(
-            "cell imbalance > 0.01 V",
-            opt(p.imbalance_minor_min, 1),
-            "min",
-        ));
-        rows.push(Row::new(
-            "cell imbalance > 0.07 V",
-            opt(p.imbalance_major_min, 1),
-            "min",
-        ));
-        rows.push(Row::new("vehicles", p.vehicles.join(", "), ""));
-        write_block(out, &format!("pack {} ({})", p.key, p.key_source), &rows)?;
+        )),
     }
-    Ok(())
+    if let Some(c) = p.cells_series {
+        rows.push(Row::new("cells in series", c.to_string(), ""));
+    }
+    rows.push(Row::new(
+        "resistance",
+        match &p.resistance_trend {
+            Some(t) => format!(
+                "first {:.1} mOhm, last {:.1} mOhm, slope {} mOhm/flight, n {}",
+                t.first * 1000.0,
+                t.last * 1000.0,
+                fixed_or_dash(t.slope_per_flight.map(|s| s * 1000.0), 2),
+                t.n
+            ),
+            None if p.resistance.is_empty() => "n/a: no estimate".into(),
+            None => format!(
+                "{} estimates, no trend (the flights of \"{}\" are of any pack)",
+                p.resistance.len(),
+                aloft_logbook::UNKNOWN
+            ),
+        },
+        "",
+    ));
+    rows.push(Row::new(
+        "capacity estimates",
+        if p.capacity.is_empty() {
+            "none".into()
+        } else {
+            p.capacity
+                .iter()
+                .map(|c| format!("{:.0}", c.value))
+                .collect::<Vec<_>>()
+                .join(", ")
+                + " mAh"
+        },
+        "",
+    ));
+    rows.push(Row::opt(
+        "cell imbalance > 0.01 V",
+        p.imbalance_minor_min,
+        1,
+        "min",
+    ));
+    rows.push(Row::opt(
+        "cell imbalance > 0.07 V",
+        p.imbalance_major_min,
+        1,
+        "min",
+    ));
+    rows.push(Row::new("vehicles", p.vehicles.join(", "), ""));
+    (format!("pack {} ({})", p.key, p.key_source), rows)
 }
 
 fn skipped_table(out: &mut impl Write, skipped: &[Skipped]) -> Result<()> {
@@ -694,8 +705,8 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
             answer.output,
             a.pack,
             answer.logs.len(),
-            opt(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
-            opt(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
+            fixed_or_dash(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
+            fixed_or_dash(answer.pack_capacity_mah.or(answer.capacity_mah), 0)
         )?,
     }
     Ok(Outcome::Ok)

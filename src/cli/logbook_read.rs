@@ -49,8 +49,7 @@ fn facts_of(f: &aloft_link::TlogFlight) -> FlightFacts {
         discharged_mah: f.discharged_mah,
         max_current_a: f.max_current_a,
         min_voltage_v: Some(f.min_voltage_v).filter(|v| v.is_finite()),
-        mean_power_w: (f.duration_s > 0.0 && f.discharged_mah.is_some())
-            .then(|| f.energy_wh * 3600.0 / f.duration_s),
+        mean_power_w: FlightFacts::mean_power_w(f.duration_s, f.energy_wh, f.discharged_mah),
         air_s: Some(f.air_s),
         high_voltage_v: Some(f.high_voltage_v).filter(|v| v.is_finite()),
         ..FlightFacts::default()

@@ -4,6 +4,7 @@
 
 mod convert;
 mod endurance;
+mod endurance_view;
 mod fit;
 mod flights;
 mod live;
@@ -12,6 +13,7 @@ mod log;
 pub(crate) mod logbook;
 mod mission;
 mod mission_args;
+mod mission_chart;
 mod mission_view;
 mod output;
 mod pack;
@@ -19,10 +21,10 @@ mod payload_sweep;
 mod plan;
 mod plot;
 mod power;
+mod power_curve;
 mod propulsion;
 mod replay;
 mod rotor;
-mod scenarios;
 #[cfg(feature = "serve")]
 mod serve;
 mod signals;

@@ -1,8 +1,7 @@
-//! Small rendering helpers shared by the subcommands.
+//! The shared writers every answer's renderer writes with (below the renderers, which pick the
+//! format): JSON, CSV, aligned tables and their cells; `--force`; a broken pipe.
 
-use std::io::{self, StdoutLock, Write};
-
-use super::Format;
+use std::io::{self, Write};
 
 /// `--force`, of every command that writes files.
 #[derive(Debug, Clone, Copy, Default, clap::Args)]
@@ -59,6 +58,11 @@ impl<'a> Row<'a> {
     pub fn num(label: &'a str, value: f64, decimals: usize, unit: &'a str) -> Self {
         Self::new(label, fixed(value, decimals), unit)
     }
+
+    /// A row of a number that may be absent (`-`), shown with `decimals` digits after the point.
+    pub fn opt(label: &'a str, value: Option<f64>, decimals: usize, unit: &'a str) -> Self {
+        Self::new(label, fixed_or_dash(value, decimals), unit)
+    }
 }
 
 /// Rows of numbers from a table of label, value, decimals and unit.
@@ -70,6 +74,25 @@ pub fn num_rows<'a>(table: &[(&'a str, f64, usize, &'a str)]) -> Vec<Row<'a>> {
 /// A number with `decimals` digits after the point, as tables show it.
 pub fn fixed(value: f64, decimals: usize) -> String {
     format!("{value:.decimals$}")
+}
+
+/// An optional number with `decimals` digits after the point, `-` when absent.
+pub fn fixed_or_dash(value: Option<f64>, decimals: usize) -> String {
+    value.map_or_else(|| "-".to_string(), |v| fixed(v, decimals))
+}
+
+/// Minutes and seconds, `m:ss`.
+pub fn mmss(t_s: f64) -> String {
+    let s = t_s.max(0.0).round() as u64;
+    format!("{}:{:02}", s / 60, s % 60)
+}
+
+/// A band of scenarios in one cell, `p5 / median / p95`, each shown by `show`; `-` when no
+/// scenario gave the figure.
+pub fn percentiles(p: Option<aloft::engine::Percentiles>, show: &dyn Fn(f64) -> String) -> String {
+    p.map_or("-".to_string(), |p| {
+        format!("{} / {} / {}", show(p.p5), show(p.p50), show(p.p95))
+    })
 }
 
 /// Write rows as an aligned two-column table with units.
@@ -108,32 +131,29 @@ pub fn write_json(out: &mut impl Write, value: &impl serde::Serialize) -> anyhow
     Ok(())
 }
 
-/// Print an answer on stdout in `format`: JSON from the answer itself, CSV and the table by the
-/// command's own writers.
-pub fn print<T: serde::Serialize>(
-    format: Format,
-    answer: &T,
-    csv: impl FnOnce(StdoutLock<'static>) -> anyhow::Result<()>,
-    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let mut out = io::stdout().lock();
-    match format {
-        Format::Json => write_json(&mut out, answer),
-        Format::Csv => csv(out),
-        Format::Table => table(&mut out),
-    }
+/// An answer as JSON, with its `uncertainty` when scenarios were drawn (`--samples N`): the
+/// answer's own keys either way, as the engine's [`WithUncertainty`] writes them.
+///
+/// [`WithUncertainty`]: aloft::engine::WithUncertainty
+#[derive(serde::Serialize)]
+#[serde(untagged)]
+pub enum MaybeUncertain<'a, A, U> {
+    /// No scenarios: the answer alone.
+    Sure(&'a A),
+    /// The answer and its scenarios.
+    Uncertain(aloft::engine::WithUncertainty<'a, A, U>),
 }
 
-/// [`print`] for an answer without a CSV of its own: `--format csv` prints the table.
-pub fn print_table_or_json<T: serde::Serialize>(
-    format: Format,
-    answer: &T,
-    table: impl FnOnce(&mut StdoutLock<'static>) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let mut out = io::stdout().lock();
-    match format {
-        Format::Json => write_json(&mut out, answer),
-        Format::Table | Format::Csv => table(&mut out),
+impl<'a, A, U> MaybeUncertain<'a, A, U> {
+    /// The answer `summary`, with `uncertainty` when there is one.
+    pub fn new(summary: &'a A, uncertainty: Option<&'a U>) -> Self {
+        match uncertainty {
+            None => Self::Sure(summary),
+            Some(uncertainty) => Self::Uncertain(aloft::engine::WithUncertainty {
+                summary,
+                uncertainty,
+            }),
+        }
     }
 }
 
@@ -162,4 +182,52 @@ pub fn write_csv_value(out: impl Write, value: &impl serde::Serialize) -> anyhow
     w.serialize(value)?;
     w.flush()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(serde::Serialize)]
+    struct Answer {
+        energy_wh: f64,
+    }
+
+    #[derive(serde::Serialize)]
+    struct Spread {
+        p5: f64,
+    }
+
+    /// Without scenarios the JSON is the answer's own; with them, its keys then `uncertainty`
+    /// (the keys `aloft mission --samples` and the C ABI promise).
+    #[test]
+    fn maybe_uncertain_is_the_answer_alone_or_the_answer_then_its_uncertainty() {
+        let (a, u) = (Answer { energy_wh: 1.5 }, Spread { p5: 0.25 });
+        let sure = MaybeUncertain::<Answer, Spread>::new(&a, None);
+        assert_eq!(
+            serde_json::to_string(&sure).unwrap(),
+            r#"{"energy_wh":1.5}"#
+        );
+        let uncertain = MaybeUncertain::new(&a, Some(&u));
+        assert_eq!(
+            serde_json::to_string(&uncertain).unwrap(),
+            r#"{"energy_wh":1.5,"uncertainty":{"p5":0.25}}"#
+        );
+    }
+
+    #[test]
+    fn cells_round_as_tables_show_them() {
+        assert_eq!(mmss(59.6), "1:00");
+        assert_eq!(mmss(-3.0), "0:00");
+        assert_eq!(mmss(3725.0), "62:05");
+        assert_eq!(fixed_or_dash(None, 2), "-");
+        assert_eq!(fixed_or_dash(Some(0.16), 1), "0.2");
+        let p = aloft::engine::Percentiles {
+            p5: 1.0,
+            p50: 2.0,
+            p95: 3.5,
+        };
+        assert_eq!(percentiles(Some(p), &|x| fixed(x, 1)), "1.0 / 2.0 / 3.5");
+        assert_eq!(percentiles(None, &|x| fixed(x, 1)), "-");
+    }
 }

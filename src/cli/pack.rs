@@ -119,12 +119,12 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         eprintln!("aloft pack fit: no usable log: no pack written");
         return Ok(Outcome::Failed);
     }
-    output::print_table_or_json(a.format, &answer, |out| render(out, &answer))?;
+    let mut out = std::io::stdout().lock();
+    match a.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Table | Format::Csv => render(&mut out, &answer)?,
+    }
     Ok(Outcome::Ok)
-}
-
-fn opt(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "-".to_string(), |v| output::fixed(v, decimals))
 }
 
 fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
@@ -133,15 +133,12 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
             Row::num("duration", r.duration_s, 1, "s"),
             Row::num("energy", r.energy_wh, 2, "Wh"),
             Row::num("lowest voltage", r.min_voltage_v, 2, "V"),
-            Row::new(
-                "discharged (coulomb count)",
-                opt(r.discharged_mah, 0),
-                "mAh",
-            ),
-            Row::new("reported drop", opt(r.reported_drop_mah, 0), "mAh"),
-            Row::new(
+            Row::opt("discharged (coulomb count)", r.discharged_mah, 0, "mAh"),
+            Row::opt("reported drop", r.reported_drop_mah, 0, "mAh"),
+            Row::opt(
                 "internal resistance (steps)",
-                opt(r.internal_resistance_ohm, 4),
+                r.internal_resistance_ohm,
+                4,
                 "ohm",
             ),
             Row::new(
@@ -151,22 +148,15 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
                     .map_or("-".into(), |e| e.steps.to_string()),
                 "",
             ),
-            Row::new(
+            Row::opt(
                 "autopilot's resistance",
-                opt(r.autopilot_internal_resistance_ohm, 4),
+                r.autopilot_internal_resistance_ohm,
+                4,
                 "ohm",
             ),
-            Row::new("capacity between rests", opt(r.capacity_mah, 0), "mAh"),
-            Row::new(
-                "cell imbalance > 0.01 V",
-                opt(r.imbalance_minor_min, 1),
-                "min",
-            ),
-            Row::new(
-                "cell imbalance > 0.07 V",
-                opt(r.imbalance_major_min, 1),
-                "min",
-            ),
+            Row::opt("capacity between rests", r.capacity_mah, 0, "mAh"),
+            Row::opt("cell imbalance > 0.01 V", r.imbalance_minor_min, 1, "min"),
+            Row::opt("cell imbalance > 0.07 V", r.imbalance_major_min, 1, "min"),
         ];
         output::write_table(out, &file_name(&r.source), &rows)?;
         if let Some(why) = &r.capacity_refused {
@@ -174,19 +164,16 @@ fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {
         }
     }
     let rows = vec![
-        Row::new(
-            "internal resistance",
-            opt(a.internal_resistance_ohm, 4),
-            "ohm",
-        ),
-        Row::new(
+        Row::opt("internal resistance", a.internal_resistance_ohm, 4, "ohm"),
+        Row::opt(
             "autopilot's resistance",
-            opt(a.autopilot_internal_resistance_ohm, 4),
+            a.autopilot_internal_resistance_ohm,
+            4,
             "ohm",
         ),
-        Row::new("capacity written", opt(a.pack_capacity_mah, 0), "mAh"),
+        Row::opt("capacity written", a.pack_capacity_mah, 0, "mAh"),
         Row::num("discharged over the logs", a.discharged_mah, 0, "mAh"),
-        Row::new("equivalent full cycles", opt(a.equivalent_cycles, 2), ""),
+        Row::opt("equivalent full cycles", a.equivalent_cycles, 2, ""),
     ];
     output::write_table(
         out,

@@ -3,15 +3,30 @@
 
 use std::io::Write;
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 
 use aloft::engine::{PayloadCurve, PayloadRow};
 
+use super::output;
 use super::plot::ChartFile;
+use super::Format;
+
+/// Draw the curve to `chart` when asked, then print it in `format`.
+pub fn render(curve: &PayloadCurve, chart: Option<ChartFile<'_>>, format: Format) -> Result<()> {
+    if let Some(file) = chart {
+        plot(file, curve).with_context(|| format!("cannot draw {}", file.path.display()))?;
+    }
+    let mut out = std::io::stdout().lock();
+    match format {
+        Format::Json => output::write_json(&mut out, curve),
+        Format::Csv => write_csv(out, curve),
+        Format::Table => write_table(&mut out, curve),
+    }
+}
 
 /// A block per pack: payload, take-off mass, hover power and endurance, best endurance and best
 /// range; the notes (where a curve stops) last.
-pub fn write_table(out: &mut impl Write, curve: &PayloadCurve) -> Result<()> {
+fn write_table(out: &mut impl Write, curve: &PayloadCurve) -> Result<()> {
     writeln!(
         out,
         "{}, wind {}, course {:.0} deg, reserve {:.0} %: endurance against payload (maximum take-off mass {:.3} kg)",
@@ -78,7 +93,7 @@ fn payload_decimals(curve: &PayloadCurve) -> usize {
 
 /// One header and one row per pack and payload (every number at full precision). The notes go
 /// to stderr: they are not data.
-pub fn write_csv(out: impl Write, curve: &PayloadCurve) -> Result<()> {
+fn write_csv(out: impl Write, curve: &PayloadCurve) -> Result<()> {
     let orbit = curve
         .rows
         .iter()
@@ -100,12 +115,11 @@ pub fn write_csv(out: impl Write, curve: &PayloadCurve) -> Result<()> {
     if orbit {
         header.extend(["orbit_power_w", "orbit_endurance_s"]);
     }
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(&header)?;
-    for r in &curve.rows {
-        w.write_record(csv_record(r, orbit))?;
-    }
-    w.flush()?;
+    output::write_csv(
+        out,
+        &header,
+        curve.rows.iter().map(|r| csv_record(r, orbit)),
+    )?;
     for n in &curve.notes {
         eprintln!("aloft: note: {n}");
     }
@@ -141,7 +155,7 @@ fn csv_record(r: &PayloadRow, orbit: bool) -> Vec<String> {
 
 /// Hover endurance (min) above and best range (km) below, against payload (kg), one line per
 /// pack: the chart manufacturers print.
-pub fn plot(file: ChartFile<'_>, curve: &PayloadCurve) -> Result<()> {
+fn plot(file: ChartFile<'_>, curve: &PayloadCurve) -> Result<()> {
     super::plot::svg_file(file, (900, 800), |root| plot_on(root, curve))
 }
 

@@ -10,8 +10,7 @@ use clap::Args;
 use aloft::engine::flags::PlanFlags;
 use aloft::engine::{answers, plan_to_fly, FlyPlan, Mission, PlanFigures};
 
-use super::mission_view::mmss;
-use super::output;
+use super::output::{self, mmss};
 use super::{Format, Outcome};
 
 #[derive(Debug, Args)]
@@ -56,7 +55,11 @@ pub fn run(mut args: PlanArgs) -> Result<Outcome> {
         Err(e) => return Err(e.into()),
     };
     plan.write(&args.output, args.force)?;
-    output::print_table_or_json(args.format, &plan, |out| write_table(out, &plan))?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &plan)?,
+        Format::Table | Format::Csv => write_table(&mut out, &plan)?,
+    }
     Ok(Outcome::Ok)
 }
 

@@ -83,12 +83,12 @@ pub fn run(mut args: PowerArgs) -> Result<Outcome> {
         return Ok(Outcome::Ok);
     }
     let answer = power_point(&vehicle, &args.query())?;
-    output::print(
-        args.format.unwrap_or_default(),
-        &answer,
-        |out| write_csv(out, &args, &answer),
-        |out| write_table(out, &args, &answer),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format.unwrap_or_default() {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Csv => write_csv(out, &args, &answer)?,
+        Format::Table => write_table(&mut out, &args, &answer)?,
+    }
     Ok(Outcome::Ok)
 }
 

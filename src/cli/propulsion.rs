@@ -55,12 +55,12 @@ pub fn run(args: PropulsionArgs) -> Result<Outcome> {
             plot_sweep(args.force.chart(path), vehicle.name(), &sweep.points)
                 .with_context(|| format!("cannot write the plot {}", path.display()))?;
         }
-        output::print(
-            args.format,
-            &sweep,
-            |out| write_sweep_csv(out, &sweep.points),
-            |out| write_sweep_table(out, vehicle.name(), &sweep.points),
-        )?;
+        let mut out = std::io::stdout().lock();
+        match args.format {
+            Format::Json => output::write_json(&mut out, &sweep)?,
+            Format::Csv => write_sweep_csv(out, &sweep.points)?,
+            Format::Table => write_sweep_table(&mut out, vehicle.name(), &sweep.points)?,
+        }
         return Ok(Outcome::Ok);
     }
     let request = match args.takeoff_mass_kg {
@@ -68,12 +68,12 @@ pub fn run(args: PropulsionArgs) -> Result<Outcome> {
         None => HoverRequest::Payload(args.payload_kg),
     };
     let h = hover(&vehicle, request)?;
-    output::print(
-        args.format,
-        &h,
-        |out| output::write_csv_value(out, &h),
-        |out| write_table(out, vehicle.name(), &h),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &h)?,
+        Format::Csv => output::write_csv_value(out, &h)?,
+        Format::Table => write_table(&mut out, vehicle.name(), &h)?,
+    }
     Ok(Outcome::Ok)
 }
 

@@ -43,7 +43,11 @@ pub fn run(args: &MissionArgs) -> Result<Outcome> {
     for n in &answer.context.notes {
         eprintln!("aloft mission --replay: {n}");
     }
-    output::print_table_or_json(args.format, &answer, |out| write_table(out, &answer))?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Table | Format::Csv => write_table(&mut out, &answer)?,
+    }
     Ok(Outcome::Ok)
 }
 

@@ -82,12 +82,12 @@ impl RotorArgs {
 
 pub fn run(args: RotorArgs) -> Result<Outcome> {
     let answer = rotor_response(&args.request())?;
-    output::print(
-        args.format,
-        &answer,
-        |out| output::write_csv_value(out, &answer.result),
-        |out| write_table(out, &answer),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &answer)?,
+        Format::Csv => output::write_csv_value(out, &answer.result)?,
+        Format::Table => write_table(&mut out, &answer)?,
+    }
     Ok(Outcome::Ok)
 }
 

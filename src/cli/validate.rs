@@ -71,12 +71,12 @@ pub fn run(mut args: ValidateArgs) -> Result<Outcome> {
             .with_context(|| format!("cannot write the plot {}", path.display()))?;
     }
     let report = &answer.report;
-    output::print(
-        args.format,
-        report,
-        |out| write_csv(out, report),
-        |out| render(out, report),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, report)?,
+        Format::Csv => write_csv(out, report)?,
+        Format::Table => render(&mut out, report)?,
+    }
     Ok(Outcome::Ok)
 }
 

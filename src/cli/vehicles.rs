@@ -64,12 +64,12 @@ pub fn run(args: VehiclesArgs) -> Result<Outcome> {
 
 fn list(format: Format) -> Result<Outcome> {
     let entries = list_vehicles()?;
-    output::print(
-        format,
-        &entries,
-        |out| list_csv(out, &entries),
-        |out| list_table(out, &entries),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match format {
+        Format::Json => output::write_json(&mut out, &entries)?,
+        Format::Csv => list_csv(out, &entries)?,
+        Format::Table => list_table(&mut out, &entries)?,
+    }
     Ok(Outcome::Ok)
 }
 
@@ -136,12 +136,12 @@ fn list_table(out: &mut impl Write, entries: &[VehicleEntry]) -> Result<()> {
 fn calibrate(args: CalibrateArgs) -> Result<Outcome> {
     let c = calibrate_spec_file(&args.spec)?;
     c.write_vehicle_file(&args.output, args.force)?;
-    output::print(
-        args.format,
-        &c,
-        |out| calibrate_csv(out, &c),
-        |out| calibrate_table(out, &c, &args.output),
-    )?;
+    let mut out = std::io::stdout().lock();
+    match args.format {
+        Format::Json => output::write_json(&mut out, &c)?,
+        Format::Csv => calibrate_csv(out, &c)?,
+        Format::Table => calibrate_table(&mut out, &c, &args.output)?,
+    }
     Ok(Outcome::Ok)
 }
 

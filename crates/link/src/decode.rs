@@ -386,14 +386,7 @@ impl Decoder {
         if b.id != 0 {
             return;
         }
-        let cells_mv: u32 = b
-            .voltages
-            .iter()
-            .filter(|&&v| v != u16::MAX)
-            .chain(b.voltages_ext.iter().filter(|&&v| v != 0 && v != u16::MAX))
-            .map(|&v| u32::from(v))
-            .sum();
-        let voltage_v = (cells_mv > 0).then(|| f64::from(cells_mv) / 1000.0);
+        let voltage_v = pack_voltage_v(b);
         let current_a = (b.current_battery != -1).then(|| f64::from(b.current_battery) / 100.0);
         self.battery_sample(voltage_v, current_a, out);
         let battery = BatteryState {
@@ -605,6 +598,19 @@ fn is_vehicle(hb: &HEARTBEAT_DATA) -> bool {
 
 fn is_mission(t: MavMissionType) -> bool {
     t == MavMissionType::MAV_MISSION_TYPE_MISSION
+}
+
+/// The pack's voltage of a BATTERY_STATUS, V: the sum of the cells it reports (mV; UINT16_MAX
+/// unreported, and 0 too in the extension); `None` when it reports none.
+pub(crate) fn pack_voltage_v(b: &BATTERY_STATUS_DATA) -> Option<f64> {
+    let cells_mv: u32 = b
+        .voltages
+        .iter()
+        .filter(|&&v| v != u16::MAX)
+        .chain(b.voltages_ext.iter().filter(|&&v| v != 0 && v != u16::MAX))
+        .map(|&v| u32::from(v))
+        .sum();
+    (cells_mv > 0).then(|| f64::from(cells_mv) / 1000.0)
 }
 
 /// State of charge of a `battery_remaining` percentage; `None` for -1 (not sent) and values

@@ -214,17 +214,9 @@ impl Gathered {
     }
 
     fn battery_status(&mut self, b: &BATTERY_STATUS_DATA) {
-        let cells_mv: u32 = b
-            .voltages
-            .iter()
-            .filter(|&&v| v != u16::MAX)
-            .chain(b.voltages_ext.iter().filter(|&&v| v != 0 && v != u16::MAX))
-            .map(|&v| u32::from(v))
-            .sum();
-        if cells_mv > 0 {
+        if let Some(voltage_v) = crate::decode::pack_voltage_v(b) {
             let current_a = (b.current_battery >= 0).then(|| f64::from(b.current_battery) / 100.0);
-            self.battery_status
-                .push((self.now_s, f64::from(cells_mv) / 1000.0, current_a));
+            self.battery_status.push((self.now_s, voltage_v, current_a));
         }
         let mah = (b.current_consumed >= 0).then(|| f64::from(b.current_consumed));
         let hj = (b.energy_consumed >= 0).then(|| f64::from(b.energy_consumed));

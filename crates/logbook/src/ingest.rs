@@ -50,9 +50,9 @@ fn check_folder(path: &Path) -> Result<()> {
     }
 }
 
-/// Refuse another program's file and a newer aloft's; whether the file is an aloft logbook
-/// already (`false`: an empty file, to be made one).
-fn check_identity(path: &Path, identity: Identity) -> Result<bool> {
+/// Refuse another program's file and a newer aloft's; the schema version of an aloft logbook
+/// (`None`: an empty file, to be made one).
+fn check_identity(path: &Path, identity: Identity) -> Result<Option<i64>> {
     match identity {
         Identity::Foreign {
             application_id,
@@ -63,8 +63,8 @@ fn check_identity(path: &Path, identity: Identity) -> Result<bool> {
             tables,
         }),
         Identity::Aloft(found) if found > SCHEMA_VERSION => Err(too_new(path, found)),
-        Identity::Aloft(_) => Ok(true),
-        Identity::Empty => Ok(false),
+        Identity::Aloft(found) => Ok(Some(found)),
+        Identity::Empty => Ok(None),
     }
 }
 
@@ -290,7 +290,7 @@ impl Logbook {
         let mut conn = file::open_to_write(path, create)?;
         conn.busy_timeout(BUSY_TIMEOUT).map_err(&sql)?;
         // Again under this connection: another `add` may have made the file meanwhile.
-        if check_identity(path, file::identify(&conn).map_err(&sql)?)? {
+        if check_identity(path, file::identify(&conn).map_err(&sql)?)?.is_some() {
             if let Some(problem) = file::quick_check(&conn).map_err(&sql)? {
                 return Err(LogbookError::Damaged {
                     path: path.to_path_buf(),
@@ -328,24 +328,15 @@ impl Logbook {
             });
         }
         let (conn, identity) = file::open_to_read(path)?;
-        match identity {
+        match check_identity(path, identity)? {
             // Read through a read-write connection where the file and its folder can be
             // written: SQLite then removes the WAL's side files when it closes (a read-only
             // one leaves them). Nothing is written either way.
-            Identity::Aloft(SCHEMA_VERSION) => Ok(Self {
+            Some(SCHEMA_VERSION) => Ok(Self {
                 conn: writable_reader(path).unwrap_or(conn),
                 path: path.to_path_buf(),
             }),
-            Identity::Aloft(found) if found > SCHEMA_VERSION => Err(too_new(path, found)),
-            Identity::Foreign {
-                application_id,
-                tables,
-            } => Err(LogbookError::NotALogbook {
-                path: path.to_path_buf(),
-                application_id,
-                tables,
-            }),
-            Identity::Aloft(found) => {
+            Some(found) => {
                 drop(conn);
                 Self::open(path).map_err(|e| match e {
                     LogbookError::ReadOnly { .. } => LogbookError::CannotMigrate {
@@ -356,7 +347,7 @@ impl Logbook {
                     e => e,
                 })
             }
-            Identity::Empty => Self::open(path),
+            None => Self::open(path),
         }
     }
 

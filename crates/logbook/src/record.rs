@@ -65,6 +65,18 @@ pub struct FlightFacts {
     pub high_voltage_v: Option<f64>,
 }
 
+impl FlightFacts {
+    /// The mean power of a flight, W: its energy over its duration, where the log measured the
+    /// current (`discharged_mah` is known; without it the energy is not the pack's).
+    pub fn mean_power_w(
+        duration_s: f64,
+        energy_wh: f64,
+        discharged_mah: Option<f64>,
+    ) -> Option<f64> {
+        (duration_s > 0.0 && discharged_mah.is_some()).then(|| energy_wh * 3600.0 / duration_s)
+    }
+}
+
 /// Read the log at `path` into the figures of its flight: the pack's figures from its battery
 /// records ([`aloft_logs::read_battery_log`], [`aloft_packs::analyse`]), the hover power from
 /// its samples joined onto the motion (absent when the log has no velocity).
@@ -186,8 +198,7 @@ fn read(path: &Path, options: &ReadOptions) -> Result<FlightFacts, String> {
         discharged_mah: r.discharged_mah,
         max_current_a: r.max_current_a,
         min_voltage_v: Some(r.min_voltage_v).filter(|v| v.is_finite()),
-        mean_power_w: (r.duration_s > 0.0 && r.discharged_mah.is_some())
-            .then(|| r.energy_wh * 3600.0 / r.duration_s),
+        mean_power_w: FlightFacts::mean_power_w(r.duration_s, r.energy_wh, r.discharged_mah),
         hover_power_w,
         resistance_ohm: r.internal_resistance_ohm,
         autopilot_resistance_ohm: r.autopilot_internal_resistance_ohm,

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use crate::battery_records::{BatteryDetails, BatteryLog, BatterySample};
+use crate::binary_samples::{BinarySamples, BinarySummary, Decoder};
 use crate::error::{LogError, Result};
 use crate::open::{open_log_with, LogReader, OpenOptions, Profile};
 
@@ -35,8 +36,7 @@ pub fn read_battery_log(
                 s?;
             }
             let summary = reader.binary_summary().cloned().unwrap_or_default();
-            let details = summary.battery_details.clone().unwrap_or_default();
-            details.into_log(&source, format, summary.warnings)
+            battery_of(&summary, &source, format)
         }
         _ => from_samples(&mut reader, &source)?,
     };
@@ -89,18 +89,7 @@ pub fn read_ulog_battery<R: std::io::Read>(
     reader: R,
     options: &crate::BinaryOptions,
 ) -> Result<BatteryLog> {
-    let o = crate::BinaryOptions {
-        battery_details: true,
-        ..*options
-    };
-    let mut it = crate::ulog::ulog_samples(reader, &o, Path::new("<bytes>"))?;
-    for s in it.by_ref() {
-        s?;
-    }
-    let s = it.summary().clone();
-    Ok(s.battery_details
-        .unwrap_or_default()
-        .into_log("<bytes>", "ulog", s.warnings))
+    read_binary_battery(reader, options, crate::ulog::ulog_samples, "ulog")
 }
 
 /// Read the battery records of an ArduPilot DataFlash log from bytes (sans-I/O).
@@ -111,18 +100,39 @@ pub fn read_dataflash_battery<R: std::io::Read>(
     reader: R,
     options: &crate::BinaryOptions,
 ) -> Result<BatteryLog> {
+    read_binary_battery(
+        reader,
+        options,
+        crate::dataflash::dataflash_samples,
+        "dataflash",
+    )
+}
+
+/// The decoder of a binary format over bytes (`ulog_samples`, `dataflash_samples`).
+type OpenBinary<R, D> = fn(R, &crate::BinaryOptions, &Path) -> Result<BinarySamples<R, D>>;
+
+/// Read a binary log's bytes through `open`, every sample, and keep its battery records.
+fn read_binary_battery<R: std::io::Read, D: Decoder>(
+    reader: R,
+    options: &crate::BinaryOptions,
+    open: OpenBinary<R, D>,
+    format: &str,
+) -> Result<BatteryLog> {
     let o = crate::BinaryOptions {
         battery_details: true,
         ..*options
     };
-    let mut it = crate::dataflash::dataflash_samples(reader, &o, Path::new("<bytes>"))?;
+    let mut it = open(reader, &o, Path::new("<bytes>"))?;
     for s in it.by_ref() {
         s?;
     }
-    let s = it.summary().clone();
-    Ok(s.battery_details
-        .unwrap_or_default()
-        .into_log("<bytes>", "dataflash", s.warnings))
+    Ok(battery_of(it.summary(), "<bytes>", format))
+}
+
+/// The battery records a binary log's summary gathered, once every sample has been read.
+fn battery_of(summary: &BinarySummary, source: &str, format: &str) -> BatteryLog {
+    let details = summary.battery_details.clone().unwrap_or_default();
+    details.into_log(source, format, summary.warnings.clone())
 }
 
 #[cfg(test)]
