@@ -32,7 +32,8 @@ pub(super) async fn asset(uri: Uri) -> Response {
     }
 }
 
-/// The content type of a page file, by its extension.
+/// The content type of a page file, by its extension (`.js` is `text/javascript`: a browser
+/// refuses a module script, `web/app.js` and `web/js/*.js`, served as any other type).
 fn content_type(path: &str) -> &'static str {
     match path.rsplit('.').next().unwrap_or("") {
         "html" => "text/html; charset=utf-8",

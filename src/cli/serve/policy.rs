@@ -2,7 +2,7 @@
 //!
 //! - **`Content-Security-Policy`**: scripts, styles, fonts and connections from the server
 //!   itself only (`'self'`), so that no inline script runs, not even one that a value slipped
-//!   into the page as markup would carry (the page puts every value in as text: `web/app.js`);
+//!   into the page as markup would carry (the page puts every value in as text: `web/js/dom.js`);
 //!   images from the server, `data:` URLs (the page's empty icon) and the tile layer's server
 //!   when `--tiles` names one; no plugin (`object-src 'none'`), no `<base>`, no form sent
 //!   anywhere, and the page in no other page's frame.

@@ -1,0 +1,232 @@
+// The plan to fly: the files to upload, one per battery (`/api/plan`), their figures against the
+// mission as given, what changed, the downloads, and each sortie on the map in its colour.
+
+import { $, options, state } from './state.js';
+import { el, tipNode } from './dom.js';
+import { fmt, mmss, pct, safeFileName, sortieColour, uniqueNames } from './format.js';
+import { api, clearError, fetchText, settle, showError } from './api.js';
+import { zipStored } from './zip.js';
+
+// The plan's options: the page's controls (no scenarios: a plan has none) and the panel's own.
+function flyOptions() {
+  const q = options();
+  q.delete('samples');
+  const add = (key, id) => {
+    const v = $(id).value.trim();
+    if (v !== '') q.set(key, v);
+  };
+  add('speeds', '#fly-speeds');
+  add('overlap_m', '#fly-overlap');
+  add('max_speed', '#fly-max-speed');
+  return q;
+}
+
+// Forget the plan shown (the mission or its conditions changed): its layers, its links.
+export function clearFly(note) {
+  state.flySeq += 1;
+  for (const url of state.flyUrls) URL.revokeObjectURL(url);
+  state.flyUrls = [];
+  if (state.flyLayer) state.flyLayer.clearLayers();
+  $('#map').classList.remove('flying');
+  $('#fly-title').textContent = '';
+  const box = $('#fly');
+  box.dataset.state = 'none';
+  delete box.dataset.batteries;
+  box.replaceChildren(el('p', { class: 'muted', text: note || 'The files to upload, one per battery, for this mission in these conditions.' }));
+}
+
+export async function planToFly() {
+  const entry = state.current;
+  if (!entry || entry.key === 'none') {
+    showError('Plan to fly: no mission selected');
+    return;
+  }
+  clearFly('planning…');
+  const seq = state.flySeq;
+  const planSeq = state.planSeq;
+  const box = $('#fly');
+  box.dataset.state = 'loading';
+  $('#plan-fly').disabled = true;
+  let ok = false;
+  try {
+    if (entry.text === null) entry.text = await fetchText(`/api/files/${entry.index}`);
+    const q = flyOptions();
+    if (entry.name) q.set('file', entry.name);
+    const plan = await api(`/api/plan?${q.toString()}`, { method: 'POST', body: entry.text, headers: { 'Content-Type': 'text/plain' } });
+    if (seq !== state.flySeq || planSeq !== state.planSeq) return;
+    renderFly(plan);
+    clearError();
+    ok = true;
+  } catch (e) {
+    if (seq !== state.flySeq) return;
+    clearFly('No plan.');
+    box.dataset.state = 'error';
+    showError(`Plan to fly: ${e instanceof Error ? e.message : String(e)}`);
+  } finally {
+    $('#plan-fly').disabled = false;
+    // Ready unless an error is shown (this plan's, or a re-plan's that replaced it).
+    settle(ok || $('#error').hidden);
+  }
+}
+
+function renderFly(plan) {
+  const box = $('#fly');
+  if (plan.feasible === false) {
+    box.dataset.state = 'infeasible';
+    box.replaceChildren(el('p', { class: 'bad', text: `No plan keeps the reserve: ${plan.reason}` }));
+    return;
+  }
+  $('#fly-title').textContent = `${plan.batteries} ${plan.batteries === 1 ? 'battery' : 'batteries'}`;
+  const children = [flyFigures(plan), flySorties(plan)];
+  const changes = flyChanges(plan);
+  if (changes) children.push(changes);
+  children.push(flyDownloads(plan));
+  box.replaceChildren(...children);
+  drawFly(plan);
+  box.dataset.batteries = String(plan.batteries);
+  box.dataset.state = 'ready';
+}
+
+// As given against the plan: batteries, flight time, energy.
+function flyFigures(plan) {
+  const head = el('tr', {}, [['', ''], ['Batteries', ''], ['Flight time', 'min:s'], ['Energy', 'Wh']].map(headCell));
+  const row = (label, f, cls) =>
+    el('tr', { class: cls }, [
+      el('th', { text: label }),
+      el('td', { class: 'n', text: f ? String(f.batteries) : '–' }),
+      el('td', { class: 'n', text: f ? mmss(f.duration_s) : '–' }),
+      el('td', { class: 'n', text: f ? fmt(f.energy_wh, 1) : '–' }),
+    ]);
+  const given = plan.as_given;
+  const rows = [row('as given', given, 'fly-given'), row('plan', plan, 'fly-plan')];
+  if (!given) rows[0].title = 'the mission as given cannot be split at whole items';
+  return el('table', { class: 'fly fly-figures' }, [el('thead', {}, [head]), el('tbody', {}, rows)]);
+}
+
+// One row per sortie, in its map colour.
+function flySorties(plan) {
+  const heads = [['#', ''], ['File', ''], ['Items', ''], ['Energy', 'Wh'], ['Time', 'min:s'], ['Landing', '%'], ['No return', 'min:s']];
+  const head = el('tr', {}, heads.map(headCell));
+  const rows = plan.sorties.map((s, k) => {
+    let items = s.first_item !== undefined ? `${s.first_item}–${s.last_item}` : '–';
+    const inside = typeof s.ends_inside_leg_fraction === 'number';
+    if (inside) items += '*';
+    const tr = el('tr', {
+      'data-sortie': String(k + 1),
+      'data-file': s.file,
+      'data-energy-wh': String(s.energy_wh),
+      'data-duration-s': String(s.duration_s),
+      'data-end-soc': String(s.end_soc),
+    }, [
+      el('td', { class: 'n' }, [el('span', { class: 'swatch', style: `background:${sortieColour(k)}` }), String(k + 1)]),
+      el('td', { class: 'file', text: s.file }),
+      el('td', { class: 'n', text: items }),
+      el('td', { class: 'n', text: fmt(s.energy_wh, 1) }),
+      el('td', { class: 'n', text: mmss(s.duration_s) }),
+      el('td', { class: 'n', text: pct(s.end_soc) }),
+      el('td', { class: 'n', text: typeof s.point_of_no_return_s === 'number' ? mmss(s.point_of_no_return_s) : 'none' }),
+    ]);
+    if (inside) tr.title = `turns home ${fmt(s.ends_inside_leg_fraction * 100, 0)} % of the way along the leg to item ${s.last_item}`;
+    tr.addEventListener('mouseenter', () => lightSortie(k, true));
+    tr.addEventListener('mouseleave', () => lightSortie(k, false));
+    return tr;
+  });
+  const key = el('p', { class: 'fly-key muted', text: 'On the map: each sortie in its colour, the route solid, the way out dashed, the way home dotted; * turns home inside a leg.' });
+  return el('div', {}, [el('div', { class: 'table-wrap' }, [el('table', { class: 'fly fly-sorties' }, [el('thead', {}, [head]), el('tbody', {}, rows)])]), key]);
+}
+
+// A header cell: its name, and its unit below it.
+function headCell([name, unit]) {
+  return el('th', {}, unit ? [name, el('br'), el('span', { class: 'unit', text: `(${unit})` })] : [name]);
+}
+
+// What changed from the mission as given.
+function flyChanges(plan) {
+  const c = plan.changes || {};
+  const speeds = c.speeds || [];
+  const lines = [];
+  if (c.cut_inside_legs) lines.push(el('li', { text: 'sorties end inside legs (*), where each pack reaches the reserve' }));
+  if (speeds.length) {
+    const leg = (s) => (s.item !== undefined ? `item ${s.item}` : `segment ${s.segment}`);
+    const from = (s) => (typeof s.from_mps === 'number' ? `${fmt(s.from_mps, 1)} m/s` : 'planning speed');
+    const list = el('ul', {}, speeds.map((s) => el('li', { text: `${leg(s)}: ${from(s)} → ${fmt(s.to_mps, 1)} m/s` })));
+    const n = speeds.length;
+    lines.push(el('li', {}, [el('details', {}, [el('summary', { text: `${n} ${n === 1 ? 'leg' : 'legs'} at the speed of least energy in ${n === 1 ? 'its' : 'their'} wind` }), list])]));
+  }
+  for (const a of c.angles || []) {
+    lines.push(el('li', { text: `survey at item ${a.item} turned to the wind: grid angle ${fmt(a.from_deg, 0)}° → ${fmt(a.to_deg, 0)}°` }));
+  }
+  for (const note of plan.notes || []) lines.push(el('li', { text: `note: ${note}` }));
+  if (!lines.length) return null;
+  return el('ul', { class: 'fly-changes' }, lines);
+}
+
+// Each file as a download, and all of them in one zip: each saved under its base name only,
+// whatever the server names it (no folder, no `..`: a zip's entry is extracted where it says).
+function flyDownloads(plan) {
+  const link = (name, blob, cls) => {
+    const url = URL.createObjectURL(blob);
+    state.flyUrls.push(url);
+    return el('a', { href: url, download: name, class: cls, text: name });
+  };
+  const texts = plan.texts || [];
+  const names = uniqueNames(texts.map((t, k) => safeFileName(t.file, `sortie-${k + 1}-of-${texts.length}.txt`)));
+  const files = texts.map((t, k) => ({ name: names[k], text: String(t.text) }));
+  const links = files.map((f) => link(f.name, new Blob([f.text], { type: 'text/plain;charset=utf-8' }), 'fly-file'));
+  const stem = files.length ? files[0].name.replace(/-1-of-\d+\.[^.]+$/, '') : 'plan';
+  links.push(link(safeFileName(`${stem}-plan.zip`, 'plan.zip'), zipStored(files), 'fly-all'));
+  return el('p', { class: 'fly-downloads' }, ['Files: ', ...links.flatMap((a, k) => (k ? [' ', a] : [a]))]);
+}
+
+// Each sortie's flown path in its own colour: its way out and way home dashed.
+function drawFly(plan) {
+  if (!state.map) return;
+  state.flyLayer.clearLayers();
+  state.flyLines = [];
+  const geo = state.mapGeo;
+  const pathOf = (seg) => (geo && seg.points_deg ? seg.points_deg.map((p) => [p[0], p[1]]) : (seg.points_m || []).map((p) => [p[1], p[0]]));
+  (plan.maps || []).forEach((m, k) => {
+    const colour = sortieColour(k);
+    const lines = [];
+    for (const [part, dash] of [['way_out', '6 6'], ['route', null], ['way_home', '2 6']]) {
+      const latlngs = (m[part] || []).flatMap(pathOf);
+      if (!latlngs.length) continue;
+      const line = L.polyline(latlngs, {
+        color: colour,
+        weight: part === 'route' ? 4 : 3,
+        opacity: 0.95,
+        dashArray: dash,
+        className: `fly fly-${part.replace('_', '-')} fly-sortie-${k + 1}`,
+        lineCap: 'round',
+        lineJoin: 'round',
+      });
+      const s = plan.sorties[k];
+      const tip = tipNode(`sortie ${k + 1} (${m.file}) · ${part.replace('_', ' ')}`, `${fmt(s.energy_wh, 1)} Wh · ${mmss(s.duration_s)} · lands at ${pct(s.end_soc)} %`);
+      line.bindTooltip(tip, { sticky: true });
+      line.on('mouseover', () => lightSortie(k, true));
+      line.on('mouseout', () => lightSortie(k, false));
+      line.addTo(state.flyLayer);
+      lines.push(line);
+    }
+    const pnr = m.point_of_no_return;
+    if (pnr) {
+      const at = geo && pnr.position_deg ? pnr.position_deg : [pnr.position_m[1], pnr.position_m[0]];
+      L.circleMarker(at, { radius: 5, className: 'fly-pnr', color: colour, weight: 2, fillColor: '#fff', fillOpacity: 1 })
+        .bindTooltip(tipNode(`sortie ${k + 1}: point of no return after ${mmss(pnr.time_s)}`))
+        .addTo(state.flyLayer);
+    }
+    state.flyLines.push(lines);
+  });
+  $('#map').classList.add('flying');
+  const bounds = state.flyLayer.getBounds();
+  if (bounds.isValid()) state.map.fitBounds(bounds, { padding: [30, 30], maxZoom: geo ? 19 : 4 });
+}
+
+function lightSortie(k, on) {
+  for (const line of (state.flyLines || [])[k] || []) {
+    line.setStyle({ weight: on ? 7 : line.options.className.includes('fly-route') ? 4 : 3 });
+    if (on) line.bringToFront();
+  }
+  const tr = document.querySelector(`#fly tr[data-sortie="${k + 1}"]`);
+  if (tr) tr.classList.toggle('highlight', on);
+}
