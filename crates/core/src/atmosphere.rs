@@ -127,9 +127,155 @@ pub fn density_altitude_m(density_kg_m3: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The figures of a day's air, each already within its range: the elevation, the temperature,
+/// the humidity and the pressure reduced to sea level (ISA's 101 325 Pa, or the day's QNH).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Day {
+    /// Elevation above mean sea level, m.
+    pub elevation_m: f64,
+    /// Air temperature, K.
+    pub temperature_k: f64,
+    /// Relative humidity, percent (0 dry to 100 saturated).
+    pub humidity_percent: f64,
+    /// Pressure reduced to sea level, Pa.
+    pub sea_level_pa: f64,
+}
+
+/// The air a [`Day`] makes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DayAir {
+    /// Static (station) pressure at the elevation, Pa.
+    pub pressure_pa: f64,
+    /// Density of the moist air, kg/m^3.
+    pub density_kg_m3: f64,
+}
+
+/// Why a day whose figures are each in range combines into air that cannot exist.
+/// (Not `non_exhaustive`: the two ways a day's air fails [`Day::air`]'s checks, matched whole by
+/// callers that name the day in their own errors.)
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum ImpossibleAir {
+    /// Water vapour at or above [`MAX_VAPOUR_FRACTION`] of the air's pressure.
+    #[error("water vapour of {vapour_pa:.0} Pa in air of {pressure_pa:.0} Pa")]
+    Vapour {
+        /// The water vapour's partial pressure, Pa.
+        vapour_pa: f64,
+        /// The air's pressure, Pa.
+        pressure_pa: f64,
+    },
+    /// A density below [`thinnest_density_kg_m3`] (ISA's at 11 km).
+    #[error("a density of {density_kg_m3:.4} kg/m^3, below {min_density_kg_m3:.4} kg/m^3")]
+    TooThin {
+        /// The density of that air, kg/m^3.
+        density_kg_m3: f64,
+        /// The thinnest air the atmosphere answers for, kg/m^3.
+        min_density_kg_m3: f64,
+    },
+}
+
+impl Day {
+    /// The station pressure at the elevation (ISA's pressure law from the sea-level pressure)
+    /// and the density of the moist air there.
+    ///
+    /// # Errors
+    /// [`ImpossibleAir::Vapour`] when the water vapour, `RH e_s(T)`, is at least
+    /// [`MAX_VAPOUR_FRACTION`] of the pressure; [`ImpossibleAir::TooThin`] when the density is
+    /// below [`thinnest_density_kg_m3`] (ISA's own 11 km is the limit itself, within a relative
+    /// 1e-9 for its rounding).
+    pub fn air(&self) -> Result<DayAir, ImpossibleAir> {
+        let pressure_pa = pressure_at_elevation_pa(self.elevation_m, self.sea_level_pa);
+        let density_kg_m3 = air_density_kg_m3(
+            pressure_pa,
+            self.temperature_k,
+            self.humidity_percent / 100.0,
+        );
+        let vapour_pa = self.humidity_percent / 100.0
+            * saturation_vapour_pressure_pa(self.temperature_k - ZERO_CELSIUS_K);
+        if vapour_pa >= MAX_VAPOUR_FRACTION * pressure_pa {
+            return Err(ImpossibleAir::Vapour {
+                vapour_pa,
+                pressure_pa,
+            });
+        }
+        let min_density_kg_m3 = thinnest_density_kg_m3();
+        if density_kg_m3 < min_density_kg_m3 * (1.0 - 1e-9) {
+            return Err(ImpossibleAir::TooThin {
+                density_kg_m3,
+                min_density_kg_m3,
+            });
+        }
+        Ok(DayAir {
+            pressure_pa,
+            density_kg_m3,
+        })
+    }
+}
+
+/// The density altitude of `density_kg_m3` ([`density_altitude_m`]) to the nearest 0.1 m (the
+/// halving's resolution), never -0, m.
+pub fn rounded_density_altitude_m(density_kg_m3: f64) -> f64 {
+    (density_altitude_m(density_kg_m3) * 10.0).round() / 10.0 + 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn day(elevation_m: f64, temperature_c: f64, humidity_percent: f64, qnh_hpa: f64) -> Day {
+        Day {
+            elevation_m,
+            temperature_k: ZERO_CELSIUS_K + temperature_c,
+            humidity_percent,
+            sea_level_pa: qnh_hpa * 100.0,
+        }
+    }
+
+    /// Issue 41's impossible day (11,000 m, 60 C, 100 %, QNH 850 hPa): e_s(60 C) = 19.9 kPa
+    /// against a station pressure of 19.0 kPa, vapour above a tenth of the air. The same day dry
+    /// at QNH 1013.25 is 22.6 kPa at 333 K: 22 632 / (287.053 x 333.15) = 0.2367 kg/m^3, below
+    /// ISA's 0.3639 at 11 km. ISA's own 11 km is air.
+    #[test]
+    fn a_day_that_cannot_exist_is_refused_by_what_is_wrong() {
+        let steam = day(11_000.0, 60.0, 100.0, 850.0).air();
+        assert!(
+            matches!(steam, Err(ImpossibleAir::Vapour { vapour_pa, pressure_pa })
+                if (vapour_pa - 19_900.0).abs() < 200.0 && (pressure_pa - 19_000.0).abs() < 200.0),
+            "{steam:?}"
+        );
+        let thin = day(11_000.0, 60.0, 0.0, 1013.25).air();
+        assert!(
+            matches!(thin, Err(ImpossibleAir::TooThin { density_kg_m3, .. })
+                if (density_kg_m3 - 0.2367).abs() < 5e-4),
+            "{thin:?}"
+        );
+        let top = day(11_000.0, -56.5, 0.0, 1013.25).air().unwrap();
+        assert!((top.density_kg_m3 - 0.36392).abs() < 2e-4);
+        assert!(
+            (top.pressure_pa - 22_632.0).abs() < 5.0,
+            "{}",
+            top.pressure_pa
+        );
+    }
+
+    /// An ordinary day is its formulas: station pressure by the ISA law from the QNH, density
+    /// of moist air at it (30 C, 80 %, sea level at ISA pressure: 1.1497 kg/m^3).
+    #[test]
+    fn an_ordinary_day_is_its_pressure_and_moist_density() {
+        let air = day(0.0, 30.0, 80.0, 1013.25).air().unwrap();
+        assert!((air.pressure_pa - 101_325.0).abs() < 1e-9);
+        assert!((air.density_kg_m3 - 1.1497).abs() < 0.001);
+    }
+
+    /// The density altitude rounded to 0.1 m: ISA's density at 1234.5 m gives 1234.5 (the
+    /// halving lands within 0.05 m), sea level gives 0 and never -0.
+    #[test]
+    fn the_rounded_density_altitude_is_to_a_tenth_of_a_metre() {
+        let h = rounded_density_altitude_m(isa_density_kg_m3(1234.5));
+        assert!((h - 1234.5).abs() < 0.1 + 1e-9, "{h}");
+        assert!(((h * 10.0).round() - h * 10.0).abs() < 1e-6, "{h}");
+        let zero = rounded_density_altitude_m(isa_density_kg_m3(0.0));
+        assert!(zero.abs() < 0.1 && zero.to_bits() != (-0.0f64).to_bits());
+    }
 
     /// PX4's test vectors (`test_atmosphere.cpp`): the pressure at 3000 m ISA, 70 109 Pa, within
     /// 20 Pa (the gas constants of the two codes differ: 287.053 against PX4's 287.1 moves it by

@@ -68,6 +68,7 @@
 //! - Only the multirotor pattern: fixed-wing turn segments are not modelled (aloft flies
 //!   multirotors); alternate transects are supported as QGroundControl reads them.
 
+mod coverage;
 mod json;
 mod projection;
 mod transects;
@@ -79,6 +80,9 @@ mod tests;
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 
+pub use coverage::{
+    candidate_angles, wind_bearing_deg, ANGLE_STEP_DEG, COVERAGE_GRID_M, COVERAGE_TOLERANCE_M,
+};
 pub use projection::QgcProjection;
 pub(crate) use write::number_json;
 pub use write::reangle_survey_item;

@@ -16,6 +16,7 @@
 
 pub mod balance;
 pub mod capacity;
+pub mod combine;
 pub mod error;
 pub mod resistance;
 
@@ -24,6 +25,7 @@ pub use capacity::{
     capacity_between_rests, coulomb_count_mah, reported_drop_mah, rest_limit_a, CapacityEstimate,
     REST_CURRENT_UNRATED_A, REST_C_RATE, REST_HOLD_S,
 };
+pub use combine::{combine_flights, median_finite, FlightsCombined};
 pub use error::PackError;
 pub use resistance::{resistance_from_steps, updates, ResistanceEstimate};
 
@@ -41,7 +43,7 @@ pub struct PackOptions {
 
 /// Everything one log says about its pack. Keys carry their units; what a log does not give is
 /// left out of the JSON (never `null`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct PackReport {
     /// The log.
     pub source: String,

@@ -138,6 +138,7 @@ pub mod pack_cursor;
 pub mod plan;
 pub mod queries;
 pub mod replay;
+pub mod route;
 pub mod trajectory;
 pub mod trim;
 pub mod wind;

@@ -22,10 +22,8 @@
 use serde::{Deserialize, Serialize};
 
 use aloft_core::atmosphere::{
-    air_density_kg_m3, density_altitude_m, isa_temperature_k, pressure_at_elevation_pa,
-    saturation_vapour_pressure_pa, thinnest_density_kg_m3, ELEVATION_RANGE_M,
-    ISA_SEA_LEVEL_PRESSURE_PA, MAX_VAPOUR_FRACTION, QNH_RANGE_HPA, TEMPERATURE_RANGE_C,
-    ZERO_CELSIUS_K,
+    isa_temperature_k, rounded_density_altitude_m, Day, DayAir, ImpossibleAir, ELEVATION_RANGE_M,
+    ISA_SEA_LEVEL_PRESSURE_PA, QNH_RANGE_HPA, TEMPERATURE_RANGE_C, ZERO_CELSIUS_K,
 };
 use aloft_core::ISA_SEA_LEVEL_DENSITY_KG_M3;
 
@@ -269,19 +267,16 @@ pub fn resolve_air(
     let sea_level_pa = input
         .qnh_hpa
         .map_or(ISA_SEA_LEVEL_PRESSURE_PA, |q| q * 100.0);
-    let pressure_pa = pressure_at_elevation_pa(elevation_m, sea_level_pa);
-    let humidity = input.humidity_percent.unwrap_or(0.0);
-    let rho = air_density_kg_m3(pressure_pa, temperature_k, humidity / 100.0);
-    check_exists(
-        DayAir {
-            elevation_m,
-            temperature_c: temperature_k - ZERO_CELSIUS_K,
-            humidity_percent: humidity,
-            qnh_hpa: sea_level_pa / 100.0,
-        },
+    let day = Day {
+        elevation_m,
+        temperature_k,
+        humidity_percent: input.humidity_percent.unwrap_or(0.0),
+        sea_level_pa,
+    };
+    let DayAir {
         pressure_pa,
-        rho,
-    )?;
+        density_kg_m3: rho,
+    } = day.air().map_err(|e| impossible(&day, e))?;
     let density_source = if input.is_empty() {
         AirSource::MissionHome
     } else {
@@ -295,55 +290,40 @@ pub fn resolve_air(
         temperature_c: Some(temperature_k - ZERO_CELSIUS_K),
         temperature_source: Some(temperature_source),
         pressure_pa: Some(pressure_pa),
-        humidity_percent: Some(humidity),
+        humidity_percent: Some(day.humidity_percent),
         density_altitude_m: rounded_density_altitude_m(rho),
     })
 }
 
-/// The figures of a day's air, each within its own range.
-struct DayAir {
-    elevation_m: f64,
-    temperature_c: f64,
-    humidity_percent: f64,
-    qnh_hpa: f64,
-}
-
-/// A day whose figures are each in range may still combine into air that cannot exist: water
-/// vapour at or above [`MAX_VAPOUR_FRACTION`] of the air's pressure `pressure_pa`, or a density
-/// `rho` below [`thinnest_density_kg_m3`] (ISA's at 11 km).
-///
-/// # Errors
-/// [`Error::AirVapour`] and [`Error::AirTooThin`], naming the combination.
-fn check_exists(day: DayAir, pressure_pa: f64, rho: f64) -> Result<(), Error> {
-    let vapour_pa = day.humidity_percent / 100.0 * saturation_vapour_pressure_pa(day.temperature_c);
-    if vapour_pa >= MAX_VAPOUR_FRACTION * pressure_pa {
-        return Err(Error::AirVapour {
-            elevation_m: day.elevation_m,
-            temperature_c: day.temperature_c,
-            humidity_percent: day.humidity_percent,
-            qnh_hpa: day.qnh_hpa,
+/// A day whose figures are each in range that combines into air that cannot exist
+/// ([`Day::air`]), as the error that names the combination.
+fn impossible(day: &Day, why: ImpossibleAir) -> Error {
+    let (elevation_m, temperature_c) = (day.elevation_m, day.temperature_k - ZERO_CELSIUS_K);
+    let (humidity_percent, qnh_hpa) = (day.humidity_percent, day.sea_level_pa / 100.0);
+    match why {
+        ImpossibleAir::Vapour {
             vapour_pa,
             pressure_pa,
-        });
+        } => Error::AirVapour {
+            elevation_m,
+            temperature_c,
+            humidity_percent,
+            qnh_hpa,
+            vapour_pa,
+            pressure_pa,
+        },
+        ImpossibleAir::TooThin {
+            density_kg_m3,
+            min_density_kg_m3,
+        } => Error::AirTooThin {
+            elevation_m,
+            temperature_c,
+            humidity_percent,
+            qnh_hpa,
+            density_kg_m3,
+            min_density_kg_m3,
+        },
     }
-    // ISA's own 11 km is the limit itself: a relative 1e-9 for its rounding.
-    let min = thinnest_density_kg_m3();
-    if rho < min * (1.0 - 1e-9) {
-        return Err(Error::AirTooThin {
-            elevation_m: day.elevation_m,
-            temperature_c: day.temperature_c,
-            humidity_percent: day.humidity_percent,
-            qnh_hpa: day.qnh_hpa,
-            density_kg_m3: rho,
-            min_density_kg_m3: min,
-        });
-    }
-    Ok(())
-}
-
-/// The density altitude of `rho` to the nearest 0.1 m (the halving's resolution), never -0.
-fn rounded_density_altitude_m(rho: f64) -> f64 {
-    (density_altitude_m(rho) * 10.0).round() / 10.0 + 0.0
 }
 
 /// The air of a flight without a mission (endurance, power): [`resolve_air`] without a home

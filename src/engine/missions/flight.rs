@@ -2,6 +2,7 @@
 //! mission spec with them: the main plan flies through it, and so do the searches that re-plan
 //! parts of a route (the loiter until the reserve, the sorties).
 
+use aloft_planner::route::first_speed;
 use aloft_planner::{
     Aircraft, Mission as Compiled, MissionReport, MissionSpec, NoSamples, Pack, PlanOptions,
     PlannerError, SampleSink, SegmentSpec, Wind,
@@ -181,20 +182,4 @@ pub(in crate::engine) fn ends_in_the_air(segments: &[SegmentSpec]) -> bool {
         }
     }
     airborne
-}
-
-/// The first ground speed the segments give.
-pub(in crate::engine) fn first_speed(segments: &[SegmentSpec]) -> Option<f64> {
-    segments.iter().find_map(|s| match *s {
-        SegmentSpec::Leg {
-            ground_speed_mps, ..
-        }
-        | SegmentSpec::Orbit {
-            ground_speed_mps, ..
-        }
-        | SegmentSpec::Return {
-            ground_speed_mps, ..
-        } => ground_speed_mps,
-        _ => None,
-    })
 }

@@ -25,15 +25,18 @@
 //!    legs (it re-flies the stretch, as an operator resuming a survey a few waypoints back does
 //!    for the images' overlap), never before where the sortie it follows began.
 //!
-//! A leg is straight from where the one before it ends to its waypoint, its height changing
-//! evenly along it: a point a fraction of the way along is that fraction of the way in all three
-//! coordinates. Each sortie's answer is its own flight: energy, end state of charge, duration.
+//! The route's geometry (where a sortie may end, the mission a sortie flies, how far back the
+//! next resumes) and the searches are [`aloft_planner::route`]'s; here are the steps, each trial a
+//! flight on the pack. Each sortie's answer is its own flight: energy, end state of charge,
+//! duration.
 
 use serde::{Deserialize, Serialize};
 
+use aloft_planner::route::{farthest_fraction, last_that_holds};
+pub(in crate::engine) use aloft_planner::route::{segment_ends_m, Cut, Route};
 use aloft_planner::{Mission as Compiled, MissionReport, MissionSpec, SegmentSpec};
 
-use crate::engine::missions::flight::{first_speed, Flight};
+use crate::engine::missions::flight::Flight;
 
 /// Most sorties aloft splits a route into: beyond it, the answer says the route needs more. A
 /// route of more than 200 packs is a campaign, not a mission, and the bound keeps the search
@@ -85,29 +88,6 @@ pub(in crate::engine) struct SplitOptions {
     pub(in crate::engine) overlap_m: f64,
 }
 
-/// A point of the route where a sortie ends: the end of segment `segment` (`fraction` 1), or a
-/// point `fraction` of the way along it (a leg).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(in crate::engine) struct Cut {
-    /// The segment, an index of the mission's segments.
-    pub(in crate::engine) segment: usize,
-    /// How far along it, 0 (exclusive) to 1.
-    pub(in crate::engine) fraction: f64,
-}
-
-impl Cut {
-    fn whole(segment: usize) -> Self {
-        Self {
-            segment,
-            fraction: 1.0,
-        }
-    }
-
-    fn is_whole(self) -> bool {
-        self.fraction >= 1.0
-    }
-}
-
 /// One sortie: where it resumes the route (`None`: the mission's own start), where it leaves it
 /// (`None`: the mission's own end), its mission and its flight.
 #[derive(Debug, Clone)]
@@ -143,7 +123,8 @@ pub(in crate::engine) fn split(
     };
     match sortie_plans(flight, &route, SplitOptions::default(), &maker) {
         Ok(plans) => {
-            let mut sorties: Vec<SortieSummary> = plans.iter().map(|p| route.summary(p)).collect();
+            let mut sorties: Vec<SortieSummary> =
+                plans.iter().map(|p| summary(&route, p)).collect();
             let batteries_required = u32::try_from(sorties.len()).ok();
             if sorties.len() == 1 {
                 sorties.clear();
@@ -180,7 +161,9 @@ pub(in crate::engine) struct SpecSorties<'r, 'f> {
 
 impl SortieMaker for SpecSorties<'_, '_> {
     fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String> {
-        Ok(self.route.sortie(self.flight, start, end))
+        Ok(self
+            .route
+            .sortie(start, end, self.flight.way_home(self.route.spec())))
     }
 }
 
@@ -193,7 +176,7 @@ pub(in crate::engine) fn sortie_plans(
     maker: &dyn SortieMaker,
 ) -> Result<Vec<SortiePlan>, String> {
     if options.inside_legs {
-        route.within_reach(flight)?;
+        within_reach(flight, route)?;
     }
     let mut plans: Vec<SortiePlan> = Vec::new();
     let mut start: Option<Cut> = None;
@@ -212,7 +195,7 @@ pub(in crate::engine) fn sortie_plans(
                 end: None,
                 spec,
                 report: rest,
-                route: from..route.spec.segments.len(),
+                route: from..route.spec().segments.len(),
             });
             return Ok(plans);
         }
@@ -270,24 +253,25 @@ fn farthest_end(
         let report = flight.trial(&spec, None).ok().filter(|r| r.feasible)?;
         Some((cut, spec, report))
     };
-    let from = route.resumes_at(start);
-    let ends: Vec<usize> = (from..route.tail)
-        .filter(|&e| route.end_m[e][2] > 0.0)
-        .collect();
-    let (mut lo, mut hi) = (0usize, ends.len());
-    let mut best = None;
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        match try_end(Cut::whole(ends[mid])) {
-            Some(found) => {
-                best = Some(found);
-                lo = mid + 1;
-            }
-            None => hi = mid,
-        }
-    }
-    let next = best.as_ref().map_or(from, |(c, _, _)| c.segment + 1);
-    partial_end(route, start, next, &try_end).or(best)
+    let ends = route.ends_from(start);
+    let best = last_that_holds(ends.len(), |k| try_end(Cut::whole(ends[k])));
+    let next = best
+        .as_ref()
+        .map_or(route.resumes_at(start), |(c, _, _)| c.segment + 1);
+    let length_m = route.leg_length_m(next);
+    let from = match start {
+        Some(c) if c.segment == next => c.fraction,
+        _ => 0.0,
+    };
+    let partial = length_m.and_then(|length_m| {
+        farthest_fraction(from, length_m, |fraction| {
+            try_end(Cut {
+                segment: next,
+                fraction,
+            })
+        })
+    });
+    partial.or(best)
 }
 
 /// The last whole segment a sortie from `start` can end with (module steps 2 and 3).
@@ -309,413 +293,47 @@ fn whole_end(
         Some((cut, spec, report))
     };
     // The candidate first, then bisection among the earlier ends (fewer segments, less energy
-    // before the return).
+    // before the return); the candidate, ends[n - 1], fails.
     let &candidate = ends.last()?;
-    if let Some(found) = try_end(candidate) {
-        return Some(found);
-    }
-    let (mut lo, mut hi) = (0usize, ends.len() - 1); // ends[hi] fails; find the last that holds
-    let mut best = None;
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        match try_end(ends[mid]) {
-            Some(found) => {
-                best = Some(found);
-                lo = mid + 1;
-            }
-            None => hi = mid,
-        }
-    }
-    best
+    try_end(candidate).or_else(|| last_that_holds(ends.len() - 1, |k| try_end(ends[k])))
 }
 
-/// Bisection on the fraction of a leg stops when the interval is shorter than this, m.
-const CUT_RESOLUTION_M: f64 = 1.0;
-
-/// The farthest point of leg `segment` a sortie from `start` can end at (module step 4), when
-/// the segment is a leg of the route beyond `start`.
-fn partial_end(
-    route: &Route<'_>,
-    start: Option<Cut>,
-    segment: usize,
-    try_end: &dyn Fn(Cut) -> Option<Ending>,
-) -> Option<Ending> {
-    let length_m = route.leg_length_m(segment)?;
-    let mut lo = match start {
-        Some(c) if c.segment == segment => c.fraction,
-        _ => 0.0,
+/// Whether a pack can fly to the route's farthest point from home and back (a sortie that only
+/// goes there): when it cannot, no way of cutting the route keeps the reserve, and the sorties
+/// cut inside legs would otherwise creep toward that point by ever shorter steps.
+///
+/// # Errors
+/// The farthest point and its item (or segment), when it is out of reach.
+fn within_reach(flight: &Flight<'_>, route: &Route<'_>) -> Result<(), String> {
+    let Some(far) = route.farthest_segment() else {
+        return Ok(());
     };
-    let mut hi = 1.0;
-    let mut best = None;
-    // Each step halves the interval; 64 steps reach any leg's metre.
-    for _ in 0..64 {
-        if (hi - lo) * length_m < CUT_RESOLUTION_M {
-            break;
-        }
-        let mid = 0.5 * (lo + hi);
-        match try_end(Cut {
-            segment,
-            fraction: mid,
-        }) {
-            Some(found) => {
-                best = Some(found);
-                lo = mid;
-            }
-            None => hi = mid,
-        }
+    let spec = route.there_and_back(far, flight.way_home(route.spec()));
+    match flight.trial(&spec, None).is_ok_and(|r| r.feasible) {
+        true => Ok(()),
+        false => Err(route.out_of_reach(far)),
     }
-    best
 }
 
-/// Where each of the `n` segments of `compiled` ends, ENU m (a segment without a piece where the
-/// one before it ended, home before the first).
-pub(in crate::engine) fn segment_ends_m(compiled: &Compiled, n: usize) -> Vec<[f64; 3]> {
-    let mut end_m: Vec<Option<[f64; 3]>> = vec![None; n];
-    for p in compiled.pieces() {
-        if let Some(slot) = end_m.get_mut(p.segment) {
-            *slot = Some(p.end_m());
-        }
-    }
-    let mut last = compiled.home_m();
-    end_m
-        .into_iter()
-        .map(|e| {
-            last = e.unwrap_or(last);
-            last
-        })
-        .collect()
-}
-
-/// The route of a mission and what its sorties need to know about it.
-pub(in crate::engine) struct Route<'a> {
-    spec: &'a MissionSpec,
-    /// First segment after the take-off.
-    first: usize,
-    /// First segment of the way down (the tail every last sortie flies).
-    tail: usize,
-    /// Where each segment ends, ENU m.
-    end_m: Vec<[f64; 3]>,
-    /// The payload at the start of each segment, kg.
-    payload_kg: Vec<f64>,
-    /// The take-off's climb rate, m/s.
-    climb_rate_mps: f64,
-    /// Home, ENU m.
-    home_m: [f64; 3],
-}
-
-impl<'a> Route<'a> {
-    /// The route of `spec`: its first segment must be a take-off and its last a landing.
-    pub(in crate::engine) fn of(
-        spec: &'a MissionSpec,
-        compiled: &Compiled,
-    ) -> Result<Self, String> {
-        let segments = &spec.segments;
-        let Some(&SegmentSpec::TakeOff { climb_rate_mps, .. }) = segments.first() else {
-            return Err("the mission does not begin with a take-off".to_string());
-        };
-        if !matches!(segments.last(), Some(SegmentSpec::Landing { .. })) {
-            return Err("the mission does not end with a landing".to_string());
-        }
-        let tail = segments
+/// The answer of a sortie of `route`.
+fn summary(route: &Route<'_>, plan: &SortiePlan) -> SortieSummary {
+    let segments = &route.spec().segments;
+    let first = match plan.start {
+        None => 0,
+        Some(_) => route.resumes_at(plan.start),
+    };
+    let last = plan.end.map_or(segments.len() - 1, |c| c.segment);
+    let report = &plan.report;
+    SortieSummary {
+        first_item: segments[first..=last].iter().find_map(SegmentSpec::item),
+        last_item: segments[first..=last]
             .iter()
-            .rposition(|s| {
-                !matches!(
-                    s,
-                    SegmentSpec::Landing { .. }
-                        | SegmentSpec::Descent { .. }
-                        | SegmentSpec::Return { .. }
-                )
-            })
-            .map_or(segments.len(), |i| i + 1);
-        if tail <= 1 {
-            return Err("the mission has no route between its take-off and landing".to_string());
-        }
-        let n = segments.len();
-        let mut phase: Vec<Option<usize>> = vec![None; n];
-        for p in compiled.pieces() {
-            phase[p.segment].get_or_insert(p.mass_phase);
-        }
-        let payloads = compiled.payloads_kg();
-        let mut last_phase = 0;
-        let mut payload_kg = Vec::with_capacity(n);
-        for p in phase {
-            last_phase = p.unwrap_or(last_phase);
-            payload_kg.push(payloads.get(last_phase).copied().unwrap_or(0.0));
-        }
-        let ends = segment_ends_m(compiled, n);
-        Ok(Self {
-            spec,
-            first: 1,
-            tail,
-            end_m: ends,
-            payload_kg,
-            climb_rate_mps,
-            home_m: compiled.home_m(),
-        })
-    }
-
-    /// The first segment of the route a sortie from `start` flies (the remainder of a leg it
-    /// resumes inside of, else the one after).
-    pub(in crate::engine) fn resumes_at(&self, start: Option<Cut>) -> usize {
-        match start {
-            None => self.first,
-            Some(c) if c.is_whole() => c.segment + 1,
-            Some(c) => c.segment,
-        }
-    }
-
-    /// The payload a sortie from `start` takes off with, kg.
-    pub(in crate::engine) fn payload_at_kg(&self, start: Option<Cut>) -> f64 {
-        self.payload_kg[self.resumes_at(start)]
-    }
-
-    /// Home's height, ENU m (the heights of a planner file are above it).
-    pub(in crate::engine) fn home_up_m(&self) -> f64 {
-        self.home_m[2]
-    }
-
-    /// Where segment `segment` begins, ENU m.
-    fn start_m(&self, segment: usize) -> [f64; 3] {
-        match segment.checked_sub(1) {
-            Some(previous) => self.end_m[previous],
-            None => self.home_m,
-        }
-    }
-
-    /// The length of segment `segment` when it is a leg of the route (before its way down), m.
-    fn leg_length_m(&self, segment: usize) -> Option<f64> {
-        let is_leg = matches!(
-            self.spec.segments.get(segment),
-            Some(SegmentSpec::Leg { .. })
-        );
-        if !is_leg || segment < self.first || segment >= self.tail {
-            return None;
-        }
-        let (a, b) = (self.start_m(segment), self.end_m[segment]);
-        Some((b[0] - a[0]).hypot(b[1] - a[1]).hypot(b[2] - a[2]))
-    }
-
-    /// The point of the route at `cut`, ENU m.
-    pub(in crate::engine) fn point_m(&self, cut: Cut) -> [f64; 3] {
-        let (a, b) = (self.start_m(cut.segment), self.end_m[cut.segment]);
-        let f = cut.fraction.clamp(0.0, 1.0);
-        [0, 1, 2].map(|k| a[k] + f * (b[k] - a[k]))
-    }
-
-    /// The point `overlap_m` back along the route's legs from `end` (module step 5), no farther
-    /// back than where the sortie from `start` began, nor across a segment that is not a leg.
-    fn back_along(&self, end: Cut, overlap_m: f64, start: Option<Cut>) -> Cut {
-        let floor = start.map_or((self.first, 0.0), |c| match c.is_whole() {
-            true => (c.segment + 1, 0.0),
-            false => (c.segment, c.fraction),
-        });
-        let (mut segment, mut fraction, mut left_m) = (end.segment, end.fraction, overlap_m);
-        while left_m > 0.0 {
-            let Some(length_m) = self.leg_length_m(segment).filter(|l| *l > 0.0) else {
-                break;
-            };
-            let lowest = if segment == floor.0 { floor.1 } else { 0.0 };
-            let available_m = (fraction - lowest) * length_m;
-            if available_m >= left_m {
-                fraction -= left_m / length_m;
-                break;
-            }
-            left_m -= available_m;
-            fraction = lowest;
-            if segment <= floor.0 || lowest > 0.0 {
-                break;
-            }
-            segment -= 1;
-            fraction = 1.0;
-        }
-        match fraction > 0.0 {
-            true => Cut { segment, fraction },
-            // At a leg's start: the end of the segment before it.
-            false => Cut::whole(segment - 1),
-        }
-    }
-
-    /// Whether a pack can fly to the route's farthest point from home and back (a sortie that
-    /// only goes there): when it cannot, no way of cutting the route keeps the reserve, and the
-    /// sorties cut inside legs would otherwise creep toward that point by ever shorter steps.
-    ///
-    /// # Errors
-    /// The farthest point and its item (or segment), when it is out of reach.
-    fn within_reach(&self, flight: &Flight<'_>) -> Result<(), String> {
-        let home = self.home_m;
-        let distance = |p: [f64; 3]| (p[0] - home[0]).hypot(p[1] - home[1]);
-        let Some(far) = (self.first..self.tail)
-            .max_by(|&a, &b| distance(self.end_m[a]).total_cmp(&distance(self.end_m[b])))
-        else {
-            return Ok(());
-        };
-        let cut = Cut::whole(far);
-        let mut spec = self.spec.clone();
-        spec.payload_kg = self.payload_kg[far];
-        spec.allow_end_in_air = false;
-        spec.segments = self.resume(cut, far + 1).to_vec();
-        spec.segments.extend(flight.way_home(self.spec));
-        if flight.trial(&spec, None).is_ok_and(|r| r.feasible) {
-            return Ok(());
-        }
-        let seg = &self.spec.segments[far];
-        let name = match seg.item() {
-            Some(i) => format!("item {i}"),
-            None => format!("segment {}", far + 1),
-        };
-        Err(format!(
-            "the route reaches {:.0} m from home at {name} ({}): a full pack cannot fly there and \
-             back with the reserve",
-            distance(self.end_m[far]),
-            seg.kind()
-        ))
-    }
-
-    /// Why no sortie from `start` can be flown.
-    fn cannot_fly(&self, start: Option<Cut>) -> String {
-        let at = self.resumes_at(start);
-        let seg = &self.spec.segments[at.min(self.spec.segments.len() - 1)];
-        let name = match seg.item() {
-            Some(i) => format!("item {i} ({})", seg.kind()),
-            None => format!("segment {} ({})", at + 1, seg.kind()),
-        };
-        format!("{name} cannot be flown from home and back with the reserve on one pack")
-    }
-
-    /// The ends a sortie from `start` may have (segments of the route that end in the air)
-    /// completed by mission time `limit_s` in `rest`, the flight of the rest of the route from
-    /// `start`.
-    fn ends_before(&self, start: Option<Cut>, rest: &MissionReport, limit_s: f64) -> Vec<usize> {
-        let prefix = self.prefix_len(start);
-        let from = self.resumes_at(start);
-        let mut t = 0.0;
-        let mut ends = Vec::new();
-        for s in &rest.segments {
-            t += s.duration_s;
-            let Some(original) = (s.index - 1).checked_sub(prefix).map(|k| from + k) else {
-                continue;
-            };
-            if original >= self.tail || t > limit_s {
-                break;
-            }
-            if self.end_m[original][2] > 0.0 {
-                ends.push(original);
-            }
-        }
-        ends
-    }
-
-    /// Segments a sortie from `start` flies before the route: the first sortie flies the
-    /// mission's own take-off (segment 0); the others a take-off and a transit.
-    fn prefix_len(&self, start: Option<Cut>) -> usize {
-        match start {
-            None => self.first,
-            Some(_) => 2,
-        }
-    }
-
-    /// The mission of the sortie from `start` (`None`: the mission's own start) to `end` (the
-    /// route's end and the mission's way down when `None`).
-    fn sortie(&self, flight: &Flight<'_>, start: Option<Cut>, end: Option<Cut>) -> MissionSpec {
-        let spec = self.spec;
-        let from = self.resumes_at(start);
-        let mut s = spec.clone();
-        s.payload_kg = self.payload_at_kg(start);
-        s.allow_end_in_air = false;
-        let mut segments = Vec::new();
-        match start {
-            None => segments.extend_from_slice(&spec.segments[..from]),
-            Some(c) => segments.extend(self.resume(c, from)),
-        }
-        match end {
-            None => segments.extend_from_slice(&spec.segments[from..]),
-            Some(e) => {
-                segments.extend_from_slice(&spec.segments[from..e.segment]);
-                segments.push(self.to_cut(e));
-                segments.extend(flight.way_home(spec));
-            }
-        }
-        s.segments = segments;
-        s
-    }
-
-    /// A take-off at home to the height of `cut` and a straight transit there, at the planning
-    /// speed (else the first speed of the route from `from`, else none).
-    fn resume(&self, cut: Cut, from: usize) -> [SegmentSpec; 2] {
-        let spec = self.spec;
-        let [east_m, north_m, up_m] = self.point_m(cut);
-        [
-            SegmentSpec::TakeOff {
-                altitude_m: up_m,
-                climb_rate_mps: self.climb_rate_mps,
-                item: None,
-            },
-            SegmentSpec::Leg {
-                east_m: Some(east_m),
-                north_m: Some(north_m),
-                latitude_deg: None,
-                longitude_deg: None,
-                altitude_m: Some(up_m),
-                ground_speed_mps: match spec.default_speed_mps {
-                    Some(_) => None,
-                    None => first_speed(&spec.segments[from..]),
-                },
-                payload_after_kg: None,
-                acceptance_radius_m: None,
-                item: None,
-            },
-        ]
-    }
-
-    /// The segment that ends the route at `cut`: the segment itself when whole, else its leg
-    /// to the point (the item's speed and number kept, its payload change not reached).
-    fn to_cut(&self, cut: Cut) -> SegmentSpec {
-        let segment = self.spec.segments[cut.segment].clone();
-        if cut.is_whole() {
-            return segment;
-        }
-        let [east, north, up] = self.point_m(cut);
-        match segment {
-            SegmentSpec::Leg {
-                ground_speed_mps,
-                acceptance_radius_m,
-                item,
-                ..
-            } => SegmentSpec::Leg {
-                east_m: Some(east),
-                north_m: Some(north),
-                latitude_deg: None,
-                longitude_deg: None,
-                altitude_m: Some(up),
-                ground_speed_mps,
-                payload_after_kg: None,
-                acceptance_radius_m,
-                item,
-            },
-            other => other,
-        }
-    }
-
-    /// The answer of a sortie.
-    fn summary(&self, plan: &SortiePlan) -> SortieSummary {
-        let segments = &self.spec.segments;
-        let first = match plan.start {
-            None => 0,
-            Some(_) => self.resumes_at(plan.start),
-        };
-        let last = plan.end.map_or(segments.len() - 1, |c| c.segment);
-        let report = &plan.report;
-        SortieSummary {
-            first_item: segments[first..=last].iter().find_map(SegmentSpec::item),
-            last_item: segments[first..=last]
-                .iter()
-                .rev()
-                .find_map(SegmentSpec::item),
-            first_segment: first + 1,
-            last_segment: last + 1,
-            duration_s: report.duration_s,
-            energy_wh: report.energy_wh,
-            end_soc: report.end_soc,
-        }
+            .rev()
+            .find_map(SegmentSpec::item),
+        first_segment: first + 1,
+        last_segment: last + 1,
+        duration_s: report.duration_s,
+        energy_wh: report.energy_wh,
+        end_soc: report.end_soc,
     }
 }

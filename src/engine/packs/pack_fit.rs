@@ -112,20 +112,6 @@ pub struct PackFitAnswer {
     pub notes: Vec<String>,
 }
 
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    Some(if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    })
-}
-
 /// Read, analyse and combine the logs into a pack (see the module docs).
 ///
 /// # Errors
@@ -301,15 +287,10 @@ fn combine(
     base: Option<&aloft_planner::BatterySpec>,
 ) -> PackFitAnswer {
     let mut notes = Vec::new();
-    let step_r = median(
-        logs.iter()
-            .filter_map(|r| r.internal_resistance_ohm)
-            .collect(),
-    );
-    let autopilot_r = median(
-        logs.iter()
-            .filter_map(|r| r.autopilot_internal_resistance_ohm)
-            .collect(),
+    let flights = aloft_packs::combine_flights(&logs, options.rated_capacity_mah);
+    let (step_r, autopilot_r) = (
+        flights.step_resistance_ohm,
+        flights.autopilot_resistance_ohm,
     );
     let (resistance, source) = match (
         step_r,
@@ -327,19 +308,14 @@ fn combine(
         }
         _ => (None, None),
     };
-    let capacity = median(logs.iter().filter_map(|r| r.capacity_mah).collect());
-    let discharged: f64 = logs.iter().filter_map(|r| r.discharged_mah).sum();
-    let rated = options
-        .rated_capacity_mah
-        .or_else(|| median(logs.iter().filter_map(|r| r.rated_capacity_mah).collect()));
     PackFitAnswer {
         internal_resistance_ohm: resistance,
         internal_resistance_source: source.map(str::to_string),
         autopilot_internal_resistance_ohm: autopilot_r,
-        capacity_mah: capacity,
+        capacity_mah: flights.capacity_mah,
         pack_capacity_mah: None,
-        discharged_mah: discharged,
-        equivalent_cycles: rated.map(|c| discharged / c),
+        discharged_mah: flights.discharged_mah,
+        equivalent_cycles: flights.equivalent_cycles,
         pack: None,
         pack_toml: None,
         output: String::new(),
@@ -373,13 +349,7 @@ fn pack_spec(
             hint: "the logs do not say it: give --cells N or --battery NAME",
         })?;
     let rated = options.rated_capacity_mah.or_else(|| {
-        median(
-            answer
-                .logs
-                .iter()
-                .filter_map(|r| r.rated_capacity_mah)
-                .collect(),
-        )
+        aloft_packs::median_finite(answer.logs.iter().filter_map(|r| r.rated_capacity_mah))
     });
     let capacity_mah = answer
         .capacity_mah
