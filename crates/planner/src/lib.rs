@@ -30,7 +30,9 @@
 //!   voltage and state of charge per segment and per mission), `return_check.rs` (the point of no
 //!   return), `report.rs` (the options and the report types);
 //! - [`queries`]: endurance and range;
-//! - [`mod@replay`]: the energy of a recorded trajectory through the same physics.
+//! - [`mod@replay`]: the energy of a recorded trajectory through the same physics;
+//! - [`sorties`]: a route cut into sorties: where a sortie may end, the mission it flies, how far
+//!   back the next resumes, and the searches for the farthest end a trial flight still holds.
 //!
 //! ## Fast paths
 //! A mission of an hour at 10 ms is 360,000 samples, so the loop has fast paths. Each is kept
@@ -138,7 +140,7 @@ pub mod pack_cursor;
 pub mod plan;
 pub mod queries;
 pub mod replay;
-pub mod route;
+pub mod sorties;
 pub mod trajectory;
 pub mod trim;
 pub mod wind;

@@ -2,7 +2,7 @@
 //! mission spec with them: the main plan flies through it, and so do the searches that re-plan
 //! parts of a route (the loiter until the reserve, the sorties).
 
-use aloft_planner::route::first_speed;
+use aloft_planner::sorties::first_speed;
 use aloft_planner::{
     Aircraft, Mission as Compiled, MissionReport, MissionSpec, NoSamples, Pack, PlanOptions,
     PlannerError, SampleSink, SegmentSpec, Wind,

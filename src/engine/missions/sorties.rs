@@ -26,14 +26,14 @@
 //!    for the images' overlap), never before where the sortie it follows began.
 //!
 //! The route's geometry (where a sortie may end, the mission a sortie flies, how far back the
-//! next resumes) and the searches are [`aloft_planner::route`]'s; here are the steps, each trial a
+//! next resumes) and the searches are [`aloft_planner::sorties`]'s; here are the steps, each trial a
 //! flight on the pack. Each sortie's answer is its own flight: energy, end state of charge,
 //! duration.
 
 use serde::{Deserialize, Serialize};
 
-use aloft_planner::route::{farthest_fraction, last_that_holds};
-pub(in crate::engine) use aloft_planner::route::{segment_ends_m, Cut, Route};
+use aloft_planner::sorties::{farthest_fraction, last_that_holds};
+pub(in crate::engine) use aloft_planner::sorties::{segment_ends_m, Cut, Route};
 use aloft_planner::{Mission as Compiled, MissionReport, MissionSpec, SegmentSpec};
 
 use crate::engine::missions::flight::Flight;
