@@ -166,7 +166,8 @@ fn write_all(tag: &str, plan: bool) -> Vec<Written> {
         } else if plan {
             let path = common::scratch(tag, &format!("{stem}.from-waypoints.plan"));
             let home = home_of(&i);
-            let text = write_plan(&ARDUPILOT, &home, &entries(&i.items)).unwrap();
+            let text =
+                write_plan(&ARDUPILOT, &home, &entries(&i.items), &Default::default()).unwrap();
             check_same_flight(&name, &i, &text);
             (text, path, Some(home))
         } else {
@@ -420,4 +421,102 @@ fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
         plans.len(),
         waypoints.len()
     );
+}
+
+/// Issue 43 item 3: the shared survey with an inclusion fence around it (0.02 deg each way of
+/// home), an exclusion circle (30 m) and a rally point, planned in a wind that takes two packs:
+/// every written sortie carries the file's `geoFence` and `rallyPoints` as given (JSON equal to
+/// what the test wrote), and MAVSDK's importer reads them from each: the polygon's four vertices
+/// (MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION 5001, the vertex count in param1, latitude and
+/// longitude in 1e-7 deg), the circle (MAV_CMD_NAV_FENCE_CIRCLE_EXCLUSION 5004, its radius in
+/// param1) and the rally point (MAV_CMD_NAV_RALLY_POINT 5100, its altitude).
+#[test]
+fn data_val_aloft_plan_keeps_the_fence_and_rally_points_in_every_file() {
+    let source = common::data_dir().join("missions/neilvaltec_test.plan");
+    let mut plan: Value = serde_json::from_str(&std::fs::read_to_string(source).unwrap()).unwrap();
+    let home = &plan["mission"]["plannedHomePosition"];
+    let (lat, lon) = (home[0].as_f64().unwrap(), home[1].as_f64().unwrap());
+    let d = 0.02;
+    let vertices = [
+        [lat - d, lon - d],
+        [lat - d, lon + d],
+        [lat + d, lon + d],
+        [lat + d, lon - d],
+    ];
+    let centre = [lat + 0.001, lon + 0.001];
+    let rally = [lat + 0.0005, lon - 0.0005, 40.0];
+    plan["geoFence"] = json!({"version": 2, "breachReturn": [lat, lon, 30.0],
+        "polygons": [{"inclusion": true, "polygon": vertices, "version": 1}],
+        "circles": [{"inclusion": false, "circle": {"center": centre, "radius": 30.0}, "version": 1}]});
+    plan["rallyPoints"] = json!({"version": 2, "points": [rally]});
+    let file = common::scratch("fence", "fenced.plan");
+    std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
+    let out = file.with_file_name("fenced-out");
+    let _ = std::fs::remove_dir_all(&out);
+    let (f, o) = (file.display().to_string(), out.display().to_string());
+    let answer = common::ok_json(&[
+        "plan",
+        &f,
+        "-o",
+        &o,
+        "--wind-speed",
+        "8",
+        "--wind-from",
+        "0",
+        "--reserve-percent",
+        "70",
+        "--format",
+        "json",
+    ]);
+    let files: Vec<String> = answer["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap().to_string())
+        .collect();
+    assert!(files.len() >= 2, "{answer}");
+    for written in &files {
+        let w: Value = serde_json::from_str(&std::fs::read_to_string(written).unwrap()).unwrap();
+        assert_eq!(w["geoFence"], plan["geoFence"], "{written}");
+        assert_eq!(w["rallyPoints"], plan["rallyPoints"], "{written}");
+    }
+    if !python_ready("mavsdk, pymavlink") {
+        return;
+    }
+    let e7 = |deg: f64| json!((deg * 1e7).round() as i64);
+    let mut args = vec![
+        "mavsdk".to_string(),
+        "--autopilot".into(),
+        "px4".into(),
+        "--airspace".into(),
+    ];
+    args.extend(files.iter().cloned());
+    let read = readers(&args);
+    for written in &files {
+        let r = &read["files"][written.as_str()];
+        let fence = r["fence"]
+            .as_array()
+            .unwrap_or_else(|| panic!("{written}: {r}"));
+        assert_eq!(fence.len(), 5, "{written}: {r}");
+        for (item, v) in fence.iter().zip(&vertices) {
+            assert_eq!(item["command"], 5001, "{item}");
+            assert_eq!(item["params"][0].as_f64(), Some(4.0), "{item}");
+            assert_eq!((&item["x"], &item["y"]), (&e7(v[0]), &e7(v[1])), "{item}");
+        }
+        assert_eq!(fence[4]["command"], 5004, "{}", fence[4]);
+        assert_eq!(fence[4]["params"][0].as_f64(), Some(30.0));
+        assert_eq!(
+            (&fence[4]["x"], &fence[4]["y"]),
+            (&e7(centre[0]), &e7(centre[1]))
+        );
+        let points = r["rally"].as_array().unwrap();
+        assert_eq!(points.len(), 1, "{r}");
+        assert_eq!(points[0]["command"], 5100);
+        assert_eq!(
+            (&points[0]["x"], &points[0]["y"]),
+            (&e7(rally[0]), &e7(rally[1]))
+        );
+        assert_eq!(points[0]["z"].as_f64(), Some(40.0));
+        assert!(!r["items"].as_array().unwrap().is_empty(), "{r}");
+    }
 }

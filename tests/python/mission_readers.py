@@ -18,7 +18,10 @@ Prints one JSON object: {"reader": ..., "files": {FILE: [item, ...]}} where an i
 {"seq", "frame", "command", "current", "autocontinue", "params": [p1..p4], "x", "y", "z"}: for
 MAVSDK, MISSION_ITEM_INT's fields (x, y int32, latitude and longitude in 1e-7 deg), for mavwp
 MISSION_ITEM's (x, y, z as parsed); NaN is written null. A file a reader refuses is
-{"error": "..."} in place of its list.
+{"error": "..."} in place of its list. With `mavsdk --airspace`, each file's answer is
+{"items": [...], "fence": [...], "rally": [...]}: the importer's mission, geofence and rally items
+(the fence as MAV_CMD_NAV_FENCE_* items, a polygon's vertices each with the vertex count in
+param1, a circle with its radius in param1; the rally points as MAV_CMD_NAV_RALLY_POINT).
 """
 import argparse
 import json
@@ -79,7 +82,7 @@ def vehicle(port, autopilot, stop):
         m.close()
 
 
-def read_with_mavsdk(files, autopilot):
+def read_with_mavsdk(files, autopilot, airspace=False):
     import mavsdk
     from mavsdk.plugins.mission_raw.mission_raw import MissionRaw
 
@@ -105,13 +108,23 @@ def read_with_mavsdk(files, autopilot):
             except mavsdk.MavsdkError as e:
                 out[path] = {"error": str(e)}
                 continue
-            out[path] = [
-                item_json(
-                    i.seq, i.frame, i.command, i.current, i.autocontinue,
-                    [i.param1, i.param2, i.param3, i.param4], i.x, i.y, i.z,
-                )
-                for i in data.mission_items
-            ]
+            def items(kind):
+                return [
+                    item_json(
+                        i.seq, i.frame, i.command, i.current, i.autocontinue,
+                        [i.param1, i.param2, i.param3, i.param4], i.x, i.y, i.z,
+                    )
+                    for i in kind
+                ]
+
+            if airspace:
+                out[path] = {
+                    "items": items(data.mission_items),
+                    "fence": items(data.geofence_items),
+                    "rally": items(data.rally_items),
+                }
+            else:
+                out[path] = items(data.mission_items)
         return {"reader": f"mavsdk {mavsdk.__version__} ({sdk.version()})", "files": out}
     finally:
         stop.set()
@@ -147,12 +160,13 @@ def main():
     sub = parser.add_subparsers(dest="reader", required=True)
     m = sub.add_parser("mavsdk")
     m.add_argument("--autopilot", choices=sorted(AUTOPILOTS), required=True)
+    m.add_argument("--airspace", action="store_true", help="the fence and rally items too")
     m.add_argument("files", nargs="+")
     w = sub.add_parser("mavwp")
     w.add_argument("files", nargs="+")
     args = parser.parse_args()
     if args.reader == "mavsdk":
-        answer = read_with_mavsdk(args.files, args.autopilot)
+        answer = read_with_mavsdk(args.files, args.autopilot, args.airspace)
     else:
         answer = read_with_mavwp(args.files)
     json.dump(answer, sys.stdout, allow_nan=False)

@@ -83,6 +83,8 @@ pub struct PlanFile {
     pub header: PlanHeader,
     /// For each of [`crate::Imported::items`], its entry.
     pub origins: Vec<ItemOrigin>,
+    /// Its geofence and rally points.
+    pub airspace: crate::Airspace,
 }
 
 /// One item as it is flown: its index in [`crate::Imported::items`] and the segments it made.

@@ -60,6 +60,7 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
         None => return Err(missing(Place::File, None, &["mission"])),
     };
     check_version(mission)?;
+    let airspace = crate::Airspace::read(root)?;
     let (home, home_amsl_m) = planned_home(mission)?;
     let mut notes = Notes::default();
     let mut surveys = Vec::new();
@@ -102,6 +103,7 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
     imported.plan = Some(PlanFile {
         header: header(mission),
         origins,
+        airspace,
     });
     Ok(imported)
 }

@@ -126,7 +126,9 @@ impl PlannerSorties<'_> {
                 .collect(),
         };
         let written = match (self.kept.format, &self.kept.plan) {
-            (SourceFormat::QgcPlan, Some(plan)) => write_plan(&plan.header, &home, &entries),
+            (SourceFormat::QgcPlan, Some(plan)) => {
+                write_plan(&plan.header, &home, &entries, &plan.airspace)
+            }
             // A file without a home row is written without one, as it was read: its first
             // position (the take-off) is home.
             _ => write_waypoint_rows(self.kept.home.as_ref(), &entries),

@@ -150,6 +150,6 @@ fn turned_mission(
     let plan = imported.plan.as_ref()?;
     let home = imported.home?;
     let entries = plan_entries(imported, angles).ok()?;
-    let text = write_plan(&plan.header, &home, &entries).ok()?;
+    let text = write_plan(&plan.header, &home, &entries, &plan.airspace).ok()?;
     Mission::from_text(&text, mission.origin()).ok()
 }

@@ -20,9 +20,10 @@
 //! `firmwareType` (0, MAV_AUTOPILOT_GENERIC, when the header has none: QGroundControl requires
 //! the key), `vehicleType`, `cruiseSpeed`, `hoverSpeed` and `globalPlanAltitudeMode` where the
 //! header has them, `plannedHomePosition` `[lat, lon, alt AMSL]` (`null` for an altitude the
-//! home has not) and `items`; `geoFence` `{"version": 2, "circles": [], "polygons": []}` and
-//! `rallyPoints` `{"version": 2, "points": []}` (MAVSDK refuses a file without them, and
-//! QGroundControl a `rallyPoints` without `version`). Each item is a SimpleItem: `type`,
+//! home has not) and `items`; the read file's `geoFence` and `rallyPoints` as it gave them
+//! ([`crate::Airspace`]), else `{"version": 2, "circles": [], "polygons": []}` and
+//! `{"version": 2, "points": []}` (MAVSDK refuses a file without them, and QGroundControl a
+//! `rallyPoints` without `version`). Each item is a SimpleItem: `type`,
 //! `command`, `frame`, `params` (exactly 7, NaN written `null`), `autoContinue` true and
 //! `doJumpId` its MAVLink sequence number (the first item 1, a survey's stored items counted),
 //! as QGroundControl saves it; the `Altitude`, `AltitudeMode` and `AMSLAltAboveTerrain` hints are
@@ -97,7 +98,8 @@ pub enum MissionEntry {
 
 /// The file `imported` was read from, written again in its format with its own items: a `.plan`
 /// with its header, home, items and surveys (verbatim; a corridor scan's stored items are
-/// written as SimpleItems, as MAVSDK reads no corridor scan); a `.waypoints` file (or a link's
+/// written as SimpleItems, as MAVSDK reads no corridor scan), its geofence and rally points as
+/// given; a `.waypoints` file (or a link's
 /// items) with its home row when it had one, its items numbered in order. Reading the text
 /// gives the same mission spec and route figures, but for a `.waypoints` file whose INDEX
 /// column did not count up by one (numbered in order now, its warning gone).
@@ -112,7 +114,12 @@ pub fn write_like_source(imported: &Imported) -> Result<String, ImportError> {
                 at: Place::File,
                 hint: "a .plan is written with its plannedHomePosition",
             })?;
-            write_plan(&plan.header, &home, &plan_entries(imported, &[])?)
+            write_plan(
+                &plan.header,
+                &home,
+                &plan_entries(imported, &[])?,
+                &plan.airspace,
+            )
         }
         (SourceFormat::QgcWpl | SourceFormat::MavlinkItems, _) => {
             let entries: Vec<MissionEntry> = imported

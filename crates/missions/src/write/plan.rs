@@ -9,12 +9,13 @@ use crate::error::{ImportError, Place};
 use crate::kept::{Home, PlanHeader};
 use crate::plan::short;
 use crate::survey::number_json;
+use crate::Airspace;
 
 /// What the file says wrote it.
 const GROUND_STATION: &str = "aloft";
 
-/// A QGroundControl `.plan` of `entries`, with `header`'s mission keys and `home` as
-/// `plannedHomePosition`.
+/// A QGroundControl `.plan` of `entries`, with `header`'s mission keys, `home` as
+/// `plannedHomePosition` and `airspace`'s geofence and rally points as the file gave them.
 ///
 /// # Errors
 /// The refusals of the module's docs (naming the item by its `seq`), a `cruiseSpeed` or
@@ -24,6 +25,7 @@ pub fn write_plan(
     header: &PlanHeader,
     home: &Home,
     entries: &[MissionEntry],
+    airspace: &Airspace,
 ) -> Result<String, ImportError> {
     check_home(home, false)?;
     let mut items = Vec::with_capacity(entries.len());
@@ -47,8 +49,8 @@ pub fn write_plan(
         "version": 1,
         "groundStation": GROUND_STATION,
         "mission": mission(header, home, items)?,
-        "geoFence": {"version": 2, "circles": [], "polygons": []},
-        "rallyPoints": {"version": 2, "points": []},
+        "geoFence": airspace.geo_fence_json(),
+        "rallyPoints": airspace.rally_points_json(),
     });
     Ok(pretty(&root))
 }

@@ -3,7 +3,7 @@
 use serde_json::{json, Value};
 
 use super::*;
-use crate::{read_plan, read_waypoints, write_plan, PlanHeader};
+use crate::{read_plan, read_waypoints, write_plan, Airspace, PlanHeader};
 
 const NAN: f64 = f64::NAN;
 
@@ -92,7 +92,7 @@ fn items_of(entries: &[MissionEntry]) -> Vec<MissionItem> {
 fn a_plan_has_the_keys_qgroundcontrol_and_mavsdk_require() {
     let mut entries = mission();
     entries.insert(2, MissionEntry::Survey(survey(3, 4)));
-    let text = write_plan(&header(), &home(), &entries).unwrap();
+    let text = write_plan(&header(), &home(), &entries, &Airspace::default()).unwrap();
     let root: Value = serde_json::from_str(&text).unwrap();
     assert_eq!(
         (&root["fileType"], &root["version"], &root["groundStation"]),
@@ -139,7 +139,7 @@ fn a_plan_has_the_keys_qgroundcontrol_and_mavsdk_require() {
 #[test]
 fn a_plan_reads_back_to_the_last_bit() {
     let entries = mission();
-    let text = write_plan(&header(), &home(), &entries).unwrap();
+    let text = write_plan(&header(), &home(), &entries, &Airspace::default()).unwrap();
     let back = read_plan(&text).unwrap();
     assert_eq!(bits(&back.items), bits(&items_of(&entries)));
     assert_eq!(back.home, Some(home()));
@@ -149,7 +149,13 @@ fn a_plan_reads_back_to_the_last_bit() {
         altitude_amsl_m: None,
         ..home()
     };
-    let text = write_plan(&PlanHeader::default(), &bare, &entries).unwrap();
+    let text = write_plan(
+        &PlanHeader::default(),
+        &bare,
+        &entries,
+        &Airspace::default(),
+    )
+    .unwrap();
     let root: Value = serde_json::from_str(&text).unwrap();
     assert_eq!(root["mission"]["firmwareType"], json!(0));
     assert_eq!(root["mission"]["plannedHomePosition"][2], Value::Null);
@@ -199,7 +205,12 @@ fn a_do_jump_is_refused_by_both_writers_naming_the_item() {
         MissionEntry::Item(item(9, 2, 177, [2.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0])),
     );
     let want = "item 9: command 177 DO_JUMP is refused: the writers write jump-free missions";
-    let e = err(write_plan(&header(), &home(), &entries));
+    let e = err(write_plan(
+        &header(),
+        &home(),
+        &entries,
+        &Airspace::default(),
+    ));
     assert!(e.starts_with(want), "{e}");
     let e = err(write_waypoints(&home(), &entries));
     assert!(e.starts_with(want), "{e}");
@@ -219,7 +230,12 @@ fn a_survey_is_refused_in_waypoints_and_must_be_a_survey_in_a_plan() {
     let mut corridor = survey(3, 4);
     corridor["complexItemType"] = json!("CorridorScan");
     entries[2] = MissionEntry::Survey(corridor);
-    let e = err(write_plan(&header(), &home(), &entries));
+    let e = err(write_plan(
+        &header(),
+        &home(),
+        &entries,
+        &Airspace::default(),
+    ));
     assert!(e.starts_with("item 3: key (survey entry) is {"), "{e}");
 }
 
@@ -236,7 +252,12 @@ fn nan_coordinates_and_infinite_values_are_refused() {
         }
         let want = format!("item 2 (command 16 NAV_WAYPOINT): {key} = NaN is invalid");
         for e in [
-            err(write_plan(&header(), &home(), &entries)),
+            err(write_plan(
+                &header(),
+                &home(),
+                &entries,
+                &Airspace::default(),
+            )),
             err(write_waypoints(&home(), &entries)),
         ] {
             assert!(e.starts_with(&want), "{e}");
@@ -246,7 +267,12 @@ fn nan_coordinates_and_infinite_values_are_refused() {
     if let MissionEntry::Item(i) = &mut entries[2] {
         i.params[0] = f64::INFINITY;
     }
-    let e = err(write_plan(&header(), &home(), &entries));
+    let e = err(write_plan(
+        &header(),
+        &home(),
+        &entries,
+        &Airspace::default(),
+    ));
     assert!(e.starts_with("item 3 (command 530"), "{e}");
     assert!(e.contains("param1 = inf is invalid"), "{e}");
     // The home: coordinates set and in range; an altitude for a .waypoints home row.
@@ -254,7 +280,12 @@ fn nan_coordinates_and_infinite_values_are_refused() {
         latitude_deg: NAN,
         ..home()
     };
-    let e = err(write_plan(&header(), &nowhere, &mission()));
+    let e = err(write_plan(
+        &header(),
+        &nowhere,
+        &mission(),
+        &Airspace::default(),
+    ));
     assert_eq!(
         e,
         "home: latitude = NaN is invalid: expected a latitude within (-90, 90) degrees"
@@ -275,7 +306,7 @@ fn nan_coordinates_and_infinite_values_are_refused() {
     );
     let mut slow = header();
     slow.hover_speed_mps = Some(0.0);
-    let e = err(write_plan(&slow, &home(), &mission()));
+    let e = err(write_plan(&slow, &home(), &mission(), &Airspace::default()));
     assert!(e.starts_with("file: key mission.hoverSpeed is 0"), "{e}");
 }
 
