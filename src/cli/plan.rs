@@ -48,7 +48,7 @@ pub fn run(mut args: PlanArgs) -> Result<Outcome> {
             let mut out = std::io::stdout().lock();
             match args.format {
                 Format::Json => writeln!(out, "{}", answers::no_plan_answer(&reason))?,
-                _ => writeln!(out, "NO PLAN keeps the reserve: {reason}")?,
+                _ => writeln!(out, "NO PLAN: {reason}")?,
             }
             return Ok(Outcome::Failed);
         }

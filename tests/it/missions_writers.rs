@@ -424,7 +424,7 @@ fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
 }
 
 /// Issue 43 item 3: the shared survey with an inclusion fence around it (0.02 deg each way of
-/// home), an exclusion circle (30 m) and a rally point, planned in a wind that takes two packs:
+/// home), an exclusion circle (30 m, clear of the route) and a rally point, planned in a wind that takes two packs:
 /// every written sortie carries the file's `geoFence` and `rallyPoints` as given (JSON equal to
 /// what the test wrote), and MAVSDK's importer reads them from each: the polygon's four vertices
 /// (MAV_CMD_NAV_FENCE_POLYGON_VERTEX_INCLUSION 5001, the vertex count in param1, latitude and
@@ -432,10 +432,7 @@ fn mavsdk_and_mavwp_read_the_sortie_files_aloft_plan_writes() {
 /// param1) and the rally point (MAV_CMD_NAV_RALLY_POINT 5100, its altitude).
 #[test]
 fn data_val_aloft_plan_keeps_the_fence_and_rally_points_in_every_file() {
-    let source = common::data_dir().join("missions/neilvaltec_test.plan");
-    let mut plan: Value = serde_json::from_str(&std::fs::read_to_string(source).unwrap()).unwrap();
-    let home = &plan["mission"]["plannedHomePosition"];
-    let (lat, lon) = (home[0].as_f64().unwrap(), home[1].as_f64().unwrap());
+    let (mut plan, [lat, lon]) = shared_survey();
     let d = 0.02;
     let vertices = [
         [lat - d, lon - d],
@@ -443,7 +440,8 @@ fn data_val_aloft_plan_keeps_the_fence_and_rally_points_in_every_file() {
         [lat + d, lon + d],
         [lat + d, lon - d],
     ];
-    let centre = [lat + 0.001, lon + 0.001];
+    // Clear of the survey (its polygon reaches about 165 m north of home): 445 m north.
+    let centre = [lat + 0.004, lon + 0.001];
     let rally = [lat + 0.0005, lon - 0.0005, 40.0];
     plan["geoFence"] = json!({"version": 2, "breachReturn": [lat, lon, 30.0],
         "polygons": [{"inclusion": true, "polygon": vertices, "version": 1}],
@@ -519,4 +517,94 @@ fn data_val_aloft_plan_keeps_the_fence_and_rally_points_in_every_file() {
         assert_eq!(points[0]["z"].as_f64(), Some(40.0));
         assert!(!r["items"].as_array().unwrap().is_empty(), "{r}");
     }
+}
+
+/// The shared survey's `.plan` as JSON, and its home's latitude and longitude.
+fn shared_survey() -> (Value, [f64; 2]) {
+    let source = common::data_dir().join("missions/neilvaltec_test.plan");
+    let plan: Value = serde_json::from_str(&std::fs::read_to_string(source).unwrap()).unwrap();
+    let home = &plan["mission"]["plannedHomePosition"];
+    let home = [home[0].as_f64().unwrap(), home[1].as_f64().unwrap()];
+    (plan, home)
+}
+
+/// Great-circle distance between two points, m (haversine, mean Earth radius 6 371 km).
+fn haversine_m(a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (la1, la2) = (a[0].to_radians(), b[0].to_radians());
+    let (dla, dlo) = ((b[0] - a[0]).to_radians(), (b[1] - a[1]).to_radians());
+    let h = (dla / 2.0).sin().powi(2) + la1.cos() * la2.cos() * (dlo / 2.0).sin().powi(2);
+    2.0 * 6_371_000.0 * h.sqrt().asin()
+}
+
+/// `aloft plan` of the shared survey with `fence` as its `geoFence`: exit code, stdout, stderr.
+fn plan_fenced(tag: &str, fence: Value) -> (i32, String, String) {
+    let (mut plan, _) = shared_survey();
+    plan["geoFence"] = fence;
+    let file = common::scratch(tag, "fenced.plan");
+    std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
+    let out = file.with_file_name("out");
+    let (f, o) = (file.display().to_string(), out.display().to_string());
+    common::run(&[
+        "plan",
+        &f,
+        "-o",
+        &o,
+        "--wind-speed",
+        "8",
+        "--wind-from",
+        "0",
+        "--reserve-percent",
+        "70",
+    ])
+}
+
+/// The "lat, lon" after `at ` at the end of a refusal.
+fn breach_point(text: &str) -> [f64; 2] {
+    let at = text.trim().rsplit("at ").next().unwrap();
+    let v: Vec<f64> = at.split(", ").map(|x| x.parse().unwrap()).collect();
+    [v[0], v[1]]
+}
+
+/// Issue 43 item 3: a 30 m exclusion circle on the survey (111 m north, 100 m east of home,
+/// inside its polygon): no plan, exit 1, naming the sortie, the fence and the item, at a point
+/// on the circle's edge (30 m from its centre, to 0.5 m: the point is printed to 1e-6 deg).
+/// An inclusion square 0.001 deg (111 m) each way of home, inside the survey's reach: no plan
+/// either, the route leaving it, at a point on its edge. Both planned before this issue.
+#[test]
+fn data_val_a_route_through_the_fence_is_refused_where_it_breaches() {
+    let (_, [lat, lon]) = shared_survey();
+    let centre = [lat + 0.001, lon + 0.001];
+    let (code, out, err) = plan_fenced(
+        "fence-circle",
+        json!({"version": 2, "polygons": [], "circles": [
+            {"inclusion": false, "circle": {"center": centre, "radius": 30.0}, "version": 1}]}),
+    );
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        out.contains("sortie ") && out.contains("enters the fence's exclusion circle 1 at item "),
+        "{out}"
+    );
+    let d = haversine_m(breach_point(&out), centre);
+    assert!((d - 30.0).abs() < 0.5, "{d} m from the centre: {out}");
+
+    let d = 0.001;
+    let square = [
+        [lat - d, lon - d],
+        [lat - d, lon + d],
+        [lat + d, lon + d],
+        [lat + d, lon - d],
+    ];
+    let (code, out, err) = plan_fenced(
+        "fence-square",
+        json!({"version": 2, "circles": [], "polygons": [
+            {"inclusion": true, "polygon": square, "version": 1}]}),
+    );
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(
+        out.contains("leaves the fence's inclusion polygon 1 at "),
+        "{out}"
+    );
+    let p = breach_point(&out);
+    let on_edge = ((p[0] - lat).abs() - d).abs() < 2e-6 || ((p[1] - lon).abs() - d).abs() < 2e-6;
+    assert!(on_edge, "{p:?} is not on the square's edge: {out}");
 }

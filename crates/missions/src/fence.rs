@@ -11,10 +11,17 @@
 //! - `rallyPoints`: `{"version": 2, "points": [[lat, lon, alt_m], ...]}`, the altitude relative
 //!   to home.
 //!
+//! A route is checked in the plane tangent at home ([`Airspace::local`], east and north in m):
+//! the vehicle must stay inside every inclusion fence and outside every exclusion fence (the
+//! fences of a `.plan` are one inclusion group, as MAVLink's fence items and the autopilots read
+//! them), horizontally; [`LocalFence::first_breach`] finds where a straight stretch first leaves
+//! or enters one (a point on a fence's edge is inside it).
+//!
 //! A `geoFence` of another version (QGroundControl's version 1 had no polygons list) or an empty
 //! object holds no fence; the writer then writes the empty version 2 objects that QGroundControl
 //! and MAVSDK require.
 
+use aloft_planner::geodesy::LocalFrame;
 use serde_json::{json, Map, Value};
 
 use crate::error::{ImportError, Place};
@@ -107,6 +114,194 @@ impl Airspace {
             .clone()
             .unwrap_or_else(|| json!({"version": 2, "points": []}))
     }
+}
+
+/// One fence in the plane tangent at home.
+#[derive(Debug, Clone, PartialEq)]
+enum Shape {
+    /// A polygon's vertices, east and north, m.
+    Polygon(Vec<[f64; 2]>),
+    /// A circle's centre, east and north, m, and radius, m.
+    Circle([f64; 2], f64),
+}
+
+/// A fence in the plane tangent at home: its shape, whether it is an inclusion fence, and its
+/// name (`inclusion polygon 1`, `exclusion circle 2`: the kind and its place among the file's
+/// polygons or circles, from 1).
+#[derive(Debug, Clone, PartialEq)]
+struct LocalShape {
+    shape: Shape,
+    inclusion: bool,
+    name: String,
+}
+
+/// An [`Airspace`]'s fences in the plane tangent at home.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LocalFence {
+    fences: Vec<LocalShape>,
+}
+
+/// Where a straight stretch first leaves an inclusion fence or enters an exclusion fence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Breach {
+    /// How far along the stretch, 0 (its start) to 1 (its end).
+    pub fraction: f64,
+    /// The point, east and north of home, m.
+    pub at_m: [f64; 2],
+    /// The fence (`inclusion polygon 1`, `exclusion circle 2`).
+    pub fence: String,
+    /// Whether the stretch leaves an inclusion fence (else it enters an exclusion fence).
+    pub leaves: bool,
+}
+
+impl Airspace {
+    /// The fences in the plane tangent at home (`frame`).
+    pub fn local(&self, frame: &LocalFrame) -> LocalFence {
+        let to_m = |p: &LatLon| frame.to_local_m(p.latitude_deg, p.longitude_deg);
+        let kind = |inclusion: bool| match inclusion {
+            true => "inclusion",
+            false => "exclusion",
+        };
+        let polygons = self.polygons.iter().enumerate().map(|(k, p)| LocalShape {
+            shape: Shape::Polygon(p.vertices.iter().map(to_m).collect()),
+            inclusion: p.inclusion,
+            name: format!("{} polygon {}", kind(p.inclusion), k + 1),
+        });
+        let circles = self.circles.iter().enumerate().map(|(k, c)| LocalShape {
+            shape: Shape::Circle(to_m(&c.centre), c.radius_m),
+            inclusion: c.inclusion,
+            name: format!("{} circle {}", kind(c.inclusion), k + 1),
+        });
+        LocalFence {
+            fences: polygons.chain(circles).collect(),
+        }
+    }
+}
+
+impl LocalFence {
+    /// Whether there is no fence.
+    pub fn is_empty(&self) -> bool {
+        self.fences.is_empty()
+    }
+
+    /// The first point of the stretch from `a` to `b` (east and north of home, m) outside an
+    /// inclusion fence or inside an exclusion fence, if any.
+    pub fn first_breach(&self, a: [f64; 2], b: [f64; 2]) -> Option<Breach> {
+        self.fences
+            .iter()
+            .filter_map(|f| {
+                let fraction = match &f.shape {
+                    Shape::Polygon(v) => polygon_breach(v, f.inclusion, a, b),
+                    Shape::Circle(c, r) => circle_breach(*c, *r, f.inclusion, a, b),
+                }?;
+                Some(Breach {
+                    fraction,
+                    at_m: [
+                        a[0] + fraction * (b[0] - a[0]),
+                        a[1] + fraction * (b[1] - a[1]),
+                    ],
+                    fence: f.name.clone(),
+                    leaves: f.inclusion,
+                })
+            })
+            .min_by(|x, y| x.fraction.total_cmp(&y.fraction))
+    }
+}
+
+/// How far along `a`-`b` it first leaves (`inclusion`) or enters the polygon `v`.
+fn polygon_breach(v: &[[f64; 2]], inclusion: bool, a: [f64; 2], b: [f64; 2]) -> Option<f64> {
+    if inside_polygon(v, a) != inclusion {
+        return Some(0.0);
+    }
+    // The first crossing of an edge (the stretch changes side there); a crossing that only
+    // touches the edge and comes back is not a breach, checked at the middle of what follows.
+    let mut crossings: Vec<f64> = (0..v.len())
+        .filter_map(|k| crossing(a, b, v[k], v[(k + 1) % v.len()]))
+        .collect();
+    crossings.sort_by(f64::total_cmp);
+    crossings.push(1.0);
+    let mut from = 0.0;
+    for t in crossings {
+        let mid = 0.5 * (from + t);
+        let p = [a[0] + mid * (b[0] - a[0]), a[1] + mid * (b[1] - a[1])];
+        if inside_polygon(v, p) != inclusion {
+            return Some(from);
+        }
+        from = t;
+    }
+    (inside_polygon(v, b) != inclusion).then_some(1.0)
+}
+
+/// How far along `a`-`b` it first leaves (`inclusion`) or enters the circle of centre `c` and
+/// radius `r`.
+fn circle_breach(c: [f64; 2], r: f64, inclusion: bool, a: [f64; 2], b: [f64; 2]) -> Option<f64> {
+    let inside = |p: [f64; 2]| (p[0] - c[0]).hypot(p[1] - c[1]) <= r;
+    if inside(a) != inclusion {
+        return Some(0.0);
+    }
+    // |a + t d - c| = r: t^2 |d|^2 + 2 t d.(a - c) + |a - c|^2 - r^2 = 0.
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let e = [a[0] - c[0], a[1] - c[1]];
+    let qa = d[0] * d[0] + d[1] * d[1];
+    let qb = 2.0 * (d[0] * e[0] + d[1] * e[1]);
+    let qc = e[0] * e[0] + e[1] * e[1] - r * r;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa <= 0.0 || disc <= 0.0 {
+        return None;
+    }
+    let root = disc.sqrt();
+    // Inside an inclusion circle the stretch leaves at the larger root; outside an exclusion
+    // circle it enters at the smaller one.
+    let t = match inclusion {
+        true => (-qb + root) / (2.0 * qa),
+        false => (-qb - root) / (2.0 * qa),
+    };
+    (t > 0.0 && t < 1.0)
+        .then_some(t)
+        .filter(|_| !inclusion || !inside(b))
+}
+
+/// Whether `q` is inside the polygon `v` (even-odd rule) or on its edge.
+fn inside_polygon(v: &[[f64; 2]], q: [f64; 2]) -> bool {
+    let mut inside = false;
+    for k in 0..v.len() {
+        let (p, n) = (v[k], v[(k + 1) % v.len()]);
+        if to_segment_m(q, p, n) < 1e-6 {
+            return true;
+        }
+        if (p[1] > q[1]) != (n[1] > q[1]) {
+            let x = p[0] + (q[1] - p[1]) / (n[1] - p[1]) * (n[0] - p[0]);
+            if q[0] < x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
+}
+
+/// Where along `a`-`b` it crosses the segment `p`-`n` (0 to 1), if it does.
+fn crossing(a: [f64; 2], b: [f64; 2], p: [f64; 2], n: [f64; 2]) -> Option<f64> {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let e = [n[0] - p[0], n[1] - p[1]];
+    let den = d[0] * e[1] - d[1] * e[0];
+    if den == 0.0 {
+        return None;
+    }
+    let w = [p[0] - a[0], p[1] - a[1]];
+    let t = (w[0] * e[1] - w[1] * e[0]) / den;
+    let u = (w[0] * d[1] - w[1] * d[0]) / den;
+    ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
+}
+
+/// Distance from `q` to the segment `a`-`b`, m.
+fn to_segment_m(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    let t = match len2 > 0.0 {
+        true => (((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0),
+        false => 0.0,
+    };
+    (q[0] - a[0] - t * d[0]).hypot(q[1] - a[1] - t * d[1])
 }
 
 /// The object when it is a version 2 one.
@@ -254,6 +449,75 @@ mod tests {
 
     fn root(text: &str) -> Map<String, Value> {
         serde_json::from_str(text).unwrap()
+    }
+
+    /// A 100 m square inclusion fence and a 10 m exclusion circle at (50, 50): a stretch across
+    /// the square's east side leaves it at x = 100 (0.5 of the way from 50 to 150); one through
+    /// the circle's centre from (20, 50) to (80, 50) enters it at x = 40 (a third of the way); one
+    /// inside and clear of both holds; one that starts outside breaches at its start; a stretch
+    /// along the edge is inside.
+    #[test]
+    fn a_stretch_breaches_where_it_leaves_or_enters_a_fence() {
+        let frame = LocalFrame::new(47.0, 8.0);
+        let deg = |e: f64, n: f64| {
+            let [la, lo] = frame.to_lat_lon_deg(e, n);
+            LatLon::new(la, lo)
+        };
+        let airspace = Airspace {
+            polygons: vec![FencePolygon {
+                inclusion: true,
+                vertices: vec![
+                    deg(0.0, 0.0),
+                    deg(100.0, 0.0),
+                    deg(100.0, 100.0),
+                    deg(0.0, 100.0),
+                ],
+            }],
+            circles: vec![FenceCircle {
+                inclusion: false,
+                centre: deg(50.0, 50.0),
+                radius_m: 10.0,
+            }],
+            ..Airspace::default()
+        };
+        let fence = airspace.local(&frame);
+        let b = fence.first_breach([50.0, 20.0], [150.0, 20.0]).unwrap();
+        assert!((b.fraction - 0.5).abs() < 1e-6, "{b:?}");
+        assert!((b.at_m[0] - 100.0).abs() < 1e-4 && b.leaves, "{b:?}");
+        assert_eq!(b.fence, "inclusion polygon 1");
+        let c = fence.first_breach([20.0, 50.0], [80.0, 50.0]).unwrap();
+        assert!((c.fraction - 1.0 / 3.0).abs() < 1e-6, "{c:?}");
+        assert_eq!(c.fence, "exclusion circle 1");
+        assert!(!c.leaves);
+        assert_eq!(fence.first_breach([10.0, 10.0], [90.0, 20.0]), None);
+        let out = fence.first_breach([-5.0, 10.0], [10.0, 10.0]).unwrap();
+        assert!(out.fraction.abs() < 1e-12);
+        assert_eq!(fence.first_breach([0.0, 10.0], [0.0, 90.0]), None);
+    }
+
+    /// A concave "U" inclusion fence: a stretch from one arm to the other, both ends inside,
+    /// leaves it across the notch (at x = 10 of a stretch from x = 5 to x = 25: a quarter).
+    /// An exclusion polygon crossed right through (both ends outside) is entered at its edge.
+    #[test]
+    fn a_stretch_with_both_ends_inside_a_concave_fence_can_still_leave_it() {
+        let u = vec![
+            [0.0, 0.0],
+            [30.0, 0.0],
+            [30.0, 30.0],
+            [20.0, 30.0],
+            [20.0, 10.0],
+            [10.0, 10.0],
+            [10.0, 30.0],
+            [0.0, 30.0],
+        ];
+        assert_eq!(
+            polygon_breach(&u, true, [5.0, 20.0], [25.0, 20.0]),
+            Some(0.25)
+        );
+        assert_eq!(polygon_breach(&u, true, [5.0, 5.0], [25.0, 5.0]), None);
+        let square = vec![[40.0, 0.0], [50.0, 0.0], [50.0, 10.0], [40.0, 10.0]];
+        let t = polygon_breach(&square, false, [30.0, 5.0], [60.0, 5.0]).unwrap();
+        assert!((t - 1.0 / 3.0).abs() < 1e-12, "{t}");
     }
 
     /// QGroundControl's own shapes: an inclusion polygon, an exclusion circle, a rally point; the

@@ -73,7 +73,7 @@ pub use aloft_logs::telemetry::MissionItem;
 pub use aloft_planner::{HomeSpec, MissionSpec, SegmentSpec};
 pub use detect::detect;
 pub use error::{ImportError, Place};
-pub use fence::{Airspace, FenceCircle, FencePolygon, RallyPoint};
+pub use fence::{Airspace, Breach, FenceCircle, FencePolygon, LocalFence, RallyPoint};
 pub use geo::{distance_m, great_circle_m, LatLon, MEAN_RADIUS_M};
 pub use items::MIN_HEIGHT_M;
 pub use jumps::MAX_REPEATED_ITEMS;

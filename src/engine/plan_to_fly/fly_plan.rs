@@ -19,13 +19,16 @@
 //!    legs, and the as-given split), the one with the fewest batteries, then the least energy; so
 //!    the plan never needs more batteries or energy than the mission as given.
 //! 5. **Files**, one per sortie in the input's format ([`FlyPlan::files`]), each a complete
-//!    mission that `aloft mission` flies in the same conditions to the sortie's answer.
+//!    mission that `aloft mission` flies in the same conditions to the sortie's answer, and whose
+//!    whole path stays inside the operator's inclusion fences and out of the exclusion ones (a
+//!    `.plan`'s geofence, written into every file with its rally points).
 
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use aloft_missions::SourceFormat;
+use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::{best_range_within_limits, MissionSpec, SegmentSpec, Wind};
 
 use crate::engine::files::{safe_stem, shown_path, OutputSet};
@@ -34,6 +37,7 @@ use crate::engine::missions::day::mission_wind;
 use crate::engine::missions::mission::{plan_mission, prepare, Prepared};
 use crate::engine::missions::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN};
 use crate::engine::missions::mission_options::MissionOptions;
+use crate::engine::missions::mission_outputs::segment_paths;
 use crate::engine::missions::sorties::{
     segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
 };
@@ -618,6 +622,7 @@ fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String
                 k + 1
             ));
         }
+        within_fence(cx, plan, (k + 1, n))?;
         texts.push(maker.text(cx.mission, plan, (k + 1, n))?);
     }
     Ok(Flown {
@@ -626,6 +631,62 @@ fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String
         plans,
         texts,
     })
+}
+
+/// Whether sortie `k` of `n` (its file read back, `plan.spec`) stays inside the operator's
+/// inclusion fences and out of the exclusion ones the whole way (take-off, fly-out, route, way
+/// home), horizontally ([`aloft_missions::LocalFence`]; an orbit as its chords).
+///
+/// # Errors
+/// The sortie, the fence, the item (or the segment aloft added) and where it first breaches.
+fn within_fence(cx: &Context<'_>, plan: &SortiePlan, (k, n): (usize, usize)) -> Result<(), String> {
+    let Some(airspace) = cx
+        .mission
+        .kept()
+        .and_then(|i| i.plan.as_ref())
+        .map(|p| &p.airspace)
+    else {
+        return Ok(());
+    };
+    let home = &plan.spec.home;
+    let (Some(latitude_deg), Some(longitude_deg)) = (home.latitude_deg, home.longitude_deg) else {
+        return Ok(());
+    };
+    let frame = LocalFrame::new(latitude_deg, longitude_deg);
+    let fence = airspace.local(&frame);
+    if fence.is_empty() {
+        return Ok(());
+    }
+    let compiled = cx
+        .prepared
+        .flight
+        .compile(&plan.spec, None)
+        .map_err(|e| e.to_string())?;
+    let origin = compiled.home_m();
+    let local = |p: [f64; 3]| [p[0] - origin[0], p[1] - origin[1]];
+    for (segment, points) in segment_paths(&compiled) {
+        let breach = points
+            .windows(2)
+            .find_map(|w| fence.first_breach(local(w[0]), local(w[1])));
+        let Some(breach) = breach else {
+            continue;
+        };
+        let seg = &plan.spec.segments[segment];
+        let what = match seg.item() {
+            Some(i) => format!("item {i} ({})", seg.kind()),
+            None => format!("segment {} ({}, aloft's own)", segment + 1, seg.kind()),
+        };
+        let [la, lo] = frame.to_lat_lon_deg(breach.at_m[0], breach.at_m[1]);
+        let verb = match breach.leaves {
+            true => "leaves",
+            false => "enters",
+        };
+        return Err(format!(
+            "sortie {k} of {n} {verb} the fence's {} at {what}, at {la:.6}, {lo:.6}",
+            breach.fence
+        ));
+    }
+    Ok(())
 }
 
 /// Who makes the sorties' missions and files: aloft's own segments (TOML, JSON) or the items of a
