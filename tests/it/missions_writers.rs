@@ -608,3 +608,79 @@ fn data_val_a_route_through_the_fence_is_refused_where_it_breaches() {
     let on_edge = ((p[0] - lat).abs() - d).abs() < 2e-6 || ((p[1] - lon).abs() - d).abs() < 2e-6;
     assert!(on_edge, "{p:?} is not on the square's edge: {out}");
 }
+
+/// The shared survey with every positioned item (its take-off and the survey's stored
+/// waypoints, all at 50 m above home, frame 3) moved into `frame` at `50 + offset_m`.
+fn survey_in_frame(frame: u32, offset_m: f64) -> Value {
+    let (mut plan, _) = shared_survey();
+    let moved = |item: &mut Value| {
+        if item["frame"] == 3 {
+            item["frame"] = json!(frame);
+            let z = item["params"][6].as_f64().unwrap();
+            item["params"][6] = json!(z + offset_m);
+        }
+    };
+    for item in plan["mission"]["items"].as_array_mut().unwrap() {
+        if item["type"] == "SimpleItem" {
+            moved(item);
+        } else if let Some(stored) = item["TransectStyleComplexItem"]["Items"].as_array_mut() {
+            stored.iter_mut().for_each(moved);
+        }
+    }
+    plan
+}
+
+/// Issue 43 item 3: in a survey flown above mean sea level (frame 0: 55 m, home at 5 m AMSL)
+/// or in terrain frame (10: 50 m), the waypoints and take-offs `aloft plan` inserts where it
+/// cuts and resumes are written in that frame at that altitude: every positioned item of every
+/// sortie is in the survey's frame at its altitude (before: frame 3 at 50 m, which above mean
+/// sea level is 45 m below the survey).
+#[test]
+fn data_val_inserted_waypoints_keep_the_frame_of_the_leg_they_cut() {
+    for (frame, offset_m) in [(0u32, 5.0), (10, 0.0)] {
+        let plan = survey_in_frame(frame, offset_m);
+        let file = common::scratch("frames", &format!("frame{frame}.plan"));
+        std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
+        let out = file.with_file_name(format!("out{frame}"));
+        let _ = std::fs::remove_dir_all(&out);
+        let (f, o) = (file.display().to_string(), out.display().to_string());
+        let answer = common::ok_json(&[
+            "plan",
+            &f,
+            "-o",
+            &o,
+            "--wind-speed",
+            "8",
+            "--wind-from",
+            "0",
+            "--reserve-percent",
+            "70",
+            "--keep-angle",
+            "--format",
+            "json",
+        ]);
+        let files = answer["files"].as_array().unwrap();
+        assert!(files.len() >= 2, "{answer}");
+        let mut inserted = 0;
+        for written in files {
+            let text = std::fs::read_to_string(written.as_str().unwrap()).unwrap();
+            let w: Value = serde_json::from_str(&text).unwrap();
+            for item in w["mission"]["items"].as_array().unwrap() {
+                let command = item["command"].as_u64().unwrap();
+                if ![16, 22].contains(&command) {
+                    continue;
+                }
+                assert_eq!(item["frame"], json!(frame), "{written}: {item}");
+                let z = item["params"][6].as_f64().unwrap();
+                assert!((z - (50.0 + offset_m)).abs() < 1e-6, "{written}: {item}");
+                inserted += usize::from(command == 22);
+            }
+        }
+        // Each sortie after the first takes off to where it resumes.
+        assert!(
+            inserted >= files.len(),
+            "{inserted} take-offs in {} files",
+            files.len()
+        );
+    }
+}

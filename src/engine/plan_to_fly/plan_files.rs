@@ -11,7 +11,7 @@
 //!
 //! then the items of the route it flies (a leg it resumes inside of is flown to its waypoint from
 //! where it resumes), and, where it turns home inside a leg, a waypoint there (NAV_WAYPOINT 16,
-//! frame 3); the camera stopped when it was on (206 with 0; IMAGE_STOP_CAPTURE 2001 after a
+//! in the leg's frame: Positions below); the camera stopped when it was on (206 with 0; IMAGE_STOP_CAPTURE 2001 after a
 //! timed capture: QGroundControl #5737, cameras that kept triggering through RTL); a return to
 //! launch (NAV_RETURN_TO_LAUNCH 20). The last sortie flies the file's own way down (the camera
 //! stopped and a return to launch written when the file ends in the air).
@@ -39,7 +39,12 @@
 //!
 //! **Positions**: a point inside a leg is placed as the planner places the leg, in the tangent
 //! plane of the leg's start (the last position before it, home at first), so that the file read
-//! back puts it where the plan cut the route; its height is above home (frame 3).
+//! back puts it where the plan cut the route. Its altitude (and a later sortie's take-off's) is
+//! in the frame of the item whose leg it cuts: above home in the relative frame (3, 6), above
+//! mean sea level in the AMSL frame (0, 5: the height above home plus the file's home altitude),
+//! in the terrain frame (10, 11) the height the leg has there as the reader flies it (linear
+//! between its items' terrain altitudes); above home (frame 3) for an AMSL leg in a file without
+//! a home altitude.
 
 use aloft_logs::telemetry::MissionItem;
 use aloft_missions::{write_plan, write_waypoint_rows, Home, Imported, MissionEntry, SourceFormat};
@@ -208,7 +213,7 @@ impl PlannerSorties<'_> {
                 let at = self.flown_at(e.segment);
                 out.extend(self.flown_items(first..at));
                 // The leg's own number: the point is on its leg, flown at its speed.
-                let mut turn = waypoint(self.point_deg(home, e), self.height_m(e));
+                let mut turn = waypoint(self.point_deg(home, e), self.altitude(home, e));
                 turn.seq = self.kept.items[flown[at].item].seq;
                 out.push(turn);
                 self.home_items(&mut out);
@@ -248,11 +253,11 @@ impl PlannerSorties<'_> {
     /// The take-off, the stopped camera, the waypoint where the sortie resumes and the items in
     /// force there (the flying order before `first`).
     fn resume_items(&self, home: &Home, cut: Cut, first: usize) -> Vec<MissionItem> {
-        let height_m = self.height_m(cut);
+        let altitude = self.altitude(home, cut);
         let mut out = vec![
             item(
                 cmd::NAV_TAKEOFF,
-                FRAME_RELATIVE,
+                altitude.frame,
                 [
                     0.0,
                     0.0,
@@ -260,11 +265,11 @@ impl PlannerSorties<'_> {
                     f64::NAN,
                     home.latitude_deg,
                     home.longitude_deg,
-                    height_m,
+                    altitude.value_m,
                 ],
             ),
             camera_trigger(0.0),
-            waypoint(self.point_deg(home, cut), height_m),
+            waypoint(self.point_deg(home, cut), altitude),
         ];
         out.extend(in_force(&self.flown_items(0..first)));
         out
@@ -311,9 +316,33 @@ impl PlannerSorties<'_> {
         frame.to_lat_lon_deg(f * d[0], f * d[1])
     }
 
-    /// The height of the route at `cut` above home, m.
-    fn height_m(&self, cut: Cut) -> f64 {
-        self.route.point_m(cut)[2] - self.route.home_up_m()
+    /// The altitude of the route at `cut` in the frame of the item whose leg it cuts (module
+    /// docs, Positions): the height above home in the relative and terrain frames (the reader
+    /// flies a terrain frame as relative), that plus the file's home altitude in the AMSL
+    /// frames; relative to home for any other frame, or an AMSL one without a home altitude.
+    fn altitude(&self, home: &Home, cut: Cut) -> Altitude {
+        let height_m = self.route.point_m(cut)[2] - self.route.home_up_m();
+        let frame = self
+            .kept
+            .flown
+            .get(self.flown_at(cut.segment))
+            .map(|f| &self.kept.items[f.item])
+            .filter(|i| has_position(i.command))
+            .map_or(FRAME_RELATIVE, |i| i.frame);
+        match (frame, home.altitude_amsl_m) {
+            (3 | 6 | 10 | 11, _) => Altitude {
+                frame,
+                value_m: height_m,
+            },
+            (0 | 5, Some(home_m)) => Altitude {
+                frame,
+                value_m: height_m + home_m,
+            },
+            _ => Altitude {
+                frame: FRAME_RELATIVE,
+                value_m: height_m,
+            },
+        }
     }
 
     /// The latitude and longitude of the item at `at` in the flying order, when it has a
@@ -398,12 +427,19 @@ fn item(command: u32, frame: u32, params: [f64; 7]) -> MissionItem {
 }
 
 /// A waypoint flown through at `[lat, lon]`, `height_m` above home.
-fn waypoint(at: [f64; 2], height_m: f64) -> MissionItem {
+fn waypoint(at: [f64; 2], altitude: Altitude) -> MissionItem {
     item(
         cmd::NAV_WAYPOINT,
-        FRAME_RELATIVE,
-        [0.0, 0.0, 0.0, f64::NAN, at[0], at[1], height_m],
+        altitude.frame,
+        [0.0, 0.0, 0.0, f64::NAN, at[0], at[1], altitude.value_m],
     )
+}
+
+/// An item's altitude: its MAV_FRAME and its value in it, m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Altitude {
+    frame: u32,
+    value_m: f64,
 }
 
 /// DO_SET_CAM_TRIGG_DIST at `distance_m` (0: stop).
