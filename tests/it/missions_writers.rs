@@ -449,23 +449,7 @@ fn data_val_aloft_plan_keeps_the_fence_and_rally_points_in_every_file() {
     plan["rallyPoints"] = json!({"version": 2, "points": [rally]});
     let file = common::scratch("fence", "fenced.plan");
     std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
-    let out = file.with_file_name("fenced-out");
-    let _ = std::fs::remove_dir_all(&out);
-    let (f, o) = (file.display().to_string(), out.display().to_string());
-    let answer = common::ok_json(&[
-        "plan",
-        &f,
-        "-o",
-        &o,
-        "--wind-speed",
-        "8",
-        "--wind-from",
-        "0",
-        "--reserve-percent",
-        "70",
-        "--format",
-        "json",
-    ]);
+    let answer = plan_in_wind(&file, &file.with_file_name("fenced-out"), &[]);
     let files: Vec<String> = answer["files"]
         .as_array()
         .unwrap()
@@ -542,20 +526,12 @@ fn plan_fenced(tag: &str, fence: Value) -> (i32, String, String) {
     plan["geoFence"] = fence;
     let file = common::scratch(tag, "fenced.plan");
     std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
-    let out = file.with_file_name("out");
-    let (f, o) = (file.display().to_string(), out.display().to_string());
-    common::run(&[
-        "plan",
-        &f,
-        "-o",
-        &o,
-        "--wind-speed",
-        "8",
-        "--wind-from",
-        "0",
-        "--reserve-percent",
-        "70",
-    ])
+    common::run(
+        &plan_args(&file, &file.with_file_name("out"), &[])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    )
 }
 
 /// The "lat, lon" after `at ` at the end of a refusal.
@@ -642,23 +618,7 @@ fn data_val_inserted_waypoints_keep_the_frame_of_the_leg_they_cut() {
         let file = common::scratch("frames", &format!("frame{frame}.plan"));
         std::fs::write(&file, serde_json::to_string_pretty(&plan).unwrap()).unwrap();
         let out = file.with_file_name(format!("out{frame}"));
-        let _ = std::fs::remove_dir_all(&out);
-        let (f, o) = (file.display().to_string(), out.display().to_string());
-        let answer = common::ok_json(&[
-            "plan",
-            &f,
-            "-o",
-            &o,
-            "--wind-speed",
-            "8",
-            "--wind-from",
-            "0",
-            "--reserve-percent",
-            "70",
-            "--keep-angle",
-            "--format",
-            "json",
-        ]);
+        let answer = plan_in_wind(&file, &out, &["--keep-angle"]);
         let files = answer["files"].as_array().unwrap();
         assert!(files.len() >= 2, "{answer}");
         let mut inserted = 0;
@@ -683,4 +643,32 @@ fn data_val_inserted_waypoints_keep_the_frame_of_the_leg_they_cut() {
             files.len()
         );
     }
+}
+
+/// `plan FILE -o OUT` in the 8 m/s northerly at a 70 % reserve (the shared survey's two packs),
+/// then `extra`.
+fn plan_args(file: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let _ = std::fs::remove_dir_all(out);
+    let (f, o) = (file.display().to_string(), out.display().to_string());
+    let mut args = vec![
+        "plan",
+        &f,
+        "-o",
+        &o,
+        "--wind-speed",
+        "8",
+        "--wind-from",
+        "0",
+        "--reserve-percent",
+        "70",
+    ];
+    args.extend_from_slice(extra);
+    args.into_iter().map(String::from).collect()
+}
+
+/// [`plan_args`] with `--format json`, which must succeed: its JSON answer.
+fn plan_in_wind(file: &Path, out: &Path, extra: &[&str]) -> Value {
+    let mut extra = extra.to_vec();
+    extra.extend(["--format", "json"]);
+    common::ok_json(&plan_args(file, out, &extra))
 }

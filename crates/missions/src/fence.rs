@@ -27,6 +27,7 @@ use serde_json::{json, Map, Value};
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
 use crate::plan::bad_key;
+use crate::plane::{inside, to_segment_m};
 
 /// A fence polygon: the vehicle stays inside an inclusion polygon and out of an exclusion one.
 #[derive(Debug, Clone, PartialEq)]
@@ -263,20 +264,8 @@ fn circle_breach(c: [f64; 2], r: f64, inclusion: bool, a: [f64; 2], b: [f64; 2])
 
 /// Whether `q` is inside the polygon `v` (even-odd rule) or on its edge.
 fn inside_polygon(v: &[[f64; 2]], q: [f64; 2]) -> bool {
-    let mut inside = false;
-    for k in 0..v.len() {
-        let (p, n) = (v[k], v[(k + 1) % v.len()]);
-        if to_segment_m(q, p, n) < 1e-6 {
-            return true;
-        }
-        if (p[1] > q[1]) != (n[1] > q[1]) {
-            let x = p[0] + (q[1] - p[1]) / (n[1] - p[1]) * (n[0] - p[0]);
-            if q[0] < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
+    let on_edge = (0..v.len()).any(|k| to_segment_m(q, v[k], v[(k + 1) % v.len()]) < 1e-6);
+    on_edge || inside(v, q)
 }
 
 /// Where along `a`-`b` it crosses the segment `p`-`n` (0 to 1), if it does.
@@ -291,17 +280,6 @@ fn crossing(a: [f64; 2], b: [f64; 2], p: [f64; 2], n: [f64; 2]) -> Option<f64> {
     let t = (w[0] * e[1] - w[1] * e[0]) / den;
     let u = (w[0] * d[1] - w[1] * d[0]) / den;
     ((0.0..=1.0).contains(&t) && (0.0..=1.0).contains(&u)).then_some(t)
-}
-
-/// Distance from `q` to the segment `a`-`b`, m.
-fn to_segment_m(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let len2 = d[0] * d[0] + d[1] * d[1];
-    let t = match len2 > 0.0 {
-        true => (((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0),
-        false => 0.0,
-    };
-    (q[0] - a[0] - t * d[0]).hypot(q[1] - a[1] - t * d[1])
 }
 
 /// The object when it is a version 2 one.

@@ -61,6 +61,7 @@ mod jumps;
 pub mod kept;
 mod notes;
 mod plan;
+mod plane;
 mod raw_item;
 mod route;
 pub mod survey;

@@ -13,6 +13,7 @@ use aloft_planner::Wind;
 
 use super::{PointKind, QgcProjection, Survey, SurveyParams};
 use crate::geo::LatLon;
+use crate::plane::{inside, to_segment_m};
 
 /// The step of the candidate grid angles, deg.
 pub const ANGLE_STEP_DEG: f64 = 15.0;
@@ -112,32 +113,6 @@ fn grid_inside(polygon: &[[f64; 2]], step_m: f64) -> impl Iterator<Item = [f64; 
             ]
         })
         .filter(move |q| inside(polygon, *q))
-}
-
-/// Whether `q` is inside `polygon` (even-odd rule).
-fn inside(polygon: &[[f64; 2]], q: [f64; 2]) -> bool {
-    let mut c = false;
-    for (k, a) in polygon.iter().enumerate() {
-        let b = polygon[(k + 1) % polygon.len()];
-        if (a[1] > q[1]) != (b[1] > q[1]) {
-            let x = a[0] + (q[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if q[0] < x {
-                c = !c;
-            }
-        }
-    }
-    c
-}
-
-/// Distance from `q` to the segment `a`-`b`, m.
-fn to_segment_m(q: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let len2 = d[0] * d[0] + d[1] * d[1];
-    let t = match len2 > 0.0 {
-        true => (((q[0] - a[0]) * d[0] + (q[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0),
-        false => 0.0,
-    };
-    (q[0] - a[0] - t * d[0]).hypot(q[1] - a[1] - t * d[1])
 }
 
 #[cfg(test)]
