@@ -244,6 +244,18 @@ pub const ENDURANCE_KEYS: [&str; 6] = [
     "max_range_m",
 ];
 
+/// The owner's statement for the flugdrohne quadrotor (docs/guide.md, "Your own quadrotor"): a
+/// 1.2 kg quadrotor on 10 in propellers with a 5000 mAh pack; its mass, propellers and pack are
+/// not logged, so every fit of its logs is given these flags.
+pub const FLUGDROHNE_OWNER: [&str; 6] = [
+    "--mass-kg",
+    "1.2",
+    "--rotor-diameter-m",
+    "0.254",
+    "--battery-capacity-mah",
+    "5000",
+];
+
 /// `aloft fit --log L... EXTRA -o OUT --format json`: exit code, JSON (null when stdout is not
 /// JSON), stderr.
 pub fn fit_json(logs: &[String], extra: &[&str], out: &Path) -> (i32, serde_json::Value, String) {
