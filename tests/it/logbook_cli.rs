@@ -426,12 +426,7 @@ fn logbook_served_as_the_command_line_answers() {
 fn logbook_pack_file_from_the_packs_logs() {
     let tmp = tempfile::tempdir().unwrap();
     let db = tmp.path().join("book.sqlite");
-    let dir = data_dir().join("px4_flugdrohne/ulg");
-    let mut ulgs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    ulgs.sort();
+    let ulgs = common::files("px4_flugdrohne/ulg", |_| true);
     let mut args = vec![
         "logbook",
         "add",

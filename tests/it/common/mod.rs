@@ -9,7 +9,7 @@ mod data;
 pub mod ros2;
 pub mod serve;
 
-pub use data::data_dir;
+pub use data::{data_dir, files};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -84,18 +84,6 @@ pub fn scratch(tag: &str, name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("aloft-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
-}
-
-/// The files of the data folder `sub` whose names pass `filter`, sorted.
-pub fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
-    let dir = data_dir().join(sub);
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
-        .collect();
-    v.sort();
-    v
 }
 
 /// The files `<prefix>*<suffix>` of the data folder `sub`, sorted; there must be some.
