@@ -28,12 +28,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use aloft::engine::answers;
-use aloft::engine::flags::{
-    EnduranceFlags, FitFlags, LiveFlags, LogInfoFlags, MissionFlags, MissionScenarioFlags,
-    PowerModelFlags, ValidateFlags,
-};
+use aloft::engine::flags::{LogInfoFlags, MissionFlags, MissionScenarioFlags, PowerModelFlags};
 use aloft::engine::{
-    plan_mission, power_model, power_point, power_values, FlightStateDeg, Mission, PowerModelQuery,
+    FlagGroup, Keyword, plan_mission, power_model, power_point, power_values, FlightStateDeg, Mission, PowerModelQuery,
     PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
@@ -63,6 +60,19 @@ pub(crate) fn engine_error(e: aloft::Error) -> PyErr {
     }
 }
 
+/// The JSON text of an entry point's answer: `function`'s keyword `options` (after its
+/// `positional` values) read as its flags, then `answer` computed with the GIL released.
+fn answer_json<T: FlagGroup + Sync>(
+    py: Python<'_>,
+    function: &str,
+    positional: &[(&str, Keyword)],
+    options: Option<&Bound<'_, PyDict>>,
+    answer: impl FnOnce(&T) -> Result<String, aloft::Error> + Send,
+) -> PyResult<String> {
+    let flags: T = options::parse(function, positional, options)?;
+    py.detach(|| answer(&flags)).map_err(engine_error)
+}
+
 /// `aloft mission --format json` as text.
 #[pyfunction]
 #[pyo3(signature = (path=None, options=None))]
@@ -71,9 +81,9 @@ fn mission_json(
     path: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let flags: MissionScenarioFlags = options::parse("mission", &[], options)?;
-    py.detach(|| answers::mission_answer(path.as_deref(), &flags))
-        .map_err(engine_error)
+    answer_json(py, "mission", &[], options, |flags: &MissionScenarioFlags| {
+        answers::mission_answer(path.as_deref(), flags)
+    })
 }
 
 /// The map of a mission (`aloft serve`'s `/api/map`) as compact JSON text.
@@ -84,9 +94,9 @@ fn mission_map_json(
     path: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    let flags: MissionScenarioFlags = options::parse("mission", &[], options)?;
-    py.detach(|| answers::mission_map_answer(path.as_deref(), &flags))
-        .map_err(engine_error)
+    answer_json(py, "mission", &[], options, |flags: &MissionScenarioFlags| {
+        answers::mission_map_answer(path.as_deref(), flags)
+    })
 }
 
 /// The columns of `aloft mission --timeseries`: names and arrays (`segment` as int64).
@@ -183,9 +193,7 @@ impl Table {
 #[pyfunction]
 #[pyo3(signature = (options=None))]
 fn endurance_json(py: Python<'_>, options: Option<&Bound<'_, PyDict>>) -> PyResult<String> {
-    let flags: EnduranceFlags = options::parse("endurance", &[], options)?;
-    py.detach(|| answers::endurance_answer(&flags))
-        .map_err(engine_error)
+    answer_json(py, "endurance", &[], options, answers::endurance_answer)
 }
 
 /// `aloft vehicles --format json` as text: the built-in vehicles with their packs and sources.
@@ -223,9 +231,9 @@ fn log_info_json(
         "max_lag",
         "the search window of the lag estimate, s; 'lag' is the lag itself in fit and validate",
     )?;
-    let flags: LogInfoFlags = options::parse("log_info", &[], options)?;
-    py.detach(|| answers::log_info_answer(&path, &flags))
-        .map_err(engine_error)
+    answer_json(py, "log_info", &[], options, |flags: &LogInfoFlags| {
+        answers::log_info_answer(&path, flags)
+    })
 }
 
 /// `aloft fit --format json` as text (the vehicle file written only when `output` is given).
@@ -241,9 +249,7 @@ fn fit_json(
     if let Some(t) = &vehicle_template {
         positional.push(("vehicle_template", options::text(t)));
     }
-    let flags: FitFlags = options::parse("fit", &positional, options)?;
-    py.detach(|| answers::fit_answer(&flags))
-        .map_err(engine_error)
+    answer_json(py, "fit", &positional, options, answers::fit_answer)
 }
 
 /// `aloft validate --format json` as text.
@@ -259,9 +265,7 @@ fn validate_json(
         ("log", options::paths(&logs)),
         ("vehicle", options::text(&vehicle)),
     ];
-    let flags: ValidateFlags = options::parse("validate", &positional, options)?;
-    py.detach(|| answers::validate_answer(&flags))
-        .map_err(engine_error)
+    answer_json(py, "validate", &positional, options, answers::validate_answer)
 }
 
 /// `aloft live --replay LOG --format json` as one JSON text: `{"updates": [...], "check" or
@@ -279,9 +283,7 @@ fn live_json(
         ("replay", options::path(&replay)),
         ("vehicle", options::text(&vehicle)),
     ];
-    let flags: LiveFlags = options::parse("live", &positional, options)?;
-    py.detach(|| answers::live_answer(&flags))
-        .map_err(engine_error)
+    answer_json(py, "live", &positional, options, answers::live_answer)
 }
 
 /// States per block of the batch kernel.

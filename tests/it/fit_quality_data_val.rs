@@ -114,20 +114,9 @@ fn data_val_no_usable_log_is_exit_1_saying_why() {
 #[test]
 fn data_val_a_failed_fit_has_no_null_in_its_json() {
     let log = data_dir().join("px4_flugdrohne/ulg/log_65_2023-6-21-08-36-08.ulg");
-    let out = scratch("fit-quality", "none-json.toml");
-    let (code, stdout, _) = run(&[
-        "fit",
-        "--log",
-        log.to_str().unwrap(),
-        "--vehicle-template",
-        &template("px4-template.toml"),
-        "-o",
-        out.to_str().unwrap(),
-        "--format",
-        "json",
-    ]);
-    assert_eq!(code, 1, "{stdout}");
-    let v: Value = serde_json::from_str(&stdout).unwrap();
+    let (code, v, err) = fit(&[log], &template("px4-template.toml"), "none-json");
+    assert_eq!(code, 1, "{err}");
+    assert!(v.is_object(), "not a JSON answer: {err}");
     assert!(common::nulls(&v).is_empty(), "{v}");
     assert!(v.get("quality").is_none_or(Value::is_string), "{v}");
     assert!(v["reason"].as_str().unwrap().contains("log_65"), "{v}");

@@ -243,17 +243,6 @@ fn data_val_px4_fit_with_defaults_gives_a_physical_vehicle_on_every_short_flight
     }
 }
 
-/// The owner's statement for the flugdrohne quadrotor (docs/guide.md, "Your own quadrotor"): its
-/// mass, propellers and pack are not logged.
-const OWNER: [&str; 6] = [
-    "--mass-kg",
-    "1.2",
-    "--rotor-diameter-m",
-    "0.254",
-    "--battery-capacity-mah",
-    "5000",
-];
-
 /// A flugdrohne ULog (`px4_flugdrohne/ulg`), as a command-line word.
 fn flugdrohne(stem: &str) -> String {
     common::data_dir()
@@ -283,7 +272,7 @@ fn flugdrohne_flights() -> Vec<String> {
 /// scratch file of `tag`.
 fn flugdrohne_vehicle(tag: &str) -> String {
     let out = common::scratch(tag, "quad.toml");
-    let (code, _, err) = common::fit_json(&flugdrohne_flights(), &OWNER, &out);
+    let (code, _, err) = common::fit_json(&flugdrohne_flights(), &common::FLUGDROHNE_OWNER, &out);
     assert_eq!(code, 0, "{err}");
     out.display().to_string()
 }
@@ -363,7 +352,11 @@ fn data_val_validate_skips_a_log_that_never_flew_as_fit_does() {
     assert!(!reason.contains("max_lag"), "{reason}");
     // fit decides the same way, in the same words.
     let out = common::scratch("never-flew", "fit.toml");
-    let (code, f, err) = common::fit_json(&[ground.clone(), flown.clone()], &OWNER, &out);
+    let (code, f, err) = common::fit_json(
+        &[ground.clone(), flown.clone()],
+        &common::FLUGDROHNE_OWNER,
+        &out,
+    );
     assert_eq!(code, 0, "{err}");
     assert_eq!(f["skipped_logs"][0]["reason"].as_str(), Some(reason), "{f}");
     // The ground log alone: nothing to validate, a failed check (exit 1) that says why.
@@ -402,7 +395,7 @@ fn data_val_a_flight_too_short_for_the_lag_search_is_skipped_saying_so() {
         .unwrap_or_else(|| panic!("no overlap in {reason}"));
     assert!((overlap - 15.0).abs() <= 0.5, "{overlap}: {reason}");
     let out = common::scratch("too-short", "fit.toml");
-    let (code, f, err) = common::fit_json(&[short, flown], &OWNER, &out);
+    let (code, f, err) = common::fit_json(&[short, flown], &common::FLUGDROHNE_OWNER, &out);
     assert_eq!(code, 0, "{err}");
     assert_eq!(f["skipped_logs"][0]["reason"].as_str(), Some(reason), "{f}");
 }

@@ -18,7 +18,7 @@
 
 use std::net::UdpSocket;
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -101,6 +101,45 @@ fn aloft_live(port: u16) -> Child {
         .expect("aloft starts")
 }
 
+/// A free UDP port of 127.0.0.1 (bound, then let go).
+fn free_port() -> u16 {
+    let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
+    probe.local_addr().expect("address").port()
+}
+
+/// The pymavlink vehicle (`tests/python/mavlink_vehicle.py PORT ARGS...`), run to its end.
+fn vehicle_run(port: u16, args: &[String]) -> Output {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mavlink_vehicle.py");
+    Command::new("python3")
+        .arg(&script)
+        .arg(port.to_string())
+        .args(args)
+        .output()
+        .expect("python3 runs")
+}
+
+/// aloft stopped after the vehicle's run (which must have succeeded): what the vehicle got (its
+/// JSON line), aloft's updates (a JSON line each) and aloft's stderr.
+fn after_the_run(mut aloft: Child, vehicle: &Output) -> (Value, Vec<Value>, String) {
+    let _ = aloft.kill();
+    let out = aloft.wait_with_output().expect("aloft's output");
+    assert!(
+        vehicle.status.success(),
+        "{}",
+        String::from_utf8_lossy(&vehicle.stderr)
+    );
+    let got: Value = serde_json::from_slice(&vehicle.stdout).expect("the vehicle's JSON line");
+    let updates: Vec<Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON line"))
+        .collect();
+    (
+        got,
+        updates,
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
 /// The NAMED_VALUE_FLOAT and STATUSTEXT aloft sent with its updates: four values an update
 /// with a band (two reserves, the point of no return where there is one, the energy left), and
 /// a text where the advice changed.
@@ -126,11 +165,8 @@ fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
     if !pymavlink_ready() {
         return;
     }
-    let port = {
-        let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
-        probe.local_addr().expect("address").port()
-    };
-    let mut aloft = aloft_live(port);
+    let port = free_port();
+    let aloft = aloft_live(port);
     std::thread::sleep(Duration::from_millis(500));
     let stop = Arc::new(AtomicBool::new(false));
     let stray = {
@@ -138,27 +174,12 @@ fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
         std::thread::spawn(move || stray(port, &stop))
     };
     std::thread::sleep(Duration::from_millis(300));
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mavlink_vehicle.py");
     let start = Instant::now();
-    let vehicle = Command::new("python3")
-        .arg(&script)
-        .args([port.to_string(), VEHICLE_S.to_string()])
-        .output()
-        .expect("python3 runs");
+    let vehicle = vehicle_run(port, &[VEHICLE_S.to_string()]);
     stop.store(true, Ordering::Relaxed);
     let (stray_sent, stray_received) = stray.join().expect("stray thread");
-    let _ = aloft.kill();
-    let out = aloft.wait_with_output().expect("aloft's output");
-    assert!(
-        vehicle.status.success() && start.elapsed() < Duration::from_secs(60),
-        "{}",
-        String::from_utf8_lossy(&vehicle.stderr)
-    );
-    let got: Value = serde_json::from_slice(&vehicle.stdout).expect("the vehicle's JSON line");
-    let updates: Vec<Value> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a JSON line"))
-        .collect();
+    let (got, updates, stderr) = after_the_run(aloft, &vehicle);
+    assert!(start.elapsed() < Duration::from_secs(60));
     let (values, texts) = replies_of(&updates);
     let count = |t: &str| got["counts"][t].as_u64().unwrap_or(0);
     eprintln!(
@@ -186,7 +207,6 @@ fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
     assert_eq!(count("MISSION_REQUEST_INT"), 2, "{got}");
     assert_eq!(count("MISSION_ACK"), 1, "{got}");
     assert_eq!(got["others"], serde_json::json!({}), "{got}");
-    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.trim().is_empty(), "{stderr}");
 }
 
@@ -202,34 +222,11 @@ fn live_udp_a_jumping_and_wrapping_charge_count_is_not_land_now() {
         return;
     }
     const SECONDS: u32 = 10;
-    let port = {
-        let probe = UdpSocket::bind("127.0.0.1:0").expect("bind");
-        probe.local_addr().expect("address").port()
-    };
-    let mut aloft = aloft_live(port);
+    let port = free_port();
+    let aloft = aloft_live(port);
     std::thread::sleep(Duration::from_millis(500));
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mavlink_vehicle.py");
-    let vehicle = Command::new("python3")
-        .arg(&script)
-        .args([
-            port.to_string(),
-            SECONDS.to_string(),
-            "wrapped-count".into(),
-        ])
-        .output()
-        .expect("python3 runs");
-    let _ = aloft.kill();
-    let out = aloft.wait_with_output().expect("aloft's output");
-    assert!(
-        vehicle.status.success(),
-        "{}",
-        String::from_utf8_lossy(&vehicle.stderr)
-    );
-    let got: Value = serde_json::from_slice(&vehicle.stdout).expect("the vehicle's JSON line");
-    let updates: Vec<Value> = String::from_utf8_lossy(&out.stdout)
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("a JSON line"))
-        .collect();
+    let vehicle = vehicle_run(port, &[SECONDS.to_string(), "wrapped-count".into()]);
+    let (got, updates, _) = after_the_run(aloft, &vehicle);
     eprintln!("the vehicle got {got}");
     let texts: Vec<&str> = got["texts"]
         .as_array()

@@ -30,14 +30,9 @@ fn run(args: &[&str]) -> (i32, String, String) {
     )
 }
 
+/// The KAIST flights (`kaist_energy_drone/*.csv`), sorted.
 fn kaist() -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(data_dir().join("kaist_energy_drone"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .collect();
-    v.sort();
-    v
+    common::files("kaist_energy_drone", |n| n.ends_with(".csv"))
 }
 
 fn s(p: &Path) -> &str {
@@ -431,12 +426,7 @@ fn logbook_served_as_the_command_line_answers() {
 fn logbook_pack_file_from_the_packs_logs() {
     let tmp = tempfile::tempdir().unwrap();
     let db = tmp.path().join("book.sqlite");
-    let dir = data_dir().join("px4_flugdrohne/ulg");
-    let mut ulgs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    ulgs.sort();
+    let ulgs = common::files("px4_flugdrohne/ulg", |_| true);
     let mut args = vec![
         "logbook",
         "add",
@@ -733,21 +723,9 @@ fn logbook_not_created_through_a_planted_link() {
 }
 
 /// Paths of every `null` in a JSON value.
+/// The paths of every `null` in `v`, each after `at`.
 fn nulls(v: &Value, at: &str, out: &mut Vec<String>) {
-    match v {
-        Value::Null => out.push(at.to_string()),
-        Value::Array(a) => {
-            for (i, x) in a.iter().enumerate() {
-                nulls(x, &format!("{at}[{i}]"), out);
-            }
-        }
-        Value::Object(o) => {
-            for (k, x) in o {
-                nulls(x, &format!("{at}.{k}"), out);
-            }
-        }
-        _ => {}
-    }
+    out.extend(common::nulls(v).into_iter().map(|p| format!("{at}{p}")));
 }
 
 /// Real logs that lack some figures (the KAIST CSVs have no clock, no cells, no rating; some

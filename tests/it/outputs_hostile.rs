@@ -429,16 +429,24 @@ fn files_of(mission: &Path, tag: &str) -> Vec<String> {
     names(&out)
 }
 
+/// A folder of its own (`tag`) with a 30-line survey (`lines.toml`) whose plan is two files or
+/// more: the folder, the mission, the names of its plan's files, and an empty `out` folder.
 #[cfg(unix)]
-#[test]
-fn plan_never_writes_through_links_planted_at_its_names() {
-    let d = folder("plan-links");
+fn a_plan_of_several_files(tag: &str) -> (PathBuf, PathBuf, Vec<String>, PathBuf) {
+    let d = folder(tag);
     let mission = d.join("lines.toml");
     std::fs::write(&mission, survey_lines("lines", 30)).unwrap();
-    let expected = files_of(&mission, "plan-links-dry");
+    let expected = files_of(&mission, &format!("{tag}-dry"));
     assert!(expected.len() >= 2, "{expected:?}");
     let out = d.join("out");
     std::fs::create_dir_all(&out).unwrap();
+    (d, mission, expected, out)
+}
+
+#[cfg(unix)]
+#[test]
+fn plan_never_writes_through_links_planted_at_its_names() {
+    let (d, mission, expected, out) = a_plan_of_several_files("plan-links");
     let victim = d.join("victim.txt");
     std::fs::write(&victim, b"precious").unwrap();
     // Links at every name the old writer used: the files and their temporary names.
@@ -468,13 +476,7 @@ fn plan_never_writes_through_links_planted_at_its_names() {
 #[test]
 fn plan_writes_its_set_all_or_nothing() {
     use std::os::unix::fs::FileTypeExt;
-    let d = folder("plan-set");
-    let mission = d.join("lines.toml");
-    std::fs::write(&mission, survey_lines("lines", 30)).unwrap();
-    let expected = files_of(&mission, "plan-set-dry");
-    assert!(expected.len() >= 2, "{expected:?}");
-    let out = d.join("out");
-    std::fs::create_dir_all(&out).unwrap();
+    let (_, mission, expected, out) = a_plan_of_several_files("plan-set");
     let fifo = out.join(&expected[1]);
     assert!(Command::new("mkfifo")
         .arg(&fifo)

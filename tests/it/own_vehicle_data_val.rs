@@ -12,20 +12,8 @@ use crate::common;
 
 use std::path::{Path, PathBuf};
 
-use common::{data_dir, fit_json as fit, run, scratch};
+use common::{data_dir, fit_json as fit, run, scratch, strings, FLUGDROHNE_OWNER as OWNER};
 use serde_json::Value;
-
-/// The flags a 1.2 kg quadrotor on 10 in propellers with a 5000 mAh pack is given (the
-/// flugdrohne mass, propellers and capacity are not documented: these are the owner's
-/// statement, the same for every run).
-const OWNER: [&str; 6] = [
-    "--mass-kg",
-    "1.2",
-    "--rotor-diameter-m",
-    "0.254",
-    "--battery-capacity-mah",
-    "5000",
-];
 
 fn flugdrohne() -> Vec<PathBuf> {
     common::files("px4_flugdrohne/ulg", |n| n.ends_with(".ulg"))
@@ -36,10 +24,6 @@ fn usable() -> Vec<PathBuf> {
         .into_iter()
         .filter(|p| !p.to_string_lossy().contains("log_65"))
         .collect()
-}
-
-fn strings(paths: &[PathBuf]) -> Vec<String> {
-    paths.iter().map(|p| p.display().to_string()).collect()
 }
 
 fn toml_of(path: &Path) -> toml::Table {

@@ -328,6 +328,23 @@ fn flugdrohne(stem: &str) -> PathBuf {
     data_dir().join(format!("px4_flugdrohne/ulg/{stem}.ulg"))
 }
 
+/// `aloft pack fit LOGS... EXTRA --capacity-mah 5000 --mass-kg 0.37 -o OUT`: the flugdrohne
+/// pack as its owner states it (5000 mA h, 0.37 kg).
+fn flugdrohne_fit(logs: &[&Path], extra: &[&str], out: &Path) -> Vec<String> {
+    let mut args: Vec<String> = vec!["pack".into(), "fit".into()];
+    args.extend(logs.iter().map(|l| s(l).to_string()));
+    args.extend(extra.iter().map(|e| e.to_string()));
+    args.extend(["--capacity-mah", "5000", "--mass-kg", "0.37", "-o", s(out)].map(String::from));
+    args
+}
+
+/// The same with `--format json`, which must succeed: its JSON.
+fn flugdrohne_fit_json(logs: &[&Path], extra: &[&str], out: &Path) -> serde_json::Value {
+    let mut args = flugdrohne_fit(logs, extra, out);
+    args.extend(["--format".into(), "json".into()]);
+    ok_json(&args)
+}
+
 /// The rows of a flugdrohne `battery_status` table: time (s from its first row), voltage (V),
 /// current (A), read here from the CSV export.
 fn battery_rows(csv: &Path) -> Vec<(f64, f64, f64)> {
@@ -376,19 +393,7 @@ fn data_val_a_short_rest_says_how_long_the_pack_rested() {
         battery_rows(&data_dir().join(format!("px4_flugdrohne/csv/{stem}_battery_status_0.csv")));
     let load_s = rows.iter().find(|r| r.2.abs() >= 0.25).unwrap().0;
     let out = tmp("short-rest.toml");
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&flugdrohne(stem)),
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let j = flugdrohne_fit_json(&[&flugdrohne(stem)], &[], &out);
     let why = j["logs"][0]["capacity_refused"].as_str().unwrap();
     assert!(!why.contains("above the rest limit"), "{why}");
     assert!(why.contains("below the rest limit of 0.25 A"), "{why}");
@@ -434,41 +439,14 @@ fn data_val_a_pack_resting_at_12_3_v_reads_about_90_percent() {
     let want = a.1 + (b.1 - a.1) * (cell_v - a.0) / (b.0 - a.0);
     assert!((0.85..0.92).contains(&want), "{cell_v} V a cell: {want}");
     let out = tmp("rested.toml");
-    let o = aloft(&[
-        "pack",
-        "fit",
-        s(&prefix),
-        "--cells",
-        "3",
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let mut args = flugdrohne_fit(&[&prefix], &["--cells", "3"], &out);
+    args.extend(["--format".into(), "json".into()]);
+    let o = aloft(&args);
     // One log that never drew current: no resistance, so no pack (exit 2, named); the report
     // of the log is in the JSON of a second run with a pack to keep the resistance from.
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&prefix),
-        s(&flugdrohne(stem)),
-        "--cells",
-        "3",
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let j = flugdrohne_fit_json(&[&prefix, &flugdrohne(stem)], &["--cells", "3"], &out);
     let why = j["logs"][0]["capacity_refused"].as_str().unwrap();
     let soc = number_after(why, "state of charge ");
     assert!(
@@ -487,20 +465,7 @@ fn data_val_pack_fit_json_carries_no_null() {
         .iter()
         .map(|s| flugdrohne(s))
         .collect();
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&logs[0]),
-        s(&logs[1]),
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let j = flugdrohne_fit_json(&[&logs[0], &logs[1]], &[], &out);
     let nulls = common::nulls(&j);
     assert!(nulls.is_empty(), "null at {nulls:?}");
 }
@@ -538,19 +503,7 @@ fn data_val_a_logged_capacity_below_10_mah_is_unset_with_a_note() {
         &["--capacity-mah"],
     );
     assert!(!out.exists());
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&log),
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let j = flugdrohne_fit_json(&[&log], &[], &out);
     let d = j["discharged_mah"].as_f64().unwrap();
     let cycles = j["equivalent_cycles"].as_f64().unwrap();
     assert!(
@@ -629,17 +582,7 @@ fn a_newline_in_a_log_name_stays_in_its_table_row() {
     let _ = std::fs::remove_file(&link);
     std::os::unix::fs::symlink(flugdrohne("log_66_2023-6-21-08-44-02"), &link).unwrap();
     let out = tmp("newline.toml");
-    let o = aloft(&[
-        "pack",
-        "fit",
-        s(&link),
-        "--capacity-mah",
-        "5000",
-        "--mass-kg",
-        "0.37",
-        "-o",
-        s(&out),
-    ]);
+    let o = aloft(&flugdrohne_fit(&[&link], &[], &out));
     let text = String::from_utf8_lossy(&o.stdout);
     assert_eq!(
         o.status.code(),

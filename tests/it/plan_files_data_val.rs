@@ -42,6 +42,13 @@ fn shared_planner_files() -> Vec<PathBuf> {
     files
 }
 
+/// The shared mission file `name` (`missions/`), which must be there.
+fn shared_mission(name: &str) -> PathBuf {
+    let path = common::data_dir().join("missions").join(name);
+    assert!(path.is_file(), "{name} in the shared missions");
+    path
+}
+
 /// `aloft plan FILE -o DIR --format json EXTRA`: exit code, JSON, stderr.
 fn plan(file: &Path, dir: &Path, extra: &[String]) -> (i32, Value, String) {
     let _ = std::fs::remove_dir_all(dir);
@@ -462,10 +469,7 @@ fn data_val_every_shared_planner_file_planned_in_wind_flies_its_files() {
 /// camera on, the survey covered.
 #[test]
 fn data_val_the_shared_survey_split_in_wind_resumes_with_the_camera_and_covers_it() {
-    let file = common::files("missions", |n| n == "neilvaltec_test.plan");
-    let file = file
-        .first()
-        .expect("neilvaltec_test.plan in the shared missions");
+    let file = &shared_mission("neilvaltec_test.plan");
     let mut seen = Seen::default();
     for extra in conditions(Some(70.0)) {
         check(file, &extra, &mut seen);
@@ -546,10 +550,7 @@ fn data_val_the_shared_waypoints_files_split_at_an_88_percent_reserve() {
         "ardupilot_DO_CHANGE_SPEED_mission.txt",
         "ardupilot_copter_loiterturns_mission.txt",
     ] {
-        let file = common::files("missions", |n| n == name);
-        let file = file
-            .first()
-            .unwrap_or_else(|| panic!("{name} in the shared missions"));
+        let file = &shared_mission(name);
         for (speed, from) in [(0.0, 0.0), (8.0, 90.0)] {
             let extra = flags(&format!(
                 "--reserve-percent 88 --wind-speed {speed} --wind-from {from}"
@@ -574,10 +575,7 @@ fn data_val_the_shared_waypoints_files_split_at_an_88_percent_reserve() {
 /// it), which `aloft mission` flies to the plan's energy; the polygon covered as before.
 #[test]
 fn data_val_a_survey_turned_on_one_pack_is_written_as_its_complex_item() {
-    let file = common::files("missions", |n| n == "neilvaltec_test.plan");
-    let file = file
-        .first()
-        .expect("neilvaltec_test.plan in the shared missions");
+    let file = &shared_mission("neilvaltec_test.plan");
     let extra = flags("--speeds keep --wind-speed 8 --wind-from 0");
     let mut seen = Seen::default();
     check(file, &extra, &mut seen);
@@ -623,10 +621,7 @@ fn data_val_a_survey_turned_on_one_pack_is_written_as_its_complex_item() {
 /// the key; its files fly their sorties as every other.
 #[test]
 fn data_val_a_survey_that_cannot_be_drawn_again_is_flown_as_stored_and_said() {
-    let file = common::files("missions", |n| n == "neilvaltec_test.plan");
-    let file = file
-        .first()
-        .expect("neilvaltec_test.plan in the shared missions");
+    let file = &shared_mission("neilvaltec_test.plan");
     let source: Value = serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap();
     type Spoil = fn(&mut Value);
     let variants: [(&str, Spoil, &str); 3] = [

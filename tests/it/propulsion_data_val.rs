@@ -73,20 +73,12 @@ fn spread(e: &[f64]) -> String {
 /// tables 9.0 % constant, 3.7 % speed-dependent; see the closing note.)
 #[test]
 fn data_val_uiuc_master_airscrew_static_even_odd() {
-    let dir = data_dir().join("uiuc_propdb/volume-1/data");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            let n = p.file_name().unwrap().to_string_lossy().to_string();
-            n.starts_with("ma_") && n.contains("_static_")
-        })
-        .collect();
-    files.sort();
+    let files = common::files("uiuc_propdb/volume-1/data", |n| {
+        n.starts_with("ma_") && n.contains("_static_")
+    });
     assert!(
         files.len() >= 8,
-        "expected the Master Airscrew static tables in {}",
-        dir.display()
+        "expected the Master Airscrew static tables in uiuc_propdb/volume-1/data"
     );
     for f in files {
         let rows = numeric_rows(&f);

@@ -172,15 +172,7 @@ fn data_val_validate_and_replay_measure_the_same_energy() {
         )
     };
     let logs: Vec<String> = flights.iter().map(|(s, kg)| arg(s, *kg)).collect();
-    let owner = [
-        "--mass-kg",
-        "1.2",
-        "--rotor-diameter-m",
-        "0.254",
-        "--battery-capacity-mah",
-        "5000",
-    ];
-    let (code, _, err) = common::fit_json(&logs, &owner, &quad);
+    let (code, _, err) = common::fit_json(&logs, &common::FLUGDROHNE_OWNER, &quad);
     assert_eq!(code, 0, "{err}");
     let kaist_vehicle = common::scratch("one-energy", "kaist.toml");
     std::fs::write(&kaist_vehicle, fit_on_08_03()).unwrap();

@@ -27,14 +27,20 @@ pub fn repo_root() -> PathBuf {
 /// `column-map` input that has no separator line.
 pub const CUSTOM_CSV: &[u8] = include_bytes!("../../../fixtures/logs/custom.csv");
 
+/// The paths in `dir` whose names pass `keep`, sorted (none where `dir` cannot be read).
+fn sorted_paths(dir: &Path, keep: impl Fn(&str) -> bool) -> Vec<PathBuf> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    paths.retain(|p| p.file_name().is_some_and(|n| keep(&n.to_string_lossy())));
+    paths.sort();
+    paths
+}
+
 /// The files of `fixtures/<dir>` whose names end in `suffix`, sorted by name.
 fn fixtures(dir: &str, suffix: &str) -> Vec<Vec<u8>> {
     let dir = repo_root().join("fixtures").join(dir);
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    paths.retain(|p| p.to_string_lossy().ends_with(suffix));
-    paths.sort();
+    let paths = sorted_paths(&dir, |name| name.ends_with(suffix));
     paths.iter().filter_map(|p| std::fs::read(p).ok()).collect()
 }
 
@@ -333,14 +339,10 @@ fn shared(sub: &str, suffixes: &[&str], limit: usize) -> Vec<Vec<u8>> {
     let Some(dir) = data_dir() else {
         return Vec::new();
     };
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir.join(sub))
-        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-        .unwrap_or_default();
-    paths.retain(|p| {
-        let name = p.to_string_lossy().to_ascii_lowercase();
+    let paths = sorted_paths(&dir.join(sub), |name| {
+        let name = name.to_ascii_lowercase();
         suffixes.iter().any(|s| name.ends_with(s))
     });
-    paths.sort();
     let head = |p: &PathBuf| -> Option<Vec<u8>> {
         use std::io::Read;
         let mut out = Vec::new();

@@ -11,29 +11,19 @@ use std::path::{Path, PathBuf};
 
 use aloft_logbook::{AddOutcome, Labels, Logbook, ReadOptions, SCHEMA_VERSION, UNKNOWN};
 
-fn sorted(dir: &Path, ext: &[&str]) -> Vec<PathBuf> {
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            p.extension()
-                .and_then(|e| e.to_str())
-                .is_some_and(|e| ext.contains(&e))
-        })
-        .collect();
-    v.sort();
-    v
+/// The files of the data folder `sub` ending `.EXT` for one of `ext`, sorted.
+fn sorted(sub: &str, ext: &[&str]) -> Vec<PathBuf> {
+    data::files(sub, |n| ext.iter().any(|e| n.ends_with(&format!(".{e}"))))
 }
 
 fn kaist() -> Vec<PathBuf> {
-    sorted(&data::data_dir().join("kaist_energy_drone"), &["csv"])
+    sorted("kaist_energy_drone", &["csv"])
 }
 
 /// The PX4 ULogs and ArduPilot DataFlash logs: the flugdrohne flights and `flight_logs/`.
 fn binary_logs() -> Vec<PathBuf> {
-    let d = data::data_dir();
-    let mut v = sorted(&d.join("px4_flugdrohne/ulg"), &["ulg"]);
-    v.extend(sorted(&d.join("flight_logs"), &["ulg", "bin", "BIN"]));
+    let mut v = sorted("px4_flugdrohne/ulg", &["ulg"]);
+    v.extend(sorted("flight_logs", &["ulg", "bin", "BIN"]));
     v
 }
 

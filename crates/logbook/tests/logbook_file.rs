@@ -15,14 +15,7 @@ use aloft_logbook::{AddOutcome, Labels, Logbook, LogbookError, ReadOptions, APPL
 const ALFT: i32 = i32::from_be_bytes(*b"alft");
 
 fn kaist() -> Vec<PathBuf> {
-    let dir = data::data_dir().join("kaist_energy_drone");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .collect();
-    v.sort();
-    v
+    data::files("kaist_energy_drone", |n| n.ends_with(".csv"))
 }
 
 fn pragma(db: &Path, name: &str) -> i64 {

@@ -18,7 +18,6 @@ use aloft_missions::{import, write_like_source, Imported, ItemOrigin, MissionIte
 
 #[path = "../../../tests/it/common/data.rs"]
 mod data;
-use data::data_dir;
 
 /// The files aloft refuses, by design (see the data's README): a VTOL mission and a malformed
 /// VTOL plan.
@@ -26,17 +25,11 @@ const REFUSED: [&str; 2] = ["uas_lol_mission8.waypoints", "wolkstein_vtol_missio
 
 /// Every mission file of the shared data, sorted.
 fn mission_files() -> Vec<PathBuf> {
-    let dir = data_dir().join("missions");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| {
-            let ext = p.extension().and_then(|e| e.to_str());
-            matches!(ext, Some("plan" | "waypoints" | "txt"))
-        })
-        .collect();
-    v.sort();
-    v
+    data::files("missions", |n| {
+        [".plan", ".waypoints", ".txt"]
+            .iter()
+            .any(|e| n.ends_with(e))
+    })
 }
 
 fn name(p: &std::path::Path) -> String {

@@ -211,15 +211,7 @@ pub fn reported_drop_mah(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn s(t: f64, v: f64, i: f64) -> BatterySample {
-        BatterySample {
-            time_s: t,
-            voltage_v: v,
-            current_a: Some(i),
-            ..BatterySample::default()
-        }
-    }
+    use crate::tests::sample as s;
 
     /// A 4S pack at 4.11 V/cell (90 %) resting 60 s, drawing 20 A for 540 s (3000 mA h), resting
     /// 60 s at 3.84 V/cell (50 %): 3000 / 0.4 = 7500 mA h.

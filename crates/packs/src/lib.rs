@@ -235,6 +235,17 @@ mod tests {
     use super::*;
     use aloft_logs::BatterySample;
 
+    /// A battery record at `time_s` drawing `current_a` at `voltage_v`: the samples of this
+    /// crate's tests.
+    pub(crate) fn sample(time_s: f64, voltage_v: f64, current_a: f64) -> BatterySample {
+        BatterySample {
+            time_s,
+            voltage_v,
+            current_a: Some(current_a),
+            ..BatterySample::default()
+        }
+    }
+
     fn log(samples: Vec<BatterySample>) -> BatteryLog {
         BatteryLog {
             source: "t".into(),
@@ -248,14 +259,7 @@ mod tests {
     /// 1 h at 0.5 A from a 1000 mA h pack: 500 mA h, half a cycle; 12 V: 6 W h.
     #[test]
     fn cycles_and_energy() {
-        let s = (0..=3600)
-            .map(|k| BatterySample {
-                time_s: k as f64,
-                voltage_v: 12.0,
-                current_a: Some(0.5),
-                ..BatterySample::default()
-            })
-            .collect();
+        let s = (0..=3600).map(|k| sample(k as f64, 12.0, 0.5)).collect();
         let r = analyse(&log(s)).unwrap();
         assert!((r.discharged_mah.unwrap() - 500.0).abs() < 1e-9);
         assert!((r.equivalent_cycles.unwrap() - 0.5).abs() < 1e-12);

@@ -132,15 +132,7 @@ pub fn resistance_from_steps(samples: &[BatterySample]) -> Option<ResistanceEsti
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn sample(t: f64, v: f64, i: f64) -> BatterySample {
-        BatterySample {
-            time_s: t,
-            voltage_v: v,
-            current_a: Some(i),
-            ..BatterySample::default()
-        }
-    }
+    use crate::tests::sample;
 
     /// A square-wave load on a pack of known resistance with a falling OCV: the steps give the
     /// resistance exactly (the OCV moves little within one step).

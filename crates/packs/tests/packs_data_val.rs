@@ -13,14 +13,7 @@ use aloft_logs::{read_battery_log, BatteryLog, BatterySample, OpenOptions, Profi
 use aloft_packs::{analyse, resistance_from_steps};
 
 fn kaist_files() -> Vec<PathBuf> {
-    let dir = data_dir().join("kaist_energy_drone");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .collect();
-    v.sort();
-    v
+    data::files("kaist_energy_drone", |n| n.ends_with(".csv"))
 }
 
 fn read(p: &std::path::Path, profile: Option<&Profile>) -> BatteryLog {
@@ -170,12 +163,7 @@ fn data_val_kaist_coulomb_count_against_the_bms() {
 /// §2.5 / §6.6: the flugdrohne flights (3S, PX4 1.14 power module) give 0.03-0.055 Ω per flight.
 #[test]
 fn data_val_flugdrohne_step_resistance() {
-    let dir = data_dir().join("px4_flugdrohne/ulg");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    files.sort();
+    let files = data::files("px4_flugdrohne/ulg", |_| true);
     assert_eq!(files.len(), 5);
     let mut clocks = 0;
     for p in files {

@@ -428,51 +428,29 @@ mod tests {
     /// Out-of-range values are refused naming the value and its range.
     #[test]
     fn absurd_air_is_refused_with_its_name_and_range() {
+        // The air given with one value, the one named.
+        let given = |name: &str, value: f64| {
+            let mut input = AirInput::default();
+            let field = match name {
+                "elevation_m" => &mut input.elevation_m,
+                "temperature_c" => &mut input.temperature_c,
+                "humidity_percent" => &mut input.humidity_percent,
+                "qnh_hpa" => &mut input.qnh_hpa,
+                other => panic!("no air value {other}"),
+            };
+            *field = Some(value);
+            input
+        };
         let cases = [
-            (
-                AirInput {
-                    elevation_m: Some(-500.0),
-                    ..AirInput::default()
-                },
-                "elevation_m",
-            ),
-            (
-                AirInput {
-                    elevation_m: Some(12_000.0),
-                    ..AirInput::default()
-                },
-                "elevation_m",
-            ),
-            (
-                AirInput {
-                    temperature_c: Some(300.0),
-                    ..AirInput::default()
-                },
-                "temperature_c",
-            ),
-            (
-                AirInput {
-                    temperature_c: Some(-273.0),
-                    ..AirInput::default()
-                },
-                "temperature_c",
-            ),
-            (
-                AirInput {
-                    humidity_percent: Some(101.0),
-                    ..AirInput::default()
-                },
-                "humidity_percent",
-            ),
-            (
-                AirInput {
-                    qnh_hpa: Some(29.92),
-                    ..AirInput::default()
-                },
-                "qnh_hpa",
-            ),
+            ("elevation_m", -500.0),
+            ("elevation_m", 12_000.0),
+            ("temperature_c", 300.0),
+            ("temperature_c", -273.0),
+            ("humidity_percent", 101.0),
+            ("qnh_hpa", 29.92),
         ];
-        for (input, name) in cases {
+        for (name, value) in cases {
+            let input = given(name, value);
             let e = resolve_air(&input, None, &m100()).unwrap_err().to_string();
             assert!(e.contains(name) && e.contains("from "), "{e}");
         }

@@ -24,3 +24,17 @@ pub fn data_dir() -> PathBuf {
     );
     dir
 }
+
+/// The files of the data folder `sub` whose names pass `filter`, sorted.
+// Included by path into test crates that list no folder.
+#[allow(dead_code)]
+pub fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
+    let dir = data_dir().join(sub);
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
+        .collect();
+    v.sort();
+    v
+}

@@ -9,7 +9,7 @@ mod data;
 pub mod ros2;
 pub mod serve;
 
-pub use data::data_dir;
+pub use data::{data_dir, files};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
@@ -84,18 +84,6 @@ pub fn scratch(tag: &str, name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("aloft-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
-}
-
-/// The files of the data folder `sub` whose names pass `filter`, sorted.
-pub fn files(sub: &str, filter: impl Fn(&str) -> bool) -> Vec<PathBuf> {
-    let dir = data_dir().join(sub);
-    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(&filter))
-        .collect();
-    v.sort();
-    v
 }
 
 /// The files `<prefix>*<suffix>` of the data folder `sub`, sorted; there must be some.
@@ -242,6 +230,18 @@ pub const ENDURANCE_KEYS: [&str; 6] = [
     "max_endurance_s",
     "max_range_speed_mps",
     "max_range_m",
+];
+
+/// The owner's statement for the flugdrohne quadrotor (docs/guide.md, "Your own quadrotor"): a
+/// 1.2 kg quadrotor on 10 in propellers with a 5000 mAh pack; its mass, propellers and pack are
+/// not logged, so every fit of its logs is given these flags.
+pub const FLUGDROHNE_OWNER: [&str; 6] = [
+    "--mass-kg",
+    "1.2",
+    "--rotor-diameter-m",
+    "0.254",
+    "--battery-capacity-mah",
+    "5000",
 ];
 
 /// `aloft fit --log L... EXTRA -o OUT --format json`: exit code, JSON (null when stdout is not

@@ -138,6 +138,25 @@ impl Server {
         ticks / 100.0
     }
 
+    /// The CPU the server spends on a request whose client leaves, s: in the first `working` of
+    /// the request sent on `client` (which must be more than 0.5 s: the work started), then in
+    /// 3 s from `settle` after the client left (`client` is closed here).
+    pub fn cpu_after_the_client_left(
+        &self,
+        client: TcpStream,
+        working: Duration,
+        settle: Duration,
+    ) -> (f64, f64) {
+        std::thread::sleep(working);
+        let busy_s = self.cpu_s();
+        assert!(busy_s > 0.5, "the work did not start: {busy_s} s of CPU");
+        drop(client);
+        std::thread::sleep(settle);
+        let after = self.cpu_s();
+        std::thread::sleep(Duration::from_secs(3));
+        (busy_s, self.cpu_s() - after)
+    }
+
     /// Open files of the server.
     pub fn open_files(&self) -> usize {
         std::fs::read_dir(format!("/proc/{}/fd", self.child.id())).map_or(0, |d| d.count())

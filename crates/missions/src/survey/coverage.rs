@@ -118,35 +118,13 @@ fn grid_inside(polygon: &[[f64; 2]], step_m: f64) -> impl Iterator<Item = [f64; 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::survey::tests::{params, survey};
 
-    fn ll(latitude_deg: f64, longitude_deg: f64) -> LatLon {
-        LatLon {
-            latitude_deg,
-            longitude_deg,
-        }
-    }
-
-    /// A 205 m (east) by 120 m (north) rectangle at 47 N (1 deg of latitude ~ 111.2 km, of
-    /// longitude ~ 75.8 km), north-south lines 30 m apart: QGroundControl puts them 20, 50, ...
-    /// 200 m east of the west side (the survey module's tests).
+    /// A 205 m (east) by 120 m (north) rectangle at 47 N, north-south lines 30 m apart:
+    /// QGroundControl puts them 20, 50, ... 200 m east of the west side (the survey module's
+    /// tests).
     fn rectangle_survey() -> Survey {
-        let (dlat, dlon) = (120.0 / 111_200.0, 205.0 / 75_840.0);
-        Survey::new(SurveyParams {
-            first_item: 3,
-            polygon: vec![
-                ll(47.0, 8.0),
-                ll(47.0, 8.0 + dlon),
-                ll(47.0 + dlat, 8.0 + dlon),
-                ll(47.0 + dlat, 8.0),
-            ],
-            turnaround_m: 10.0,
-            camera_in_turnaround: true,
-            altitude_m: 50.0,
-            spacing_m: 30.0,
-            trigger_distance_m: 20.0,
-            ..SurveyParams::default()
-        })
-        .unwrap()
+        survey(params())
     }
 
     /// Lines at x = 20, 50, ... 200 m reach 15 + 0.5 m either side: the whole rectangle but

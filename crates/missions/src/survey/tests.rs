@@ -31,7 +31,9 @@ fn rectangle() -> Vec<LatLon> {
     ]
 }
 
-fn params() -> SurveyParams {
+/// The rectangle's survey: north-south lines 30 m apart, 50 m up, a photo every 20 m, 10 m
+/// turnarounds with the camera on (the coverage module's tests too).
+pub(super) fn params() -> SurveyParams {
     SurveyParams {
         first_item: 3,
         polygon: rectangle(),
@@ -45,7 +47,7 @@ fn params() -> SurveyParams {
     }
 }
 
-fn survey(p: SurveyParams) -> Survey {
+pub(super) fn survey(p: SurveyParams) -> Survey {
     Survey::new(p).unwrap()
 }
 
