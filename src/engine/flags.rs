@@ -29,7 +29,9 @@ use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::{GustSpec, MissionOptions};
 use crate::engine::performance::payload_sweep::PayloadSweep;
 use crate::engine::performance::power::PowerModelQuery;
-use crate::engine::plan_to_fly::fly_plan::{FlyPlanRequest, SpeedChoice, DEFAULT_OVERLAP_M};
+use crate::engine::plan_to_fly::fly_plan::{
+    FlyPlanRequest, SpeedChoice, DEFAULT_LOITER_UNLIMITED_S, DEFAULT_OVERLAP_M,
+};
 use crate::engine::step_meter::StepMeter;
 use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenarios::{
@@ -772,6 +774,12 @@ pub struct PlanFlags {
     /// where that saves energy, its transects drawn again as QGroundControl draws them).
     #[arg(long)]
     pub keep_angle: bool,
+    /// How long an unlimited loiter (NAV_LOITER_UNLIM) is flown, s, before the operator
+    /// continues the mission with the items after it (each sortie keeps them and the
+    /// mission's own landing).
+    #[arg(value_parser = finite(), long, default_value_t = DEFAULT_LOITER_UNLIMITED_S,
+        value_name = "S", allow_negative_numbers = true)]
+    pub loiter_unlimited_s: f64,
     /// What the request may spend (set by a caller that serves others: its cancellation; no
     /// flag).
     #[arg(skip)]
@@ -815,9 +823,18 @@ impl PlanFlags {
                 expected: "a time above 0 and at most 3600 s",
             });
         }
+        if !(0.0..=86_400.0).contains(&self.loiter_unlimited_s) {
+            return Err(Error::InvalidInput {
+                name: "loiter_unlimited_s",
+                value: self.loiter_unlimited_s,
+                unit: "s",
+                expected: "from 0 to 86400 s",
+            });
+        }
         Ok(FlyPlanRequest {
             options: self.mission.options(),
             overlap_m: self.overlap_m,
+            loiter_unlimited_s: self.loiter_unlimited_s,
             speeds: self.speeds,
             max_speed_mps: self.max_speed,
             camera_interval_s: self.camera_interval_s,

@@ -270,3 +270,72 @@ fn a_cancelled_plan_stops() {
     let e = aloft::engine::plan_to_fly(&vehicle, &mission, &request).unwrap_err();
     assert!(matches!(e, aloft::Error::Cancelled), "{e}");
 }
+
+/// Issue 43 item 3: a `.waypoints` mission whose second waypoint is an unlimited loiter
+/// (NAV_LOITER_UNLIM 17; the shared brucdeng file with row 2 changed), then three waypoints and
+/// the operator's LAND. The written file keeps them in order with the LAND and no return to
+/// launch (before: the route ended at the loiter, the four items dropped and an RTL written);
+/// the notes say the loiter was planned at 60 s, and the plan flies as the same file with a
+/// timed loiter there (NAV_LOITER_TIME 19 of 60 s: the same duration and energy, to 1e-9) and
+/// longer than with `--loiter-unlimited-s 0` by the minute and the stop (60 to 65 s). A
+/// negative time is refused naming the flag.
+#[test]
+fn data_val_the_items_after_an_unlimited_loiter_are_kept_with_the_landing() {
+    let mission = write_mission("loiter_unlim.waypoints", &brucdeng_with_row_2(&["17"]));
+    let timed = write_mission("loiter_time.waypoints", &brucdeng_with_row_2(&["19", "60"]));
+    let (answer, dir) = plan(&mission, &[]);
+    let notes = answer["notes"].to_string();
+    assert!(
+        notes.contains("LOITER_UNLIM: flown as a loiter of 60 s"),
+        "{answer}"
+    );
+    let files = answer["files"].as_array().unwrap();
+    let last = std::fs::read_to_string(files.last().unwrap().as_str().unwrap()).unwrap();
+    let commands: Vec<&str> = last
+        .lines()
+        .skip(2)
+        .map(|l| l.split('\t').nth(3).unwrap())
+        .filter(|c| *c != "178")
+        .collect();
+    let tail: Vec<&str> = commands.iter().rev().take(5).rev().copied().collect();
+    assert_eq!(tail, ["17", "16", "16", "16", "21"], "{last}");
+    assert!(!commands.contains(&"20"), "{last}");
+    let (as_timed, _) = plan(&timed, &[]);
+    for key in ["duration_s", "energy_wh"] {
+        assert!(
+            (f(&answer[key]) - f(&as_timed[key])).abs() < 1e-9,
+            "{key}: {answer} {as_timed}"
+        );
+    }
+    let (none, _) = plan(&mission, &["--loiter-unlimited-s", "0"]);
+    let longer_s = f(&answer["duration_s"]) - f(&none["duration_s"]);
+    assert!((60.0..65.0).contains(&longer_s), "{longer_s} s");
+    let _ = std::fs::remove_dir_all(&dir);
+    let m = mission.display().to_string();
+    let o = dir.display().to_string();
+    let (code, _, err) = run(&["plan", &m, "-o", &o, "--loiter-unlimited-s", "-1"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("loiter_unlimited_s") || err.contains("loiter-unlimited-s"),
+        "{err}"
+    );
+}
+
+/// The shared brucdeng `.waypoints` file with row 2's command and first parameters replaced by
+/// `fields` (command, then p1...).
+fn brucdeng_with_row_2(fields: &[&str]) -> String {
+    let source = common::data_dir().join("missions/brucdeng_aircart_mission.waypoints");
+    std::fs::read_to_string(source)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let mut c: Vec<&str> = l.split('\t').collect();
+            if c.first() == Some(&"2") {
+                for (k, v) in fields.iter().enumerate() {
+                    c[3 + k] = v;
+                }
+            }
+            c.join("\t") + "\n"
+        })
+        .collect()
+}

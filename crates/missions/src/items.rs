@@ -14,7 +14,7 @@
 //! | NAV_LOITER_TIME (19) | a leg to the point and a hover of p1 s |
 //! | NAV_LOITER_TURNS (18) | an orbit of p1 turns, radius abs(p3) about the point (p3 < 0: counter-clockwise), at ArduPilot's default circle rate of 20 deg/s (`CIRCLE_RATE`), at most the planning speed |
 //! | NAV_LOITER_TO_ALT (31) | a leg to the point, then a vertical climb or descent to p7 |
-//! | NAV_LOITER_UNLIM (17) | a leg to the point, then a loiter until the reserve: the route ends (the rest is unreachable, warned) |
+//! | NAV_LOITER_UNLIM (17) | a leg to the point, then a loiter until the reserve: the route ends (the rest is unreachable, warned); with [`ReadOptions::loiter_unlimited_s`], a hover of that long and the route goes on (said) |
 //! | NAV_DELAY (93), CONDITION_DELAY (112) | a hover of p1 s (in the air) |
 //! | DO_CHANGE_SPEED (178) | p1 0 (air) or 1 (ground): the ground speed of the following legs is p2; -1 no change; -2 back to the planning speed. p1 2 or 3 (climb, descent): noted, not modelled |
 //! | DO_JUMP (177) | unrolled (`jumps.rs`) |
@@ -89,6 +89,16 @@ impl Autopilot {
     }
 }
 
+/// How a reader flies what a file leaves to the operator.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ReadOptions {
+    /// An unlimited loiter (NAV_LOITER_UNLIM) flown as a hover of this long, s, after which the
+    /// route goes on with the items after it (`aloft plan`: the operator continues the mission);
+    /// `None`: a loiter until the reserve, where the route ends (`aloft mission`: how long it
+    /// can loiter).
+    pub loiter_unlimited_s: Option<f64>,
+}
+
 /// Home and the file's conventions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Source {
@@ -102,6 +112,8 @@ pub(crate) struct Source {
     pub(crate) jumps_by: JumpsBy,
     /// The file's planning speed, m/s (orbits are flown at most at it).
     pub(crate) default_speed_mps: f64,
+    /// How what the file leaves to the operator is flown.
+    pub(crate) options: ReadOptions,
 }
 
 /// What the items fly.
@@ -272,7 +284,10 @@ impl<'a> Flight<'a> {
             NAV_LOITER_TO_ALT => self.loiter_to_alt(item)?,
             NAV_DELAY | CONDITION_DELAY => self.delay(item)?,
             NAV_RETURN_TO_LAUNCH => return self.return_to_launch(item).map(Some),
-            NAV_LOITER_UNLIM => return self.loiter_unlimited(item).map(Some),
+            NAV_LOITER_UNLIM => match self.source.options.loiter_unlimited_s {
+                Some(hold_s) => self.loiter_for(item, hold_s)?,
+                None => return self.loiter_unlimited(item).map(Some),
+            },
             DO_CHANGE_SPEED => self.change_speed(item),
             DO_GRIPPER => self.gripper(item)?,
             c if role(c) == Role::Unknown => self.notes.add(
@@ -428,6 +443,23 @@ impl<'a> Flight<'a> {
             "LOITER_UNLIM: the route ends here with a loiter until the reserve",
         );
         Ok("the LOITER_UNLIM")
+    }
+
+    /// NAV_LOITER_UNLIM (17) flown for `hold_s` ([`ReadOptions::loiter_unlimited_s`]): to the
+    /// point, a hover of `hold_s`, and on (said).
+    fn loiter_for(&mut self, item: &RawItem, hold_s: f64) -> Result<(), ImportError> {
+        let target = self.target(item)?;
+        self.climb_if_landed(item, target)?;
+        self.fly_to(item, target, None)?;
+        self.hover(item, hold_s)?;
+        self.notes.add(
+            item.at,
+            format!(
+                "LOITER_UNLIM: flown as a loiter of {} s, then the items after it (the operator continues the mission)",
+                aloft_core::Num(hold_s)
+            ),
+        );
+        Ok(())
     }
 
     /// NAV_RETURN_TO_LAUNCH (20): back over home and land; the route ends.

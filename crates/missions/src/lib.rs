@@ -76,12 +76,12 @@ pub use detect::detect;
 pub use error::{ImportError, Place};
 pub use fence::{Airspace, Breach, FenceCircle, FencePolygon, LocalFence, RallyPoint};
 pub use geo::{distance_m, great_circle_m, LatLon, MEAN_RADIUS_M};
-pub use items::MIN_HEIGHT_M;
+pub use items::{ReadOptions, MIN_HEIGHT_M};
 pub use jumps::MAX_REPEATED_ITEMS;
 pub use kept::{FlownItem, Home, ItemOrigin, PlanFile, PlanHeader};
-pub use plan::read_plan;
+pub use plan::{read_plan, read_plan_with};
 pub use route::{route_figures, RouteFigures};
-pub use wpl::{read_items, read_waypoints};
+pub use wpl::{read_items, read_items_with, read_waypoints, read_waypoints_with};
 pub use write::{
     plan_entries, write_like_source, write_plan, write_waypoint_rows, write_waypoints, MissionEntry,
 };
@@ -187,9 +187,17 @@ impl Imported {
 /// [`ImportError::UnknownFormat`] for anything else (aloft's own TOML or JSON included), and the
 /// readers' errors.
 pub fn import(text: &str) -> Result<Imported, ImportError> {
+    import_with(text, ReadOptions::default())
+}
+
+/// [`import`] with `options`.
+///
+/// # Errors
+/// As [`import`].
+pub fn import_with(text: &str, options: ReadOptions) -> Result<Imported, ImportError> {
     match detect(text) {
-        SourceFormat::QgcPlan => read_plan(text),
-        SourceFormat::QgcWpl => read_waypoints(text),
+        SourceFormat::QgcPlan => read_plan_with(text, options),
+        SourceFormat::QgcWpl => read_waypoints_with(text, options),
         SourceFormat::AloftToml | SourceFormat::AloftJson | SourceFormat::MavlinkItems => {
             Err(ImportError::UnknownFormat)
         }

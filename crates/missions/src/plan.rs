@@ -25,7 +25,7 @@ use serde_json::{Map, Value};
 
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
-use crate::items::{translate, Autopilot, Source};
+use crate::items::{translate, Autopilot, ReadOptions, Source};
 use crate::jumps::JumpsBy;
 use crate::kept::{Home, ItemOrigin, PlanFile, PlanHeader};
 use crate::notes::Notes;
@@ -46,6 +46,14 @@ const SIMPLE_KEYS: [&str; 4] = ["type", "command", "frame", "autoContinue"];
 /// mistyped keys (naming the item and the key), refused items and vehicles, and the errors of
 /// the items' semantics (see the crate's docs).
 pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
+    read_plan_with(text, ReadOptions::default())
+}
+
+/// [`read_plan`] with `options`.
+///
+/// # Errors
+/// As [`read_plan`].
+pub fn read_plan_with(text: &str, options: ReadOptions) -> Result<Imported, ImportError> {
     let root: Value = serde_json::from_str(text.trim_start_matches('\u{feff}')).map_err(|e| {
         ImportError::Json {
             line: e.line(),
@@ -77,6 +85,7 @@ pub fn read_plan(text: &str) -> Result<Imported, ImportError> {
         autopilot,
         jumps_by: JumpsBy::DoJumpId,
         default_speed_mps: hover_speed(mission, &mut notes)?,
+        options,
     };
     let translation = translate(&items, &source, notes)?;
     let description = format!(

@@ -17,7 +17,7 @@
 
 use crate::error::{ImportError, Place};
 use crate::geo::LatLon;
-use crate::items::{translate, Autopilot, Source};
+use crate::items::{translate, Autopilot, ReadOptions, Source};
 use crate::jumps::JumpsBy;
 use crate::kept::Home;
 use crate::notes::Notes;
@@ -51,6 +51,14 @@ const FIELDS: [&str; 12] = [
 /// number (naming the line and the column; P1-P4 may also be `NaN`, "not set"), no home
 /// position, and the errors of the items' semantics (see the crate's docs).
 pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
+    read_waypoints_with(text, ReadOptions::default())
+}
+
+/// [`read_waypoints`] with `options`.
+///
+/// # Errors
+/// As [`read_waypoints`].
+pub fn read_waypoints_with(text: &str, options: ReadOptions) -> Result<Imported, ImportError> {
     let text = text.trim_start_matches('\u{feff}');
     let mut lines = text.lines().enumerate();
     let header = lines.next().map_or("", |(_, l)| l.trim());
@@ -70,7 +78,7 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
             rows.push(row(k + 1, line)?);
         }
     }
-    from_rows(rows, SourceFormat::QgcWpl, "QGC WPL 110 waypoints")
+    from_rows(rows, SourceFormat::QgcWpl, "QGC WPL 110 waypoints", options)
 }
 
 /// Read a mission as a MAVLink link or log carries it (MISSION_ITEM_INT, DataFlash `CMD`): the
@@ -81,6 +89,17 @@ pub fn read_waypoints(text: &str) -> Result<Imported, ImportError> {
 /// # Errors
 /// The errors of the items' semantics, as [`read_waypoints`] (an infinite coordinate, say).
 pub fn read_items(items: &[aloft_logs::telemetry::MissionItem]) -> Result<Imported, ImportError> {
+    read_items_with(items, ReadOptions::default())
+}
+
+/// [`read_items`] with `options`.
+///
+/// # Errors
+/// As [`read_items`].
+pub fn read_items_with(
+    items: &[aloft_logs::telemetry::MissionItem],
+    options: ReadOptions,
+) -> Result<Imported, ImportError> {
     let rows = items
         .iter()
         .map(|item| RawItem {
@@ -92,7 +111,7 @@ pub fn read_items(items: &[aloft_logs::telemetry::MissionItem]) -> Result<Import
             jump_id: None,
         })
         .collect();
-    from_rows(rows, SourceFormat::MavlinkItems, "MAVLink mission")
+    from_rows(rows, SourceFormat::MavlinkItems, "MAVLink mission", options)
 }
 
 /// The home row apart, then the items' semantics: what a `.waypoints` file and a link's
@@ -101,6 +120,7 @@ fn from_rows(
     rows: Vec<RawItem>,
     format: SourceFormat,
     what: &str,
+    options: ReadOptions,
 ) -> Result<Imported, ImportError> {
     let mut notes = Notes::default();
     let home_row = home_row(&rows);
@@ -111,6 +131,7 @@ fn from_rows(
         autopilot: Autopilot::ArduPilot,
         jumps_by: JumpsBy::RowIndex,
         default_speed_mps: ARDUPILOT_WPNAV_SPEED_MPS,
+        options,
     };
     let translation = translate(&items, &source, notes)?;
     let description = format!("{what}, {} items", items.len());

@@ -152,9 +152,10 @@ def plan(
             own limits apply anyway).
         **options: ``aloft plan``'s ``camera_interval_s`` (s: the camera's shortest time
             between photos; a leg where it triggers every D m is given at most D / this;
-            default a ``.plan`` survey's ``MinTriggerInterval``, else 2) and ``keep_angle``
+            default a ``.plan`` survey's ``MinTriggerInterval``, else 2), ``keep_angle``
             (True: keep every survey's grid angle; else a QGroundControl survey is turned to the
-            wind where that saves energy); and the mission's options, as :func:`mission`'s
+            wind where that saves energy) and ``loiter_unlimited_s`` (s, default 60: how long an
+            unlimited loiter is flown before the items after it); and the mission's options, as :func:`mission`'s
             without the Monte-Carlo ones: ``vehicle``, ``battery``, ``payload_kg`` (kg),
             ``wind_speed`` (m/s) and ``wind_from`` (deg, blowing FROM), ``wind_profile``,
             ``wind_field``, ``gust_std``, ``reserve_percent`` (% of the usable capacity at

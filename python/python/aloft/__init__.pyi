@@ -80,6 +80,7 @@ class PlanKeywords(MissionKeywords, total=False):
 
     camera_interval_s: Optional[float]
     keep_angle: bool
+    loiter_unlimited_s: Optional[float]
 
 class EnduranceKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     """`aloft endurance`'s flags."""

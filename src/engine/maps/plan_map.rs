@@ -2,7 +2,7 @@
 //! path, from its own file.
 //!
 //! Each sortie's file ([`FlyPlan::texts`]) is read back as `aloft mission` reads it
-//! ([`Mission::from_text`]), planned in the plan's conditions ([`FlyPlanRequest::options`]) and
+//! ([`Mission::from_text_with`], an unlimited loiter as the plan flew it), planned in the plan's conditions ([`FlyPlanRequest::options`]) and
 //! drawn by [`mission_map`]: so the path on the map is the one the file flies, corners and the
 //! way home the planner adds included, in east-north-up metres from home and, for a planner file
 //! (a geographic home), in latitude and longitude.
@@ -58,7 +58,10 @@ pub fn fly_plan_map(
         .zip(&plan.texts)
         .enumerate()
         .map(|(k, (sortie, text))| {
-            let mission = Mission::from_text(text, &sortie.file)?;
+            let read = aloft_missions::ReadOptions {
+                loiter_unlimited_s: Some(request.loiter_unlimited_s),
+            };
+            let mission = Mission::from_text_with(text, &sortie.file, read)?;
             let flown = plan_mission(vehicle, &mission, &request.options)?;
             let map = mission_map(&flown, &mission, None);
             // Every sortie after the first resumes the route: a take-off and a transit.

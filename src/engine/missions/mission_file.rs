@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use aloft_missions::{route_figures, RouteFigures, SourceFormat};
+use aloft_missions::{route_figures, ReadOptions, RouteFigures, SourceFormat};
 use aloft_planner::MissionSpec;
 
 use crate::engine::files::read_text_file;
@@ -29,6 +29,19 @@ pub struct Mission {
     /// The planner file as read (`.plan`, `.waypoints`): what `aloft plan` needs to write it
     /// again (its home, items, a `.plan`'s header and surveys, the flying order).
     kept: Option<Box<aloft_missions::Imported>>,
+    /// What a planner file was read from, to read it again with other options.
+    source: Option<PlannerSource>,
+    /// The options it was read with.
+    read: ReadOptions,
+}
+
+/// What a planner file was read from.
+#[derive(Debug, Clone, PartialEq)]
+enum PlannerSource {
+    /// The file's text.
+    Text(std::sync::Arc<str>),
+    /// A link's or a log's mission items.
+    Items(std::sync::Arc<[aloft_logs::telemetry::MissionItem]>),
 }
 
 impl Mission {
@@ -64,6 +77,8 @@ impl Mission {
             spec,
             origin: origin.to_string(),
             kept: None,
+            source: None,
+            read: ReadOptions::default(),
         }
     }
 
@@ -106,7 +121,8 @@ impl Mission {
     /// [`Error::MissionImport`] naming the item (or row, or line) and the command or key.
     pub fn from_planner_file(text: &str, origin: &str) -> Result<Self, Error> {
         check_size(text, origin)?;
-        Self::of_imported(aloft_missions::import(text), origin)
+        let source = PlannerSource::Text(text.into());
+        Self::read(source, origin, ReadOptions::default())
     }
 
     /// A mission as a MAVLink link or log carries it (MISSION_ITEM_INT, DataFlash `CMD`; item 0
@@ -118,15 +134,20 @@ impl Mission {
         items: &[aloft_logs::telemetry::MissionItem],
         origin: &str,
     ) -> Result<Self, Error> {
-        Self::of_imported(aloft_missions::read_items(items), origin)
+        Self::read(
+            PlannerSource::Items(items.into()),
+            origin,
+            ReadOptions::default(),
+        )
     }
 
-    /// What an importer read, or its error naming `origin`.
-    fn of_imported(
-        imported: Result<aloft_missions::Imported, aloft_missions::ImportError>,
-        origin: &str,
-    ) -> Result<Self, Error> {
-        let imported = imported.map_err(|source| Error::MissionImport {
+    /// The planner file read from `source` with `options`, or its error naming `origin`.
+    fn read(source: PlannerSource, origin: &str, options: ReadOptions) -> Result<Self, Error> {
+        let imported = match &source {
+            PlannerSource::Text(text) => aloft_missions::import_with(text, options),
+            PlannerSource::Items(items) => aloft_missions::read_items_with(items, options),
+        }
+        .map_err(|source| Error::MissionImport {
             origin: origin.to_string(),
             source,
         })?;
@@ -135,7 +156,37 @@ impl Mission {
             origin: origin.to_string(),
             route: imported.route.clone(),
             kept: Some(Box::new(imported)),
+            source: Some(source),
+            read: options,
         })
+    }
+
+    /// The options the mission was read with.
+    pub fn read_options(&self) -> ReadOptions {
+        self.read
+    }
+
+    /// As [`Mission::from_text`], a planner file read with `options`.
+    ///
+    /// # Errors
+    /// As [`Mission::from_text`].
+    pub fn from_text_with(text: &str, origin: &str, options: ReadOptions) -> Result<Self, Error> {
+        let mission = Self::from_text(text, origin)?;
+        match options == ReadOptions::default() {
+            true => Ok(mission),
+            false => mission.read_with(options),
+        }
+    }
+
+    /// The mission read again with `options` (a planner file; any other mission as it is).
+    ///
+    /// # Errors
+    /// As the reader's with those options.
+    pub fn read_with(&self, options: ReadOptions) -> Result<Self, Error> {
+        match &self.source {
+            Some(source) => Self::read(source.clone(), &self.origin, options),
+            None => Ok(self.clone()),
+        }
     }
 
     /// Any of the four formats, recognised from the content (not the file name): a

@@ -3,6 +3,11 @@
 //!
 //! The steps, each candidate flown by the planner that answers `aloft mission`:
 //!
+//! 0. **The operator's whole mission**: an unlimited loiter (NAV_LOITER_UNLIM) is flown for
+//!    [`FlyPlanRequest::loiter_unlimited_s`] and the items after it, with the mission's own
+//!    landing, are planned and written (`aloft mission` ends the route there with a loiter until
+//!    the reserve); the answer's `notes` say what was assumed.
+//!
 //! 1. **As given**: the mission with its own speeds, split into sorties at whole items as
 //!    `aloft mission` splits it, flown from the files that split gives (each ending with a return
 //!    to launch, as every file does: a mission that ends in the air is priced with its autopilot's
@@ -52,6 +57,12 @@ use crate::error::Error;
 /// next overlap (QGroundControl issue #4254 asks for a few waypoints back).
 pub const DEFAULT_OVERLAP_M: f64 = 10.0;
 
+/// How long an unlimited loiter (NAV_LOITER_UNLIM) is planned to last by default, s: the
+/// autopilot loiters there until the operator continues the mission, which no file says; a
+/// minute is a short wait for an operator's go (a delivery confirmed, a check), and the plan
+/// says what it assumed so that an operator who waits longer sets `--loiter-unlimited-s`.
+pub const DEFAULT_LOITER_UNLIMITED_S: f64 = 60.0;
+
 /// The camera's shortest time between photos when neither the request nor the file gives one,
 /// s: a conservative interval for a survey camera that does not state its own (give
 /// `--camera-interval-s` for yours), so that no photo is skipped.
@@ -78,6 +89,8 @@ pub struct FlyPlanRequest {
     pub options: MissionOptions,
     /// How far back along the route a sortie resumes, m.
     pub overlap_m: f64,
+    /// How long an unlimited loiter is flown before the items after it, s.
+    pub loiter_unlimited_s: f64,
     /// Which legs get the wind's speed.
     pub speeds: SpeedChoice,
     /// Highest ground speed a leg is given, m/s (the vehicle's own limits apply anyway).
@@ -100,6 +113,7 @@ impl Default for FlyPlanRequest {
         Self {
             options: MissionOptions::default(),
             overlap_m: DEFAULT_OVERLAP_M,
+            loiter_unlimited_s: DEFAULT_LOITER_UNLIMITED_S,
             speeds: SpeedChoice::default(),
             max_speed_mps: None,
             camera_interval_s: None,
@@ -213,6 +227,10 @@ pub fn plan_to_fly(
     request: &FlyPlanRequest,
 ) -> Result<FlyPlan, Error> {
     let options = &request.options;
+    // An unlimited loiter lasts a stated time, and the items after it are flown (module step 0).
+    let mission = &mission.read_with(aloft_missions::ReadOptions {
+        loiter_unlimited_s: Some(request.loiter_unlimited_s),
+    })?;
     // The air once: every candidate flies the vehicle in it (and finds it so when it decides
     // the air again from its own file).
     let (vehicle, air) = crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;
@@ -270,6 +288,7 @@ pub fn plan_to_fly(
     if !request.keep_angle {
         plan.notes = unturnable(mission);
     }
+    plan.notes.extend(loiters_assumed(mission));
     finite(plan, "plan", || {
         format!(
             "plan of mission {} with {}",
@@ -277,6 +296,17 @@ pub fn plan_to_fly(
             vehicle.name()
         )
     })
+}
+
+/// What the plan assumed of the unlimited loiters (the reader's words for each).
+fn loiters_assumed(mission: &Mission) -> Vec<String> {
+    mission
+        .route()
+        .warnings
+        .iter()
+        .filter(|w| w.contains("LOITER_UNLIM: flown as a loiter of"))
+        .cloned()
+        .collect()
 }
 
 /// The best candidate of `mission` (module steps 2-4) and the figures of the mission as given,
@@ -707,6 +737,7 @@ impl<'a> Maker<'a> {
                 vehicle: cx.vehicle,
                 options: cx.options,
                 flight: &cx.prepared.flight,
+                read: cx.mission.read_options(),
             }),
             None => Maker::Spec(SpecSorties {
                 route,

@@ -91,12 +91,15 @@ pub(in crate::engine) struct PlannerSorties<'a> {
     pub(in crate::engine) options: &'a MissionOptions,
     /// The request's flight, to fly a file as `aloft mission` does.
     pub(in crate::engine) flight: &'a Flight<'a>,
+    /// How a file is read back (as the mission was read: an unlimited loiter's time).
+    pub(in crate::engine) read: aloft_missions::ReadOptions,
 }
 
 impl SortieMaker for PlannerSorties<'_> {
     fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String> {
         let text = self.text(start, end)?;
-        let mission = Mission::from_text(&text, "the sortie's file").map_err(|e| e.to_string())?;
+        let mission = Mission::from_text_with(&text, "the sortie's file", self.read)
+            .map_err(|e| e.to_string())?;
         let payload_kg = self.route.payload_at_kg(start);
         let flown = flown_mission(
             self.flight,

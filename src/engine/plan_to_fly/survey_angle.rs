@@ -151,5 +151,5 @@ fn turned_mission(
     let home = imported.home?;
     let entries = plan_entries(imported, angles).ok()?;
     let text = write_plan(&plan.header, &home, &entries, &plan.airspace).ok()?;
-    Mission::from_text(&text, mission.origin()).ok()
+    Mission::from_text_with(&text, mission.origin(), mission.read_options()).ok()
 }

@@ -294,6 +294,35 @@ fn loiter_unlimited_ends_the_route_with_a_loiter_until_the_reserve() {
     assert_eq!(i.counted.unreachable, 1);
 }
 
+/// Issue 43 item 3: with `loiter_unlimited_s` (`aloft plan`), the unlimited loiter is a hover
+/// of that long at its point and the items after it are flown: the waypoint after it and the
+/// landing, nothing unreachable.
+#[test]
+fn loiter_unlimited_for_a_stated_time_goes_on_with_the_items_after_it() {
+    let rows = [
+        take_off(20.0),
+        row(2, 3, 17, [0.0; 4], -35.001, 149.0, 20.0),
+        row(3, 3, 16, [0.0; 4], -35.002, 149.0, 20.0),
+        row(4, 3, 21, [0.0; 4], -35.002, 149.0, 0.0),
+    ];
+    let text = format!("QGC WPL 110\n{HOME}\n{}\n", rows.join("\n"));
+    let options = crate::ReadOptions {
+        loiter_unlimited_s: Some(90.0),
+    };
+    let i = crate::read_waypoints_with(&text, options).unwrap();
+    assert_eq!(items(&i), [1, 2, 2, 3, 4, 4].map(Some), "{:?}", kinds(&i));
+    assert_eq!(
+        kinds(&i),
+        ["take-off", "leg", "hover", "leg", "descent", "landing"]
+    );
+    match i.spec.segments[2] {
+        SegmentSpec::Hover { duration_s, .. } => assert_eq!(duration_s, 90.0),
+        ref s => panic!("{s:?}"),
+    }
+    assert!(warned(&i, "row 2: LOITER_UNLIM: flown as a loiter of 90 s"));
+    assert_eq!(i.counted.unreachable, 0);
+}
+
 #[test]
 fn spline_waypoints_are_flown_straight_with_a_note() {
     let i = wpl(&[

@@ -505,6 +505,7 @@ fn regenerated_items_fly_as_the_same_items_read_from_a_file() {
         autopilot: Autopilot::Px4,
         jumps_by: crate::jumps::JumpsBy::DoJumpId,
         default_speed_mps: 5.0,
+        options: crate::ReadOptions::default(),
     };
     let flown = translate(&raw, &source, crate::notes::Notes::default()).unwrap();
     assert_eq!(flown.segments, read.spec.segments);
