@@ -316,7 +316,7 @@ fn loiter_unlimited_for_a_stated_time_goes_on_with_the_items_after_it() {
         ["take-off", "leg", "hover", "leg", "descent", "landing"]
     );
     match i.spec.segments[2] {
-        SegmentSpec::Hover { duration_s, .. } => assert_eq!(duration_s, 90.0),
+        SegmentSpec::Hover { duration_s, .. } => assert!((duration_s - 90.0).abs() < 1e-12),
         ref s => panic!("{s:?}"),
     }
     assert!(warned(&i, "row 2: LOITER_UNLIM: flown as a loiter of 90 s"));
