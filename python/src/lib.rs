@@ -30,8 +30,8 @@ use pyo3::types::PyDict;
 use aloft::engine::answers;
 use aloft::engine::flags::{LogInfoFlags, MissionFlags, MissionScenarioFlags, PowerModelFlags};
 use aloft::engine::{
-    FlagGroup, Keyword, plan_mission, power_model, power_point, power_values, FlightStateDeg, Mission, PowerModelQuery,
-    PowerQuery, Vehicle, POWER_KEYS,
+    plan_mission, power_model, power_point, power_values, FlagGroup, FlightStateDeg, Keyword,
+    Mission, PowerModelQuery, PowerQuery, Vehicle, POWER_KEYS,
 };
 use aloft_power::{AoaInput, FlightState, PowerBreakdown};
 
@@ -81,9 +81,13 @@ fn mission_json(
     path: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    answer_json(py, "mission", &[], options, |flags: &MissionScenarioFlags| {
-        answers::mission_answer(path.as_deref(), flags)
-    })
+    answer_json(
+        py,
+        "mission",
+        &[],
+        options,
+        |flags: &MissionScenarioFlags| answers::mission_answer(path.as_deref(), flags),
+    )
 }
 
 /// The map of a mission (`aloft serve`'s `/api/map`) as compact JSON text.
@@ -94,9 +98,13 @@ fn mission_map_json(
     path: Option<PathBuf>,
     options: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<String> {
-    answer_json(py, "mission", &[], options, |flags: &MissionScenarioFlags| {
-        answers::mission_map_answer(path.as_deref(), flags)
-    })
+    answer_json(
+        py,
+        "mission",
+        &[],
+        options,
+        |flags: &MissionScenarioFlags| answers::mission_map_answer(path.as_deref(), flags),
+    )
 }
 
 /// The columns of `aloft mission --timeseries`: names and arrays (`segment` as int64).
@@ -265,7 +273,13 @@ fn validate_json(
         ("log", options::paths(&logs)),
         ("vehicle", options::text(&vehicle)),
     ];
-    answer_json(py, "validate", &positional, options, answers::validate_answer)
+    answer_json(
+        py,
+        "validate",
+        &positional,
+        options,
+        answers::validate_answer,
+    )
 }
 
 /// `aloft live --replay LOG --format json` as one JSON text: `{"updates": [...], "check" or
