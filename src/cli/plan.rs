@@ -90,10 +90,23 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
     };
     row(out, "plan", &figures)?;
     writeln!(out)?;
-    writeln!(out, "Sorties")?;
+    let sc = &plan.scenarios;
+    let sp = &sc.spreads;
     writeln!(
         out,
-        "   #  items      energy     min:s  battery end  point of no return  file"
+        "Sorties cut to land with the reserve in {} % of {} scenarios of the day (1 sd: wind \
+         {:.1} m/s and {:.0}\u{b0}, pack capacity {:.0} %, power {:.0} %, payload {:.1} kg)",
+        100.0 * plan.confidence,
+        sc.samples,
+        sp.wind_speed_sd_mps,
+        sp.wind_from_sd_deg,
+        sp.capacity_sd_percent,
+        sp.power_sd_percent,
+        sp.payload_sd_kg
+    )?;
+    writeln!(
+        out,
+        "   #  items      energy     min:s  battery end  at landing p5-p95  with reserve  point of no return  file"
     )?;
     for (k, s) in plan.sorties.iter().enumerate() {
         let items = match (s.first_item, s.last_item) {
@@ -103,9 +116,16 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
         let pnr = s
             .point_of_no_return_s
             .map_or_else(|| "none".to_string(), mmss);
+        let band = s.landing_soc.map_or_else(
+            || "-".to_string(),
+            |b| format!("{:.1}-{:.1} %", 100.0 * b.p5, 100.0 * b.p95),
+        );
+        let share = s
+            .p_reserve
+            .map_or_else(|| "-".to_string(), |p| format!("{:.1} %", 100.0 * p));
         writeln!(
             out,
-            "  {:>2}  {items:<9} {:>6.1} Wh {:>7} {:>10.1} %  {pnr:>18}  {}",
+            "  {:>2}  {items:<9} {:>6.1} Wh {:>7} {:>10.1} %  {band:>17}  {share:>12}  {pnr:>18}  {}",
             k + 1,
             s.energy_wh,
             mmss(s.duration_s),
@@ -125,7 +145,7 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
     for a in &plan.changes.angles {
         writeln!(
             out,
-            "survey at item {} turned to the wind: grid angle {}\u{b0} -> {}\u{b0}",
+            "survey at item {} turned to the wind: grid angle {:.1}\u{b0} -> {:.1}\u{b0}",
             a.item, a.from_deg, a.to_deg
         )?;
     }
@@ -135,7 +155,7 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
     if plan.changes.cut_inside_legs {
         writeln!(
             out,
-            "sorties end inside legs, where each pack reaches the reserve"
+            "sorties end inside legs, where each pack reaches the reserve at the plan's confidence"
         )?;
     }
     Ok(())

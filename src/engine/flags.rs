@@ -30,7 +30,9 @@ use crate::engine::missions::mission_options::{GustSpec, MissionOptions};
 use crate::engine::performance::payload_sweep::PayloadSweep;
 use crate::engine::performance::power::PowerModelQuery;
 use crate::engine::plan_to_fly::fly_plan::{
-    FlyPlanRequest, SpeedChoice, DEFAULT_LOITER_UNLIMITED_S, DEFAULT_OVERLAP_M,
+    FlyPlanRequest, PlanConfidence, SpeedChoice, DEFAULT_CAPACITY_SD_PERCENT, DEFAULT_CONFIDENCE,
+    DEFAULT_LOITER_UNLIMITED_S, DEFAULT_OVERLAP_M, DEFAULT_PLAN_SCENARIOS,
+    DEFAULT_WIND_FROM_SD_DEG,
 };
 use crate::engine::step_meter::StepMeter;
 use crate::engine::step_meter::WorkBounds;
@@ -748,6 +750,67 @@ fn speeds_parser() -> impl TypedValueParser<Value = SpeedChoice> {
     ])
 }
 
+/// How sure a plan's sorties must be: the confidence and the scenarios it is judged in (as
+/// `aloft mission`'s scenario flags, with a plan's defaults: the forecast's error and the
+/// models').
+#[derive(Debug, Clone, Args)]
+pub struct PlanConfidenceFlags {
+    /// Share of the day's scenarios each sortie must land with the reserve in, 0.5 to 0.999
+    /// (0.5: cut for the forecast alone, today's nominal cut).
+    #[arg(long, value_parser = finite(), default_value_t = DEFAULT_CONFIDENCE, value_name = "P",
+        allow_negative_numbers = true)]
+    pub confidence: f64,
+    /// Scenarios drawn to judge each sortie (1 to 100000).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_PLAN_SCENARIOS,
+        value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_SCENARIOS)))]
+    pub samples: u32,
+    /// Seed of the scenarios' draws (the same seed gives the same plan).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Spread of the wind speed, m/s (normal, clipped at 0; default: 25 % of the forecast
+    /// speed and at least 1.5 m/s).
+    #[arg(long, value_parser = spread(50.0), value_name = "M/S", allow_negative_numbers = true)]
+    pub wind_speed_sd: Option<f64>,
+    /// Spread of the wind direction, degrees (normal).
+    #[arg(long, value_parser = spread(180.0), default_value_t = DEFAULT_WIND_FROM_SD_DEG,
+        value_name = "DEG", allow_negative_numbers = true)]
+    pub wind_from_sd: f64,
+    /// Spread of the take-off payload, kg (normal, clipped at 0).
+    #[arg(long, value_parser = spread(1000.0), default_value_t = 0.0, value_name = "KG",
+        allow_negative_numbers = true)]
+    pub payload_sd_kg: f64,
+    /// Spread of the pack's capacity (health), percent of its rating (normal).
+    #[arg(long, value_parser = spread(50.0), default_value_t = DEFAULT_CAPACITY_SD_PERCENT,
+        value_name = "PERCENT", allow_negative_numbers = true)]
+    pub capacity_sd_percent: f64,
+    /// Spread of the model's electrical power, percent (normal; aloft's own whole-flight
+    /// energy errors).
+    #[arg(long, value_parser = spread(50.0), default_value_t = DEFAULT_POWER_SD_PERCENT,
+        value_name = "PERCENT", allow_negative_numbers = true)]
+    pub power_sd_percent: f64,
+    /// Threads for the scenarios (0: one per core); the plan does not depend on it.
+    #[arg(long, default_value_t = 0, value_name = "N",
+        value_parser = clap::value_parser!(u16).range(0..=1024))]
+    pub threads: u16,
+}
+
+impl PlanConfidenceFlags {
+    /// The engine's confidence of these flags.
+    pub fn confidence(&self) -> PlanConfidence {
+        PlanConfidence {
+            confidence: self.confidence,
+            samples: self.samples,
+            seed: self.seed,
+            wind_speed_sd_mps: self.wind_speed_sd,
+            wind_from_sd_deg: self.wind_from_sd,
+            payload_sd_kg: self.payload_sd_kg,
+            capacity_sd_percent: self.capacity_sd_percent,
+            power_sd_percent: self.power_sd_percent,
+            threads: usize::from(self.threads),
+        }
+    }
+}
+
 /// The options of `aloft plan` (the mission's, and how the plan is made).
 #[derive(Debug, Clone, Args)]
 pub struct PlanFlags {
@@ -774,6 +837,9 @@ pub struct PlanFlags {
     /// where that saves energy, its transects drawn again as QGroundControl draws them).
     #[arg(long)]
     pub keep_angle: bool,
+    /// How sure each sortie must be.
+    #[command(flatten)]
+    pub sure: PlanConfidenceFlags,
     /// How long an unlimited loiter (NAV_LOITER_UNLIM) is flown, s, before the operator
     /// continues the mission with the items after it (each sortie keeps them and the
     /// mission's own landing).
@@ -838,6 +904,8 @@ impl PlanFlags {
             speeds: self.speeds,
             max_speed_mps: self.max_speed,
             camera_interval_s: self.camera_interval_s,
+            confidence: self.sure.confidence(),
+            scenarios: None,
             keep_angle: self.keep_angle,
             bounds: self.bounds.clone(),
         })

@@ -144,8 +144,10 @@ pub use performance::propulsion::{
     RotorRequest, SweepPoint, BUILTIN_ROTORS,
 };
 pub use plan_to_fly::fly_plan::{
-    plan_to_fly, FlyPlan, FlyPlanRequest, FlySortie, PlanChanges, PlanFigures, SpeedChange,
-    SpeedChoice, DEFAULT_CAMERA_INTERVAL_S, DEFAULT_OVERLAP_M,
+    plan_to_fly, FlyPlan, FlyPlanRequest, FlySortie, PlanChanges, PlanConfidence, PlanFigures,
+    PlanScenarios, SpeedChange, SpeedChoice, DEFAULT_CAMERA_INTERVAL_S,
+    DEFAULT_CAPACITY_SD_PERCENT, DEFAULT_CONFIDENCE, DEFAULT_OVERLAP_M, DEFAULT_PLAN_SCENARIOS,
+    DEFAULT_WIND_FROM_SD_DEG, MIN_WIND_SPEED_SD_MPS, WIND_SPEED_SD_SHARE,
 };
 pub use plan_to_fly::survey_angle::{AngleChange, ANGLE_STEP_DEG};
 pub use step_meter::{StepMeter, WorkBounds};

@@ -35,9 +35,20 @@ fn plan(mission: &Path, extra: &[&str]) -> (Value, PathBuf) {
 }
 
 /// `aloft mission FILE EXTRA --format json` of a written file.
+/// `aloft mission FILE --format json` in the conditions of `extra` (a plan's flags; its
+/// `--confidence` is the plan's alone).
 fn fly(file: &str, extra: &[&str]) -> Value {
     let mut args = vec!["mission", file, "--format", "json"];
-    args.extend_from_slice(extra);
+    let mut k = 0;
+    while k < extra.len() {
+        match extra[k] {
+            "--confidence" => k += 2,
+            flag => {
+                args.push(flag);
+                k += 1;
+            }
+        }
+    }
     let out = aloft(&args);
     assert!(
         matches!(out.status.code(), Some(0 | 1)),
@@ -51,15 +62,30 @@ fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-/// Every file flies to its sortie's answer and keeps the reserve; the first pack is used to the
-/// reserve (it turns home inside a leg); the plan needs no more than the mission as given.
+/// Every file flies to its sortie's answer and keeps the reserve; cut for the forecast alone
+/// (`--confidence 0.5`, the nominal cut), the first pack is used to the reserve (it turns home
+/// inside a leg) and the plan needs no more than the mission as given.
 #[test]
 fn each_file_flies_its_sortie_and_keeps_the_reserve() {
     let mission = write_mission("lines.toml", &survey_lines("lines", 24));
     for wind in [
-        vec![],
-        vec!["--wind-speed", "6", "--wind-from", "90"],
-        vec!["--wind-speed", "8", "--wind-from", "200"],
+        vec!["--confidence", "0.5"],
+        vec![
+            "--wind-speed",
+            "6",
+            "--wind-from",
+            "90",
+            "--confidence",
+            "0.5",
+        ],
+        vec![
+            "--wind-speed",
+            "8",
+            "--wind-from",
+            "200",
+            "--confidence",
+            "0.5",
+        ],
     ] {
         let (answer, _) = plan(&mission, &wind);
         let files = answer["files"].as_array().unwrap();

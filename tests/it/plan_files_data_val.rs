@@ -241,8 +241,13 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
     if files.len() > 1 {
         seen.split += 1;
     }
-    // No more than the mission as given.
-    if let Some(given) = answer.get("as_given") {
+    // Cut for the forecast alone, no more than the mission as given (which is cut so); at a
+    // confidence, every sortie lands with the reserve in that share of the plan's scenarios.
+    let confidence = f(&answer["confidence"]);
+    for s in sorties.iter().filter(|_| confidence > 0.5) {
+        assert!(f(&s["p_reserve"]) >= confidence, "{tag}: {s}");
+    }
+    if let Some(given) = answer.get("as_given").filter(|_| confidence == 0.5) {
         assert!(
             answer["batteries"].as_u64() <= given["batteries"].as_u64(),
             "{tag}: {answer}"
@@ -401,7 +406,9 @@ fn mission_flags(extra: &[String]) -> Vec<&str> {
     let mut k = 0;
     while k < extra.len() {
         match extra[k].as_str() {
-            "--speeds" | "--overlap-m" | "--camera-interval-s" | "--max-speed" => k += 2,
+            "--speeds" | "--overlap-m" | "--camera-interval-s" | "--max-speed" | "--confidence" => {
+                k += 2
+            }
             "--keep-angle" => k += 1,
             flag => {
                 out.push(flag);
@@ -462,7 +469,10 @@ fn data_val_every_shared_planner_file_planned_in_wind_flies_its_files() {
         "plans {} (split {}), no plan {}, resumed with the camera {}, camera-on route {:.0} m",
         seen.plans, seen.split, seen.no_plan, seen.resumed_with_camera, seen.camera_m
     );
-    assert!(seen.plans >= 40, "plans: {}", seen.plans);
+    // 39 of the 50 file-and-wind pairs have a plan at the default confidence: in the 12 m/s
+    // winds, drawn with their 3 m/s spread, the M100 cannot hold its way in more than 5 % of the
+    // scenarios on most files.
+    assert!(seen.plans >= 38, "plans: {}", seen.plans);
 }
 
 /// The shared QGroundControl survey at a 70 % reserve: several packs, each resuming with the
@@ -471,7 +481,10 @@ fn data_val_every_shared_planner_file_planned_in_wind_flies_its_files() {
 fn data_val_the_shared_survey_split_in_wind_resumes_with_the_camera_and_covers_it() {
     let file = &shared_mission("neilvaltec_test.plan");
     let mut seen = Seen::default();
-    for extra in conditions(Some(70.0)) {
+    // Cut for the forecast alone: at a 70 % reserve, 12 m/s winds drawn with their default
+    // spread (3 m/s) leave no sortie that lands with it at a confidence of 95 %.
+    for mut extra in conditions(Some(70.0)) {
+        extra.extend(["--confidence".to_string(), "0.5".to_string()]);
         check(file, &extra, &mut seen);
     }
     eprintln!(

@@ -324,8 +324,8 @@ fn plan_requests_are_refused_as_mission_requests_are() {
     error(400, "overlap_m=nan", "'overlap_m' of POST /api/plan");
     error(
         400,
-        "samples=10",
-        "unknown option 'samples' for POST /api/plan",
+        "sweep_speed=10",
+        "unknown option 'sweep_speed' for POST /api/plan",
     );
     error(400, "vehicle=/etc/passwd", "'vehicle' of POST /api/plan");
     // Out of range: the command line's own message.

@@ -137,6 +137,7 @@ pub mod ground_effect;
 pub mod mission;
 pub mod mission_toml;
 pub mod pack_cursor;
+pub mod percentiles;
 pub mod plan;
 pub mod queries;
 pub mod replay;
@@ -156,6 +157,7 @@ pub use mission::{
     WindSpec,
 };
 pub use pack_cursor::{PackCursor, PackStep};
+pub use percentiles::Percentiles;
 pub use plan::{
     plan, plan_into, EdgeReport, MissionReport, NoProgressWhy, NoSamples, PlanOptions,
     PointOfNoReturn, Sample, SampleSink, SegmentReport, Shortfall, Stuck, DEFAULT_MAX_SAMPLES,

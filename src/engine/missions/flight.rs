@@ -29,6 +29,23 @@ pub(in crate::engine) struct Flight<'a> {
     pub(in crate::engine) meter: Option<StepMeter>,
 }
 
+impl<'a> Flight<'a> {
+    /// The same flight with the reserve `reserve_fraction` (a sortie cut with a margin), its
+    /// steps counted in the same budget.
+    pub(in crate::engine) fn with_reserve(&self, reserve_fraction: f64) -> Flight<'a> {
+        Flight {
+            aircraft: self.aircraft,
+            pack: self.pack,
+            wind: self.wind,
+            options: PlanOptions {
+                reserve_fraction,
+                ..self.options
+            },
+            meter: self.meter.clone(),
+        }
+    }
+}
+
 impl Flight<'_> {
     /// Compile `spec` (its take-off payload overridden by `payload_kg` when given).
     ///

@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::sorties::{farthest_fraction, last_that_holds};
 pub(in crate::engine) use aloft_planner::sorties::{segment_ends_m, Cut, Route};
-use aloft_planner::{Mission as Compiled, MissionReport, MissionSpec, SegmentSpec};
+use aloft_planner::{Mission as Compiled, MissionReport, MissionSpec, Percentiles, SegmentSpec};
 
 use crate::engine::missions::flight::Flight;
 
@@ -103,7 +103,54 @@ pub(in crate::engine) struct SortiePlan {
     /// The mission's segments it flies, whole or in part (the first sortie's take-off and the
     /// last one's way down included).
     pub(in crate::engine) route: std::ops::Range<usize>,
+    /// How it lands in the scenarios of the day, when a [`SortieCheck`] cut it.
+    pub(in crate::engine) band: Option<LandingBand>,
+    /// The margin it was cut with above the reserve, a share of the usable capacity.
+    pub(in crate::engine) margin: f64,
 }
+
+/// How a sortie lands in the scenarios of the day (`aloft plan --confidence`).
+#[derive(Debug, Clone, PartialEq)]
+pub(in crate::engine) struct LandingBand {
+    /// Its pack's state of charge at landing over the scenarios flown to the end (absent when
+    /// none was).
+    pub(in crate::engine) landing_soc: Option<Percentiles>,
+    /// The share of the scenarios that land with the reserve.
+    pub(in crate::engine) p_reserve: f64,
+    /// The reserve's margin that the share [`SortieCheck::confidence`] of the scenarios reach
+    /// or exceed, a fraction of the capacity (the charge left above the reserve at landing; a
+    /// scenario that does not finish counts as far below): at or above 0 the sortie holds.
+    pub(in crate::engine) margin_reached: f64,
+    /// The share of the scenarios the vehicle cannot fly at all (beyond its envelope, its pack's
+    /// power), which no margin of charge makes up for.
+    pub(in crate::engine) cannot_fly: f64,
+}
+
+/// What cuts sorties at a confidence: the band of a sortie's mission over the day's scenarios.
+pub(in crate::engine) trait SortieCheck: Sync {
+    /// The share of the scenarios that must land with the reserve (0.5 or less: the nominal cut,
+    /// the bands only reported).
+    fn confidence(&self) -> f64;
+
+    /// The band of `spec` flown in every scenario.
+    ///
+    /// # Errors
+    /// Why the scenarios cannot be flown (a request wrong whatever is drawn).
+    fn band(&self, spec: &MissionSpec) -> Result<LandingBand, String>;
+}
+
+/// Most times one sortie is cut again with a new margin before the plan says it cannot reach its
+/// confidence: the margin a cut needs changes little with where it ends (the same legs, the
+/// same wind), so the second or third cut holds.
+const MAX_MARGIN_ROUNDS: usize = 6;
+
+/// A margin this far above what the confidence asks is taken back (the cut moved on): the
+/// sorties are cut to within this much of the band's edge, a fraction of the capacity.
+const MARGIN_TOLERANCE: f64 = 0.01;
+
+/// Added to each raise of the margin, a fraction of the capacity: the next cut lands a little
+/// above the band's edge rather than on it.
+const MARGIN_STEP: f64 = 0.002;
 
 /// The sorties of `spec` (compiled as `compiled`), a mission one pack cannot fly; a route that
 /// cannot be split says why (a sortie that cannot be compiled or flown is one that cannot be
@@ -175,46 +222,230 @@ pub(in crate::engine) fn sortie_plans(
     options: SplitOptions,
     maker: &dyn SortieMaker,
 ) -> Result<Vec<SortiePlan>, String> {
+    confident_sortie_plans(flight, route, options, maker, (None, Margins::Nominal))
+}
+
+/// How the margins of [`confident_sortie_plans`] are set: the reserve each sortie is cut with
+/// is the request's plus its margin (a share of the usable capacity).
+#[derive(Debug, Clone, Copy)]
+pub(in crate::engine) enum Margins<'a> {
+    /// None: the nominal cut (the bands reported when there is a check).
+    Nominal,
+    /// Searched for each sortie until the check's confidence holds.
+    Searched,
+    /// Given for each sortie in order but the last, whose margin is searched, each sortie
+    /// checked: a route that takes more sorties than given, or a sortie that does not hold, is
+    /// refused.
+    Given(&'a [f64]),
+}
+
+/// The sorties of `route` as [`sortie_plans`] cuts them with the reserve raised by a margin
+/// (`margins`), each sortie's landing band from `check` when given (module step 6).
+///
+/// [`Margins::Searched`]: a sortie is cut with a margin (the last sortie's to begin with), its
+/// band taken, and the margin raised by what the band lacks (or lowered by what it holds beyond
+/// [`MARGIN_TOLERANCE`]) until the share [`SortieCheck::confidence`] of the scenarios lands it
+/// with the reserve: the margin a cut needs changes little with where it ends, so the second or
+/// third cut holds; where a cut crosses a turn and the band jumps, the margin is halved between
+/// the highest that failed and the lowest that held. The sortie that holds with the least margin
+/// is kept.
+///
+/// # Errors
+/// Why the route cannot be split, or not at that confidence (or with the margins given).
+pub(in crate::engine) fn confident_sortie_plans(
+    flight: &Flight<'_>,
+    route: &Route<'_>,
+    options: SplitOptions,
+    maker: &dyn SortieMaker,
+    (check, margins): (Option<&dyn SortieCheck>, Margins<'_>),
+) -> Result<Vec<SortiePlan>, String> {
     if options.inside_legs {
         within_reach(flight, route)?;
     }
     let mut plans: Vec<SortiePlan> = Vec::new();
     let mut start: Option<Cut> = None;
+    let mut margin = 0.0;
     loop {
         if plans.len() == MAX_SORTIES {
             return Err(format!("the route takes more than {MAX_SORTIES} sorties"));
         }
-        let spec = maker.sortie(start, None)?;
-        let rest = flight
-            .trial(&spec, None)
-            .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
-        let from = start.map_or(0, |_| route.resumes_at(start));
-        if rest.feasible {
-            plans.push(SortiePlan {
-                start,
-                end: None,
-                spec,
-                report: rest,
-                route: from..route.spec().segments.len(),
-            });
-            return Ok(plans);
-        }
-        let found = match options.inside_legs {
-            true => farthest_end(flight, route, maker, start),
-            false => whole_end(flight, route, maker, (start, &rest)),
-        };
-        let Some((end, spec, report)) = found else {
-            return Err(route.cannot_fly(start));
-        };
-        plans.push(SortiePlan {
+        let trials = Trials {
+            flight,
+            route,
+            options,
+            maker,
             start,
-            end: Some(end),
-            spec,
-            report,
-            route: from..end.segment + 1,
-        });
-        start = Some(route.back_along(end, options.overlap_m, start));
+        };
+        let plan = match (check, margins) {
+            (Some(check), Margins::Searched) if check.confidence() > 0.5 => {
+                let plan = trials.searched(check, margin)?;
+                margin = plan.margin;
+                plan
+            }
+            (_, Margins::Given(given)) if plans.len() >= given.len() => {
+                return Err(format!("the route takes more than {} sorties", given.len()));
+            }
+            // The last sortie given flies the rest of the route when that holds: its margin is
+            // searched, as its band is narrower than the others' (a shorter flight).
+            (Some(check), Margins::Given(given)) if plans.len() + 1 == given.len() => {
+                trials.searched(check, 0.0)?
+            }
+            (_, Margins::Given(given)) => {
+                let plan = trials.cut(given[plans.len()], check)?;
+                if plan.band.as_ref().is_some_and(|b| b.margin_reached < 0.0) {
+                    return Err(format!("sortie {} does not hold", plans.len() + 1));
+                }
+                plan
+            }
+            (check, _) => trials.cut(0.0, check)?,
+        };
+        let end = plan.end;
+        plans.push(plan);
+        match end {
+            None => return Ok(plans),
+            Some(end) => start = Some(route.back_along(end, options.overlap_m, start)),
+        }
     }
+}
+
+/// The trials of one sortie from `start`.
+struct Trials<'t, 'f> {
+    flight: &'t Flight<'f>,
+    route: &'t Route<'t>,
+    options: SplitOptions,
+    maker: &'t dyn SortieMaker,
+    start: Option<Cut>,
+}
+
+impl Trials<'_, '_> {
+    /// The sortie cut with the reserve raised by `margin`, with its band when there is a check.
+    fn cut(&self, margin: f64, check: Option<&dyn SortieCheck>) -> Result<SortiePlan, String> {
+        let raised = self
+            .flight
+            .with_reserve(self.flight.options.reserve_fraction + margin);
+        let mut plan = next_sortie(&raised, self.route, self.options, self.maker, self.start)?;
+        plan.margin = margin;
+        if let Some(check) = check {
+            plan.band = Some(check.band(&plan.spec)?);
+        }
+        Ok(plan)
+    }
+
+    /// The sortie cut with the least margin found that holds at `check`'s confidence, the search
+    /// starting from `margin` ([`Margins::Searched`]).
+    fn searched(&self, check: &dyn SortieCheck, mut margin: f64) -> Result<SortiePlan, String> {
+        let reserve = self.flight.options.reserve_fraction;
+        // The highest margin that failed, and the sortie that held with the least.
+        let mut failed: Option<f64> = None;
+        let mut held: Option<SortiePlan> = None;
+        // The margin the last band asked for, and the share it could not fly at all.
+        let mut asked = margin;
+        let mut cannot_fly = 0.0;
+        for _ in 0..MAX_MARGIN_ROUNDS {
+            // No end lands with the reserve raised so far: the one that held is kept, if any.
+            let Ok(plan) = self.cut(margin, Some(check)) else {
+                break;
+            };
+            let reached = plan.band.as_ref().map_or(-1.0, |b| b.margin_reached);
+            asked = margin - reached;
+            cannot_fly = plan.band.as_ref().map_or(0.0, |b| b.cannot_fly);
+            let holds = reached >= 0.0;
+            // The last sortie is not cut: any margin it lands with is kept.
+            let done = holds && (plan.end.is_none() || reached <= MARGIN_TOLERANCE);
+            match holds {
+                true if held.as_ref().is_none_or(|h| margin < h.margin) => held = Some(plan),
+                true => {}
+                false => failed = Some(failed.map_or(margin, |f| f.max(margin))),
+            }
+            if done {
+                break;
+            }
+            // What the band lacks (or holds beyond what it asks), kept between the margins
+            // tried when it would leave them.
+            let mut next = (margin - reached + MARGIN_STEP).max(0.0);
+            if let (Some(lo), Some(hi)) = (failed, held.as_ref().map(|h| h.margin)) {
+                if hi - lo < MARGIN_STEP {
+                    break;
+                }
+                if !(lo < next && next < hi) {
+                    next = 0.5 * (lo + hi);
+                }
+            }
+            if reserve + next >= MAX_RESERVE {
+                break;
+            }
+            margin = next;
+        }
+        held.ok_or_else(|| {
+            let c = check.confidence();
+            if cannot_fly > 1.0 - c {
+                return format!(
+                    "{} at a confidence of {} %: in {:.1} % of the day's scenarios the vehicle \
+                     cannot fly it at all (a wind beyond its envelope, a power beyond its pack), \
+                     which no margin of charge makes up for",
+                    self.route.cannot_fly(self.start),
+                    100.0 * c,
+                    100.0 * cannot_fly
+                );
+            }
+            format!(
+                "{} at a confidence of {} %: in the day's scenarios it needs a margin of {:.0} % \
+                 of the usable capacity above the {:.0} % reserve (a lower --confidence, narrower \
+                 spreads or a lower reserve ask less)",
+                self.route.cannot_fly(self.start),
+                100.0 * check.confidence(),
+                100.0 * asked,
+                100.0 * reserve
+            )
+        })
+    }
+}
+
+/// The highest reserve a margin raises the cut to, a fraction of the capacity: beyond it no
+/// sortie is worth flying.
+const MAX_RESERVE: f64 = 0.95;
+
+/// The sortie from `start` as the greedy cut finds it (the module's steps 1-4) with `flight`'s
+/// reserve: the rest of the route when it lands with the reserve, else the farthest end.
+fn next_sortie(
+    flight: &Flight<'_>,
+    route: &Route<'_>,
+    options: SplitOptions,
+    maker: &dyn SortieMaker,
+    start: Option<Cut>,
+) -> Result<SortiePlan, String> {
+    let spec = maker.sortie(start, None)?;
+    let rest = flight
+        .trial(&spec, None)
+        .map_err(|e| format!("a sortie cannot be flown: {e}"))?;
+    let from = start.map_or(0, |_| route.resumes_at(start));
+    if rest.feasible {
+        return Ok(SortiePlan {
+            start,
+            end: None,
+            spec,
+            report: rest,
+            route: from..route.spec().segments.len(),
+            band: None,
+            margin: 0.0,
+        });
+    }
+    let found = match options.inside_legs {
+        true => farthest_end(flight, route, maker, start),
+        false => whole_end(flight, route, maker, (start, &rest)),
+    };
+    let Some((end, spec, report)) = found else {
+        return Err(route.cannot_fly(start));
+    };
+    Ok(SortiePlan {
+        start,
+        end: Some(end),
+        spec,
+        report,
+        route: from..end.segment + 1,
+        band: None,
+        margin: 0.0,
+    })
 }
 
 impl Sorties {

@@ -44,13 +44,17 @@ use crate::engine::missions::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN
 use crate::engine::missions::mission_options::MissionOptions;
 use crate::engine::missions::mission_outputs::segment_paths;
 use crate::engine::missions::sorties::{
-    segment_ends_m, sortie_plans, Route, SortieMaker, SortiePlan, SpecSorties, SplitOptions,
+    confident_sortie_plans, segment_ends_m, Margins, Route, SortieCheck, SortieMaker, SortiePlan,
+    SpecSorties, SplitOptions,
 };
 use crate::engine::plan_to_fly::plan_files::PlannerSorties;
 use crate::engine::plan_to_fly::survey_angle::{turned_to_wind, unturnable, AngleChange};
 use crate::engine::step_meter::WorkBounds;
+use crate::engine::uncertainty::scenarios::{ScenarioOptions, Spreads};
+use crate::engine::uncertainty::sortie_bands::SortieScenarios;
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
+use aloft_planner::Percentiles;
 
 /// How far back along the route a sortie resumes by default, m: a frame of a survey camera at
 /// the usual 10-30 m trigger distance, so that the last images of one sortie and the first of the
@@ -67,6 +71,117 @@ pub const DEFAULT_LOITER_UNLIMITED_S: f64 = 60.0;
 /// s: a conservative interval for a survey camera that does not state its own (give
 /// `--camera-interval-s` for yours), so that no photo is skipped.
 pub const DEFAULT_CAMERA_INTERVAL_S: f64 = 2.0;
+
+/// The share of the day's scenarios each sortie lands with the reserve in by default: the 5th
+/// percentile of its landing charge at the reserve or above.
+pub const DEFAULT_CONFIDENCE: f64 = 0.95;
+
+/// Scenarios a plan draws by default: the 5th percentile of 400 draws is the 20th smallest, and
+/// the share that holds is known to about 1.1 percentage points (one standard error,
+/// `sqrt(0.95 x 0.05 / 400)`).
+pub const DEFAULT_PLAN_SCENARIOS: u32 = 400;
+
+/// The wind speed's spread a plan draws by default, a share of the forecast speed (one standard
+/// deviation), and at least [`MIN_WIND_SPEED_SD_MPS`] (see [`PlanConfidence`]).
+pub const WIND_SPEED_SD_SHARE: f64 = 0.25;
+
+/// The least wind speed spread a plan draws by default, m/s.
+pub const MIN_WIND_SPEED_SD_MPS: f64 = 1.5;
+
+/// The wind direction's spread a plan draws by default, degrees.
+pub const DEFAULT_WIND_FROM_SD_DEG: f64 = 25.0;
+
+/// The pack capacity's spread a plan draws by default, percent: packs of one model and age
+/// differ by a few percent (the KAIST packs' counted charge is 0.88 to 0.96 of what their
+/// management system reports, ../shared/research/air-packs.md).
+pub const DEFAULT_CAPACITY_SD_PERCENT: f64 = 3.0;
+
+/// How sure a plan must be, and of what: each sortie is cut where the share `confidence` of the
+/// scenarios (`samples` draws from `seed`) still lands it with the reserve. The spreads are the
+/// forecast's error and the models' (one standard deviation each); a weather forecast's 10 m
+/// wind is off by about 1.5 to 2.5 m/s (root mean square) and 20 to 40 degrees a day ahead, so
+/// the defaults draw the speed with a spread of [`WIND_SPEED_SD_SHARE`] of the forecast and at
+/// least [`MIN_WIND_SPEED_SD_MPS`], the direction with [`DEFAULT_WIND_FROM_SD_DEG`], the pack's
+/// capacity with [`DEFAULT_CAPACITY_SD_PERCENT`], the model's power with aloft's own 3 %
+/// ([`crate::engine::DEFAULT_POWER_SD_PERCENT`]), and no payload spread (an operator weighs
+/// it). docs/guide.md, "Plans that hold", says where these come from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanConfidence {
+    /// The share of the scenarios each sortie must land with the reserve in, 0.5 to 0.999 (0.5:
+    /// the nominal cut, the bands still reported).
+    pub confidence: f64,
+    /// Scenarios drawn (1 to 100,000).
+    pub samples: u32,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Wind speed spread, m/s (default: a share of the forecast, see above).
+    pub wind_speed_sd_mps: Option<f64>,
+    /// Wind direction spread, degrees.
+    pub wind_from_sd_deg: f64,
+    /// Payload spread, kg.
+    pub payload_sd_kg: f64,
+    /// Pack capacity spread, percent.
+    pub capacity_sd_percent: f64,
+    /// Electrical power spread (the model's error), percent.
+    pub power_sd_percent: f64,
+    /// Threads for the scenarios (0: one per core); the answer does not depend on it.
+    pub threads: usize,
+}
+
+impl Default for PlanConfidence {
+    fn default() -> Self {
+        Self {
+            confidence: DEFAULT_CONFIDENCE,
+            samples: DEFAULT_PLAN_SCENARIOS,
+            seed: 1,
+            wind_speed_sd_mps: None,
+            wind_from_sd_deg: DEFAULT_WIND_FROM_SD_DEG,
+            payload_sd_kg: 0.0,
+            capacity_sd_percent: DEFAULT_CAPACITY_SD_PERCENT,
+            power_sd_percent: crate::engine::uncertainty::scenarios::DEFAULT_POWER_SD_PERCENT,
+            threads: 0,
+        }
+    }
+}
+
+impl PlanConfidence {
+    /// The scenario options for a forecast of `forecast_mps` (the wind's speed at its reference
+    /// height; `None` for a gridded field, whose wind is not drawn unless a spread is given).
+    fn scenarios(&self, forecast_mps: Option<f64>, bounds: &WorkBounds) -> ScenarioOptions {
+        let speed_sd = self.wind_speed_sd_mps.unwrap_or(match forecast_mps {
+            Some(v) => (WIND_SPEED_SD_SHARE * v).max(MIN_WIND_SPEED_SD_MPS),
+            None => 0.0,
+        });
+        let from_sd = match forecast_mps {
+            Some(_) => self.wind_from_sd_deg,
+            None if self.wind_speed_sd_mps.is_some() => self.wind_from_sd_deg,
+            None => 0.0,
+        };
+        ScenarioOptions {
+            samples: self.samples,
+            seed: self.seed,
+            wind_speed_sd_mps: speed_sd,
+            wind_from_sd_deg: from_sd,
+            payload_sd_kg: self.payload_sd_kg,
+            capacity_sd_percent: self.capacity_sd_percent,
+            power_sd_percent: self.power_sd_percent,
+            threads: self.threads,
+            soc_fan: false,
+            bounds: bounds.clone(),
+        }
+    }
+}
+
+/// The scenarios a plan's sorties were checked in (the answer's `scenarios`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlanScenarios {
+    /// Scenarios drawn.
+    pub samples: u32,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// The spreads drawn (one standard deviation each).
+    pub spreads: Spreads,
+}
 
 /// Which legs get the wind's speed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -98,6 +213,11 @@ pub struct FlyPlanRequest {
     /// The camera's shortest time between photos, s (default: a `.plan` survey's
     /// `CameraCalc.MinTriggerInterval`, else [`DEFAULT_CAMERA_INTERVAL_S`]).
     pub camera_interval_s: Option<f64>,
+    /// How sure each sortie must be to land with the reserve.
+    pub confidence: PlanConfidence,
+    /// The scenarios of [`FlyPlanRequest::confidence`] once resolved for the forecast (set by
+    /// [`plan_to_fly`]; a caller leaves it `None`).
+    pub scenarios: Option<ScenarioOptions>,
     /// Keep the grid angle of every survey (else each QGroundControl survey is turned to the
     /// wind where that saves energy and covers its polygon as before, its transects drawn again
     /// at every [`ANGLE_STEP_DEG`](crate::engine::plan_to_fly::survey_angle::ANGLE_STEP_DEG) degrees and along and across the wind).
@@ -117,6 +237,8 @@ impl Default for FlyPlanRequest {
             speeds: SpeedChoice::default(),
             max_speed_mps: None,
             camera_interval_s: None,
+            confidence: PlanConfidence::default(),
+            scenarios: None,
             keep_angle: false,
             bounds: WorkBounds::default(),
         }
@@ -157,6 +279,12 @@ pub struct FlySortie {
     /// Its point of no return, s after take-off (absent: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_s: Option<f64>,
+    /// Its pack's state of charge at landing over the day's scenarios (those that land).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub landing_soc: Option<Percentiles>,
+    /// The share of the day's scenarios in which it lands with the reserve.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p_reserve: Option<f64>,
 }
 
 /// A leg given another speed.
@@ -197,6 +325,10 @@ pub struct FlyPlan {
     pub energy_wh: f64,
     /// Flight time of all its flights, s.
     pub duration_s: f64,
+    /// The share of the day's scenarios each sortie was cut to land with the reserve in.
+    pub confidence: f64,
+    /// The scenarios drawn.
+    pub scenarios: PlanScenarios,
     /// The air flown in (flattened: `air_density_kg_m3`, `density_source`, ...).
     #[serde(flatten)]
     pub air: crate::engine::conditions::air::Air,
@@ -244,9 +376,14 @@ pub fn plan_to_fly(
     };
     let options = &request.options;
     let (wind, _) = mission_wind(options, mission, vehicle)?;
+    let scenarios = plan_scenarios(mission, request)?;
+    let request = &FlyPlanRequest {
+        scenarios: Some(scenarios.clone()),
+        ..request.clone()
+    };
     // The mission as given is planned while its surveys are turned (two threads).
     let (planned, turned) = std::thread::scope(|scope| {
-        let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind));
+        let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind, None));
         let turned = match request.keep_angle {
             true => Ok(None),
             false => turned_to_wind(
@@ -266,24 +403,34 @@ pub fn plan_to_fly(
     let (best, given) = planned?;
     let turned = turned?;
     // The surveys turned to the wind, when that needs fewer batteries or less energy.
-    let (best, angles) = match turned {
-        Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind) {
+    let (best, angles, turned) = match turned {
+        Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind, None) {
             Ok((t, _))
                 if (t.figures.batteries, t.figures.energy_wh)
                     < (best.figures.batteries, best.figures.energy_wh) =>
             {
-                (t, angles)
+                (t, angles, Some(turned))
             }
-            _ => (best, Vec::new()),
+            _ => (best, Vec::new(), None),
         },
-        None => (best, Vec::new()),
+        None => (best, Vec::new(), None),
     };
+    // The best way of flying it, cut again at the confidence with its margins balanced (module
+    // step 4): the same candidate of the same mission, each sortie judged in the day's scenarios.
+    let chosen = turned.as_ref().unwrap_or(mission);
+    let (best, _) = plan_for(vehicle, chosen, request, &wind, Some(best.candidate.kind))?;
     let as_given = match given {
         Some(figures) => Some(figures),
         None => as_given_figures(vehicle, mission, options)?,
     };
     let mut plan = answer(mission, &best, as_given)?;
     plan.air = air;
+    plan.confidence = request.confidence.confidence;
+    plan.scenarios = PlanScenarios {
+        samples: scenarios.samples,
+        seed: scenarios.seed,
+        spreads: scenarios.spreads(),
+    };
     plan.changes.angles = angles;
     if !request.keep_angle {
         plan.notes = unturnable(mission);
@@ -296,6 +443,37 @@ pub fn plan_to_fly(
             vehicle.name()
         )
     })
+}
+
+/// The scenarios of `request` around the forecast the mission flies in (its options' wind, else
+/// the mission's, else still air; none drawn around a gridded field unless asked).
+///
+/// # Errors
+/// A confidence outside 0.5 to 0.999; invalid scenario options.
+fn plan_scenarios(mission: &Mission, request: &FlyPlanRequest) -> Result<ScenarioOptions, Error> {
+    let c = &request.confidence;
+    if !(0.5..=0.999).contains(&c.confidence) {
+        return Err(Error::InvalidInput {
+            name: "confidence",
+            value: c.confidence,
+            unit: "",
+            expected: "a share of the scenarios from 0.5 (the nominal cut) to 0.999",
+        });
+    }
+    let options = &request.options;
+    let forecast_mps = match options.wind_field {
+        Some(_) => None,
+        None => Some(
+            options
+                .wind
+                .as_ref()
+                .or(mission.spec().wind.as_ref())
+                .map_or(0.0, |w| w.speed_mps),
+        ),
+    };
+    let sc = c.scenarios(forecast_mps, &request.bounds);
+    sc.check()?;
+    Ok(sc)
 }
 
 /// What the plan assumed of the unlimited loiters (the reader's words for each).
@@ -316,6 +494,7 @@ fn plan_for(
     mission: &Mission,
     request: &FlyPlanRequest,
     wind: &Wind,
+    sure: Option<usize>,
 ) -> Result<(Flown, Option<PlanFigures>), Error> {
     let options = &request.options;
     let aircraft = vehicle.aircraft()?;
@@ -325,13 +504,27 @@ fn plan_for(
     if let Some(payload_kg) = options.payload_kg {
         prepared.spec.payload_kg = payload_kg;
     }
-    let candidates = candidates((vehicle, mission), &prepared, wind, request)?;
+    let mut candidates = candidates((vehicle, mission), &prepared, wind, request)?;
+    if let Some(kind) = sure {
+        candidates.retain(|c| c.kind == kind);
+    }
+    let scenarios = request
+        .scenarios
+        .clone()
+        .unwrap_or_else(|| request.confidence.scenarios(Some(0.0), &request.bounds));
+    let check = SortieScenarios::new(
+        (vehicle, mission, options),
+        &prepared.flight,
+        &scenarios,
+        request.confidence.confidence,
+    )?;
     let cx = Context {
         vehicle,
         mission,
         options,
         prepared: &prepared,
         bounds: &request.bounds,
+        check: sure.map(|_| &check),
     };
     best_candidate(&cx, candidates)
 }
@@ -365,6 +558,8 @@ fn as_given_figures(
 /// A way of flying the mission: its spec, how it is cut and the speeds changed; `as_given` for
 /// the mission as given split at whole items.
 struct Candidate {
+    /// Which of [`candidates`] it is (its place in their order).
+    kind: usize,
     spec: MissionSpec,
     split: SplitOptions,
     speeds: Vec<SpeedChange>,
@@ -384,12 +579,14 @@ fn candidates(
     };
     let mut out = vec![
         Candidate {
+            kind: 0,
             spec: prepared.spec.clone(),
             split: inside,
             speeds: Vec::new(),
             as_given: false,
         },
         Candidate {
+            kind: 1,
             spec: prepared.spec.clone(),
             split: SplitOptions::default(),
             speeds: Vec::new(),
@@ -400,6 +597,7 @@ fn candidates(
         let (spec, speeds) = speeds_for_wind((vehicle, mission), prepared, wind, request)?;
         if !speeds.is_empty() {
             out.push(Candidate {
+                kind: 2,
                 spec,
                 split: inside,
                 speeds,
@@ -568,6 +766,9 @@ struct Context<'a> {
     options: &'a MissionOptions,
     prepared: &'a Prepared<'a>,
     bounds: &'a WorkBounds,
+    /// The day's scenarios each sortie is checked in (none: the nominal cut, to choose the
+    /// candidate).
+    check: Option<&'a SortieScenarios<'a>>,
 }
 
 /// The best candidate (module step 4), and the figures of the mission as given split at whole
@@ -638,7 +839,7 @@ fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String
         .map_err(|e| e.to_string())?;
     let route = Route::of(&candidate.spec, &compiled)?;
     let maker = Maker::of(cx, &route, &candidate);
-    let mut plans = sortie_plans(flight, &route, candidate.split, maker.as_dyn())?;
+    let mut plans = balanced_sortie_plans(cx, &route, candidate.split, maker.as_dyn())?;
     let n = plans.len();
     let mut texts = Vec::with_capacity(n);
     for (k, plan) in plans.iter_mut().enumerate() {
@@ -662,6 +863,78 @@ fn fly_candidate(cx: &Context<'_>, candidate: Candidate) -> Result<Flown, String
         texts,
     })
 }
+
+/// The sorties of `route` cut at the plan's confidence (module step 3), their margins balanced:
+/// with the fewest packs that reach the confidence, the slack the last sortie would land with is
+/// shared out, every sortie but the last cut again with its margin raised by the same share of
+/// the capacity (a little under the last one's slack over the sorties' count) and checked: up
+/// to [`BALANCE_PASSES`] cuts while the last keeps more than [`BALANCE_FROM`], the share halved
+/// after a cut that needs more packs or does not hold, the unbalanced cut kept when none does.
+fn balanced_sortie_plans(
+    cx: &Context<'_>,
+    route: &Route<'_>,
+    split: SplitOptions,
+    maker: &dyn SortieMaker,
+) -> Result<Vec<SortiePlan>, String> {
+    let flight = &cx.prepared.flight;
+    let Some(check) = cx.check else {
+        return confident_sortie_plans(flight, route, split, maker, (None, Margins::Nominal));
+    };
+    let check: &dyn SortieCheck = check;
+    let mut best = confident_sortie_plans(
+        flight,
+        route,
+        split,
+        maker,
+        (Some(check), Margins::Searched),
+    )?;
+    let n = best.len();
+    if n < 2 || check.confidence() <= 0.5 {
+        return Ok(best);
+    }
+    let searched: Vec<f64> = best.iter().map(|p| p.margin).collect();
+    // The share added to every margin so far, and the next step of it.
+    let mut extra = 0.0;
+    let mut step = BALANCE_SHARE * last_slack(&best) / n as f64;
+    for _ in 0..BALANCE_PASSES {
+        if step <= BALANCE_FROM / n as f64 || cx.bounds.cancelled() {
+            break;
+        }
+        let mut margins: Vec<f64> = searched.iter().map(|m| m + extra + step).collect();
+        margins[n - 1] = searched[n - 1];
+        let given = Margins::Given(&margins);
+        match confident_sortie_plans(flight, route, split, maker, (Some(check), given)) {
+            Ok(plans) => {
+                extra += step;
+                best = plans;
+                step = BALANCE_SHARE * last_slack(&best) / n as f64;
+            }
+            Err(_) => step *= 0.5,
+        }
+    }
+    Ok(best)
+}
+
+/// What the last of `plans` lands with beyond what the confidence asks, a share of the usable
+/// capacity.
+fn last_slack(plans: &[SortiePlan]) -> f64 {
+    plans
+        .last()
+        .and_then(|p| p.band.as_ref())
+        .map_or(0.0, |b| b.margin_reached)
+}
+
+/// How many times the sorties are cut again to share the margins out.
+const BALANCE_PASSES: usize = 2;
+
+/// The last sortie's slack over the confidence below which the sorties are not balanced, a
+/// fraction of the capacity.
+const BALANCE_FROM: f64 = 0.02;
+
+/// The share of the even split of the last sortie's slack each sortie is cut to keep: a little
+/// under all of it, since cutting a sortie earlier moves its fly-out's and way home's energy,
+/// not only the route's, onto the next.
+const BALANCE_SHARE: f64 = 0.8;
 
 /// Whether sortie `k` of `n` (its file read back, `plan.spec`) stays inside the operator's
 /// inclusion fences and out of the exclusion ones the whole way (take-off, fly-out, route, way
@@ -798,6 +1071,12 @@ fn answer(
         batteries: best.figures.batteries,
         energy_wh: best.figures.energy_wh,
         duration_s: best.figures.duration_s,
+        confidence: DEFAULT_CONFIDENCE,
+        scenarios: PlanScenarios {
+            samples: 0,
+            seed: 0,
+            spreads: ScenarioOptions::default().spreads(),
+        },
         air: crate::engine::conditions::air::Air::sea_level(),
         sorties,
         as_given,
@@ -831,6 +1110,8 @@ fn sortie_answer(file: &str, plan: &SortiePlan, spec: &MissionSpec) -> FlySortie
         duration_s: plan.report.duration_s,
         end_soc: plan.report.end_soc,
         point_of_no_return_s: plan.report.point_of_no_return.map(|p| p.time_s),
+        landing_soc: plan.band.as_ref().and_then(|b| b.landing_soc),
+        p_reserve: plan.band.as_ref().map(|b| b.p_reserve),
     }
 }
 

@@ -4,3 +4,4 @@
 
 pub(crate) mod scenario_stats;
 pub(crate) mod scenarios;
+pub(crate) mod sortie_bands;

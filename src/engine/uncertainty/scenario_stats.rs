@@ -5,40 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
-/// The 5th, 50th and 95th percentiles of a figure over scenarios (nearest rank: the `p`-th
-/// percentile of `n` values is the `ceil(p n / 100)`-th smallest).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Percentiles {
-    /// 5th percentile.
-    pub p5: f64,
-    /// Median.
-    pub p50: f64,
-    /// 95th percentile.
-    pub p95: f64,
-}
-
-impl Percentiles {
-    /// The percentiles of `values` (sorted in place); `None` when there are none.
-    pub(in crate::engine) fn of(values: &mut [f64]) -> Option<Self> {
-        if values.is_empty() {
-            return None;
-        }
-        values.sort_by(f64::total_cmp);
-        Some(Self {
-            p5: nearest_rank(values, 5),
-            p50: nearest_rank(values, 50),
-            p95: nearest_rank(values, 95),
-        })
-    }
-}
-
-/// The `p`-th percentile (`p` in 1..=100) of sorted, non-empty `values` by nearest rank, in
-/// integer arithmetic (`ceil(p n / 100)`, so 5 % of 1000 is the 50th value exactly).
-pub(in crate::engine) fn nearest_rank(sorted: &[f64], p: usize) -> f64 {
-    let n = sorted.len();
-    let rank = (p * n).div_ceil(100).clamp(1, n);
-    sorted[rank - 1]
-}
+pub use aloft_planner::percentiles::{nearest_rank, Percentiles};
 
 /// Percentiles of the time of the point of no return, s: each absent when it falls among the
 /// scenarios without a point of no return.

@@ -261,7 +261,7 @@ impl ScenarioOptions {
     }
 
     /// Threads to use for `n` scenarios.
-    fn thread_count(&self, n: usize) -> usize {
+    pub(super) fn thread_count(&self, n: usize) -> usize {
         let t = match self.threads {
             0 => std::thread::available_parallelism().map_or(1, |c| c.get()),
             t => t,
@@ -461,7 +461,7 @@ fn scaled<'a, T: Clone, E>(
 
 /// The aircraft and pack of a scenario: the aircraft scaled by its model error and the pack's
 /// capacity drawn, each when its spread is on.
-fn scaled_models<'a>(
+pub(super) fn scaled_models<'a>(
     aircraft: &'a Aircraft,
     pack: &'a Pack,
     sc: &ScenarioOptions,
@@ -494,7 +494,7 @@ fn drawn_wind_spec(spec: &WindSpec, sc: &ScenarioOptions, d: &Draws) -> WindSpec
 
 /// Whether a planner error says that the vehicle cannot fly this scenario (its limits), rather
 /// than that the request is wrong.
-fn cannot_fly(e: &PlannerError) -> bool {
+pub(super) fn cannot_fly(e: &PlannerError) -> bool {
     match e {
         PlannerError::Propulsion(_) | PlannerError::NoHeadway { .. } => true,
         PlannerError::Unreachable { name, .. } => name.starts_with("take-off mass"),
@@ -506,7 +506,7 @@ fn cannot_fly(e: &PlannerError) -> bool {
 // Missions.
 
 /// The winds of a mission's scenarios: what is decided once, and how scenario `i`'s is drawn.
-struct Winds {
+pub(super) struct Winds {
     /// The wind of the deterministic plan.
     nominal: Wind,
     /// The wind without the request's gusts (a scenario's gusts replace whatever it carries).
@@ -518,7 +518,7 @@ struct Winds {
 }
 
 impl Winds {
-    fn new(
+    pub(super) fn new(
         vehicle: &Vehicle,
         mission: &Mission,
         options: &MissionOptions,
@@ -557,7 +557,7 @@ impl Winds {
     }
 
     /// The wind of a scenario: the plan's when nothing about it is drawn.
-    fn of(&self, sc: &ScenarioOptions, d: &Draws) -> Result<Cow<'_, Wind>, Error> {
+    pub(super) fn of(&self, sc: &ScenarioOptions, d: &Draws) -> Result<Cow<'_, Wind>, Error> {
         let wind_error = |e| Error::Wind {
             origin: "scenario wind".to_string(),
             source: Box::new(e),
@@ -859,7 +859,7 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
 /// t + threads, ...`), each with its own state from `state`, until `bounds` is cancelled: the
 /// results in index order and the states. The first error by index is returned, whatever thread
 /// met it ([`Error::Cancelled`] once cancelled).
-fn run_indexed<R: Send, S: Send>(
+pub(super) fn run_indexed<R: Send, S: Send>(
     n: usize,
     (threads, bounds): (usize, &WorkBounds),
     state: impl Fn() -> S + Sync,

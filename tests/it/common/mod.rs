@@ -5,6 +5,7 @@
 //! `mod common;`.
 #![allow(dead_code)] // not every test file uses every helper
 
+pub mod big_survey;
 mod data;
 pub mod ros2;
 pub mod serve;
