@@ -47,6 +47,7 @@ mod pack_voltage_data_val;
 mod packs_cli;
 mod payload_sweep;
 mod plan_cli;
+mod plan_confidence;
 mod plan_files_data_val;
 mod planner_checks;
 mod planner_cli;

@@ -155,8 +155,13 @@ def plan(
             default a ``.plan`` survey's ``MinTriggerInterval``, else 2), ``keep_angle``
             (True: keep every survey's grid angle; else a QGroundControl survey is turned to the
             wind where that saves energy) and ``loiter_unlimited_s`` (s, default 60: how long an
-            unlimited loiter is flown before the items after it); and the mission's options, as :func:`mission`'s
-            without the Monte-Carlo ones: ``vehicle``, ``battery``, ``payload_kg`` (kg),
+            unlimited loiter is flown before the items after it); how sure each sortie must be:
+            ``confidence`` (default 0.95: each sortie lands with the reserve in that share of the
+            day's scenarios; 0.5 cuts for the forecast alone), ``samples`` (default 400), ``seed``
+            and the spreads ``wind_speed_sd`` (m/s, default 25 % of the forecast and at least
+            1.5), ``wind_from_sd`` (deg, default 25), ``payload_sd_kg`` (default 0),
+            ``capacity_sd_percent`` (default 3), ``power_sd_percent`` (default 3), ``threads``;
+            and the mission's options, as :func:`mission`'s without the Monte-Carlo ones: ``vehicle``, ``battery``, ``payload_kg`` (kg),
             ``wind_speed`` (m/s) and ``wind_from`` (deg, blowing FROM), ``wind_profile``,
             ``wind_field``, ``gust_std``, ``reserve_percent`` (% of the usable capacity at
             landing), ``start_percent``, ``time_step`` (s), ``speed`` (m/s),
@@ -168,7 +173,10 @@ def plan(
         ``energy_wh`` (Wh, all sorties), ``duration_s`` (s, all sorties), ``sorties`` (per
         file: ``file``, ``first_item`` and ``last_item`` of a planner file,
         ``ends_inside_leg_fraction`` where it turns home inside a leg, ``energy_wh``,
-        ``duration_s``, ``end_soc`` (0-1), ``point_of_no_return_s``), ``as_given`` (the
+        ``duration_s``, ``end_soc`` (0-1, for the forecast), ``landing_soc`` (``p5``, ``p50``,
+        ``p95`` over the day's scenarios, 0-1), ``p_reserve`` (the share of the scenarios that
+        land with the reserve), ``point_of_no_return_s``), ``confidence`` and ``scenarios``
+        (``samples``, ``seed``, ``spreads``), ``as_given`` (the
         mission split at whole items: ``batteries``, ``energy_wh``, ``duration_s``), ``changes``
         (``speeds``: the legs given another speed, m/s; ``angles``: the surveys turned, deg;
         ``cut_inside_legs``), ``notes`` when there is something the plan could not do (a

@@ -81,6 +81,15 @@ class PlanKeywords(MissionKeywords, total=False):
     camera_interval_s: Optional[float]
     keep_angle: bool
     loiter_unlimited_s: Optional[float]
+    confidence: Optional[float]
+    samples: Optional[int]
+    seed: Optional[int]
+    wind_speed_sd: Optional[float]
+    wind_from_sd: Optional[float]
+    payload_sd_kg: Optional[float]
+    capacity_sd_percent: Optional[float]
+    power_sd_percent: Optional[float]
+    threads: Optional[int]
 
 class EnduranceKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     """`aloft endurance`'s flags."""
