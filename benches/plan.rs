@@ -1,30 +1,45 @@
-//! Bench of `aloft plan` (issue 33): [`plan_to_fly`] on the largest survey of the shared data.
+//! Bench of `aloft plan` (issues 33 and 43): [`plan_to_fly`] on the largest survey of the shared
+//! data, and on one of a held-out survey's size built from it.
 //!
-//! Target: at most 2 s per plan on the 2-core machine (an operator waits for it at the field).
-//! The mission is `$ALOFT_DATA_DIR/missions/neilvaltec_test.plan` (default `../shared/data`): a
-//! QGroundControl survey v5 of 52 waypoints and 15 camera triggers, about 5 km, flown by the
-//! DJI M100 with its default pack. Two cases, each a reserve that makes several sorties:
+//! Targets on the 2-core machine (an operator waits for it at the field): at most 2 s per plan of
+//! the shared survey; a 38 km survey planned at the default confidence (0.95 of 400 scenarios)
+//! in at most 3 s, and for the forecast alone (`confidence` 0.5) in at most 1 s (issue 43).
+//! The shared mission is `$ALOFT_DATA_DIR/missions/neilvaltec_test.plan` (default
+//! `../shared/data`): a QGroundControl survey v5 of 52 waypoints and 15 camera triggers, about
+//! 5 km, flown by the DJI M100 with its default pack. Cases, each a reserve that makes several
+//! sorties:
 //!
 //! - `plan/plan_to_fly/survey_wind_8mps`: wind 8 m/s from the north, reserve 70 % (2 sorties
-//!   when written: the survey turned to the wind, the legs at the wind's speeds);
-//! - `plan/plan_to_fly/survey_still_air`: still air, reserve 80 % (4 sorties when written).
+//!   when written: the survey turned to the wind, the legs at the wind's speeds), cut for the
+//!   forecast alone (confidence 0.5, as before issue 43);
+//! - `plan/plan_to_fly/survey_still_air`: still air, reserve 80 % (4 sorties when written), cut
+//!   for the forecast alone;
+//! - `plan/plan_to_fly/survey_38km_confidence_95`: the shared survey's polygon scaled 2.8 times
+//!   (`tests/it/common/big_survey.rs`: its transects drawn again at the same spacing, about
+//!   38 km of flight), wind 8 m/s from 240 deg, the 20 % reserve, the default confidence (6
+//!   sorties);
+//! - `plan/plan_to_fly/survey_38km_nominal`: the same cut for the forecast alone (4 sorties).
 //!
 //! Each plan flies every candidate (the mission's speeds and the wind's, cut inside legs, the
 //! as-given split; then the same for the survey turned to the angle of least energy, where one
-//! saves energy) and each candidate's sorties from their own files read back; no file is written. Without the shared data the bench says so and
-//! measures nothing.
+//! saves energy) and each candidate's sorties from their own files read back, then cuts the best
+//! again with each sortie judged in the day's scenarios; no file is written. Without the shared
+//! data the bench says so and measures nothing.
 //!
-//! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples) while
-//! other builds kept its load average at about 3.5: `survey_wind_8mps` 623-749 ms,
-//! `survey_still_air` 402-467 ms. Before surveys were turned to the wind (3 sorties in the wind),
-//! at a load average of about 2: 241-277 ms and 339-374 ms.
+//! Measured on the 2-core machine (`--warm-up-time 1 --measurement-time 5`, 10 samples): see
+//! README.md, "Performance".
 
 use std::hint::black_box;
 use std::path::PathBuf;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 
-use aloft::engine::{plan_to_fly, FlyPlanRequest, Mission, MissionOptions, Vehicle};
+use aloft::engine::{
+    plan_to_fly, FlyPlanRequest, Mission, MissionOptions, PlanConfidence, Vehicle,
+};
+
+#[path = "../tests/it/common/big_survey.rs"]
+mod big_survey;
 
 fn data_dir() -> PathBuf {
     std::env::var_os("ALOFT_DATA_DIR").map_or_else(
@@ -33,10 +48,15 @@ fn data_dir() -> PathBuf {
     )
 }
 
-/// The request: the mission's options as JSON (`aloft mission`'s), the plan's defaults.
-fn request(options_json: &str) -> FlyPlanRequest {
+/// The request: the mission's options as JSON (`aloft mission`'s), the plan's defaults but the
+/// confidence.
+fn request(options_json: &str, confidence: f64) -> FlyPlanRequest {
     FlyPlanRequest {
         options: MissionOptions::from_json(options_json).expect("mission options"),
+        confidence: PlanConfidence {
+            confidence,
+            ..PlanConfidence::default()
+        },
         ..FlyPlanRequest::default()
     }
 }
@@ -52,19 +72,31 @@ fn bench_plan(c: &mut Criterion) {
     }
     let vehicle = Vehicle::builtin("dji-m100").expect("built-in vehicle");
     let mission = Mission::load(Some(&path)).expect("the shared survey reads");
+    let big = Mission::from_text(&big_survey::scaled_survey(&path, 2.8), "survey-38km.plan")
+        .expect("the scaled survey reads");
+    let wind_240 = r#"{"wind": {"speed_mps": 8, "from_deg": 240}}"#;
     let cases = [
         (
             "survey_wind_8mps",
+            &mission,
             r#"{"reserve_percent": 70, "wind": {"speed_mps": 8, "from_deg": 0}}"#,
+            0.5,
         ),
-        ("survey_still_air", r#"{"reserve_percent": 80}"#),
+        (
+            "survey_still_air",
+            &mission,
+            r#"{"reserve_percent": 80}"#,
+            0.5,
+        ),
+        ("survey_38km_confidence_95", &big, wind_240, 0.95),
+        ("survey_38km_nominal", &big, wind_240, 0.5),
     ];
     let mut group = c.benchmark_group("plan/plan_to_fly");
     group.sample_size(10);
-    for (name, options) in cases {
-        let request = request(options);
+    for (name, mission, options, confidence) in cases {
+        let request = request(options, confidence);
         // The workload is the one described above: several sorties, each with its file.
-        let plan = plan_to_fly(&vehicle, &mission, &request).expect("a plan");
+        let plan = plan_to_fly(&vehicle, mission, &request).expect("a plan");
         assert!(
             plan.sorties.len() >= 2,
             "{name}: {} sortie(s)",
@@ -73,13 +105,7 @@ fn bench_plan(c: &mut Criterion) {
         assert_eq!(plan.texts.len(), plan.sorties.len(), "{name}");
         eprintln!("{name}: {} sorties", plan.sorties.len());
         group.bench_function(name, |b| {
-            b.iter(|| {
-                plan_to_fly(
-                    black_box(&vehicle),
-                    black_box(&mission),
-                    black_box(&request),
-                )
-            })
+            b.iter(|| plan_to_fly(black_box(&vehicle), black_box(mission), black_box(&request)))
         });
     }
     group.finish();

@@ -149,6 +149,13 @@ fn write_table(out: &mut impl Write, plan: &FlyPlan) -> Result<()> {
             a.item, a.from_deg, a.to_deg
         )?;
     }
+    for k in &plan.changes.angles_kept {
+        writeln!(
+            out,
+            "survey at item {} kept at {:.1}\u{b0}: {}",
+            k.item, k.angle_deg, k.why
+        )?;
+    }
     for note in &plan.notes {
         writeln!(out, "note: {note}")?;
     }

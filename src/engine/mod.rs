@@ -149,7 +149,7 @@ pub use plan_to_fly::fly_plan::{
     DEFAULT_CAPACITY_SD_PERCENT, DEFAULT_CONFIDENCE, DEFAULT_OVERLAP_M, DEFAULT_PLAN_SCENARIOS,
     DEFAULT_WIND_FROM_SD_DEG, MIN_WIND_SPEED_SD_MPS, WIND_SPEED_SD_SHARE,
 };
-pub use plan_to_fly::survey_angle::{AngleChange, ANGLE_STEP_DEG};
+pub use plan_to_fly::survey_angle::{AngleChange, AngleKept, ANGLE_STEP_DEG};
 pub use step_meter::{StepMeter, WorkBounds};
 pub use uncertainty::scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use uncertainty::scenarios::{

@@ -682,3 +682,119 @@ fn data_val_a_survey_that_cannot_be_drawn_again_is_flown_as_stored_and_said() {
         assert_eq!(answer["changes"]["angles"], serde_json::json!([]), "{name}");
     }
 }
+
+/// A survey beyond one pack is turned to the wind where that saves energy, and a survey kept at
+/// its angle says why: each angle is judged by the energy of the whole route (on one pack, a
+/// route beyond it stops where the pack is empty, every angle cost that pack, and no survey of
+/// several packs was ever turned). The shared survey's polygon scaled 2 times (about 20 km, two
+/// packs at least), planned for the forecast alone in 8 m/s from 240 deg: turned, it takes no
+/// more packs and less energy than with its angle kept; in still air the angle is kept, with
+/// the angle tried and what it costs.
+#[test]
+fn data_val_a_survey_beyond_one_pack_is_turned_to_the_wind() {
+    let file = scratch("plan-files", "survey-20km.plan");
+    std::fs::write(
+        &file,
+        common::big_survey::scaled_survey(&shared_mission("neilvaltec_test.plan"), 2.0),
+    )
+    .unwrap();
+    let wind = flags("--wind-speed 8 --wind-from 240 --confidence 0.5");
+    let (code, turned, err) = plan(&file, &scratch("plan-files", "turned-20km"), &wind);
+    assert_eq!(code, 0, "{err}");
+    let angles = turned["changes"]["angles"].as_array().unwrap();
+    assert_eq!(angles.len(), 1, "{}", turned["changes"]);
+    assert!(f(&turned["batteries"]) >= 2.0, "{turned}");
+    let mut kept_flags = wind.clone();
+    kept_flags.push("--keep-angle".to_string());
+    let (_, kept, _) = plan(&file, &scratch("plan-files", "kept-20km"), &kept_flags);
+    assert!(f(&turned["batteries"]) <= f(&kept["batteries"]));
+    assert!(
+        f(&turned["energy_wh"]) < f(&kept["energy_wh"]),
+        "{turned} {kept}"
+    );
+    let still = flags("--confidence 0.5");
+    let (_, calm, _) = plan(&file, &scratch("plan-files", "calm-20km"), &still);
+    let why = &calm["changes"]["angles_kept"];
+    assert_eq!(calm["changes"]["angles"], serde_json::json!([]), "{calm}");
+    assert_eq!(why.as_array().map_or(0, Vec::len), 1, "{}", calm["changes"]);
+    assert!(why[0]["tried_deg"].is_number(), "{why}");
+    assert!(why[0]["why"].as_str().unwrap().contains("Wh"), "{why}");
+}
+
+/// The operator's highest planned leg speed of a shared planner file, read from the raw file
+/// (not through aloft's reader): each position item flown at the last DO_CHANGE_SPEED (178)
+/// ground or air speed before it, else the planning speed (a `.plan`'s `hoverSpeed`; for a
+/// `.waypoints` file ArduPilot's WPNAV_SPEED default, 10 m/s).
+fn highest_planned_speed(file: &Path) -> f64 {
+    let text = std::fs::read_to_string(file).unwrap();
+    // (command, speed param) in file order.
+    let (planning, rows): (f64, Vec<(u64, f64)>) = if text.starts_with("QGC WPL") {
+        let rows = text
+            .lines()
+            .skip(1)
+            .filter_map(|l| {
+                let c: Vec<&str> = l.split_whitespace().collect();
+                Some((c.get(3)?.parse().ok()?, c.get(5)?.parse().ok()?))
+            })
+            .collect();
+        (10.0, rows)
+    } else {
+        let v: Value = serde_json::from_str(&text).unwrap();
+        let m = &v["mission"];
+        let mut rows = Vec::new();
+        for it in m["items"].as_array().unwrap() {
+            let inner = it["TransectStyleComplexItem"]["Items"].as_array();
+            for s in inner.map_or_else(|| vec![it], |a| a.iter().collect()) {
+                let p = s["params"].as_array();
+                let speed = p
+                    .and_then(|p| p.get(1))
+                    .and_then(Value::as_f64)
+                    .unwrap_or(0.0);
+                rows.push((s["command"].as_u64().unwrap_or(0), speed));
+            }
+        }
+        (m["hoverSpeed"].as_f64().unwrap_or(5.0), rows)
+    };
+    let mut in_force = planning;
+    let mut highest: f64 = 0.0;
+    for (command, speed) in rows {
+        match command {
+            178 if speed > 0.0 => in_force = speed,
+            16 | 17 | 18 | 19 | 21 => highest = highest.max(in_force),
+            _ => {}
+        }
+    }
+    highest
+}
+
+/// Speeds an operator accepts: by default no leg of a shared file (all but the surveys) is
+/// written faster than the file's own highest planned speed, read from the raw file; the
+/// survey's camera legs at most its 25 m trigger distance over the 2 s camera interval.
+#[test]
+fn data_val_no_leg_is_written_faster_than_the_operator_planned() {
+    for file in shared_planner_files() {
+        let name = file.file_name().unwrap().to_string_lossy().to_string();
+        let (code, answer, _) = plan(
+            &file,
+            &scratch("plan-files", "speeds"),
+            &flags("--wind-speed 6 --wind-from 240 --confidence 0.5"),
+        );
+        if code != 0 {
+            continue;
+        }
+        let highest = highest_planned_speed(&file);
+        let survey = name == "neilvaltec_test.plan";
+        let cap = if survey {
+            highest.max(25.0 / 2.0)
+        } else {
+            highest
+        };
+        for c in answer["changes"]["speeds"].as_array().unwrap() {
+            assert!(f(&c["to_mps"]) <= cap + 1e-9, "{name}: {c} above {cap} m/s");
+        }
+        eprintln!(
+            "{name}: highest planned {highest} m/s, {} legs re-speeded",
+            answer["changes"]["speeds"].as_array().unwrap().len()
+        );
+    }
+}

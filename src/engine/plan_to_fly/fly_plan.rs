@@ -17,7 +17,11 @@
 //!    energy per metre along its course in the wind at its height
 //!    ([`aloft_planner::best_range_within_limits`]: within the vehicle's speed and its steady
 //!    envelope), at most `max_speed_mps`, rounded to 0.1 m/s. A speed the operator set on a leg
-//!    is kept unless [`SpeedChoice::Energy`]; [`SpeedChoice::Keep`] changes none.
+//!    is kept unless [`SpeedChoice::Energy`]; [`SpeedChoice::Keep`] changes none. With
+//!    [`SpeedChoice::Wind`] and no `max_speed_mps`, no leg is given more than the operator's
+//!    fastest planned speed (the planning speed, a `.plan`'s `hoverSpeed`, and every speed the
+//!    items set), but a survey leg where the camera triggers every D m, which may go up to D per
+//!    camera interval: a mission planned slow and low is not written fast.
 //! 3. **Sorties cut inside legs** ([`crate::engine::missions::sorties`], steps 4 and 5): each pack used to the
 //!    reserve, the next sortie resuming `overlap_m` back along the route.
 //! 4. **The best**: of the candidates (the mission's own speeds and the wind's, each cut inside
@@ -48,7 +52,9 @@ use crate::engine::missions::sorties::{
     SpecSorties, SplitOptions,
 };
 use crate::engine::plan_to_fly::plan_files::PlannerSorties;
-use crate::engine::plan_to_fly::survey_angle::{turned_to_wind, unturnable, AngleChange};
+use crate::engine::plan_to_fly::survey_angle::{
+    turned_to_wind, unturnable, AngleChange, AngleKept,
+};
 use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenarios::{ScenarioOptions, Spreads};
 use crate::engine::uncertainty::sortie_bands::SortieScenarios;
@@ -312,6 +318,10 @@ pub struct PlanChanges {
     /// Surveys given another grid angle.
     #[serde(default)]
     pub angles: Vec<AngleChange>,
+    /// Surveys kept at their grid angle, with why (the angle tried, what it would have cost or
+    /// covered).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub angles_kept: Vec<AngleKept>,
 }
 
 /// The answer of `aloft plan`: the plan beside the mission as given, its sorties and files.
@@ -385,7 +395,7 @@ pub fn plan_to_fly(
     let (planned, turned) = std::thread::scope(|scope| {
         let planned = scope.spawn(|| plan_for(vehicle, mission, request, &wind, None));
         let turned = match request.keep_angle {
-            true => Ok(None),
+            true => Ok((None, Vec::new())),
             false => turned_to_wind(
                 mission,
                 &wind,
@@ -403,6 +413,7 @@ pub fn plan_to_fly(
     let (best, given) = planned?;
     let turned = turned?;
     // The surveys turned to the wind, when that needs fewer batteries or less energy.
+    let (turned, mut kept) = turned;
     let (best, angles, turned) = match turned {
         Some((turned, angles)) => match plan_for(vehicle, &turned, request, &wind, None) {
             Ok((t, _))
@@ -411,14 +422,26 @@ pub fn plan_to_fly(
             {
                 (t, angles, Some(turned))
             }
-            _ => (best, Vec::new(), None),
+            // The turned survey saves energy flown whole, but not once cut into sorties.
+            planned => {
+                kept.extend(
+                    angles
+                        .iter()
+                        .map(|a| turn_not_kept(a, &best, planned.as_ref().ok())),
+                );
+                (best, Vec::new(), None)
+            }
         },
         None => (best, Vec::new(), None),
     };
     // The best way of flying it, cut again at the confidence with its margins balanced (module
     // step 4): the same candidate of the same mission, each sortie judged in the day's scenarios.
+    // Cut for the forecast alone (0.5), the sorties are the nominal phase's: their bands only.
     let chosen = turned.as_ref().unwrap_or(mission);
-    let (best, _) = plan_for(vehicle, chosen, request, &wind, Some(best.candidate.kind))?;
+    let best = match request.confidence.confidence > 0.5 {
+        true => plan_for(vehicle, chosen, request, &wind, Some(best.candidate.kind))?.0,
+        false => with_bands(vehicle, chosen, request, &wind, best)?,
+    };
     let as_given = match given {
         Some(figures) => Some(figures),
         None => as_given_figures(vehicle, mission, options)?,
@@ -432,6 +455,7 @@ pub fn plan_to_fly(
         spreads: scenarios.spreads(),
     };
     plan.changes.angles = angles;
+    plan.changes.angles_kept = kept;
     if !request.keep_angle {
         plan.notes = unturnable(mission);
     }
@@ -474,6 +498,35 @@ fn plan_scenarios(mission: &Mission, request: &FlyPlanRequest) -> Result<Scenari
     let sc = c.scenarios(forecast_mps, &request.bounds);
     sc.check()?;
     Ok(sc)
+}
+
+/// Why the survey turn `a` is not kept: the plan of the turned mission (`planned`, when it has
+/// one) needs more packs or energy than `best`'s.
+fn turn_not_kept(
+    a: &AngleChange,
+    best: &Flown,
+    planned: Option<&(Flown, Option<PlanFigures>)>,
+) -> AngleKept {
+    let b = &best.figures;
+    let why =
+        match planned {
+            Some((t, _)) => format!(
+            "turned to {:.1}\u{b0} it saves energy flown whole, but cut into sorties it takes {} \
+             packs and {:.1} Wh against {} and {:.1} Wh at {:.1}\u{b0}",
+            a.to_deg, t.figures.batteries, t.figures.energy_wh, b.batteries, b.energy_wh, a.from_deg
+        ),
+            None => format!(
+            "turned to {:.1}\u{b0} it saves energy flown whole, but cannot be cut into sorties \
+             that keep the reserve",
+            a.to_deg
+        ),
+        };
+    AngleKept {
+        item: a.item,
+        angle_deg: a.from_deg,
+        tried_deg: Some(a.to_deg),
+        why,
+    }
 }
 
 /// What the plan assumed of the unlimited loiters (the reader's words for each).
@@ -527,6 +580,40 @@ fn plan_for(
         check: sure.map(|_| &check),
     };
     best_candidate(&cx, candidates)
+}
+
+/// `flown`'s sorties (of `mission`), each with its landing band in the day's scenarios.
+///
+/// # Errors
+/// As [`plan_for`].
+fn with_bands(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    request: &FlyPlanRequest,
+    wind: &Wind,
+    mut flown: Flown,
+) -> Result<Flown, Error> {
+    let options = &request.options;
+    let aircraft = vehicle.aircraft()?;
+    let battery = vehicle.battery(options.battery.as_deref())?;
+    let prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
+    let scenarios = request
+        .scenarios
+        .clone()
+        .unwrap_or_else(|| request.confidence.scenarios(Some(0.0), &request.bounds));
+    let check = SortieScenarios::new(
+        (vehicle, mission, options),
+        &prepared.flight,
+        &scenarios,
+        request.confidence.confidence,
+    )?;
+    for plan in &mut flown.plans {
+        let band = check
+            .band(&plan.spec)
+            .map_err(|reason| Error::NoPlan { reason })?;
+        plan.band = Some(band);
+    }
+    Ok(flown)
 }
 
 /// The mission as given: its batteries and the energy and time of its sorties (or its one
@@ -636,6 +723,12 @@ pub(in crate::engine) fn speeds_for_wind(
         (Some(a), Some(b)) => Some(a.min(b)),
         (a, b) => a.or(b),
     };
+    // No leg faster than the operator planned any (module step 2) unless asked.
+    let operators_mps = match (request.speeds, request.max_speed_mps) {
+        (SpeedChoice::Wind, None) => highest_planned_mps(&spec),
+        _ => None,
+    };
+    let planning_mps = spec.default_speed_mps;
     let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
     let triggers = camera_triggers_m(mission);
     let interval_s = camera_interval_s(mission, request);
@@ -657,19 +750,25 @@ pub(in crate::engine) fn speeds_for_wind(
         } else {
             ends[i - 1]
         };
-        // A leg flown with the camera triggering every D m: at most D per camera interval.
+        // A leg flown with the camera triggering every D m: at most D per camera interval (the
+        // operator's survey legs may go that fast); any other at most the operator's fastest.
         let camera_mps = triggers
             .get(i)
             .filter(|d| **d > 0.0)
             .map(|d| d / interval_s);
-        let max_mps = match (max_mps, camera_mps) {
+        let cap_mps = camera_mps.or(operators_mps);
+        let max_mps = match (max_mps, cap_mps) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         };
         let Some(v) = leg_speed_mps(&powered, wind, (start, ends[i]), max_mps) else {
             continue;
         };
-        if ground_speed_mps.is_some_and(|g| (g - v).abs() < 0.05) {
+        // A leg that flies that speed already (its own, or the planning speed) is not changed.
+        if ground_speed_mps
+            .or(planning_mps)
+            .is_some_and(|g| (g - v).abs() < 0.05)
+        {
             continue;
         }
         changes.push(SpeedChange {
@@ -681,6 +780,25 @@ pub(in crate::engine) fn speeds_for_wind(
         *ground_speed_mps = Some(v);
     }
     Ok((spec, changes))
+}
+
+/// The highest ground speed the operator planned any leg of `spec` at, m/s: each leg's and
+/// orbit's own speed (a DO_CHANGE_SPEED in force), else the planning speed (a `.plan`'s
+/// `hoverSpeed`, a `.waypoints` file's autopilot default, `--speed`); `None` when none is known.
+fn highest_planned_mps(spec: &MissionSpec) -> Option<f64> {
+    spec.segments
+        .iter()
+        .filter_map(|s| match *s {
+            SegmentSpec::Leg {
+                ground_speed_mps, ..
+            }
+            | SegmentSpec::Orbit {
+                ground_speed_mps, ..
+            } => ground_speed_mps.or(spec.default_speed_mps),
+            _ => None,
+        })
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .reduce(f64::max)
 }
 
 /// The camera trigger distance in force on each segment of a planner file's mission, m (0: the
@@ -1083,6 +1201,7 @@ fn answer(
         changes: PlanChanges {
             speeds: best.candidate.speeds.clone(),
             angles: Vec::new(),
+            angles_kept: Vec::new(),
             cut_inside_legs: best.candidate.split.inside_legs
                 && best
                     .plans
@@ -1175,8 +1294,8 @@ impl FlyPlan {
     }
 }
 
-/// The energy of `mission` flown whole with the legs' speeds for the wind, Wh; `None` when it
-/// cannot be flown.
+/// The energy of `mission` flown whole with the legs' speeds for the wind, on a pack as large as
+/// the route needs, Wh; `None` when it cannot be flown.
 fn energy_wh(
     vehicle: &Vehicle,
     mission: &Mission,
@@ -1198,6 +1317,23 @@ fn energy_wh(
                 .0
         }
     };
-    let report = prepared.flight.trial(&spec, None).ok()?;
+    // The whole route, however many packs it takes: on one pack a route beyond it stops where
+    // the pack is empty, and every angle would cost that pack.
+    let whole = battery.with_capacity_factor(WHOLE_ROUTE_PACKS).ok()?;
+    let flight = crate::engine::missions::flight::Flight {
+        pack: &whole,
+        options: aloft_planner::PlanOptions {
+            point_of_no_return: false,
+            ..prepared.flight.options
+        },
+        ..prepared
+            .flight
+            .with_reserve(prepared.flight.options.reserve_fraction)
+    };
+    let report = flight.trial(&spec, None).ok()?;
     Some(report.energy_wh)
 }
+
+/// The packs' worth of charge a survey's angle is judged with ([`energy_wh`]): the most sorties
+/// a route is cut into.
+const WHOLE_ROUTE_PACKS: f64 = crate::engine::missions::sorties::MAX_SORTIES as f64;

@@ -41,8 +41,22 @@ pub struct AngleChange {
     pub to_deg: f64,
 }
 
-/// The mission with its surveys turned to the wind, and the turns; `None` when no survey can
-/// be turned or no turn saves energy.
+/// A survey kept at its grid angle, and why (the answer's `changes.angles_kept`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleKept {
+    /// The survey's first item in the input.
+    pub item: u32,
+    /// Its grid angle, kept, deg.
+    pub angle_deg: f64,
+    /// The angle of least energy tried (absent: none covered the polygon as the operator's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tried_deg: Option<f64>,
+    /// Why it was kept: what the angle tried would have cost, or covered.
+    pub why: String,
+}
+
+/// The mission with its surveys turned to the wind, and the turns (`None` when no survey can
+/// be turned or no turn saves energy); and the surveys kept at their angle, with why.
 ///
 /// # Errors
 /// [`Error::Cancelled`] once `bounds` say the caller gave up. `energy_wh` flies a mission whole
@@ -52,21 +66,23 @@ pub(in crate::engine) fn turned_to_wind(
     wind: &Wind,
     energy_wh: &dyn Fn(&Mission) -> Option<f64>,
     bounds: &WorkBounds,
-) -> Result<Option<(Mission, Vec<AngleChange>)>, Error> {
+) -> Result<Turned, Error> {
+    let none = || Ok((None, Vec::new()));
     let Some(imported) = mission.kept().filter(|k| k.plan.is_some()) else {
-        return Ok(None);
+        return none();
     };
     let turnable: Vec<usize> = (0..imported.surveys.len())
         .filter(|&s| imported.surveys[s].survey.is_ok())
         .collect();
     if turnable.is_empty() {
-        return Ok(None);
+        return none();
     }
     let Some(mut best_wh) = energy_wh(mission) else {
-        return Ok(None);
+        return none();
     };
     let mut angles: Vec<(usize, f64)> = Vec::new();
     let mut best_mission: Option<Mission> = None;
+    let mut kept: Vec<AngleKept> = Vec::new();
     for s in turnable {
         let Ok(survey) = &imported.surveys[s].survey else {
             continue;
@@ -75,17 +91,26 @@ pub(in crate::engine) fn turned_to_wind(
         let Some(own_covered) = survey.covered_points() else {
             continue;
         };
+        let own_deg = survey.params().angle_deg;
+        // The least energy of an angle tried that covers the polygon, and the most points an
+        // angle that did not cover it covered.
+        let mut least: Option<(f64, f64)> = None;
+        let mut short: Option<(f64, usize)> = None;
+        let own_wh = best_wh;
         for angle in candidate_angles(survey.params(), wind) {
             if bounds.cancelled() {
                 return Err(Error::Cancelled);
             }
             // The polygon covered as before (a line lost at a corner is a gap in the images).
             let turned_survey = survey.with_angle(angle).ok();
-            if turned_survey
+            let covered = turned_survey
                 .as_ref()
-                .and_then(aloft_missions::survey::Survey::covered_points)
-                .is_none_or(|n| n < own_covered)
-            {
+                .and_then(aloft_missions::survey::Survey::covered_points);
+            if covered.is_none_or(|n| n < own_covered) {
+                let n = covered.unwrap_or(0);
+                if short.is_none_or(|(_, m)| n > m) {
+                    short = Some((angle, n));
+                }
                 continue;
             }
             let mut trial = angles.clone();
@@ -96,6 +121,9 @@ pub(in crate::engine) fn turned_to_wind(
             let Some(wh) = energy_wh(&turned) else {
                 continue;
             };
+            if (angle - own_deg).abs() > 1e-9 && least.is_none_or(|(_, w)| wh < w) {
+                least = Some((angle, wh));
+            }
             // A saving of at least a part in 10^6: an angle as good as the operator's is not a
             // change.
             if wh < best_wh * (1.0 - 1e-6) {
@@ -103,13 +131,21 @@ pub(in crate::engine) fn turned_to_wind(
                 chosen = Some((angle, turned));
             }
         }
-        if let Some((angle, turned)) = chosen {
-            angles.push((s, angle));
-            best_mission = Some(turned);
+        match chosen {
+            Some((angle, turned)) => {
+                angles.push((s, angle));
+                best_mission = Some(turned);
+            }
+            None => kept.push(why_kept(
+                imported.surveys[s].first_item,
+                (own_deg, own_wh, own_covered),
+                least,
+                short,
+            )),
         }
     }
     let Some(turned) = best_mission else {
-        return Ok(None);
+        return Ok((None, kept));
     };
     let changes = angles
         .iter()
@@ -123,7 +159,47 @@ pub(in crate::engine) fn turned_to_wind(
             })
         })
         .collect();
-    Ok(Some((turned, changes)))
+    Ok((Some((turned, changes)), kept))
+}
+
+/// What [`turned_to_wind`] answers: the mission turned and its turns, when one saves energy;
+/// the surveys kept at their angle, with why.
+pub(in crate::engine) type Turned = (Option<(Mission, Vec<AngleChange>)>, Vec<AngleKept>);
+
+/// Why the survey at `item` is kept at its angle `own_deg` (its mission flown whole costs
+/// `own_wh` and its angle covers `own_covered` points of the polygon): the angle of least
+/// energy tried (`least`: angle, Wh) saves none, or no other angle covered the polygon
+/// (`short`: the best of those, angle and points).
+fn why_kept(
+    item: u32,
+    (own_deg, own_wh, own_covered): (f64, f64, usize),
+    least: Option<(f64, f64)>,
+    short: Option<(f64, usize)>,
+) -> AngleKept {
+    let (tried_deg, why) = match (least, short) {
+        (Some((deg, wh)), _) => (
+            Some(deg),
+            format!(
+                "no angle saves energy: the least of those tried, {deg:.1}\u{b0}, costs {wh:.1} Wh \
+                 flown whole against {own_wh:.1} Wh at {own_deg:.1}\u{b0}"
+            ),
+        ),
+        (None, Some((deg, n))) => (
+            Some(deg),
+            format!(
+                "every other angle tried leaves part of the polygon uncovered: the best, \
+                 {deg:.1}\u{b0}, covers {n} of the {own_covered} points {own_deg:.1}\u{b0} covers \
+                 (a 3 m grid)"
+            ),
+        ),
+        (None, None) => (None, "no other angle could be drawn or flown".to_string()),
+    };
+    AngleKept {
+        item,
+        angle_deg: own_deg,
+        tried_deg,
+        why,
+    }
 }
 
 /// Why each survey of `mission` that cannot be drawn again is flown as its stored items and not
