@@ -308,7 +308,7 @@ impl<'a> Route<'a> {
         let mut spec = self.spec.clone();
         spec.payload_kg = self.payload_kg[far];
         spec.allow_end_in_air = false;
-        spec.segments = self.resume(Cut::whole(far), far + 1).to_vec();
+        spec.segments = self.resume(Cut::whole(far), far + 1, None).to_vec();
         spec.segments.extend(way_home);
         spec
     }
@@ -386,6 +386,18 @@ impl<'a> Route<'a> {
         end: Option<Cut>,
         way_home: [SegmentSpec; 2],
     ) -> MissionSpec {
+        self.sortie_flying_out(start, end, way_home, None)
+    }
+
+    /// [`Route::sortie`] with its fly-out from home to `start` at `fly_out_mps` (else at the
+    /// planning speed, or the first speed of the route from there).
+    pub fn sortie_flying_out(
+        &self,
+        start: Option<Cut>,
+        end: Option<Cut>,
+        way_home: [SegmentSpec; 2],
+        fly_out_mps: Option<f64>,
+    ) -> MissionSpec {
         let spec = self.spec;
         let from = self.resumes_at(start);
         let mut s = spec.clone();
@@ -394,7 +406,7 @@ impl<'a> Route<'a> {
         let mut segments = Vec::new();
         match start {
             None => segments.extend_from_slice(&spec.segments[..from]),
-            Some(c) => segments.extend(self.resume(c, from)),
+            Some(c) => segments.extend(self.resume(c, from, fly_out_mps)),
         }
         match end {
             None => segments.extend_from_slice(&spec.segments[from..]),
@@ -408,9 +420,10 @@ impl<'a> Route<'a> {
         s
     }
 
-    /// A take-off at home to the height of `cut` and a straight transit there, at the planning
-    /// speed (else the first speed of the route from `from`, else none).
-    fn resume(&self, cut: Cut, from: usize) -> [SegmentSpec; 2] {
+    /// A take-off at home to the height of `cut` and a straight transit there, at `fly_out_mps`
+    /// when given, else the planning speed (else the first speed of the route from `from`, else
+    /// none).
+    fn resume(&self, cut: Cut, from: usize, fly_out_mps: Option<f64>) -> [SegmentSpec; 2] {
         let spec = self.spec;
         let [east_m, north_m, up_m] = self.point_m(cut);
         [
@@ -425,10 +438,10 @@ impl<'a> Route<'a> {
                 latitude_deg: None,
                 longitude_deg: None,
                 altitude_m: Some(up_m),
-                ground_speed_mps: match spec.default_speed_mps {
+                ground_speed_mps: fly_out_mps.or(match spec.default_speed_mps {
                     Some(_) => None,
                     None => first_speed(&spec.segments[from..]),
-                },
+                }),
                 payload_after_kg: None,
                 acceptance_radius_m: None,
                 item: None,

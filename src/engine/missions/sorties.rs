@@ -167,6 +167,7 @@ pub(in crate::engine) fn split(
     let maker = SpecSorties {
         route: &route,
         flight,
+        fly_out: None,
     };
     match sortie_plans(flight, &route, SplitOptions::default(), &maker) {
         Ok(plans) => {
@@ -198,19 +199,32 @@ pub(in crate::engine) trait SortieMaker {
     fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String>;
 }
 
+/// The ground speed of a sortie's fly-out from home to where it resumes the route (`aloft
+/// plan`: the speed of least energy in its wind); `None` flies it at the planning speed.
+pub(in crate::engine) trait FlyOutSpeed: Sync {
+    /// The fly-out's ground speed to `point_m` (ENU m, home's frame), m/s.
+    fn speed_mps(&self, point_m: [f64; 3]) -> Option<f64>;
+}
+
 /// The sorties' missions as aloft's own segments.
 pub(in crate::engine) struct SpecSorties<'r, 'f> {
     /// The route cut.
     pub(in crate::engine) route: &'r Route<'r>,
     /// What every flight shares (the way home's speed and landing).
     pub(in crate::engine) flight: &'r Flight<'f>,
+    /// The fly-out's speed, when aloft chooses it.
+    pub(in crate::engine) fly_out: Option<&'r dyn FlyOutSpeed>,
 }
 
 impl SortieMaker for SpecSorties<'_, '_> {
     fn sortie(&self, start: Option<Cut>, end: Option<Cut>) -> Result<MissionSpec, String> {
+        let way_home = self.flight.way_home(self.route.spec());
+        let fly_out_mps = start
+            .zip(self.fly_out)
+            .and_then(|(c, f)| f.speed_mps(self.route.point_m(c)));
         Ok(self
             .route
-            .sortie(start, end, self.flight.way_home(self.route.spec())))
+            .sortie_flying_out(start, end, way_home, fly_out_mps))
     }
 }
 

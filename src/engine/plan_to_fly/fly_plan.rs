@@ -48,8 +48,8 @@ use crate::engine::missions::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN
 use crate::engine::missions::mission_options::MissionOptions;
 use crate::engine::missions::mission_outputs::segment_paths;
 use crate::engine::missions::sorties::{
-    confident_sortie_plans, segment_ends_m, Margins, Route, SortieCheck, SortieMaker, SortiePlan,
-    SpecSorties, SplitOptions,
+    confident_sortie_plans, segment_ends_m, FlyOutSpeed, Margins, Route, SortieCheck, SortieMaker,
+    SortiePlan, SpecSorties, SplitOptions,
 };
 use crate::engine::plan_to_fly::plan_files::PlannerSorties;
 use crate::engine::plan_to_fly::survey_angle::{
@@ -571,6 +571,7 @@ fn plan_for(
         &scenarios,
         request.confidence.confidence,
     )?;
+    let fly_out = FlyOut::of(vehicle, &prepared, request, wind)?;
     let cx = Context {
         vehicle,
         mission,
@@ -578,6 +579,7 @@ fn plan_for(
         prepared: &prepared,
         bounds: &request.bounds,
         check: sure.map(|_| &check),
+        fly_out: fly_out.as_ref(),
     };
     best_candidate(&cx, candidates)
 }
@@ -702,32 +704,12 @@ pub(in crate::engine) fn speeds_for_wind(
     wind: &Wind,
     request: &FlyPlanRequest,
 ) -> Result<(MissionSpec, Vec<SpeedChange>), Error> {
-    let flight = &prepared.flight;
-    let payload = prepared
-        .compiled
-        .payloads_kg()
-        .first()
-        .copied()
-        .unwrap_or(0.0);
-    let mass = vehicle.takeoff_mass_with(flight.pack, payload)?;
-    let powered = flight
-        .aircraft
-        .at_mass(mass.total_kg, request.options.aoa)?;
+    let SpeedLimits {
+        powered,
+        max_mps,
+        operators_mps,
+    } = speed_limits(vehicle, prepared, request)?;
     let mut spec = prepared.spec.clone();
-    // A planner file's speeds are flown at most at what the vehicle holds within its tilt limit
-    // in still air (as `aloft mission` flies them): a faster choice would be written and not flown.
-    let tilt_mps = spec
-        .clamp_speeds
-        .then(|| flight.aircraft.tilt_limited_speed_mps(mass.total_kg));
-    let max_mps = match (request.max_speed_mps, tilt_mps) {
-        (Some(a), Some(b)) => Some(a.min(b)),
-        (a, b) => a.or(b),
-    };
-    // No leg faster than the operator planned any (module step 2) unless asked.
-    let operators_mps = match (request.speeds, request.max_speed_mps) {
-        (SpeedChoice::Wind, None) => highest_planned_mps(&spec),
-        _ => None,
-    };
     let planning_mps = spec.default_speed_mps;
     let ends = segment_ends_m(&prepared.compiled, spec.segments.len());
     let triggers = camera_triggers_m(mission);
@@ -780,6 +762,110 @@ pub(in crate::engine) fn speeds_for_wind(
         *ground_speed_mps = Some(v);
     }
     Ok((spec, changes))
+}
+
+/// What bounds the speeds aloft gives: the vehicle at its take-off mass, the highest speed
+/// anywhere (`--max-speed`, the tilt limit of a planner file's speeds), and the operator's
+/// fastest planned speed where that bounds them too.
+pub(in crate::engine) struct SpeedLimits<'a> {
+    /// The vehicle at its take-off mass.
+    pub(in crate::engine) powered: aloft_planner::Powered<'a>,
+    /// At most anywhere, m/s.
+    pub(in crate::engine) max_mps: Option<f64>,
+    /// At most, for legs that are not a survey's camera legs (and below the RTL altitude for
+    /// aloft's own), m/s: the operator's fastest planned speed with `--speeds wind` and no
+    /// `--max-speed`.
+    pub(in crate::engine) operators_mps: Option<f64>,
+}
+
+/// The [`SpeedLimits`] of `prepared` for `request`.
+///
+/// # Errors
+/// A take-off mass or a model the vehicle refuses.
+pub(in crate::engine) fn speed_limits<'a>(
+    vehicle: &Vehicle,
+    prepared: &Prepared<'a>,
+    request: &FlyPlanRequest,
+) -> Result<SpeedLimits<'a>, Error> {
+    let flight = &prepared.flight;
+    let payload = prepared
+        .compiled
+        .payloads_kg()
+        .first()
+        .copied()
+        .unwrap_or(0.0);
+    let mass = vehicle.takeoff_mass_with(flight.pack, payload)?;
+    let powered = flight
+        .aircraft
+        .at_mass(mass.total_kg, request.options.aoa)?;
+    // A planner file's speeds are flown at most at what the vehicle holds within its tilt limit
+    // in still air (as `aloft mission` flies them): a faster choice would be written and not flown.
+    let tilt_mps = prepared
+        .spec
+        .clamp_speeds
+        .then(|| flight.aircraft.tilt_limited_speed_mps(mass.total_kg));
+    let max_mps = match (request.max_speed_mps, tilt_mps) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    };
+    // No leg faster than the operator planned any (module step 2) unless asked.
+    let operators_mps = match (request.speeds, request.max_speed_mps) {
+        (SpeedChoice::Wind, None) => highest_planned_mps(&prepared.spec),
+        _ => None,
+    };
+    Ok(SpeedLimits {
+        powered,
+        max_mps,
+        operators_mps,
+    })
+}
+
+/// A resumed sortie's fly-out from home to where it resumes, at the ground speed of least energy
+/// per metre along its course in the wind at its height (within the vehicle's speed and
+/// envelope, `--max-speed`), no faster than the operator's planned speeds unless it flies at or
+/// above the RTL altitude (module step 3).
+pub(in crate::engine) struct FlyOut<'a> {
+    limits: SpeedLimits<'a>,
+    wind: &'a Wind,
+    home_m: [f64; 3],
+    rtl_altitude_m: Option<f64>,
+}
+
+impl<'a> FlyOut<'a> {
+    /// The fly-outs of `prepared` for `request` in `wind`; `None` with `--speeds keep`.
+    ///
+    /// # Errors
+    /// As [`speed_limits`].
+    pub(in crate::engine) fn of(
+        vehicle: &Vehicle,
+        prepared: &Prepared<'a>,
+        request: &FlyPlanRequest,
+        wind: &'a Wind,
+    ) -> Result<Option<Self>, Error> {
+        if request.speeds == SpeedChoice::Keep {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            limits: speed_limits(vehicle, prepared, request)?,
+            wind,
+            home_m: prepared.compiled.home_m(),
+            rtl_altitude_m: prepared.spec.rtl_altitude_m,
+        }))
+    }
+}
+
+impl FlyOutSpeed for FlyOut<'_> {
+    fn speed_mps(&self, point_m: [f64; 3]) -> Option<f64> {
+        let height_m = point_m[2] - self.home_m[2];
+        let high = self.rtl_altitude_m.is_some_and(|r| height_m >= r - 1e-6);
+        let cap = match (high, self.limits.max_mps, self.limits.operators_mps) {
+            (false, Some(a), Some(b)) => Some(a.min(b)),
+            (false, a, b) => a.or(b),
+            (true, a, _) => a,
+        };
+        let from = [self.home_m[0], self.home_m[1], point_m[2]];
+        leg_speed_mps(&self.limits.powered, self.wind, (from, point_m), cap)
+    }
 }
 
 /// The highest ground speed the operator planned any leg of `spec` at, m/s: each leg's and
@@ -887,6 +973,8 @@ struct Context<'a> {
     /// The day's scenarios each sortie is checked in (none: the nominal cut, to choose the
     /// candidate).
     check: Option<&'a SortieScenarios<'a>>,
+    /// The speed of a resumed sortie's fly-out.
+    fly_out: Option<&'a FlyOut<'a>>,
 }
 
 /// The best candidate (module step 4), and the figures of the mission as given split at whole
@@ -1129,10 +1217,12 @@ impl<'a> Maker<'a> {
                 options: cx.options,
                 flight: &cx.prepared.flight,
                 read: cx.mission.read_options(),
+                fly_out: cx.fly_out.map(|f| f as &dyn FlyOutSpeed),
             }),
             None => Maker::Spec(SpecSorties {
                 route,
                 flight: &cx.prepared.flight,
+                fly_out: cx.fly_out.map(|f| f as &dyn FlyOutSpeed),
             }),
         }
     }

@@ -55,7 +55,7 @@ use crate::engine::missions::flight::Flight;
 use crate::engine::missions::mission::flown_mission;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::MissionOptions;
-use crate::engine::missions::sorties::{Cut, Route, SortieMaker};
+use crate::engine::missions::sorties::{Cut, FlyOutSpeed, Route, SortieMaker};
 use crate::engine::vehicles::vehicle::Vehicle;
 
 /// MAV_CMD numbers of the items written or read here.
@@ -93,6 +93,8 @@ pub(in crate::engine) struct PlannerSorties<'a> {
     pub(in crate::engine) flight: &'a Flight<'a>,
     /// How a file is read back (as the mission was read: an unlimited loiter's time).
     pub(in crate::engine) read: aloft_missions::ReadOptions,
+    /// The speed of a resumed sortie's fly-out, when aloft chooses it.
+    pub(in crate::engine) fly_out: Option<&'a dyn FlyOutSpeed>,
 }
 
 impl SortieMaker for PlannerSorties<'_> {
@@ -223,7 +225,7 @@ impl PlannerSorties<'_> {
             }
         }
         let mut out = match self.speeds_changed {
-            true => self.with_speeds(out),
+            true => self.with_speeds(out, start.and_then(|c| self.fly_out_mps(c))),
             false => out,
         };
         for (k, item) in out.iter_mut().enumerate() {
@@ -257,6 +259,24 @@ impl PlannerSorties<'_> {
     /// force there (the flying order before `first`).
     fn resume_items(&self, home: &Home, cut: Cut, first: usize) -> Vec<MissionItem> {
         let altitude = self.altitude(home, cut);
+        let restored = in_force(&self.flown_items(0..first));
+        // The fly-out at its own speed, and the route's restored after it (the speed in force
+        // there, else the planning speed); with the speeds written from the plan's spec, those
+        // are written there.
+        let planning = self.spec.default_speed_mps;
+        let fly_out = self
+            .fly_out_mps(cut)
+            .filter(|v| !self.speeds_changed && planning.is_none_or(|p| (v - p).abs() >= 0.05));
+        let speed = |v: f64| {
+            item(
+                cmd::DO_CHANGE_SPEED,
+                FRAME_MISSION,
+                [1.0, v, -1.0, 0.0, 0.0, 0.0, 0.0],
+            )
+        };
+        let has_speed = restored
+            .iter()
+            .any(|i| i.command == cmd::DO_CHANGE_SPEED && i.params[0] <= 1.0);
         let mut out = vec![
             item(
                 cmd::NAV_TAKEOFF,
@@ -272,10 +292,19 @@ impl PlannerSorties<'_> {
                 ],
             ),
             camera_trigger(0.0),
-            waypoint(self.point_deg(home, cut), altitude),
         ];
-        out.extend(in_force(&self.flown_items(0..first)));
+        out.extend(fly_out.map(speed));
+        out.push(waypoint(self.point_deg(home, cut), altitude));
+        if fly_out.is_some() && !has_speed {
+            out.extend(planning.map(speed));
+        }
+        out.extend(restored);
         out
+    }
+
+    /// The ground speed of the fly-out to `cut`, when aloft chooses it.
+    fn fly_out_mps(&self, cut: Cut) -> Option<f64> {
+        self.fly_out?.speed_mps(self.route.point_m(cut))
     }
 
     /// The camera stopped when it is on, and a return to launch.
@@ -367,16 +396,22 @@ impl PlannerSorties<'_> {
     }
 
     /// `items` with every speed written from the plan's spec (module docs, Speeds).
-    fn with_speeds(&self, items: Vec<MissionItem>) -> Vec<MissionItem> {
+    /// A resumed sortie's first move (its fly-out) at `fly_out_mps` when given.
+    fn with_speeds(&self, items: Vec<MissionItem>, fly_out_mps: Option<f64>) -> Vec<MissionItem> {
         let mut out = Vec::with_capacity(items.len() + 8);
         let mut in_force: Option<f64> = None;
+        let mut fly_out = fly_out_mps;
         let planning = self.spec.default_speed_mps;
         for it in items {
             let horizontal = it.command == cmd::DO_CHANGE_SPEED && it.params[0] <= 1.0;
             if horizontal {
                 continue;
             }
-            if let Some(want) = self.speed_of(&it).or(planning).filter(|_| moves(&it)) {
+            let want = match moves(&it) {
+                true => fly_out.take().or(self.speed_of(&it)).or(planning),
+                false => None,
+            };
+            if let Some(want) = want {
                 if in_force.is_none_or(|v| (v - want).abs() > 1e-9) {
                     out.push(item(
                         cmd::DO_CHANGE_SPEED,
