@@ -66,10 +66,21 @@ impl Survey {
 /// (widened by the reach) the point lies outside (the count is the plain one's:
 /// `covered_count_is_the_plain_count` below).
 struct Reach {
-    /// Per stretch: its start, its direction (end minus start), its squared length, and its box
-    /// widened by the reach (west, south, east, north), m.
-    lines: Vec<([f64; 2], [f64; 2], f64, [f64; 4])>,
+    lines: Vec<Stretch>,
     reach2_m2: f64,
+}
+
+/// A camera-on stretch as [`Reach`] measures it.
+#[derive(Debug, Clone, Copy)]
+struct Stretch {
+    /// Its start, m.
+    a: [f64; 2],
+    /// Its direction: end minus start, m.
+    d: [f64; 2],
+    /// Its squared length, m^2.
+    len2: f64,
+    /// Its box widened by the reach: west, south, east, north, m.
+    bounds: [f64; 4],
 }
 
 impl Reach {
@@ -84,7 +95,12 @@ impl Reach {
                     a[0].max(b[0]) + reach_m,
                     a[1].max(b[1]) + reach_m,
                 ];
-                (a, d, d[0] * d[0] + d[1] * d[1], bounds)
+                Stretch {
+                    a,
+                    d,
+                    len2: d[0] * d[0] + d[1] * d[1],
+                    bounds,
+                }
             })
             .collect();
         Self {
@@ -95,7 +111,7 @@ impl Reach {
 
     /// Whether `q` lies within the reach of a stretch.
     fn any_within(&self, q: [f64; 2]) -> bool {
-        self.lines.iter().any(|&(a, d, len2, bounds)| {
+        self.lines.iter().any(|&Stretch { a, d, len2, bounds }| {
             if q[0] < bounds[0] || q[1] < bounds[1] || q[0] > bounds[2] || q[1] > bounds[3] {
                 return false;
             }
