@@ -798,3 +798,69 @@ fn data_val_no_leg_is_written_faster_than_the_operator_planned() {
         );
     }
 }
+
+/// The DO_CHANGE_SPEED ground speeds (param 2) of a `.plan`'s simple items, with the index of the
+/// item each comes before, and the index of the first waypoint after the take-off.
+fn speeds_and_resume(text: &str) -> (Vec<(usize, f64)>, Option<usize>) {
+    let v: Value = serde_json::from_str(text).unwrap();
+    let items = v["mission"]["items"].as_array().unwrap();
+    let speeds = items
+        .iter()
+        .enumerate()
+        .filter(|(_, it)| it["command"] == 178)
+        .map(|(k, it)| (k, f(&it["params"][1])))
+        .collect();
+    let resume = items.iter().position(|it| it["command"] == 16);
+    (speeds, resume)
+}
+
+/// A resumed sortie's fly-out, aloft's own leg, is written at its own speed only where it may
+/// go faster than the operator planned: below the RTL altitude (none known by default) no faster
+/// than the survey's `hoverSpeed` (5 m/s); with `--rtl-altitude-m 40` (the survey flies at
+/// 50 m) at the speed of least energy in its wind, above 5 m/s and within the M100's 17 m/s,
+/// set just before the resume waypoint, and the survey's own speed set again right after it
+/// (among the items that restore what was in force there).
+#[test]
+fn data_val_a_resumed_sortie_flies_out_at_its_own_speed_above_the_rtl_altitude() {
+    let file = scratch("plan-files", "survey-20km-fly-out.plan");
+    std::fs::write(
+        &file,
+        common::big_survey::scaled_survey(&shared_mission("neilvaltec_test.plan"), 2.0),
+    )
+    .unwrap();
+    for (extra, fast) in [("", false), (" --rtl-altitude-m 40", true)] {
+        let flags = flags(&format!(
+            "--wind-speed 8 --wind-from 240 --confidence 0.5 --keep-angle{extra}"
+        ));
+        let (code, answer, err) = plan(&file, &scratch("plan-files", "fly-out"), &flags);
+        assert_eq!(code, 0, "{err}");
+        let files: Vec<&str> = answer["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert!(files.len() >= 2, "{answer}");
+        for later in &files[1..] {
+            let (speeds, resume) = speeds_and_resume(&std::fs::read_to_string(later).unwrap());
+            let resume = resume.unwrap();
+            let before: Vec<f64> = speeds
+                .iter()
+                .filter(|(k, _)| *k < resume)
+                .map(|s| s.1)
+                .collect();
+            let out = before.last().copied().unwrap_or(5.0);
+            match fast {
+                false => assert!(out <= 5.0 + 1e-9, "{later}: fly-out at {out}"),
+                true => {
+                    assert!(out > 5.0 && out <= 17.0, "{later}: fly-out at {out}");
+                    // The route's speed set again among the items that restore its state.
+                    assert!(
+                        speeds.iter().any(|(k, _)| *k > resume && *k <= resume + 4),
+                        "{later}: {speeds:?}, resume at {resume}"
+                    );
+                }
+            }
+        }
+    }
+}
