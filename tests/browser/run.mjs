@@ -301,8 +301,8 @@ async function main() {
     executablePath: CHROMIUM,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
   });
-  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup or =logbook.
-  const only = { markup: markupEverywhere, logbook: logbookPanel }[process.env.ALOFT_BROWSER_ONLY];
+  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup, =logbook or =fly.
+  const only = { markup: markupEverywhere, logbook: logbookPanel, fly: planToFlyPanel }[process.env.ALOFT_BROWSER_ONLY];
   if (only) {
     await only();
     await noProblems();
@@ -502,112 +502,7 @@ async function main() {
     main.stop();
   }
 
-  // --- 9: plan to fly: the files of `aloft plan`, drawn and offered on the page
-  const fly = await serve([PLAN_MISSION]);
-  try {
-    const page = await openPage(fly.url);
-    const conditions = ['--reserve-percent', '70', '--wind-speed', '8', '--wind-from', '0'];
-    const out = path.join(SHOTS, 'plan-to-fly-cli');
-    const cli = cliPlan(PLAN_MISSION, conditions, out);
-    const n = cli.json.sorties.length;
-    const before = await plans(page);
-    await setOptions(page, { reserve: '70', 'wind-speed': '8', 'wind-from': '0' });
-    await waitReady(page, before);
-    let seconds = NaN;
-    await check(`plan to fly ${path.basename(PLAN_MISSION)} (reserve 70 %, wind 8 m/s from 0): the sorties' table equals aloft plan (${n} sorties)`, async () => {
-      assert(n >= 2, `aloft plan gives ${n} sorties`);
-      const t0 = Date.now();
-      await page.click('#plan-fly');
-      await page.waitForSelector('#fly[data-state="ready"] table.fly-sorties tbody tr', { timeout: 60000 });
-      seconds = (Date.now() - t0) / 1000;
-      const rows = await page.$$eval('#fly table.fly-sorties tbody tr', (trs) => trs.map((tr) => ({ file: tr.dataset.file, energy: tr.dataset.energyWh, soc: tr.dataset.endSoc, text: tr.textContent })));
-      assert(rows.length === n, `${rows.length} rows`);
-      cli.json.sorties.forEach((s, k) => {
-        assert(rows[k].file === path.basename(s.file), `row ${k} file ${rows[k].file}`);
-        assert(rows[k].energy === String(s.energy_wh) && rows[k].soc === String(s.end_soc), `row ${k}: ${JSON.stringify(rows[k])}`);
-      });
-      const figures = await page.$$eval('#fly table.fly-figures tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
-      const mmss = (s) => `${Math.floor(Math.round(s) / 60)}:${String(Math.round(s) % 60).padStart(2, '0')}`;
-      assert(figures[0][1] === String(cli.json.as_given.batteries) && figures[0][2] === mmss(cli.json.as_given.duration_s), `as given ${figures[0]}`);
-      assert(figures[1][1] === String(n) && figures[1][2] === mmss(cli.json.duration_s), `plan ${figures[1]}`);
-      assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
-      // What changed names each survey the plan turned, with the angles aloft plan gives.
-      const changed = await page.$eval('#fly ul.fly-changes', (u) => u.textContent);
-      const angles = cli.json.changes.angles || [];
-      assert(angles.length >= 1, 'aloft plan turns the survey in this wind');
-      for (const a of angles) {
-        assert(changed.includes(`survey at item ${a.item} turned to the wind`) && changed.includes(`${Math.round(a.to_deg)}°`), changed);
-      }
-    });
-    console.log(`# plan to fly: ${n} sorties of ${path.basename(PLAN_MISSION)} in ${seconds.toFixed(2)} s from the click to the table (target 3 s)`);
-    await check('plan to fly: each sortie drawn in its own colour (way out, route, way home), the route behind', async () => {
-      for (const part of ['fly-way-out', 'fly-route', 'fly-way-home']) {
-        const count = await page.$$eval(`#map path.${part}`, (ps) => ps.length);
-        assert(count === n, `${count} ${part} paths`);
-      }
-      const colours = await page.$$eval('#map path.fly-route', (ps) => ps.map((p) => p.getAttribute('stroke')));
-      assert(new Set(colours).size === n, `colours ${colours}`);
-      for (let k = 1; k <= n; k++) {
-        const own = await page.$$eval(`#map path.fly-sortie-${k}`, (ps) => new Set(ps.map((p) => p.getAttribute('stroke'))).size);
-        assert(own === 1, `sortie ${k} in ${own} colours`);
-      }
-      assert(await page.$eval('#map', (m) => m.classList.contains('flying')), 'the route is not set back');
-    });
-    await shot(page, 'plan-to-fly');
-    await check('plan to fly: each file downloads as aloft plan writes it, and all of them in one zip', async () => {
-      const links = await page.$$eval('#fly a.fly-file', (as) => as.map((a) => a.getAttribute('download')));
-      assert(links.join(',') === cli.json.files.map((f) => path.basename(f)).join(','), `links ${links}`);
-      for (let k = 0; k < n; k++) {
-        const [download] = await Promise.all([page.waitForEvent('download'), page.click(`#fly a.fly-file >> nth=${k}`)]);
-        const got = readFileSync(await download.path(), 'utf8');
-        assert(download.suggestedFilename() === links[k], download.suggestedFilename());
-        assert(got === readFileSync(cli.json.files[k], 'utf8'), `${links[k]} differs from the file aloft plan wrote`);
-      }
-      const [zip] = await Promise.all([page.waitForEvent('download'), page.click('#fly a.fly-all')]);
-      const zipPath = path.join(SHOTS, zip.suggestedFilename());
-      await zip.saveAs(zipPath);
-      // Python's zipfile (CRCs checked by testzip) reads it: the same files, the same texts.
-      const listed = JSON.parse(execFileSync('python3', ['-c', ZIP_READER, zipPath, ...cli.json.files], { encoding: 'utf8' }));
-      assert(listed.bad === null && listed.names.join(',') === links.join(','), JSON.stringify(listed));
-      assert(listed.same, 'a file in the zip differs from the file aloft plan wrote');
-    });
-    await check('plan to fly: changing the wind forgets the plan (its layers and its files)', async () => {
-      const b = await plans(page);
-      await setOptions(page, { 'wind-from': '90' });
-      await waitReady(page, b);
-      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths left');
-      assert((await page.$$('#fly a.fly-file')).length === 0, 'download links left');
-      assert((await page.$eval('#fly', (e) => e.dataset.state)) === 'none', 'state');
-    });
-    await check('plan to fly: no plan at a 99 % reserve shows why, as aloft plan says it', async () => {
-      const b = await plans(page);
-      await setOptions(page, { reserve: '99', 'wind-from': '0' });
-      await waitReady(page, b);
-      const none = cliPlan(PLAN_MISSION, ['--reserve-percent', '99', '--wind-speed', '8', '--wind-from', '0'], path.join(SHOTS, 'plan-to-fly-none'));
-      assert(none.status === 1 && none.json.feasible === false, `aloft plan exit ${none.status}`);
-      await page.click('#plan-fly');
-      await page.waitForSelector('#fly[data-state="infeasible"]', { timeout: 60000 });
-      const text = await page.$eval('#fly', (e) => e.textContent);
-      assert(text.includes(none.json.reason), text);
-      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths drawn');
-    });
-    await check('plan to fly: an option out of range shows the server message', async () => {
-      const b = await plans(page);
-      await setOptions(page, { reserve: '70' });
-      await waitReady(page, b);
-      await refusing(async () => {
-        await page.fill('#fly-overlap', '-5');
-        await page.click('#plan-fly');
-        await page.waitForSelector('#fly[data-state="error"]', { timeout: 60000 });
-      });
-      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
-      assert(shown.includes('overlap_m') && shown.startsWith('Plan to fly: '), shown);
-      await page.fill('#fly-overlap', '');
-    });
-    await page.context().close();
-  } finally {
-    fly.stop();
-  }
+  await planToFlyPanel();
 
   // --- geographic map with a tile layer (tiles served by aloft itself: works offline)
   const geo = await serve([DROP_MISSION, '--tiles', '/vendor/leaflet/images/layers.png?{z}/{x}/{y}', '--attribution', 'test tiles']);
@@ -779,6 +674,116 @@ async function main() {
 
   // --- 7: no page errors anywhere
   await noProblems();
+}
+
+// --- 9: plan to fly: the files of `aloft plan`, drawn and offered on the page
+async function planToFlyPanel() {
+  const fly = await serve([PLAN_MISSION]);
+  try {
+    const page = await openPage(fly.url);
+    const conditions = ['--reserve-percent', '70', '--wind-speed', '8', '--wind-from', '0'];
+    const out = path.join(SHOTS, 'plan-to-fly-cli');
+    const cli = cliPlan(PLAN_MISSION, conditions, out);
+    const n = cli.json.sorties.length;
+    const before = await plans(page);
+    await setOptions(page, { reserve: '70', 'wind-speed': '8', 'wind-from': '0' });
+    await waitReady(page, before);
+    let seconds = NaN;
+    await check(`plan to fly ${path.basename(PLAN_MISSION)} (reserve 70 %, wind 8 m/s from 0): the sorties' table equals aloft plan (${n} sorties)`, async () => {
+      assert(n >= 2, `aloft plan gives ${n} sorties`);
+      const t0 = Date.now();
+      await page.click('#plan-fly');
+      await page.waitForSelector('#fly[data-state="ready"] table.fly-sorties tbody tr', { timeout: 60000 });
+      seconds = (Date.now() - t0) / 1000;
+      const rows = await page.$$eval('#fly table.fly-sorties tbody tr', (trs) => trs.map((tr) => ({ file: tr.dataset.file, energy: tr.dataset.energyWh, soc: tr.dataset.endSoc, text: tr.textContent })));
+      assert(rows.length === n, `${rows.length} rows`);
+      cli.json.sorties.forEach((s, k) => {
+        assert(rows[k].file === path.basename(s.file), `row ${k} file ${rows[k].file}`);
+        assert(rows[k].energy === String(s.energy_wh) && rows[k].soc === String(s.end_soc), `row ${k}: ${JSON.stringify(rows[k])}`);
+      });
+      const figures = await page.$$eval('#fly table.fly-figures tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+      const mmss = (s) => `${Math.floor(Math.round(s) / 60)}:${String(Math.round(s) % 60).padStart(2, '0')}`;
+      assert(figures[0][1] === String(cli.json.as_given.batteries) && figures[0][2] === mmss(cli.json.as_given.duration_s), `as given ${figures[0]}`);
+      assert(figures[1][1] === String(n) && figures[1][2] === mmss(cli.json.duration_s), `plan ${figures[1]}`);
+      assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
+      // What changed names each survey the plan turned, with the angles aloft plan gives.
+      const changed = await page.$eval('#fly ul.fly-changes', (u) => u.textContent);
+      const angles = cli.json.changes.angles || [];
+      assert(angles.length >= 1, 'aloft plan turns the survey in this wind');
+      for (const a of angles) {
+        assert(changed.includes(`survey at item ${a.item} turned to the wind`) && changed.includes(`${Math.round(a.to_deg)}°`), changed);
+      }
+    });
+    console.log(`# plan to fly: ${n} sorties of ${path.basename(PLAN_MISSION)} in ${seconds.toFixed(2)} s from the click to the table (target 3 s)`);
+    await check('plan to fly: each sortie drawn in its own colour (way out, route, way home), the route behind', async () => {
+      for (const part of ['fly-way-out', 'fly-route', 'fly-way-home']) {
+        const count = await page.$$eval(`#map path.${part}`, (ps) => ps.length);
+        assert(count === n, `${count} ${part} paths`);
+      }
+      const colours = await page.$$eval('#map path.fly-route', (ps) => ps.map((p) => p.getAttribute('stroke')));
+      assert(new Set(colours).size === n, `colours ${colours}`);
+      for (let k = 1; k <= n; k++) {
+        const own = await page.$$eval(`#map path.fly-sortie-${k}`, (ps) => new Set(ps.map((p) => p.getAttribute('stroke'))).size);
+        assert(own === 1, `sortie ${k} in ${own} colours`);
+      }
+      assert(await page.$eval('#map', (m) => m.classList.contains('flying')), 'the route is not set back');
+    });
+    await shot(page, 'plan-to-fly');
+    await check('plan to fly: each file downloads as aloft plan writes it, and all of them in one zip', async () => {
+      const links = await page.$$eval('#fly a.fly-file', (as) => as.map((a) => a.getAttribute('download')));
+      assert(links.join(',') === cli.json.files.map((f) => path.basename(f)).join(','), `links ${links}`);
+      for (let k = 0; k < n; k++) {
+        const [download] = await Promise.all([page.waitForEvent('download'), page.click(`#fly a.fly-file >> nth=${k}`)]);
+        const got = readFileSync(await download.path(), 'utf8');
+        assert(download.suggestedFilename() === links[k], download.suggestedFilename());
+        assert(got === readFileSync(cli.json.files[k], 'utf8'), `${links[k]} differs from the file aloft plan wrote`);
+      }
+      const [zip] = await Promise.all([page.waitForEvent('download'), page.click('#fly a.fly-all')]);
+      const zipPath = path.join(SHOTS, zip.suggestedFilename());
+      await zip.saveAs(zipPath);
+      // Python's zipfile (CRCs checked by testzip) reads it: the same files, the same texts.
+      const listed = JSON.parse(execFileSync('python3', ['-c', ZIP_READER, zipPath, ...cli.json.files], { encoding: 'utf8' }));
+      assert(listed.bad === null && listed.names.join(',') === links.join(','), JSON.stringify(listed));
+      assert(listed.same, 'a file in the zip differs from the file aloft plan wrote');
+    });
+    await check('plan to fly: changing the wind forgets the plan (its layers and its files)', async () => {
+      const b = await plans(page);
+      await setOptions(page, { 'wind-from': '90' });
+      await waitReady(page, b);
+      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths left');
+      assert((await page.$$('#fly a.fly-file')).length === 0, 'download links left');
+      assert((await page.$eval('#fly', (e) => e.dataset.state)) === 'none', 'state');
+    });
+    await check('plan to fly: no plan at a 99 % reserve shows why, as aloft plan says it', async () => {
+      const b = await plans(page);
+      await setOptions(page, { reserve: '99', 'wind-from': '0' });
+      await waitReady(page, b);
+      const none = cliPlan(PLAN_MISSION, ['--reserve-percent', '99', '--wind-speed', '8', '--wind-from', '0'], path.join(SHOTS, 'plan-to-fly-none'));
+      assert(none.status === 1 && none.json.feasible === false, `aloft plan exit ${none.status}`);
+      await page.click('#plan-fly');
+      await page.waitForSelector('#fly[data-state="infeasible"]', { timeout: 60000 });
+      const text = await page.$eval('#fly', (e) => e.textContent);
+      assert(text.includes(none.json.reason), text);
+      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths drawn');
+    });
+    await check('plan to fly: an option out of range shows the server message', async () => {
+      const b = await plans(page);
+      await setOptions(page, { reserve: '70' });
+      await waitReady(page, b);
+      await refusing(async () => {
+        await page.fill('#fly-overlap', '-5');
+        await page.click('#plan-fly');
+        await page.waitForSelector('#fly[data-state="error"]', { timeout: 60000 });
+      });
+      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
+      assert(shown.includes('overlap_m') && shown.startsWith('Plan to fly: '), shown);
+      await page.fill('#fly-overlap', '');
+    });
+    await page.context().close();
+  } finally {
+    fly.stop();
+  }
+
 }
 
 async function noProblems() {
