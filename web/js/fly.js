@@ -6,6 +6,7 @@ import { el, tipNode } from './dom.js';
 import { fmt, mmss, pct, safeFileName, sortieColour, uniqueNames } from './format.js';
 import { api, clearError, fetchText, settle, showError } from './api.js';
 import { zipStored } from './zip.js';
+import { replanPending } from './mission.js';
 
 // The plan's options: the page's controls (no scenarios: a plan has none) and the panel's own.
 function flyOptions() {
@@ -41,6 +42,9 @@ export async function planToFly() {
     showError('Plan to fly: no mission selected');
     return;
   }
+  // The values just typed: their re-plan, still waiting, runs now (it forgets any plan shown),
+  // and this plan is asked for after it, with the same values (read below, at the press).
+  replanPending();
   clearFly('planning…');
   const seq = state.flySeq;
   const planSeq = state.planSeq;
