@@ -130,7 +130,7 @@ function flyConfidence(plan) {
 function flySorties(plan) {
   const heads = [
     ['#', ''], ['File items', ''], ['Mission items', ''], ['Energy', 'Wh'], ['Time', 'min:s'],
-    ['Landing', 'p5–p95, %'], ['Reserve', 'kept, %'], ['No return', 'min:s'],
+    ['Landing', 'p5–p95, %'], ['Reserve', 'kept, %'], ['No return', 'min:s'], ['File', ''],
   ];
   const head = el('tr', {}, heads.map(headCell));
   const texts = plan.texts || [];
@@ -148,7 +148,7 @@ function flySorties(plan) {
       'data-end-soc': String(s.end_soc),
       'data-p-reserve': typeof s.p_reserve === 'number' ? String(s.p_reserve) : undefined,
     }, [
-      el('td', { class: 'n', title: s.file }, [el('span', { class: 'swatch', style: `background:${sortieColour(k)}` }), String(k + 1)]),
+      el('td', { class: 'n' }, [el('span', { class: 'swatch', style: `background:${sortieColour(k)}` }), String(k + 1)]),
       el('td', { class: 'n file-items', text: own ? `${own[0]}–${own[1]}` : '–' }),
       el('td', { class: 'n mission-items', text: items }),
       el('td', { class: 'n', text: fmt(s.energy_wh, 1) }),
@@ -156,8 +156,9 @@ function flySorties(plan) {
       el('td', { class: 'n band', text: band ? `${pct(band.p5)}–${pct(band.p95)}` : '–' }),
       el('td', { class: 'n p-reserve', text: pct(s.p_reserve) }),
       el('td', { class: 'n', text: typeof s.point_of_no_return_s === 'number' ? mmss(s.point_of_no_return_s) : 'none' }),
+      el('td', { class: 'file', text: s.file }),
     ]);
-    const tips = [s.file];
+    const tips = [];
     if (own) tips.push(`items ${own[0]}–${own[1]} as QGroundControl lists ${texts[k].file}`);
     if (s.first_item !== undefined) tips.push(`the mission's items ${s.first_item}–${s.last_item}`);
     if (inside) tips.push(`turns home ${fmt(s.ends_inside_leg_fraction * 100, 0)} % of the way along the leg to the mission's item ${s.last_item}`);
@@ -171,7 +172,7 @@ function flySorties(plan) {
   });
   const key = el('p', {
     class: 'fly-key muted',
-    text: 'Sortie k flies the k-th file below (its name on hover). File items: as QGroundControl lists that file (0 is home); mission items: those of the mission as given; * turns home inside a leg; landing p5–p95: the battery at landing over the day\'s scenarios (the forecast\'s on hover); reserve kept: the share of them landing with the reserve. On the map: each sortie in its colour, the route solid, the way out dashed, the way home dotted; ◆ where a sortie turns home, ■ where the next resumes.',
+    text: 'File items: as QGroundControl lists that file (0 is home); mission items: those of the mission as given; * turns home inside a leg; landing p5–p95: the battery at landing over the day\'s scenarios (the forecast\'s on hover); reserve kept: the share of them landing with the reserve. On the map: each sortie in its colour, the route solid, the way out dashed, the way home dotted; ◆ where a sortie turns home, ■ where the next resumes.',
   });
   return el('div', {}, [el('div', { class: 'table-wrap' }, [el('table', { class: 'fly fly-sorties' }, [el('thead', {}, [head]), el('tbody', {}, rows)])]), key]);
 }
