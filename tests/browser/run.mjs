@@ -24,6 +24,7 @@ const DEMO = path.join(repo, 'fixtures/missions/demo-survey.toml');
 const LOG = path.join(DATA, 'flight_logs/px4_esc_status_log.ulg');
 const DROP_MISSION = path.join(DATA, 'missions/kasperg3_mission.plan');
 const PLAN_MISSION = path.join(DATA, 'missions/neilvaltec_test.plan');
+const PLAN_WAYPOINTS = path.join(DATA, 'missions/brucdeng_aircart_mission.waypoints');
 const TLOG = path.join(DATA, 'telemetry/ayoub_auto_mission_sitl.tlog');
 const MISSION_EXT = /\.(plan|waypoints|toml|json|txt)$/i;
 const started = Date.now();
@@ -143,6 +144,71 @@ function cliPlan(file, args, dir) {
     throw new Error(`aloft ${argv.join(' ')}: exit ${e.status}: ${e.stderr}`);
   }
 }
+
+// The mission items of a written file as QGroundControl lists them, read from its text alone:
+// [{seq, command, lat, lon}], numbered in order from 1 (0 is the planned home: a `.plan`'s
+// `plannedHomePosition`, a `.waypoints` file's first row), a survey's items counted one by one.
+function fileItems(file) {
+  const text = readFileSync(file, 'utf8');
+  if (file.endsWith('.plan')) {
+    const flat = [];
+    for (const it of JSON.parse(text).mission.items) {
+      if (it.type === 'SimpleItem') flat.push(it);
+      else for (const sub of it.TransectStyleComplexItem.Items) flat.push(sub);
+    }
+    return flat.map((it, k) => ({ seq: k + 1, command: it.command, lat: it.params[4], lon: it.params[5] }));
+  }
+  const rows = text.trim().split('\n').slice(1).map((l) => l.trim().split(/\s+/).map(Number));
+  return rows.slice(1).map((r, k) => ({ seq: k + 1, command: r[3], lat: r[8], lon: r[9] }));
+}
+
+// Where a written sortie turns home (its last NAV_WAYPOINT before its RTL) and where it resumes
+// the route (its first NAV_WAYPOINT after its take-off), from the file's items.
+function turnsHome(items) {
+  const rtl = items.findIndex((it) => it.command === 20);
+  const before = (rtl < 0 ? items : items.slice(0, rtl)).filter((it) => it.command === 16);
+  return before[before.length - 1];
+}
+function resumes(items) {
+  const takeoff = items.findIndex((it) => it.command === 22);
+  return items.slice(takeoff + 1).find((it) => it.command === 16);
+}
+
+// The sorties' table of the page: one object per row, the cells by their class.
+async function flyRows(page) {
+  return page.$$eval('#fly table.fly-sorties tbody tr', (trs) =>
+    trs.map((tr) => {
+      const cell = (cls) => {
+        const td = tr.querySelector(`td.${cls}`);
+        return td ? td.textContent : null;
+      };
+      return {
+        file: tr.dataset.file,
+        energy: tr.dataset.energyWh,
+        soc: tr.dataset.endSoc,
+        fileItems: cell('file-items'),
+        missionItems: cell('mission-items'),
+        band: cell('band'),
+        share: cell('p-reserve'),
+        text: tr.textContent,
+      };
+    }),
+  );
+}
+
+// The page's answer settled: no plan to fly in flight, no re-plan pending or in flight.
+async function flySettled(page, timeout = 60000) {
+  await page.waitForFunction(
+    () => !document.querySelector('#plan-fly').disabled && document.body.dataset.state !== 'loading' && document.querySelector('#fly').dataset.state !== 'loading',
+    null,
+    { timeout },
+  );
+  // a re-plan debounced after the answer (250 ms) would still forget it
+  await new Promise((r) => setTimeout(r, 600));
+  await page.waitForFunction(() => document.body.dataset.state !== 'loading', null, { timeout });
+}
+
+const percent1 = (x) => (100 * x).toFixed(1);
 
 // A zip read by Python's zipfile: argv zip, then the files it should hold in order.
 const ZIP_READER = `
@@ -301,8 +367,8 @@ async function main() {
     executablePath: CHROMIUM,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
   });
-  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup or =logbook.
-  const only = { markup: markupEverywhere, logbook: logbookPanel }[process.env.ALOFT_BROWSER_ONLY];
+  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup, =logbook or =fly.
+  const only = { markup: markupEverywhere, logbook: logbookPanel, fly: planToFlyPanel }[process.env.ALOFT_BROWSER_ONLY];
   if (only) {
     await only();
     await noProblems();
@@ -502,112 +568,7 @@ async function main() {
     main.stop();
   }
 
-  // --- 9: plan to fly: the files of `aloft plan`, drawn and offered on the page
-  const fly = await serve([PLAN_MISSION]);
-  try {
-    const page = await openPage(fly.url);
-    const conditions = ['--reserve-percent', '70', '--wind-speed', '8', '--wind-from', '0'];
-    const out = path.join(SHOTS, 'plan-to-fly-cli');
-    const cli = cliPlan(PLAN_MISSION, conditions, out);
-    const n = cli.json.sorties.length;
-    const before = await plans(page);
-    await setOptions(page, { reserve: '70', 'wind-speed': '8', 'wind-from': '0' });
-    await waitReady(page, before);
-    let seconds = NaN;
-    await check(`plan to fly ${path.basename(PLAN_MISSION)} (reserve 70 %, wind 8 m/s from 0): the sorties' table equals aloft plan (${n} sorties)`, async () => {
-      assert(n >= 2, `aloft plan gives ${n} sorties`);
-      const t0 = Date.now();
-      await page.click('#plan-fly');
-      await page.waitForSelector('#fly[data-state="ready"] table.fly-sorties tbody tr', { timeout: 60000 });
-      seconds = (Date.now() - t0) / 1000;
-      const rows = await page.$$eval('#fly table.fly-sorties tbody tr', (trs) => trs.map((tr) => ({ file: tr.dataset.file, energy: tr.dataset.energyWh, soc: tr.dataset.endSoc, text: tr.textContent })));
-      assert(rows.length === n, `${rows.length} rows`);
-      cli.json.sorties.forEach((s, k) => {
-        assert(rows[k].file === path.basename(s.file), `row ${k} file ${rows[k].file}`);
-        assert(rows[k].energy === String(s.energy_wh) && rows[k].soc === String(s.end_soc), `row ${k}: ${JSON.stringify(rows[k])}`);
-      });
-      const figures = await page.$$eval('#fly table.fly-figures tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
-      const mmss = (s) => `${Math.floor(Math.round(s) / 60)}:${String(Math.round(s) % 60).padStart(2, '0')}`;
-      assert(figures[0][1] === String(cli.json.as_given.batteries) && figures[0][2] === mmss(cli.json.as_given.duration_s), `as given ${figures[0]}`);
-      assert(figures[1][1] === String(n) && figures[1][2] === mmss(cli.json.duration_s), `plan ${figures[1]}`);
-      assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
-      // What changed names each survey the plan turned, with the angles aloft plan gives.
-      const changed = await page.$eval('#fly ul.fly-changes', (u) => u.textContent);
-      const angles = cli.json.changes.angles || [];
-      assert(angles.length >= 1, 'aloft plan turns the survey in this wind');
-      for (const a of angles) {
-        assert(changed.includes(`survey at item ${a.item} turned to the wind`) && changed.includes(`${Math.round(a.to_deg)}°`), changed);
-      }
-    });
-    console.log(`# plan to fly: ${n} sorties of ${path.basename(PLAN_MISSION)} in ${seconds.toFixed(2)} s from the click to the table (target 3 s)`);
-    await check('plan to fly: each sortie drawn in its own colour (way out, route, way home), the route behind', async () => {
-      for (const part of ['fly-way-out', 'fly-route', 'fly-way-home']) {
-        const count = await page.$$eval(`#map path.${part}`, (ps) => ps.length);
-        assert(count === n, `${count} ${part} paths`);
-      }
-      const colours = await page.$$eval('#map path.fly-route', (ps) => ps.map((p) => p.getAttribute('stroke')));
-      assert(new Set(colours).size === n, `colours ${colours}`);
-      for (let k = 1; k <= n; k++) {
-        const own = await page.$$eval(`#map path.fly-sortie-${k}`, (ps) => new Set(ps.map((p) => p.getAttribute('stroke'))).size);
-        assert(own === 1, `sortie ${k} in ${own} colours`);
-      }
-      assert(await page.$eval('#map', (m) => m.classList.contains('flying')), 'the route is not set back');
-    });
-    await shot(page, 'plan-to-fly');
-    await check('plan to fly: each file downloads as aloft plan writes it, and all of them in one zip', async () => {
-      const links = await page.$$eval('#fly a.fly-file', (as) => as.map((a) => a.getAttribute('download')));
-      assert(links.join(',') === cli.json.files.map((f) => path.basename(f)).join(','), `links ${links}`);
-      for (let k = 0; k < n; k++) {
-        const [download] = await Promise.all([page.waitForEvent('download'), page.click(`#fly a.fly-file >> nth=${k}`)]);
-        const got = readFileSync(await download.path(), 'utf8');
-        assert(download.suggestedFilename() === links[k], download.suggestedFilename());
-        assert(got === readFileSync(cli.json.files[k], 'utf8'), `${links[k]} differs from the file aloft plan wrote`);
-      }
-      const [zip] = await Promise.all([page.waitForEvent('download'), page.click('#fly a.fly-all')]);
-      const zipPath = path.join(SHOTS, zip.suggestedFilename());
-      await zip.saveAs(zipPath);
-      // Python's zipfile (CRCs checked by testzip) reads it: the same files, the same texts.
-      const listed = JSON.parse(execFileSync('python3', ['-c', ZIP_READER, zipPath, ...cli.json.files], { encoding: 'utf8' }));
-      assert(listed.bad === null && listed.names.join(',') === links.join(','), JSON.stringify(listed));
-      assert(listed.same, 'a file in the zip differs from the file aloft plan wrote');
-    });
-    await check('plan to fly: changing the wind forgets the plan (its layers and its files)', async () => {
-      const b = await plans(page);
-      await setOptions(page, { 'wind-from': '90' });
-      await waitReady(page, b);
-      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths left');
-      assert((await page.$$('#fly a.fly-file')).length === 0, 'download links left');
-      assert((await page.$eval('#fly', (e) => e.dataset.state)) === 'none', 'state');
-    });
-    await check('plan to fly: no plan at a 99 % reserve shows why, as aloft plan says it', async () => {
-      const b = await plans(page);
-      await setOptions(page, { reserve: '99', 'wind-from': '0' });
-      await waitReady(page, b);
-      const none = cliPlan(PLAN_MISSION, ['--reserve-percent', '99', '--wind-speed', '8', '--wind-from', '0'], path.join(SHOTS, 'plan-to-fly-none'));
-      assert(none.status === 1 && none.json.feasible === false, `aloft plan exit ${none.status}`);
-      await page.click('#plan-fly');
-      await page.waitForSelector('#fly[data-state="infeasible"]', { timeout: 60000 });
-      const text = await page.$eval('#fly', (e) => e.textContent);
-      assert(text.includes(none.json.reason), text);
-      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths drawn');
-    });
-    await check('plan to fly: an option out of range shows the server message', async () => {
-      const b = await plans(page);
-      await setOptions(page, { reserve: '70' });
-      await waitReady(page, b);
-      await refusing(async () => {
-        await page.fill('#fly-overlap', '-5');
-        await page.click('#plan-fly');
-        await page.waitForSelector('#fly[data-state="error"]', { timeout: 60000 });
-      });
-      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
-      assert(shown.includes('overlap_m') && shown.startsWith('Plan to fly: '), shown);
-      await page.fill('#fly-overlap', '');
-    });
-    await page.context().close();
-  } finally {
-    fly.stop();
-  }
+  await planToFlyPanel();
 
   // --- geographic map with a tile layer (tiles served by aloft itself: works offline)
   const geo = await serve([DROP_MISSION, '--tiles', '/vendor/leaflet/images/layers.png?{z}/{x}/{y}', '--attribution', 'test tiles']);
@@ -779,6 +740,244 @@ async function main() {
 
   // --- 7: no page errors anywhere
   await noProblems();
+}
+
+// --- 9: plan to fly: the files of `aloft plan`, drawn and offered on the page
+async function planToFlyPanel() {
+  const fly = await serve([PLAN_MISSION, PLAN_WAYPOINTS]);
+  try {
+    const page = await openPage(fly.url);
+    const conditions = ['--reserve-percent', '70', '--wind-speed', '8', '--wind-from', '0'];
+    const out = path.join(SHOTS, 'plan-to-fly-cli');
+    const cli = cliPlan(PLAN_MISSION, conditions, out);
+    const n = cli.json.sorties.length;
+    const before = await plans(page);
+    await setOptions(page, { reserve: '70', 'wind-speed': '8', 'wind-from': '0' });
+    await waitReady(page, before);
+    let seconds = NaN;
+    await check(`plan to fly ${path.basename(PLAN_MISSION)} (reserve 70 %, wind 8 m/s from 0): the sorties' table equals aloft plan (${n} sorties)`, async () => {
+      assert(n >= 2, `aloft plan gives ${n} sorties`);
+      const t0 = Date.now();
+      await page.click('#plan-fly');
+      await page.waitForSelector('#fly[data-state="ready"] table.fly-sorties tbody tr', { timeout: 60000 });
+      seconds = (Date.now() - t0) / 1000;
+      const rows = await page.$$eval('#fly table.fly-sorties tbody tr', (trs) => trs.map((tr) => ({ file: tr.dataset.file, energy: tr.dataset.energyWh, soc: tr.dataset.endSoc, text: tr.textContent })));
+      assert(rows.length === n, `${rows.length} rows`);
+      cli.json.sorties.forEach((s, k) => {
+        assert(rows[k].file === path.basename(s.file), `row ${k} file ${rows[k].file}`);
+        assert(rows[k].energy === String(s.energy_wh) && rows[k].soc === String(s.end_soc), `row ${k}: ${JSON.stringify(rows[k])}`);
+      });
+      const figures = await page.$$eval('#fly table.fly-figures tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+      const mmss = (s) => `${Math.floor(Math.round(s) / 60)}:${String(Math.round(s) % 60).padStart(2, '0')}`;
+      assert(figures[0][1] === String(cli.json.as_given.batteries) && figures[0][2] === mmss(cli.json.as_given.duration_s), `as given ${figures[0]}`);
+      assert(figures[1][1] === String(n) && figures[1][2] === mmss(cli.json.duration_s), `plan ${figures[1]}`);
+      assert(await page.$eval('#error', (e) => e.hidden), 'error banner shown');
+      // What changed names each survey the plan turned, with the angles aloft plan gives.
+      const changed = await page.$eval('#fly ul.fly-changes', (u) => u.textContent);
+      const angles = cli.json.changes.angles || [];
+      assert(angles.length >= 1, 'aloft plan turns the survey in this wind');
+      for (const a of angles) {
+        assert(changed.includes(`survey at item ${a.item} turned to the wind`) && changed.includes(`${Math.round(a.to_deg)}°`), changed);
+      }
+    });
+    console.log(`# plan to fly: ${n} sorties of ${path.basename(PLAN_MISSION)} in ${seconds.toFixed(2)} s from the click to the table (target 3 s)`);
+    await check('plan to fly: each sortie drawn in its own colour (way out, route, way home), the route behind', async () => {
+      for (const part of ['fly-way-out', 'fly-route', 'fly-way-home']) {
+        const count = await page.$$eval(`#map path.${part}`, (ps) => ps.length);
+        assert(count === n, `${count} ${part} paths`);
+      }
+      const colours = await page.$$eval('#map path.fly-route', (ps) => ps.map((p) => p.getAttribute('stroke')));
+      assert(new Set(colours).size === n, `colours ${colours}`);
+      for (let k = 1; k <= n; k++) {
+        const own = await page.$$eval(`#map path.fly-sortie-${k}`, (ps) => new Set(ps.map((p) => p.getAttribute('stroke'))).size);
+        assert(own === 1, `sortie ${k} in ${own} colours`);
+      }
+      assert(await page.$eval('#map', (m) => m.classList.contains('flying')), 'the route is not set back');
+    });
+    await check(`plan to fly: where each sortie turns home and the next resumes, marked and labelled at the written files' waypoints (${n - 1} cuts)`, async () => {
+      const marks = await page.$$eval('#map .fly-mark', (ms) =>
+        ms.map((m) => ({ tag: m.tagName, kind: m.dataset.kind, sortie: m.dataset.sortie, lat: Number(m.dataset.latDeg), lon: Number(m.dataset.lonDeg) })),
+      );
+      const labels = await page.$$eval('#map .leaflet-tooltip.fly-mark-label', (ts) => ts.map((t) => t.textContent));
+      const cuts = marks.filter((m) => m.kind === 'cut');
+      const resumed = marks.filter((m) => m.kind === 'resume');
+      assert(cuts.length === n - 1 && resumed.length === n - 1, `${cuts.length} cut and ${resumed.length} resume marks for ${n} sorties`);
+      // markers of their own (the marker pane), none of them a path of the route or of a sortie
+      assert(marks.every((m) => m.tag === 'DIV'), JSON.stringify(marks));
+      assert(labels.length === 2 * (n - 1), `${labels.length} labels`);
+      // The mark is where the flown path turns: within the waypoint's acceptance radius of the
+      // file's waypoint (2 m, PX4's and ArduPilot's default, where a pass-through corner starts;
+      // 0.5 m more for the turn's own curve), and nearer it than any other waypoint of the file.
+      const metres = (a, b) => {
+        const r = 6371000;
+        const rad = Math.PI / 180;
+        const x = (b.lon - a.lon) * rad * Math.cos(((a.lat + b.lat) / 2) * rad) * r;
+        return Math.hypot(x, (b.lat - a.lat) * rad * r);
+      };
+      const near = (m, it, items) =>
+        metres(m, it) <= 2.5 && items.filter((o) => o.command === 16 && o.seq !== it.seq).every((o) => metres(m, o) > metres(m, it));
+      for (let k = 1; k < n; k++) {
+        const s = cli.json.sorties[k - 1];
+        const ownItems = fileItems(cli.json.files[k - 1]);
+        const cut = turnsHome(ownItems);
+        const mark = cuts.find((m) => m.sortie === String(k));
+        assert(mark && near(mark, cut, ownItems), `sortie ${k} turns home at ${JSON.stringify(mark)}, its file at item ${cut.seq} ${cut.lat}, ${cut.lon}`);
+        const home = labels.find((t) => t.startsWith(`sortie ${k} turns home`));
+        assert(home && home.includes(`item ${cut.seq} of its file`), `label ${home} (file item ${cut.seq})`);
+        if (typeof s.ends_inside_leg_fraction === 'number') {
+          const along = `${Math.round(100 * s.ends_inside_leg_fraction)} % of the way to mission item ${s.last_item}`;
+          assert(home.includes(along), `label ${home} lacks '${along}'`);
+        }
+        const nextItems = fileItems(cli.json.files[k]);
+        const res = resumes(nextItems);
+        const back = resumed.find((m) => m.sortie === String(k + 1));
+        assert(back && near(back, res, nextItems), `sortie ${k + 1} resumes at ${JSON.stringify(back)}, its file at item ${res.seq} ${res.lat}, ${res.lon}`);
+        const again = labels.find((t) => t.startsWith(`sortie ${k + 1} resumes`));
+        assert(again && again.includes(`item ${res.seq} of its file`), `label ${again} (file item ${res.seq})`);
+      }
+    });
+    await check("plan to fly: each sortie's items as its file numbers them (QGroundControl's), the mission's items it covers labelled as such", async () => {
+      const heads = await page.$$eval('#fly table.fly-sorties thead th', (ths) => ths.map((th) => th.textContent));
+      assert(heads.some((h) => h.startsWith('File items')) && heads.some((h) => h.startsWith('Mission items')), `heads ${heads}`);
+      const rows = await flyRows(page);
+      cli.json.sorties.forEach((s, k) => {
+        const items = fileItems(cli.json.files[k]);
+        const own = `${items[0].seq}–${items[items.length - 1].seq}`;
+        assert(rows[k].fileItems === own, `sortie ${k + 1}: file items '${rows[k].fileItems}', its file has ${own}`);
+        assert(rows[k].missionItems && rows[k].missionItems.startsWith(`${s.first_item}–${s.last_item}`), `sortie ${k + 1}: mission items '${rows[k].missionItems}'`);
+      });
+    });
+    await check("plan to fly: each sortie's landing band (p5–p95) and share with the reserve, the plan's confidence and scenarios above the table", async () => {
+      const rows = await flyRows(page);
+      cli.json.sorties.forEach((s, k) => {
+        const band = `${percent1(s.landing_soc.p5)}–${percent1(s.landing_soc.p95)}`;
+        assert(rows[k].band === band, `sortie ${k + 1}: band '${rows[k].band}', aloft plan ${band}`);
+        assert(rows[k].share === percent1(s.p_reserve), `sortie ${k + 1}: share '${rows[k].share}', aloft plan ${s.p_reserve}`);
+      });
+      const line = await page.$eval('#fly p.fly-confidence', (p) => p.textContent);
+      const sc = cli.json.scenarios;
+      const sp = sc.spreads;
+      for (const part of [`${Number((100 * cli.json.confidence).toFixed(1))} % of ${sc.samples} scenarios`, `wind ${sp.wind_speed_sd_mps.toFixed(1)} m/s and ${Math.round(sp.wind_from_sd_deg)}°`, `capacity ${Math.round(sp.capacity_sd_percent)} %`, `power ${Math.round(sp.power_sd_percent)} %`]) {
+        assert(line.includes(part), `'${line}' lacks '${part}'`);
+      }
+      const above = await page.$eval('#fly p.fly-confidence', (p) => Boolean(p.compareDocumentPosition(document.querySelector('#fly table.fly-sorties')) & Node.DOCUMENT_POSITION_FOLLOWING));
+      assert(above, 'the line is not above the table');
+    });
+    await shot(page, 'plan-to-fly');
+    await check('plan to fly: each file downloads as aloft plan writes it, and all of them in one zip', async () => {
+      const links = await page.$$eval('#fly a.fly-file', (as) => as.map((a) => a.getAttribute('download')));
+      assert(links.join(',') === cli.json.files.map((f) => path.basename(f)).join(','), `links ${links}`);
+      for (let k = 0; k < n; k++) {
+        const [download] = await Promise.all([page.waitForEvent('download'), page.click(`#fly a.fly-file >> nth=${k}`)]);
+        const got = readFileSync(await download.path(), 'utf8');
+        assert(download.suggestedFilename() === links[k], download.suggestedFilename());
+        assert(got === readFileSync(cli.json.files[k], 'utf8'), `${links[k]} differs from the file aloft plan wrote`);
+      }
+      const [zip] = await Promise.all([page.waitForEvent('download'), page.click('#fly a.fly-all')]);
+      const zipPath = path.join(SHOTS, zip.suggestedFilename());
+      await zip.saveAs(zipPath);
+      // Python's zipfile (CRCs checked by testzip) reads it: the same files, the same texts.
+      const listed = JSON.parse(execFileSync('python3', ['-c', ZIP_READER, zipPath, ...cli.json.files], { encoding: 'utf8' }));
+      assert(listed.bad === null && listed.names.join(',') === links.join(','), JSON.stringify(listed));
+      assert(listed.same, 'a file in the zip differs from the file aloft plan wrote');
+    });
+    await check('plan to fly: the confidence control (0.5 to 0.999, default 0.95) is sent as confidence', async () => {
+      const attrs = await page.$eval('#fly-confidence', (i) => ({ type: i.type, min: i.min, max: i.max, step: i.step, value: i.value }));
+      assert(JSON.stringify(attrs) === JSON.stringify({ type: 'number', min: '0.5', max: '0.999', step: '0.01', value: '0.95' }), JSON.stringify(attrs));
+      const half = cliPlan(PLAN_MISSION, [...conditions, '--confidence', '0.5'], path.join(SHOTS, 'plan-to-fly-half'));
+      const energies = (j) => j.sorties.map((s) => String(s.energy_wh)).join(',');
+      assert(energies(half.json) !== energies(cli.json), 'aloft plan cuts the same at 0.5 and 0.95: the check could not tell');
+      await page.fill('#fly-confidence', '0.5');
+      await page.click('#plan-fly');
+      await flySettled(page);
+      assert((await page.$eval('#fly', (e) => e.dataset.state)) === 'ready', 'no plan shown');
+      const rows = await flyRows(page);
+      assert(rows.map((r) => r.energy).join(',') === energies(half.json), `page ${rows.map((r) => r.energy)} vs aloft plan --confidence 0.5 ${energies(half.json)}`);
+      const line = await page.$eval('#fly p.fly-confidence', (p) => p.textContent);
+      assert(line.includes('50 % of'), line);
+      await refusing(async () => {
+        await page.fill('#fly-confidence', '0.3');
+        await page.click('#plan-fly');
+        await page.waitForSelector('#fly[data-state="error"]', { timeout: 60000 });
+      });
+      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
+      assert(shown.startsWith('Plan to fly: ') && shown.includes('confidence'), shown);
+      await page.fill('#fly-confidence', '0.95');
+    });
+    for (const [wind, how] of [['5', 'pressed right after typing the wind'], ['7', 'pressed once the typed wind is re-planned, the field still in focus']]) {
+      await check(`plan to fly: ${how}, it plans with the wind typed (${wind} m/s) and keeps the plan`, async () => {
+        const typed = cliPlan(PLAN_MISSION, ['--reserve-percent', '70', '--wind-speed', wind, '--wind-from', '0'], path.join(SHOTS, `plan-to-fly-typed-${wind}`));
+        const b = await plans(page);
+        await page.fill('#wind-speed', wind);
+        if (wind === '7') await waitReady(page, b);
+        await page.click('#plan-fly');
+        await flySettled(page);
+        const state = await page.$eval('#fly', (e) => e.dataset.state);
+        assert(state === 'ready', `the plan to fly is '${state}'`);
+        const rows = await flyRows(page);
+        const want = typed.json.sorties.map((s) => String(s.energy_wh)).join(',');
+        assert(rows.map((r) => r.energy).join(',') === want, `page ${rows.map((r) => r.energy)} vs aloft plan at ${wind} m/s ${want}`);
+      });
+    }
+    {
+      const b = await plans(page);
+      await setOptions(page, { 'wind-speed': '8' });
+      await waitReady(page, b);
+    }
+    await check('plan to fly: changing the wind forgets the plan (its layers and its files)', async () => {
+      const b = await plans(page);
+      await setOptions(page, { 'wind-from': '90' });
+      await waitReady(page, b);
+      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths left');
+      assert((await page.$$('#fly a.fly-file')).length === 0, 'download links left');
+      assert((await page.$eval('#fly', (e) => e.dataset.state)) === 'none', 'state');
+    });
+    await check('plan to fly: no plan at a 99 % reserve shows why, as aloft plan says it', async () => {
+      const b = await plans(page);
+      await setOptions(page, { reserve: '99', 'wind-from': '0' });
+      await waitReady(page, b);
+      const none = cliPlan(PLAN_MISSION, ['--reserve-percent', '99', '--wind-speed', '8', '--wind-from', '0'], path.join(SHOTS, 'plan-to-fly-none'));
+      assert(none.status === 1 && none.json.feasible === false, `aloft plan exit ${none.status}`);
+      await page.click('#plan-fly');
+      await page.waitForSelector('#fly[data-state="infeasible"]', { timeout: 60000 });
+      const text = await page.$eval('#fly', (e) => e.textContent);
+      assert(text.includes(none.json.reason), text);
+      assert((await page.$$('#map path.fly')).length === 0, 'sortie paths drawn');
+    });
+    await check('plan to fly: an option out of range shows the server message', async () => {
+      const b = await plans(page);
+      await setOptions(page, { reserve: '70' });
+      await waitReady(page, b);
+      await refusing(async () => {
+        await page.fill('#fly-overlap', '-5');
+        await page.click('#plan-fly');
+        await page.waitForSelector('#fly[data-state="error"]', { timeout: 60000 });
+      });
+      const shown = await page.$eval('#error', (e) => (e.hidden ? '' : e.textContent));
+      assert(shown.includes('overlap_m') && shown.startsWith('Plan to fly: '), shown);
+      await page.fill('#fly-overlap', '');
+    });
+    await check(`plan to fly ${path.basename(PLAN_WAYPOINTS)}: the file items are its rows' (QGroundControl's), the mission's items labelled apart`, async () => {
+      const wcli = cliPlan(PLAN_WAYPOINTS, conditions, path.join(SHOTS, 'plan-to-fly-waypoints'));
+      const b = await plans(page);
+      await page.selectOption('#mission-select', { label: path.basename(PLAN_WAYPOINTS) });
+      await waitReady(page, b);
+      await page.click('#plan-fly');
+      await flySettled(page);
+      const rows = await flyRows(page);
+      assert(rows.length === wcli.json.sorties.length, `${rows.length} rows`);
+      wcli.json.sorties.forEach((s, k) => {
+        const items = fileItems(wcli.json.files[k]);
+        const own = `${items[0].seq}–${items[items.length - 1].seq}`;
+        assert(rows[k].fileItems === own, `sortie ${k + 1}: file items '${rows[k].fileItems}', its file has ${own}`);
+        assert(rows[k].missionItems && rows[k].missionItems.startsWith(`${s.first_item}–${s.last_item}`), `mission items '${rows[k].missionItems}'`);
+      });
+    });
+    await page.context().close();
+  } finally {
+    fly.stop();
+  }
+
 }
 
 async function noProblems() {

@@ -34,6 +34,16 @@ export function replanSoon() {
   }, 250);
 }
 
+// The re-plan still waiting out its debounce, run now; its promise, or null when none waits.
+// "Plan to fly" calls it first: run after the press, that re-plan (of the values just typed, or
+// of the `change` a field sends when the press takes its focus) would forget the plan asked for.
+export function replanPending() {
+  if (!debounceTimer) return null;
+  clearTimeout(debounceTimer);
+  debounceTimer = null;
+  return replan();
+}
+
 export async function replan() {
   const seq = ++state.planSeq;
   const entry = state.current;
