@@ -215,7 +215,6 @@ def test_without_output_nothing_is_written(data, tmp_path, monkeypatch):
     ({"camera_interval_s": 0}, ["--camera-interval-s", "0"]),
     ({"confidence": 0.3}, ["--confidence", "0.3"]),
     ({"confidence": 1.0}, ["--confidence", "1"]),
-    ({"wind_from_sd": 200}, ["--wind-from-sd", "200"]),
 ])
 def test_bad_values_refused_with_the_clis_message(cli, tmp_path, options, flags):
     """The engine's refusal, as the binary prints it; nothing written."""
@@ -237,6 +236,8 @@ def test_bad_values_refused_with_the_clis_message(cli, tmp_path, options, flags)
     ({"sweep_speed": 10}, "unknown option 'sweep_speed' for aloft.plan"),
     ({"wind_speed": 8}, "'wind_speed' of aloft.plan needs 'wind_from'"),
     ({"force": True}, "'force' of aloft.plan needs 'output'"),
+    ({"wind_from_sd": 200},
+     "invalid value '200' for 'wind_from_sd' of aloft.plan: a standard deviation from 0 to 180"),
 ])
 def test_bad_option_raises_naming_it(tmp_path, monkeypatch, options, message):
     monkeypatch.chdir(tmp_path)
