@@ -75,21 +75,14 @@ class ScenarioKeywords(MissionKeywords, total=False):
     power_sd_percent: Optional[float]
     threads: Optional[int]
 
-class PlanKeywords(MissionKeywords, total=False):
-    """`aloft plan`'s own flags beyond the mission's (the rest are arguments of `plan`)."""
+class PlanKeywords(ScenarioKeywords, total=False):
+    """`aloft plan`'s own flags beyond the mission's and its scenarios' (with a plan's defaults:
+    400 samples, the forecast's spreads); the rest are arguments of `plan`."""
 
     camera_interval_s: Optional[float]
     keep_angle: bool
     loiter_unlimited_s: Optional[float]
     confidence: Optional[float]
-    samples: Optional[int]
-    seed: Optional[int]
-    wind_speed_sd: Optional[float]
-    wind_from_sd: Optional[float]
-    payload_sd_kg: Optional[float]
-    capacity_sd_percent: Optional[float]
-    power_sd_percent: Optional[float]
-    threads: Optional[int]
 
 class EnduranceKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     """`aloft endurance`'s flags."""

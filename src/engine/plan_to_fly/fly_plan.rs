@@ -561,16 +561,7 @@ fn plan_for(
     if let Some(kind) = sure {
         candidates.retain(|c| c.kind == kind);
     }
-    let scenarios = request
-        .scenarios
-        .clone()
-        .unwrap_or_else(|| request.confidence.scenarios(Some(0.0), &request.bounds));
-    let check = SortieScenarios::new(
-        (vehicle, mission, options),
-        &prepared.flight,
-        &scenarios,
-        request.confidence.confidence,
-    )?;
+    let check = day_scenarios((vehicle, mission), request, &prepared)?;
     let fly_out = FlyOut::of(vehicle, &prepared, request, wind)?;
     let cx = Context {
         vehicle,
@@ -582,6 +573,27 @@ fn plan_for(
         fly_out: fly_out.as_ref(),
     };
     best_candidate(&cx, candidates)
+}
+
+/// The day's scenarios of `request` that the sorties of `mission` (as `prepared`) are judged in.
+///
+/// # Errors
+/// Invalid scenario options; wind spreads with a gridded wind field.
+fn day_scenarios<'a>(
+    (vehicle, mission): (&Vehicle, &Mission),
+    request: &FlyPlanRequest,
+    prepared: &Prepared<'a>,
+) -> Result<SortieScenarios<'a>, Error> {
+    let scenarios = request
+        .scenarios
+        .clone()
+        .unwrap_or_else(|| request.confidence.scenarios(Some(0.0), &request.bounds));
+    SortieScenarios::new(
+        (vehicle, mission, &request.options),
+        &prepared.flight,
+        &scenarios,
+        request.confidence.confidence,
+    )
 }
 
 /// `flown`'s sorties (of `mission`), each with its landing band in the day's scenarios.
@@ -599,16 +611,7 @@ fn with_bands(
     let aircraft = vehicle.aircraft()?;
     let battery = vehicle.battery(options.battery.as_deref())?;
     let prepared = prepare(vehicle, mission, options, (aircraft, &battery, wind))?;
-    let scenarios = request
-        .scenarios
-        .clone()
-        .unwrap_or_else(|| request.confidence.scenarios(Some(0.0), &request.bounds));
-    let check = SortieScenarios::new(
-        (vehicle, mission, options),
-        &prepared.flight,
-        &scenarios,
-        request.confidence.confidence,
-    )?;
+    let check = day_scenarios((vehicle, mission), request, &prepared)?;
     for plan in &mut flown.plans {
         let band = check
             .band(&plan.spec)
