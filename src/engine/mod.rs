@@ -98,8 +98,9 @@ pub use identification::validate::{
 pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::estimator::InFlightEstimator;
 pub use live::{
-    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveRecorder, LiveReplayRequest,
-    LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position, LIVE_SCENARIOS,
+    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveFailsafe, LiveRecorder,
+    LiveReplayRequest, LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position,
+    SocBand, TimeBand, LIVE_SCENARIOS,
 };
 pub use logs::{
     check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,

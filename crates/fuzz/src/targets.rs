@@ -588,6 +588,7 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
         Event::Reboot => ("reboot", Vec::new()),
         Event::LinkLost { silent_s } => ("link-lost", vec![*silent_s]),
         Event::ClockBack { back_s } => ("clock-back", vec![*back_s]),
+        Event::Parameter { value, .. } => ("parameter", vec![*value]),
     }
 }
 

@@ -66,6 +66,15 @@ pub enum Event {
         /// The step back, s.
         back_s: f64,
     },
+    /// One of the vehicle's parameters (PARAM_VALUE on a link; a flight log's parameters,
+    /// sent before its first record): what its failsafes act on (ArduPilot `BATT_*`, PX4
+    /// `BAT_*`/`BAT1_*`).
+    Parameter {
+        /// The parameter's name, as the autopilot spells it (at most 16 characters).
+        name: String,
+        /// Its value.
+        value: f64,
+    },
 }
 
 /// The vehicle's HEARTBEAT.

@@ -33,12 +33,14 @@ mod charge;
 mod count;
 mod estimate;
 pub(crate) mod estimator;
+mod failsafes;
 mod record;
 mod replay;
 mod sources;
 mod tracker;
 
 pub use ahead::LIVE_SCENARIOS;
+pub use failsafes::{LiveFailsafe, TimeBand};
 pub use record::LiveRecorder;
 pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
 pub use sources::LiveSource;
@@ -72,6 +74,19 @@ pub struct LiveUpdate {
     /// full pack is assumed).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub soc: Option<f64>,
+    /// The state of charge's band from the estimator, 0-1.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub soc_band: Option<SocBand>,
+    /// The autopilot's own state of charge as it last reported it, 0-1 (beside `soc`, which is
+    /// aloft's estimate).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reported_soc: Option<f64>,
+    /// The pack's voltage as measured now, V.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub voltage_v: Option<f64>,
+    /// The pack's current as measured now, A (positive discharging).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub current_a: Option<f64>,
     /// Electrical energy used so far, Wh (measured; the model's without power data).
     pub energy_used_wh: f64,
     /// Measured electrical power now, W.
@@ -97,6 +112,9 @@ pub struct LiveUpdate {
     /// turn back everywhere.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub point_of_no_return_s: Option<f64>,
+    /// The failsafes the vehicle watches and when each triggers on the rest of the route.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failsafes: Vec<LiveFailsafe>,
     /// What to do: `continue`, `return now` or `land now`; on the ground, `continue` or `do not
     /// take off`. A graver advice at once, a milder one once it has held
     /// ([`advice`](self::advice)).
@@ -117,6 +135,15 @@ pub struct LiveUpdate {
     /// several joined by `; `.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+}
+
+/// A band of the state of charge, 0-1.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SocBand {
+    /// 5th percentile.
+    pub p5: f64,
+    /// 95th percentile.
+    pub p95: f64,
 }
 
 /// Where the vehicle is: from home (else the stream's first fix), and geodetic where the source
@@ -576,6 +603,10 @@ impl<'a> LiveSession<'a> {
             // measured): the assumed full pack is not shown as the vehicle's state (the note
             // says what is assumed).
             soc: (!self.charge.assumed_full() || t.power_available() || t.in_air()).then_some(soc),
+            soc_band: None,
+            reported_soc: None,
+            voltage_v: t.voltage_v,
+            current_a: t.current_a,
             energy_used_wh: t.energy_used_wh(),
             power_w: t.power_w,
             power_available: t.power_available(),
@@ -585,6 +616,7 @@ impl<'a> LiveSession<'a> {
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
             landing_soc: answer.as_ref().and_then(|a| a.landing_soc),
             point_of_no_return_s,
+            failsafes: Vec::new(),
             advice: answer
                 .as_ref()
                 .map(|a| self.advice.advise(now, &a.shares).as_str()),

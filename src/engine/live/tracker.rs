@@ -2,6 +2,8 @@
 //! messages said (position, velocity, attitude, power, battery, mode, mission), the energy so far
 //! and the efficiency estimate. Memory is bounded whatever the flight's length.
 
+use std::collections::BTreeMap;
+
 use aloft_core::Trapezoid;
 use aloft_logs::frame::euler_to_mat_ned_frd;
 use aloft_logs::sample::{Attitude, GeoOrigin, Sample};
@@ -77,6 +79,9 @@ pub(crate) struct Tracker {
     vel: Option<([f64; 3], f64)>,
     att: Option<(Attitude, f64)>,
     pub power_w: Option<f64>,
+    /// The pack's last measured voltage (V) and current (A).
+    pub voltage_v: Option<f64>,
+    pub current_a: Option<f64>,
     landed: Option<bool>,
     pub heartbeat: Option<Heartbeat>,
     /// The mission as the vehicle holds it, and how many times one arrived (a re-upload).
@@ -96,6 +101,9 @@ pub(crate) struct Tracker {
     pub reboots: u32,
     /// A step back of the source's clock not yet said in an update.
     pub clock_note: Option<String>,
+    /// The vehicle's parameters heard so far (its failsafes' thresholds), by name; kept across
+    /// a restart (the same vehicle).
+    pub parameters: BTreeMap<String, f64>,
 }
 
 impl Tracker {
@@ -113,6 +121,8 @@ impl Tracker {
             vel: None,
             att: None,
             power_w: None,
+            voltage_v: None,
+            current_a: None,
             landed: None,
             heartbeat: None,
             mission: None,
@@ -128,6 +138,7 @@ impl Tracker {
             link_lost: false,
             reboots: 0,
             clock_note: None,
+            parameters: BTreeMap::new(),
         }
     }
 
@@ -159,6 +170,11 @@ impl Tracker {
                      times go on from before the step"
                 ));
             }
+            Event::Parameter { name, value } => {
+                if value.is_finite() {
+                    self.parameters.insert(name.clone(), *value);
+                }
+            }
         }
     }
 
@@ -168,9 +184,11 @@ impl Tracker {
         let fresh = Self::new(self.model.clone(), self.drag, self.prior_sd);
         let reboots = self.reboots + 1;
         let now_s = self.now_s;
+        let parameters = std::mem::take(&mut self.parameters);
         *self = Self {
             now_s,
             reboots,
+            parameters,
             ..fresh
         };
     }
@@ -184,6 +202,12 @@ impl Tracker {
     }
 
     fn sample(&mut self, time_s: f64, s: &Sample) {
+        if let Some(v) = s.voltage_v.filter(|v| v.is_finite() && *v > 0.0) {
+            self.voltage_v = Some(v);
+        }
+        if let Some(i) = s.current_a.filter(|i| i.is_finite()) {
+            self.current_a = Some(i);
+        }
         if let Some(p) = s.pos_enu_m {
             self.pos_enu = Some(p);
         }
