@@ -80,4 +80,16 @@ pub enum PackError {
         /// The smallest drop used, 0-1.
         min_drop: f64,
     },
+    /// A value out of its range (a circuit's, a filter's start).
+    #[error("{name} = {value} {unit} is invalid: {expected}")]
+    InvalidValue {
+        /// The value's name.
+        name: &'static str,
+        /// The value.
+        value: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// What it should be.
+        expected: &'static str,
+    },
 }

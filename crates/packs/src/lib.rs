@@ -19,6 +19,7 @@ pub mod capacity;
 pub mod combine;
 pub mod error;
 pub mod resistance;
+pub mod soc_filter;
 
 pub use balance::{cell_balance, CellBalance, MAJOR_SPREAD_V, MINOR_SPREAD_V};
 pub use capacity::{
@@ -28,6 +29,7 @@ pub use capacity::{
 pub use combine::{combine_flights, median_finite, FlightsCombined};
 pub use error::PackError;
 pub use resistance::{resistance_from_steps, updates, ResistanceEstimate};
+pub use soc_filter::{Circuit, FilterTuning, ReportKind, SocEstimate, SocFilter};
 
 use aloft_logs::BatteryLog;
 use serde::Serialize;
