@@ -186,21 +186,29 @@ impl Default for FilterTuning {
     /// readings scatter by 0.1 V at rest on the shared 3S PX4 flights, and one RC pair's sag errs
     /// by more: with 50 mV once a second the band held simulated packs drawn from these priors
     /// 80 % of the time, with these 88 %), 30 mV a cell for a generic curve's offset and 20 mV a cell per
-    /// 10 % of charge for its shape, the resistance within 30 %, drifting 2 % a minute, the
-    /// capacity within 3 %, the current sensor within 0.3 A.
+    /// 10 % of charge for its shape, the resistance within 60 %, drifting 2 % a minute, the RC
+    /// pair's within 80 % and its voltage wandering 50 mV a cell per square root of a second,
+    /// the capacity within 3 %, the current sensor within 0.3 A.
+    ///
+    /// The last is what the flights asked: one RC pair of 30 s does not hold a LiPo's
+    /// polarisation over a flight, and where its voltage may not wander the filter reads the
+    /// rest of the sag as charge drawn. On the five shared PX4 flights (their rested voltage
+    /// before take-off less the charge counted, docs/validation.md), the worst error in the air
+    /// was 3-17 points with 10 mV and a resistance within 30 %, 2-8 points with these; the
+    /// simulated packs of the tests hold either.
     fn default() -> Self {
         Self {
             voltage_sd_cell_v: 0.08,
             voltage_interval_s: 2.0,
             curve_offset_sd_cell_v: 0.03,
             curve_shape_sd_cell_v: 0.03,
-            resistance_sd: 0.3,
+            resistance_sd: 0.6,
             rc_resistance_sd: 0.8,
             resistance_drift: 0.02,
             capacity_sd: 0.03,
             current_offset_sd_a: 0.3,
             rc_sd_cell_v: 0.02,
-            rc_drift_cell_v: 0.01,
+            rc_drift_cell_v: 0.05,
         }
     }
 }

@@ -150,6 +150,16 @@ impl Pack {
     pub(crate) fn ocv_table_v(&self) -> &[f64] {
         &self.ocv_table_v
     }
+
+    /// The cell's open-circuit curve this pack flies on (its table, per cell): what a state of
+    /// charge estimator reads the voltage through.
+    pub fn ocv_curve(&self) -> OcvCurve {
+        let n = self.ocv_table_v.len();
+        let cells = f64::from(self.cells_series);
+        let soc = (0..n).map(|k| k as f64 / (n - 1) as f64).collect();
+        let cell_v = self.ocv_table_v.iter().map(|v| v / cells).collect();
+        OcvCurve::new(soc, cell_v).unwrap_or_else(|_| OcvCurve::typical_lipo())
+    }
 }
 
 /// What the pack is.

@@ -143,6 +143,8 @@ pub(crate) struct Charge {
     before_falls: Vec<Anchor>,
     distrust: Option<Distrust>,
     took_off: bool,
+    /// Whether the last report was believed (it is the state of charge now).
+    last_believed: bool,
 }
 
 impl Charge {
@@ -159,6 +161,7 @@ impl Charge {
             before_falls: Vec::new(),
             distrust: None,
             took_off: false,
+            last_believed: false,
         }
     }
 
@@ -230,6 +233,16 @@ impl Charge {
     /// A state of charge `soc` (0-1) the vehicle reports, in the air or not, with `drawn` up to
     /// now.
     pub(crate) fn report(&mut self, soc: f64, in_air: bool, drawn: Drawn) {
+        self.last_believed = false;
+        self.believe(soc, in_air, drawn);
+        self.last_believed = self
+            .reported
+            .is_some_and(|r| r.soc.to_bits() == soc.to_bits())
+            && self.distrust.is_none();
+    }
+
+    /// [`Self::report`] but for the flag of the last report believed.
+    fn believe(&mut self, soc: f64, in_air: bool, drawn: Drawn) {
         if self
             .distrust
             .is_some_and(|d| !matches!(d, Distrust::OutOfRange { .. }))
@@ -341,6 +354,24 @@ impl Charge {
             drawn: boot,
         };
         (SocSource::AssumedFull, full)
+    }
+
+    /// Whether the last report was believed.
+    pub(crate) fn last_report_believed(&self) -> bool {
+        self.last_believed
+    }
+
+    /// What the state of charge starts from before take-off ([`super::pack_state`]): the rested
+    /// voltage, else the believed report less the charge drawn since, else a full pack.
+    pub(crate) fn start(&self, drawn: Drawn) -> super::pack_state::Start {
+        use super::pack_state::Start;
+        if let Some((_, v)) = self.rested {
+            return Start::Rested(v);
+        }
+        match self.anchor().0 {
+            SocSource::Reported => Start::Reported(self.soc(drawn).0),
+            _ => Start::Full,
+        }
     }
 
     /// Whether the state of charge is only the full pack assumed at the start (nothing from the

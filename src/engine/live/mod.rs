@@ -34,6 +34,7 @@ mod count;
 mod estimate;
 pub(crate) mod estimator;
 mod failsafes;
+mod pack_state;
 mod record;
 mod replay;
 mod sources;
@@ -49,6 +50,7 @@ use advice::AdviceHold;
 use ahead::{Ahead, AheadAnswer};
 use charge::{Charge, Drawn};
 use count::ChargeCount;
+use pack_state::{report_kind, PackState};
 use tracker::Tracker;
 
 /// One update: a line of `aloft live --format json`. Fields that are not known yet (no fix, no
@@ -351,6 +353,8 @@ pub struct LiveSession<'a> {
     charge: Charge,
     /// The autopilot's count of the charge drawn, believed or not.
     count: ChargeCount,
+    /// The state of charge's filter.
+    pack_state: PackState,
     /// The advice given, for its hysteresis.
     advice: AdviceHold,
     eta0: f64,
@@ -365,6 +369,10 @@ pub struct LiveSession<'a> {
     /// The rest's duration at the last update (p50), s: the horizon of the ratio's drift.
     rest_s: f64,
 }
+
+/// A disagreement between the vehicle's report and the estimate the note explains, state of
+/// charge (0-1).
+const DISAGREE: f64 = 0.10;
 
 /// The rest's duration before the first answer, s.
 const DEFAULT_REST_S: f64 = 300.0;
@@ -399,6 +407,7 @@ impl<'a> LiveSession<'a> {
                 scenarios: request.scenarios,
             },
             count: ChargeCount::new(pack.capacity_ah()),
+            pack_state: PackState::new(&pack),
             charge: Charge::new(pack),
             advice: AdviceHold::default(),
             eta0,
@@ -419,9 +428,13 @@ impl<'a> LiveSession<'a> {
         }
     }
 
-    /// The state of charge now ([`charge`](self::charge)).
+    /// The state of charge now: the filter's ([`pack_state`](self::pack_state)), else what
+    /// [`charge`](self::charge) makes of the reports.
     fn soc(&self) -> f64 {
-        self.charge.soc(self.drawn()).0
+        match self.pack_state.estimate() {
+            Some(e) => e.soc,
+            None => self.charge.soc(self.drawn()).0,
+        }
     }
 
     /// Read the mission the source sent, once per upload (a mission aloft cannot read is kept as
@@ -448,6 +461,7 @@ impl<'a> LiveSession<'a> {
             // Another flight, maybe another pack: nothing reported holds, no advice either.
             Event::Reboot => {
                 *c = Charge::new(c.pack().clone());
+                self.pack_state = PackState::new(c.pack());
                 self.advice = AdviceHold::default();
             }
             Event::Battery(b) => {
@@ -469,6 +483,67 @@ impl<'a> LiveSession<'a> {
         if in_air {
             c.in_air();
         }
+        self.follow_pack(event, drawn);
+    }
+
+    /// The filter of the state of charge ([`pack_state`](self::pack_state)): started from the
+    /// evidence before take-off, then fed each sample and report.
+    fn follow_pack(&mut self, event: &aloft_logs::telemetry::Telemetry, drawn: Drawn) {
+        use aloft_logs::telemetry::Event;
+        let t = &self.tracker;
+        let kind = report_kind(&t.parameters);
+        let p = &mut self.pack_state;
+        if !p.running() {
+            p.start_from(self.charge.start(drawn), kind);
+            if t.in_air() {
+                p.in_air();
+            }
+        }
+        let now = t.now_s;
+        let believed = self.charge.last_report_believed();
+        match &event.event {
+            Event::Sample(s) => {
+                let measured = (s.voltage_v, s.current_a, s.electrical_power_w());
+                p.sample(now, measured, t.energy_used_wh());
+                if let Some(soc) = s.soc {
+                    p.report(now, soc, believed, kind);
+                }
+            }
+            Event::Battery(b) => {
+                if let Some(soc) = b.soc {
+                    p.report(now, soc, believed, kind);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// What the note says where the vehicle's report and the estimate disagree by more than
+    /// [`DISAGREE`], and why they may.
+    fn disagreement_note(&self) -> Option<String> {
+        let estimate = self.pack_state.estimate()?;
+        let reported = self.pack_state.reported()?;
+        if (reported - estimate.soc).abs() <= DISAGREE {
+            return None;
+        }
+        let why = match report_kind(&self.tracker.parameters) {
+            aloft_packs::ReportKind::Voltage => {
+                "PX4 without BAT1_CAPACITY reads its charge from the voltage under load, which \
+                 sags with the current"
+            }
+            _ => {
+                "an autopilot counts the charge drawn from the capacity it is given, from a pack \
+                 it takes as full at boot"
+            }
+        };
+        Some(format!(
+            "the vehicle reports {:.0} % where the pack's circuit and the charge drawn say {:.0} % \
+             ({:.0}-{:.0} %): {why}",
+            100.0 * reported,
+            100.0 * estimate.soc,
+            100.0 * estimate.p5,
+            100.0 * estimate.p95
+        ))
     }
 
     /// The autopilot's count and the current it is judged by ([`count`](self::count)); a
@@ -589,22 +664,30 @@ impl<'a> LiveSession<'a> {
             .and_then(|()| answer.as_ref()?.duration_s)
             .map(|d| t.air_measured_j / t.air_s * d.p50 / 3600.0);
         let wind = t.wind.map(|(w, _)| w);
-        let note = [note, self.charge.note()]
+        let note = [note, self.charge.note(), self.disagreement_note()]
             .into_iter()
             .flatten()
             .reduce(|a, b| format!("{a}; {b}"));
+        // Nothing from the pack yet on the ground (no report, no rested voltage, no power
+        // measured): the assumed full pack is not shown as the vehicle's state (the note says
+        // what is assumed).
+        let shown = !self.charge.assumed_full() || t.power_available() || t.in_air();
         LiveUpdate {
             time_s: now,
             in_air: t.in_air(),
             mode: t.heartbeat.as_ref().map(|h| h.mode.clone()),
             mission_item: t.mission_current,
             position: position(t),
-            // Nothing from the pack yet on the ground (no report, no rested voltage, no power
-            // measured): the assumed full pack is not shown as the vehicle's state (the note
-            // says what is assumed).
-            soc: (!self.charge.assumed_full() || t.power_available() || t.in_air()).then_some(soc),
-            soc_band: None,
-            reported_soc: None,
+            soc: shown.then_some(soc),
+            soc_band: self
+                .pack_state
+                .estimate()
+                .filter(|_| shown)
+                .map(|e| SocBand {
+                    p5: e.p5,
+                    p95: e.p95,
+                }),
+            reported_soc: self.pack_state.reported(),
             voltage_v: t.voltage_v,
             current_a: t.current_a,
             energy_used_wh: t.energy_used_wh(),

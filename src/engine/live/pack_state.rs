@@ -1,0 +1,203 @@
+//! The pack's state of charge in flight: [`aloft_packs::SocFilter`] (an extended Kalman filter
+//! over the pack's equivalent circuit) fed the flight's current and voltage.
+//!
+//! - **Started** on the ground from what [`super::charge`] makes of the evidence before take-off:
+//!   the rested voltage (on the pack's open-circuit curve, as sure as a generic curve allows),
+//!   else the vehicle's believed report (as sure as its kind, [`ReportKind`]), else a full pack
+//!   with a wide band ([`ASSUMED_FULL_SD`]); started again whenever that evidence changes, until
+//!   take-off. A stream that starts in the air starts at its first sample the same way.
+//! - **In the air and after**: each sample counts the current since the last (the measured
+//!   current, else the measured power over the voltage, else the energy used over the voltage)
+//!   and reads the voltage through the circuit (only where the current is known: the sag is the
+//!   circuit's to explain). The vehicle's reports are measurements, at most one every
+//!   [`REPORT_INTERVAL_S`] and only while [`super::charge`] believes them; a report the autopilot
+//!   derives from the voltage (PX4 without `BAT1_CAPACITY`) adds nothing to the voltage the filter
+//!   reads itself and is not taken.
+
+use std::collections::BTreeMap;
+
+use aloft_packs::{Circuit, FilterTuning, ReportKind, SocEstimate, SocFilter};
+use aloft_planner::battery::Pack;
+
+/// The band of a full pack assumed at the start (one standard deviation): the voltage in the
+/// air corrects it.
+pub(crate) const ASSUMED_FULL_SD: f64 = 0.3;
+
+/// Least time between two of the vehicle's reports taken as measurements, s (a report at 5 Hz
+/// is one estimate repeated, not five).
+pub(crate) const REPORT_INTERVAL_S: f64 = 10.0;
+
+/// Longest gap over which the measured current is held to count the charge, s; over a longer
+/// one (a silent link) the energy used is counted instead.
+const MAX_CURRENT_GAP_S: f64 = 5.0;
+
+/// What the state of charge starts from before take-off.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Start {
+    /// The rested voltage before take-off, V (the pack's open-circuit voltage).
+    Rested(f64),
+    /// The vehicle's believed report (0-1), less what was drawn since.
+    Reported(f64),
+    /// Nothing: a full pack.
+    Full,
+}
+
+/// The filter and what it was last fed.
+#[derive(Debug, Clone)]
+pub(crate) struct PackState {
+    circuit: Circuit,
+    filter: Option<SocFilter>,
+    /// Time of the last sample counted, s, and the energy used then, W h.
+    last: Option<(f64, f64)>,
+    /// Last voltage measured, V.
+    voltage_v: Option<f64>,
+    took_off: bool,
+    start: Option<Start>,
+    /// The vehicle's last report (0-1) and when it was last taken as a measurement, s.
+    reported: Option<f64>,
+    last_fused_s: f64,
+}
+
+impl PackState {
+    /// The state of a flight on `pack` (its open-circuit curve, cells, capacity and resistance;
+    /// the default RC pair).
+    pub(crate) fn new(pack: &Pack) -> Self {
+        let circuit = Circuit::with_default_rc(
+            pack.ocv_curve(),
+            pack.cells_series(),
+            pack.capacity_ah(),
+            pack.resistance_ohm(),
+        );
+        Self {
+            circuit,
+            filter: None,
+            last: None,
+            voltage_v: None,
+            took_off: false,
+            start: None,
+            reported: None,
+            last_fused_s: f64::NEG_INFINITY,
+        }
+    }
+
+    /// The estimate now and its band; `None` before anything started it.
+    pub(crate) fn estimate(&self) -> Option<SocEstimate> {
+        self.filter.as_ref().map(SocFilter::band)
+    }
+
+    /// The filter itself (to fly the rest of the route on).
+    pub(crate) fn filter(&self) -> Option<&SocFilter> {
+        self.filter.as_ref()
+    }
+
+    /// The vehicle's last report, 0-1.
+    pub(crate) fn reported(&self) -> Option<f64> {
+        self.reported
+    }
+
+    /// Before take-off (and at the first sample of a stream that starts in the air): start the
+    /// filter from `start` where it changed.
+    pub(crate) fn start_from(&mut self, start: Start, kind: ReportKind) {
+        if self.took_off && self.filter.is_some() {
+            return;
+        }
+        if self.start == Some(start) && self.filter.is_some() {
+            return;
+        }
+        let tuning = FilterTuning::default();
+        let c = self.circuit.clone();
+        let filter = match start {
+            Start::Rested(v) => SocFilter::from_rested_voltage(c, tuning, v),
+            Start::Reported(soc) => SocFilter::new(c, tuning, soc.clamp(0.0, 1.0), kind.sd()),
+            Start::Full => SocFilter::new(c, tuning, 1.0, ASSUMED_FULL_SD),
+        };
+        // The circuit is the vehicle file's pack, checked when it was read: a start it refuses
+        // keeps the filter it had.
+        if let Ok(f) = filter {
+            self.filter = Some(f);
+            self.start = Some(start);
+        }
+    }
+
+    /// The vehicle took off: from now on the filter runs on.
+    pub(crate) fn in_air(&mut self) {
+        self.took_off = true;
+    }
+
+    /// Whether the filter runs on (it started in the air or took off).
+    pub(crate) fn running(&self) -> bool {
+        self.took_off
+    }
+
+    /// A sample at `time_s`: its voltage (V), current (A) and power (W) where measured, and the
+    /// energy used so far (W h, measured or the model's).
+    pub(crate) fn sample(
+        &mut self,
+        time_s: f64,
+        measured: (Option<f64>, Option<f64>, Option<f64>),
+        energy_used_wh: f64,
+    ) {
+        let (voltage_v, current_a, power_w) = measured;
+        if let Some(v) = voltage_v.filter(|v| v.is_finite() && *v > 0.0) {
+            self.voltage_v = Some(v);
+        }
+        let current_a = current_a.filter(|i| i.is_finite()).or_else(|| {
+            let v = self.voltage_v?;
+            power_w.filter(|p| p.is_finite()).map(|p| p / v)
+        });
+        let last = self.last.replace((time_s, energy_used_wh));
+        let Some(filter) = self.filter.as_mut().filter(|_| self.took_off) else {
+            return;
+        };
+        let Some((t0, e0)) = last else {
+            return;
+        };
+        let dt_s = time_s - t0;
+        if !(dt_s > 0.0) {
+            return;
+        }
+        match current_a {
+            Some(i) if dt_s <= MAX_CURRENT_GAP_S => filter.predict(dt_s, i),
+            _ => {
+                // The charge of the energy used at the pack's voltage.
+                let v = self.voltage_v.unwrap_or_else(|| self.circuit.ocv_v(0.5));
+                let charge_as = 3600.0 * (energy_used_wh - e0).max(0.0) / v;
+                filter.predict(dt_s, charge_as / dt_s);
+            }
+        }
+        if let (Some(v), Some(i)) = (voltage_v, current_a) {
+            filter.voltage(v, i);
+        }
+    }
+
+    /// A state of charge `soc` (0-1) the vehicle reports at `time_s`, `believed` as
+    /// [`super::charge`] judges it, of `kind`.
+    pub(crate) fn report(&mut self, time_s: f64, soc: f64, believed: bool, kind: ReportKind) {
+        if !(soc.is_finite() && (0.0..=1.0).contains(&soc)) {
+            return;
+        }
+        self.reported = Some(soc);
+        let Some(filter) = self.filter.as_mut().filter(|_| self.took_off) else {
+            return;
+        };
+        let adds = (kind != ReportKind::Voltage || self.voltage_v.is_none());
+        if believed && adds && time_s - self.last_fused_s >= REPORT_INTERVAL_S {
+            filter.report(soc, kind);
+            self.last_fused_s = time_s;
+        }
+    }
+}
+
+/// What kind of state of charge the vehicle reports, from its parameters: PX4 (`BAT1_*`, or the
+/// older `BAT_*`) without a capacity (`BAT1_CAPACITY` unset: -1) estimates it from the voltage
+/// under load (battery.cpp); PX4 with a capacity, ArduPilot (its monitors count from the
+/// capacity) and a vehicle whose parameters are not known count the charge drawn.
+pub(crate) fn report_kind(parameters: &BTreeMap<String, f64>) -> ReportKind {
+    let capacity = parameters
+        .get("BAT1_CAPACITY")
+        .or_else(|| parameters.get("BAT_CAPACITY"));
+    match capacity {
+        Some(c) if !(*c > 0.0) => ReportKind::Voltage,
+        _ => ReportKind::Counted,
+    }
+}
