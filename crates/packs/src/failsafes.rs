@@ -732,3 +732,265 @@ fn px4_level(kind: FailsafeKind) -> Px4Warning {
         FailsafeKind::Emergency => Px4Warning::Emergency,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn map(entries: &[(&str, f64)]) -> BTreeMap<String, f64> {
+        entries.iter().map(|(k, v)| (k.to_string(), *v)).collect()
+    }
+
+    /// Steps `monitor` at `dt_s` through `(duration_s, voltage_v, current_a)` segments; the
+    /// time after the first sample at which each failsafe triggered.
+    fn run(
+        monitor: &mut FailsafeMonitor,
+        dt_s: f64,
+        segments: &[(f64, f64, f64)],
+    ) -> Vec<Option<f64>> {
+        let mut out = vec![None; monitor.failsafes().len()];
+        let mut t = 0.0;
+        let mut first = true;
+        for &(duration_s, v, i) in segments {
+            let steps = (duration_s / dt_s).round() as usize;
+            for _ in 0..steps {
+                let step_s = if first { 0.0 } else { dt_s };
+                first = false;
+                t += step_s;
+                for k in monitor.step(step_s, v, Some(i), None).indexes() {
+                    out[k] = Some(t);
+                }
+            }
+        }
+        out
+    }
+
+    /// ArduPilot's timer (default 10 s): a voltage below `BATT_LOW_VOLT` for 9 s that then
+    /// recovers does not trigger; one that stays triggers at the first sample more than 10 s
+    /// after the first one below.
+    #[test]
+    fn ardupilot_low_voltage_needs_the_timer() {
+        let v = VehicleFailsafes::from_parameters(&map(&[("BATT_LOW_VOLT", 10.5)]), Some(3), &[])
+            .unwrap();
+        assert_eq!(v.failsafes.len(), 1);
+        assert_eq!(v.failsafes[0].action, FailsafeAction::Unknown);
+        assert!((v.failsafes[0].threshold_cell_v.unwrap() - 3.5).abs() < 1e-12);
+        let mut m = v.monitor();
+        let t = run(
+            &mut m,
+            0.1,
+            &[(1.0, 11.0, 10.0), (9.0, 10.0, 10.0), (5.0, 11.0, 10.0)],
+        );
+        assert_eq!(t, vec![None]);
+        let mut m = v.monitor();
+        let t = run(&mut m, 0.1, &[(1.0, 11.0, 10.0), (30.0, 10.0, 10.0)]);
+        // First below at 1.0 s; fires at the first sample past 11.0 s (0.1 s steps).
+        let fired = t[0].expect("triggers");
+        assert!(fired > 11.0 - 1e-9 && fired < 11.1 + 1e-9, "{fired}");
+        // BATT_LOW_TIMER 0 disables it.
+        let off = VehicleFailsafes::from_parameters(
+            &map(&[("BATT_LOW_VOLT", 10.5), ("BATT_LOW_TIMER", 0.0)]),
+            None,
+            &[],
+        )
+        .unwrap();
+        assert_eq!(
+            run(&mut off.monitor(), 0.1, &[(60.0, 10.0, 10.0)]),
+            vec![None]
+        );
+    }
+
+    /// A purely resistive pack (12 V behind 0.05 Ω): 30 s of current steps between 5 and
+    /// 10 A (11.75 and 11.5 V, not below an 11.5 V threshold), then steps between 5 and 20 A
+    /// (11.0 V at 20 A, below). On the raw voltage the failsafe fires 2 s (the timer) after
+    /// the first 20 A sample; sag-compensated with ArduPilot's estimate, which has converged
+    /// to 0.05 Ω by then (`−ΔV/ΔI` of values filtered alike is R exactly on such a pack), it
+    /// reads 12 V and never fires.
+    #[test]
+    fn sag_compensation_uses_ardupilots_resistance() {
+        let pack = |i: f64| (3.0, 12.0 - 0.05 * i, i);
+        let mut segments: Vec<(f64, f64, f64)> = (0..10)
+            .map(|k| pack(if k % 2 == 0 { 5.0 } else { 10.0 }))
+            .collect();
+        segments.extend((0..10).map(|k| pack(if k % 2 == 0 { 20.0 } else { 5.0 })));
+        let raw_params = map(&[("BATT_LOW_VOLT", 11.5), ("BATT_LOW_TIMER", 2.0)]);
+        let raw = VehicleFailsafes::from_parameters(&raw_params, None, &[]).unwrap();
+        let t = run(&mut raw.monitor(), 0.1, &segments);
+        // The first 20 A sample is at 30.0 s (samples from 0 s every 0.1 s).
+        assert!(t[0].is_some_and(|t| t > 32.0 && t < 32.2), "{t:?}");
+        let params = map(&[
+            ("BATT_LOW_VOLT", 11.5),
+            ("BATT_LOW_TIMER", 2.0),
+            ("BATT_FS_VOLTSRC", 1.0),
+        ]);
+        let sag = VehicleFailsafes::from_parameters(&params, None, &[]).unwrap();
+        let mut m = sag.monitor();
+        let t = run(&mut m, 0.1, &segments);
+        let r = m.ardupilot_resistance_ohm().unwrap();
+        assert!((r - 0.05).abs() < 1e-3, "{r}");
+        assert_eq!(t, vec![None]);
+    }
+
+    /// `BATT_LOW_MAH` 1000 and `BATT_CRT_MAH` 500 of a 5000 mA h capacity: at a constant 7 A
+    /// the charge left, `5000 − 7 t / 3.6`, falls below 1000 at 2057.1 s and below 500 at
+    /// 2314.3 s; each fires at once (no timer), on the first sample past. Action 0 is kept,
+    /// flagged as a warning only.
+    #[test]
+    fn ardupilot_capacity_thresholds() {
+        let params = map(&[
+            ("BATT_CAPACITY", 5000.0),
+            ("BATT_LOW_MAH", 1000.0),
+            ("BATT_CRT_MAH", 500.0),
+            ("BATT_FS_LOW_ACT", 0.0),
+            ("BATT_FS_CRT_ACT", 1.0),
+        ]);
+        let v = VehicleFailsafes::from_parameters(&params, None, &[]).unwrap();
+        let kinds: Vec<_> = v
+            .failsafes
+            .iter()
+            .map(|f| (f.kind, f.unit, f.action.clone()))
+            .collect();
+        assert_eq!(
+            kinds,
+            vec![
+                (
+                    FailsafeKind::Low,
+                    FailsafeUnit::MilliampHour,
+                    FailsafeAction::WarnOnly
+                ),
+                (
+                    FailsafeKind::Critical,
+                    FailsafeUnit::MilliampHour,
+                    FailsafeAction::Acts {
+                        param: "BATT_FS_CRT_ACT",
+                        value: 1
+                    }
+                ),
+            ]
+        );
+        let t = run(&mut v.monitor(), 1.0, &[(2500.0, 11.0, 7.0)]);
+        assert!(t[0].is_some_and(|t| (t - 2058.0).abs() < 1e-6), "{t:?}");
+        assert!(t[1].is_some_and(|t| (t - 2315.0).abs() < 1e-6), "{t:?}");
+    }
+
+    /// PX4's levels through the monitor: a 3S pack whose loaded voltage falls linearly (no
+    /// current: no load correction) crosses 0.15, 0.07 and 0.05 of the voltage range; each
+    /// fires once, 1 s (the voltage filter's lag) after the voltage itself crosses.
+    #[test]
+    fn px4_levels_fire_in_order_once() {
+        let params = map(&[
+            ("BAT1_N_CELLS", 3.0),
+            ("BAT1_V_EMPTY", 3.5),
+            ("BAT1_V_CHARGED", 4.2),
+            ("COM_LOW_BAT_ACT", 3.0),
+        ]);
+        let v = VehicleFailsafes::from_parameters(&params, Some(3), &[]).unwrap();
+        let sources: Vec<_> = v.failsafes.iter().map(|f| f.source.as_str()).collect();
+        assert_eq!(sources, ["BAT_LOW_THR", "BAT_CRIT_THR", "BAT_EMERGEN_THR"]);
+        assert_eq!(v.failsafes[0].action, FailsafeAction::WarnOnly);
+        let mut m = v.monitor();
+        // soc(t) = 0.5 − 0.001 t: 0.15 at 350 s, 0.07 at 430 s, 0.05 at 450 s.
+        let dt = 0.01;
+        let mut fired = [None; 3];
+        for k in 0..50_000 {
+            let t = k as f64 * dt;
+            let soc = 0.5 - 0.001 * t;
+            let volts = 3.0 * (3.5 + 0.7 * soc);
+            for i in m
+                .step(if k == 0 { 0.0 } else { dt }, volts, Some(0.0), None)
+                .indexes()
+            {
+                assert!(fired[i].is_none());
+                fired[i] = Some(t);
+            }
+        }
+        for (i, at) in [351.0, 431.0, 451.0].into_iter().enumerate() {
+            let t = fired[i].unwrap();
+            assert!((t - at).abs() < 0.02, "{i}: {t} vs {at}");
+        }
+    }
+
+    /// A `--low-voltage-v` threshold of 11 V on the voltage averaged over 5 s: a dip from 12 V
+    /// to 10 V for 2 s averages 11.2 V and does not trigger; one of 3 s averages 10.8 V at its
+    /// end and does (the average falls below 11 V at 2.5 s into the dip). It replaces
+    /// `BATT_LOW_VOLT`; `BATT_CRT_VOLT` stays.
+    #[test]
+    fn generic_threshold_on_the_5_s_average() {
+        let flag = VoltageThreshold {
+            kind: FailsafeKind::Low,
+            voltage_v: 11.0,
+            source: "--low-voltage-v".into(),
+        };
+        let params = map(&[("BATT_LOW_VOLT", 10.5), ("BATT_CRT_VOLT", 9.0)]);
+        let v =
+            VehicleFailsafes::from_parameters(&params, None, std::slice::from_ref(&flag)).unwrap();
+        let sources: Vec<_> = v.failsafes.iter().map(|f| f.source.as_str()).collect();
+        assert_eq!(sources, ["--low-voltage-v", "BATT_CRT_VOLT"]);
+        let only = VehicleFailsafes::from_parameters(&BTreeMap::new(), None, &[flag]).unwrap();
+        let t = run(
+            &mut only.monitor(),
+            0.1,
+            &[(10.0, 12.0, 10.0), (2.0, 10.0, 10.0), (10.0, 12.0, 10.0)],
+        );
+        assert_eq!(t, vec![None]);
+        let t = run(
+            &mut only.monitor(),
+            0.1,
+            &[(10.0, 12.0, 10.0), (3.0, 10.0, 10.0), (10.0, 12.0, 10.0)],
+        );
+        // The dip's samples start at 10.0 s (held from there); 10 V over 2.5 of 5 s is 11 V.
+        assert!(t[0].is_some_and(|t| t > 12.4 && t < 12.7), "{t:?}");
+    }
+
+    #[test]
+    fn bad_thresholds_are_named() {
+        for (entries, name) in [
+            (vec![("BATT_LOW_VOLT", f64::NAN)], "BATT_LOW_VOLT"),
+            (vec![("BATT_LOW_MAH", -10.0)], "BATT_LOW_MAH"),
+            (vec![("BATT_FS_VOLTSRC", 2.0)], "BATT_FS_VOLTSRC"),
+            (
+                vec![("BATT_LOW_MAH", 500.0), ("BATT_CAPACITY", 0.0)],
+                "BATT_CAPACITY",
+            ),
+            (
+                vec![("BAT1_N_CELLS", 3.0), ("BAT1_CAPACITY", -2.0)],
+                "BAT1_CAPACITY",
+            ),
+        ] {
+            let err = VehicleFailsafes::from_parameters(&map(&entries), None, &[]).unwrap_err();
+            assert!(err.to_string().contains(name), "{err}");
+        }
+        let flag = VoltageThreshold {
+            kind: FailsafeKind::Critical,
+            voltage_v: -1.0,
+            source: "--critical-voltage-v".into(),
+        };
+        let err = VehicleFailsafes::from_parameters(&BTreeMap::new(), None, &[flag]).unwrap_err();
+        assert!(err.to_string().contains("--critical-voltage-v"), "{err}");
+    }
+
+    /// A clone at "now" steps on from the same timers: the original's trigger time is the
+    /// clone's.
+    #[test]
+    fn a_clone_carries_the_timers() {
+        let v =
+            VehicleFailsafes::from_parameters(&map(&[("BATT_LOW_VOLT", 10.5)]), None, &[]).unwrap();
+        let mut m = v.monitor();
+        let t = run(&mut m, 0.1, &[(6.0, 10.0, 10.0)]);
+        assert_eq!(t, vec![None]);
+        let mut copy = m.clone();
+        let mut fired_after_s = None;
+        for k in 1..=100 {
+            if !copy.step(0.1, 10.0, Some(10.0), None).is_empty() {
+                fired_after_s = Some(k as f64 * 0.1);
+                break;
+            }
+        }
+        // Below since 0 s, 5.9 s stepped: fires 10 s after the start, 4.1-4.2 s on.
+        assert!(
+            fired_after_s.is_some_and(|s| s > 4.05 && s < 4.25),
+            "{fired_after_s:?}"
+        );
+        assert!(!m.has_triggered(0));
+    }
+}
