@@ -92,4 +92,27 @@ pub enum PackError {
         /// What it should be.
         expected: &'static str,
     },
+    /// An autopilot parameter (or a threshold given for one) that is not a number, or lies
+    /// outside what the autopilot accepts.
+    #[error("parameter {name} = {value} is invalid: expected {expected}")]
+    InvalidParameter {
+        /// The parameter (`BAT1_CAPACITY`, `BATT_LOW_VOLT`) or the flag (`--low-voltage-v`).
+        name: String,
+        /// Its value, in the parameter's own unit.
+        value: f64,
+        /// What it may be, in words with the unit.
+        expected: &'static str,
+    },
+    /// The empty cell voltage is not below the full one, so no voltage reads as a state of charge.
+    #[error("parameter {empty_name} = {empty_v} V is not below {charged_name} = {charged_v} V: the empty cell voltage must be below the full one")]
+    EmptyNotBelowCharged {
+        /// The empty voltage's parameter (`BAT1_V_EMPTY`).
+        empty_name: String,
+        /// Its value, V a cell.
+        empty_v: f64,
+        /// The full voltage's parameter (`BAT1_V_CHARGED`).
+        charged_name: String,
+        /// Its value, V a cell.
+        charged_v: f64,
+    },
 }

@@ -18,6 +18,8 @@ pub mod balance;
 pub mod capacity;
 pub mod combine;
 pub mod error;
+pub mod failsafes;
+pub mod px4;
 pub mod resistance;
 pub mod soc_filter;
 
@@ -28,6 +30,11 @@ pub use capacity::{
 };
 pub use combine::{combine_flights, median_finite, FlightsCombined};
 pub use error::PackError;
+pub use failsafes::{
+    ArduPilotResistance, Failsafe, FailsafeAction, FailsafeKind, FailsafeMonitor, FailsafeUnit,
+    Judged, Triggered, VehicleFailsafes, VoltageThreshold, LOADED_AVERAGE_WINDOW_S,
+};
+pub use px4::{Px4Battery, Px4BatteryParams, Px4Estimate, Px4Resume, Px4Warning};
 pub use resistance::{resistance_from_steps, updates, ResistanceEstimate};
 pub use soc_filter::{Circuit, FilterTuning, ReportKind, SocEstimate, SocFilter};
 
