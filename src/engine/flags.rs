@@ -967,6 +967,13 @@ pub struct LiveFlags {
     /// else 20).
     #[arg(value_parser = finite(), long, value_name = "PERCENT")]
     pub reserve_percent: Option<f64>,
+    /// The autopilot's low-voltage failsafe, pack volts, judged on the voltage under load
+    /// averaged over 5 s (in place of the vehicle's own BATT_LOW_VOLT).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub low_voltage_v: Option<f64>,
+    /// The autopilot's critical-voltage failsafe, pack volts (in place of BATT_CRT_VOLT).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub critical_voltage_v: Option<f64>,
     /// Monte-Carlo scenarios of the route ahead per update.
     #[arg(long, default_value_t = super::LIVE_SCENARIOS, value_parser = clap::value_parser!(u32).range(1..=10_000), value_name = "N")]
     pub scenarios: u32,
@@ -1059,6 +1066,19 @@ impl LiveFlags {
                 expected: "a positive number of seconds, at most 1e9",
             });
         }
+        for (name, v) in [
+            ("low-voltage-v", self.low_voltage_v),
+            ("critical-voltage-v", self.critical_voltage_v),
+        ] {
+            if v.is_some_and(|v| !(v > 0.0 && v <= 1e4)) {
+                return Err(Error::InvalidInput {
+                    name,
+                    value: v.unwrap_or(f64::NAN),
+                    unit: "V",
+                    expected: "a positive pack voltage up to 10000 V",
+                });
+            }
+        }
         let source = match (&self.replay, &self.tlog, &self.connect) {
             (Some(path), _, _) => LiveSource::Replay {
                 logs: logs(path),
@@ -1091,6 +1111,8 @@ impl LiveFlags {
                 reserve_percent: self.reserve_percent,
                 speed_mps: None,
                 scenarios: self.scenarios,
+                low_voltage_v: self.low_voltage_v,
+                critical_voltage_v: self.critical_voltage_v,
                 air: self.air.input(),
             }),
         })

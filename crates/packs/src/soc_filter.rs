@@ -389,6 +389,26 @@ impl SocFilter {
         self.p[(S, S)].max(0.0).sqrt()
     }
 
+    /// The filter with its state of charge moved `z` standard deviations, and every other state
+    /// with it by its covariance (the conditional mean): one draw of the present state, for a
+    /// Monte-Carlo flight of the rest on it. A `z` that is not finite changes nothing.
+    pub fn drawn(&self, z: f64) -> Self {
+        let mut f = self.clone();
+        let sd = self.soc_sd();
+        if !(z.is_finite() && sd > 0.0) {
+            return f;
+        }
+        f.x += self.p.column(S) * (z / sd);
+        f.x[S] = f.x[S].clamp(0.0, 1.0);
+        f.keep_resistance_positive();
+        f
+    }
+
+    /// The state of charge the filter holds (its mean, not clamped).
+    pub fn soc(&self) -> f64 {
+        self.x[S]
+    }
+
     /// The series resistance the filter has learned, ohm.
     pub fn resistance_ohm(&self) -> f64 {
         self.x[R0]
@@ -713,6 +733,20 @@ mod tests {
         assert!(f.band().p5 < 0.6 && f.band().p95 > 0.6);
         // The circuit at rest gives the rested voltage back.
         assert!((f.terminal_v(0.0) - v).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_draw_moves_the_offset_with_the_charge() {
+        // Started from a rested voltage, the charge and the curve's offset are one uncertainty:
+        // a draw of the charge moves the offset so that the circuit still gives the rested
+        // voltage.
+        let c = circuit();
+        let v = c.ocv_v(0.6);
+        let f = SocFilter::from_rested_voltage(c, FilterTuning::default(), v).unwrap();
+        let d = f.drawn(1.5);
+        assert!((d.soc() - (0.6 + 1.5 * f.soc_sd())).abs() < 1e-12);
+        assert!((d.terminal_v(0.0) - v).abs() < 0.02, "{}", d.terminal_v(0.0));
+        assert_eq!(f.drawn(f64::NAN), f);
     }
 
     #[test]

@@ -24,11 +24,14 @@ use aloft_planner::{geodesy::LocalFrame, HomeSpec, MissionSpec, SegmentSpec, Win
 
 use super::advice::Shares;
 use super::estimate::Ratio;
+use super::failsafes::{LiveFailsafe, Watched};
 use super::tracker::{wind_from_deg, Tracker, WindSource};
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::MissionOptions;
 use crate::engine::uncertainty::scenario_stats::Percentiles;
-use crate::engine::uncertainty::scenarios::{plan_scenarios, ScenarioOptions, Uncertainty};
+use crate::engine::uncertainty::scenarios::{
+    plan_scenarios_watched, ScenarioOptions, ScenarioWatch, Uncertainty,
+};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 
@@ -65,8 +68,29 @@ pub(crate) struct AheadAnswer {
     /// The rest's point of no return (p5 of the scenarios), s from now: `None` where the route
     /// can turn back everywhere.
     pub point_of_no_return_s: Option<f64>,
-    /// The shares of the scenarios that land with the reserve, for the advice.
+    /// The shares of the scenarios that land with the reserve (and before an acting failsafe),
+    /// for the advice.
     pub shares: Shares,
+    /// The failsafes watched and when each triggers on the rest.
+    pub failsafes: Vec<LiveFailsafe>,
+    /// The least voltage under load on the rest, V.
+    pub least_voltage_v: Option<Percentiles>,
+}
+
+/// The pack's state and the failsafes watched, to fly the rest on.
+#[derive(Clone, Copy)]
+pub(crate) struct OnPack<'a> {
+    pub filter: &'a aloft_packs::SocFilter,
+    pub watched: &'a Watched,
+}
+
+/// What the scenarios of one route say: the planner's answer, and where the pack was followed,
+/// the share that holds (lands with the reserve before any acting failsafe) and each
+/// scenario's run.
+struct Flown {
+    u: Uncertainty,
+    holds: f64,
+    runs: Vec<Vec<f64>>,
 }
 
 /// The route ahead's inputs that do not change within a flight.
@@ -89,33 +113,47 @@ impl Ahead<'_> {
         &self,
         t: &Tracker,
         mission: Option<&Mission>,
-        soc: f64,
-        ratio: Ratio,
+        (soc, ratio): (f64, Ratio),
+        pack: Option<OnPack<'_>>,
     ) -> Result<Option<AheadAnswer>, Error> {
         let vehicle = self.vehicle_at(ratio)?;
         let Some((rest, is_return)) = rest_spec(t, mission) else {
             return Ok(None);
         };
-        let rest_u = self.fly(&vehicle, rest, t, soc, ratio)?;
-        let back = match Shares::needs_back(rest_u.p_feasible, t.in_air(), is_return) {
+        let rest = self.fly(&vehicle, rest, t, (soc, ratio), pack)?;
+        // A failsafe that acted already: the route no longer holds, a return is its answer
+        // (where the rest is not one already).
+        let acted = pack.is_some_and(|p| p.watched.acted()) && !is_return;
+        let rest_holds = if acted { 0.0 } else { rest.holds };
+        let back = match Shares::needs_back(rest_holds, t.in_air(), is_return) {
             true => {
-                let back = self.fly(&vehicle, return_spec(t, mission), t, soc, ratio)?;
-                Some(back.p_feasible)
+                let back_spec = return_spec(t, mission);
+                Some(self.fly(&vehicle, back_spec, t, (soc, ratio), pack)?.holds)
             }
             false => None,
         };
         let shares = Shares {
-            rest: rest_u.p_feasible,
+            rest: rest_holds,
             back,
             in_air: t.in_air(),
             rest_is_return: is_return,
         };
+        let failsafes = pack.map_or_else(Vec::new, |p| p.watched.answer(&rest.runs));
+        let mut least: Vec<f64> = rest
+            .runs
+            .iter()
+            .filter_map(|r| r.last().copied())
+            .filter(|v| v.is_finite())
+            .collect();
+        let u = rest.u;
         Ok(Some(AheadAnswer {
-            remaining_wh: rest_u.energy_wh,
-            landing_soc: rest_u.end_soc,
-            duration_s: rest_u.duration_s,
-            point_of_no_return_s: rest_u.point_of_no_return_s.p5,
+            remaining_wh: u.energy_wh,
+            landing_soc: u.end_soc,
+            duration_s: u.duration_s,
+            point_of_no_return_s: u.point_of_no_return_s.p5,
             shares,
+            failsafes,
+            least_voltage_v: Percentiles::of(&mut least),
         }))
     }
 
@@ -130,15 +168,15 @@ impl Ahead<'_> {
         }
     }
 
-    /// The scenarios of `spec` from the present state.
+    /// The scenarios of `spec` from the present state, on the pack where it is followed.
     fn fly(
         &self,
         vehicle: &Vehicle,
         spec: MissionSpec,
         t: &Tracker,
-        soc: f64,
-        ratio: Ratio,
-    ) -> Result<Uncertainty, Error> {
+        (soc, ratio): (f64, Ratio),
+        pack: Option<OnPack<'_>>,
+    ) -> Result<Flown, Error> {
         let mission = Mission::of_spec(spec, "ahead", SourceFormat::AloftToml);
         let (speed_sd, from_sd) = wind_sd(t.wind.map(|(_, source)| source));
         let wind = match t.wind {
@@ -164,7 +202,37 @@ impl Ahead<'_> {
             power_sd_percent: (100.0 * ratio.log_sd).clamp(0.0, 50.0),
             ..ScenarioOptions::default()
         };
-        plan_scenarios(vehicle, &mission, &options, &sc)
+        let watch = pack.map(|p| p.watched.ahead(p.filter, sc.seed));
+        let (u, seen) = plan_scenarios_watched(
+            vehicle,
+            &mission,
+            &options,
+            &sc,
+            watch.as_ref().map(|w| w as &dyn ScenarioWatch),
+        )?;
+        let Some(p) = pack else {
+            let holds = u.p_feasible;
+            return Ok(Flown {
+                u,
+                holds,
+                runs: Vec::new(),
+            });
+        };
+        // A scenario holds where it lands with the reserve before any failsafe that acts.
+        let acting = p.watched.acting();
+        let holding = seen
+            .iter()
+            .filter(|(feasible, run)| {
+                *feasible
+                    && !run
+                        .iter()
+                        .zip(&acting)
+                        .any(|(time_s, acts)| *acts && time_s.is_finite())
+            })
+            .count();
+        let holds = holding as f64 / seen.len().max(1) as f64;
+        let runs = seen.into_iter().map(|(_, r)| r).collect();
+        Ok(Flown { u, holds, runs })
     }
 }
 

@@ -1,7 +1,14 @@
 //! The autopilot's failsafes ahead of a flight followed live: for each one the vehicle watches,
 //! when it triggers on the rest of the route.
 
+use std::collections::BTreeMap;
+
+use aloft_packs::{
+    FailsafeAction, FailsafeMonitor, SocFilter, VehicleFailsafes, VoltageThreshold,
+};
 use serde::Serialize;
+
+use crate::engine::uncertainty::scenarios::{Draws, ScenarioWatch, WatchRun};
 
 /// When a failsafe triggers, s from now, over the scenarios of the route ahead: a percentile is
 /// left out where it falls on scenarios in which the failsafe does not trigger before the
@@ -38,4 +45,203 @@ pub struct LiveFailsafe {
     pub time_s: Option<TimeBand>,
     /// Whether it triggers before the route's landing (in at least 5 % of the scenarios).
     pub before_home: bool,
+}
+
+/// The failsafes a followed flight watches and their monitor, fed the measured samples so its
+/// filters and timers stand where the autopilot's stand now ([`aloft_packs::FailsafeMonitor`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Watched {
+    vehicle: VehicleFailsafes,
+    monitor: FailsafeMonitor,
+    /// The parameters it was built from (a change rebuilds it).
+    parameters: BTreeMap<String, f64>,
+    last_time_s: Option<f64>,
+}
+
+impl Watched {
+    /// The failsafes of `parameters` (the vehicle's, as heard), the pack's `cells` and the
+    /// flags' `thresholds`; `None` where there is none to watch or the parameters are not a
+    /// vehicle's (the reason, for the note).
+    pub(crate) fn new(
+        parameters: &BTreeMap<String, f64>,
+        cells: u32,
+        thresholds: &[VoltageThreshold],
+    ) -> Result<Option<Self>, String> {
+        let vehicle = VehicleFailsafes::from_parameters(parameters, Some(cells), thresholds)
+            .map_err(|e| format!("the vehicle's failsafes are not watched: {e}"))?;
+        if vehicle.failsafes.is_empty() {
+            return Ok(None);
+        }
+        Ok(Some(Self {
+            monitor: vehicle.monitor(),
+            vehicle,
+            parameters: parameters.clone(),
+            last_time_s: None,
+        }))
+    }
+
+    /// Whether it was built from `parameters`.
+    pub(crate) fn is_of(&self, parameters: &BTreeMap<String, f64>) -> bool {
+        &self.parameters == parameters
+    }
+
+    /// A measured sample at `time_s`: the pack's voltage (V), current (A) and the autopilot's
+    /// count of the charge drawn (mA h), where known.
+    pub(crate) fn sample(
+        &mut self,
+        time_s: f64,
+        voltage_v: f64,
+        current_a: Option<f64>,
+        drawn_mah: Option<f64>,
+    ) {
+        let dt_s = self.last_time_s.map_or(0.0, |t| (time_s - t).max(0.0));
+        self.last_time_s = Some(time_s);
+        self.monitor.step(dt_s, voltage_v, current_a, drawn_mah);
+    }
+
+    /// The failsafes that end the flight when they trigger (an action, or one not known: a
+    /// flag's), by index: a warning alone does not.
+    pub(crate) fn acting(&self) -> Vec<bool> {
+        self.vehicle
+            .failsafes
+            .iter()
+            .map(|f| f.action != FailsafeAction::WarnOnly)
+            .collect()
+    }
+
+    /// Whether a failsafe that acts has triggered already.
+    pub(crate) fn acted(&self) -> bool {
+        self.acting()
+            .iter()
+            .enumerate()
+            .any(|(i, acts)| *acts && self.monitor.has_triggered(i))
+    }
+
+    /// The watch of the route ahead's scenarios, from the pack's state `filter` (its draws
+    /// under `seed`).
+    pub(crate) fn ahead<'a>(&'a self, filter: &'a SocFilter, seed: u64) -> AheadWatch<'a> {
+        AheadWatch {
+            watched: self,
+            filter,
+            seed,
+        }
+    }
+
+    /// Each failsafe as the update says it, from the scenarios' runs (`runs`: each scenario's
+    /// first trigger time per failsafe, s from now, infinite where it does not trigger).
+    pub(crate) fn answer(&self, runs: &[Vec<f64>]) -> Vec<LiveFailsafe> {
+        let n = runs.len();
+        self.vehicle
+            .failsafes
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let (time_s, share) = if self.monitor.has_triggered(i) {
+                    let now = Some(0.0);
+                    let band = TimeBand {
+                        p5: now,
+                        p50: now,
+                        p95: now,
+                    };
+                    (Some(band), 1.0)
+                } else {
+                    let mut t: Vec<f64> = runs
+                        .iter()
+                        .map(|r| r.get(i).copied().unwrap_or(f64::INFINITY))
+                        .collect();
+                    t.sort_by(f64::total_cmp);
+                    let share = t.iter().filter(|x| x.is_finite()).count() as f64 / n.max(1) as f64;
+                    (time_band(&t), share)
+                };
+                LiveFailsafe {
+                    kind: f.kind.as_str(),
+                    source: f.source.clone(),
+                    threshold: f.threshold,
+                    unit: f.unit.as_str(),
+                    time_s,
+                    before_home: share >= BEFORE_HOME_SHARE,
+                }
+            })
+            .collect()
+    }
+}
+
+/// Share of the scenarios in which a failsafe must trigger before the landing for the update
+/// to say it comes before home (the band's p5).
+pub(crate) const BEFORE_HOME_SHARE: f64 = 0.05;
+
+/// The 5th, 50th and 95th percentiles (nearest rank) of sorted times, each left out where it
+/// falls on a scenario without a trigger; `None` where none triggers.
+fn time_band(sorted: &[f64]) -> Option<TimeBand> {
+    if sorted.first().is_none_or(|t| !t.is_finite()) {
+        return None;
+    }
+    let at = |p: f64| {
+        let k = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+        Some(sorted[k]).filter(|t| t.is_finite())
+    };
+    Some(TimeBand {
+        p5: at(0.05),
+        p50: at(0.5),
+        p95: at(0.95),
+    })
+}
+
+/// The route ahead's scenarios followed on the pack: each from a draw of the pack's state now,
+/// the filter's circuit giving the voltage under the planned current, the failsafes' monitor
+/// (as it stands now) judging it.
+pub(crate) struct AheadWatch<'a> {
+    watched: &'a Watched,
+    filter: &'a SocFilter,
+    seed: u64,
+}
+
+impl ScenarioWatch for AheadWatch<'_> {
+    fn start(&self, index: usize) -> (Option<f64>, Box<dyn WatchRun>) {
+        let z = Draws::of(self.seed, index).pack_state;
+        let filter = self.filter.drawn(z);
+        let n = self.watched.vehicle.failsafes.len();
+        let run = AheadRun {
+            soc0: filter.soc(),
+            filter,
+            monitor: self.watched.monitor.clone(),
+            last_time_s: 0.0,
+            first_s: vec![f64::INFINITY; n],
+            least_v: f64::INFINITY,
+        };
+        (Some(run.soc0.clamp(0.0, 1.0)), Box::new(run))
+    }
+}
+
+/// One scenario of the route ahead on the pack.
+struct AheadRun {
+    soc0: f64,
+    filter: SocFilter,
+    monitor: FailsafeMonitor,
+    last_time_s: f64,
+    first_s: Vec<f64>,
+    least_v: f64,
+}
+
+impl WatchRun for AheadRun {
+    fn take(&mut self, sample: &aloft_planner::Sample) {
+        let dt_s = (sample.time_s - self.last_time_s).max(0.0);
+        self.last_time_s = sample.time_s;
+        let i = sample.current_a;
+        self.filter.predict(dt_s, i);
+        let v = self.filter.terminal_v(i);
+        self.least_v = self.least_v.min(v);
+        for k in self.monitor.step(dt_s, v, Some(i), None).indexes() {
+            if let Some(t) = self.first_s.get_mut(k) {
+                *t = t.min(sample.time_s);
+            }
+        }
+    }
+
+    /// The first trigger time of each failsafe, then the least voltage under load.
+    fn finish(&mut self) -> Vec<f64> {
+        let mut out = self.first_s.clone();
+        out.push(self.least_v);
+        out
+    }
 }

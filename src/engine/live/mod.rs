@@ -50,6 +50,7 @@ use advice::AdviceHold;
 use ahead::{Ahead, AheadAnswer};
 use charge::{Charge, Drawn};
 use count::ChargeCount;
+use failsafes::Watched;
 use pack_state::{report_kind, PackState};
 use tracker::Tracker;
 
@@ -117,6 +118,10 @@ pub struct LiveUpdate {
     /// The failsafes the vehicle watches and when each triggers on the rest of the route.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub failsafes: Vec<LiveFailsafe>,
+    /// The least voltage under load on the rest of the route, V (the pack's circuit as the
+    /// filter holds it, under the planned current).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub least_voltage_v: Option<Percentiles>,
     /// What to do: `continue`, `return now` or `land now`; on the ground, `continue` or `do not
     /// take off`. A graver advice at once, a milder one once it has held
     /// ([`advice`](self::advice)).
@@ -184,6 +189,11 @@ pub struct LiveRequest {
     pub speed_mps: Option<f64>,
     /// Scenarios per update (default [`LIVE_SCENARIOS`]).
     pub scenarios: u32,
+    /// The autopilot's low-voltage failsafe, pack volts, judged on the voltage under load
+    /// averaged over 5 s (`--low-voltage-v`: in place of the vehicle's `BATT_LOW_VOLT`).
+    pub low_voltage_v: Option<f64>,
+    /// The critical-voltage failsafe, pack volts (`--critical-voltage-v`).
+    pub critical_voltage_v: Option<f64>,
     /// The day's air (default: the mission's home altitude in ISA air, else the vehicle file's
     /// density).
     pub air: AirInput,
@@ -200,6 +210,8 @@ impl LiveRequest {
             reserve_percent: None,
             speed_mps: None,
             scenarios: LIVE_SCENARIOS,
+            low_voltage_v: None,
+            critical_voltage_v: None,
             air: AirInput::default(),
         }
     }
@@ -355,6 +367,11 @@ pub struct LiveSession<'a> {
     count: ChargeCount,
     /// The state of charge's filter.
     pack_state: PackState,
+    /// The failsafes watched (from the vehicle's parameters and the flags), or why not; `None`
+    /// before they are built (at the start, after a restart).
+    watched: Option<Result<Option<Watched>, String>>,
+    /// The flags' voltage thresholds.
+    thresholds: Vec<aloft_packs::VoltageThreshold>,
     /// The advice given, for its hysteresis.
     advice: AdviceHold,
     eta0: f64,
@@ -368,6 +385,28 @@ pub struct LiveSession<'a> {
     on_ground: Option<(GroundKey, AheadAnswer)>,
     /// The rest's duration at the last update (p50), s: the horizon of the ratio's drift.
     rest_s: f64,
+}
+
+/// The flags' voltage failsafes, as the failsafes' monitor takes them.
+fn thresholds(request: &LiveRequest) -> Vec<aloft_packs::VoltageThreshold> {
+    use aloft_packs::{FailsafeKind, VoltageThreshold};
+    [
+        (FailsafeKind::Low, "--low-voltage-v", request.low_voltage_v),
+        (
+            FailsafeKind::Critical,
+            "--critical-voltage-v",
+            request.critical_voltage_v,
+        ),
+    ]
+    .into_iter()
+    .filter_map(|(kind, source, v)| {
+        v.map(|voltage_v| VoltageThreshold {
+            kind,
+            voltage_v,
+            source: source.to_string(),
+        })
+    })
+    .collect()
 }
 
 /// A disagreement between the vehicle's report and the estimate the note explains, state of
@@ -408,6 +447,8 @@ impl<'a> LiveSession<'a> {
             },
             count: ChargeCount::new(pack.capacity_ah()),
             pack_state: PackState::new(&pack),
+            watched: None,
+            thresholds: thresholds(request),
             charge: Charge::new(pack),
             advice: AdviceHold::default(),
             eta0,
@@ -484,6 +525,32 @@ impl<'a> LiveSession<'a> {
             c.in_air();
         }
         self.follow_pack(event, drawn);
+        self.follow_failsafes(event);
+    }
+
+    /// The failsafes watched: built from the vehicle's parameters as they arrive (and the
+    /// flags'), their monitor fed each measured sample.
+    fn follow_failsafes(&mut self, event: &aloft_logs::telemetry::Telemetry) {
+        use aloft_logs::telemetry::Event;
+        let t = &self.tracker;
+        if matches!(event.event, Event::Reboot) {
+            self.watched = None;
+        }
+        let stale = match &self.watched {
+            None => true,
+            Some(Ok(Some(w))) => !w.is_of(&t.parameters),
+            Some(_) => matches!(event.event, Event::Parameter { .. }),
+        };
+        if stale {
+            let cells = self.charge.pack().cells_series();
+            self.watched = Some(Watched::new(&t.parameters, cells, &self.thresholds));
+        }
+        if let (Event::Sample(s), Some(Ok(Some(w)))) = (&event.event, &mut self.watched) {
+            if let Some(v) = s.voltage_v.filter(|v| v.is_finite() && *v > 0.0) {
+                let drawn_mah = self.count.believed_ah().map(|a| 1000.0 * a);
+                w.sample(t.now_s, v, s.current_a, drawn_mah);
+            }
+        }
     }
 
     /// The filter of the state of charge ([`pack_state`](self::pack_state)): started from the
@@ -617,7 +684,13 @@ impl<'a> LiveSession<'a> {
                     }
                     (None, None) => None,
                 };
-                match self.ahead.answer(&self.tracker, mission, soc, ratio) {
+                let pack = match (self.pack_state.filter(), &self.watched) {
+                    (Some(filter), Some(Ok(Some(watched)))) => {
+                        Some(ahead::OnPack { filter, watched })
+                    }
+                    _ => None,
+                };
+                match self.ahead.answer(&self.tracker, mission, (soc, ratio), pack) {
                     Ok(a) => (a, None),
                     Err(e) => (None, Some(aloft_core::one_line(&e.to_string()))),
                 }
@@ -664,7 +737,8 @@ impl<'a> LiveSession<'a> {
             .and_then(|()| answer.as_ref()?.duration_s)
             .map(|d| t.air_measured_j / t.air_s * d.p50 / 3600.0);
         let wind = t.wind.map(|(w, _)| w);
-        let note = [note, self.charge.note(), self.disagreement_note()]
+        let watched_note = self.watched.as_ref().and_then(|w| w.as_ref().err().cloned());
+        let note = [note, self.charge.note(), self.disagreement_note(), watched_note]
             .into_iter()
             .flatten()
             .reduce(|a, b| format!("{a}; {b}"));
@@ -699,7 +773,10 @@ impl<'a> LiveSession<'a> {
             remaining_wh: answer.as_ref().and_then(|a| a.remaining_wh),
             landing_soc: answer.as_ref().and_then(|a| a.landing_soc),
             point_of_no_return_s,
-            failsafes: Vec::new(),
+            failsafes: answer
+                .as_ref()
+                .map_or_else(Vec::new, |a| a.failsafes.clone()),
+            least_voltage_v: answer.as_ref().and_then(|a| a.least_voltage_v),
             advice: answer
                 .as_ref()
                 .map(|a| self.advice.advise(now, &a.shares).as_str()),

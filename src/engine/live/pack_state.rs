@@ -180,7 +180,7 @@ impl PackState {
         let Some(filter) = self.filter.as_mut().filter(|_| self.took_off) else {
             return;
         };
-        let adds = (kind != ReportKind::Voltage || self.voltage_v.is_none());
+        let adds = kind != ReportKind::Voltage || self.voltage_v.is_none();
         if believed && adds && time_s - self.last_fused_s >= REPORT_INTERVAL_S {
             filter.report(soc, kind);
             self.last_fused_s = time_s;

@@ -422,6 +422,9 @@ pub(in crate::engine) struct Draws {
     pub(in crate::engine) capacity: f64,
     pub(in crate::engine) power: f64,
     pub(in crate::engine) gust_seed: u64,
+    /// The pack's state now (`aloft live`: its state of charge's draw), drawn last so that
+    /// the other draws are what they were before it.
+    pub(in crate::engine) pack_state: f64,
 }
 
 impl Draws {
@@ -435,6 +438,7 @@ impl Draws {
             capacity: s.normal(),
             power: s.normal(),
             gust_seed: s.next_u64(),
+            pack_state: s.normal(),
         }
     }
 }
@@ -601,6 +605,8 @@ struct Record {
     segment_end_soc: Vec<f64>,
     /// Why the vehicle cannot fly it, when it cannot.
     cannot_fly: Option<String>,
+    /// What a [`ScenarioWatch`] saw of it.
+    watched: Vec<f64>,
 }
 
 impl Record {
@@ -614,6 +620,7 @@ impl Record {
             pnr_s: 0.0,
             segment_end_soc: Vec::new(),
             cannot_fly: Some(e.to_string()),
+            watched: Vec::new(),
         }
     }
 
@@ -639,6 +646,7 @@ impl Record {
                 .as_ref()
                 .filter(|_| stuck)
                 .map(|why| reason(why, &r.segments, vehicle)),
+            watched: Vec::new(),
         }
     }
 }
@@ -711,13 +719,14 @@ impl<'a> MissionScenarios<'a> {
         Ok(planned.max(flown))
     }
 
-    /// Fly scenario `index`, its samples into `sink` (the state-of-charge fan) when given.
+    /// Fly scenario `index`, its samples into `sink` (the state-of-charge fan) when given, and
+    /// into `watch`'s run of it when given.
     fn fly(
         &self,
         sc: &ScenarioOptions,
         index: usize,
         keep_segments: bool,
-        fan: Option<&mut FanHistogram>,
+        (fan, watch): (Option<&mut FanHistogram>, Option<&dyn ScenarioWatch>),
     ) -> Result<Record, Error> {
         let d = Draws::of(sc.seed, index);
         let (aircraft, pack) = scaled_models(self.aircraft, &self.pack, sc, &d)?;
@@ -727,29 +736,89 @@ impl<'a> MissionScenarios<'a> {
         } else {
             self.payload_kg
         };
+        let (start_soc, mut run) = match watch {
+            Some(w) => {
+                let (s, r) = w.start(index);
+                (s, Some(r))
+            }
+            None => (None, None),
+        };
+        let mut options = self.options;
+        if let Some(s) = start_soc {
+            options.start_soc = s;
+        }
         let flight = Flight {
             aircraft: &aircraft,
             pack: &pack,
             wind: &wind,
-            options: self.options,
+            options,
             meter: None,
         };
-        let report = flight
-            .compile(&self.spec, payload_kg)
-            .and_then(|c| match fan {
-                Some(h) => {
-                    let mut sink = FanSink::new(h);
-                    let r = flight.fly_into(&c, &mut sink);
-                    sink.finish();
-                    r
+        let report = match flight.compile(&self.spec, payload_kg) {
+            Ok(c) => {
+                let mut sink = Sinks {
+                    fan: fan.map(FanSink::new),
+                    watch: run.as_deref_mut(),
+                };
+                let r = match sink.wants() {
+                    true => flight.fly_into(&c, &mut sink),
+                    false => flight.fly_into(&c, &mut NoSamples),
+                };
+                if let Some(f) = sink.fan {
+                    f.finish();
                 }
-                None => flight.fly_into(&c, &mut NoSamples),
-            });
+                r
+            }
+            Err(e) => Err(e),
+        };
+        let watched = run.map_or_else(Vec::new, |mut r| r.finish());
         match report {
-            Ok(r) => Ok(Record::of(&r, keep_segments, self.vehicle)),
+            Ok(r) => Ok(Record {
+                watched,
+                ..Record::of(&r, keep_segments, self.vehicle)
+            }),
             Err(e) if cannot_fly(&e) => Ok(Record::cannot_fly(&e)),
             Err(e) => Err(mission_error(self.origin, self.vehicle, e)),
         }
+    }
+}
+
+/// Something that follows each scenario's flight sample by sample, beside what every scenario
+/// gives (`aloft live`: the autopilot's failsafes on the pack flown).
+pub(in crate::engine) trait ScenarioWatch: Sync {
+    /// The state of charge scenario `index` starts from (`None`: the options'), and its run.
+    fn start(&self, index: usize) -> (Option<f64>, Box<dyn WatchRun>);
+}
+
+/// A [`ScenarioWatch`]'s run of one scenario.
+pub(in crate::engine) trait WatchRun: Send {
+    /// The next sample of the flight.
+    fn take(&mut self, sample: &aloft_planner::Sample);
+    /// What it saw, once the flight is over.
+    fn finish(&mut self) -> Vec<f64>;
+}
+
+/// The state-of-charge fan's sink and a watch's run, either or both.
+struct Sinks<'h, 'w> {
+    fan: Option<FanSink<'h>>,
+    watch: Option<&'w mut (dyn WatchRun + 'static)>,
+}
+
+impl Sinks<'_, '_> {
+    fn wants(&self) -> bool {
+        self.fan.is_some() || self.watch.is_some()
+    }
+}
+
+impl aloft_planner::SampleSink for Sinks<'_, '_> {
+    fn take(&mut self, sample: &aloft_planner::Sample) -> Result<(), PlannerError> {
+        if let Some(f) = self.fan.as_mut() {
+            f.take(sample)?;
+        }
+        if let Some(w) = self.watch.as_mut() {
+            w.take(sample);
+        }
+        Ok(())
     }
 }
 
@@ -778,6 +847,22 @@ pub fn plan_scenarios(
     options: &MissionOptions,
     sc: &ScenarioOptions,
 ) -> Result<Uncertainty, Error> {
+    Ok(plan_scenarios_watched(vehicle, mission, options, sc, None)?.0)
+}
+
+/// [`plan_scenarios`], each scenario followed by `watch` where given: whether each scenario
+/// landed with the reserve and what the watch saw of it, in index order, beside the answer
+/// (nothing seen of a scenario the vehicle cannot fly).
+///
+/// # Errors
+/// As [`plan_scenarios`].
+pub(in crate::engine) fn plan_scenarios_watched(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    sc: &ScenarioOptions,
+    watch: Option<&dyn ScenarioWatch>,
+) -> Result<(Uncertainty, Vec<(bool, Vec<f64>)>), Error> {
     sc.check()?;
     let (vehicle, _air) =
         crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;
@@ -799,7 +884,7 @@ pub fn plan_scenarios(
         n,
         (sc.thread_count(n), &sc.bounds),
         || fan_grid.map(FanHistogram::new),
-        |i, fan| setup.fly(sc, i, keep_segments, fan.as_mut()),
+        |i, fan| setup.fly(sc, i, keep_segments, (fan.as_mut(), watch)),
     )?;
     let soc_fan = fans
         .into_iter()
@@ -807,13 +892,17 @@ pub fn plan_scenarios(
         .reduce(FanHistogram::merge)
         .and_then(|h| h.bands());
     let u = summarise(sc, &records, soc_fan);
-    finite(u, "uncertainty", || {
+    let u = finite(u, "uncertainty", || {
         format!(
             "scenarios of mission {} with {}",
             mission.origin(),
             vehicle.name()
         )
-    })
+    })?;
+    Ok((
+        u,
+        records.into_iter().map(|r| (r.feasible, r.watched)).collect(),
+    ))
 }
 
 /// The answer from the records of every scenario, in index order.
