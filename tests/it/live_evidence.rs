@@ -12,14 +12,18 @@
 //!   the advice follows the evidence back to `continue`, within the hold time the docs state.
 //! - The advice does not flap with a report that alternates across the line between two
 //!   advices: it turns at once to the graver one and back only after the milder one has held.
+//!
+//! The pack's voltage is the pack's own (issue 44): its open-circuit voltage on the generic LiPo
+//! curve at the pack's true state of charge, less `I R` (the TB47D's 0.048 ohm), so that the
+//! state of charge, now aloft's estimate from the current, the voltage and the reports, has
+//! one pack to follow.
 
 use aloft::engine::{LiveRequest, LiveSession, LiveUpdate, Vehicle};
 use aloft_logs::sample::{Attitude, Sample};
 use aloft_logs::telemetry::{BatteryState, Event, Heartbeat, Telemetry};
 
-/// The hover's current, A, and voltage, V.
+/// The hover's current, A.
 const CURRENT_A: f64 = 12.0;
-const VOLTAGE_V: f64 = 22.8;
 
 /// The TB47D's capacity, A h, and rated energy, W h (`fixtures/vehicles/dji-m100.toml`).
 const CAPACITY_AH: f64 = 4.5;
@@ -41,9 +45,28 @@ const INT32_MAX_AH: f64 = 2_147_483.647;
 /// `None` for nothing.
 type BatteryAt = dyn Fn(u32) -> (Option<f64>, Option<f64>);
 
+/// The TB47D's resistance, ohm (`fixtures/vehicles/dji-m100.toml`), and cells.
+const RESISTANCE_OHM: f64 = 0.048;
+const CELLS: u32 = 6;
+
+/// The pack's voltage under the hover's current at state of charge `soc`, V.
+fn loaded_v(soc: f64) -> f64 {
+    aloft_propulsion::OcvCurve::typical_lipo().pack_v(soc, CELLS) - CURRENT_A * RESISTANCE_OHM
+}
+
 /// A session over `seconds` of the hover, an update every second after the battery's message;
-/// `reserve_percent` the reserve asked (default 20).
+/// `reserve_percent` the reserve asked (default 20); the pack at `from` (0-1) at 0 s.
 fn fly(seconds: u32, reserve_percent: Option<f64>, battery: &BatteryAt) -> Vec<LiveUpdate> {
+    fly_pack(seconds, reserve_percent, 0.70, battery)
+}
+
+/// [`fly`] with the pack at `from` at 0 s.
+fn fly_pack(
+    seconds: u32,
+    reserve_percent: Option<f64>,
+    from: f64,
+    battery: &BatteryAt,
+) -> Vec<LiveUpdate> {
     let vehicle = Vehicle::builtin("dji-m100").expect("built-in vehicle");
     let request = LiveRequest {
         scenarios: 20,
@@ -75,7 +98,7 @@ fn fly(seconds: u32, reserve_percent: Option<f64>, battery: &BatteryAt) -> Vec<L
             session.apply(&at(t, Event::Sample(motion)));
             let power = Sample {
                 time_s: t,
-                voltage_v: Some(VOLTAGE_V),
+                voltage_v: Some(loaded_v(from - drawn_ah(t) / CAPACITY_AH)),
                 current_a: Some(CURRENT_A),
                 ..Sample::default()
             };
@@ -119,14 +142,17 @@ fn notes(updates: &[LiveUpdate], word: &str) -> Vec<(f64, String)> {
         .collect()
 }
 
-/// Every update in the air says `continue` and follows the reports within 1.5 % (MAVLink's whole
-/// percent, and up to a second of drawing between the report and the update).
+/// Every update in the air says `continue`, and from 3 s on (the first report at 0.8 s, the
+/// stream starting in the air without a rested voltage) the state of charge follows the pack
+/// within 2 % (MAVLink's whole percent, the filter's pull between the report and the voltage).
 fn follows_the_reports(updates: &[LiveUpdate], from: f64) {
     for u in updates {
         assert!(u.in_air, "{u:?}");
         assert_eq!(u.advice, Some("continue"), "{u:?}");
         let want = from - drawn_ah(u.time_s) / CAPACITY_AH;
-        assert!((soc(u) - want).abs() < 0.015, "{} vs {want}: {u:?}", soc(u));
+        if u.time_s >= 3.0 {
+            assert!((soc(u) - want).abs() < 0.02, "{} vs {want}: {u:?}", soc(u));
+        }
     }
 }
 
@@ -189,42 +215,38 @@ fn a_negative_charge_count_is_not_believed() {
     said_once(&updates, "negative");
 }
 
-/// Without reports, the count is the evidence until it jumps (at 20 s, by 1 A h in a second
-/// at 12 A, which draws 3.3 mA h a second); from then on the charge drawn is the energy used
-/// over the pack's rated energy, from the start (a full pack at the autopilot's boot, the count
-/// at 0). Before: 1 A h taken off at once (22 % of the pack).
+/// Without reports, a count that jumps (at 20 s, by 1 A h in a second at 12 A, which draws
+/// 3.3 mA h a second) is not believed (said once), and the state of charge follows the pack
+/// (a full pack at the start: the current counted, the voltage through the pack's circuit)
+/// within 3 % throughout (this pack has no RC pair, the filter's default one is learned away
+/// over the flight). Before: 1 A h taken off at once (22 % of the pack).
 #[test]
-fn without_reports_a_jumping_count_gives_way_to_the_energy_used() {
-    let updates = fly(40, None, &|s| {
+fn without_reports_a_jumping_count_is_not_taken_off_the_pack() {
+    let updates = fly_pack(40, None, 1.0, &|s| {
         let t = f64::from(s) + 0.8;
         let count = drawn_ah(t) + if s < 20 { 0.0 } else { 1.0 };
         (None, Some((count * 1000.0).round() / 1000.0))
     });
     for u in &updates {
-        let t = u.time_s;
-        let want = match t < 20.5 {
-            // The count believed: full at boot less the count (to a mA h).
-            true => 1.0 - drawn_ah(t) / CAPACITY_AH,
-            // The energy measured since the first power sample (at 0 s).
-            false => 1.0 - VOLTAGE_V * CURRENT_A * t / 3600.0 / RATED_WH,
-        };
+        let want = 1.0 - drawn_ah(u.time_s) / CAPACITY_AH;
         assert!(
-            (soc(u) - want).abs() < 0.002,
-            "at {t} s: {} vs {want}",
+            (soc(u) - want).abs() < 0.03,
+            "at {} s: {} vs {want}",
+            u.time_s,
             soc(u)
         );
     }
     said_once(&updates, "rose from");
 }
 
-/// 20 s of a reported 0 % (from 10 s to 30 s) between reports of a pack drawn from 90 %: the
-/// 0 % is believed once it has lasted (a fall that lasts is a new estimate), and the advice
-/// turns to `land now`; when the reports come back to the pack's track, so does the state of
-/// charge at once, and the advice returns to `continue` within the hold time. Before: `land
-/// now` to the end of the flight.
+/// 20 s of a reported 0 % (from 10 s to 30 s) between reports of a pack drawn from 90 %, its
+/// voltage the pack's: the report is not the pack's state (its voltage under load says 80-90 %
+/// through the circuit), so the state of charge stays with the pack within 5 %, the advice is
+/// `continue` throughout, and the note says the report and the estimate disagree. Before
+/// issue 41: `land now` to the end of the flight; before issue 44: `land now` for the 20 s.
 #[test]
-fn the_advice_follows_a_report_that_returns_after_20_s_at_zero() {
-    let updates = fly(60, None, &|s| {
+fn a_report_of_zero_for_20_s_does_not_empty_the_pack() {
+    let updates = fly_pack(60, None, 0.90, &|s| {
         let t = f64::from(s) + 0.8;
         let soc = if (10..30).contains(&s) {
             0.0
@@ -233,56 +255,40 @@ fn the_advice_follows_a_report_that_returns_after_20_s_at_zero() {
         };
         (Some(soc), None)
     });
-    for u in &updates {
-        println!("{:5.1} s  {:.3}  {:?}", u.time_s, soc(u), u.advice);
-    }
-    assert!(
-        updates
-            .iter()
-            .any(|u| u.time_s < 30.0 && u.advice == Some("land now")),
-        "{updates:?}"
-    );
-    for u in updates.iter().filter(|u| u.time_s >= 30.0) {
+    for u in updates.iter().filter(|u| u.time_s >= 3.0) {
         let want = 0.90 - drawn_ah(u.time_s) / CAPACITY_AH;
-        assert!((soc(u) - want).abs() < 0.015, "{} vs {want}: {u:?}", soc(u));
-    }
-    for u in updates.iter().filter(|u| u.time_s >= 30.0 + HOLD_S + 1.0) {
+        assert!((soc(u) - want).abs() < 0.05, "{} vs {want}: {u:?}", soc(u));
         assert_eq!(u.advice, Some("continue"), "{u:?}");
     }
+    assert!(
+        !notes(&updates, "the vehicle reports 0 %").is_empty(),
+        "{updates:?}"
+    );
 }
 
 /// A report that alternates every second between a level where the reserve holds and one
-/// where it does not (34 % and 22 % with a 20 % reserve, within 15 % of each other: each is
-/// believed): `land now` at the first low report, and it holds while the reports alternate;
-/// `continue` only after the high level has held for the hold time. Each level alone gives its
-/// own advice (checked first), so the line lies between them.
+/// where it does not (34 % and 22 % with a 20 % reserve), the pack's voltage following each
+/// level as its own pack would: each level alone gives its own advice (checked first); the
+/// pack at 34 % with the report alternating from 10 s to 30 s: the advice does not flap (it
+/// changes at most twice: once to the graver, once back after the hold time).
 #[test]
 fn the_advice_does_not_flap_with_a_report_across_the_line() {
     let (high, low) = (0.34, 0.22);
-    let steady = |level: f64| fly(8, Some(20.0), &move |_| (Some(level), None));
+    let steady = |level: f64| fly_pack(8, Some(20.0), level, &move |_| (Some(level), None));
     assert!(steady(high).iter().all(|u| u.advice == Some("continue")));
-    assert!(steady(low).iter().all(|u| u.advice == Some("land now")));
-    // High to 10 s, alternating to 30 s, high again.
-    let updates = fly(50, Some(20.0), &move |s| {
+    assert!(steady(low)
+        .iter()
+        .filter(|u| u.time_s >= 3.0)
+        .all(|u| u.advice == Some("land now")));
+    let updates = fly_pack(50, Some(20.0), high, &move |s| {
         let level = match (10..30).contains(&s) && s % 2 == 0 {
             true => low,
             false => high,
         };
         (Some(level), None)
     });
-    let advice = |from: f64, to: f64| {
-        updates
-            .iter()
-            .filter(move |u| (from..to).contains(&u.time_s))
-            .map(|u| u.advice.expect("advice"))
-            .collect::<Vec<_>>()
-    };
-    assert!(advice(0.0, 10.0).iter().all(|a| *a == "continue"));
-    let alternating = advice(10.0, 30.0);
-    assert!(
-        alternating.iter().all(|a| *a == "land now"),
-        "{alternating:?}"
-    );
-    let after = advice(30.0 + HOLD_S + 1.0, 51.0);
-    assert!(after.iter().all(|a| *a == "continue"), "{after:?}");
+    let advice: Vec<&str> = updates.iter().map(|u| u.advice.expect("advice")).collect();
+    let changes = advice.windows(2).filter(|w| w[0] != w[1]).count();
+    assert!(changes <= 2, "{advice:?}");
+    assert_eq!(advice.last(), Some(&"continue"), "{advice:?}");
 }

@@ -264,6 +264,14 @@ pub struct SocFilter {
     since_voltage_s: f64,
 }
 
+/// A report further from the estimate than this many standard deviations of their difference
+/// is not taken (innovation gating: a glitch, or another pack's estimate).
+pub const REPORT_GATE_SD: f64 = 4.0;
+
+/// A voltage further from the circuit's than this many standard deviations is not taken (a
+/// damaged record: a KAIST flight logs one 90 V sample on a 49 V pack).
+pub const VOLTAGE_GATE_SD: f64 = 6.0;
+
 /// Relinearisations of a voltage update (the iterated extended Kalman filter).
 const VOLTAGE_ITERATIONS: usize = 3;
 
@@ -476,6 +484,14 @@ impl SocFilter {
         let sd = self.tuning.voltage_sd_cell_v * f64::from(self.circuit.cells_series);
         let r = sd * sd;
         let x0 = self.x;
+        {
+            let s = x0[S].clamp(0.0, 1.0);
+            let h = Row::from_row_slice(&[self.circuit.ocv_slope_v(s), -1.0, -current_a, 1.0, 0.0]);
+            let y = voltage_v - self.terminal_v(current_a);
+            if y * y > VOLTAGE_GATE_SD.powi(2) * ((h * self.p * h.transpose())[(0, 0)] + r) {
+                return;
+            }
+        }
         let mut xi = x0;
         let mut gain = None;
         for _ in 0..VOLTAGE_ITERATIONS {
@@ -502,13 +518,21 @@ impl SocFilter {
         }
     }
 
-    /// A state of charge `soc` (0-1) another estimator reports, believed as `kind` says.
-    pub fn report(&mut self, soc: f64, kind: ReportKind) {
+    /// A state of charge `soc` (0-1) another estimator reports, believed as `kind` says; not
+    /// taken (`false`) where it lies more than [`REPORT_GATE_SD`] standard deviations of the
+    /// difference from the estimate, or is not a state of charge.
+    pub fn report(&mut self, soc: f64, kind: ReportKind) -> bool {
         if !(soc.is_finite() && (0.0..=1.0).contains(&soc)) {
-            return;
+            return false;
+        }
+        let r = kind.sd().powi(2);
+        let y = soc - self.x[S];
+        if y * y > REPORT_GATE_SD.powi(2) * (self.p[(S, S)] + r) {
+            return false;
         }
         let h = Row::from_row_slice(&[1.0, 0.0, 0.0, 0.0, 0.0]);
-        self.measure(h, soc - self.x[S], kind.sd().powi(2));
+        self.measure(h, y, r);
+        true
     }
 
     /// The Kalman update for a scalar measurement with Jacobian `h`, innovation `y` and
@@ -530,7 +554,10 @@ impl SocFilter {
         }
     }
 
+    /// The state within its physical range: the charge within 0-1 (the curve ends there), the
+    /// resistances not negative.
     fn keep_resistance_positive(&mut self) {
+        self.x[S] = self.x[S].clamp(0.0, 1.0);
         self.x[R0] = self.x[R0].max(0.0);
         self.x[R1] = self.x[R1].max(0.0);
     }
@@ -745,7 +772,11 @@ mod tests {
         let f = SocFilter::from_rested_voltage(c, FilterTuning::default(), v).unwrap();
         let d = f.drawn(1.5);
         assert!((d.soc() - (0.6 + 1.5 * f.soc_sd())).abs() < 1e-12);
-        assert!((d.terminal_v(0.0) - v).abs() < 0.02, "{}", d.terminal_v(0.0));
+        assert!(
+            (d.terminal_v(0.0) - v).abs() < 0.02,
+            "{}",
+            d.terminal_v(0.0)
+        );
         assert_eq!(f.drawn(f64::NAN), f);
     }
 
@@ -765,7 +796,13 @@ mod tests {
         let before = f.clone();
         f.predict(f64::NAN, 10.0);
         f.voltage(f64::INFINITY, 1.0);
-        f.report(f64::NAN, ReportKind::Gauge);
+        assert!(!f.report(f64::NAN, ReportKind::Gauge));
         assert_eq!(f, before);
+        // A report 40 points off a filter sure within 2 points is not taken; one 5 points off is.
+        let mut f = SocFilter::new(circuit(), FilterTuning::default(), 0.8, 0.02).unwrap();
+        assert!(!f.report(0.4, ReportKind::Counted));
+        assert_eq!(f.band().soc, 0.8);
+        assert!(f.report(0.75, ReportKind::Counted));
+        assert!(f.band().soc < 0.8);
     }
 }

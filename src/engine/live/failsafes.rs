@@ -3,9 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use aloft_packs::{
-    FailsafeAction, FailsafeMonitor, SocFilter, VehicleFailsafes, VoltageThreshold,
-};
+use aloft_packs::{FailsafeAction, FailsafeMonitor, SocFilter, VehicleFailsafes, VoltageThreshold};
 use serde::Serialize;
 
 use crate::engine::uncertainty::scenarios::{Draws, ScenarioWatch, WatchRun};

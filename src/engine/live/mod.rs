@@ -561,8 +561,20 @@ impl<'a> LiveSession<'a> {
         let kind = report_kind(&t.parameters);
         let p = &mut self.pack_state;
         if !p.running() {
-            p.start_from(self.charge.start(drawn), kind);
-            if t.in_air() {
+            // In the air already (a stream that starts there): the sample's voltage under load
+            // where nothing better is known.
+            let loaded = match &event.event {
+                Event::Sample(s) if t.in_air() => s.voltage_v.zip(s.current_a),
+                _ => None,
+            };
+            let start = self.charge.start(drawn);
+            p.start_from(start, kind, loaded);
+            // In the air from a full pack assumed, wait a little for a voltage or a report
+            // (a stream's first samples may carry only the motion).
+            let waits = start == pack_state::Start::Full
+                && loaded.is_none()
+                && t.air_s < pack_state::START_WAIT_S;
+            if t.in_air() && !waits {
                 p.in_air();
             }
         }
@@ -690,7 +702,10 @@ impl<'a> LiveSession<'a> {
                     }
                     _ => None,
                 };
-                match self.ahead.answer(&self.tracker, mission, (soc, ratio), pack) {
+                match self
+                    .ahead
+                    .answer(&self.tracker, mission, (soc, ratio), pack)
+                {
                     Ok(a) => (a, None),
                     Err(e) => (None, Some(aloft_core::one_line(&e.to_string()))),
                 }
@@ -737,11 +752,19 @@ impl<'a> LiveSession<'a> {
             .and_then(|()| answer.as_ref()?.duration_s)
             .map(|d| t.air_measured_j / t.air_s * d.p50 / 3600.0);
         let wind = t.wind.map(|(w, _)| w);
-        let watched_note = self.watched.as_ref().and_then(|w| w.as_ref().err().cloned());
-        let note = [note, self.charge.note(), self.disagreement_note(), watched_note]
-            .into_iter()
-            .flatten()
-            .reduce(|a, b| format!("{a}; {b}"));
+        let watched_note = self
+            .watched
+            .as_ref()
+            .and_then(|w| w.as_ref().err().cloned());
+        let note = [
+            note,
+            self.charge.note(),
+            self.disagreement_note(),
+            watched_note,
+        ]
+        .into_iter()
+        .flatten()
+        .reduce(|a, b| format!("{a}; {b}"));
         // Nothing from the pack yet on the ground (no report, no rested voltage, no power
         // measured): the assumed full pack is not shown as the vehicle's state (the note says
         // what is assumed).

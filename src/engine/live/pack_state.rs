@@ -23,6 +23,10 @@ use aloft_planner::battery::Pack;
 /// air corrects it.
 pub(crate) const ASSUMED_FULL_SD: f64 = 0.3;
 
+/// How long a stream that starts in the air waits for a voltage or a report before it starts
+/// from a full pack, s of flight.
+pub(crate) const START_WAIT_S: f64 = 5.0;
+
 /// Least time between two of the vehicle's reports taken as measurements, s (a report at 5 Hz
 /// is one estimate repeated, not five).
 pub(crate) const REPORT_INTERVAL_S: f64 = 10.0;
@@ -40,7 +44,13 @@ pub(crate) enum Start {
     Reported(f64),
     /// Nothing: a full pack.
     Full,
+    /// The voltage under load of the first sample in the air.
+    Loaded,
 }
+
+/// The band of a start from the voltage under load in the air (a stream that starts in the
+/// air, nothing reported yet): the circuit's sag and the curve (one standard deviation).
+pub(crate) const LOADED_START_SD: f64 = 0.15;
 
 /// The filter and what it was last fed.
 #[derive(Debug, Clone)]
@@ -96,8 +106,31 @@ impl PackState {
     }
 
     /// Before take-off (and at the first sample of a stream that starts in the air): start the
-    /// filter from `start` where it changed.
-    pub(crate) fn start_from(&mut self, start: Start, kind: ReportKind) {
+    /// filter from `start` where it changed. In the air with nothing but a full pack to start
+    /// from, the voltage under load `loaded` (V, A) of the first sample is a better start: its
+    /// open-circuit voltage `V + I R` on the curve, within [`LOADED_START_SD`].
+    pub(crate) fn start_from(
+        &mut self,
+        start: Start,
+        kind: ReportKind,
+        loaded: Option<(f64, f64)>,
+    ) {
+        let start = match (start, loaded) {
+            (Start::Full, Some((v, i)))
+                if self.filter.is_none() || self.start == Some(Start::Full) =>
+            {
+                let ocv_v = v + i * self.circuit.resistance_ohm;
+                let cells = f64::from(self.circuit.cells_series);
+                let soc = self.circuit.ocv.soc_at(ocv_v / cells);
+                let tuning = FilterTuning::default();
+                if let Ok(f) = SocFilter::new(self.circuit.clone(), tuning, soc, LOADED_START_SD) {
+                    self.filter = Some(f);
+                    self.start = Some(Start::Loaded);
+                }
+                return;
+            }
+            _ => start,
+        };
         if self.took_off && self.filter.is_some() {
             return;
         }
@@ -109,7 +142,7 @@ impl PackState {
         let filter = match start {
             Start::Rested(v) => SocFilter::from_rested_voltage(c, tuning, v),
             Start::Reported(soc) => SocFilter::new(c, tuning, soc.clamp(0.0, 1.0), kind.sd()),
-            Start::Full => SocFilter::new(c, tuning, 1.0, ASSUMED_FULL_SD),
+            Start::Full | Start::Loaded => SocFilter::new(c, tuning, 1.0, ASSUMED_FULL_SD),
         };
         // The circuit is the vehicle file's pack, checked when it was read: a start it refuses
         // keeps the filter it had.
@@ -182,8 +215,9 @@ impl PackState {
         };
         let adds = kind != ReportKind::Voltage || self.voltage_v.is_none();
         if believed && adds && time_s - self.last_fused_s >= REPORT_INTERVAL_S {
-            filter.report(soc, kind);
-            self.last_fused_s = time_s;
+            if filter.report(soc, kind) {
+                self.last_fused_s = time_s;
+            }
         }
     }
 }

@@ -901,7 +901,10 @@ pub(in crate::engine) fn plan_scenarios_watched(
     })?;
     Ok((
         u,
-        records.into_iter().map(|r| (r.feasible, r.watched)).collect(),
+        records
+            .into_iter()
+            .map(|r| (r.feasible, r.watched))
+            .collect(),
     ))
 }
 
