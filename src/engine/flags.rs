@@ -976,6 +976,10 @@ pub struct LiveFlags {
     /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER).
     #[arg(long, default_value_t = 190, value_name = "ID")]
     pub component_id: u8,
+    /// The BATTERY_STATUS id aloft's own estimate of the pack is sent under, 0-255 (100: above
+    /// ArduPilot's 0-15 and PX4's 0-3, so no autopilot battery's).
+    #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID")]
+    pub battery_id: u8,
     /// Silence of the vehicle after which the link is said lost, s (in a telemetry log: a
     /// forward step of its clock longer than this, not waited through nor counted as time).
     #[arg(value_parser = finite(), long, default_value_t = 5.0, value_name = "S")]
@@ -1092,6 +1096,7 @@ impl LiveFlags {
                 speed_mps: None,
                 scenarios: self.scenarios,
                 air: self.air.input(),
+                battery_id: self.battery_id,
             }),
         })
     }
