@@ -978,7 +978,7 @@ pub struct LiveFlags {
     pub component_id: u8,
     /// The BATTERY_STATUS id aloft's own estimate of the pack is sent under, 0-255 (100: above
     /// ArduPilot's 0-15 and PX4's 0-3, so no autopilot battery's).
-    #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID")]
+    #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID", allow_negative_numbers = true)]
     pub battery_id: u8,
     /// Silence of the vehicle after which the link is said lost, s (in a telemetry log: a
     /// forward step of its clock longer than this, not waited through nor counted as time).
