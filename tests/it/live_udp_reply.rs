@@ -387,7 +387,9 @@ fn live_udp_the_vehicles_failsafe_parameters_arrive_as_events() {
     if !pymavlink_ready() {
         return;
     }
-    let cases: [(&[&str], [(&str, f64); 2]); 2] = [
+    /// The vehicle's flags, and the parameters it answers with their values.
+    type Case<'a> = (&'a [&'a str], [(&'a str, f64); 2]);
+    let cases: [Case; 2] = [
         (&[], [("BATT_LOW_VOLT", 10.5), ("BATT_FS_LOW_ACT", 2.0)]),
         (&["px4"], [("BAT1_N_CELLS", 3.0), ("BAT_LOW_THR", 0.15)]),
     ];
