@@ -983,6 +983,10 @@ pub struct LiveFlags {
     /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER).
     #[arg(long, default_value_t = 190, value_name = "ID")]
     pub component_id: u8,
+    /// The BATTERY_STATUS id aloft's own estimate of the pack is sent under, 0-255 (100: above
+    /// ArduPilot's 0-15 and PX4's 0-3, so no autopilot battery's).
+    #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID", allow_negative_numbers = true)]
+    pub battery_id: u8,
     /// Silence of the vehicle after which the link is said lost, s (in a telemetry log: a
     /// forward step of its clock longer than this, not waited through nor counted as time).
     #[arg(value_parser = finite(), long, default_value_t = 5.0, value_name = "S")]
@@ -1114,6 +1118,7 @@ impl LiveFlags {
                 low_voltage_v: self.low_voltage_v,
                 critical_voltage_v: self.critical_voltage_v,
                 air: self.air.input(),
+                battery_id: self.battery_id,
             }),
         })
     }

@@ -682,11 +682,14 @@ impl FlightLogs {
         Ok((profile, open))
     }
 
-    /// The first log as events, read as it is (no alignment): its samples, and a DataFlash
-    /// log's mode, arming and mission ([`aloft_logs::flight_events`]) from a second pass over
-    /// the file.
+    /// The first log as events, read as it is (no alignment): a ULog's or DataFlash log's
+    /// battery parameters (`BAT*`, `BATT_*`: what its failsafes act on) before its first
+    /// record, its samples, and a DataFlash log's mode, arming and mission
+    /// ([`aloft_logs::flight_events`]) from a second pass over the file.
     pub(crate) fn events_of_first(&self) -> Result<aloft_logs::telemetry::LogEvents, Error> {
-        let (profile, open) = self.open_options()?;
+        let (profile, mut open) = self.open_options()?;
+        // The parameters are collected with the battery's details.
+        open.binary.battery_details = true;
         let path = self.logs.first().ok_or_else(|| Error::InvalidInput {
             name: "replay",
             value: 0.0,
@@ -706,7 +709,17 @@ impl FlightLogs {
             }
             _ => Vec::new(),
         };
-        Ok(aloft_logs::telemetry::LogEvents::with_events(log, events))
+        let parameters = reader
+            .binary_summary()
+            .and_then(|s| s.kept_parameters())
+            .map(|p| {
+                p.iter()
+                    .filter(|(name, _)| name.starts_with("BAT"))
+                    .map(|(name, value)| (name.clone(), *value))
+                    .collect()
+            })
+            .unwrap_or_default();
+        Ok(aloft_logs::telemetry::LogEvents::with_events(log, events).with_parameters(parameters))
     }
 
     /// Read every log, align power with motion, and set the angle-of-attack model.

@@ -21,7 +21,7 @@
 //! | packs | [`PackFitRequest`] → [`fit_pack`] (logs → a pack file); a `--battery` value → [`fly_with_battery`] (the command line: [`load_flying`]) (a pack name, or a [`PackFile`] flown, for every command that flies) | [`PackFitAnswer`], [`FlyingPack`] | `packs/` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `live/` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `uncertainty/` |
-//! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`replies`] to the link | `live/` |
+//! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`LiveReplies`] to the link | `live/` |
 //! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `maps/` |
 //! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `plan_to_fly/` (sorties: `missions/sorties.rs`) |
 //! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `maps/` |
@@ -98,9 +98,9 @@ pub use identification::validate::{
 pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::estimator::InFlightEstimator;
 pub use live::{
-    follow_live, replay_live, replies, LiveCheck, LiveCheckpoint, LiveFailsafe, LiveRecorder,
-    LiveReplayRequest, LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate, Position,
-    SocBand, TimeBand, LIVE_SCENARIOS,
+    follow_live, replay_live, LiveCheck, LiveCheckpoint, LiveFailsafe, LiveRecorder,
+    LiveReplayRequest, LiveReplies, LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate,
+    Position, SocBand, TimeBand, DEFAULT_BATTERY_ID, LIVE_SCENARIOS,
 };
 pub use logs::{
     check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,

@@ -468,3 +468,29 @@ fn a_long_waypoint_file_without_jumps_is_flown() {
     assert!(!err.contains("loop"), "{err}");
     let _ = std::fs::remove_file(p);
 }
+
+/// `--battery-id` is a MAVLink battery id, 0-255: anything else is refused with one line naming
+/// it (exit 2), on the command line and as Python's or the page's `battery_id` keyword.
+#[test]
+fn a_battery_id_outside_0_255_is_refused_naming_it() {
+    for bad in ["256", "-1", "1.5", "x", "1e3"] {
+        let (code, out, err) =
+            common::run(&["live", "--replay", "no-such.ulg", "--battery-id", bad]);
+        assert_eq!(code, 2, "{bad}: {out} {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains("--battery-id"), "{bad}: {err}");
+        assert!(err.contains(bad), "{bad}: {err}");
+    }
+    use aloft::engine::{flags::LiveFlags, parse_keywords, Keyword};
+    let kw = |v: &str| vec![("battery_id".to_string(), Keyword::One(v.into()))];
+    let replay = [("replay", Keyword::One("x.ulg".into()))];
+    let err = parse_keywords::<LiveFlags>("aloft.live", &replay, &kw("300"))
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("'battery_id' of aloft.live"), "{err}");
+    let ok = parse_keywords::<LiveFlags>("aloft.live", &replay, &kw("255")).unwrap();
+    assert_eq!(ok.battery_id, 255);
+    let default = parse_keywords::<LiveFlags>("aloft.live", &replay, &[]).unwrap();
+    assert_eq!(default.battery_id, aloft::engine::DEFAULT_BATTERY_ID);
+}

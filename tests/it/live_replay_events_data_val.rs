@@ -68,3 +68,35 @@ fn data_val_dataflash_mission_and_items_flown() {
     );
     assert_eq!(current[1].1, 2);
 }
+
+/// `aloft live --replay sitl_ac47_00000002.BIN` sends the log's 28 battery parameters (`BAT*`,
+/// as pymavlink 2.4.50 lists its `PARM` records) before its first record: `BATT_LOW_VOLT` 10.5 V
+/// and `BATT_CAPACITY` 3300 mA h among them.
+#[test]
+fn data_val_a_replayed_log_sends_its_battery_parameters_first() {
+    let path = data_dir()
+        .join("flight_logs")
+        .join("sitl_ac47_00000002.BIN");
+    let source = aloft::engine::LiveSource::Replay {
+        logs: aloft::engine::FlightLogs {
+            logs: vec![path],
+            ..Default::default()
+        },
+        speed: None,
+    };
+    let mut events = source.open().unwrap();
+    let mut parameters = std::collections::BTreeMap::new();
+    while let Some(t) = events.next_event().unwrap() {
+        match t.event {
+            Event::Parameter { name, value } => {
+                parameters.insert(name, value);
+            }
+            Event::Origin(_) => {}
+            _ => break,
+        }
+    }
+    assert_eq!(parameters.len(), 28, "{parameters:?}");
+    assert!(parameters.keys().all(|k| k.starts_with("BAT")));
+    assert_eq!(parameters.get("BATT_LOW_VOLT"), Some(&10.5));
+    assert_eq!(parameters.get("BATT_CAPACITY"), Some(&3300.0));
+}

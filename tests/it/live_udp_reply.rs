@@ -84,6 +84,11 @@ fn stray(port: u16, stop: &AtomicBool) -> (u32, u32) {
 
 /// `aloft live --connect udpin:127.0.0.1:PORT`, JSON, an update every 0.5 s.
 fn aloft_live(port: u16) -> Child {
+    aloft_live_with(port, &[])
+}
+
+/// The same with more flags.
+fn aloft_live_with(port: u16, more: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_aloft"))
         .args(["live", "--connect", &format!("udpin:127.0.0.1:{port}")])
         .args([
@@ -95,6 +100,7 @@ fn aloft_live(port: u16) -> Child {
             "0.5",
         ])
         .args(["--scenarios", "20", "--link-timeout", "30"])
+        .args(more)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -263,4 +269,164 @@ fn live_udp_a_jumping_and_wrapping_charge_count_is_not_land_now() {
         notes.iter().all(|n| n.contains("not believed")),
         "{notes:?}"
     );
+}
+
+/// aloft's battery and its texts as a stock ground station decodes them (pymavlink 2.4.50's
+/// BATTERY_STATUS and STATUSTEXT), and the failsafe parameters it asked the vehicle for.
+///
+/// The vehicle hovers at 22.8 V and 14 A reporting 80 % left (SYS_STATUS); aloft runs with
+/// `--battery-id 42`. Every update is a BATTERY_STATUS of id 42 from aloft's component (190):
+/// `voltages[0]` 22,800 mV and the others UINT16_MAX (cells not known), `current_battery`
+/// 1,400 cA, `battery_remaining` aloft's `soc` of an update in percent, no time (0: no failsafe
+/// ahead yet), charge OK (1) under `continue`, function ALL (1), type LIPO (1), temperature
+/// INT16_MAX, consumed and energy -1. `aloft: continue` comes at INFO (6), which QGroundControl
+/// does not speak. ArduPilot's nine failsafe parameters are each asked by name (index -1) of
+/// the vehicle (1, 1).
+#[test]
+fn live_udp_alofts_battery_and_text_severities_reach_the_ground_station() {
+    if !pymavlink_ready() {
+        return;
+    }
+    let port = free_port();
+    let aloft = aloft_live_with(port, &["--battery-id", "42"]);
+    std::thread::sleep(Duration::from_millis(500));
+    let vehicle = vehicle_run(port, &["6".to_string()]);
+    let (got, updates, stderr) = after_the_run(aloft, &vehicle);
+    assert!(stderr.trim().is_empty(), "{stderr}");
+    let batteries = got["batteries"].as_array().expect("batteries");
+    let with_soc: Vec<i64> = updates
+        .iter()
+        .filter_map(|u| u["soc"].as_f64())
+        .map(|s| (100.0 * s).round() as i64)
+        .collect();
+    eprintln!(
+        "{} BATTERY_STATUS; soc of the updates {with_soc:?}",
+        batteries.len()
+    );
+    assert!(batteries.len() >= 8, "{got}");
+    assert_eq!(
+        batteries.len() as u64,
+        got["counts"]["BATTERY_STATUS"].as_u64().unwrap()
+    );
+    let mut cells = vec![serde_json::json!(22_800)];
+    cells.extend(std::iter::repeat_n(serde_json::json!(65_535), 9));
+    let cells = Value::Array(cells);
+    let unknown = Value::Array(vec![serde_json::json!(65_535); 10]);
+    for b in batteries {
+        assert_eq!(b["id"], 42, "{b}");
+        assert_eq!(b["component"], 190, "{b}");
+        // Before the vehicle's first SYS_STATUS, not known.
+        let measured = b["current_battery"] != -1;
+        assert_eq!(
+            &b["voltages"],
+            if measured { &cells } else { &unknown },
+            "{b}"
+        );
+        assert!(!measured || b["current_battery"] == 1_400, "{b}");
+        assert_eq!(b["time_remaining"], 0, "{b}");
+        assert_eq!(b["temperature"], i64::from(i16::MAX), "{b}");
+        assert_eq!(b["current_consumed"], -1, "{b}");
+        assert_eq!(b["energy_consumed"], -1, "{b}");
+        assert_eq!(
+            (&b["battery_function"], &b["type"]),
+            (&1.into(), &1.into()),
+            "{b}"
+        );
+        let remaining = b["battery_remaining"].as_i64().unwrap();
+        assert!(
+            remaining == -1 || with_soc.contains(&remaining),
+            "{remaining} not an update's soc {with_soc:?}"
+        );
+    }
+    // The vehicle's 80 % less a few seconds at 14 A, once aloft has it.
+    let last = batteries.last().unwrap();
+    let remaining = last["battery_remaining"].as_i64().unwrap();
+    assert!((75..=80).contains(&remaining), "{last}");
+    assert_eq!(last["voltages"], cells, "{last}");
+    assert_eq!(last["current_battery"], 1_400, "{last}");
+    assert_eq!(last["charge_state"], 1, "{last}");
+    let severities = got["severities"].as_array().expect("severities");
+    assert!(!severities.is_empty(), "{got}");
+    for t in severities {
+        assert!(t[0].as_str().unwrap().starts_with("aloft: continue"), "{t}");
+        assert_eq!(t[1], 6, "{t}");
+    }
+    let asked: std::collections::BTreeSet<&str> = got["asked"]
+        .as_array()
+        .expect("asked")
+        .iter()
+        .map(|a| {
+            assert_eq!(
+                (&a[1], &a[2], &a[3]),
+                (&(-1).into(), &1.into(), &1.into()),
+                "{a}"
+            );
+            a[0].as_str().unwrap()
+        })
+        .collect();
+    let want = [
+        "BATT_CAPACITY",
+        "BATT_CRT_MAH",
+        "BATT_CRT_VOLT",
+        "BATT_FS_CRT_ACT",
+        "BATT_FS_LOW_ACT",
+        "BATT_FS_VOLTSRC",
+        "BATT_LOW_MAH",
+        "BATT_LOW_TIMER",
+        "BATT_LOW_VOLT",
+    ];
+    assert_eq!(asked, want.into_iter().collect());
+}
+
+/// The vehicle's failsafe parameters reach aloft's events as each autopilot encodes them, the
+/// PARAM_VALUE made by pymavlink: ArduPilot's cast (BATT_LOW_VOLT 10.5, BATT_FS_LOW_ACT INT8 2)
+/// and PX4's bytewise copy (BAT1_N_CELLS INT32 3 sent as the float of bits 3; BAT_LOW_THR 0.15),
+/// asked by aloft's link on its own.
+#[test]
+fn live_udp_the_vehicles_failsafe_parameters_arrive_as_events() {
+    if !pymavlink_ready() {
+        return;
+    }
+    /// The vehicle's flags, and the parameters it answers with their values.
+    type Case<'a> = (&'a [&'a str], [(&'a str, f64); 2]);
+    let cases: [Case; 2] = [
+        (&[], [("BATT_LOW_VOLT", 10.5), ("BATT_FS_LOW_ACT", 2.0)]),
+        (&["px4"], [("BAT1_N_CELLS", 3.0), ("BAT_LOW_THR", 0.15)]),
+    ];
+    for (flags, want) in cases {
+        let port = free_port();
+        let options = aloft_link::LinkOptions {
+            request_mission: false,
+            ..aloft_link::LinkOptions::default()
+        };
+        let mut link =
+            aloft_link::LinkSource::connect(&format!("udpin:127.0.0.1:{port}"), options).unwrap();
+        let mut args = vec!["3".to_string()];
+        args.extend(flags.iter().map(|f| f.to_string()));
+        let vehicle = std::thread::spawn(move || vehicle_run(port, &args));
+        let mut heard = std::collections::BTreeMap::new();
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while heard.len() < 2 && Instant::now() < deadline {
+            let Some(t) = link.next_telemetry().expect("link up") else {
+                break;
+            };
+            if let aloft_link::Event::Parameter { name, value } = t.event {
+                heard.insert(name, value);
+            }
+        }
+        let out = vehicle.join().expect("vehicle");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for (name, value) in want {
+            let got = heard.get(name).copied();
+            // 0.15 travels as an f32: within its half-ulp.
+            assert!(
+                got.is_some_and(|g| (g - value).abs() < 1e-7),
+                "{flags:?} {name}: {got:?} in {heard:?}"
+            );
+        }
+    }
 }

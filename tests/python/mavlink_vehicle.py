@@ -2,7 +2,7 @@
 """A vehicle on a UDP link, written with pymavlink (the independent MAVLink implementation), for
 tests/it/live_udp_reply.rs:
 
-    python3 tests/python/mavlink_vehicle.py PORT SECONDS [wrapped-count]
+    python3 tests/python/mavlink_vehicle.py PORT SECONDS [wrapped-count] [px4]
 
 From an ephemeral port of 127.0.0.1 it sends to 127.0.0.1:PORT, for SECONDS, what an armed
 ArduCopter quadrotor hovering in LOITER 20 m above its home sends (MAVLink 2, system 1,
@@ -10,7 +10,13 @@ component 1): GLOBAL_POSITION_INT and ATTITUDE at 5 Hz; HEARTBEAT, SYS_STATUS,
 EXTENDED_SYS_STATE and HOME_POSITION at 1 Hz. It answers a mission download (MISSION_COUNT 2,
 then each MISSION_ITEM_INT asked for). Then it listens one second more and prints, as one JSON
 line, what it received from system 255 (aloft): messages by type, the NAMED_VALUE_FLOAT names,
-the STATUSTEXT texts, and messages from any other system.
+the STATUSTEXT texts and their severities, the BATTERY_STATUS fields, the names of the
+PARAM_REQUEST_READ, and messages from any other system.
+
+It answers PARAM_REQUEST_READ of its failsafe parameters with PARAM_VALUE as the autopilot
+does: ArduPilot casts every value to the float (BATT_LOW_VOLT REAL32 10.5, BATT_FS_LOW_ACT INT8
+2); with `px4` the vehicle is a PX4 (HEARTBEAT autopilot MAV_AUTOPILOT_PX4) that copies an
+integer's bytes into the float (BAT1_N_CELLS INT32 3, BAT_LOW_THR REAL32 0.15).
 
 With `wrapped-count` it reports 70 % left (SYS_STATUS and BATTERY_STATUS) and sends
 BATTERY_STATUS at 1 Hz with a count of the charge drawn (`current_consumed`) that counts 14 A
@@ -19,6 +25,7 @@ for 2 s, then goes back to 10 mAh and counts on from there.
 """
 import json
 import os
+import struct
 import sys
 import time
 
@@ -29,6 +36,17 @@ from pymavlink.dialects.v20 import ardupilotmega as mav  # noqa: E402
 HOME = (473_977_000, 85_456_000, 488_000)  # 1e-7 deg, 1e-7 deg, mm
 UP_MM = 20_000
 PERIOD_S = 0.2
+
+# name: (value as sent in param_value, MAV_PARAM_TYPE)
+ARDUPILOT_PARAMS = {
+    "BATT_LOW_VOLT": (10.5, mav.MAV_PARAM_TYPE_REAL32),
+    "BATT_FS_LOW_ACT": (2.0, mav.MAV_PARAM_TYPE_INT8),
+}
+PX4_PARAMS = {
+    # The INT32 3 copied bytewise into the float (PX4's encoding).
+    "BAT1_N_CELLS": (struct.unpack("<f", struct.pack("<i", 3))[0], mav.MAV_PARAM_TYPE_INT32),
+    "BAT_LOW_THR": (0.15, mav.MAV_PARAM_TYPE_REAL32),
+}
 
 
 INT32_MAX = 2**31 - 1
@@ -47,12 +65,12 @@ def wrapped_count(t):
     return 10 + drawn
 
 
-def send_telemetry(m, k, boot_ms, wrapped):
+def send_telemetry(m, k, boot_ms, wrapped, px4):
     """The k-th 0.2 s step of the hover."""
     if k % 5 == 0:
         m.mav.heartbeat_send(
             mav.MAV_TYPE_QUADROTOR,
-            mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
+            mav.MAV_AUTOPILOT_PX4 if px4 else mav.MAV_AUTOPILOT_ARDUPILOTMEGA,
             mav.MAV_MODE_FLAG_SAFETY_ARMED | mav.MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
             5,  # LOITER
             mav.MAV_STATE_ACTIVE,
@@ -70,10 +88,14 @@ def send_telemetry(m, k, boot_ms, wrapped):
     m.mav.attitude_send(boot_ms, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
-def answer(m, msg):
-    """The mission download: two items, home and a waypoint 50 m north, 20 m up."""
+def answer(m, msg, params):
+    """The mission download: two items, home and a waypoint 50 m north, 20 m up; the failsafe
+    parameters this vehicle has."""
     t = msg.get_type()
-    if t == "MISSION_REQUEST_LIST":
+    if t == "PARAM_REQUEST_READ" and msg.param_id in params:
+        value, kind = params[msg.param_id]
+        m.mav.param_value_send(msg.param_id.encode(), value, kind, 900, 7)
+    elif t == "MISSION_REQUEST_LIST":
         m.mav.mission_count_send(msg.get_srcSystem(), msg.get_srcComponent(), 2, 0)
     elif t in ("MISSION_REQUEST_INT", "MISSION_REQUEST"):
         north = 0 if msg.seq == 0 else 4_500
@@ -86,17 +108,20 @@ def answer(m, msg):
 
 def main():
     port, seconds = int(sys.argv[1]), float(sys.argv[2])
-    wrapped = sys.argv[3:] == ["wrapped-count"]
+    wrapped = "wrapped-count" in sys.argv[3:]
+    px4 = "px4" in sys.argv[3:]
+    params = PX4_PARAMS if px4 else ARDUPILOT_PARAMS
     m = mavutil.mavlink_connection(
         f"udpout:127.0.0.1:{port}", source_system=1, source_component=1, dialect="ardupilotmega"
     )
     counts, names, texts, others = {}, {}, [], {}
+    severities, batteries, asked = [], [], []
     start = time.monotonic()
     k = 0
     while time.monotonic() - start < seconds + 1.0:
         now = time.monotonic() - start
         if now < seconds and now >= k * PERIOD_S:
-            send_telemetry(m, k, 60_000 + int(now * 1000), wrapped)
+            send_telemetry(m, k, 60_000 + int(now * 1000), wrapped, px4)
             k += 1
         msg = m.recv_msg()
         if msg is None:
@@ -113,9 +138,30 @@ def main():
             names[msg.name] = names.get(msg.name, 0) + 1
         elif t == "STATUSTEXT":
             texts.append(msg.text)
+            severities.append([msg.text, msg.severity])
+        elif t == "BATTERY_STATUS":
+            batteries.append({
+                "component": msg.get_srcComponent(),
+                "id": msg.id,
+                "battery_remaining": msg.battery_remaining,
+                "voltages": list(msg.voltages),
+                "current_battery": msg.current_battery,
+                "current_consumed": msg.current_consumed,
+                "energy_consumed": msg.energy_consumed,
+                "temperature": msg.temperature,
+                "time_remaining": msg.time_remaining,
+                "charge_state": msg.charge_state,
+                "battery_function": msg.battery_function,
+                "type": msg.type,
+            })
+        elif t == "PARAM_REQUEST_READ":
+            asked.append([msg.param_id, msg.param_index, msg.target_system, msg.target_component])
         if now < seconds:
-            answer(m, msg)
-    print(json.dumps({"counts": counts, "names": names, "texts": texts, "others": others}))
+            answer(m, msg, params)
+    print(json.dumps({
+        "counts": counts, "names": names, "texts": texts, "others": others,
+        "severities": severities, "batteries": batteries, "asked": asked,
+    }))
 
 
 if __name__ == "__main__":

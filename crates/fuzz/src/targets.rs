@@ -592,6 +592,28 @@ fn event_numbers(e: &aloft_link::Event) -> (&'static str, Vec<f64>) {
     }
 }
 
+/// The BATTERY_STATUS `aloft live` would send after `u`: its percentage within 0-100 or -1, its
+/// time not negative.
+fn check_battery_reply(u: &aloft::engine::LiveUpdate, o: &mut Outcome) {
+    let mut replies = aloft::engine::LiveReplies::new(aloft::engine::DEFAULT_BATTERY_ID);
+    for r in replies.replies(None, u) {
+        let aloft_link::Reply::Battery(b) = r else {
+            continue;
+        };
+        let aloft_link::mavlink::dialects::ardupilotmega::MavMessage::BATTERY_STATUS(m) =
+            aloft_link::battery_status(&b)
+        else {
+            continue;
+        };
+        if !(-1..=100).contains(&m.battery_remaining) || m.time_remaining < 0 {
+            o.broken.push(Problem {
+                check: "live-battery-status",
+                detail: format!("{m:?} from {b:?}"),
+            });
+        }
+    }
+}
+
 /// A telemetry log: every event of [`aloft_link::TlogSource`], with its invariants checked (time
 /// finite and never going back, computed values finite, all bytes read), and the answer the
 /// counts of events by kind; on every 4th input the frames of [`aloft_link::TlogReader`] and the
@@ -681,6 +703,7 @@ fn tlog(data: &[u8]) -> Outcome {
             });
         }
         answer.insert("live_advice".into(), u.advice.unwrap_or("-").into());
+        check_battery_reply(&u, &mut o);
     }
     answer.insert("frames".into(), stats.frames.into());
     answer.insert("bad_frames".into(), stats.bad_frames().into());

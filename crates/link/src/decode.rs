@@ -20,6 +20,7 @@
 //! | HOME_POSITION | [`Event::Home`], ENU from the origin (held until the origin; up where `relative_alt` is 0); dropped off the Earth or over 100 km from the vehicle |
 //! | EXTENDED_SYS_STATE | [`Event::Sample`]: landed (ON_GROUND) or not (IN_AIR, TAKEOFF, LANDING) |
 //! | MISSION_CURRENT | [`Event::MissionCurrent`] |
+//! | PARAM_VALUE | [`Event::Parameter`], asked for or not: its value decoded by [`param_value`] |
 //! | MISSION_COUNT, MISSION_ITEM(_INT), MISSION_ACK | [`Event::Mission`] ([`crate::mission`]) |
 //! | SYSTEM_TIME, ATTITUDE, GLOBAL_POSITION_INT `time_boot_ms` | [`Event::Reboot`] when it goes back by more than [`REBOOT_BACK_MS`] |
 //!
@@ -54,9 +55,10 @@ use aloft_logs::sample::{Attitude, GeoOrigin, Sample};
 use aloft_logs::telemetry::{BatteryState, Event, Heartbeat, MissionItem, Telemetry};
 #[allow(deprecated)] // MISSION_ITEM_DATA (see `Decoder::vehicle_message`)
 use mavlink::dialects::ardupilotmega::{
-    MavAutopilot, MavLandedState, MavMessage, MavMissionType, MavModeFlag, MavType, ATTITUDE_DATA,
-    BATTERY_STATUS_DATA, GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA, HOME_POSITION_DATA,
-    MISSION_ITEM_DATA, MISSION_ITEM_INT_DATA, SYS_STATUS_DATA, WIND_DATA,
+    MavAutopilot, MavLandedState, MavMessage, MavMissionType, MavModeFlag, MavParamType, MavType,
+    ATTITUDE_DATA, BATTERY_STATUS_DATA, GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA,
+    HOME_POSITION_DATA, MISSION_ITEM_DATA, MISSION_ITEM_INT_DATA, PARAM_VALUE_DATA,
+    SYS_STATUS_DATA, WIND_DATA,
 };
 use mavlink::MavHeader;
 
@@ -107,6 +109,10 @@ enum Verdict {
 #[derive(Debug, Default)]
 pub struct Decoder {
     vehicle: Option<Sender>,
+    /// The vehicle's autopilot (its first HEARTBEAT's): how its parameters are encoded.
+    autopilot: Option<MavAutopilot>,
+    /// Restarts of the vehicle seen.
+    reboots: u32,
     origin: Option<GeoOrigin>,
     /// HOME_POSITION received before the origin: latitude, longitude (rad).
     pending_home: Option<[f64; 2]>,
@@ -134,6 +140,16 @@ impl Decoder {
     /// The vehicle's system and component ids, once its HEARTBEAT was seen.
     pub fn vehicle(&self) -> Option<(u32, u8)> {
         self.vehicle
+    }
+
+    /// The vehicle's autopilot (MAV_AUTOPILOT of its first HEARTBEAT), once seen.
+    pub fn autopilot(&self) -> Option<MavAutopilot> {
+        self.autopilot
+    }
+
+    /// Restarts of the vehicle seen so far ([`Event::Reboot`]).
+    pub fn reboots(&self) -> u32 {
+        self.reboots
     }
 
     /// The origin of the ENU positions, once the first fix was seen.
@@ -184,6 +200,7 @@ impl Decoder {
             if let MavMessage::HEARTBEAT(hb) = msg {
                 if is_vehicle(hb) {
                     self.vehicle = Some(sender);
+                    self.autopilot = Some(hb.autopilot);
                 }
             }
         }
@@ -276,6 +293,7 @@ impl Decoder {
             MavMessage::MISSION_CURRENT(m) => {
                 self.emit(out, Event::MissionCurrent(u32::from(m.seq)));
             }
+            MavMessage::PARAM_VALUE(p) => self.parameter(p, out),
             MavMessage::MISSION_COUNT(c) if is_mission(c.mission_type) => {
                 let done = self.mission.count(sender, c.count);
                 self.mission_event(done, out);
@@ -361,6 +379,21 @@ impl Decoder {
                 consumed_ah: None,
             };
             self.emit(out, Event::Battery(battery));
+        }
+    }
+
+    /// PARAM_VALUE: the parameter by name, its value as [`param_value`] decodes it (not sent
+    /// where it cannot be, or is not finite).
+    fn parameter(&self, p: &PARAM_VALUE_DATA, out: &mut impl Extend<Telemetry>) {
+        // The id up to its first NUL (16 characters without one); not UTF-8: not a name.
+        let Ok(name) = p.param_id.to_str() else {
+            return;
+        };
+        let bytewise = self.autopilot == Some(MavAutopilot::MAV_AUTOPILOT_PX4);
+        let value = param_value(p.param_value, p.param_type, bytewise);
+        if let (false, Some(value)) = (name.is_empty(), value.filter(|v| v.is_finite())) {
+            let name = name.to_string();
+            self.emit(out, Event::Parameter { name, value });
         }
     }
 
@@ -579,6 +612,7 @@ impl Decoder {
             return;
         }
         self.emit(out, Event::Reboot);
+        self.reboots += 1;
         self.origin = None;
         self.last_fix = None;
         self.pending_home = None;
@@ -611,6 +645,37 @@ pub(crate) fn pack_voltage_v(b: &BATTERY_STATUS_DATA) -> Option<f64> {
         .map(|&v| u32::from(v))
         .sum();
     (cells_mv > 0).then(|| f64::from(cells_mv) / 1000.0)
+}
+
+/// The value of a PARAM_VALUE's `param_value` (a float on the wire) as the parameter's own
+/// number.
+///
+/// The rule: a `REAL32` parameter is the float itself. An integer parameter is encoded one of
+/// two ways (MAVLink parameter protocol, "Parameter encoding"; AUTOPILOT_VERSION capabilities
+/// `MAV_PROTOCOL_CAPABILITY_PARAM_ENCODE_BYTEWISE` and `..._C_CAST`): PX4 copies the integer's
+/// bytes into the float (`bytewise`: the float's bits, read as the type, are the value; an
+/// `INT32` of 3 is the float 4.2e-45), ArduPilot and the others convert the integer to a float
+/// (a C cast: the float is the value). Which one is decided by the vehicle's HEARTBEAT autopilot
+/// (`MAV_AUTOPILOT_PX4` bytewise), as QGroundControl does. 64-bit types do not fit the float and
+/// are `None`.
+pub fn param_value(raw: f32, kind: MavParamType, bytewise: bool) -> Option<f64> {
+    use MavParamType as T;
+    let bits = raw.to_bits();
+    let integer = match kind {
+        T::MAV_PARAM_TYPE_REAL32 => return Some(f64::from(raw)),
+        T::MAV_PARAM_TYPE_UINT64 | T::MAV_PARAM_TYPE_INT64 | T::MAV_PARAM_TYPE_REAL64 => {
+            return None
+        }
+        _ if !bytewise => return Some(f64::from(raw)),
+        // The low bytes of the float's bits, as the type (little-endian copy of the value).
+        T::MAV_PARAM_TYPE_UINT8 => f64::from(bits as u8),
+        T::MAV_PARAM_TYPE_INT8 => f64::from(bits as u8 as i8),
+        T::MAV_PARAM_TYPE_UINT16 => f64::from(bits as u16),
+        T::MAV_PARAM_TYPE_INT16 => f64::from(bits as u16 as i16),
+        T::MAV_PARAM_TYPE_UINT32 => f64::from(bits),
+        T::MAV_PARAM_TYPE_INT32 => f64::from(bits as i32),
+    };
+    Some(integer)
 }
 
 /// State of charge of a `battery_remaining` percentage; `None` for -1 (not sent) and values

@@ -17,7 +17,8 @@
 //!   [`TelemetrySource`]s; a live link reads on a thread,
 //!   reports silence as [`Event::LinkLost`], answers with
 //!   [`LinkSource::reply`] (on `udpin`, to the vehicle's address only), and downloads the
-//!   mission when none passed ([`request`]); a telemetry log's clock steps are taken out of its
+//!   mission when none passed ([`request`]) and the vehicle's failsafe parameters
+//!   ([`params`]); a telemetry log's clock steps are taken out of its
 //!   times and said ([`Event::LinkLost`], [`Event::ClockBack`]).
 //!
 //! Positions are believed only on the Earth and within a multirotor's reach of the last one
@@ -45,13 +46,15 @@ pub mod error;
 pub mod flight;
 pub mod mission;
 mod modes;
+pub mod params;
 pub mod request;
 pub mod source;
 pub mod tlog;
 mod transport;
 
 pub use aloft_logs::telemetry::{
-    BatteryState, Event, Heartbeat, MissionItem, Reply, Telemetry, TelemetrySource,
+    BatteryReply, BatteryState, ChargeState, Event, Heartbeat, MissionItem, Reply, Severity,
+    Telemetry, TelemetrySource,
 };
 pub use decode::{Decoder, FixStats};
 pub use error::{LinkError, Result};
@@ -62,6 +65,7 @@ pub use mavlink;
 pub use mission::MAX_MISSION_ITEMS;
 pub use modes::mode_name;
 pub use source::{
-    describe_fixes, describe_stats, gcs_heartbeat, LinkOptions, LinkSource, LinkStats, TlogSource,
+    battery_status, describe_fixes, describe_stats, gcs_heartbeat, LinkOptions, LinkSource,
+    LinkStats, TlogSource,
 };
 pub use tlog::{TlogFrame, TlogReader, TlogStats};

@@ -22,7 +22,10 @@
 //! - a HEARTBEAT (MAV_TYPE_GCS) every second, so that routers and autopilots that answer the
 //!   last sender send to aloft ([`LinkOptions::heartbeat`]);
 //! - [`LinkSource::reply`]: NAMED_VALUE_FLOAT (`time_boot_ms` since the link opened, a name of at
-//!   most 10 bytes) and STATUSTEXT (WARNING or INFO, at most 50 bytes, cut at a character);
+//!   most 10 bytes), STATUSTEXT (at the reply's severity, at most 50 bytes, cut at a character)
+//!   and BATTERY_STATUS of aloft's own battery ([`battery_status`]);
+//! - PARAM_REQUEST_READ of the vehicle's failsafe parameters when it is first heard and after it
+//!   restarts ([`crate::params`], [`LinkOptions::request_parameters`]);
 //! - the mission download of [`crate::request`] when no mission passed on the link
 //!   ([`LinkOptions::request_mission`]).
 //!
@@ -41,10 +44,13 @@ use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use aloft_logs::telemetry::{Event, Reply, Telemetry, TelemetrySource};
+use aloft_logs::telemetry::{
+    BatteryReply, ChargeState, Event, Reply, Severity, Telemetry, TelemetrySource,
+};
 use mavlink::dialects::ardupilotmega::{
-    MavAutopilot, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, HEARTBEAT_DATA,
-    NAMED_VALUE_FLOAT_DATA, STATUSTEXT_DATA,
+    MavAutopilot, MavBatteryChargeState, MavBatteryFault, MavBatteryFunction, MavBatteryMode,
+    MavBatteryType, MavMessage, MavModeFlag, MavSeverity, MavState, MavType, BATTERY_STATUS_DATA,
+    HEARTBEAT_DATA, NAMED_VALUE_FLOAT_DATA, STATUSTEXT_DATA,
 };
 use mavlink::{
     MAVLinkMessageRaw, MAVLinkV1MessageRaw, MAVLinkV2MessageRaw, MavHeader, MavlinkVersion, Message,
@@ -52,6 +58,7 @@ use mavlink::{
 
 use crate::decode::{Decoder, FixStats, MAX_SPEED_MPS};
 use crate::error::LinkError;
+use crate::params::ParamRequest;
 use crate::request::MissionRequest;
 use crate::tlog::{TlogReader, TlogStats};
 use crate::transport::{parse_url, Incoming, Transport};
@@ -276,6 +283,9 @@ pub struct LinkOptions {
     pub heartbeat: bool,
     /// Ask the vehicle for its mission when none passed on the link (default true).
     pub request_mission: bool,
+    /// Ask the vehicle for its failsafe parameters when it is first heard and after it
+    /// restarts (default true; [`crate::params`]).
+    pub request_parameters: bool,
 }
 
 impl Default for LinkOptions {
@@ -286,6 +296,7 @@ impl Default for LinkOptions {
             timeout: Duration::from_secs(5),
             heartbeat: true,
             request_mission: true,
+            request_parameters: true,
         }
     }
 }
@@ -330,6 +341,7 @@ pub struct LinkSource {
     vehicle_version: MavlinkVersion,
     sequence: u8,
     request: MissionRequest,
+    params: ParamRequest,
     stats: LinkStats,
     closed: bool,
     /// Set from outside (Ctrl-C): the stream ends at the next look, within [`TICK`].
@@ -378,6 +390,7 @@ impl LinkSource {
                 (options.system_id, options.component_id),
                 options.request_mission,
             ),
+            params: ParamRequest::new(options.request_parameters),
             stats: LinkStats::default(),
             closed: false,
             interrupt: None,
@@ -439,14 +452,16 @@ impl LinkSource {
         }
     }
 
-    /// Sends a reply to the ground station (NAMED_VALUE_FLOAT or STATUSTEXT) from aloft's ids.
+    /// Sends a reply to the ground station (NAMED_VALUE_FLOAT, STATUSTEXT or BATTERY_STATUS)
+    /// from aloft's ids.
     pub fn reply(&mut self, reply: &Reply) -> Result<(), LinkError> {
         let (message, name) = match reply {
             Reply::Value { name, value } => (
                 named_value(self.boot_ms(), name, *value),
                 "NAMED_VALUE_FLOAT",
             ),
-            Reply::Text { text, warning } => (status_text(text, *warning), "STATUSTEXT"),
+            Reply::Text { text, severity } => (status_text(text, *severity), "STATUSTEXT"),
+            Reply::Battery(b) => (battery_status(b), "BATTERY_STATUS"),
         };
         self.send(&message, name)
     }
@@ -500,6 +515,7 @@ impl LinkSource {
         if let Some(answer) = self.request.on_vehicle_message(at, header, message) {
             self.send(&answer, answer.message_name())?;
         }
+        self.params.on_vehicle_message(message);
         Ok(())
     }
 
@@ -520,6 +536,13 @@ impl LinkSource {
             if let Some(msg) = self.request.tick(now, self.decoder.vehicle(), known) {
                 self.send(&msg, msg.message_name())?;
             }
+        }
+        let (vehicle, autopilot) = (self.decoder.vehicle(), self.decoder.autopilot());
+        let asks = self
+            .params
+            .tick(now, vehicle, autopilot, self.decoder.reboots());
+        for msg in asks {
+            self.send(&msg, msg.message_name())?;
         }
         Ok(())
     }
@@ -614,12 +637,13 @@ fn named_value(time_boot_ms: u32, name: &str, value: f64) -> MavMessage {
     })
 }
 
-/// STATUSTEXT at WARNING or INFO severity: the text's first 50 bytes, cut at a character.
-fn status_text(text: &str, warning: bool) -> MavMessage {
-    let severity = if warning {
-        MavSeverity::MAV_SEVERITY_WARNING
-    } else {
-        MavSeverity::MAV_SEVERITY_INFO
+/// STATUSTEXT at `severity`: the text's first 50 bytes, cut at a character.
+fn status_text(text: &str, severity: Severity) -> MavMessage {
+    let severity = match severity {
+        Severity::Critical => MavSeverity::MAV_SEVERITY_CRITICAL,
+        Severity::Warning => MavSeverity::MAV_SEVERITY_WARNING,
+        Severity::Notice => MavSeverity::MAV_SEVERITY_NOTICE,
+        Severity::Info => MavSeverity::MAV_SEVERITY_INFO,
     };
     MavMessage::STATUSTEXT(STATUSTEXT_DATA {
         severity,
@@ -627,6 +651,87 @@ fn status_text(text: &str, warning: bool) -> MavMessage {
         id: 0,
         chunk_seq: 0,
     })
+}
+
+/// The largest value of one `voltages` field, mV: UINT16_MAX is "no cell".
+const CELL_MAX_MV: u16 = u16::MAX - 1;
+
+/// BATTERY_STATUS of aloft's own battery, as common.xml asks of a battery whose cells are not
+/// known:
+/// - `voltages[0]` the pack's voltage, mV, the others UINT16_MAX; a pack above 65,534 mV fills
+///   cell 0 with 65,534 and the rest in cell 1 (and on, for each further 65,534 mV); a voltage
+///   not known, or beyond ten fields (655 V), leaves every field UINT16_MAX; `voltages_ext` 0
+///   (none);
+/// - `current_battery` cA, saturated to the `int16` range (-1 is "not measured": a current that
+///   rounds to -1 cA is sent as 0); `current_consumed` mA h (-1 not known);
+///   `energy_consumed` -1; `battery_remaining` percent, rounded into 0-100 (-1 not known);
+///   `temperature` INT16_MAX (not known);
+/// - extensions: `time_remaining` s, rounded, at least 1 (0 is "not provided"); `charge_state`
+///   from the reply; `battery_function` ALL, `type` LIPO, `mode` 0, `fault_bitmask` 0.
+pub fn battery_status(b: &BatteryReply) -> MavMessage {
+    let current_battery = b.current_a.filter(|i| i.is_finite()).map_or(-1, |i| {
+        let ca = (i * 100.0)
+            .round()
+            .clamp(f64::from(i16::MIN), f64::from(i16::MAX)) as i16;
+        if ca == -1 {
+            0
+        } else {
+            ca
+        }
+    });
+    let finite = |v: Option<f64>| v.filter(|v| v.is_finite());
+    MavMessage::BATTERY_STATUS(BATTERY_STATUS_DATA {
+        current_consumed: finite(b.consumed_mah)
+            .map_or(-1, |c| c.round().clamp(0.0, f64::from(i32::MAX)) as i32),
+        energy_consumed: -1,
+        temperature: i16::MAX,
+        voltages: pack_voltages(finite(b.voltage_v)),
+        current_battery,
+        id: b.id,
+        battery_function: MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL,
+        mavtype: MavBatteryType::MAV_BATTERY_TYPE_LIPO,
+        battery_remaining: finite(b.remaining_percent)
+            .map_or(-1, |p| p.round().clamp(0.0, 100.0) as i8),
+        time_remaining: finite(b.time_remaining_s)
+            .filter(|t| *t >= 0.0)
+            .map_or(0, |t| t.round().clamp(1.0, f64::from(i32::MAX)) as i32),
+        charge_state: charge_state(b.charge_state),
+        voltages_ext: [0; 4],
+        mode: MavBatteryMode::MAV_BATTERY_MODE_UNKNOWN,
+        fault_bitmask: MavBatteryFault::empty(),
+    })
+}
+
+/// The `voltages` of a pack of `voltage_v` whose cells are not known (see [`battery_status`]).
+fn pack_voltages(voltage_v: Option<f64>) -> [u16; 10] {
+    let mut fields = [u16::MAX; 10];
+    let Some(v) = voltage_v.filter(|v| *v >= 0.0) else {
+        return fields;
+    };
+    let mut left_mv = (v * 1000.0).round();
+    let cell = f64::from(CELL_MAX_MV);
+    if left_mv > cell * fields.len() as f64 {
+        return fields;
+    }
+    for field in &mut fields {
+        *field = left_mv.min(cell) as u16;
+        left_mv -= cell;
+        if left_mv <= 0.0 {
+            break;
+        }
+    }
+    fields
+}
+
+/// MAV_BATTERY_CHARGE_STATE of a charge state.
+fn charge_state(state: ChargeState) -> MavBatteryChargeState {
+    match state {
+        ChargeState::Undefined => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_UNDEFINED,
+        ChargeState::Ok => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_OK,
+        ChargeState::Low => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_LOW,
+        ChargeState::Critical => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_CRITICAL,
+        ChargeState::Emergency => MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_EMERGENCY,
+    }
 }
 
 /// The longest prefix of `s` of at most `max` bytes that ends at a character boundary.
@@ -730,10 +835,139 @@ mod tests {
         assert_eq!(truncated("energy_remaining", 10), "energy_rem");
         assert_eq!(truncated("ééééééé", 5), "éé");
         let long = "x".repeat(80);
-        let MavMessage::STATUSTEXT(t) = status_text(&long, true) else {
+        let MavMessage::STATUSTEXT(t) = status_text(&long, Severity::Warning) else {
             panic!("not a STATUSTEXT")
         };
         assert_eq!(t.text.to_str().unwrap().len(), 50);
         assert_eq!(t.severity, MavSeverity::MAV_SEVERITY_WARNING);
+    }
+
+    fn battery(b: &BatteryReply) -> BATTERY_STATUS_DATA {
+        let MavMessage::BATTERY_STATUS(d) = battery_status(b) else {
+            panic!("not a BATTERY_STATUS")
+        };
+        d
+    }
+
+    /// Field by field against common.xml's BATTERY_STATUS (147): a 3S pack at 11.1 V, 12.34 A,
+    /// 63 %, 190 s to the first failsafe, low.
+    #[test]
+    fn battery_status_fills_each_field_as_common_xml_says() {
+        let d = battery(&BatteryReply {
+            id: 100,
+            remaining_percent: Some(62.6),
+            time_remaining_s: Some(190.4),
+            voltage_v: Some(11.1),
+            current_a: Some(12.34),
+            consumed_mah: Some(850.2),
+            charge_state: ChargeState::Low,
+        });
+        assert_eq!(d.id, 100);
+        // Cells unknown: the pack in cell 0, the others UINT16_MAX; cells 11-14 0 (none).
+        let mut cells = [u16::MAX; 10];
+        cells[0] = 11_100;
+        assert_eq!(d.voltages, cells);
+        assert_eq!(d.voltages_ext, [0; 4]);
+        assert_eq!(d.current_battery, 1_234);
+        assert_eq!(d.current_consumed, 850);
+        assert_eq!(d.energy_consumed, -1);
+        assert_eq!(d.battery_remaining, 63);
+        assert_eq!(d.temperature, i16::MAX);
+        assert_eq!(d.time_remaining, 190);
+        assert_eq!(
+            d.charge_state,
+            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_LOW
+        );
+        assert_eq!(
+            d.battery_function,
+            MavBatteryFunction::MAV_BATTERY_FUNCTION_ALL
+        );
+        assert_eq!(d.mavtype, MavBatteryType::MAV_BATTERY_TYPE_LIPO);
+        assert_eq!(d.mode, MavBatteryMode::MAV_BATTERY_MODE_UNKNOWN);
+        assert!(d.fault_bitmask.is_empty());
+    }
+
+    /// Nothing known: every field its "unknown" value (-1, UINT16_MAX, 0 for the time).
+    #[test]
+    fn battery_status_unknowns_are_mavlinks_invalid_values() {
+        let d = battery(&BatteryReply {
+            id: 7,
+            voltage_v: Some(f64::NAN),
+            ..BatteryReply::default()
+        });
+        assert_eq!(d.voltages, [u16::MAX; 10]);
+        assert_eq!(d.current_battery, -1);
+        assert_eq!(d.current_consumed, -1);
+        assert_eq!(d.battery_remaining, -1);
+        assert_eq!(d.time_remaining, 0);
+        assert_eq!(
+            d.charge_state,
+            MavBatteryChargeState::MAV_BATTERY_CHARGE_STATE_UNDEFINED
+        );
+    }
+
+    /// Above 65,534 mV cell 0 holds 65,534 and cell 1 the rest; beyond ten fields (655.34 V)
+    /// the voltage is not sent. Currents saturate at the int16 range, and one that would read
+    /// as -1 (unknown) is 0; a time under 1 s is 1 (0 is "not provided"); percentages are cut
+    /// to 0-100.
+    #[test]
+    fn battery_status_edges() {
+        let v = |volts: f64| {
+            battery(&BatteryReply {
+                voltage_v: Some(volts),
+                ..BatteryReply::default()
+            })
+            .voltages
+        };
+        let mut two = [u16::MAX; 10];
+        two[0] = 65_534;
+        two[1] = 4_466; // 70,000 - 65,534 mV
+        assert_eq!(v(70.0), two);
+        let mut exact = [u16::MAX; 10];
+        exact[0] = 65_534;
+        assert_eq!(v(65.534), exact);
+        assert_eq!(v(700.0), [u16::MAX; 10]);
+        assert_eq!(v(0.0)[0], 0);
+        let i = |amps: f64| {
+            battery(&BatteryReply {
+                current_a: Some(amps),
+                ..BatteryReply::default()
+            })
+            .current_battery
+        };
+        assert_eq!(i(400.0), i16::MAX);
+        assert_eq!(i(-400.0), i16::MIN);
+        assert_eq!(i(-0.01), 0);
+        assert_eq!(i(-0.5), -50);
+        let other = battery(&BatteryReply {
+            time_remaining_s: Some(0.2),
+            remaining_percent: Some(104.0),
+            ..BatteryReply::default()
+        });
+        assert_eq!(other.time_remaining, 1);
+        assert_eq!(other.battery_remaining, 100);
+        let below = battery(&BatteryReply {
+            time_remaining_s: Some(-3.0),
+            remaining_percent: Some(-2.0),
+            ..BatteryReply::default()
+        });
+        assert_eq!(below.time_remaining, 0);
+        assert_eq!(below.battery_remaining, 0);
+    }
+
+    #[test]
+    fn statustext_severities_are_mavlinks() {
+        for (severity, want) in [
+            (Severity::Critical, MavSeverity::MAV_SEVERITY_CRITICAL),
+            (Severity::Warning, MavSeverity::MAV_SEVERITY_WARNING),
+            (Severity::Notice, MavSeverity::MAV_SEVERITY_NOTICE),
+            (Severity::Info, MavSeverity::MAV_SEVERITY_INFO),
+        ] {
+            let MavMessage::STATUSTEXT(t) = status_text("aloft: x", severity) else {
+                panic!("not a STATUSTEXT")
+            };
+            assert_eq!(t.severity, want);
+            assert_eq!(t.severity as u8, severity.mav_severity());
+        }
     }
 }

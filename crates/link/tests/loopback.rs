@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use aloft_link::mavlink::dialects::ardupilotmega::{
     MavAutopilot, MavFrame, MavMessage, MavModeFlag, MavSeverity, MavState, MavType,
     GLOBAL_POSITION_INT_DATA, HEARTBEAT_DATA, MISSION_COUNT_DATA, MISSION_ITEM_INT_DATA,
-    SYS_STATUS_DATA,
+    PARAM_VALUE_DATA, SYS_STATUS_DATA,
 };
 use aloft_link::mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
 use aloft_link::{Event, LinkOptions, LinkSource, Reply, Telemetry};
@@ -79,6 +79,16 @@ fn answer(msg: &MavMessage) -> Option<MavMessage> {
                 target_system: 255,
                 target_component: 190,
                 ..MISSION_ITEM_INT_DATA::default()
+            }))
+        }
+        // The one failsafe parameter this vehicle answers (an INT8 would be cast as well).
+        MavMessage::PARAM_REQUEST_READ(r) if r.param_id.to_str() == Ok("BATT_LOW_VOLT") => {
+            Some(MavMessage::PARAM_VALUE(PARAM_VALUE_DATA {
+                param_value: 10.5,
+                param_count: 1_000,
+                param_index: 42,
+                param_id: "BATT_LOW_VOLT".into(),
+                param_type: aloft_link::mavlink::dialects::ardupilotmega::MavParamType::MAV_PARAM_TYPE_REAL32,
             }))
         }
         _ => None,
@@ -164,7 +174,7 @@ fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
 
     // Telemetry: heartbeat, origin and position, battery.
     let mut seen = (false, false, false);
-    events_until(&mut link, |t| {
+    let first = events_until(&mut link, |t| {
         match &t.event {
             Event::Heartbeat(h) => seen.0 = h.armed && h.mode == "AUTO",
             Event::Origin(o) => seen.1 = (o.lat_rad.to_degrees() - 47.3977).abs() < 1e-9,
@@ -183,11 +193,19 @@ fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
     .expect("send");
     link.reply(&Reply::Text {
         text: "aloft: return now, 12 % margin left at home".into(),
-        warning: true,
+        severity: aloft_link::Severity::Warning,
     })
     .expect("send");
 
-    // The mission, downloaded by aloft START_AFTER the vehicle's first message.
+    // The failsafe parameter asked for and answered, then the mission, downloaded by aloft
+    // START_AFTER the vehicle's first message.
+    let low_volt = Event::Parameter {
+        name: "BATT_LOW_VOLT".into(),
+        value: 10.5,
+    };
+    if !first.iter().any(|t| t.event == low_volt) {
+        events_until(&mut link, |t| t.event == low_volt);
+    }
     let ev = events_until(&mut link, |t| matches!(t.event, Event::Mission(_)));
     let Some(Event::Mission(m)) = ev.last().map(|t| &t.event) else {
         unreachable!()
@@ -255,6 +273,30 @@ fn check_received(received: &[Received]) {
     assert!(received.iter().any(
         |(_, _, m)| matches!(m, MavMessage::HEARTBEAT(h) if h.mavtype == MavType::MAV_TYPE_GCS)
     ));
+    // ArduPilot's failsafe parameters, each asked by name of the vehicle (1, 1).
+    let asked: std::collections::BTreeSet<&str> = received
+        .iter()
+        .filter_map(|(_, _, m)| match m {
+            MavMessage::PARAM_REQUEST_READ(r)
+                if r.param_index == -1 && (r.target_system, r.target_component) == (1, 1) =>
+            {
+                r.param_id.to_str().ok()
+            }
+            _ => None,
+        })
+        .collect();
+    let want = [
+        "BATT_LOW_VOLT",
+        "BATT_CRT_VOLT",
+        "BATT_LOW_MAH",
+        "BATT_CRT_MAH",
+        "BATT_LOW_TIMER",
+        "BATT_FS_VOLTSRC",
+        "BATT_FS_LOW_ACT",
+        "BATT_FS_CRT_ACT",
+        "BATT_CAPACITY",
+    ];
+    assert_eq!(asked, want.into_iter().collect());
 }
 
 #[test]

@@ -143,6 +143,12 @@ impl BinarySummary {
         }
     }
 
+    /// The parameters read ([`crate::battery_records::is_kept_parameter`]: the battery's
+    /// and the flight envelope's), by name, when [`BinaryOptions::battery_details`] is set.
+    pub fn kept_parameters(&self) -> Option<&BTreeMap<String, f64>> {
+        self.battery_details.as_ref().map(|d| &d.parameters)
+    }
+
     /// A decoder resynchronised: the bytes from `from` to `at` were skipped (`what`: "ULog
     /// record", "DataFlash data").
     pub(crate) fn resynchronised(&mut self, what: &str, from: u64, at: u64) {

@@ -160,13 +160,89 @@ pub enum Reply {
         /// The value.
         value: f64,
     },
-    /// A text (STATUSTEXT, at most 50 characters), at warning severity or as information.
+    /// A text (STATUSTEXT, at most 50 characters) at a severity.
     Text {
         /// The text.
         text: String,
-        /// WARNING severity (else INFO).
-        warning: bool,
+        /// How grave it is (QGroundControl speaks [`Severity::Notice`] and graver).
+        severity: Severity,
     },
+    /// aloft's own estimate of the pack, as a battery of its own id (BATTERY_STATUS).
+    Battery(BatteryReply),
+}
+
+/// The severity of a [`Reply::Text`]: MAVLink's MAV_SEVERITY, the four aloft uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Severity {
+    /// Action required now (MAV_SEVERITY_CRITICAL, 2).
+    Critical,
+    /// Something will go wrong unless acted on (MAV_SEVERITY_WARNING, 4).
+    Warning,
+    /// Unusual, not an error (MAV_SEVERITY_NOTICE, 5).
+    Notice,
+    /// Information (MAV_SEVERITY_INFO, 6).
+    Info,
+}
+
+impl Severity {
+    /// Its MAV_SEVERITY value.
+    pub fn mav_severity(self) -> u8 {
+        match self {
+            Severity::Critical => 2,
+            Severity::Warning => 4,
+            Severity::Notice => 5,
+            Severity::Info => 6,
+        }
+    }
+}
+
+/// How far the pack is discharged, as a ground station shows it (MAV_BATTERY_CHARGE_STATE).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum ChargeState {
+    /// Not known (MAV_BATTERY_CHARGE_STATE_UNDEFINED, 0).
+    #[default]
+    Undefined,
+    /// Normal operation (OK, 1).
+    Ok,
+    /// Warn and watch closely (LOW, 2).
+    Low,
+    /// Return or abort now (CRITICAL, 3).
+    Critical,
+    /// Too low for an ordinary return: land now (EMERGENCY, 4).
+    Emergency,
+}
+
+impl ChargeState {
+    /// Its MAV_BATTERY_CHARGE_STATE value.
+    pub fn mav_charge_state(self) -> u8 {
+        match self {
+            ChargeState::Undefined => 0,
+            ChargeState::Ok => 1,
+            ChargeState::Low => 2,
+            ChargeState::Critical => 3,
+            ChargeState::Emergency => 4,
+        }
+    }
+}
+
+/// aloft's estimate of the pack, sent as a battery of its own (BATTERY_STATUS); `None` is "not
+/// known" (MAVLink's invalid value for the field).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BatteryReply {
+    /// The battery id aloft's battery is shown under (`--battery-id`).
+    pub id: u8,
+    /// State of charge, percent (0-100).
+    pub remaining_percent: Option<f64>,
+    /// Time remaining, s (until the first failsafe ahead).
+    pub time_remaining_s: Option<f64>,
+    /// The pack's voltage, V (measured).
+    pub voltage_v: Option<f64>,
+    /// The pack's current, A, positive discharging (measured).
+    pub current_a: Option<f64>,
+    /// Charge drawn, mA h.
+    pub consumed_mah: Option<f64>,
+    /// How far it is discharged.
+    pub charge_state: ChargeState,
 }
 
 /// A source played at a pace: event `t` is returned no earlier than `t / speed` seconds of wall
@@ -248,11 +324,13 @@ impl<S: TelemetrySource> TelemetrySource for Paced<S> {
     }
 }
 
-/// A flight log replayed as events: its origin (where its positions were geodetic), then a
-/// sample event per record and the log's other events (a DataFlash log's mode, arming and
-/// mission: [`crate::flight_events`]) in time order (`aloft live --replay`).
+/// A flight log replayed as events: its origin (where its positions were geodetic), its
+/// parameters ([`LogEvents::with_parameters`]), then a sample event per record and the log's
+/// other events (a DataFlash log's mode, arming and mission: [`crate::flight_events`]) in time
+/// order (`aloft live --replay`).
 pub struct LogEvents {
     origin: Option<GeoOrigin>,
+    parameters: std::vec::IntoIter<(String, f64)>,
     samples: std::iter::Peekable<std::vec::IntoIter<Sample>>,
     events: std::iter::Peekable<std::vec::IntoIter<Telemetry>>,
 }
@@ -267,9 +345,17 @@ impl LogEvents {
     pub fn with_events(log: Log, events: Vec<Telemetry>) -> Self {
         Self {
             origin: log.origin,
+            parameters: Vec::new().into_iter(),
             samples: log.samples.into_iter().peekable(),
             events: events.into_iter().peekable(),
         }
+    }
+
+    /// The same, with the log's `parameters` (name, value) sent as [`Event::Parameter`] before
+    /// its first record (after its origin), at the first record's time.
+    pub fn with_parameters(mut self, parameters: Vec<(String, f64)>) -> Self {
+        self.parameters = parameters.into_iter();
+        self
     }
 }
 
@@ -280,6 +366,13 @@ impl TelemetrySource for LogEvents {
             return Ok(Some(Telemetry {
                 time_s: first,
                 event: Event::Origin(o),
+            }));
+        }
+        if let Some((name, value)) = self.parameters.next() {
+            let first = self.samples.peek().map_or(0.0, |s| s.time_s);
+            return Ok(Some(Telemetry {
+                time_s: first,
+                event: Event::Parameter { name, value },
             }));
         }
         let sample_first = match (self.samples.peek(), self.events.peek()) {
@@ -295,5 +388,79 @@ impl TelemetrySource for LogEvents {
             }),
             false => self.events.next(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The log's parameters come after its origin and before its first record, at that
+    /// record's time, in the order given.
+    #[test]
+    fn a_replayed_log_sends_its_parameters_before_its_first_record() {
+        let samples = [3.0, 3.5].map(|time_s| Sample {
+            time_s,
+            ..Sample::default()
+        });
+        let log = Log {
+            samples: samples.to_vec(),
+            origin: Some(GeoOrigin {
+                lat_rad: 0.8,
+                lon_rad: 0.1,
+                alt_m: 10.0,
+            }),
+            ..Log::default()
+        };
+        let params = vec![
+            ("BAT_LOW_THR".to_string(), 0.15),
+            ("BAT1_N_CELLS".into(), 3.0),
+        ];
+        let mut events = LogEvents::new(log).with_parameters(params);
+        let got: Vec<Telemetry> = std::iter::from_fn(|| events.next_event().unwrap()).collect();
+        assert_eq!(got.len(), 5);
+        assert!(matches!(got[0].event, Event::Origin(_)));
+        assert_eq!(
+            got[1].event,
+            Event::Parameter {
+                name: "BAT_LOW_THR".into(),
+                value: 0.15
+            }
+        );
+        assert_eq!(
+            got[2].event,
+            Event::Parameter {
+                name: "BAT1_N_CELLS".into(),
+                value: 3.0
+            }
+        );
+        // Times copied from the samples, not computed: exact.
+        assert_eq!(got[1].time_s.to_bits(), 3.0f64.to_bits());
+        let Event::Sample(first) = &got[3].event else {
+            panic!("not a sample: {:?}", got[3])
+        };
+        assert_eq!(first.time_s.to_bits(), 3.0f64.to_bits());
+    }
+
+    #[test]
+    fn severities_and_charge_states_are_mavlinks() {
+        let sev = [
+            Severity::Critical,
+            Severity::Warning,
+            Severity::Notice,
+            Severity::Info,
+        ]
+        .map(Severity::mav_severity);
+        // common.xml MAV_SEVERITY: CRITICAL 2, WARNING 4, NOTICE 5, INFO 6.
+        assert_eq!(sev, [2, 4, 5, 6]);
+        let states = [
+            ChargeState::Undefined,
+            ChargeState::Ok,
+            ChargeState::Low,
+            ChargeState::Critical,
+            ChargeState::Emergency,
+        ]
+        .map(ChargeState::mav_charge_state);
+        assert_eq!(states, [0, 1, 2, 3, 4]);
     }
 }

@@ -10,7 +10,7 @@
 //!   predicted power ([`estimate`](self::estimate)), the wind from the autopilot or the tilt, and
 //!   the rest of the route flown from the present state in Monte-Carlo scenarios
 //!   ([`ahead`](self::ahead)), with the advice and its hysteresis ([`advice`](self::advice)); on
-//!   a link, the answer sent back ([`replies`]).
+//!   a link, the answer sent back ([`LiveReplies`]: values, aloft's own battery, texts).
 //! - [`replay_live`]: the validation route (`--route log`), a flight log replayed with the rest of
 //!   the logged path as the route ahead, so each prediction is checked against the energy the
 //!   log measured from then to the end.
@@ -18,7 +18,7 @@
 use serde::Serialize;
 
 use aloft_logs::frame::enu_to_geodetic;
-use aloft_logs::telemetry::{Reply, TelemetrySource};
+use aloft_logs::telemetry::TelemetrySource;
 
 use crate::engine::conditions::air::AirInput;
 use crate::engine::finite::finite;
@@ -37,6 +37,7 @@ mod failsafes;
 mod pack_state;
 mod record;
 mod replay;
+mod replies;
 mod sources;
 mod tracker;
 
@@ -44,6 +45,7 @@ pub use ahead::LIVE_SCENARIOS;
 pub use failsafes::{LiveFailsafe, TimeBand};
 pub use record::LiveRecorder;
 pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
+pub use replies::{LiveReplies, DEFAULT_BATTERY_ID};
 pub use sources::LiveSource;
 
 use advice::AdviceHold;
@@ -197,6 +199,9 @@ pub struct LiveRequest {
     /// The day's air (default: the mission's home altitude in ISA air, else the vehicle file's
     /// density).
     pub air: AirInput,
+    /// The BATTERY_STATUS id aloft's own battery is sent under on a link (default
+    /// [`DEFAULT_BATTERY_ID`]).
+    pub battery_id: u8,
 }
 
 impl LiveRequest {
@@ -213,6 +218,7 @@ impl LiveRequest {
             low_voltage_v: None,
             critical_voltage_v: None,
             air: AirInput::default(),
+            battery_id: DEFAULT_BATTERY_ID,
         }
     }
 }
@@ -239,7 +245,7 @@ pub struct LiveSummary {
 }
 
 /// Follow `source` to its end: an update every `every_s` seconds of its time to `emit`, and on a
-/// link the answer sent back through [`TelemetrySource::reply`] ([`replies`]).
+/// link the answer sent back through [`TelemetrySource::reply`] ([`LiveReplies`]).
 ///
 /// Steps per event: fold it into the flight's state; at an update, the state of charge, the
 /// efficiency's estimate, then the route ahead and the advice, then the replies.
@@ -266,6 +272,7 @@ pub fn follow_live(
     let mut updates = 0;
     let (mut first_s, mut next_s) = (None, f64::NEG_INFINITY);
     let mut last: Option<LiveUpdate> = None;
+    let mut replies = LiveReplies::new(request.battery_id);
     while let Some(event) = source.next_event().map_err(Error::Link)? {
         follower.apply(&event);
         let now = follower.tracker.now_s;
@@ -285,7 +292,7 @@ pub fn follow_live(
             _ => follower.update(),
         };
         let update = finite(update, "live", || "the live update".to_string())?;
-        for reply in replies(last.as_ref(), &update) {
+        for reply in replies.replies(last.as_ref(), &update) {
             source.reply(&reply).map_err(Error::Link)?;
         }
         emit(&update)?;
@@ -312,47 +319,6 @@ pub(crate) fn check_every(every_s: f64) -> Result<(), Error> {
         unit: "s",
         expected: "a positive number of seconds",
     })
-}
-
-/// What `aloft live` sends back on a link after `update` (the one before it `previous`): the
-/// reserve at landing (p50 and p5, percent), the seconds to the point of no return and the
-/// remaining energy as NAMED_VALUE_FLOAT, and a STATUSTEXT when the advice changes (at warning
-/// severity unless it is `continue`).
-pub fn replies(previous: Option<&LiveUpdate>, update: &LiveUpdate) -> Vec<Reply> {
-    let mut out = Vec::new();
-    if let Some(l) = update.landing_soc {
-        out.push(Reply::Value {
-            name: "rsv_p50",
-            value: 100.0 * l.p50,
-        });
-        out.push(Reply::Value {
-            name: "rsv_p5",
-            value: 100.0 * l.p5,
-        });
-    }
-    if let Some(pnr) = update.point_of_no_return_s {
-        out.push(Reply::Value {
-            name: "pnr_s",
-            value: pnr,
-        });
-    }
-    if let Some(r) = update.remaining_wh {
-        out.push(Reply::Value {
-            name: "rem_wh",
-            value: r.p50,
-        });
-    }
-    let before = previous.and_then(|p| p.advice);
-    if let Some(advice) = update.advice.filter(|a| Some(*a) != before) {
-        let landing = update.landing_soc.map_or_else(String::new, |l| {
-            format!(", lands at {:.0}% (p5)", 100.0 * l.p5)
-        });
-        out.push(Reply::Text {
-            text: format!("aloft: {advice}{landing}"),
-            warning: advice != "continue",
-        });
-    }
-    out
 }
 
 /// A flight followed event by event: [`follow_live`]'s state, for a caller that feeds the events
@@ -823,57 +789,4 @@ fn position(t: &Tracker) -> Option<Position> {
         latitude_deg: geo.map(|g| g.0.to_degrees()),
         longitude_deg: geo.map(|g| g.1.to_degrees()),
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn update(advice: &'static str, landing_p5: f64) -> LiveUpdate {
-        LiveUpdate {
-            remaining_wh: Some(Percentiles {
-                p5: 4.5,
-                p50: 5.0,
-                p95: 5.5,
-            }),
-            landing_soc: Some(Percentiles {
-                p5: landing_p5,
-                p50: landing_p5 + 0.02,
-                p95: landing_p5 + 0.04,
-            }),
-            point_of_no_return_s: Some(42.0),
-            advice: Some(advice),
-            ..LiveUpdate::default()
-        }
-    }
-
-    /// Every update sends the four values; a STATUSTEXT only when the advice changes, at warning
-    /// severity unless it is `continue`.
-    #[test]
-    fn replies_send_the_values_and_the_advice_when_it_changes() {
-        let first = update("continue", 0.30);
-        let r = replies(None, &first);
-        let values: Vec<(&str, f64)> = r
-            .iter()
-            .filter_map(|r| match r {
-                Reply::Value { name, value } => Some((*name, *value)),
-                Reply::Text { .. } => None,
-            })
-            .collect();
-        assert_eq!(values.len(), 4);
-        assert_eq!(values[0].0, "rsv_p50");
-        assert!((values[0].1 - 32.0).abs() < 1e-9);
-        assert_eq!(values[1].0, "rsv_p5");
-        assert_eq!(values[2], ("pnr_s", 42.0));
-        assert_eq!(values[3], ("rem_wh", 5.0));
-        assert!(
-            matches!(&r[4], Reply::Text { text, warning: false } if text == "aloft: continue, lands at 30% (p5)")
-        );
-        // The same advice again: values only.
-        assert_eq!(replies(Some(&first), &update("continue", 0.25)).len(), 4);
-        let turn = replies(Some(&first), &update("return now", 0.12));
-        assert!(
-            matches!(&turn[4], Reply::Text { text, warning: true } if text.starts_with("aloft: return now"))
-        );
-    }
 }

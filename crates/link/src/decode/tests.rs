@@ -668,3 +668,109 @@ fn an_upload_by_the_ground_station_is_the_mission_and_fences_are_not() {
     assert!(close(m[0].params[4], 1.2345, TOL) && close(m[0].params[5], -2.0, TOL));
     assert_eq!(d.mission().map(<[MissionItem]>::len), Some(1));
 }
+
+fn param(name: &str, raw: f32, kind: MavParamType) -> MavMessage {
+    MavMessage::PARAM_VALUE(mavlink::dialects::ardupilotmega::PARAM_VALUE_DATA {
+        param_value: raw,
+        param_count: 900,
+        param_index: 7,
+        param_id: name.into(),
+        param_type: kind,
+    })
+}
+
+fn parameters(ev: &[Telemetry]) -> Vec<(String, f64)> {
+    ev.iter()
+        .filter_map(|t| match &t.event {
+            Event::Parameter { name, value } => Some((name.clone(), *value)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// ArduPilot casts every parameter to the float (BATT_FS_LOW_ACT INT8 2 is 2.0); PX4 copies an
+/// integer's bytes (BAT1_N_CELLS INT32 3 is the float whose bits are 3), and a float is the
+/// float on both. The bits below are built here from the integers, not taken from aloft.
+#[test]
+fn parameter_values_are_decoded_as_each_autopilot_encodes_them() {
+    use MavParamType as T;
+    let mut ardu = decoder();
+    let ev = events(
+        &mut ardu,
+        1.0,
+        h(1, 1),
+        param("BATT_FS_LOW_ACT", 2.0, T::MAV_PARAM_TYPE_INT8),
+    );
+    assert_eq!(parameters(&ev), [("BATT_FS_LOW_ACT".to_string(), 2.0)]);
+    let ev = events(
+        &mut ardu,
+        1.0,
+        h(1, 1),
+        param("BATT_LOW_VOLT", 10.5, T::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(parameters(&ev), [("BATT_LOW_VOLT".to_string(), 10.5)]);
+
+    let mut px4 = Decoder::new();
+    let px4_hb = hb(
+        MavAutopilot::MAV_AUTOPILOT_PX4,
+        MavType::MAV_TYPE_QUADROTOR,
+        false,
+        0,
+    );
+    events(&mut px4, 0.0, h(1, 1), px4_hb);
+    let cells = f32::from_bits(3_u32);
+    let ev = events(
+        &mut px4,
+        1.0,
+        h(1, 1),
+        param("BAT1_N_CELLS", cells, T::MAV_PARAM_TYPE_INT32),
+    );
+    assert_eq!(parameters(&ev), [("BAT1_N_CELLS".to_string(), 3.0)]);
+    // A negative INT32 (COM_LOW_BAT_ACT is small, so a made-up -5) is its two's complement.
+    let minus5 = f32::from_bits((-5_i32) as u32);
+    let ev = events(
+        &mut px4,
+        1.0,
+        h(1, 1),
+        param("X_NEG", minus5, T::MAV_PARAM_TYPE_INT32),
+    );
+    assert_eq!(parameters(&ev), [("X_NEG".to_string(), -5.0)]);
+    let ev = events(
+        &mut px4,
+        1.0,
+        h(1, 1),
+        param("BAT_LOW_THR", 0.15, T::MAV_PARAM_TYPE_REAL32),
+    );
+    assert!(close(parameters(&ev)[0].1, 0.15, 1e-7));
+    // A name of 16 characters has no NUL; it is read whole.
+    let ev = events(
+        &mut px4,
+        1.0,
+        h(1, 1),
+        param("ABCDEFGHIJKLMNOP", 1.0, T::MAV_PARAM_TYPE_REAL32),
+    );
+    assert_eq!(parameters(&ev)[0].0, "ABCDEFGHIJKLMNOP");
+}
+
+/// 64-bit types do not fit the float, a value that is not finite is no value, another
+/// component's parameter is not the vehicle's.
+#[test]
+fn parameters_that_cannot_be_read_are_not_sent() {
+    use MavParamType as T;
+    let mut d = decoder();
+    for msg in [
+        param("A", 1.0, T::MAV_PARAM_TYPE_INT64),
+        param("B", 1.0, T::MAV_PARAM_TYPE_REAL64),
+        param("C", f32::NAN, T::MAV_PARAM_TYPE_REAL32),
+        param("", 1.0, T::MAV_PARAM_TYPE_REAL32),
+    ] {
+        assert!(parameters(&events(&mut d, 1.0, h(1, 1), msg)).is_empty());
+    }
+    let other = events(
+        &mut d,
+        1.0,
+        h(1, 100),
+        param("BATT_LOW_VOLT", 10.5, T::MAV_PARAM_TYPE_REAL32),
+    );
+    assert!(parameters(&other).is_empty());
+}
