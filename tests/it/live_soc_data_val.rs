@@ -1,10 +1,12 @@
-//! `aloft live --replay` starts from the state of charge the vehicle reports, not a full pack
-//! (a defect found on the shared PX4 flights: PX4 said 69 % at take-off, aloft 100 %), and every
-//! figure of every update stays in its physical range on every shared log aloft can replay.
+//! `aloft live --replay` follows the pack's own state of charge, not a full pack (a defect found
+//! on the shared PX4 flights: PX4 said 69 % at take-off, aloft 100 %) nor PX4's voltage-based
+//! report, which sags under load (issue 44), and every figure of every update stays in its
+//! physical range on every shared log aloft can replay.
 //!
 //! The expected states of charge are read here from the per-topic CSVs beside the ULog files
 //! (`px4_flugdrohne/csv`, decoded by `ulog2csv`, independently of aloft): `battery_status`
-//! (`remaining`, `voltage_v`) and `vehicle_land_detected` (take-off and landing).
+//! (`remaining`, `voltage_v`, `current_a`, `discharged_mah`) and `vehicle_land_detected`
+//! (take-off and landing).
 
 use crate::common;
 
@@ -131,12 +133,12 @@ fn table(log: &str, topic: &str, names: &[&str]) -> Vec<Vec<f64>> {
 /// What PX4 reported on one flight, read from its CSVs: the boot time of the ULog's first
 /// sample (the first `vehicle_local_position`, s), the take-off and the last landing (boot
 /// time, s) from `vehicle_land_detected`, and `battery_status` rows `(time s, remaining,
-/// voltage V, current A)`.
+/// voltage V, current A, discharged mA h)`.
 struct Reported {
     first_s: f64,
     take_off_s: f64,
     landing_s: f64,
-    battery: Vec<[f64; 4]>,
+    battery: Vec<[f64; 5]>,
 }
 
 impl Reported {
@@ -149,10 +151,16 @@ impl Reported {
             .filter(|w| w[0][1] < 0.5 && w[1][1] > 0.5)
             .map(|w| w[1][0] * 1e-6)
             .collect();
-        let names = ["timestamp", "remaining", "voltage_v", "current_a"];
+        let names = [
+            "timestamp",
+            "remaining",
+            "voltage_v",
+            "current_a",
+            "discharged_mah",
+        ];
         let battery = table(log, "battery_status", &names)
             .into_iter()
-            .map(|r| [r[0] * 1e-6, r[1], r[2], r[3]])
+            .map(|r| [r[0] * 1e-6, r[1], r[2], r[3], r[4]])
             .collect();
         Self {
             first_s,
@@ -163,13 +171,35 @@ impl Reported {
     }
 
     /// The last `battery_status` row at or before boot time `t_s`.
-    fn at(&self, t_s: f64) -> [f64; 4] {
+    fn at(&self, t_s: f64) -> [f64; 5] {
         *self.battery.iter().rev().find(|r| r[0] <= t_s).unwrap()
     }
 
     /// `remaining` at the stream time of an update (s from the first sample).
     fn remaining_at_stream_s(&self, time_s: f64) -> f64 {
         self.at(self.first_s + time_s)[1]
+    }
+
+    /// The pack's rested voltage before take-off: the median of the records at under 0.5 A in
+    /// the 10 s before it, V.
+    fn rested_v(&self) -> f64 {
+        let mut v: Vec<f64> = self
+            .battery
+            .iter()
+            .filter(|b| b[0] < self.take_off_s && b[0] >= self.take_off_s - 10.0 && b[3] < 0.5)
+            .map(|b| b[2])
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    }
+
+    /// The pack's state of charge at the stream time of an update: the rested voltage's on the
+    /// generic LiPo curve (the vehicle's pack gives none of its own), less the charge PX4
+    /// counted since take-off over the 5000 mA h the owner states.
+    fn counted_at_stream_s(&self, time_s: f64) -> f64 {
+        let s0 = aloft_propulsion::OcvCurve::typical_lipo().soc_at(self.rested_v() / 3.0);
+        let drawn = self.at(self.first_s + time_s)[4] - self.at(self.take_off_s)[4];
+        s0 - drawn / 5000.0
     }
 }
 
@@ -181,21 +211,28 @@ fn in_air(v: &[Value]) -> Vec<&Value> {
     v.iter().filter(|u| u["in_air"] == true).collect()
 }
 
-/// The defect as the user found it: `log_66`, where PX4 reports 69 % at take-off, was followed
-/// from a full pack (100 % at take-off, "continue" all flight with a 60 % reserve, efficiency
-/// up to 1.23). Each update in the air now says PX4's state of charge (within 2 %: the updates
-/// fall between PX4's 5 Hz records, which move by up to 1.3 % from one to the next), the first
-/// one the take-off's, the last one the landing's; with a 60 % reserve the advice turns from
-/// `continue`. The same on the other flights whose PX4 estimate is configured (the other two
-/// report a constant 100 %: below).
+/// Issue 44 on the five PX4 flights (3S, 5000 mA h from the owner): the state of charge in the
+/// air is the pack's (its rested voltage before take-off on the pack's curve, less the charge
+/// PX4 counted since, computed here from the CSVs) within 9 points, and within 4 on `log_66`,
+/// the flight that reports 69 % at take-off; it does not rise at touchdown by more than 3
+/// points; and the vehicle's own report is beside it as `reported_soc` (PX4's `remaining`
+/// within 2 %: the updates fall between PX4's 5 Hz records). PX4 estimates from the voltage
+/// under load (`BAT1_CAPACITY` unset), which sags: before, `soc` was that report, which fell to
+/// 44 % in the air on `log_66` (the pack 59-63 %), 53 % on `log_65` (65-68 %), 72 % on
+/// `1x_wo_Last_5m` (85-92 %), and rose 4 points at the first update on the ground. Measured
+/// now: worst 2.7, 1.8, 6.3, 7.4, 8.3 points from the pack's, no rise over 0.6 points. With a
+/// 60 % reserve `log_66` still does not say `continue` throughout.
 #[test]
-fn data_val_live_replay_follows_the_px4_reported_soc() {
+fn data_val_live_replay_follows_the_pack_not_the_sagging_report() {
     let dir = data_dir().join("px4_flugdrohne/ulg");
     let vehicle = px4_vehicle("log_66_2023-6-21-08-44-02");
+    let configured = ["log_66", "log_65", "1x_wo_Last"];
     for log in [
         "log_66_2023-6-21-08-44-02",
         "log_65_2023-6-21-08-36-08",
         "1x_wo_Last_5m",
+        "log_20_2023-6-7-10-52-56",
+        "log_30_2023-6-7-12-11-06",
     ] {
         let r = Reported::of(log);
         let ulog = dir.join(format!("{log}.ulg")).display().to_string();
@@ -205,33 +242,45 @@ fn data_val_live_replay_follows_the_px4_reported_soc() {
             &["--every", "1", "--reserve-percent", "60"],
         );
         let air = in_air(&v);
-        let first = num(air[0], "soc");
-        let take_off = r.at(r.take_off_s)[1];
-        let last = num(air[air.len() - 1], "soc");
-        let landing = r.at(r.landing_s)[1];
-        println!(
-            "{log}: take-off PX4 {take_off:.3} aloft {first:.3}; landing PX4 {landing:.3} aloft \
-             {last:.3}; advice {:?}",
-            air.iter()
-                .map(|u| u["advice"].as_str().unwrap_or("-"))
-                .collect::<Vec<_>>()
-        );
-        assert!(
-            (first - take_off).abs() < 0.02,
-            "{log}: {first} vs {take_off}"
-        );
+        let tolerance = if log.starts_with("log_66") {
+            0.04
+        } else {
+            0.09
+        };
+        let mut worst: f64 = 0.0;
         for u in &air {
-            let want = r.remaining_at_stream_s(num(u, "time_s"));
-            let soc = num(u, "soc");
-            assert!((soc - want).abs() < 0.02, "{log}: {u} vs PX4 {want}");
+            let t = num(u, "time_s");
+            let (soc, want) = (num(u, "soc"), r.counted_at_stream_s(t));
+            worst = worst.max((soc - want).abs());
+            assert!(
+                (soc - want).abs() <= tolerance,
+                "{log}: {u} vs the pack's {want}"
+            );
+            if configured.iter().any(|c| log.starts_with(c)) {
+                let px4 = r.remaining_at_stream_s(t);
+                let reported = num(u, "reported_soc");
+                assert!((reported - px4).abs() < 0.02, "{log}: {u} vs PX4 {px4}");
+            }
         }
-        // The last update in the air is up to 1 s before the landing.
-        assert!((last - landing).abs() < 0.03, "{log}: {last} vs {landing}");
+        // Touchdown: the first update on the ground after the last landing against the last
+        // one in the air.
+        let last_air = air[air.len() - 1];
+        let t_last = num(last_air, "time_s");
+        let after = v
+            .iter()
+            .find(|u| u["in_air"] == false && num(u, "time_s") > t_last);
+        let rise = after.map_or(0.0, |u| num(u, "soc") - num(last_air, "soc"));
+        println!("{log}: worst {worst:.3} from the pack's; rise at touchdown {rise:+.3}");
+        assert!(rise <= 0.03, "{log}: rose {rise} at touchdown");
         if log.starts_with("log_66") {
-            assert!((take_off - 0.69).abs() < 0.01, "{take_off}");
+            assert!(
+                (r.at(r.take_off_s)[1] - 0.69).abs() < 0.01,
+                "{:?}",
+                r.at(r.take_off_s)
+            );
             assert!(
                 air.iter().any(|u| u["advice"] != "continue"),
-                "{log}: continue all flight with a 60 % reserve from 69 %"
+                "{log}: continue all flight with a 60 % reserve from 60 %"
             );
         }
     }
