@@ -226,7 +226,7 @@ impl WatchRun for AheadRun {
         let dt_s = (sample.time_s - self.last_time_s).max(0.0);
         self.last_time_s = sample.time_s;
         let i = sample.current_a;
-        self.filter.predict(dt_s, i);
+        self.filter.predict_mean(dt_s, i);
         let v = self.filter.terminal_v(i);
         self.least_v = self.least_v.min(v);
         for k in self.monitor.step(dt_s, v, Some(i), None).indexes() {
