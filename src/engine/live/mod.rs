@@ -722,11 +722,19 @@ impl<'a> LiveSession<'a> {
             .watched
             .as_ref()
             .and_then(|w| w.as_ref().err().cloned());
+        let foreign_note = self.pack_state.foreign_v().map(|v| {
+            format!(
+                "the pack's voltage ({v:.1} V) is not a voltage of the {}-cell pack of the \
+                 vehicle file: the state of charge is the vehicle's report, less the charge drawn",
+                self.charge.pack().cells_series()
+            )
+        });
         let note = [
             note,
             self.charge.note(),
             self.disagreement_note(),
             watched_note,
+            foreign_note,
         ]
         .into_iter()
         .flatten()

@@ -66,7 +66,14 @@ pub(crate) struct PackState {
     /// The vehicle's last report (0-1) and when it was last taken as a measurement, s.
     reported: Option<f64>,
     last_fused_s: f64,
+    /// A voltage that is not this pack's (V): the vehicle file's pack is not the one flown,
+    /// and the filter is not used.
+    foreign_v: Option<f64>,
 }
+
+/// The voltages a pack may show under load, V per cell: below, or above, it is another pack
+/// (other cells in series).
+pub(crate) const PACK_CELL_V: (f64, f64) = (2.5, 4.35);
 
 impl PackState {
     /// The state of a flight on `pack` (its open-circuit curve, cells, capacity and resistance;
@@ -87,17 +94,27 @@ impl PackState {
             start: None,
             reported: None,
             last_fused_s: f64::NEG_INFINITY,
+            foreign_v: None,
         }
     }
 
-    /// The estimate now and its band; `None` before anything started it.
+    /// The estimate now and its band; `None` before anything started it, or where the voltage
+    /// is not this pack's.
     pub(crate) fn estimate(&self) -> Option<SocEstimate> {
+        if self.foreign_v.is_some() {
+            return None;
+        }
         self.filter.as_ref().map(SocFilter::band)
     }
 
-    /// The filter itself (to fly the rest of the route on).
+    /// A voltage seen that is not this pack's, V.
+    pub(crate) fn foreign_v(&self) -> Option<f64> {
+        self.foreign_v
+    }
+
+    /// The filter itself (to fly the rest of the route on), where the voltage is this pack's.
     pub(crate) fn filter(&self) -> Option<&SocFilter> {
-        self.filter.as_ref()
+        self.filter.as_ref().filter(|_| self.foreign_v.is_none())
     }
 
     /// The vehicle's last report, 0-1.
@@ -173,6 +190,10 @@ impl PackState {
         let (voltage_v, current_a, power_w) = measured;
         if let Some(v) = voltage_v.filter(|v| v.is_finite() && *v > 0.0) {
             self.voltage_v = Some(v);
+            let cell_v = v / f64::from(self.circuit.cells_series);
+            if !(PACK_CELL_V.0..=PACK_CELL_V.1).contains(&cell_v) {
+                self.foreign_v.get_or_insert(v);
+            }
         }
         let current_a = current_a.filter(|i| i.is_finite()).or_else(|| {
             let v = self.voltage_v?;
