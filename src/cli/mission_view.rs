@@ -327,7 +327,7 @@ fn write_bands(out: &mut impl Write, u: &Uncertainty) -> Result<()> {
 fn band_rows(u: &Uncertainty) -> Vec<Row<'static>> {
     let t = u.point_of_no_return_s;
     let pnr = |v: Option<f64>| v.map_or("none".to_string(), mmss);
-    vec![
+    let mut rows = vec![
         Row::new(
             "energy used",
             percentiles(u.energy_wh, &|x| format!("{x:.1}")),
@@ -344,7 +344,28 @@ fn band_rows(u: &Uncertainty) -> Vec<Row<'static>> {
             format!("{} / {} / {}", pnr(t.p5), pnr(t.p50), pnr(t.p95)),
             "min:s",
         ),
-    ]
+    ];
+    // A failsafe's time in each percentile: `never` where that scenario does not trigger it.
+    let never = |v: Option<f64>| v.map_or("never".to_string(), mmss);
+    for f in &u.failsafes {
+        let b = f.time_s.unwrap_or_default();
+        let label = match f.kind.as_str() {
+            "low" => "low-voltage failsafe",
+            _ => "critical-voltage failsafe",
+        };
+        rows.push(Row::new(
+            label,
+            format!(
+                "{} / {} / {} min:s at {:.1} V",
+                never(b.p5),
+                never(b.p50),
+                never(b.p95),
+                f.voltage_v
+            ),
+            "",
+        ));
+    }
+    rows
 }
 
 /// The segments with the operator's item numbers when the mission came from a planner file;

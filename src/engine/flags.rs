@@ -256,8 +256,12 @@ pub struct MissionFlags {
     #[arg(value_parser = finite(), long, value_name = "PERCENT")]
     pub reserve_percent: Option<f64>,
     /// State of charge at take-off, percent.
-    #[arg(value_parser = finite(), long, default_value_t = 100.0, value_name = "PERCENT")]
+    #[arg(value_parser = finite(), long, default_value_t = 100.0, value_name = "PERCENT", conflicts_with = "start_voltage_v")]
     pub start_percent: f64,
+    /// The pack's rested voltage before take-off, V: the state of charge at take-off is read on
+    /// the pack's open-circuit curve (in place of --start-percent).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub start_voltage_v: Option<f64>,
     /// Sampling step, s (default: the mission's, else 0.1).
     #[arg(value_parser = finite(), long, value_name = "S")]
     pub time_step: Option<f64>,
@@ -308,6 +312,7 @@ impl MissionFlags {
             }),
             reserve_percent: self.reserve_percent,
             start_percent: self.start_percent,
+            start_voltage_v: self.start_voltage_v,
             time_step_s: self.time_step,
             aoa: self.aoa,
             ground_effect: !self.no_ground_effect,

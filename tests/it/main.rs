@@ -43,6 +43,7 @@ mod missions_writers;
 mod one_mass;
 mod outputs_hostile;
 mod own_vehicle_data_val;
+mod pack_state_cli;
 mod pack_voltage_data_val;
 mod packs_cli;
 mod payload_sweep;

@@ -6,23 +6,9 @@ use std::collections::BTreeMap;
 use aloft_packs::{FailsafeAction, FailsafeMonitor, SocFilter, VehicleFailsafes, VoltageThreshold};
 use serde::Serialize;
 
+use crate::engine::uncertainty::scenario_stats::time_band;
+pub use crate::engine::uncertainty::scenario_stats::TimeBand;
 use crate::engine::uncertainty::scenarios::{Draws, ScenarioWatch, WatchRun};
-
-/// When a failsafe triggers, s from now, over the scenarios of the route ahead: a percentile is
-/// left out where it falls on scenarios in which the failsafe does not trigger before the
-/// landing (`p95` absent: in more than 5 % of them it never does).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
-pub struct TimeBand {
-    /// 5th percentile, s.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub p5: Option<f64>,
-    /// Median, s.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub p50: Option<f64>,
-    /// 95th percentile, s.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub p95: Option<f64>,
-}
 
 /// One failsafe the vehicle watches, and when it triggers on the rest of the route.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -37,8 +23,9 @@ pub struct LiveFailsafe {
     /// What the threshold is in: `V` (the pack's voltage under load), `fraction` (PX4's own
     /// estimate of the state of charge) or `mAh` (the charge drawn).
     pub unit: &'static str,
-    /// When it triggers, s from now (left out where it does not trigger before the landing in
-    /// any scenario).
+    /// When it triggers, s from now, over the scenarios (a percentile left out where it falls
+    /// on scenarios in which it does not trigger before the landing; the whole left out where
+    /// it triggers in none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_s: Option<TimeBand>,
     /// Whether it triggers before the route's landing (in at least 5 % of the scenarios).
@@ -167,23 +154,6 @@ impl Watched {
 /// Share of the scenarios in which a failsafe must trigger before the landing for the update
 /// to say it comes before home (the band's p5).
 pub(crate) const BEFORE_HOME_SHARE: f64 = 0.05;
-
-/// The 5th, 50th and 95th percentiles (nearest rank) of sorted times, each left out where it
-/// falls on a scenario without a trigger; `None` where none triggers.
-fn time_band(sorted: &[f64]) -> Option<TimeBand> {
-    if sorted.first().is_none_or(|t| !t.is_finite()) {
-        return None;
-    }
-    let at = |p: f64| {
-        let k = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
-        Some(sorted[k]).filter(|t| t.is_finite())
-    };
-    Some(TimeBand {
-        p5: at(0.05),
-        p50: at(0.5),
-        p95: at(0.95),
-    })
-}
 
 /// The route ahead's scenarios followed on the pack: each from a draw of the pack's state now,
 /// the filter's circuit giving the voltage under the planned current, the failsafes' monitor

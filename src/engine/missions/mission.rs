@@ -384,7 +384,7 @@ pub(in crate::engine) fn prepare<'a>(
         aircraft,
         pack,
         wind,
-        options: planner_options(options, mission.spec())?,
+        options: planner_options(options, mission.spec(), pack)?,
         meter: options.meter.clone(),
     };
     let flown = flown_mission(&flight, mission, vehicle, (options, options.payload_kg))
@@ -473,7 +473,9 @@ fn fly_into_outputs(
 
 /// The voltage failsafes a mission watches: (`low` / `critical`, pack volts), each positive and
 /// finite.
-fn failsafe_thresholds(options: &MissionOptions) -> Result<Vec<(&'static str, f64)>, Error> {
+pub(in crate::engine) fn failsafe_thresholds(
+    options: &MissionOptions,
+) -> Result<Vec<(&'static str, f64)>, Error> {
     let mut out = Vec::new();
     for (kind, name, v) in [
         ("low", "low_voltage_v", options.low_voltage_v),
@@ -541,6 +543,7 @@ pub(in crate::engine) fn check_options(options: &MissionOptions) -> Result<(), E
 pub(in crate::engine) fn planner_options(
     options: &MissionOptions,
     spec: &MissionSpec,
+    pack: &Pack,
 ) -> Result<PlanOptions, Error> {
     let reserve_percent = options
         .reserve_percent
@@ -559,10 +562,46 @@ pub(in crate::engine) fn planner_options(
         aoa: options.aoa,
         ground_effect: options.ground_effect,
         reserve_fraction: reserve_percent / 100.0,
-        start_soc: options.start_percent / 100.0,
+        start_soc: start_soc(options, pack)?,
         record_samples: options.record_samples,
         ..PlanOptions::default()
     })
+}
+
+/// How far a rested cell voltage may lie outside the pack's open-circuit curve and still be
+/// this pack's, V (a cell just off the charger, a sensor's calibration).
+const REST_MARGIN_CELL_V: f64 = 0.05;
+
+/// The state of charge at take-off: `start_voltage_v` on the pack's open-circuit curve where
+/// given, else `start_percent`.
+///
+/// # Errors
+/// A rested voltage that is not this pack's (outside its curve by more than
+/// [`REST_MARGIN_CELL_V`] a cell), or given with a `start_percent` other than 100.
+pub(in crate::engine) fn start_soc(options: &MissionOptions, pack: &Pack) -> Result<f64, Error> {
+    let Some(v) = options.start_voltage_v else {
+        return Ok(options.start_percent / 100.0);
+    };
+    if options.start_percent != 100.0 {
+        return Err(Error::InvalidInput {
+            name: "start_voltage_v",
+            value: v,
+            unit: "V",
+            expected: "either a rested voltage or a start percent, not both",
+        });
+    }
+    let margin_v = REST_MARGIN_CELL_V * f64::from(pack.cells_series());
+    let (empty_v, full_v) = (pack.ocv_v(0.0) - margin_v, pack.ocv_v(1.0) + margin_v);
+    if !(v.is_finite() && (empty_v..=full_v).contains(&v)) {
+        return Err(Error::InvalidInput {
+            name: "start_voltage_v",
+            value: v,
+            unit: "V",
+            expected: "a rested voltage of the pack flown, on its open-circuit curve",
+        });
+    }
+    // At least a tenth of a per cent: the planner starts from a charge.
+    Ok(pack.soc_at_ocv_v(v).max(0.001))
 }
 
 #[cfg(test)]

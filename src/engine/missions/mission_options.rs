@@ -33,6 +33,10 @@ pub struct MissionOptions {
     pub reserve_percent: Option<f64>,
     /// State of charge at take-off, percent (default 100).
     pub start_percent: f64,
+    /// The pack's rested voltage before take-off, V: the state of charge at take-off is its
+    /// place on the pack's open-circuit curve (in place of `start_percent`, which must then be
+    /// left at 100).
+    pub start_voltage_v: Option<f64>,
     /// Sampling step, s (default: the mission's, else 0.1).
     pub time_step_s: Option<f64>,
     /// Angle-of-attack model (default geometric).
@@ -78,6 +82,7 @@ impl Default for MissionOptions {
             critical_voltage_v: None,
             reserve_percent: None,
             start_percent: 100.0,
+            start_voltage_v: None,
             time_step_s: None,
             aoa: AoaModel::Geometric,
             ground_effect: true,

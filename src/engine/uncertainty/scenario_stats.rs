@@ -287,3 +287,36 @@ mod tests {
         }
     }
 }
+
+/// When something happens in a flight (a failsafe triggers), s, over scenarios: a percentile is
+/// left out where it falls on scenarios in which it does not happen before the landing (`p95`
+/// absent: in more than 5 % of them it never does).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct TimeBand {
+    /// 5th percentile, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p5: Option<f64>,
+    /// Median, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p50: Option<f64>,
+    /// 95th percentile, s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p95: Option<f64>,
+}
+
+/// The 5th, 50th and 95th percentiles (nearest rank) of sorted times, infinite where it does not
+/// happen, each left out where it falls on such a scenario; `None` where it happens in none.
+pub(in crate::engine) fn time_band(sorted: &[f64]) -> Option<TimeBand> {
+    if sorted.first().is_none_or(|t| !t.is_finite()) {
+        return None;
+    }
+    let at = |p: f64| {
+        let k = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+        Some(sorted[k]).filter(|t| t.is_finite())
+    };
+    Some(TimeBand {
+        p5: at(0.05),
+        p50: at(0.5),
+        p95: at(0.95),
+    })
+}

@@ -87,6 +87,7 @@ use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };
+use crate::engine::uncertainty::scenario_stats::{time_band, TimeBand};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 
@@ -318,6 +319,61 @@ pub struct Uncertainty {
     /// not in the JSON).
     #[serde(skip)]
     pub soc_fan: Option<SocFan>,
+    /// The voltage failsafes watched (`--low-voltage-v`, `--critical-voltage-v`, a pack file's
+    /// `[failsafe]`) and when each triggers over the scenarios: the first time the predicted
+    /// voltage under load falls below it, as the mission's `failsafes` say it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub failsafes: Vec<FailsafeBand>,
+}
+
+/// When a voltage failsafe triggers over a mission's scenarios.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailsafeBand {
+    /// `low` or `critical`.
+    pub kind: String,
+    /// The threshold, pack volts.
+    pub voltage_v: f64,
+    /// Share of the scenarios in which it triggers.
+    pub p_triggers: f64,
+    /// When, s from take-off (percentiles left out where they fall on scenarios in which it
+    /// does not trigger; the whole left out where it triggers in none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_s: Option<TimeBand>,
+}
+
+/// The first time the voltage under load falls below each threshold, in each scenario.
+struct Crossings {
+    thresholds_v: Vec<f64>,
+}
+
+impl ScenarioWatch for Crossings {
+    fn start(&self, _index: usize) -> (Option<f64>, Box<dyn WatchRun>) {
+        let run = CrossingRun {
+            thresholds_v: self.thresholds_v.clone(),
+            first_s: vec![f64::INFINITY; self.thresholds_v.len()],
+        };
+        (None, Box::new(run))
+    }
+}
+
+/// One scenario's [`Crossings`].
+struct CrossingRun {
+    thresholds_v: Vec<f64>,
+    first_s: Vec<f64>,
+}
+
+impl WatchRun for CrossingRun {
+    fn take(&mut self, sample: &aloft_planner::Sample) {
+        for (first, th) in self.first_s.iter_mut().zip(&self.thresholds_v) {
+            if sample.voltage_v < *th && first.is_infinite() {
+                *first = sample.time_s;
+            }
+        }
+    }
+
+    fn finish(&mut self) -> Vec<f64> {
+        self.first_s.clone()
+    }
 }
 
 /// A deterministic answer with its `uncertainty` over scenarios: the answer's keys, then
@@ -666,7 +722,7 @@ impl<'a> MissionScenarios<'a> {
         let plan_options = aloft_planner::PlanOptions {
             // Scenarios run on every core already: one thread per flight.
             second_thread: false,
-            ..planner_options(options, mission.spec())?
+            ..planner_options(options, mission.spec(), &pack)?
         };
         let (spec, _) = flown_spec(mission, vehicle, options);
         let flight = Flight {
@@ -847,7 +903,32 @@ pub fn plan_scenarios(
     options: &MissionOptions,
     sc: &ScenarioOptions,
 ) -> Result<Uncertainty, Error> {
-    Ok(plan_scenarios_watched(vehicle, mission, options, sc, None)?.0)
+    let watched = crate::engine::missions::mission::failsafe_thresholds(options)?;
+    let crossings = Crossings {
+        thresholds_v: watched.iter().map(|w| w.1).collect(),
+    };
+    let watch = (!watched.is_empty()).then_some(&crossings as &dyn ScenarioWatch);
+    let (mut u, seen) = plan_scenarios_watched(vehicle, mission, options, sc, watch)?;
+    u.failsafes = watched
+        .iter()
+        .enumerate()
+        .map(|(i, (kind, voltage_v))| {
+            // A scenario the vehicle cannot fly has no voltage: it does not trigger.
+            let mut t: Vec<f64> = seen
+                .iter()
+                .map(|(_, run)| run.get(i).copied().unwrap_or(f64::INFINITY))
+                .collect();
+            t.sort_by(f64::total_cmp);
+            let n = t.len().max(1) as f64;
+            FailsafeBand {
+                kind: kind.to_string(),
+                voltage_v: *voltage_v,
+                p_triggers: t.iter().filter(|x| x.is_finite()).count() as f64 / n,
+                time_s: time_band(&t),
+            }
+        })
+        .collect();
+    Ok(u)
 }
 
 /// [`plan_scenarios`], each scenario followed by `watch` where given: whether each scenario
@@ -944,6 +1025,7 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
         },
         segments: SegmentBand::of(completed.iter().map(|r| r.segment_end_soc.as_slice())),
         soc_fan,
+        failsafes: Vec::new(),
     }
 }
 
