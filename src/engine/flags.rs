@@ -985,9 +985,15 @@ pub struct LiveFlags {
     /// aloft's MAVLink system id on the link (a ground station's).
     #[arg(long, default_value_t = 255, value_name = "ID")]
     pub system_id: u8,
-    /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER).
+    /// aloft's MAVLink component id (190: MAV_COMP_ID_MISSIONPLANNER), for its requests and
+    /// heartbeat.
     #[arg(long, default_value_t = 190, value_name = "ID")]
     pub component_id: u8,
+    /// The component of the vehicle's own system aloft's battery, texts and values are sent
+    /// from, 1-255 (191: MAV_COMP_ID_ONBOARD_COMPUTER), so a ground station shows them beside
+    /// the autopilot's.
+    #[arg(long, default_value_t = super::DEFAULT_DISPLAY_COMPONENT_ID, value_parser = clap::value_parser!(u8).range(1..), value_name = "ID", allow_negative_numbers = true)]
+    pub display_component_id: u8,
     /// The BATTERY_STATUS id aloft's own estimate of the pack is sent under, 0-255 (100: above
     /// ArduPilot's 0-15 and PX4's 0-3, so no autopilot battery's).
     #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID", allow_negative_numbers = true)]
@@ -1102,6 +1108,7 @@ impl LiveFlags {
                 url: url.clone().unwrap_or_default(),
                 system_id: self.system_id,
                 component_id: self.component_id,
+                display_component_id: self.display_component_id,
                 timeout_s: self.link_timeout,
             },
         };

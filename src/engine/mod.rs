@@ -100,7 +100,7 @@ pub use live::estimator::InFlightEstimator;
 pub use live::{
     follow_live, replay_live, LiveCheck, LiveCheckpoint, LiveFailsafe, LiveRecorder,
     LiveReplayRequest, LiveReplies, LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate,
-    Position, SocBand, TimeBand, DEFAULT_BATTERY_ID, LIVE_SCENARIOS,
+    Position, SocBand, TimeBand, DEFAULT_BATTERY_ID, DEFAULT_DISPLAY_COMPONENT_ID, LIVE_SCENARIOS,
 };
 pub use logs::{
     check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,

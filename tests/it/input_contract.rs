@@ -469,6 +469,30 @@ fn a_long_waypoint_file_without_jumps_is_flown() {
     let _ = std::fs::remove_file(p);
 }
 
+/// `--display-component-id` is the component aloft's battery and texts come from on the
+/// vehicle's system, 1-255: 0 is MAVLink's broadcast id, not a sender's, and is refused with
+/// one line naming it (exit 2), as is anything outside a byte.
+#[test]
+fn a_display_component_id_of_0_is_refused_naming_it() {
+    for bad in ["0", "256", "-1", "x"] {
+        let (code, out, err) = common::run(&[
+            "live",
+            "--replay",
+            "no-such.ulg",
+            "--display-component-id",
+            bad,
+        ]);
+        assert_eq!(code, 2, "{bad}: {out} {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains("--display-component-id"), "{bad}: {err}");
+        assert!(err.contains(bad), "{bad}: {err}");
+    }
+    use aloft::engine::{flags::LiveFlags, parse_keywords};
+    let replay = [("replay", aloft::engine::Keyword::One("x.ulg".into()))];
+    let default = parse_keywords::<LiveFlags>("aloft.live", &replay, &[]).unwrap();
+    assert_eq!(default.display_component_id, 191);
+}
+
 /// `--battery-id` is a MAVLink battery id, 0-255: anything else is refused with one line naming
 /// it (exit 2), on the command line and as Python's or the page's `battery_id` keyword.
 #[test]

@@ -184,6 +184,34 @@ fn a_charge_count_that_jumps_to_int32_max_is_not_believed() {
 /// from there) and after 5 s comes back to its own track: not believed while it is back, said
 /// once, the reports followed, `continue`. Before: the count's return took 0.5 A h (11 % of
 /// the pack) off at once.
+/// aloft's BATTERY_STATUS carries the autopilot's count where it is believed (issue 44):
+/// `current_consumed` the count of the second's battery message (0.5 A h plus what 12 A drew,
+/// in mA h) while it is on track, and "not known" (`None`, sent as -1) once it has jumped to
+/// `INT32_MAX`, never the jump itself. Before, it was never sent.
+#[test]
+fn alofts_battery_carries_the_count_where_it_is_believed() {
+    let updates = fly(20, None, &|s| {
+        let t = f64::from(s) + 0.8;
+        let count = if s < 10 { counted(t) } else { INT32_MAX_AH };
+        (Some(reported(0.70, t)), Some(count))
+    });
+    let mut replies = aloft::engine::LiveReplies::new(100);
+    for (s, u) in updates.iter().enumerate() {
+        let battery = replies.replies(None, u).into_iter().find_map(|r| match r {
+            aloft_logs::telemetry::Reply::Battery(b) => Some(b),
+            _ => None,
+        });
+        let consumed_mah = battery.expect("a battery every update").consumed_mah;
+        let want = (s < 10).then(|| 1000.0 * counted(s as f64 + 0.8));
+        // The count is whole mA h: equal to within a float's rounding of A h to mA h.
+        let close = match (consumed_mah, want) {
+            (Some(c), Some(w)) => (c - w).abs() < 1e-6,
+            (c, w) => c.is_none() && w.is_none(),
+        };
+        assert!(close, "second {s}: {consumed_mah:?}, want {want:?}");
+    }
+}
+
 #[test]
 fn a_charge_count_that_goes_back_is_not_believed() {
     let updates = fly(30, None, &|s| {

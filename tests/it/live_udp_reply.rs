@@ -12,6 +12,10 @@
 //! `current_consumed`) that jumps to `INT32_MAX`, wraps to `INT32_MIN` and goes back (issue 41):
 //! no `land now` reaches it, and the updates say the count was not believed.
 //!
+//! aloft's battery, texts and values come from the vehicle's system and aloft's display
+//! component (1, 191), and a QGroundControl-like filter (only the vehicle's system id) takes
+//! them; its requests and heartbeat still come from its own ids (255, 190).
+//!
 //! It needs python3 with pymavlink (`.ci/run` installs it). Without it the test says so and
 //! passes, unless `ALOFT_PYMAVLINK_TESTS=require` or `CI` is set, where it fails.
 #![cfg(feature = "live")]
@@ -146,6 +150,40 @@ fn after_the_run(mut aloft: Child, vehicle: &Output) -> (Value, Vec<Value>, Stri
     )
 }
 
+/// The senders of the messages of type `t` the vehicle got, `[[system, component], ...]`.
+fn senders<'a>(got: &'a Value, t: &str) -> &'a Value {
+    &got["senders"][t]
+}
+
+/// What a ground station shows, aloft's own ids: the battery, texts and values from the
+/// vehicle's system (1) and the display component (191), and nothing else; the requests and
+/// the heartbeat from (255, 190).
+fn check_senders(got: &Value) {
+    let display = serde_json::json!([[1, 191]]);
+    let own = serde_json::json!([[255, 190]]);
+    for (t, ids) in [
+        ("NAMED_VALUE_FLOAT", &display),
+        ("STATUSTEXT", &display),
+        ("BATTERY_STATUS", &display),
+        ("HEARTBEAT", &own),
+        ("PARAM_REQUEST_READ", &own),
+        ("MISSION_REQUEST_LIST", &own),
+        ("MISSION_REQUEST_INT", &own),
+        ("MISSION_ACK", &own),
+    ] {
+        let s = senders(got, t);
+        assert!(s.is_null() || s == ids, "{t} from {s}, not {ids}");
+    }
+    // The QGroundControl-like filter takes every displayed message and only those.
+    for (t, n) in got["shown"].as_object().expect("shown") {
+        assert!(
+            ["NAMED_VALUE_FLOAT", "STATUSTEXT", "BATTERY_STATUS"].contains(&t.as_str()),
+            "{t}"
+        );
+        assert_eq!(n, &got["counts"][t], "{t}");
+    }
+}
+
 /// The NAMED_VALUE_FLOAT and STATUSTEXT aloft sent with its updates: four values an update
 /// with a band (two reserves, the point of no return where there is one, the energy left), and
 /// a text where the advice changed.
@@ -213,6 +251,8 @@ fn live_udpin_answers_the_vehicle_not_a_stray_sender() {
     assert_eq!(count("MISSION_REQUEST_INT"), 2, "{got}");
     assert_eq!(count("MISSION_ACK"), 1, "{got}");
     assert_eq!(got["others"], serde_json::json!({}), "{got}");
+    check_senders(&got);
+    assert_eq!(got["shown"]["STATUSTEXT"], texts, "{got}");
     assert!(stderr.trim().is_empty(), "{stderr}");
 }
 
@@ -275,7 +315,8 @@ fn live_udp_a_jumping_and_wrapping_charge_count_is_not_land_now() {
 /// BATTERY_STATUS and STATUSTEXT), and the failsafe parameters it asked the vehicle for.
 ///
 /// The vehicle hovers at 22.8 V and 14 A reporting 80 % left (SYS_STATUS); aloft runs with
-/// `--battery-id 42`. Every update is a BATTERY_STATUS of id 42 from aloft's component (190):
+/// `--battery-id 42`. Every update is a BATTERY_STATUS of id 42 from the vehicle's system and
+/// aloft's display component (1, 191), which a QGroundControl-like filter takes:
 /// `voltages[0]` 22,800 mV and the others UINT16_MAX (cells not known), `current_battery`
 /// 1,400 cA, `battery_remaining` aloft's `soc` of an update in percent, no time (0: no failsafe
 /// ahead yet), charge OK (1) under `continue`, function ALL (1), type LIPO (1), temperature
@@ -314,7 +355,11 @@ fn live_udp_alofts_battery_and_text_severities_reach_the_ground_station() {
     let unknown = Value::Array(vec![serde_json::json!(65_535); 10]);
     for b in batteries {
         assert_eq!(b["id"], 42, "{b}");
-        assert_eq!(b["component"], 190, "{b}");
+        assert_eq!(
+            (&b["system"], &b["component"]),
+            (&1.into(), &191.into()),
+            "{b}"
+        );
         // Before the vehicle's first SYS_STATUS, not known.
         let measured = b["current_battery"] != -1;
         assert_eq!(
@@ -345,8 +390,11 @@ fn live_udp_alofts_battery_and_text_severities_reach_the_ground_station() {
     assert_eq!(last["voltages"], cells, "{last}");
     assert_eq!(last["current_battery"], 1_400, "{last}");
     assert_eq!(last["charge_state"], 1, "{last}");
+    check_senders(&got);
+    assert_eq!(got["shown"]["BATTERY_STATUS"], batteries.len(), "{got}");
     let severities = got["severities"].as_array().expect("severities");
     assert!(!severities.is_empty(), "{got}");
+    assert_eq!(got["shown"]["STATUSTEXT"], severities.len(), "{got}");
     for t in severities {
         assert!(t[0].as_str().unwrap().starts_with("aloft: continue"), "{t}");
         assert_eq!(t[1], 6, "{t}");

@@ -9,9 +9,12 @@ ArduCopter quadrotor hovering in LOITER 20 m above its home sends (MAVLink 2, sy
 component 1): GLOBAL_POSITION_INT and ATTITUDE at 5 Hz; HEARTBEAT, SYS_STATUS,
 EXTENDED_SYS_STATE and HOME_POSITION at 1 Hz. It answers a mission download (MISSION_COUNT 2,
 then each MISSION_ITEM_INT asked for). Then it listens one second more and prints, as one JSON
-line, what it received from system 255 (aloft): messages by type, the NAMED_VALUE_FLOAT names,
-the STATUSTEXT texts and their severities, the BATTERY_STATUS fields, the names of the
-PARAM_REQUEST_READ, and messages from any other system.
+line, what it received from aloft, whose ids are (255, 190) as a ground station and (1, 191) as
+a component of the vehicle's system: messages by type, the senders of each type, the messages a
+QGroundControl-like filter takes (those of the vehicle's system id, as its
+Vehicle::_mavlinkMessageReceived), the NAMED_VALUE_FLOAT names, the STATUSTEXT texts and their
+severities, the BATTERY_STATUS fields, the names of the PARAM_REQUEST_READ, and messages from any
+other sender.
 
 It answers PARAM_REQUEST_READ of its failsafe parameters with PARAM_VALUE as the autopilot
 does: ArduPilot casts every value to the float (BATT_LOW_VOLT REAL32 10.5, BATT_FS_LOW_ACT INT8
@@ -48,6 +51,10 @@ PX4_PARAMS = {
     "BAT_LOW_THR": (0.15, mav.MAV_PARAM_TYPE_REAL32),
 }
 
+
+# aloft's senders: a ground station's ids, and its display component on the vehicle's system.
+ALOFT = {(255, 190), (1, 191)}
+VEHICLE_SYSTEM = 1
 
 INT32_MAX = 2**31 - 1
 INT32_MIN = -(2**31)
@@ -114,7 +121,7 @@ def main():
     m = mavutil.mavlink_connection(
         f"udpout:127.0.0.1:{port}", source_system=1, source_component=1, dialect="ardupilotmega"
     )
-    counts, names, texts, others = {}, {}, [], {}
+    counts, names, texts, others, senders, shown = {}, {}, [], {}, {}, {}
     severities, batteries, asked = [], [], []
     start = time.monotonic()
     k = 0
@@ -130,10 +137,15 @@ def main():
         t = msg.get_type()
         if t == "BAD_DATA":
             continue
-        if msg.get_srcSystem() != 255:
+        src = (msg.get_srcSystem(), msg.get_srcComponent())
+        if src not in ALOFT:
             others[t] = others.get(t, 0) + 1
             continue
         counts[t] = counts.get(t, 0) + 1
+        senders.setdefault(t, set()).add(src)
+        # QGroundControl's vehicle takes a message of its system id, whatever the component.
+        if src[0] == VEHICLE_SYSTEM:
+            shown[t] = shown.get(t, 0) + 1
         if t == "NAMED_VALUE_FLOAT":
             names[msg.name] = names.get(msg.name, 0) + 1
         elif t == "STATUSTEXT":
@@ -141,6 +153,7 @@ def main():
             severities.append([msg.text, msg.severity])
         elif t == "BATTERY_STATUS":
             batteries.append({
+                "system": msg.get_srcSystem(),
                 "component": msg.get_srcComponent(),
                 "id": msg.id,
                 "battery_remaining": msg.battery_remaining,
@@ -161,6 +174,7 @@ def main():
     print(json.dumps({
         "counts": counts, "names": names, "texts": texts, "others": others,
         "severities": severities, "batteries": batteries, "asked": asked,
+        "senders": {t: sorted(list(x) for x in v) for t, v in senders.items()}, "shown": shown,
     }))
 
 

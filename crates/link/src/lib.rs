@@ -66,6 +66,6 @@ pub use mission::MAX_MISSION_ITEMS;
 pub use modes::mode_name;
 pub use source::{
     battery_status, describe_fixes, describe_stats, gcs_heartbeat, LinkOptions, LinkSource,
-    LinkStats, TlogSource,
+    LinkStats, TlogSource, DISPLAY_COMPONENT_ID, DISPLAY_HEARD,
 };
 pub use tlog::{TlogFrame, TlogReader, TlogStats};

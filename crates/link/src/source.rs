@@ -16,18 +16,31 @@
 //!
 //! Event times are seconds since the link opened, at each message's arrival.
 //!
-//! aloft speaks on the link as a ground station with [`LinkOptions::system_id`] and
-//! [`LinkOptions::component_id`] (default 255/190), in the MAVLink version the vehicle speaks
-//! (MAVLink 2 until the vehicle is heard):
+//! aloft speaks on the link, in the MAVLink version the vehicle speaks (MAVLink 2 until the
+//! vehicle is heard), as a ground station with [`LinkOptions::system_id`] and
+//! [`LinkOptions::component_id`] (default 255/190):
 //! - a HEARTBEAT (MAV_TYPE_GCS) every second, so that routers and autopilots that answer the
 //!   last sender send to aloft ([`LinkOptions::heartbeat`]);
-//! - [`LinkSource::reply`]: NAMED_VALUE_FLOAT (`time_boot_ms` since the link opened, a name of at
-//!   most 10 bytes), STATUSTEXT (at the reply's severity, at most 50 bytes, cut at a character)
-//!   and BATTERY_STATUS of aloft's own battery ([`battery_status`]);
 //! - PARAM_REQUEST_READ of the vehicle's failsafe parameters when it is first heard and after it
 //!   restarts ([`crate::params`], [`LinkOptions::request_parameters`]);
 //! - the mission download of [`crate::request`] when no mission passed on the link
-//!   ([`LinkOptions::request_mission`]).
+//!   ([`LinkOptions::request_mission`]);
+//!
+//! and, for a ground station to show beside the autopilot's, as a component of the vehicle's
+//! own system ([`LinkOptions::display_component_id`], default 191), [`LinkSource::reply`]:
+//! NAMED_VALUE_FLOAT (`time_boot_ms` since the link opened, a name of at most 10 bytes),
+//! STATUSTEXT (at the reply's severity, at most 50 bytes, cut at a character) and BATTERY_STATUS
+//! of aloft's own battery ([`battery_status`]). QGroundControl's vehicle takes only messages of
+//! its system id (`Vehicle::_mavlinkMessageReceived`), whatever the component, and needs no
+//! HEARTBEAT of that component; none is sent, because an ONBOARD_CONTROLLER heartbeat of its
+//! own system makes PX4 say "Connection to mission computer lost" when aloft stops
+//! (`COM_OBC_LOSS_T`). These replies are sent only once the vehicle is known and while it was
+//! heard in the last [`DISPLAY_HEARD`] ([`LinkSource::display_ids`]): QGroundControl counts any
+//! message of the vehicle's system as the vehicle being there, so aloft must not keep a silent
+//! vehicle alive on its screen. BATTERY_STATUS goes from the vehicle's system only to an
+//! ArduPilot: PX4 takes a BATTERY_STATUS of its own system from another component as a battery
+//! of its own (`MavlinkReceiver::handle_message_battery_status`), whose warning drives its
+//! battery failsafe; to any other autopilot it goes from aloft's own ids.
 //!
 //! On `udpin` every message goes to the address the vehicle's last HEARTBEAT came from (the
 //! vehicle as the [`Decoder`] decides it), never to another sender on the port, whatever and
@@ -270,6 +283,16 @@ impl<R: Read> TelemetrySource for TlogSource<R> {
     }
 }
 
+/// The component of the vehicle's system aloft's displayed replies come from unless told
+/// otherwise: MAV_COMP_ID_ONBOARD_COMPUTER, common.xml's id for a generic component on the
+/// companion computer, which neither ArduPilot nor PX4 routes or watches specially (PX4 watches
+/// heartbeats of 68, 240 and 241 and MAVSDK's companion is 195).
+pub const DISPLAY_COMPONENT_ID: u8 = 191;
+
+/// Longest silence of the vehicle after which aloft's displayed replies are no longer sent
+/// (QGroundControl would take them for the vehicle's own and not say the link is lost).
+pub const DISPLAY_HEARD: Duration = Duration::from_secs(2);
+
 /// How aloft takes part in a live link.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinkOptions {
@@ -277,6 +300,9 @@ pub struct LinkOptions {
     pub system_id: u8,
     /// aloft's component id (190, MAV_COMP_ID_MISSIONPLANNER, by default).
     pub component_id: u8,
+    /// The component of the vehicle's system aloft's displayed replies come from
+    /// ([`DISPLAY_COMPONENT_ID`] by default; 0 is broadcast and not a sender's id).
+    pub display_component_id: u8,
     /// Silence of the vehicle after which [`Event::LinkLost`] is returned (5 s by default).
     pub timeout: Duration,
     /// Send a ground-station HEARTBEAT every second (default true).
@@ -293,6 +319,7 @@ impl Default for LinkOptions {
         Self {
             system_id: 255,
             component_id: 190,
+            display_component_id: DISPLAY_COMPONENT_ID,
             timeout: Duration::from_secs(5),
             heartbeat: true,
             request_mission: true,
@@ -339,7 +366,9 @@ pub struct LinkSource {
     last_lost: Option<Instant>,
     last_heartbeat: Option<Instant>,
     vehicle_version: MavlinkVersion,
+    /// The sequence of aloft's own ids, and of its display component.
     sequence: u8,
+    display_sequence: u8,
     request: MissionRequest,
     params: ParamRequest,
     stats: LinkStats,
@@ -386,6 +415,7 @@ impl LinkSource {
             last_heartbeat: None,
             vehicle_version: MavlinkVersion::V2,
             sequence: 0,
+            display_sequence: 0,
             request: MissionRequest::new(
                 (options.system_id, options.component_id),
                 options.request_mission,
@@ -453,7 +483,8 @@ impl LinkSource {
     }
 
     /// Sends a reply to the ground station (NAMED_VALUE_FLOAT, STATUSTEXT or BATTERY_STATUS)
-    /// from aloft's ids.
+    /// from the ids [`LinkSource::display_ids`] gives; dropped (not an error) where it gives
+    /// none.
     pub fn reply(&mut self, reply: &Reply) -> Result<(), LinkError> {
         let (message, name) = match reply {
             Reply::Value { name, value } => (
@@ -463,7 +494,36 @@ impl LinkSource {
             Reply::Text { text, severity } => (status_text(text, *severity), "STATUSTEXT"),
             Reply::Battery(b) => (battery_status(b), "BATTERY_STATUS"),
         };
-        self.send(&message, name)
+        let battery = matches!(reply, Reply::Battery(_));
+        match self.display_ids(battery, Instant::now()) {
+            Some(ids) => self.send_from(&message, name, ids),
+            None => Ok(()),
+        }
+    }
+
+    /// The (system, component) a displayed reply is sent from at `now`: the vehicle's system and
+    /// [`LinkOptions::display_component_id`]; aloft's own ids for a BATTERY_STATUS to a vehicle
+    /// that is not an ArduPilot (see the module docs); none before the vehicle is known, nor
+    /// once it has been silent longer than [`DISPLAY_HEARD`].
+    pub fn display_ids(&self, battery: bool, now: Instant) -> Option<(u8, u8)> {
+        let (system, _) = self.decoder.vehicle()?;
+        let heard = self.last_vehicle?;
+        if now.saturating_duration_since(heard) > DISPLAY_HEARD {
+            return None;
+        }
+        let ardupilot = self.decoder.autopilot() == Some(MavAutopilot::MAV_AUTOPILOT_ARDUPILOTMEGA);
+        if battery && !ardupilot {
+            return Some(self.own_ids());
+        }
+        Some((
+            u8::try_from(system).ok()?,
+            self.options.display_component_id,
+        ))
+    }
+
+    /// aloft's own (system, component): a ground station's.
+    fn own_ids(&self) -> (u8, u8) {
+        (self.options.system_id, self.options.component_id)
     }
 
     /// What has been received, passed over and sent so far.
@@ -547,13 +607,29 @@ impl LinkSource {
         Ok(())
     }
 
+    /// Sends `message` from aloft's own ids.
     fn send(&mut self, message: &MavMessage, name: &'static str) -> Result<(), LinkError> {
-        let header = MavHeader {
-            system_id: u32::from(self.options.system_id),
-            component_id: self.options.component_id,
-            sequence: self.sequence,
+        self.send_from(message, name, self.own_ids())
+    }
+
+    /// Sends `message` from `(system, component)`, each sender with its own sequence.
+    fn send_from(
+        &mut self,
+        message: &MavMessage,
+        name: &'static str,
+        (system, component): (u8, u8),
+    ) -> Result<(), LinkError> {
+        let sequence = if (system, component) == self.own_ids() {
+            &mut self.sequence
+        } else {
+            &mut self.display_sequence
         };
-        self.sequence = self.sequence.wrapping_add(1);
+        let header = MavHeader {
+            system_id: u32::from(system),
+            component_id: component,
+            sequence: *sequence,
+        };
+        *sequence = sequence.wrapping_add(1);
         let raw = match self.vehicle_version {
             MavlinkVersion::V1 => {
                 let mut raw = MAVLinkV1MessageRaw::new();

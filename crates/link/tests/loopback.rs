@@ -1,6 +1,10 @@
 //! A live link on the loopback interface: `LinkSource` listens on `udpin:127.0.0.1:PORT`; a
 //! simulated vehicle on another UDP socket of 127.0.0.1 sends MAVLink 1 telemetry, answers the
 //! mission download, and receives aloft's replies; then falls silent.
+//!
+//! aloft's requests and heartbeat come from its own ids (255, 190); its replies, which a ground
+//! station displays, from the vehicle's system (1) and aloft's display component (191), as
+//! QGroundControl takes only messages of the vehicle's system id.
 
 use std::net::UdpSocket;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -14,7 +18,7 @@ use aloft_link::mavlink::dialects::ardupilotmega::{
     PARAM_VALUE_DATA, SYS_STATUS_DATA,
 };
 use aloft_link::mavlink::{MavHeader, MavlinkReader, MavlinkVersion};
-use aloft_link::{Event, LinkOptions, LinkSource, Reply, Telemetry};
+use aloft_link::{BatteryReply, Event, LinkOptions, LinkSource, Reply, Telemetry};
 
 const VEHICLE: MavHeader = MavHeader {
     system_id: 1,
@@ -196,6 +200,12 @@ fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
         severity: aloft_link::Severity::Warning,
     })
     .expect("send");
+    link.reply(&Reply::Battery(BatteryReply {
+        id: 100,
+        remaining_percent: Some(63.0),
+        ..BatteryReply::default()
+    }))
+    .expect("send");
 
     // The failsafe parameter asked for and answered, then the mission, downloaded by aloft
     // START_AFTER the vehicle's first message.
@@ -222,6 +232,21 @@ fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
     assert!((0.6..1.5).contains(&silent_s), "{silent_s}");
     let again = link.next_telemetry().expect("link up").expect("open");
     assert!(matches!(again.event, Event::LinkLost { silent_s } if silent_s >= 1.2));
+    assert_eq!(
+        Duration::from_secs_f64(DISPLAY_HEARD_S),
+        aloft_link::DISPLAY_HEARD
+    );
+    // Silent for longer than DISPLAY_HEARD: a reply now is not sent (from the vehicle's system
+    // it would keep a ground station from saying the vehicle is gone).
+    while link.next_telemetry().expect("link up").is_some_and(
+        |t| !matches!(t.event, Event::LinkLost { silent_s } if silent_s > DISPLAY_HEARD_S),
+    ) {}
+    link.reply(&Reply::Text {
+        text: SILENT_TEXT.into(),
+        severity: aloft_link::Severity::Critical,
+    })
+    .expect("dropped, not an error");
+    std::thread::sleep(Duration::from_millis(200));
     done.store(true, Ordering::Relaxed);
     sim.join().expect("vehicle thread");
 
@@ -233,12 +258,42 @@ fn a_live_link_on_loopback_decodes_answers_and_reports_silence() {
     );
 }
 
-/// What the vehicle received: from 255/190, in MAVLink 1 (the vehicle's version), the value and
-/// the text replied, the mission download and the ground station's heartbeat.
+/// aloft_link::DISPLAY_HEARD, s.
+const DISPLAY_HEARD_S: f64 = 2.0;
+
+/// A text replied once the vehicle has long been silent.
+const SILENT_TEXT: &str = "aloft: said to a silent vehicle";
+
+/// The messages a ground station displays.
+fn displayed(m: &MavMessage) -> bool {
+    matches!(
+        m,
+        MavMessage::NAMED_VALUE_FLOAT(_)
+            | MavMessage::STATUSTEXT(_)
+            | MavMessage::BATTERY_STATUS(_)
+    )
+}
+
+/// What the vehicle received, in MAVLink 1 (the vehicle's version): the value, the text and the
+/// battery replied from (1, 191), each with the next sequence of that sender; the mission
+/// download and the ground station's heartbeat from (255, 190); nothing after the silence.
 fn check_received(received: &[Received]) {
+    assert!(received.iter().all(|(v, _, _)| *v == MavlinkVersion::V1));
+    let ids = |h: &MavHeader| (h.system_id, h.component_id);
+    let shown: Vec<&Received> = received.iter().filter(|(_, _, m)| displayed(m)).collect();
+    assert_eq!(shown.len(), 3, "{shown:?}");
+    for (k, (_, h, _)) in shown.iter().enumerate() {
+        assert_eq!((ids(h), usize::from(h.sequence)), ((1, 191), k), "{h:?}");
+    }
     assert!(received
         .iter()
-        .all(|(v, h, _)| *v == MavlinkVersion::V1 && (h.system_id, h.component_id) == (255, 190)));
+        .filter(|(_, _, m)| !displayed(m))
+        .all(|(_, h, _)| ids(h) == (255, 190)));
+    let battery = received.iter().find_map(|(_, _, m)| match m {
+        MavMessage::BATTERY_STATUS(b) => Some((b.id, b.battery_remaining)),
+        _ => None,
+    });
+    assert_eq!(battery, Some((100, 63)));
     let value = received.iter().find_map(|(_, _, m)| match m {
         MavMessage::NAMED_VALUE_FLOAT(v) => Some(v.clone()),
         _ => None,
@@ -251,6 +306,9 @@ fn check_received(received: &[Received]) {
         _ => None,
     });
     let text = text.expect("STATUSTEXT");
+    assert!(!received.iter().any(
+        |(_, _, m)| matches!(m, MavMessage::STATUSTEXT(t) if t.text.to_str() == Ok(SILENT_TEXT))
+    ));
     assert_eq!(text.severity, MavSeverity::MAV_SEVERITY_WARNING);
     assert_eq!(
         text.text.to_str().unwrap(),
@@ -307,5 +365,90 @@ fn a_tcp_link_that_cannot_connect_is_an_error_naming_it() {
     assert!(
         e.starts_with("tcpout:127.0.0.1:1: cannot open the link"),
         "{e}"
+    );
+}
+
+/// A frame aloft sent: its (system, component) and message name.
+type Sent = ((u32, u8), &'static str);
+
+/// The frames in `socket` until it is quiet for 100 ms, but for heartbeats: (sender, name) each,
+/// and the address they came from.
+fn drain(socket: &UdpSocket) -> (Vec<Sent>, Option<std::net::SocketAddr>) {
+    let (mut got, mut from) = (Vec::new(), None);
+    let mut buf = [0u8; 2048];
+    while let Ok((n, at)) = socket.recv_from(&mut buf) {
+        from = Some(at);
+        let mut reader = MavlinkReader::new(&buf[..n]);
+        while let Ok(raw) = reader.read_any_raw_message::<MavMessage>() {
+            let name = <MavMessage as aloft_link::mavlink::Message>::parse(
+                raw.version(),
+                raw.message_id(),
+                raw.payload(),
+            )
+            .map(|m| aloft_link::mavlink::Message::message_name(&m))
+            .expect("decodes");
+            if name != "HEARTBEAT" {
+                got.push(((raw.system_id(), raw.component_id()), name));
+            }
+        }
+    }
+    (got, from)
+}
+
+/// A PX4 takes a BATTERY_STATUS of its own system from another component as a battery of its
+/// own, whose warning drives its battery failsafe (`MavlinkReceiver::handle_message_battery_status`):
+/// to a PX4, aloft's battery goes from aloft's own ids (255, 190), its texts from (1, 191). On
+/// `udpout`, where aloft has a peer from the start, no reply leaves before the vehicle is heard.
+#[test]
+fn alofts_battery_does_not_come_from_a_px4s_own_system() {
+    let socket = UdpSocket::bind("127.0.0.1:0").expect("bind");
+    let port = socket.local_addr().expect("address").port();
+    socket
+        .set_read_timeout(Some(Duration::from_millis(100)))
+        .expect("timeout");
+    let options = LinkOptions {
+        request_mission: false,
+        request_parameters: false,
+        ..LinkOptions::default()
+    };
+    let mut link =
+        LinkSource::connect(&format!("udpout:127.0.0.1:{port}"), options).expect("udpout");
+    let text = |t: &str| Reply::Text {
+        text: t.into(),
+        severity: aloft_link::Severity::Warning,
+    };
+    let battery = Reply::Battery(BatteryReply {
+        id: 100,
+        ..BatteryReply::default()
+    });
+    // aloft's heartbeat tells the vehicle where aloft is.
+    let mut aloft = None;
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while aloft.is_none() && Instant::now() < deadline {
+        let _ = link.next_telemetry();
+        link.reply(&text("aloft: before the vehicle"))
+            .expect("dropped");
+        link.reply(&battery).expect("dropped");
+        let (got, from) = drain(&socket);
+        assert_eq!(got, [], "sent before the vehicle was heard");
+        aloft = from;
+    }
+    let aloft = aloft.expect("aloft's heartbeat");
+    let px4 = MavMessage::HEARTBEAT(HEARTBEAT_DATA {
+        mavtype: MavType::MAV_TYPE_QUADROTOR,
+        autopilot: MavAutopilot::MAV_AUTOPILOT_PX4,
+        ..HEARTBEAT_DATA::default()
+    });
+    while link.decoder().vehicle().is_none() && Instant::now() < deadline {
+        socket.send_to(&frame(&px4), aloft).expect("send");
+        let _ = link.next_telemetry();
+    }
+    assert_eq!(link.decoder().vehicle(), Some((1, 1)));
+    link.reply(&text("aloft: to a PX4")).expect("send");
+    link.reply(&battery).expect("send");
+    let (got, _) = drain(&socket);
+    assert_eq!(
+        got,
+        [((1, 191), "STATUSTEXT"), ((255, 190), "BATTERY_STATUS")]
     );
 }

@@ -45,7 +45,7 @@ pub use ahead::LIVE_SCENARIOS;
 pub use failsafes::{LiveFailsafe, TimeBand};
 pub use record::LiveRecorder;
 pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
-pub use replies::{LiveReplies, DEFAULT_BATTERY_ID};
+pub use replies::{LiveReplies, DEFAULT_BATTERY_ID, DEFAULT_DISPLAY_COMPONENT_ID};
 pub use sources::LiveSource;
 
 use advice::AdviceHold;
@@ -92,6 +92,10 @@ pub struct LiveUpdate {
     /// The pack's current as measured now, A (positive discharging).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub current_a: Option<f64>,
+    /// The autopilot's count of the charge drawn, A h, where it is believed
+    /// ([`count`](self::count)); sent as aloft's BATTERY_STATUS `current_consumed`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub charge_drawn_ah: Option<f64>,
     /// Electrical energy used so far, Wh (measured; the model's without power data).
     pub energy_used_wh: f64,
     /// Measured electrical power now, W.
@@ -761,6 +765,7 @@ impl<'a> LiveSession<'a> {
             reported_soc: self.pack_state.reported(),
             voltage_v: t.voltage_v,
             current_a: t.current_a,
+            charge_drawn_ah: self.count.believed_ah(),
             energy_used_wh: t.energy_used_wh(),
             power_w: t.power_w,
             power_available: t.power_available(),

@@ -5,8 +5,9 @@
 //!   in its Quick tab; QGroundControl ignores them.
 //! - BATTERY_STATUS of aloft's own battery (`--battery-id`, [`DEFAULT_BATTERY_ID`]) at every
 //!   update: aloft's state of charge, the time to the first failsafe that comes before home (its
-//!   p5, the conservative end), the voltage and current as measured, and a charge state from the
-//!   advice and the failsafes ([`charge_state`]). QGroundControl shows each battery id it hears
+//!   p5, the conservative end), the voltage and current as measured, the autopilot's count of
+//!   the charge drawn where it is believed, and a charge state from the advice and the
+//!   failsafes ([`charge_state`]). QGroundControl shows each battery id it hears
 //!   as a battery of its own.
 //! - STATUSTEXT when the advice changes, at a severity that QGroundControl speaks for `return now`,
 //!   `do not take off` (WARNING) and `land now` (CRITICAL) and not for `continue` (INFO: it
@@ -24,6 +25,11 @@ use super::{LiveFailsafe, LiveUpdate};
 /// instance as the id, 0-15 with its up to 16 monitors; PX4 its `battery_status.id - 1`, 0-3
 /// with its up to 4 instances), so it never takes a battery's place in a ground station.
 pub const DEFAULT_BATTERY_ID: u8 = 100;
+
+/// The component of the vehicle's system aloft's replies are sent from unless
+/// `--display-component-id` says otherwise: MAV_COMP_ID_ONBOARD_COMPUTER (see
+/// `aloft_link::DISPLAY_COMPONENT_ID`).
+pub const DEFAULT_DISPLAY_COMPONENT_ID: u8 = 191;
 
 /// The longest STATUSTEXT a message holds in one chunk, characters.
 const TEXT_MAX: usize = 50;
@@ -78,7 +84,7 @@ impl LiveReplies {
             time_remaining_s: first_failsafe_s(&update.failsafes),
             voltage_v: update.voltage_v,
             current_a: update.current_a,
-            consumed_mah: None,
+            consumed_mah: update.charge_drawn_ah.map(|c| 1000.0 * c),
             charge_state: charge_state(update),
         }
     }

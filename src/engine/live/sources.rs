@@ -40,6 +40,8 @@ pub enum LiveSource {
         system_id: u8,
         /// aloft's component id.
         component_id: u8,
+        /// The component of the vehicle's system aloft's displayed replies come from.
+        display_component_id: u8,
         /// Silence after which the link is said lost, s.
         timeout_s: f64,
     },
@@ -82,8 +84,14 @@ impl LiveSource {
                 url,
                 system_id,
                 component_id,
+                display_component_id,
                 timeout_s,
-            } => connect(url, (*system_id, *component_id), *timeout_s, stop),
+            } => connect(
+                url,
+                [*system_id, *component_id, *display_component_id],
+                *timeout_s,
+                stop,
+            ),
         }
     }
 }
@@ -144,13 +152,14 @@ fn timeout(timeout_s: f64) -> Result<std::time::Duration, Error> {
 #[cfg(feature = "live")]
 fn connect(
     url: &str,
-    (system_id, component_id): (u8, u8),
+    [system_id, component_id, display_component_id]: [u8; 3],
     timeout_s: f64,
     stop: Option<Arc<AtomicBool>>,
 ) -> Result<Box<dyn TelemetrySource>, Error> {
     let options = aloft_link::LinkOptions {
         system_id,
         component_id,
+        display_component_id,
         timeout: timeout(timeout_s)?,
         ..aloft_link::LinkOptions::default()
     };
@@ -173,11 +182,24 @@ fn open_tlog(path: &std::path::Path, _: f64) -> Result<Box<dyn TelemetrySource>,
 #[cfg(not(feature = "live"))]
 fn connect(
     url: &str,
-    _: (u8, u8),
+    _: [u8; 3],
     _: f64,
     _: Option<Arc<AtomicBool>>,
 ) -> Result<Box<dyn TelemetrySource>, Error> {
     Err(Error::Link(format!(
         "{url}: MAVLink links need aloft built with the `live` feature"
     )))
+}
+
+#[cfg(all(test, feature = "live"))]
+mod tests {
+    /// The engine's default display component is the link's (the engine builds without the
+    /// link crate, so it keeps its own copy).
+    #[test]
+    fn the_display_component_defaults_agree() {
+        assert_eq!(
+            super::super::DEFAULT_DISPLAY_COMPONENT_ID,
+            aloft_link::DISPLAY_COMPONENT_ID
+        );
+    }
 }
