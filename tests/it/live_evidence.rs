@@ -25,13 +25,8 @@ use aloft_logs::telemetry::{BatteryState, Event, Heartbeat, Telemetry};
 /// The hover's current, A.
 const CURRENT_A: f64 = 12.0;
 
-/// The TB47D's capacity, A h, and rated energy, W h (`fixtures/vehicles/dji-m100.toml`).
+/// The TB47D's capacity, A h (`fixtures/vehicles/dji-m100.toml`).
 const CAPACITY_AH: f64 = 4.5;
-const RATED_WH: f64 = 99.9;
-
-/// How long a milder advice must hold before it is given, s (docs/guide.md, "the advice"):
-/// the hold time the tests allow, plus one update.
-const HOLD_S: f64 = 5.0;
 
 /// The charge the hover draws in `t_s` seconds, A h.
 fn drawn_ah(t_s: f64) -> f64 {

@@ -131,13 +131,12 @@ fn table(log: &str, topic: &str, names: &[&str]) -> Vec<Vec<f64>> {
 }
 
 /// What PX4 reported on one flight, read from its CSVs: the boot time of the ULog's first
-/// sample (the first `vehicle_local_position`, s), the take-off and the last landing (boot
-/// time, s) from `vehicle_land_detected`, and `battery_status` rows `(time s, remaining,
+/// sample (the first `vehicle_local_position`, s), the take-off (boot time, s) from
+/// `vehicle_land_detected`, and `battery_status` rows `(time s, remaining,
 /// voltage V, current A, discharged mA h)`.
 struct Reported {
     first_s: f64,
     take_off_s: f64,
-    landing_s: f64,
     battery: Vec<[f64; 5]>,
 }
 
@@ -146,11 +145,6 @@ impl Reported {
         let first_s = table(log, "vehicle_local_position", &["timestamp"])[0][0] * 1e-6;
         let land = table(log, "vehicle_land_detected", &["timestamp", "landed"]);
         let take_off_s = land.iter().find(|r| r[1] < 0.5).unwrap()[0] * 1e-6;
-        let landed: Vec<f64> = land
-            .windows(2)
-            .filter(|w| w[0][1] < 0.5 && w[1][1] > 0.5)
-            .map(|w| w[1][0] * 1e-6)
-            .collect();
         let names = [
             "timestamp",
             "remaining",
@@ -165,7 +159,6 @@ impl Reported {
         Self {
             first_s,
             take_off_s,
-            landing_s: *landed.last().unwrap(),
             battery,
         }
     }

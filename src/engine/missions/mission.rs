@@ -582,7 +582,7 @@ pub(in crate::engine) fn start_soc(options: &MissionOptions, pack: &Pack) -> Res
     let Some(v) = options.start_voltage_v else {
         return Ok(options.start_percent / 100.0);
     };
-    if options.start_percent != 100.0 {
+    if (options.start_percent - 100.0).abs() > 1e-9 {
         return Err(Error::InvalidInput {
             name: "start_voltage_v",
             value: v,

@@ -839,6 +839,10 @@ impl<'a> MissionScenarios<'a> {
     }
 }
 
+/// What a [`ScenarioWatch`] saw of one scenario: whether it landed with the reserve, and the
+/// run's own figures.
+pub(in crate::engine) type Watched = (bool, Vec<f64>);
+
 /// Something that follows each scenario's flight sample by sample, beside what every scenario
 /// gives (`aloft live`: the autopilot's failsafes on the pack flown).
 pub(in crate::engine) trait ScenarioWatch: Sync {
@@ -943,7 +947,7 @@ pub(in crate::engine) fn plan_scenarios_watched(
     options: &MissionOptions,
     sc: &ScenarioOptions,
     watch: Option<&dyn ScenarioWatch>,
-) -> Result<(Uncertainty, Vec<(bool, Vec<f64>)>), Error> {
+) -> Result<(Uncertainty, Vec<Watched>), Error> {
     sc.check()?;
     let (vehicle, _air) =
         crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;
