@@ -94,6 +94,11 @@ impl Watched {
             .collect()
     }
 
+    /// PX4's own estimate now, as the monitor emulates it (0-1), on a PX4.
+    pub(crate) fn px4_remaining(&self) -> Option<f64> {
+        self.monitor.px4_estimate().map(|e| e.remaining)
+    }
+
     /// Whether a failsafe that acts has triggered already.
     pub(crate) fn acted(&self) -> bool {
         self.acting()

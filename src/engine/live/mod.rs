@@ -595,6 +595,34 @@ impl<'a> LiveSession<'a> {
         ))
     }
 
+    /// Where a PX4 failsafe, acting on PX4's own estimate, comes before home: when, what PX4's
+    /// estimate says now and what the pack holds (`PX4 triggers its low-battery failsafe
+    /// (BAT_LOW_THR 15 %) in 3:10 (p50) although the pack holds 31 %: its own estimate says
+    /// 22 %`).
+    fn px4_note(&self, failsafes: &[LiveFailsafe], soc: f64) -> Option<String> {
+        let Some(Ok(Some(w))) = &self.watched else {
+            return None;
+        };
+        let px4 = w.px4_remaining()?;
+        let f = failsafes
+            .iter()
+            .find(|f| f.unit == "fraction" && f.before_home)?;
+        let when = match f.time_s.and_then(|t| t.p50) {
+            Some(t) if t > 0.0 => format!("in {} (p50)", replies::clock(t)),
+            Some(_) => "now".to_string(),
+            None => "before the landing (p5)".to_string(),
+        };
+        Some(format!(
+            "PX4 triggers its {} battery failsafe ({} {:.0} %) {when} although the pack holds \
+             {:.0} %: its own estimate says {:.0} %",
+            f.kind,
+            f.source,
+            100.0 * f.threshold,
+            100.0 * soc,
+            100.0 * px4
+        ))
+    }
+
     /// The autopilot's count and the current it is judged by ([`count`](self::count)); a
     /// restart starts the count over.
     fn apply_count(&mut self, event: &aloft_logs::telemetry::Event) {
@@ -733,12 +761,16 @@ impl<'a> LiveSession<'a> {
                 self.charge.pack().cells_series()
             )
         });
+        let px4_note = answer
+            .as_ref()
+            .and_then(|a| self.px4_note(&a.failsafes, soc));
         let note = [
             note,
             self.charge.note(),
             self.disagreement_note(),
             watched_note,
             foreign_note,
+            px4_note,
         ]
         .into_iter()
         .flatten()

@@ -185,7 +185,7 @@ fn failsafe_text(f: &LiveFailsafe) -> String {
 }
 
 /// `m:ss`, or `h:mm:ss` from an hour, of a number of seconds (rounded; negative is 0).
-fn clock(seconds: f64) -> String {
+pub(crate) fn clock(seconds: f64) -> String {
     let total = seconds.max(0.0).round() as u64;
     let (h, m, s) = (total / 3600, total / 60 % 60, total % 60);
     if h > 0 {
