@@ -494,7 +494,10 @@ impl OcvCurve {
         } else {
             soc.clamp(self.soc[0], self.soc[self.soc.len() - 1])
         };
-        let k = match self.soc.iter().position(|&x| x >= s) {
+        // The first point at or above `s` (the points rise strictly: a binary search finds the
+        // one a scan from the start would).
+        let first = self.soc.partition_point(|&x| x < s);
+        let k = match (first < self.soc.len()).then_some(first) {
             Some(0) | None => {
                 return if s <= self.soc[0] {
                     self.cell_v[0]
@@ -553,6 +556,41 @@ pub(crate) fn seed_pack_constants(resistance_ohm: f64) -> BatteryConstants {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The plain lookup the binary search replaced: the first point at or above `s` by a scan.
+    fn cell_v_by_scan(c: &OcvCurve, soc: f64) -> f64 {
+        let s = soc.clamp(c.soc[0], c.soc[c.soc.len() - 1]);
+        match c.soc.iter().position(|&x| x >= s) {
+            Some(0) | None => {
+                if s <= c.soc[0] {
+                    c.cell_v[0]
+                } else {
+                    c.cell_v[c.cell_v.len() - 1]
+                }
+            }
+            Some(k) => {
+                let (s0, s1) = (c.soc[k - 1], c.soc[k]);
+                let (v0, v1) = (c.cell_v[k - 1], c.cell_v[k]);
+                v0 + (v1 - v0) * (s - s0) / (s1 - s0)
+            }
+        }
+    }
+
+    #[test]
+    fn the_binary_search_looks_up_what_the_scan_did_bit_for_bit() {
+        let c = OcvCurve::typical_lipo();
+        for k in -100..=1100 {
+            let soc = f64::from(k) / 1000.0;
+            assert_eq!(
+                c.cell_v(soc).to_bits(),
+                cell_v_by_scan(&c, soc).to_bits(),
+                "{soc}"
+            );
+        }
+        for &soc in &c.soc {
+            assert_eq!(c.cell_v(soc).to_bits(), cell_v_by_scan(&c, soc).to_bits());
+        }
+    }
 
     fn seed_pack(r: f64) -> Battery {
         Battery::new(seed_pack_constants(r)).unwrap()
