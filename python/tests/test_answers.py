@@ -234,12 +234,44 @@ def test_live_replay_equals_cli(cli, data):
         assert len(got["updates"]) >= 2
 
 
+def test_live_failsafes_and_the_pack_state_equal_cli(cli, data):
+    """Issue 44: the failsafe thresholds reach ``aloft.live`` as on the command line: the
+    updates carry ``failsafes`` (the flag's, as the source) and ``soc_band`` where the pack is
+    the vehicle's own (this log's 4S-size simulator pack is not the M100's 6S: its reports)."""
+    log = data / "flight_logs" / "sitl_ac47_00000002.BIN"
+    rc, out, err = cli.run("live", "--replay", str(log), "--vehicle", "dji-m100", "--every", "5",
+                           "--low-voltage-v", "10.5", "--format", "json")
+    assert rc == 0, err
+    lines = [json.loads(line) for line in out.splitlines()]
+    got = aloft.live(log, "dji-m100", every=5, low_voltage_v=10.5)
+    assert got["updates"] == lines[:-1]
+    sources = {f["source"] for u in got["updates"] for f in u.get("failsafes", [])}
+    assert sources <= {"--low-voltage-v", "BATT_LOW_VOLT", "BATT_CRT_VOLT", "BATT_LOW_MAH",
+                       "BATT_CRT_MAH"}, sources
+
+
+def test_mission_from_a_rested_voltage_equals_cli(cli):
+    """``start_voltage_v``: the M100's 6S pack rested at 3.58 V a cell starts at 4.56 % on the
+    generic LiPo curve (5 % x (3.58 - 3.27) / (3.61 - 3.27)), with the failsafe's band."""
+    flags = ["--start-voltage-v", "21.48", "--critical-voltage-v", "19.8", "--samples", "20"]
+    rc, out, err = cli.run("mission", *flags, "--format", "json")
+    assert rc in (0, 1), err
+    got = aloft.mission(start_voltage_v=21.48, critical_voltage_v=19.8, samples=20)
+    assert got == json.loads(out)
+    assert abs(got["start_soc"] - 0.05 * (3.58 - 3.27) / (3.61 - 3.27)) < 1e-9
+    assert got["uncertainty"]["failsafes"][0]["kind"] == "critical"
+    with pytest.raises(aloft.AloftError, match="start_voltage_v"):
+        aloft.mission(start_voltage_v=5.0)
+
+
 def test_live_refuses_bad_options_and_links(data):
     log = data / "flight_logs" / "sitl_ac47_00000002.BIN"
     with pytest.raises(aloft.AloftError, match="every"):
         aloft.live(log, "dji-m100", every=0)
     with pytest.raises(aloft.AloftError, match="live"):
         aloft.live(log, "dji-m100", speed="fast")
+    with pytest.raises(aloft.AloftError, match="low-voltage-v"):
+        aloft.live(log, "dji-m100", low_voltage_v=-1)
 
 
 def test_fit_of_an_own_vehicle_equals_cli(cli, data, tmp_path):

@@ -72,7 +72,8 @@ def mission(path: Optional[PathLike] = None, **options: Any) -> Dict[str, Any]:
             ``wind_speed`` and ``wind_from`` (m/s and degrees the wind blows FROM; give both),
             ``wind_profile`` (``"uniform"``, ``"power-law"``, ``"log"``),
             ``wind_reference_height``, ``wind_exponent``, ``wind_roughness``, ``wind_field``
-            (CSV path), ``gust_std``, ``gust_seed``, ``reserve_percent``, ``start_percent``,
+            (CSV path), ``gust_std``, ``gust_seed``, ``reserve_percent``, ``start_percent`` (or
+            ``start_voltage_v``, the rested voltage),
             ``time_step``, ``speed``, ``rtl_altitude_m``, ``corners`` (``"pass"``, ``"stop"``),
             ``aoa`` (``"geometric"``, ``"paper"``), ``no_ground_effect``; the day's air:
             ``elevation_m`` (m above mean sea level; default the mission's home altitude),
@@ -329,7 +330,9 @@ def live(replay: PathLike, vehicle: str, **options: Any) -> Dict[str, Any]:
         vehicle: Built-in name or TOML path of a vehicle with a ``[power]`` table.
         **options: ``route`` (``"mission"``, the default, or ``"log"``), ``mission`` (a mission
             file), ``profile``, ``every`` (s), ``battery``, ``payload_kg``,
-            ``reserve_percent``, ``scenarios``, ``speed``. Telemetry logs and MAVLink links
+            ``reserve_percent``, ``scenarios``, ``speed``, ``low_voltage_v`` and
+            ``critical_voltage_v`` (pack volts: the failsafes flown on the rest, in place of the
+            vehicle's own). Telemetry logs and MAVLink links
             (``tlog``, ``connect``) need the command line: this package is built without them.
     """
     return json.loads(_native.live_json(str(replay), vehicle, options))

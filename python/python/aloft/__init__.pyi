@@ -54,6 +54,7 @@ class MissionKeywords(VehicleKeywords, WindKeywords, AirKeywords, total=False):
     gust_seed: Optional[int]
     reserve_percent: Optional[float]
     start_percent: Optional[float]
+    start_voltage_v: Optional[float]
     time_step: Optional[float]
     speed: Optional[float]
     rtl_altitude_m: Optional[float]
