@@ -979,6 +979,10 @@ pub struct LiveFlags {
     /// The autopilot's critical-voltage failsafe, pack volts (in place of BATT_CRT_VOLT).
     #[arg(value_parser = finite(), long, value_name = "V")]
     pub critical_voltage_v: Option<f64>,
+    /// The pack's rested voltage before take-off, V: the state of charge starts from it on the
+    /// pack's open-circuit curve (where the stream starts after it, or says nothing of it).
+    #[arg(value_parser = finite(), long, value_name = "V")]
+    pub start_voltage_v: Option<f64>,
     /// Monte-Carlo scenarios of the route ahead per update.
     #[arg(long, default_value_t = super::LIVE_SCENARIOS, value_parser = clap::value_parser!(u32).range(1..=10_000), value_name = "N")]
     pub scenarios: u32,
@@ -1129,6 +1133,7 @@ impl LiveFlags {
                 scenarios: self.scenarios,
                 low_voltage_v: self.low_voltage_v,
                 critical_voltage_v: self.critical_voltage_v,
+                start_voltage_v: self.start_voltage_v,
                 air: self.air.input(),
                 battery_id: self.battery_id,
             }),

@@ -423,3 +423,35 @@ fn data_val_no_state_of_charge_is_shown_before_the_pack_says_one() {
         assert!(u["soc"].is_number(), "{u}");
     }
 }
+
+/// `--start-voltage-v`: the state of charge starts from the rested voltage given, before any the
+/// log gives (`log_66` rested at 11.68 V; told 11.0 V, 3.667 V a cell, 8.5 % on the generic LiPo
+/// curve: 5 % + 5 % x (3.667 - 3.61) / (3.69 - 3.61)), and the charge drawn is counted from it; a
+/// voltage that is not the pack's is refused naming it.
+#[test]
+fn data_val_live_starts_from_the_rested_voltage_given() {
+    let dir = data_dir().join("px4_flugdrohne/ulg");
+    let vehicle = px4_vehicle("log_66_2023-6-21-08-44-02");
+    let log = "log_66_2023-6-21-08-44-02";
+    let ulog = dir.join(format!("{log}.ulg")).display().to_string();
+    let v = updates(
+        &["--replay", &ulog],
+        &vehicle,
+        &["--every", "1", "--start-voltage-v", "11.0"],
+    );
+    let air = in_air(&v);
+    let want = 0.05 + 0.05 * (11.0 / 3.0 - 3.61) / (3.69 - 3.61);
+    let first = num(air[0], "soc");
+    assert!((first - want).abs() < 0.02, "{first} vs {want}");
+    let out = aloft(&[
+        "live",
+        "--replay",
+        &ulog,
+        "--vehicle",
+        &vehicle,
+        "--start-voltage-v",
+        "20",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("start_voltage_v"), "{}", stderr(&out));
+}

@@ -200,6 +200,9 @@ pub struct LiveRequest {
     pub low_voltage_v: Option<f64>,
     /// The critical-voltage failsafe, pack volts (`--critical-voltage-v`).
     pub critical_voltage_v: Option<f64>,
+    /// The pack's rested voltage before take-off, V (`--start-voltage-v`): the state of charge
+    /// starts from it on the pack's curve, before any the stream gives.
+    pub start_voltage_v: Option<f64>,
     /// The day's air (default: the mission's home altitude in ISA air, else the vehicle file's
     /// density).
     pub air: AirInput,
@@ -221,6 +224,7 @@ impl LiveRequest {
             scenarios: LIVE_SCENARIOS,
             low_voltage_v: None,
             critical_voltage_v: None,
+            start_voltage_v: None,
             air: AirInput::default(),
             battery_id: DEFAULT_BATTERY_ID,
         }
@@ -342,6 +346,8 @@ pub struct LiveSession<'a> {
     watched: Option<Result<Option<Watched>, String>>,
     /// The flags' voltage thresholds.
     thresholds: Vec<aloft_packs::VoltageThreshold>,
+    /// The rested voltage given (`--start-voltage-v`), V.
+    start_voltage_v: Option<f64>,
     /// The advice given, for its hysteresis.
     advice: AdviceHold,
     eta0: f64,
@@ -399,6 +405,13 @@ impl<'a> LiveSession<'a> {
         let (model, mass) =
             vehicle.power_model_with(request.battery.as_deref(), request.payload_kg)?;
         let pack = vehicle.battery(request.battery.as_deref())?;
+        if let Some(v) = request.start_voltage_v {
+            let options = crate::engine::missions::mission_options::MissionOptions {
+                start_voltage_v: Some(v),
+                ..Default::default()
+            };
+            crate::engine::missions::mission::start_soc(&options, &pack)?;
+        }
         let drag = vehicle
             .aircraft()
             .ok()
@@ -423,6 +436,7 @@ impl<'a> LiveSession<'a> {
             advice: AdviceHold::default(),
             eta0,
             given_mission: request.mission.as_ref(),
+            start_voltage_v: request.start_voltage_v,
             learned: None,
             point_of_no_return_at: None,
             on_ground: None,
@@ -537,7 +551,10 @@ impl<'a> LiveSession<'a> {
                 Event::Sample(s) if t.in_air() => s.voltage_v.zip(s.current_a),
                 _ => None,
             };
-            let start = self.charge.start(drawn);
+            let start = match self.start_voltage_v {
+                Some(v) => pack_state::Start::Rested(v),
+                None => self.charge.start(drawn),
+            };
             p.start_from(start, kind, loaded);
             // In the air from a full pack assumed, wait a little for a voltage or a report
             // (a stream's first samples may carry only the motion).
