@@ -781,9 +781,20 @@ impl<'a> LiveSession<'a> {
         let px4_note = answer
             .as_ref()
             .and_then(|a| self.px4_note(&a.failsafes, soc));
+        // Where the state of charge started, where the evidence before take-off is not what
+        // `charge` says of it: the rested voltage given, or the first voltage in the air.
+        let charge_note = match (self.start_voltage_v, self.pack_state.start()) {
+            (Some(_), _) => None,
+            (None, Some(pack_state::Start::Loaded)) => Some(
+                "no state of charge from the vehicle before take-off: the flight starts from its \
+                 first voltage under load in the air, within 15 points"
+                    .to_string(),
+            ),
+            _ => self.charge.note(),
+        };
         let note = [
             note,
-            self.charge.note(),
+            charge_note,
             self.disagreement_note(),
             watched_note,
             foreign_note,

@@ -117,6 +117,11 @@ impl PackState {
         self.filter.as_ref().filter(|_| self.foreign_v.is_none())
     }
 
+    /// What the filter started from (`None`: not started).
+    pub(crate) fn start(&self) -> Option<Start> {
+        self.start
+    }
+
     /// The vehicle's last report, 0-1.
     pub(crate) fn reported(&self) -> Option<f64> {
         self.reported
