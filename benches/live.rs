@@ -24,13 +24,8 @@ fn data_dir() -> PathBuf {
     )
 }
 
-fn bench_update(c: &mut Criterion) {
-    let vehicle = Vehicle::builtin("dji-m100").expect("built-in vehicle");
-    let request = LiveRequest {
-        scenarios: LIVE_SCENARIOS,
-        ..LiveRequest::new()
-    };
-    let mut session = LiveSession::new(&vehicle, &request).expect("session");
+/// The shared simulator mission folded into `session` up to 100 s.
+fn fold_to_100_s(session: &mut LiveSession<'_>) {
     let path = data_dir().join("telemetry/ayoub_auto_mission_sitl.tlog");
     let mut source = TlogSource::open(&path).expect("the shared telemetry log");
     while let Some(t) = source.next_event().expect("readable") {
@@ -39,6 +34,16 @@ fn bench_update(c: &mut Criterion) {
             break;
         }
     }
+}
+
+fn bench_update(c: &mut Criterion) {
+    let vehicle = Vehicle::builtin("dji-m100").expect("built-in vehicle");
+    let request = LiveRequest {
+        scenarios: LIVE_SCENARIOS,
+        ..LiveRequest::new()
+    };
+    let mut session = LiveSession::new(&vehicle, &request).expect("session");
+    fold_to_100_s(&mut session);
     let first = session.update();
     assert!(first.in_air && first.remaining_wh.is_some(), "{first:?}");
     c.bench_function("live/update/200_scenarios", |b| {
@@ -75,14 +80,7 @@ fn bench_update_on_the_pack(c: &mut Criterion) {
         ..LiveRequest::new()
     };
     let mut session = LiveSession::new(&vehicle, &request).expect("session");
-    let path = data_dir().join("telemetry/ayoub_auto_mission_sitl.tlog");
-    let mut source = TlogSource::open(&path).expect("the shared telemetry log");
-    while let Some(t) = source.next_event().expect("readable") {
-        session.apply(&t);
-        if t.time_s >= 100.0 {
-            break;
-        }
-    }
+    fold_to_100_s(&mut session);
     let first = session.update();
     assert!(
         first.in_air && first.soc_band.is_some() && !first.failsafes.is_empty(),

@@ -171,8 +171,17 @@ fn panel(u: &LiveUpdate) -> Vec<String> {
     let mut lines = vec![
         format!("aloft live · t {:.1} s · {mode}{item} · {state}", u.time_s),
         format!(
-            "battery   {} %   used {:.2} Wh   power {} W   eta {:.4}",
+            "battery   {} %{}{}   used {:.2} Wh   power {} W   eta {:.4}",
             fixed_or_dash(u.soc.map(|s| 100.0 * s), 1),
+            u.soc_band.map_or_else(String::new, |b| format!(
+                " (p5-p95 {:.0}-{:.0} %)",
+                100.0 * b.p5,
+                100.0 * b.p95
+            )),
+            u.reported_soc.map_or_else(String::new, |r| format!(
+                "; the vehicle says {:.0} %",
+                100.0 * r
+            )),
             u.energy_used_wh,
             fixed_or_dash(u.power_w, 0),
             u.efficiency
@@ -190,6 +199,26 @@ fn panel(u: &LiveUpdate) -> Vec<String> {
         format!("no return {pnr}"),
         format!("advice    {}", u.advice.unwrap_or("-")),
     ];
+    // Each failsafe that comes before home, in the place of the advice it shapes.
+    for f in u.failsafes.iter().filter(|f| f.before_home) {
+        let t = f.time_s.unwrap_or_default();
+        let at = |v: Option<f64>| v.map_or("never".to_string(), |s| format!("{s:.0} s"));
+        let threshold = match f.unit {
+            "fraction" => format!("{:.0} %", 100.0 * f.threshold),
+            unit => format!("{} {unit}", aloft_core::Num(f.threshold)),
+        };
+        lines.insert(
+            lines.len() - 1,
+            format!(
+                "failsafe  {} ({} {threshold}) in {} / {} / {} (p5 / p50 / p95)",
+                f.kind,
+                f.source,
+                at(t.p5),
+                at(t.p50),
+                at(t.p95)
+            ),
+        );
+    }
     if let Some(note) = &u.note {
         lines.push(format!("note      {note}"));
     }
@@ -310,6 +339,32 @@ mod tests {
         let lines = panel(&u);
         assert!(lines[0].ends_with("LINK LOST (last estimate)"));
         assert_eq!(lines[5], "no return passed 10 s ago");
+        // The estimate's band, the vehicle's own figure and a failsafe before home.
+        u.soc_band = Some(aloft::engine::SocBand { p5: 0.55, p95: 0.65 });
+        u.reported_soc = Some(0.48);
+        u.failsafes = vec![aloft::engine::LiveFailsafe {
+            kind: "low",
+            source: "BAT_LOW_THR".to_string(),
+            threshold: 0.15,
+            unit: "fraction",
+            time_s: Some(aloft::engine::TimeBand {
+                p5: Some(190.0),
+                p50: Some(230.0),
+                p95: None,
+            }),
+            before_home: true,
+        }];
+        let lines = panel(&u);
+        assert!(
+            lines[1].starts_with("battery   60.0 % (p5-p95 55-65 %); the vehicle says 48 %"),
+            "{}",
+            lines[1]
+        );
+        assert_eq!(
+            lines[6],
+            "failsafe  low (BAT_LOW_THR 15 %) in 190 s / 230 s / never (p5 / p50 / p95)"
+        );
+        assert_eq!(lines[7], "advice    continue");
     }
 
     fn sample() -> LiveUpdate {

@@ -51,6 +51,21 @@ use crate::PackError;
 /// z-score of the 5th and 95th percentiles of a Gaussian.
 const Z_90: f64 = 1.644_853_626_951_472_2;
 
+/// A value out of its range, named.
+fn invalid(
+    name: &'static str,
+    value: f64,
+    unit: &'static str,
+    expected: &'static str,
+) -> PackError {
+    PackError::InvalidValue {
+        name,
+        value,
+        unit,
+        expected,
+    }
+}
+
 /// The RC pair's time constant where none was fitted, s.
 pub const DEFAULT_RC_TIME_CONSTANT_S: f64 = 30.0;
 
@@ -98,14 +113,7 @@ impl Circuit {
     /// # Errors
     /// [`PackError::InvalidValue`] naming the first value out of its range.
     pub fn check(&self) -> Result<(), PackError> {
-        let bad = |name: &'static str, value: f64, unit: &'static str, expected: &'static str| {
-            Err(PackError::InvalidValue {
-                name,
-                value,
-                unit,
-                expected,
-            })
-        };
+        let bad = |name, value, unit, expected| Err(invalid(name, value, unit, expected));
         if self.cells_series == 0 {
             return bad("cells_series", 0.0, "", "at least one cell");
         }
@@ -301,20 +309,10 @@ impl SocFilter {
     ) -> Result<Self, PackError> {
         circuit.check()?;
         if !(soc.is_finite() && (0.0..=1.0).contains(&soc)) {
-            return Err(PackError::InvalidValue {
-                name: "soc",
-                value: soc,
-                unit: "",
-                expected: "a state of charge from 0 to 1",
-            });
+            return Err(invalid("soc", soc, "", "a state of charge from 0 to 1"));
         }
         if !(soc_sd.is_finite() && soc_sd >= 0.0) {
-            return Err(PackError::InvalidValue {
-                name: "soc_sd",
-                value: soc_sd,
-                unit: "",
-                expected: "zero or positive, finite",
-            });
+            return Err(invalid("soc_sd", soc_sd, "", "zero or positive, finite"));
         }
         let cells = f64::from(circuit.cells_series);
         let x = Vect::from([
@@ -355,12 +353,7 @@ impl SocFilter {
         rested_v: f64,
     ) -> Result<Self, PackError> {
         if !(rested_v.is_finite() && rested_v > 0.0) {
-            return Err(PackError::InvalidValue {
-                name: "rested_v",
-                value: rested_v,
-                unit: "V",
-                expected: "a positive voltage",
-            });
+            return Err(invalid("rested_v", rested_v, "V", "a positive voltage"));
         }
         let cells = f64::from(circuit.cells_series);
         let soc = circuit.ocv.soc_at(rested_v / cells);
