@@ -228,7 +228,7 @@ impl PackState {
             return;
         };
         let dt_s = time_s - t0;
-        if !(dt_s > 0.0) {
+        if dt_s.is_nan() || dt_s <= 0.0 {
             return;
         }
         match current_a {
@@ -256,10 +256,12 @@ impl PackState {
             return;
         };
         let adds = kind != ReportKind::Voltage || self.voltage_v.is_none();
-        if believed && adds && time_s - self.last_fused_s >= REPORT_INTERVAL_S {
-            if filter.report(soc, kind) {
-                self.last_fused_s = time_s;
-            }
+        if believed
+            && adds
+            && time_s - self.last_fused_s >= REPORT_INTERVAL_S
+            && filter.report(soc, kind)
+        {
+            self.last_fused_s = time_s;
         }
     }
 }
@@ -273,7 +275,7 @@ pub(crate) fn report_kind(parameters: &BTreeMap<String, f64>) -> ReportKind {
         .get("BAT1_CAPACITY")
         .or_else(|| parameters.get("BAT_CAPACITY"));
     match capacity {
-        Some(c) if !(*c > 0.0) => ReportKind::Voltage,
+        Some(c) if c.is_nan() || *c <= 0.0 => ReportKind::Voltage,
         _ => ReportKind::Counted,
     }
 }

@@ -397,11 +397,9 @@ fn naive_time_s(averages: &VecDeque<(f64, f64)>, now_s: f64, threshold_v: f64) -
         stt += (t - mean_t) * (t - mean_t);
         stv += (t - mean_t) * (v - mean_v);
     }
-    if !(stt > 0.0) {
-        return None;
-    }
-    let slope_v_s = stv / stt;
-    if !(slope_v_s < 0.0) {
+    // A line needs two distinct times; it reaches the threshold only where it falls.
+    let slope_v_s = Some(stv / stt).filter(|_| stt > 0.0)?;
+    if slope_v_s.is_nan() || slope_v_s >= 0.0 {
         return None;
     }
     let v_now = mean_v + slope_v_s * (now_s - mean_t);
