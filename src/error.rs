@@ -294,6 +294,15 @@ pub enum Error {
         /// File.
         origin: String,
     },
+    /// A log without the pack's voltage, asked for the voltage failsafes (`aloft live --route
+    /// log` with `--low-voltage-v` or `--critical-voltage-v`).
+    #[error("{origin}: no pack voltage in this log, so the voltage failsafes ({flags}) cannot be judged")]
+    NoVoltage {
+        /// File.
+        origin: String,
+        /// The flags given.
+        flags: String,
+    },
     /// A log without velocity and attitude.
     #[error("{origin}: no samples with both velocity and attitude")]
     NoMotion {

@@ -9,8 +9,8 @@ use clap::{Args, ValueEnum};
 
 use aloft::engine::flags::{LiveFlags, LiveTask};
 use aloft::engine::{
-    follow_live, replay_live, Error, LiveCheck, LiveCheckpoint, LiveRecorder, LiveSummary,
-    LiveUpdate,
+    follow_live, replay_live, Error, FailsafeCheck, LiveCheck, LiveCheckpoint, LiveRecorder,
+    LiveSummary, LiveUpdate,
 };
 
 use super::output::{fixed, fixed_or_dash, percentiles};
@@ -300,8 +300,58 @@ fn render_check(out: &mut impl Write, c: &LiveCheck) -> Result<()> {
     for p in &c.checkpoints {
         writeln!(out, "{}", checkpoint_row(p))?;
     }
+    for f in &c.failsafes {
+        render_failsafe_check(out, f)?;
+    }
     Ok(())
 }
+
+/// One voltage failsafe of the validation replay: when the log crossed it, and the predictions
+/// made before.
+fn render_failsafe_check(out: &mut impl Write, f: &FailsafeCheck) -> Result<()> {
+    let crossed = f.crossed_s.map_or_else(
+        || "the log's 5 s average never fell below it".to_string(),
+        |t| format!("the log's 5 s average fell below it at {t:.1} s"),
+    );
+    writeln!(
+        out,
+        "\n{} failsafe {:.2} V ({}): {crossed}",
+        f.kind, f.threshold, f.source
+    )?;
+    if f.crossed_s.is_some() {
+        writeln!(out, "{FAILSAFE_HEADER}")?;
+    }
+    for p in &f.checkpoints {
+        let predicted = p.predicted_s.map_or_else(
+            || "-".to_string(),
+            |b| {
+                format!(
+                    "{} ({} - {})",
+                    fixed_or_dash(b.p50, 0),
+                    fixed_or_dash(b.p5, 0),
+                    fixed_or_dash(b.p95, 0)
+                )
+            },
+        );
+        writeln!(
+            out,
+            "{:>7} {:>8.1} {:>8.0} {:>22} {:>8} {:>8} {:>11} {:>8}",
+            p.before,
+            p.log_time_s,
+            p.actual_s,
+            predicted,
+            fixed_or_dash(p.error_s, 0),
+            fixed_or_dash(p.naive_s, 0),
+            fixed_or_dash(p.naive_error_s, 0),
+            if p.in_band { "yes" } else { "no" }
+        )?;
+    }
+    Ok(())
+}
+
+/// The column heads of a failsafe's checkpoints.
+const FAILSAFE_HEADER: &str =
+    " before   time s  actual s  predicted s p50 (p5 - p95)  error s  naive s  naive err s  in band";
 
 /// The column heads of the checkpoints.
 const CHECK_HEADER: &str = "    at   time s    error %  naive err %  in band";

@@ -973,7 +973,8 @@ pub struct LiveFlags {
     #[arg(value_parser = finite(), long, value_name = "PERCENT")]
     pub reserve_percent: Option<f64>,
     /// The autopilot's low-voltage failsafe, pack volts, judged on the voltage under load
-    /// averaged over 5 s (in place of the vehicle's own BATT_LOW_VOLT).
+    /// averaged over 5 s (in place of the vehicle's own BATT_LOW_VOLT). With --route log the
+    /// time until it triggers is predicted at each update and checked against the log's.
     #[arg(value_parser = finite(), long, value_name = "V")]
     pub low_voltage_v: Option<f64>,
     /// The autopilot's critical-voltage failsafe, pack volts (in place of BATT_CRT_VOLT).
@@ -1050,14 +1051,29 @@ impl LiveFlags {
     /// The engine's task of these flags.
     ///
     /// # Errors
-    /// `--route log` without `--replay`, a `--speed` that is neither `max` nor a positive
-    /// number, a link timeout that is not positive, and a `--mission` that cannot be read.
+    /// A voltage threshold (`--low-voltage-v`, `--critical-voltage-v`) that is not positive,
+    /// on either route; `--route log` without `--replay`, a `--speed` that is neither `max` nor
+    /// a positive number, a link timeout that is not positive, and a `--mission` that cannot be
+    /// read.
     pub fn request(&self) -> Result<LiveTask, Error> {
         let logs = |path: &PathBuf| FlightLogs {
             logs: vec![path.clone()],
             profile: self.profile.clone(),
             ..FlightLogs::default()
         };
+        for (name, v) in [
+            ("low-voltage-v", self.low_voltage_v),
+            ("critical-voltage-v", self.critical_voltage_v),
+        ] {
+            if v.is_some_and(|v| !(v > 0.0 && v <= 1e4)) {
+                return Err(Error::InvalidInput {
+                    name,
+                    value: v.unwrap_or(f64::NAN),
+                    unit: "V",
+                    expected: "a positive pack voltage up to 10000 V",
+                });
+            }
+        }
         if self.route == RouteFlag::Log {
             let path = self.replay.as_ref().ok_or(Error::MissingValue {
                 flag: "--replay",
@@ -1069,6 +1085,8 @@ impl LiveFlags {
                 payload_kg: self.payload_kg,
                 every_s: self.every,
                 air: self.air.input(),
+                low_voltage_v: self.low_voltage_v,
+                critical_voltage_v: self.critical_voltage_v,
             }));
         }
         let speed = match self.speed {
@@ -1084,19 +1102,6 @@ impl LiveFlags {
                 unit: "s",
                 expected: "a positive number of seconds, at most 1e9",
             });
-        }
-        for (name, v) in [
-            ("low-voltage-v", self.low_voltage_v),
-            ("critical-voltage-v", self.critical_voltage_v),
-        ] {
-            if v.is_some_and(|v| !(v > 0.0 && v <= 1e4)) {
-                return Err(Error::InvalidInput {
-                    name,
-                    value: v.unwrap_or(f64::NAN),
-                    unit: "V",
-                    expected: "a positive pack voltage up to 10000 V",
-                });
-            }
         }
         let source = match (&self.replay, &self.tlog, &self.connect) {
             (Some(path), _, _) => LiveSource::Replay {

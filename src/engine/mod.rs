@@ -98,9 +98,10 @@ pub use identification::validate::{
 pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::estimator::InFlightEstimator;
 pub use live::{
-    follow_live, replay_live, LiveCheck, LiveCheckpoint, LiveFailsafe, LiveRecorder,
-    LiveReplayRequest, LiveReplies, LiveRequest, LiveSession, LiveSource, LiveSummary, LiveUpdate,
-    Position, SocBand, TimeBand, DEFAULT_BATTERY_ID, DEFAULT_DISPLAY_COMPONENT_ID, LIVE_SCENARIOS,
+    follow_live, replay_live, FailsafeCheck, FailsafeCheckpoint, LiveCheck, LiveCheckpoint,
+    LiveFailsafe, LiveRecorder, LiveReplayRequest, LiveReplies, LiveRequest, LiveSession,
+    LiveSource, LiveSummary, LiveUpdate, Position, SocBand, TimeBand, DEFAULT_BATTERY_ID,
+    DEFAULT_DISPLAY_COMPONENT_ID, LIVE_SCENARIOS,
 };
 pub use logs::{
     check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,

@@ -518,3 +518,29 @@ fn a_battery_id_outside_0_255_is_refused_naming_it() {
     let default = parse_keywords::<LiveFlags>("aloft.live", &replay, &[]).unwrap();
     assert_eq!(default.battery_id, aloft::engine::DEFAULT_BATTERY_ID);
 }
+
+/// The voltage failsafes of `aloft live --route log` are checked as on the followed route: a
+/// threshold that is not a positive voltage (0, negative, NaN) is refused with one line naming
+/// the flag (exit 2), before the log is read.
+#[test]
+fn a_route_log_voltage_threshold_that_is_not_positive_is_refused_naming_it() {
+    let log = common::fixture("logs", "kaist_small.csv")
+        .display()
+        .to_string();
+    for flag in ["--low-voltage-v", "--critical-voltage-v"] {
+        for bad in ["0", "-1", "NaN"] {
+            let given = format!("{flag}={bad}");
+            let args = [
+                "live",
+                "--replay",
+                log.as_str(),
+                "--profile",
+                "kaist",
+                "--route",
+                "log",
+                given.as_str(),
+            ];
+            assert_refused(&args, &[flag.trim_start_matches('-')]);
+        }
+    }
+}

@@ -17,16 +17,7 @@ use common::ok_json as aloft;
 
 use std::sync::OnceLock;
 
-/// The flights of one day, as command-line words.
-fn kaist(day: &str) -> Vec<String> {
-    common::strings(&common::files_like("kaist_energy_drone", day, ".csv"))
-}
-
-const DAYS: [&str; 3] = ["2018-08-03", "2018-08-06", "2018-08-08"];
-
-fn words(w: &[&str]) -> Vec<String> {
-    w.iter().map(|s| s.to_string()).collect()
-}
+use common::kaist::{fit_without_day, kaist, words, DAYS};
 
 /// One held-out flight.
 #[derive(Debug, Clone)]
@@ -97,20 +88,10 @@ fn live_check(path: &str, vehicle: &str) -> serde_json::Value {
 
 /// Fit on every day but `held_out`, then judge each flight of `held_out`.
 fn judge_day(held_out: &'static str) -> Vec<Judged> {
-    let template = format!(
-        "{}/fixtures/vehicles/kaist-template.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
     let vehicle =
         std::env::temp_dir().join(format!("aloft-lodo-{}-{held_out}.toml", std::process::id()));
     let vehicle = vehicle.display().to_string();
-    let mut fit = words(&["fit", "--profile", "kaist", "--log"]);
-    for d in DAYS.iter().filter(|d| **d != held_out) {
-        fit.extend(kaist(d));
-    }
-    fit.extend(words(&["--vehicle-template", &template, "-o", &vehicle]));
-    fit.extend(words(&["--format", "json"]));
-    let fitted = aloft(&fit);
+    let fitted = fit_without_day(held_out, &vehicle);
     println!(
         "held out {held_out}: fitted {:?}, drag {}",
         fitted["fitted_parameters"], fitted["drag"]["mu_n"]

@@ -17,6 +17,7 @@ mod ffi_c;
 mod fit_quality_data_val;
 mod identify_data_val;
 mod input_contract;
+mod kaist_failsafe_data_val;
 mod kaist_lodo_data_val;
 mod live_evidence;
 mod live_interrupt;

@@ -14,101 +14,14 @@ use crate::common;
 
 use std::path::PathBuf;
 
-use aloft_logs::{read_battery_log, BatteryLog, OpenOptions, Profile};
-use aloft_planner::{BatterySpec, Pack};
+use aloft_logs::{read_battery_log, OpenOptions, Profile};
 
-/// A record: time s, voltage V, current A.
-type Record = (f64, f64, f64);
-
-/// The (time s, voltage V, current A) of a log's records with a current, each record once (the
-/// KAIST rows repeat the pack's 1 Hz values at 10 Hz).
-fn records(log: &BatteryLog) -> Vec<Record> {
-    let mut out: Vec<Record> = Vec::new();
-    for s in &log.samples {
-        let Some(i) = s.current_a else { continue };
-        if out.last().is_some_and(|&(_, v, c)| {
-            v.to_bits() == s.voltage_v.to_bits() && c.to_bits() == i.to_bits()
-        }) {
-            continue;
-        }
-        out.push((s.time_s, s.voltage_v, i));
-    }
-    // A logged glitch is not the pack: a record more than 5 V from both neighbours, which agree
-    // within 1 V, is left out (one in the shared files: 90 V in `2018-08-06.11_52_45`, research
-    // note section 2.5). The pack cannot jump 5 V and back in two seconds.
-    let glitch = |k: usize| {
-        k > 0
-            && k + 1 < out.len()
-            && (out[k].1 - out[k - 1].1).abs() > 5.0
-            && (out[k].1 - out[k + 1].1).abs() > 5.0
-            && (out[k - 1].1 - out[k + 1].1).abs() < 1.0
-    };
-    let keep: Vec<bool> = (0..out.len()).map(|k| !glitch(k)).collect();
-    out.into_iter()
-        .zip(keep)
-        .filter_map(|(r, k)| k.then_some(r))
-        .collect()
-}
-
-/// A 12S pack of `capacity_mah` and `r_ohm` on the generic LiPo open-circuit curve.
-fn pack(capacity_mah: f64, r_ohm: f64) -> Pack {
-    let nominal = 12.0 * 3.7;
-    Pack::new(&BatterySpec {
-        name: "kaist".into(),
-        cells_series: 12,
-        capacity_mah,
-        nominal_v: Some(nominal),
-        energy_wh: Some(capacity_mah / 1000.0 * nominal),
-        mass_kg: Some(1.0),
-        internal_resistance_ohm: Some(r_ohm),
-        cutoff_cell_v: Some(3.0),
-        ..BatterySpec::default()
-    })
-    .unwrap()
-}
-
-/// The RMS (V) of the terminal voltage the pack predicts for the logged power, against the
-/// logged voltage: the state of charge starts where the first record's voltage plus `I R` sits on
-/// the open-circuit curve and is counted down by the current the pack gives for the logged power.
-fn rms_v(pack: &Pack, recs: &[Record]) -> f64 {
-    let (_, v0, i0) = recs[0];
-    let mut soc = pack.soc_at_ocv_v(v0 + i0 * pack.resistance_ohm());
-    let mut sum = 0.0;
-    for w in recs.windows(2) {
-        let (t0, v, i) = w[0];
-        let t1 = w[1].0;
-        let Some(draw) = pack.draw(v * i, soc) else {
-            return f64::INFINITY;
-        };
-        sum += (draw.terminal_v - v).powi(2);
-        soc -= draw.current_a * (t1 - t0) / (3600.0 * pack.capacity_ah());
-    }
-    (sum / (recs.len() - 1) as f64).sqrt()
-}
-
-/// The capacity (mA h, 250 mA h steps) whose predicted voltage fits `recs` best with `r_ohm`.
-fn best_capacity(recs: &[Record], r_ohm: f64) -> f64 {
-    (20..=200)
-        .map(|k| f64::from(k) * 250.0)
-        .min_by(|a, b| rms_v(&pack(*a, r_ohm), recs).total_cmp(&rms_v(&pack(*b, r_ohm), recs)))
-        .unwrap()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n % 2 {
-        1 => v[n / 2],
-        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
+use common::kaist::{best_capacity, median, pack, records, rms_v, Record};
 
 #[test]
 fn data_val_kaist_voltage_under_load_on_held_out_flights() {
     let profile = Profile::resolve("kaist").unwrap();
-    let long: Vec<PathBuf> = common::files("kaist_energy_drone", |n| {
-        n.ends_with(".csv") && !n.contains("testgpsfense")
-    });
+    let long: Vec<PathBuf> = common::kaist::long_flights();
     assert_eq!(long.len(), 10);
     let flights: Vec<(String, Vec<Record>, f64)> = long
         .iter()

@@ -30,6 +30,11 @@ pub struct LiveFailsafe {
     pub time_s: Option<TimeBand>,
     /// Whether it triggers before the route's landing (in at least 5 % of the scenarios).
     pub before_home: bool,
+    /// The naive rate's time, s from now (`--route log` only): the voltage under load averaged
+    /// over 5 s, its linear trend over the last 60 s extrapolated to the threshold (left out
+    /// where the trend does not fall).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naive_time_s: Option<f64>,
 }
 
 /// The failsafes a followed flight watches and their monitor, fed the measured samples so its
@@ -63,6 +68,11 @@ impl Watched {
             parameters: parameters.clone(),
             last_time_s: None,
         }))
+    }
+
+    /// The monitor as it stands after the samples fed so far.
+    pub(crate) fn monitor(&self) -> &FailsafeMonitor {
+        &self.monitor
     }
 
     /// Whether it was built from `parameters`.
@@ -150,6 +160,7 @@ impl Watched {
                     unit: f.unit.as_str(),
                     time_s,
                     before_home: share >= BEFORE_HOME_SHARE,
+                    naive_time_s: None,
                 }
             })
             .collect()

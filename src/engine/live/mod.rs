@@ -37,6 +37,7 @@ mod failsafes;
 mod pack_state;
 mod record;
 mod replay;
+mod replay_failsafes;
 mod replies;
 mod sources;
 mod tracker;
@@ -44,7 +45,9 @@ mod tracker;
 pub use ahead::LIVE_SCENARIOS;
 pub use failsafes::{LiveFailsafe, TimeBand};
 pub use record::LiveRecorder;
-pub use replay::{replay_live, LiveCheck, LiveCheckpoint, LiveReplayRequest};
+pub use replay::{
+    replay_live, FailsafeCheck, FailsafeCheckpoint, LiveCheck, LiveCheckpoint, LiveReplayRequest,
+};
 pub use replies::{LiveReplies, DEFAULT_BATTERY_ID, DEFAULT_DISPLAY_COMPONENT_ID};
 pub use sources::LiveSource;
 
@@ -363,15 +366,19 @@ pub struct LiveSession<'a> {
     rest_s: f64,
 }
 
-/// The flags' voltage failsafes, as the failsafes' monitor takes them.
-fn thresholds(request: &LiveRequest) -> Vec<aloft_packs::VoltageThreshold> {
+/// The flags' voltage failsafes (`--low-voltage-v`, `--critical-voltage-v`), as the failsafes'
+/// monitor takes them.
+pub(crate) fn thresholds(
+    low_voltage_v: Option<f64>,
+    critical_voltage_v: Option<f64>,
+) -> Vec<aloft_packs::VoltageThreshold> {
     use aloft_packs::{FailsafeKind, VoltageThreshold};
     [
-        (FailsafeKind::Low, "--low-voltage-v", request.low_voltage_v),
+        (FailsafeKind::Low, "--low-voltage-v", low_voltage_v),
         (
             FailsafeKind::Critical,
             "--critical-voltage-v",
-            request.critical_voltage_v,
+            critical_voltage_v,
         ),
     ]
     .into_iter()
@@ -431,7 +438,7 @@ impl<'a> LiveSession<'a> {
             count: ChargeCount::new(pack.capacity_ah()),
             pack_state: PackState::new(&pack),
             watched: None,
-            thresholds: thresholds(request),
+            thresholds: thresholds(request.low_voltage_v, request.critical_voltage_v),
             charge: Charge::new(pack),
             advice: AdviceHold::default(),
             eta0,

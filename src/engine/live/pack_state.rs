@@ -69,7 +69,14 @@ pub(crate) struct PackState {
     /// A voltage that is not this pack's (V): the vehicle file's pack is not the one flown,
     /// and the filter is not used.
     foreign_v: Option<f64>,
+    /// Since when the voltages have been outside this pack's range, s (a glitch lasts less
+    /// than [`FOREIGN_AFTER_S`]).
+    outside_since_s: Option<f64>,
 }
+
+/// How long voltages outside the pack's range must last, once the pack's own voltage was seen,
+/// before they are another pack's, s: a logged glitch (one 1 Hz record) is not.
+pub(crate) const FOREIGN_AFTER_S: f64 = 5.0;
 
 /// The voltages a pack may show under load, V per cell: below, or above, it is another pack
 /// (other cells in series).
@@ -95,6 +102,7 @@ impl PackState {
             reported: None,
             last_fused_s: f64::NEG_INFINITY,
             foreign_v: None,
+            outside_since_s: None,
         }
     }
 
@@ -174,6 +182,23 @@ impl PackState {
         }
     }
 
+    /// `v` (V) at `time_s` where it is this pack's. Outside the pack's range it is not read: it
+    /// is another pack's at once where the pack's own was never seen, else once it has lasted
+    /// [`FOREIGN_AFTER_S`] (before that, a glitch).
+    fn own_voltage(&mut self, time_s: f64, v: f64) -> Option<f64> {
+        let cell_v = v / f64::from(self.circuit.cells_series);
+        if (PACK_CELL_V.0..=PACK_CELL_V.1).contains(&cell_v) {
+            self.outside_since_s = None;
+            self.voltage_v = Some(v);
+            return Some(v);
+        }
+        let since = *self.outside_since_s.get_or_insert(time_s);
+        if self.voltage_v.is_none() || time_s - since >= FOREIGN_AFTER_S {
+            self.foreign_v.get_or_insert(v);
+        }
+        None
+    }
+
     /// The vehicle took off: from now on the filter runs on.
     pub(crate) fn in_air(&mut self) {
         self.took_off = true;
@@ -193,13 +218,9 @@ impl PackState {
         energy_used_wh: f64,
     ) {
         let (voltage_v, current_a, power_w) = measured;
-        if let Some(v) = voltage_v.filter(|v| v.is_finite() && *v > 0.0) {
-            self.voltage_v = Some(v);
-            let cell_v = v / f64::from(self.circuit.cells_series);
-            if !(PACK_CELL_V.0..=PACK_CELL_V.1).contains(&cell_v) {
-                self.foreign_v.get_or_insert(v);
-            }
-        }
+        let voltage_v = voltage_v
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .and_then(|v| self.own_voltage(time_s, v));
         let current_a = current_a.filter(|i| i.is_finite()).or_else(|| {
             let v = self.voltage_v?;
             power_w.filter(|p| p.is_finite()).map(|p| p / v)
@@ -261,5 +282,62 @@ pub(crate) fn report_kind(parameters: &BTreeMap<String, f64>) -> ReportKind {
     match capacity {
         Some(c) if c.is_nan() || *c <= 0.0 => ReportKind::Voltage,
         _ => ReportKind::Counted,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use aloft_planner::BatterySpec;
+
+    /// A 12S pack of 10 A h on the generic curve.
+    fn pack_12s() -> Pack {
+        Pack::new(&BatterySpec {
+            name: "12s".into(),
+            cells_series: 12,
+            capacity_mah: 10_000.0,
+            nominal_v: Some(44.4),
+            energy_wh: Some(444.0),
+            mass_kg: Some(1.0),
+            internal_resistance_ohm: Some(0.02),
+            cutoff_cell_v: Some(3.0),
+            ..BatterySpec::default()
+        })
+        .unwrap()
+    }
+
+    /// A state in the air from a loaded 12S voltage, fed `voltages` (V at 25 A) at 10 Hz.
+    fn fed(voltages: &[f64]) -> PackState {
+        let mut p = PackState::new(&pack_12s());
+        p.start_from(Start::Full, ReportKind::Counted, Some((voltages[0], 25.0)));
+        p.in_air();
+        for (k, v) in voltages.iter().enumerate() {
+            p.sample(0.1 * k as f64, (Some(*v), Some(25.0), None), 0.0);
+        }
+        p
+    }
+
+    /// One logged glitch (KAIST `2018-08-06.11_52_45`: one 1 Hz record of 90 V, repeated over
+    /// ten 10 Hz rows, between 48 V records) is not another pack: the filter runs on.
+    #[test]
+    fn a_one_second_voltage_glitch_is_not_another_pack() {
+        let mut v = vec![48.0; 100];
+        v.extend([90.0; 10]);
+        v.extend([48.0; 100]);
+        let p = fed(&v);
+        assert_eq!(p.foreign_v(), None);
+        assert!(p.filter().is_some() && p.estimate().is_some());
+    }
+
+    /// A voltage that is another pack's from the first sample (a 4S pack's 16 V read as 12S),
+    /// or for longer than [`FOREIGN_AFTER_S`], is another pack's.
+    #[test]
+    fn another_packs_voltage_is_said_at_once_or_when_it_lasts() {
+        assert_eq!(fed(&[16.0; 20]).foreign_v(), Some(16.0));
+        let mut v = vec![48.0; 10];
+        v.extend([16.0; 80]);
+        let p = fed(&v);
+        assert_eq!(p.foreign_v(), Some(16.0));
+        assert!(p.filter().is_none());
     }
 }

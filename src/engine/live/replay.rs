@@ -22,6 +22,9 @@
 use serde::Serialize;
 
 use super::estimate::RatioEstimator;
+use super::failsafes::LiveFailsafe;
+use super::replay_failsafes::{Ahead, PackReplay};
+pub use super::replay_failsafes::{FailsafeCheck, FailsafeCheckpoint};
 use super::LiveUpdate;
 use crate::engine::finite::finite;
 use crate::engine::logs::FlightLogs;
@@ -47,6 +50,11 @@ pub struct LiveReplayRequest {
     /// The day's air (default: the log's own density where it has one, else the vehicle
     /// file's).
     pub air: crate::engine::conditions::air::AirInput,
+    /// The low-voltage failsafe, pack volts, judged on the voltage under load averaged over
+    /// 5 s (`--low-voltage-v`): the time until it triggers is predicted at each update.
+    pub low_voltage_v: Option<f64>,
+    /// The critical-voltage failsafe, pack volts (`--critical-voltage-v`).
+    pub critical_voltage_v: Option<f64>,
 }
 
 /// The end of a validation replay: how the predictions did against the measured rest.
@@ -62,6 +70,10 @@ pub struct LiveCheck {
     pub checkpoints: Vec<LiveCheckpoint>,
     /// Fraction of the updates whose p5-p95 band holds the measured rest.
     pub band_coverage: f64,
+    /// The voltage failsafes of the flags (`--low-voltage-v`, `--critical-voltage-v`): when
+    /// the log crossed each, and the predictions 300 s and 120 s before.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failsafes: Vec<FailsafeCheck>,
 }
 
 /// The prediction at one checkpoint of a validation replay.
@@ -95,7 +107,7 @@ pub fn replay_live(
 ) -> Result<LiveCheck, Error> {
     super::check_every(request.every_s)?;
     let mut flights = request.logs.load()?;
-    let (flight, _) = flights.swap_remove(0);
+    let (flight, log) = flights.swap_remove(0);
     // The flight in its own air: the given day, else the log's, else the vehicle file's.
     let air =
         crate::engine::conditions::air::log_air(&request.air, flight.air_density_kg_m3, vehicle)?;
@@ -107,6 +119,8 @@ pub fn replay_live(
     let prior_sd = super::estimate::prior_sd(&model);
     let eta0 = model.vehicle().efficiency();
     let mut estimator = RatioEstimator::new(prior_sd);
+    let thresholds = super::thresholds(request.low_voltage_v, request.critical_voltage_v);
+    let mut pack = PackReplay::new(vehicle, request.battery.as_deref(), &thresholds, &log)?;
     let mut judge = Judge::new(series.duration_s());
     let (mut t, mut next) = (series.t[0], 0);
     let end = series.t[series.t.len() - 1];
@@ -120,13 +134,19 @@ pub fn replay_live(
             );
             next += 1;
         }
-        let update = series.update_at(next.max(1) - 1, &estimator, eta0);
+        let k = next.max(1) - 1;
+        let mut update = series.update_at(k, &estimator, eta0);
+        if let Some(pack) = pack.as_mut() {
+            update.failsafes = series.failsafes_at(k, flight.lag_s, &mut update, eta0, pack);
+        }
         let update = finite(update, "live", || flight.source.clone())?;
         judge.add(&update, t - series.t[0]);
         emit(&update)?;
         t += request.every_s;
     }
-    Ok(judge.finish(flight.source.clone()))
+    let mut check = judge.finish(flight.source.clone());
+    check.failsafes = pack.map_or_else(Vec::new, PackReplay::finish);
+    Ok(check)
 }
 
 /// A flight's measured and predicted power, with their running energies.
@@ -202,6 +222,39 @@ impl Series {
     }
 }
 
+impl Series {
+    /// The voltage failsafes at the update at sample `k` (`update`, whose pack state they fill
+    /// in): the pack's records up to its power's time (`t + lag_s`), the rest flown at the power
+    /// ratios of the energy ahead's band (`eta_0 / efficiency` at p50, scaled as p5 and p95
+    /// are), then judged.
+    fn failsafes_at(
+        &self,
+        k: usize,
+        lag_s: f64,
+        update: &mut LiveUpdate,
+        eta0: f64,
+        pack: &mut PackReplay,
+    ) -> Vec<LiveFailsafe> {
+        let now_s = self.t[k] + lag_s;
+        pack.advance(now_s);
+        let ratio = eta0 / update.efficiency;
+        let (lo, hi) = match update.remaining_wh {
+            Some(b) if b.p50 > 0.0 => (b.p5 / b.p50, b.p95 / b.p50),
+            _ => (1.0, 1.0),
+        };
+        let ahead = Ahead {
+            t: &self.t,
+            predicted_w: &self.predicted_w,
+            k,
+            ratios: (ratio * lo, ratio, ratio * hi),
+        };
+        let failsafes = pack.predict(now_s, &ahead);
+        pack.state_into(update);
+        pack.judge(now_s, &failsafes);
+        failsafes
+    }
+}
+
 /// The running check of a validation replay.
 struct Judge {
     duration_s: f64,
@@ -261,6 +314,7 @@ impl Judge {
             duration_s: self.duration_s,
             checkpoints: self.checkpoints,
             band_coverage: self.in_band as f64 / self.judged.max(1) as f64,
+            failsafes: Vec::new(),
         }
     }
 }

@@ -232,6 +232,7 @@ mod tests {
                 p95: None,
             }),
             before_home: before,
+            naive_time_s: None,
         }
     }
 

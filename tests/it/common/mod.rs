@@ -7,6 +7,7 @@
 
 pub mod big_survey;
 mod data;
+pub mod kaist;
 pub mod ros2;
 pub mod serve;
 
