@@ -359,9 +359,12 @@ const CHECK_HEADER: &str = "    at   time s    error %  naive err %  in band";
 /// One checkpoint as a line of text.
 fn checkpoint_row(p: &LiveCheckpoint) -> String {
     let in_band = if p.in_band { "yes" } else { "no" };
+    let naive = p
+        .naive_error_percent
+        .map_or_else(|| "-".to_string(), |e| format!("{e:+.2}"));
     format!(
-        "{:>6} {:>8.1} {:>+10.2} {:>+12.2} {in_band:>8}",
-        p.at, p.time_s, p.error_percent, p.naive_error_percent
+        "{:>6} {:>8.1} {:>+10.2} {naive:>12} {in_band:>8}",
+        p.at, p.time_s, p.error_percent
     )
 }
 
@@ -390,7 +393,10 @@ mod tests {
         assert!(lines[0].ends_with("LINK LOST (last estimate)"));
         assert_eq!(lines[5], "no return passed 10 s ago");
         // The estimate's band, the vehicle's own figure and a failsafe before home.
-        u.soc_band = Some(aloft::engine::SocBand { p5: 0.55, p95: 0.65 });
+        u.soc_band = Some(aloft::engine::SocBand {
+            p5: 0.55,
+            p95: 0.65,
+        });
         u.reported_soc = Some(0.48);
         u.failsafes = vec![aloft::engine::LiveFailsafe {
             kind: "low",

@@ -85,8 +85,10 @@ pub struct LiveCheckpoint {
     pub time_s: f64,
     /// `(p50 - measured) / measured`, percent.
     pub error_percent: f64,
-    /// The naive rate's error, percent.
-    pub naive_error_percent: f64,
+    /// The naive rate's error, percent (left out where the naive rate has no figure: at the
+    /// first update).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naive_error_percent: Option<f64>,
     /// Whether p5-p95 holds the measured rest.
     pub in_band: bool,
 }
@@ -301,7 +303,7 @@ impl Judge {
                 at,
                 time_s: u.time_s,
                 error_percent: percent(band.p50),
-                naive_error_percent: u.naive_remaining_wh.map_or(f64::NAN, percent),
+                naive_error_percent: u.naive_remaining_wh.map(percent),
                 in_band: inside,
             });
         }

@@ -14,7 +14,9 @@
 //!    energy ahead takes (at p50, and at the p5 and p95 ratios for the band), turned into the
 //!    pack's current through the filter's circuit, `I = P / V(I)` (two fixed-point steps from
 //!    the last current), stepped through [`SocFilter::predict_mean`] and a clone of the
-//!    monitor: the first trigger of each failsafe, s from now. The highest power gives `p5`.
+//!    monitor: the first trigger of each failsafe, s from now. The highest power on the pack's
+//!    state drawn 1.645 standard deviations emptier ([`SocFilter::drawn`]) gives `p5`, the
+//!    lowest on one as much fuller `p95`.
 //! 3. **The naive rate**: a least-squares line through the 5 s average over the last
 //!    [`NAIVE_WINDOW_S`], extrapolated to the threshold (none where it does not fall).
 //!
@@ -30,6 +32,9 @@ use super::failsafes::{LiveFailsafe, TimeBand, Watched};
 use super::pack_state::{PackState, Start};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
+
+/// z-score of the 5th and 95th percentiles of a Gaussian.
+const Z_90: f64 = 1.644_853_626_951_472_2;
 
 /// The span of the 5 s averages the naive rate fits its line to, s.
 pub(crate) const NAIVE_WINDOW_S: f64 = 60.0;
@@ -223,10 +228,13 @@ impl PackReplay {
     pub(crate) fn predict(&self, now_s: f64, ahead: &Ahead<'_>) -> Vec<LiveFailsafe> {
         let runs: Vec<Vec<f64>> = match self.pack.filter() {
             Some(filter) => {
+                // The band's ends: the higher power on the pack's state drawn 1.645 sd emptier
+                // (its charge, and the curve's offset and the RC pair with it), and the lower on
+                // one as much fuller.
                 let (lo, mid, hi) = ahead.ratios;
-                [hi, mid, lo]
+                [(hi, -Z_90), (mid, 0.0), (lo, Z_90)]
                     .iter()
-                    .map(|r| self.fly(filter, ahead, *r))
+                    .map(|(r, z)| self.fly(&filter.drawn(*z), ahead, *r))
                     .collect()
             }
             None => Vec::new(),
