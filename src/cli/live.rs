@@ -409,6 +409,7 @@ mod tests {
                 p95: None,
             }),
             before_home: true,
+            naive_time_s: None,
         }];
         let lines = panel(&u);
         assert!(
