@@ -20,6 +20,7 @@ pub mod combine;
 pub mod error;
 pub mod failsafes;
 pub mod px4;
+pub mod rc;
 pub mod resistance;
 pub mod soc_filter;
 
@@ -35,6 +36,7 @@ pub use failsafes::{
     Judged, Triggered, VehicleFailsafes, VoltageThreshold, LOADED_AVERAGE_WINDOW_S,
 };
 pub use px4::{Px4Battery, Px4BatteryParams, Px4Estimate, Px4Resume, Px4Warning};
+pub use rc::{rc_from_flight, rc_of_flights, RcEstimate};
 pub use resistance::{resistance_from_steps, updates, ResistanceEstimate};
 pub use soc_filter::{Circuit, FilterTuning, ReportKind, SocEstimate, SocFilter};
 
