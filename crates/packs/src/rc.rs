@@ -73,7 +73,7 @@ pub fn rc_from_flight(samples: &[BatterySample], r0_ohm: f64) -> Option<RcEstima
     let current: Vec<f64> = u.iter().map(|x| x.2).collect();
     let r = detrended(&t, &rest);
     let total: f64 = r.iter().map(|x| x * x).sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return None;
     }
     let fits: Vec<(f64, f64, f64)> = TAU_GRID_S
