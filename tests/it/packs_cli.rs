@@ -702,7 +702,10 @@ fn data_val_pack_fit_on_kaist_writes_the_packs_own_curve() {
     // Measured: 0.069 V on the fitted curve, 0.427 V on the generic one (the pack 49 V falling
     // to 44 V; the resistance alone leaves 0.15-0.19 V on the generic curve with a fitted
     // capacity, docs/validation.md).
-    assert!(fitted < 0.1 && fitted < 0.5 * generic, "{fitted} against {generic}");
+    assert!(
+        fitted < 0.1 && fitted < 0.5 * generic,
+        "{fitted} against {generic}"
+    );
 }
 
 /// A gauge that reads more than the capacity given: no curve, said, and the pack still written
