@@ -4,10 +4,10 @@
 //!
 //! For each day that has long flights (2018-08-03 and 2018-08-06: five each; 2018-08-08's one
 //! flight lasts 300 s), the vehicle is fitted on the other days (`aloft fit`, as the
-//! leave-one-day-out check of the energy does) and so is the pack: its resistance the median of
-//! the current-step estimates of the other days' long flights (`aloft_packs::analyse`, what
-//! `aloft pack fit` combines), its capacity the median over them of the capacity whose predicted
-//! voltage under load fits each best (tests/it/pack_voltage_data_val.rs). Each flight of the
+//! leave-one-day-out check of the energy does) and so is the pack: `aloft pack fit` on the other
+//! days' long flights, its resistance the median of their current-step estimates, its own
+//! open-circuit curve from their gauge (issue 44), on a capacity their gauge holds (the most it
+//! read, rounded up to 100 mA h). Each flight of the
 //! held-out day is then replayed with a threshold it reached: the voltage under load averaged
 //! over 5 s (time-weighted, computed here from the CSV) as it stood at 85 % of the flight,
 //! rounded to 10 mV. The test finds when that average first fell below it, checks that aloft's
@@ -19,9 +19,11 @@
 //! Data from `ALOFT_DATA_DIR` (default `../shared/data`).
 
 use crate::common;
-use common::kaist::{best_capacity, fit_without_day, kaist, median, pack_evidence, DAYS};
+use common::kaist::{
+    fit_without_day, kaist, median, most_gauge_mah, pack_evidence, pack_fit, DAYS,
+};
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// Share of the flight at which the threshold is read from the 5 s average.
@@ -104,24 +106,52 @@ fn first_below(averages: &[f64], threshold_v: f64) -> usize {
     averages.iter().position(|a| *a < threshold_v).unwrap()
 }
 
-/// The vehicle fitted without `held_out` with a pack fitted on the other days' long flights.
+/// The vehicle fitted without `held_out` with a pack fitted on the other days' long flights:
+/// the resistance of their current steps, and their own open-circuit curve (`aloft pack fit` on
+/// them) on a capacity their gauge holds (the most it read, rounded up to 100 mA h; no rated
+/// capacity is logged).
 fn vehicle_without(held_out: &str) -> String {
     let path =
         std::env::temp_dir().join(format!("aloft-fs-{}-{held_out}.toml", std::process::id()));
     let path = path.display().to_string();
     fit_without_day(held_out, &path);
-    let others: Vec<_> = common::kaist::long_flights()
+    let other_days: Vec<PathBuf> = common::kaist::long_flights()
         .into_iter()
         .filter(|p| !p.to_string_lossy().contains(held_out))
-        .map(|p| pack_evidence(&p))
         .collect();
+    let others: Vec<_> = other_days.iter().map(|p| pack_evidence(p)).collect();
     let r_ohm = median(others.iter().map(|o| o.1).collect());
-    let q_mah = median(others.iter().map(|o| best_capacity(&o.0, r_ohm)).collect());
-    println!("held out {held_out}: pack {q_mah:.0} mAh, {r_ohm:.4} ohm");
+    let gauge_mah = other_days
+        .iter()
+        .map(|p| most_gauge_mah(p))
+        .fold(0.0, f64::max);
+    let q_mah = (gauge_mah / 100.0).ceil() * 100.0;
+    let pack_file = format!("{path}.pack.toml");
+    let fit = pack_fit(&other_days, q_mah, &pack_file);
+    std::fs::remove_file(&pack_file).ok();
+    let battery = &fit["pack"]["battery"];
+    let list = |k: &str| {
+        let v: Vec<String> = battery[k]
+            .as_array()
+            .unwrap_or_else(|| panic!("no {k}: {}", fit["ocv_refused"]))
+            .iter()
+            .map(|x| x.as_f64().unwrap().to_string())
+            .collect();
+        v.join(", ")
+    };
+    let (ocv_soc, ocv_cell_v) = (list("ocv_soc"), list("ocv_cell_v"));
+    println!(
+        "held out {held_out}: pack {q_mah:.0} mAh, {r_ohm:.4} ohm, its curve measured over {:.3}-{:.3}",
+        fit["ocv"]["measured_from_soc"], fit["ocv"]["measured_to_soc"]
+    );
+    // The resistance pack fit writes is the one the steps give here.
+    let fitted_r = battery["internal_resistance_ohm"].as_f64().unwrap();
+    assert!((fitted_r / r_ohm - 1.0).abs() < 1e-9, "{fitted_r} {r_ohm}");
     let pack = format!(
         "\n[[battery]]\nname = \"kaist-12s\"\ndefault = true\ncells_series = 12\n\
          capacity_mah = {q_mah}\nnominal_v = 44.4\nenergy_wh = {}\nmass_kg = 1.0\n\
-         internal_resistance_ohm = {r_ohm}\ncutoff_cell_v = 3.0\n",
+         internal_resistance_ohm = {r_ohm}\ncutoff_cell_v = 3.0\n\
+         ocv_soc = [{ocv_soc}]\nocv_cell_v = [{ocv_cell_v}]\n",
         q_mah / 1000.0 * 44.4
     );
     let mut text = std::fs::read_to_string(&path).unwrap();
@@ -328,20 +358,24 @@ fn data_val_kaist_failsafe_crossing_matches_the_csv() {
     }
 }
 
-/// 120 s before the crossing, aloft's p50 is within 90 s of it by the median over the ten
-/// held-out flights (measured: 62 s; worst 78 s), and it is early, never late by more than one
-/// update interval (10 s), at 300 s and 120 s before (measured: early on every flight, by 24-142
-/// s): the pack flown is the generic LiPo curve with a capacity and resistance fitted on other
-/// days, whose voltage under the model's power falls faster than this pack's. The naive rate is
-/// closer by the median (35 s at 120 s, 80 s at 300 s, against 62 and 97 s) but late on half the
-/// flights (by up to 145 s at 120 s before): reported, not asserted (a test that failed when aloft
-/// got better would be no test of aloft).
+/// On the pack's own open-circuit curve (issue 44), aloft's p50 is within 65 s of the crossing
+/// 120 s before it and within 90 s 300 s before it, by the median over the ten held-out flights
+/// (measured: 54 s and 76 s; on the generic LiPo curve 62 s and 97 s), and it is early, never late
+/// by more than one update interval (10 s), at 300 s and 120 s before (measured: early on every
+/// flight, by 28-125 s). What is left is not the curve: the pack's voltage under the logged
+/// power is predicted within 0.06-0.12 V RMS on it (tests/it/pack_voltage_data_val.rs); the
+/// model's power ahead is the next suspect. The naive rate is closer by the median at 120 s
+/// (35 s) but late on half the flights (by up to 145 s): reported, not asserted (a test that
+/// failed when aloft got better would be no test of aloft).
 #[test]
-fn data_val_kaist_failsafe_predicted_early_within_90_s_at_120_s() {
+fn data_val_kaist_failsafe_predicted_early_on_the_packs_own_curve() {
     let j = judged();
     let at_120 = summary(j, "120 s");
     assert_eq!(at_120.n, 10);
-    assert!(at_120.predicted_abs_s < 90.0, "{at_120:?}");
+    assert!(at_120.predicted_abs_s < 65.0, "{at_120:?}");
+    let at_300 = summary(j, "300 s");
+    assert_eq!(at_300.n, 10);
+    assert!(at_300.predicted_abs_s < 90.0, "{at_300:?}");
     for f in j {
         for c in &f.checkpoints {
             let p50 = c

@@ -115,4 +115,30 @@ pub enum PackError {
         /// Its value, V a cell.
         charged_v: f64,
     },
+    /// The records' state of charge is unknown: no gauge and no rested start.
+    #[error("the state of charge of the records is unknown: the log has no pack gauge (remaining mA h) and does not start with a rest of {rest_hold_s:.0} s, so no open-circuit curve is fitted")]
+    OcvChargeUnknown {
+        /// How long a rest must hold, s.
+        rest_hold_s: f64,
+    },
+    /// The pack's gauge reads more than the capacity the curve is fitted on.
+    #[error("the pack's gauge reads {gauge_mah:.0} mA h at the start, more than the capacity of {capacity_mah:.0} mA h: give the pack's full capacity (--capacity-mah)")]
+    OcvGaugeAboveCapacity {
+        /// The charge the gauge says the pack held at the first record, mA h.
+        gauge_mah: f64,
+        /// The capacity, mA h.
+        capacity_mah: f64,
+    },
+    /// Too few bins of state of charge hold enough records for an open-circuit curve.
+    #[error("only {bins} bin(s) of {bin_soc} state of charge hold {min_records} records or more; at least {min_bins} are needed for an open-circuit curve")]
+    OcvTooFewRecords {
+        /// Bins with enough records.
+        bins: usize,
+        /// Bins needed.
+        min_bins: usize,
+        /// Records a bin needs.
+        min_records: usize,
+        /// A bin's width, 0-1.
+        bin_soc: f64,
+    },
 }

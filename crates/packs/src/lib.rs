@@ -4,7 +4,8 @@
 //! steps ([`resistance_from_steps`]), the charge drawn and the capacity between two rested
 //! points ([`capacity_between_rests`]), equivalent full cycles, cell balance
 //! ([`cell_balance`]), and the autopilot's own figures beside them ([`analyse`] →
-//! [`PackReport`]). Input is an [`aloft_logs::BatteryLog`] (read by
+//! [`PackReport`]), the pack's own open-circuit curve ([`flight_ocv`], [`combine_flight_ocv`]).
+//! Input is an [`aloft_logs::BatteryLog`] (read by
 //! [`aloft_logs::read_battery_log`]); this crate does no I/O.
 //!
 //! Units: SI with the unit in the name, except charge in mA h (`_mah`, as packs are rated) and
@@ -19,6 +20,7 @@ pub mod capacity;
 pub mod combine;
 pub mod error;
 pub mod failsafes;
+pub mod ocv_fit;
 pub mod px4;
 pub mod rc;
 pub mod resistance;
@@ -34,6 +36,10 @@ pub use error::PackError;
 pub use failsafes::{
     ArduPilotResistance, Failsafe, FailsafeAction, FailsafeKind, FailsafeMonitor, FailsafeUnit,
     Judged, Triggered, VehicleFailsafes, VoltageThreshold, LOADED_AVERAGE_WINDOW_S,
+};
+pub use ocv_fit::{
+    combine_flight_ocv, flight_ocv, ChargeAnchor, FittedOcv, FlightOcv, OcvBin, MIN_MEASURED_BINS,
+    MIN_RECORDS_PER_BIN, OCV_BIN_SOC,
 };
 pub use px4::{Px4Battery, Px4BatteryParams, Px4Estimate, Px4Resume, Px4Warning};
 pub use rc::{rc_from_flight, rc_of_flights, RcEstimate};

@@ -15,6 +15,11 @@
 //!   (nominal voltage), [`DEFAULT_CUTOFF_CELL_V`] (cut-off) and a usable fraction of 1; the
 //!   mass has no default.
 //! - `[failsafe]`: ArduPilot's `BATT_LOW_VOLT` / `BATT_CRT_VOLT` as logged (the last log's).
+//! - `ocv_soc`, `ocv_cell_v`: the pack's own open-circuit curve ([`aloft_packs::flight_ocv`],
+//!   [`aloft_packs::combine_flight_ocv`]) on the capacity and resistance written, where the logs
+//!   carry the pack's gauge or start rested and cover enough charge; the generic curve outside
+//!   what they measured (`[fitted]` `ocv_measured_soc`). Otherwise the `--battery` pack's curve
+//!   (or none: the generic one) is kept and the answer says why (`ocv_refused`).
 //!
 //! A log that cannot be read is an error naming it (exit 2); a log without battery records or
 //! without current is skipped with its reason; with none usable the answer has no pack (exit 1).
@@ -23,8 +28,9 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use aloft_logs::BatterySample;
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
-use aloft_packs::{analyse_with, PackOptions, PackReport};
+use aloft_packs::{analyse_with, FittedOcv, PackOptions, PackReport};
 
 use crate::engine::files::{check_output, write_output};
 use crate::engine::finite::finite;
@@ -100,6 +106,12 @@ pub struct PackFitAnswer {
     /// Discharged charge / rated charge over all the logs.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub equivalent_cycles: Option<f64>,
+    /// The pack's own open-circuit curve written, and the part of it the logs measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ocv: Option<FittedOcv>,
+    /// Why no open-circuit curve was fitted, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ocv_refused: Option<String>,
     /// The pack written (none when no log was usable).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pack: Option<PackFile>,
@@ -138,13 +150,14 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
     if answer.logs.is_empty() {
         return Ok(answer);
     }
-    let spec = pack_spec(
+    let mut spec = pack_spec(
         request,
         &mut answer,
         &options,
         base.as_ref(),
         analysed.serial,
     )?;
+    fit_curve(&mut spec, &mut answer, &analysed.records);
     let failsafe = analysed.failsafe;
     let pack = PackFile {
         battery: spec,
@@ -216,6 +229,8 @@ struct Analysed {
     /// What the logs' readers noted (a capacity parameter no pack has), each after its log's
     /// name.
     notes: Vec<String>,
+    /// Each analysed log's records, in the order of `logs`.
+    records: Vec<Vec<BatterySample>>,
 }
 
 /// Read and analyse each log: one that reads but holds no battery record (no power sensor) or
@@ -237,6 +252,7 @@ fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analy
         failsafe: Failsafe::default(),
         serial: None,
         notes: Vec::new(),
+        records: Vec::new(),
     };
     for path in &request.logs {
         let file = path.display().to_string();
@@ -268,6 +284,7 @@ fn analyse_logs(request: &PackFitRequest, options: &PackOptions) -> Result<Analy
                 f.critical_voltage_v = r.critical_voltage_failsafe_v.or(f.critical_voltage_v);
                 out.serial = out.serial.or(r.pack_id.clone());
                 out.logs.push(r);
+                out.records.push(log.samples);
             }
             Err(e) => out.skipped.push(SkippedLog {
                 file,
@@ -316,6 +333,8 @@ fn combine(
         pack_capacity_mah: None,
         discharged_mah: flights.discharged_mah,
         equivalent_cycles: flights.equivalent_cycles,
+        ocv: None,
+        ocv_refused: None,
         pack: None,
         pack_toml: None,
         output: String::new(),
@@ -398,6 +417,68 @@ fn pack_spec(
     Ok(spec)
 }
 
+/// The pack's own open-circuit curve from the logs' records on the capacity and resistance of
+/// `spec` (module docs): written into `spec` and the answer, or the reason there is none in the
+/// answer (the `--battery` pack's curve, if any, kept).
+fn fit_curve(
+    spec: &mut aloft_planner::BatterySpec,
+    answer: &mut PackFitAnswer,
+    records: &[Vec<BatterySample>],
+) {
+    let r_ohm = spec.internal_resistance_ohm.unwrap_or(f64::NAN);
+    let mut flights = Vec::new();
+    let mut refused = Vec::new();
+    for (report, samples) in answer.logs.iter().zip(records) {
+        match aloft_packs::flight_ocv(samples, Some(spec.cells_series), spec.capacity_mah, r_ohm) {
+            Ok(f) => flights.push(f),
+            Err(e) => refused.push(format!("{}: {e}", file_name(&report.source))),
+        }
+    }
+    match aloft_packs::combine_flight_ocv(&flights) {
+        Ok(fitted) => {
+            answer.notes.push(format!(
+                "open-circuit curve fitted on {} log(s) from {:.1} to {:.1} % of charge ({}); the generic LiPo curve joined outside",
+                fitted.flights,
+                100.0 * fitted.measured_from_soc,
+                100.0 * fitted.measured_to_soc,
+                flights[0].anchor.words(),
+            ));
+            if !refused.is_empty() {
+                answer.notes.push(format!(
+                    "open-circuit curve: log(s) left out: {}",
+                    refused.join("; ")
+                ));
+            }
+            spec.ocv_soc = Some(fitted.soc.clone());
+            spec.ocv_cell_v = Some(fitted.cell_v.clone());
+            answer.ocv = Some(fitted);
+        }
+        Err(e) => {
+            let why = if refused.is_empty() {
+                e.to_string()
+            } else {
+                refused.join("; ")
+            };
+            let kept = if spec.ocv_soc.is_some() {
+                "the --battery pack's curve is kept"
+            } else {
+                "the generic LiPo curve is flown"
+            };
+            answer
+                .notes
+                .push(format!("no open-circuit curve fitted ({kept}): {why}"));
+            answer.ocv_refused = Some(why);
+        }
+    }
+}
+
+/// A log's file name (its source as given when it has none).
+fn file_name(source: &str) -> String {
+    std::path::Path::new(source)
+        .file_name()
+        .map_or_else(|| source.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 /// The `[fitted]` table: the logs, steps and the autopilot's figures.
 fn fitted_table(a: &PackFitAnswer) -> toml::Table {
     let mut t = toml::Table::new();
@@ -446,6 +527,16 @@ fn fitted_table(a: &PackFitAnswer) -> toml::Table {
         "discharged_mah".into(),
         toml::Value::Float(a.discharged_mah),
     );
+    if let Some(o) = &a.ocv {
+        t.insert(
+            "ocv_measured_soc".into(),
+            floats(vec![o.measured_from_soc, o.measured_to_soc]),
+        );
+        t.insert("ocv_logs".into(), toml::Value::Integer(o.flights as i64));
+    }
+    if let Some(why) = &a.ocv_refused {
+        t.insert("ocv_refused".into(), toml::Value::String(why.clone()));
+    }
     if !a.skipped.is_empty() {
         t.insert(
             "skipped".into(),

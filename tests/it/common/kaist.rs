@@ -93,6 +93,25 @@ pub fn pack(capacity_mah: f64, r_ohm: f64) -> Pack {
     .unwrap()
 }
 
+/// [`pack`] on the open-circuit curve `(ocv_soc, ocv_cell_v)` instead of the generic one.
+pub fn pack_on_curve(capacity_mah: f64, r_ohm: f64, ocv_soc: &[f64], ocv_cell_v: &[f64]) -> Pack {
+    let nominal = 12.0 * 3.7;
+    Pack::new(&BatterySpec {
+        name: "kaist".into(),
+        cells_series: 12,
+        capacity_mah,
+        nominal_v: Some(nominal),
+        energy_wh: Some(capacity_mah / 1000.0 * nominal),
+        mass_kg: Some(1.0),
+        internal_resistance_ohm: Some(r_ohm),
+        cutoff_cell_v: Some(3.0),
+        ocv_soc: Some(ocv_soc.to_vec()),
+        ocv_cell_v: Some(ocv_cell_v.to_vec()),
+        ..BatterySpec::default()
+    })
+    .unwrap()
+}
+
 /// The RMS (V) of the terminal voltage the pack predicts for the logged power, against the
 /// logged voltage: the state of charge starts where the first record's voltage plus `I R` sits on
 /// the open-circuit curve and is counted down by the current the pack gives for the logged power.
@@ -127,6 +146,40 @@ pub fn median(mut v: Vec<f64>) -> f64 {
         1 => v[n / 2],
         _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
     }
+}
+
+/// The most the pack's gauge (KAIST's BMS `capacity`, mA h) reads in `path`.
+pub fn most_gauge_mah(path: &std::path::Path) -> f64 {
+    let profile = aloft_logs::Profile::resolve("kaist").unwrap();
+    let log = aloft_logs::read_battery_log(path, Some(&profile), &Default::default()).unwrap();
+    log.samples
+        .iter()
+        .filter_map(|s| s.remaining_mah)
+        .fold(0.0, f64::max)
+}
+
+/// `aloft pack fit` on `logs` (12S, `capacity_mah`), written to `out`: its JSON answer, the
+/// pack's own open-circuit curve in `pack.battery.ocv_soc` / `ocv_cell_v`.
+pub fn pack_fit(logs: &[PathBuf], capacity_mah: f64, out: &str) -> serde_json::Value {
+    let mut args = words(&["pack", "fit"]);
+    args.extend(super::strings(logs));
+    let capacity = format!("{capacity_mah}");
+    args.extend(words(&[
+        "--profile",
+        "kaist",
+        "--cells",
+        "12",
+        "--capacity-mah",
+        &capacity,
+        "--mass-kg",
+        "1.0",
+        "-o",
+        out,
+        "--force",
+        "--format",
+        "json",
+    ]));
+    super::ok_json(&args)
 }
 
 /// A long flight's pack evidence: its records and the resistance of its current steps (ohm,
