@@ -63,6 +63,9 @@ pub struct Pack {
     max_current_a: f64,
     /// Pack open-circuit voltage at `k / (OCV_TABLE_POINTS - 1)`, V.
     ocv_table_v: Vec<f64>,
+    /// The RC pair of the equivalent circuit where the pack file gives one: resistance (ohm)
+    /// and time constant (s).
+    rc_pair: Option<(f64, f64)>,
 }
 
 /// The pack's answer to a power demand.
@@ -203,6 +206,11 @@ impl Pack {
     /// State of charge at which the usable charge is exhausted, `1 - usable_fraction`.
     pub fn empty_soc(&self) -> f64 {
         1.0 - self.usable_fraction
+    }
+    /// The RC pair of the pack's equivalent circuit, where the pack file gives one: resistance
+    /// (ohm) and time constant (s).
+    pub fn rc_pair(&self) -> Option<(f64, f64)> {
+        self.rc_pair
     }
     /// Rated continuous current, A (infinite when none is given).
     pub fn max_current_a(&self) -> f64 {
@@ -357,6 +365,29 @@ impl Pack {
         let ocv_table_v = (0..OCV_TABLE_POINTS)
             .map(|k| cells * curve.cell_v(k as f64 / (OCV_TABLE_POINTS - 1) as f64))
             .collect();
+        let rc_pair = match (spec.rc_resistance_ohm, spec.rc_time_constant_s) {
+            (Some(r), Some(tau)) => Some((
+                pos("rc_resistance_ohm", r, "ohm")?,
+                pos("rc_time_constant_s", tau, "s")?,
+            )),
+            (None, None) => None,
+            (Some(r), None) => {
+                return Err(bad(
+                    "rc_resistance_ohm",
+                    r,
+                    "ohm",
+                    "given with rc_time_constant_s",
+                ))
+            }
+            (None, Some(t)) => {
+                return Err(bad(
+                    "rc_time_constant_s",
+                    t,
+                    "s",
+                    "given with rc_resistance_ohm",
+                ))
+            }
+        };
         Ok(Pack {
             name: spec.name.clone(),
             cells_series: spec.cells_series,
@@ -369,6 +400,7 @@ impl Pack {
             usable_fraction: u,
             max_current_a,
             ocv_table_v,
+            rc_pair,
         })
     }
 }

@@ -27,6 +27,7 @@
 //! | `effective_capacity_fraction` | `C_e` of eq (31) | - | seed |
 //! | `full_charge_cell_v` | full-charge cell voltage of eq (30) (default 4.1 V) | V | seed |
 //! | `ocv_soc`, `ocv_cell_v` | a measured open-circuit curve (default: typical LiPo) | -, V | planner |
+//! | `rc_resistance_ohm`, `rc_time_constant_s` | the RC pair of the pack's equivalent circuit (default: the state-of-charge filter's) | ohm, s | in flight |
 //! | `max_current_a` | rated continuous current (default: no limit) | A | both |
 //!
 //! Capacity is in mA h everywhere (as packs are labelled) and the nominal voltage is the pack's
@@ -113,6 +114,13 @@ pub struct BatterySpec {
     /// Open-circuit curve: cell voltage at each `ocv_soc` point, V.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ocv_cell_v: Option<Vec<f64>>,
+    /// The RC pair of the pack's equivalent circuit: its resistance, ohm (`aloft pack fit`,
+    /// where the logs identify it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rc_resistance_ohm: Option<f64>,
+    /// The RC pair's time constant, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rc_time_constant_s: Option<f64>,
     /// Rated continuous current, A.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_current_a: Option<f64>,
@@ -142,6 +150,8 @@ impl Default for BatterySpec {
             full_charge_cell_v: None,
             ocv_soc: None,
             ocv_cell_v: None,
+            rc_resistance_ohm: None,
+            rc_time_constant_s: None,
             max_current_a: None,
         }
     }
@@ -237,6 +247,8 @@ struct BatteryTable {
     full_charge_cell_v: Option<f64>,
     ocv_soc: Option<Vec<f64>>,
     ocv_cell_v: Option<Vec<f64>>,
+    rc_resistance_ohm: Option<f64>,
+    rc_time_constant_s: Option<f64>,
     max_current_a: Option<f64>,
     /// Old key: the capacity is `capacity_mah`.
     capacity_ah: Option<f64>,
@@ -284,6 +296,8 @@ impl TryFrom<BatteryTable> for BatterySpec {
             full_charge_cell_v: t.full_charge_cell_v,
             ocv_soc: t.ocv_soc,
             ocv_cell_v: t.ocv_cell_v,
+            rc_resistance_ohm: t.rc_resistance_ohm,
+            rc_time_constant_s: t.rc_time_constant_s,
             max_current_a: t.max_current_a,
         })
     }

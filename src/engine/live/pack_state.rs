@@ -86,12 +86,17 @@ impl PackState {
     /// The state of a flight on `pack` (its open-circuit curve, cells, capacity and resistance;
     /// the default RC pair).
     pub(crate) fn new(pack: &Pack) -> Self {
-        let circuit = Circuit::with_default_rc(
+        let mut circuit = Circuit::with_default_rc(
             pack.ocv_curve(),
             pack.cells_series(),
             pack.capacity_ah(),
             pack.resistance_ohm(),
         );
+        // The pack file's RC pair where `aloft pack fit` identified one.
+        if let Some((r, tau)) = pack.rc_pair() {
+            circuit.rc_resistance_ohm = r;
+            circuit.rc_time_constant_s = tau;
+        }
         Self {
             circuit,
             filter: None,
@@ -339,5 +344,39 @@ mod tests {
         let p = fed(&v);
         assert_eq!(p.foreign_v(), Some(16.0));
         assert!(p.filter().is_none());
+    }
+
+    /// The pack file's RC pair is the circuit's (a pair `aloft pack fit` identified); without
+    /// one, the filter's default; half a pair is refused naming the key given.
+    #[test]
+    fn the_pack_files_rc_pair_is_the_circuits() {
+        let spec = |r: Option<f64>, tau: Option<f64>| BatterySpec {
+            name: "12s".into(),
+            cells_series: 12,
+            capacity_mah: 10_000.0,
+            nominal_v: Some(44.4),
+            energy_wh: Some(444.0),
+            mass_kg: Some(1.0),
+            internal_resistance_ohm: Some(0.02),
+            cutoff_cell_v: Some(3.0),
+            rc_resistance_ohm: r,
+            rc_time_constant_s: tau,
+            ..BatterySpec::default()
+        };
+        let p = PackState::new(&Pack::new(&spec(Some(0.015), Some(12.0))).unwrap());
+        let c = &p.circuit;
+        assert_eq!(
+            (c.rc_resistance_ohm, c.rc_time_constant_s).to_owned(),
+            (0.015, 12.0)
+        );
+        let d = PackState::new(&pack_12s());
+        let default = aloft_packs::soc_filter::DEFAULT_RC_TIME_CONSTANT_S;
+        assert!((d.circuit.rc_time_constant_s - default).abs() < 1e-12);
+        let e = Pack::new(&spec(Some(0.015), None)).unwrap_err().to_string();
+        assert!(e.contains("rc_resistance_ohm"), "{e}");
+        let e = Pack::new(&spec(Some(0.015), Some(-1.0)))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("rc_time_constant_s"), "{e}");
     }
 }

@@ -20,6 +20,11 @@
 //!   carry the pack's gauge or start rested and cover enough charge; the generic curve outside
 //!   what they measured (`[fitted]` `ocv_measured_soc`). Otherwise the `--battery` pack's curve
 //!   (or none: the generic one) is kept and the answer says why (`ocv_refused`).
+//! - `rc_resistance_ohm`, `rc_time_constant_s`: the RC pair of the pack's equivalent circuit
+//!   ([`aloft_packs::rc_from_flight`], [`aloft_packs::rc_of_flights`]) where at least three
+//!   flights identify one and agree; otherwise none is written (the state-of-charge filter keeps
+//!   its default pair and learns its resistance in flight) and the answer says why
+//!   (`rc_refused`).
 //!
 //! A log that cannot be read is an error naming it (exit 2); a log without battery records or
 //! without current is skipped with its reason; with none usable the answer has no pack (exit 1).
@@ -112,6 +117,15 @@ pub struct PackFitAnswer {
     /// Why no open-circuit curve was fitted, in words.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ocv_refused: Option<String>,
+    /// The RC pair written: resistance (ohm) and time constant (s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rc_resistance_ohm: Option<f64>,
+    /// The RC pair's time constant written, s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rc_time_constant_s: Option<f64>,
+    /// Why no RC pair was written, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rc_refused: Option<String>,
     /// The pack written (none when no log was usable).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pack: Option<PackFile>,
@@ -158,6 +172,7 @@ pub fn fit_pack(request: &PackFitRequest) -> Result<PackFitAnswer, Error> {
         analysed.serial,
     )?;
     fit_curve(&mut spec, &mut answer, &analysed.records);
+    fit_rc(&mut spec, &mut answer, &analysed.records);
     let failsafe = analysed.failsafe;
     let pack = PackFile {
         battery: spec,
@@ -335,6 +350,9 @@ fn combine(
         equivalent_cycles: flights.equivalent_cycles,
         ocv: None,
         ocv_refused: None,
+        rc_resistance_ohm: None,
+        rc_time_constant_s: None,
+        rc_refused: None,
         pack: None,
         pack_toml: None,
         output: String::new(),
@@ -472,6 +490,35 @@ fn fit_curve(
     }
 }
 
+/// The RC pair from the flights' records, on the resistance written (module docs).
+fn fit_rc(
+    spec: &mut aloft_planner::BatterySpec,
+    answer: &mut PackFitAnswer,
+    records: &[Vec<BatterySample>],
+) {
+    let r0_ohm = spec.internal_resistance_ohm.unwrap_or(f64::NAN);
+    let flights: Vec<aloft_packs::RcEstimate> = records
+        .iter()
+        .filter_map(|samples| aloft_packs::rc_from_flight(samples, r0_ohm))
+        .collect();
+    match aloft_packs::rc_of_flights(&flights) {
+        Ok((tau_s, r_ohm)) => {
+            spec.rc_resistance_ohm = Some(r_ohm);
+            spec.rc_time_constant_s = Some(tau_s);
+            answer.rc_resistance_ohm = Some(r_ohm);
+            answer.rc_time_constant_s = Some(tau_s);
+        }
+        Err(why) => {
+            answer.notes.push(format!(
+                "no RC pair written (the state-of-charge filter's default, {} s, is flown and its \
+                 resistance learned in flight): {why}",
+                aloft_packs::soc_filter::DEFAULT_RC_TIME_CONSTANT_S
+            ));
+            answer.rc_refused = Some(why);
+        }
+    }
+}
+
 /// A log's file name (its source as given when it has none).
 fn file_name(source: &str) -> String {
     std::path::Path::new(source)
@@ -533,6 +580,9 @@ fn fitted_table(a: &PackFitAnswer) -> toml::Table {
             floats(vec![o.measured_from_soc, o.measured_to_soc]),
         );
         t.insert("ocv_logs".into(), toml::Value::Integer(o.flights as i64));
+    }
+    if let Some(why) = &a.rc_refused {
+        t.insert("rc_refused".into(), toml::Value::String(why.clone()));
     }
     if let Some(why) = &a.ocv_refused {
         t.insert("ocv_refused".into(), toml::Value::String(why.clone()));
