@@ -147,11 +147,17 @@ fn vehicle_without(held_out: &str) -> String {
     // The resistance pack fit writes is the one the steps give here.
     let fitted_r = battery["internal_resistance_ohm"].as_f64().unwrap();
     assert!((fitted_r / r_ohm - 1.0).abs() < 1e-9, "{fitted_r} {r_ohm}");
+    // The RC pair pack fit writes beside its curve (none identified on these logs: one of no
+    // resistance, the curve fitted under load holding the mean polarisation).
+    let rc = ["rc_resistance_ohm", "rc_time_constant_s"]
+        .iter()
+        .filter_map(|k| battery[*k].as_f64().map(|v| format!("{k} = {v:?}\n")))
+        .collect::<String>();
     let pack = format!(
         "\n[[battery]]\nname = \"kaist-12s\"\ndefault = true\ncells_series = 12\n\
          capacity_mah = {q_mah}\nnominal_v = 44.4\nenergy_wh = {}\nmass_kg = 1.0\n\
          internal_resistance_ohm = {r_ohm}\ncutoff_cell_v = 3.0\n\
-         ocv_soc = [{ocv_soc}]\nocv_cell_v = [{ocv_cell_v}]\n",
+         ocv_soc = [{ocv_soc}]\nocv_cell_v = [{ocv_cell_v}]\n{rc}",
         q_mah / 1000.0 * 44.4
     );
     let mut text = std::fs::read_to_string(&path).unwrap();
@@ -358,30 +364,29 @@ fn data_val_kaist_failsafe_crossing_matches_the_csv() {
     }
 }
 
-/// On the pack's own open-circuit curve (issue 44), aloft's p50 is within 65 s of the crossing
-/// 120 s before it and within 90 s 300 s before it, by the median over the ten held-out flights
-/// (measured: 54 s and 76 s; on the generic LiPo curve 62 s and 97 s), and it is early, never late
-/// by more than one update interval (10 s), at 300 s and 120 s before (measured: early on every
-/// flight, by 28-125 s). What is left is not the curve: the pack's voltage under the logged
-/// power is predicted within 0.06-0.12 V RMS on it (tests/it/pack_voltage_data_val.rs); the
-/// model's power ahead is the next suspect. The naive rate is closer by the median at 120 s
-/// (35 s) but late on half the flights (by up to 145 s): reported, not asserted (a test that
-/// failed when aloft got better would be no test of aloft).
+/// On the pack's own open-circuit curve with the RC pair `aloft pack fit` writes beside it (one of
+/// no resistance: the curve, fitted under load, holds the mean polarisation), aloft's p50 is
+/// within 15 s of the crossing 120 s before it and within 30 s 300 s before it, by the median over
+/// the ten held-out flights (measured: 6 s and 14 s; with the filter's default pair on the same
+/// curve, counting that sag twice, 54 s and 76 s, early on every flight; on the generic LiPo curve
+/// 62 s and 97 s); its p5-p95 band holds the crossing on at least 7 of the 10 (measured: 9 and 8;
+/// before, 0); and its p5, the time a ground station is sent, is later than the crossing by at
+/// most 30 s (measured: once, by 23 s, 300 s before). The naive rate (median 35 s and 80 s,
+/// late on half the flights by up to 145 s) is worse by the median at both: reported, and asserted
+/// only as aloft's own bound.
 #[test]
-fn data_val_kaist_failsafe_predicted_early_on_the_packs_own_curve() {
+fn data_val_kaist_failsafe_predicted_on_the_packs_own_circuit() {
     let j = judged();
-    let at_120 = summary(j, "120 s");
-    assert_eq!(at_120.n, 10);
-    assert!(at_120.predicted_abs_s < 65.0, "{at_120:?}");
-    let at_300 = summary(j, "300 s");
-    assert_eq!(at_300.n, 10);
-    assert!(at_300.predicted_abs_s < 90.0, "{at_300:?}");
+    for (at, bound_s) in [("120 s", 15.0), ("300 s", 30.0)] {
+        let s = summary(j, at);
+        assert_eq!(s.n, 10);
+        assert!(s.predicted_abs_s < bound_s, "{at}: {s:?}");
+        assert!(s.in_band >= 7, "{at}: {s:?}");
+    }
     for f in j {
         for c in &f.checkpoints {
-            let p50 = c
-                .p50
-                .unwrap_or_else(|| panic!("{}: no p50 at {c:?}", f.file));
-            assert!(p50 <= c.actual_s + 10.0, "{}: late at {c:?}", f.file);
+            let p5 = c.p5.unwrap_or_else(|| panic!("{}: no p5 at {c:?}", f.file));
+            assert!(p5 <= c.actual_s + 30.0, "{}: late at {c:?}", f.file);
         }
     }
 }

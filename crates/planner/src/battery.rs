@@ -366,10 +366,18 @@ impl Pack {
             .map(|k| cells * curve.cell_v(k as f64 / (OCV_TABLE_POINTS - 1) as f64))
             .collect();
         let rc_pair = match (spec.rc_resistance_ohm, spec.rc_time_constant_s) {
-            (Some(r), Some(tau)) => Some((
-                pos("rc_resistance_ohm", r, "ohm")?,
-                pos("rc_time_constant_s", tau, "s")?,
-            )),
+            // No resistance is a pair that holds no sag (a curve fitted under load holds it).
+            (Some(r), Some(tau)) if r.is_finite() && (0.0..=1e7).contains(&r) => {
+                Some((r, pos("rc_time_constant_s", tau, "s")?))
+            }
+            (Some(r), Some(_)) => {
+                return Err(bad(
+                    "rc_resistance_ohm",
+                    r,
+                    "ohm",
+                    "zero or positive, finite",
+                ))
+            }
             (None, None) => None,
             (Some(r), None) => {
                 return Err(bad(

@@ -22,9 +22,10 @@
 //!   (or none: the generic one) is kept and the answer says why (`ocv_refused`).
 //! - `rc_resistance_ohm`, `rc_time_constant_s`: the RC pair of the pack's equivalent circuit
 //!   ([`aloft_packs::rc_from_flight`], [`aloft_packs::rc_of_flights`]) where at least three
-//!   flights identify one and agree; otherwise none is written (the state-of-charge filter keeps
-//!   its default pair and learns its resistance in flight) and the answer says why
-//!   (`rc_refused`).
+//!   flights identify one and agree. Otherwise, beside a curve fitted here (under load, `V + I R`:
+//!   it holds the pack's mean polarisation already), a pair of no resistance, so that the
+//!   state-of-charge filter does not count that sag twice; beside none, no pair (the filter keeps
+//!   its default and learns its resistance in flight). The answer says why (`rc_refused`).
 //!
 //! A log that cannot be read is an error naming it (exit 2); a log without battery records or
 //! without current is skipped with its reason; with none usable the answer has no pack (exit 1).
@@ -501,6 +502,7 @@ fn fit_rc(
         .iter()
         .filter_map(|samples| aloft_packs::rc_from_flight(samples, r0_ohm))
         .collect();
+    let tau_default = aloft_packs::soc_filter::DEFAULT_RC_TIME_CONSTANT_S;
     match aloft_packs::rc_of_flights(&flights) {
         Ok((tau_s, r_ohm)) => {
             spec.rc_resistance_ohm = Some(r_ohm);
@@ -508,11 +510,23 @@ fn fit_rc(
             answer.rc_resistance_ohm = Some(r_ohm);
             answer.rc_time_constant_s = Some(tau_s);
         }
+        // The curve fitted here is the voltage under load less `I R`: it holds the pack's mean
+        // polarisation, which an RC pair beside it would count again.
+        Err(why) if answer.ocv.is_some() => {
+            spec.rc_resistance_ohm = Some(0.0);
+            spec.rc_time_constant_s = Some(tau_default);
+            answer.rc_resistance_ohm = Some(0.0);
+            answer.rc_time_constant_s = Some(tau_default);
+            answer.notes.push(format!(
+                "no RC pair identified ({why}): the open-circuit curve fitted under load holds the \
+                 pack's mean polarisation, so the pair written has no resistance"
+            ));
+            answer.rc_refused = Some(why);
+        }
         Err(why) => {
             answer.notes.push(format!(
-                "no RC pair written (the state-of-charge filter's default, {} s, is flown and its \
-                 resistance learned in flight): {why}",
-                aloft_packs::soc_filter::DEFAULT_RC_TIME_CONSTANT_S
+                "no RC pair written (the state-of-charge filter's default, {tau_default} s, is \
+                 flown and its resistance learned in flight): {why}"
             ));
             answer.rc_refused = Some(why);
         }
