@@ -44,7 +44,11 @@ pub struct LiveArgs {
 pub fn run(mut args: LiveArgs) -> Result<Outcome> {
     let flying = aloft::engine::load_flying(&args.flags.vehicle, &mut args.flags.battery)?;
     let vehicle = flying.vehicle;
-    let task = args.flags.request()?;
+    let mut task = args.flags.request()?;
+    // The pack file's `[failsafe]`, watched where the flags give none.
+    if let (LiveTask::Follow { request, .. }, Some(f)) = (&mut task, &flying.failsafe) {
+        request.pack_failsafe_v = [f.low_voltage_v, f.critical_voltage_v];
+    }
     let stdout = std::io::stdout();
     let panel = args.format == LiveFormat::Table
         && stdout.is_terminal()

@@ -1138,6 +1138,7 @@ impl LiveFlags {
                 scenarios: self.scenarios,
                 low_voltage_v: self.low_voltage_v,
                 critical_voltage_v: self.critical_voltage_v,
+                pack_failsafe_v: [None, None],
                 start_voltage_v: self.start_voltage_v,
                 air: self.air.input(),
                 battery_id: self.battery_id,

@@ -455,3 +455,54 @@ fn data_val_live_starts_from_the_rested_voltage_given() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("start_voltage_v"), "{}", stderr(&out));
 }
+
+/// A pack file's `[failsafe]` is watched in flight where the flags give none (its source
+/// `[failsafe]`), and a flag replaces it (its source the flag): `log_66` flown on a 3S pack file
+/// whose low-voltage failsafe is 10.8 V, which the flight's loaded voltage reaches (10.16 V at
+/// 25 A).
+#[test]
+fn data_val_live_watches_the_pack_files_failsafe() {
+    let dir = data_dir().join("px4_flugdrohne/ulg");
+    let vehicle = px4_vehicle("log_66_2023-6-21-08-44-02");
+    let ulog = dir
+        .join("log_66_2023-6-21-08-44-02.ulg")
+        .display()
+        .to_string();
+    let pack = common::scratch("live-soc", "pack-failsafe.toml");
+    std::fs::write(
+        &pack,
+        "[battery]\nname = \"3S-file\"\ncells_series = 3\ncapacity_mah = 5000.0\n\
+         nominal_v = 11.1\nenergy_wh = 55.5\nmass_kg = 0.4\ninternal_resistance_ohm = 0.02\n\
+         cutoff_cell_v = 3.3\n\n[failsafe]\nlow_voltage_v = 10.8\n",
+    )
+    .unwrap();
+    let pack = pack.display().to_string();
+    let sources = |extra: &[&str]| {
+        let mut args = vec!["--every", "5", "--battery", pack.as_str()];
+        args.extend(extra);
+        let v = updates(&["--replay", &ulog], &vehicle, &args);
+        v.iter()
+            .flat_map(|u| u["failsafes"].as_array().cloned().unwrap_or_default())
+            .filter(|f| f["unit"] == "V")
+            .map(|f| {
+                let t = f["threshold"].as_f64().unwrap();
+                (f["source"].as_str().unwrap().to_string(), format!("{t}"))
+            })
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    let from_file = sources(&[]);
+    assert!(
+        from_file
+            .iter()
+            .any(|(s, t)| s == "[failsafe]" && t == "10.8"),
+        "{from_file:?}"
+    );
+    let from_flag = sources(&["--low-voltage-v", "10.5"]);
+    assert!(!from_flag.is_empty());
+    assert!(
+        from_flag
+            .iter()
+            .all(|(s, t)| s == "--low-voltage-v" && t == "10.5"),
+        "{from_flag:?}"
+    );
+}

@@ -203,6 +203,9 @@ pub struct LiveRequest {
     pub low_voltage_v: Option<f64>,
     /// The critical-voltage failsafe, pack volts (`--critical-voltage-v`).
     pub critical_voltage_v: Option<f64>,
+    /// The pack file's `[failsafe]` (low, critical; pack volts), watched where the flags give
+    /// none.
+    pub pack_failsafe_v: [Option<f64>; 2],
     /// The pack's rested voltage before take-off, V (`--start-voltage-v`): the state of charge
     /// starts from it on the pack's curve, before any the stream gives.
     pub start_voltage_v: Option<f64>,
@@ -227,6 +230,7 @@ impl LiveRequest {
             scenarios: LIVE_SCENARIOS,
             low_voltage_v: None,
             critical_voltage_v: None,
+            pack_failsafe_v: [None, None],
             start_voltage_v: None,
             air: AirInput::default(),
             battery_id: DEFAULT_BATTERY_ID,
@@ -368,28 +372,32 @@ pub struct LiveSession<'a> {
 
 /// The flags' voltage failsafes (`--low-voltage-v`, `--critical-voltage-v`), as the failsafes'
 /// monitor takes them.
+/// The flags' (`[low, critical]`, pack volts), else the pack file's `[failsafe]` (`pack`).
 pub(crate) fn thresholds(
-    low_voltage_v: Option<f64>,
-    critical_voltage_v: Option<f64>,
+    flags: [Option<f64>; 2],
+    pack: [Option<f64>; 2],
 ) -> Vec<aloft_packs::VoltageThreshold> {
     use aloft_packs::{FailsafeKind, VoltageThreshold};
-    [
-        (FailsafeKind::Low, "--low-voltage-v", low_voltage_v),
-        (
-            FailsafeKind::Critical,
-            "--critical-voltage-v",
-            critical_voltage_v,
-        ),
-    ]
-    .into_iter()
-    .filter_map(|(kind, source, v)| {
-        v.map(|voltage_v| VoltageThreshold {
-            kind,
-            voltage_v,
-            source: source.to_string(),
+    let kinds = [
+        (FailsafeKind::Low, "--low-voltage-v"),
+        (FailsafeKind::Critical, "--critical-voltage-v"),
+    ];
+    kinds
+        .into_iter()
+        .zip(flags.into_iter().zip(pack))
+        .filter_map(|((kind, flag), (given, file))| {
+            let (voltage_v, source) = match (given, file) {
+                (Some(v), _) => (v, flag),
+                (None, Some(v)) => (v, "[failsafe]"),
+                (None, None) => return None,
+            };
+            Some(VoltageThreshold {
+                kind,
+                voltage_v,
+                source: source.to_string(),
+            })
         })
-    })
-    .collect()
+        .collect()
 }
 
 /// A disagreement between the vehicle's report and the estimate the note explains, state of
@@ -438,7 +446,10 @@ impl<'a> LiveSession<'a> {
             count: ChargeCount::new(pack.capacity_ah()),
             pack_state: PackState::new(&pack),
             watched: None,
-            thresholds: thresholds(request.low_voltage_v, request.critical_voltage_v),
+            thresholds: thresholds(
+                [request.low_voltage_v, request.critical_voltage_v],
+                request.pack_failsafe_v,
+            ),
             charge: Charge::new(pack),
             advice: AdviceHold::default(),
             eta0,

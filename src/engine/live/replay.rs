@@ -121,7 +121,10 @@ pub fn replay_live(
     let prior_sd = super::estimate::prior_sd(&model);
     let eta0 = model.vehicle().efficiency();
     let mut estimator = RatioEstimator::new(prior_sd);
-    let thresholds = super::thresholds(request.low_voltage_v, request.critical_voltage_v);
+    let thresholds = super::thresholds(
+        [request.low_voltage_v, request.critical_voltage_v],
+        [None, None],
+    );
     let mut pack = PackReplay::new(vehicle, request.battery.as_deref(), &thresholds, &log)?;
     let mut judge = Judge::new(series.duration_s());
     let (mut t, mut next) = (series.t[0], 0);
