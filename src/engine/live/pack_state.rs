@@ -296,8 +296,8 @@ mod tests {
     use aloft_planner::BatterySpec;
 
     /// A 12S pack of 10 A h on the generic curve.
-    fn pack_12s() -> Pack {
-        Pack::new(&BatterySpec {
+    fn spec_12s() -> BatterySpec {
+        BatterySpec {
             name: "12s".into(),
             cells_series: 12,
             capacity_mah: 10_000.0,
@@ -307,8 +307,11 @@ mod tests {
             internal_resistance_ohm: Some(0.02),
             cutoff_cell_v: Some(3.0),
             ..BatterySpec::default()
-        })
-        .unwrap()
+        }
+    }
+
+    fn pack_12s() -> Pack {
+        Pack::new(&spec_12s()).unwrap()
     }
 
     /// A state in the air from a loaded 12S voltage, fed `voltages` (V at 25 A) at 10 Hz.
@@ -351,17 +354,9 @@ mod tests {
     #[test]
     fn the_pack_files_rc_pair_is_the_circuits() {
         let spec = |r: Option<f64>, tau: Option<f64>| BatterySpec {
-            name: "12s".into(),
-            cells_series: 12,
-            capacity_mah: 10_000.0,
-            nominal_v: Some(44.4),
-            energy_wh: Some(444.0),
-            mass_kg: Some(1.0),
-            internal_resistance_ohm: Some(0.02),
-            cutoff_cell_v: Some(3.0),
             rc_resistance_ohm: r,
             rc_time_constant_s: tau,
-            ..BatterySpec::default()
+            ..spec_12s()
         };
         let p = PackState::new(&Pack::new(&spec(Some(0.015), Some(12.0))).unwrap());
         let c = &p.circuit;
