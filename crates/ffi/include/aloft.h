@@ -119,8 +119,9 @@ AloftStatus aloft_vehicle_power_json(const struct AloftVehicle *vehicle,
 
 // Plan a mission with `vehicle` into `*out`. `mission` is TOML or JSON text, or NULL for the
 // built-in demonstration mission; `options_json` is NULL (the CLI's defaults) or a JSON object
-// of mission options (`battery`, `payload_kg`, `wind`, `reserve_percent`, `start_percent`,
-// `time_step_s`, `aoa`, `ground_effect`). An infeasible mission is a plan with `feasible` false.
+// of mission options (`battery`, `payload_kg`, `wind`, `reserve_percent`, `start_percent` or
+// `start_voltage_v`, `time_step_s`, `aoa`, `ground_effect`). An infeasible mission is a plan
+// with `feasible` false.
 //
 // # Safety
 // `vehicle` is NULL or a pointer (checked); `mission` and `options_json` are NULL or

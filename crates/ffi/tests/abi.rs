@@ -438,3 +438,40 @@ fn static_strings_are_valid() {
         .unwrap();
     assert_eq!(demo, aloft::engine::DEMO_MISSION);
 }
+
+/// Issue 44: `start_voltage_v` in the options starts the mission from the pack's rested voltage
+/// on its curve (the M100's 6S at 3.58 V a cell: 5 % x (3.58 - 3.27) / (3.61 - 3.27) on the
+/// generic LiPo curve), as `aloft mission --start-voltage-v`; one off the curve is an error naming
+/// it.
+#[test]
+fn a_rested_voltage_in_the_options_starts_the_mission_on_the_curve() {
+    let v = m100();
+    let mut out = null_mut();
+    // SAFETY: a live vehicle, NULL mission, a NUL-terminated options text, an out pointer.
+    let s = unsafe {
+        aloft_mission_json(
+            v,
+            std::ptr::null(),
+            c"{\"start_voltage_v\": 21.48}".as_ptr(),
+            &mut out,
+        )
+    };
+    assert_eq!(s, AloftStatus::Ok, "{}", last_error());
+    let json: serde_json::Value = serde_json::from_str(&take(out)).unwrap();
+    let want = 0.05 * (3.58 - 3.27) / (3.61 - 3.27);
+    assert!((json["start_soc"].as_f64().unwrap() - want).abs() < 1e-9, "{json}");
+    let mut out = null_mut();
+    // SAFETY: as above.
+    let s = unsafe {
+        aloft_mission_json(
+            v,
+            std::ptr::null(),
+            c"{\"start_voltage_v\": 5.0}".as_ptr(),
+            &mut out,
+        )
+    };
+    assert_ne!(s, AloftStatus::Ok);
+    assert!(last_error().contains("start_voltage_v"), "{}", last_error());
+    // SAFETY: freed once.
+    assert_eq!(unsafe { aloft_vehicle_free(v) }, AloftStatus::Ok);
+}
