@@ -459,7 +459,10 @@ fn a_rested_voltage_in_the_options_starts_the_mission_on_the_curve() {
     assert_eq!(s, AloftStatus::Ok, "{}", last_error());
     let json: serde_json::Value = serde_json::from_str(&take(out)).unwrap();
     let want = 0.05 * (3.58 - 3.27) / (3.61 - 3.27);
-    assert!((json["start_soc"].as_f64().unwrap() - want).abs() < 1e-9, "{json}");
+    assert!(
+        (json["start_soc"].as_f64().unwrap() - want).abs() < 1e-9,
+        "{json}"
+    );
     let mut out = null_mut();
     // SAFETY: as above.
     let s = unsafe {
