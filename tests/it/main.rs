@@ -13,7 +13,6 @@ mod disclosure;
 mod doc_commands;
 mod engine_cli;
 mod examples;
-mod ffi_c;
 mod fit_quality_data_val;
 mod identify_data_val;
 mod input_contract;

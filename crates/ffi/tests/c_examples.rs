@@ -1,67 +1,37 @@
 //! The C programs of `examples/c/`, built with the system C compiler (`cc`) against the static
-//! library of `aloft-ffi` and run:
+//! library cargo built for this test (`<target>/<profile>/deps/libaloft_ffi.a`: the same build of
+//! the library the Rust tests of this crate link, so no second build of the engine with other
+//! features) and run:
 //! - `mission.c` prints the energy of the built-in demonstration mission with the built-in M100;
-//!   it must equal the CLI's (`aloft mission --format json`) to the last digit, and the summary
-//!   JSON it prints must be the CLI's text byte for byte;
+//!   it must equal the engine's to the last digit, and the summary JSON it prints must be the
+//!   engine's text byte for byte (`tests/it/engine_cli.rs` holds the CLI's `aloft mission
+//!   --format json` to the same text);
 //! - `bad_input.c` feeds the ABI null pointers, invalid UTF-8, malformed TOML and JSON, double
 //!   frees and foreign pointers; every call must return its error code with a message.
-//!
-//! The static library is built by a nested `cargo build -p aloft-ffi` into this test's target
-//! directory and profile (a no-op when it is up to date).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The target directory and profile directory of this test binary (`<target>/<profile>/deps/..`).
-fn target_dirs() -> (PathBuf, PathBuf) {
-    let exe = std::env::current_exe().expect("test executable path");
-    let profile_dir = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("<target>/<profile>/deps/<test>")
-        .to_path_buf();
-    let target_dir = profile_dir
-        .parent()
-        .expect("<target>/<profile>")
-        .to_path_buf();
-    (target_dir, profile_dir)
-}
+use aloft::engine::{plan_mission, Mission, MissionOptions, Vehicle};
 
-/// Build `libaloft_ffi.a` for this profile and return its path.
+/// `libaloft_ffi.a` of this build: beside this test executable (`<profile>/deps/`).
 fn static_lib() -> PathBuf {
-    let (target_dir, profile_dir) = target_dirs();
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
-    let mut cmd = Command::new(cargo);
-    cmd.args([
-        "build",
-        "--quiet",
-        "-p",
-        "aloft-ffi",
-        "--lib",
-        "--target-dir",
-    ])
-    .arg(&target_dir)
-    .current_dir(env!("CARGO_MANIFEST_DIR"));
-    match profile_dir.file_name().and_then(|n| n.to_str()) {
-        Some("debug") => {}
-        Some("release") => {
-            cmd.arg("--release");
-        }
-        Some(other) => {
-            cmd.args(["--profile", other]);
-        }
-        None => panic!("no profile directory in {}", profile_dir.display()),
-    }
-    let status = cmd.status().expect("run cargo build -p aloft-ffi");
-    assert!(status.success(), "cargo build -p aloft-ffi failed");
-    let lib = profile_dir.join("libaloft_ffi.a");
-    assert!(lib.exists(), "{} not built", lib.display());
+    let exe = std::env::current_exe().expect("test executable path");
+    let lib = exe
+        .parent()
+        .expect("<target>/<profile>/deps/<test>")
+        .join("libaloft_ffi.a");
+    assert!(
+        lib.exists(),
+        "{} not built (crate-type staticlib in crates/ffi/Cargo.toml)",
+        lib.display()
+    );
     lib
 }
 
 /// Compile `examples/c/<name>.c` against the static library; return the executable.
 fn build_c(name: &str) -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let lib = static_lib();
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("aloft-c-{name}"));
     let status = Command::new("cc")
@@ -95,7 +65,7 @@ fn value_of<'a>(text: &'a str, key: &str) -> &'a str {
 }
 
 #[test]
-fn c_example_energy_equals_the_cli_to_the_last_digit() {
+fn c_example_energy_equals_the_engine_to_the_last_digit() {
     let exe = build_c("mission");
     let c = Command::new(&exe).output().expect("run the C example");
     let c_out = String::from_utf8(c.stdout).expect("UTF-8");
@@ -106,39 +76,32 @@ fn c_example_energy_equals_the_cli_to_the_last_digit() {
         String::from_utf8_lossy(&c.stderr)
     );
 
-    let cli = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .args(["mission", "--format", "json"])
-        .output()
-        .expect("run aloft mission");
-    assert_eq!(cli.status.code(), Some(0), "aloft mission failed");
-    let cli_json = String::from_utf8(cli.stdout).expect("UTF-8");
-    let cli_value: serde_json::Value = serde_json::from_str(&cli_json).expect("CLI JSON");
-    let cli_energy = cli_value["energy_wh"].as_f64().expect("energy_wh");
+    let plan = plan_mission(
+        &Vehicle::builtin("dji-m100").expect("built-in M100"),
+        &Mission::demo(),
+        &MissionOptions::default(),
+    )
+    .expect("the demonstration mission plans");
+    let engine_json = plan.to_json().expect("summary JSON") + "\n";
+    let engine_value: serde_json::Value = serde_json::from_str(&engine_json).expect("JSON");
+    let engine_energy = engine_value["energy_wh"].as_f64().expect("energy_wh");
 
     // %.17g round-trips a double: equal bits mean equal at every printed precision.
     let c_energy: f64 = value_of(&c_out, "energy_wh:").parse().expect("a number");
     assert_eq!(
         c_energy.to_bits(),
-        cli_energy.to_bits(),
-        "C {c_energy:e} vs CLI {cli_energy:e}"
+        engine_energy.to_bits(),
+        "C {c_energy:e} vs engine {engine_energy:e}"
     );
-    // And as the CLI's table prints it.
-    let table = Command::new(env!("CARGO_BIN_EXE_aloft"))
-        .arg("mission")
-        .output()
-        .expect("run aloft mission");
-    let table = String::from_utf8(table.stdout).expect("UTF-8");
-    let cli_printed = value_of(&table, "  energy used")
-        .trim_end_matches("Wh")
-        .trim();
+    // And rounded as the CLI's table prints it (`{:.1}`).
     assert_eq!(
         value_of(&c_out, "energy used:"),
-        format!("{cli_printed} Wh")
+        format!("{engine_energy:.1} Wh")
     );
 
-    // The summary JSON the C program printed is the CLI's, byte for byte.
+    // The summary JSON the C program printed is the engine's, byte for byte.
     let c_json = &c_out[c_out.find('{').expect("JSON in the C output")..];
-    assert_eq!(c_json, cli_json);
+    assert_eq!(c_json, engine_json);
 }
 
 #[test]
