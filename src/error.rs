@@ -344,6 +344,14 @@ pub enum Error {
     /// error is large and this enum travels in every `Result` of the facade.
     #[error(transparent)]
     Planner(Box<aloft_planner::PlannerError>),
+    /// A terrain tile that cannot be read, or no ground (no tile, a void) under a place asked.
+    #[error(transparent)]
+    Terrain(#[from] aloft_terrain::TerrainError),
+    /// Terrain asked for a mission placed in metres from home: the tiles need latitudes.
+    #[error(
+        "terrain needs a mission placed by latitude and longitude (its home and waypoints); this one is placed in metres from home"
+    )]
+    TerrainNeedsPlace,
     /// A wind the planner rejects (a speed, a profile, a field, gusts).
     #[error("{origin}: {source}")]
     Wind {

@@ -44,7 +44,7 @@ pub fn run(mut args: MissionArgs) -> Result<Outcome> {
             .with_context(|| format!("cannot draw {}", path.display()))?;
     }
     view.print(args.format)?;
-    Ok(if plan.report().feasible {
+    Ok(if plan.summary().feasible {
         Outcome::Ok
     } else {
         Outcome::Failed

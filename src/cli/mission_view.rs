@@ -60,6 +60,7 @@ impl MissionView<'_> {
             Some(u) => write_bands(out, u)?,
             None => write_failsafes(out, plan.summary())?,
         }
+        write_clearance(out, plan.summary())?;
         write_segments(out, plan.report(), self.scenarios)?;
         writeln!(out)?;
         write_sorties(out, plan.summary())?;
@@ -117,6 +118,12 @@ fn header(plan: &Plan) -> Result<String> {
     }
     writeln!(head)?;
     match &r.shortfall {
+        // Over terrain a route the pack flies may still pass too close to the ground.
+        None if !s.feasible => writeln!(
+            head,
+            "NOT FEASIBLE: {}.",
+            s.reason.as_deref().unwrap_or("see the segments")
+        )?,
         None => writeln!(
             head,
             "FEASIBLE: lands with {:.0} % of the battery's capacity still usable ({:.0} % reserve required).",
@@ -306,6 +313,39 @@ fn write_failsafes(out: &mut impl Write, s: &MissionSummary) -> Result<()> {
     if !s.failsafes.is_empty() {
         writeln!(out)?;
     }
+    Ok(())
+}
+
+/// Over terrain, the least height above the ground of the segments in the air and where
+/// ("least clearance: 23.4 m above the ground in segment 7 (item 9), at 44.27012, -71.30310"),
+/// then a blank line.
+fn write_clearance(out: &mut impl Write, s: &MissionSummary) -> Result<()> {
+    let Some(least_m) = s.min_clearance_m else {
+        return Ok(());
+    };
+    // The segment that holds it (the take-off and the landing are not judged, so a judged one
+    // holds the least).
+    let at = s
+        .segments
+        .iter()
+        .filter(|g| !matches!(g.kind.as_str(), "take-off" | "landing"))
+        .find(|g| g.min_clearance_m.is_some_and(|c| c <= least_m));
+    match at {
+        Some(g) => {
+            let item = g.item.map(|i| format!(" (item {i})")).unwrap_or_default();
+            let place = g
+                .min_clearance_at
+                .map(|p| format!(", at {:.5}, {:.5}", p.latitude_deg, p.longitude_deg))
+                .unwrap_or_default();
+            writeln!(
+                out,
+                "least clearance: {least_m:.1} m above the ground in segment {}{item}{place}",
+                g.index
+            )?;
+        }
+        None => writeln!(out, "least clearance: {least_m:.1} m above the ground")?,
+    }
+    writeln!(out)?;
     Ok(())
 }
 

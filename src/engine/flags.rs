@@ -26,7 +26,7 @@ use crate::engine::identification::validate::ValidateRequest;
 use crate::engine::live::{LiveReplayRequest, LiveRequest, LiveSource};
 use crate::engine::logs::{FlightLogs, LogArg, LogReadOptions};
 use crate::engine::missions::mission_file::Mission;
-use crate::engine::missions::mission_options::{GustSpec, MissionOptions};
+use crate::engine::missions::mission_options::{GustSpec, MissionOptions, DEFAULT_MIN_CLEARANCE_M};
 use crate::engine::performance::payload_sweep::PayloadSweep;
 use crate::engine::performance::power::PowerModelQuery;
 use crate::engine::plan_to_fly::fly_plan::{
@@ -293,6 +293,15 @@ pub struct MissionFlags {
     /// The autopilot's critical-voltage failsafe, pack volts (ArduPilot BATT_CRT_VOLT).
     #[arg(value_parser = finite(), long, value_name = "V")]
     pub critical_voltage_v: Option<f64>,
+    /// Elevation tiles, offline: a directory of SRTM .hgt (.hgt.zip) and WGS84 GeoTIFF files.
+    /// Each segment's least height above the ground is given, terrain-frame items are flown
+    /// over the ground (default: the ALOFT_TERRAIN environment variable; none: a flat Earth).
+    #[arg(long, value_name = "DIR", env = "ALOFT_TERRAIN")]
+    pub terrain: Option<PathBuf>,
+    /// With --terrain: a segment in the air (take-off and landing excepted) that passes closer
+    /// to the ground than this makes the mission infeasible (exit 1), m.
+    #[arg(value_parser = finite(), long, value_name = "M", default_value_t = DEFAULT_MIN_CLEARANCE_M)]
+    pub min_clearance_m: f64,
     /// The request's budget of planner steps, set by a caller that serves others (no flag).
     #[arg(skip)]
     pub meter: Option<StepMeter>,
@@ -323,6 +332,8 @@ impl MissionFlags {
             air: self.air.input(),
             low_voltage_v: self.low_voltage_v,
             critical_voltage_v: self.critical_voltage_v,
+            terrain: self.terrain.clone(),
+            min_clearance_m: Some(self.min_clearance_m),
             meter: self.meter.clone(),
         }
     }

@@ -112,12 +112,14 @@ pub use maps::mission_map::{
 };
 pub use maps::plan_map::{fly_plan_map, SortieMap};
 pub use missions::flown::PlanningSpeed;
+pub use missions::ground::{GroundAt, HOME_DISAGREES_M};
 pub use missions::loiter::LoiterSummary;
 pub use missions::mission::{
-    plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
+    open_terrain_dir, plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan,
+    PlanContext, Remaining,
 };
 pub use missions::mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
-pub use missions::mission_options::{GustSpec, MissionOptions};
+pub use missions::mission_options::{GustSpec, MissionOptions, DEFAULT_MIN_CLEARANCE_M};
 pub use missions::mission_outputs::{MissionOutputs, PLOT_SAMPLES};
 pub use missions::sorties::{SortieSummary, MAX_SORTIES};
 pub use missions::summary::{

@@ -97,6 +97,10 @@ pub struct ReadOptions {
     /// `None`: a loiter until the reserve, where the route ends (`aloft mission`: how long it
     /// can loiter).
     pub loiter_unlimited_s: Option<f64>,
+    /// Terrain-frame items (frame 10/11) are flown over the ground by the caller, which has the
+    /// terrain: their heights are above the ground under the vehicle, said without the warning
+    /// that they are flown as relative to home (default false: no terrain).
+    pub terrain: bool,
 }
 
 /// Home and the file's conventions.

@@ -17,6 +17,8 @@
 //! - `route.rs`: [`route_figures`], the planned horizontal path, climb, descent and holds of a
 //!   mission spec, whatever its source;
 //! - `geo.rs`: per-leg distances on the WGS-84 ellipsoid;
+//! - [`follow_terrain`]: a path that keeps its height over the ground, as QGroundControl bakes a
+//!   terrain-following survey (on ground profiles the caller reads);
 //! - [`survey`]: a QGroundControl survey's description, and its transects and items regenerated
 //!   exactly as QGroundControl draws them (also at a new grid angle, for a writer);
 //! - [`kept`]: what the readers keep besides the spec ([`Imported::home`], [`Imported::items`],
@@ -55,6 +57,7 @@ mod commands;
 mod detect;
 mod error;
 mod fence;
+pub mod follow_terrain;
 mod geo;
 mod items;
 mod jumps;

@@ -148,7 +148,9 @@ impl Walk {
                 self.move_to(Some(self.home));
             }
             SegmentSpec::Descent { altitude_m, .. } => self.climb_or_descend_to(Some(*altitude_m)),
-            SegmentSpec::Landing { .. } => self.climb_or_descend_to(Some(0.0)),
+            SegmentSpec::Landing { ground_m, .. } => {
+                self.climb_or_descend_to(Some(ground_m.unwrap_or(0.0)))
+            }
             SegmentSpec::LoiterUntilReserve { .. } => {}
         }
     }

@@ -191,9 +191,18 @@ async fn planned<T: MissionRequest>(
 ) -> Answered {
     let limit_name = "the limit on mission files";
     within_declared(&headers, MISSION_LIMIT, limit_name)?;
+    if query.iter().any(|(k, _)| k == "terrain") {
+        let m = format!(
+            "{request}: 'terrain' names a directory: a request names none (the server's tiles \
+             are `aloft serve --terrain DIR`)"
+        );
+        return Err(Refused::from(error(StatusCode::BAD_REQUEST, &m)));
+    }
     let mut flags: T = flags(request, &query, &shared)?;
     let vehicle = shared.vehicles.vehicle(request, &flags.mission().vehicle)?;
     with_default_pack(&shared.vehicles, flags.mission());
+    // The server's tiles, and only those (not the environment's ALOFT_TERRAIN).
+    flags.mission().terrain = shared.terrain.clone();
     let body = read_whole(body, MISSION_LIMIT, limit_name).await?;
     let origin = file_name(&query, "upload");
     let work = shared.clone();

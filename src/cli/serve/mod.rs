@@ -123,6 +123,11 @@ pub struct ServeArgs {
     #[cfg(feature = "logbook")]
     #[arg(long, value_name = "FILE")]
     logbook: Option<PathBuf>,
+    /// Elevation tiles (SRTM .hgt, .hgt.zip, WGS84 GeoTIFF) under every mission request: each
+    /// segment's least height above the ground, terrain-frame items flown over it, the profile
+    /// on the page. Only this directory: a request never names one.
+    #[arg(long, value_name = "DIR")]
+    terrain: Option<PathBuf>,
 }
 
 /// What every request shares.
@@ -145,6 +150,8 @@ struct Shared {
     vehicles: vehicles::Fleet,
     /// The logbook given with `--logbook`.
     logbook: Option<PathBuf>,
+    /// The terrain tiles given with `--terrain`.
+    terrain: Option<PathBuf>,
     /// The Content-Security-Policy of every answer ([`policy`]).
     policy: HeaderValue,
 }
@@ -164,6 +171,10 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
         fleet.fly_default_with(battery)?;
     }
     let logbook = logbook_of(&args)?;
+    // Tiles that cannot be read stop the server at its start, not each request.
+    if let Some(dir) = &args.terrain {
+        aloft::engine::open_terrain_dir(dir).map_err(|e| anyhow::anyhow!("--terrain: {e}"))?;
+    }
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -246,6 +257,7 @@ async fn serve(args: ServeArgs, given: AtStart, uploads: PathBuf) -> Result<()> 
         work: work::Pool::new(args.max_request_steps),
         vehicles: given.vehicles,
         logbook: given.logbook,
+        terrain: args.terrain,
         policy: given.policy,
     });
     let app = router(shared);

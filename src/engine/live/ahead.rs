@@ -353,5 +353,6 @@ fn landing() -> SegmentSpec {
         rate_mps: LANDING_RATE_MPS,
         payload_after_kg: None,
         item: None,
+        ground_m: None,
     }
 }

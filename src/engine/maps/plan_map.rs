@@ -60,6 +60,7 @@ pub fn fly_plan_map(
         .map(|(k, (sortie, text))| {
             let read = aloft_missions::ReadOptions {
                 loiter_unlimited_s: Some(request.loiter_unlimited_s),
+                ..aloft_missions::ReadOptions::default()
             };
             let mission = Mission::from_text_with(text, &sortie.file, read)?;
             let flown = plan_mission(vehicle, &mission, &request.options)?;

@@ -142,6 +142,7 @@ impl Flight<'_> {
                 rate_mps,
                 payload_after_kg: None,
                 item: None,
+                ground_m: None,
             },
         ]
     }

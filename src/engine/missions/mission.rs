@@ -12,9 +12,10 @@ use crate::engine::finite::finite;
 use crate::engine::missions::day::{mission_air, mission_wind};
 use crate::engine::missions::flight::Flight;
 use crate::engine::missions::flown::flown_spec;
+use crate::engine::missions::ground::{judge_clearances, Ground};
 use crate::engine::missions::loiter::resolve_loiter;
 use crate::engine::missions::mission_file::Mission;
-use crate::engine::missions::mission_options::MissionOptions;
+use crate::engine::missions::mission_options::{MissionOptions, DEFAULT_MIN_CLEARANCE_M};
 use crate::engine::missions::mission_outputs::{path_points, MissionOutputs, OutputSink};
 use crate::engine::missions::sorties::{split, Sorties};
 use crate::engine::missions::summary::{
@@ -226,9 +227,22 @@ pub fn plan_mission_with(
     options: &MissionOptions,
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
+    // Over terrain: the mission flown over the ground (its terrain-frame legs followed), in the
+    // air of home's ground.
+    let over = over_terrain(mission, options)?;
+    let (mission, terrain) = match &over {
+        Some((m, t)) => (m, Some(t)),
+        None => (mission, None),
+    };
     let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
     let (wind, wind_text) = mission_wind(options, mission, &vehicle)?;
-    plan_in(&vehicle, mission, options, (&wind, wind_text, air), outputs)
+    plan_in(
+        &vehicle,
+        (mission, terrain),
+        options,
+        (&wind, wind_text, air),
+        outputs,
+    )
 }
 
 /// [`plan_mission`] in a wind built by the caller, which replaces the options' and the mission
@@ -242,9 +256,20 @@ pub fn plan_mission_in(
     options: &MissionOptions,
     wind: &Wind,
 ) -> Result<Plan, Error> {
+    let over = over_terrain(mission, options)?;
+    let (mission, terrain) = match &over {
+        Some((m, t)) => (m, Some(t)),
+        None => (mission, None),
+    };
     let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
     let wind = (wind, "given by the caller".to_string(), air);
-    plan_in(&vehicle, mission, options, wind, &MissionOutputs::default())
+    plan_in(
+        &vehicle,
+        (mission, terrain),
+        options,
+        wind,
+        &MissionOutputs::default(),
+    )
 }
 
 /// The steps of a plan: the pack and the flight's fixed parts, the spec flown (the options
@@ -252,7 +277,7 @@ pub fn plan_mission_in(
 /// outputs), the sorties when one pack is not enough, the summary.
 fn plan_in(
     vehicle: &Vehicle,
-    mission: &Mission,
+    (mission, terrain): (&Mission, Option<&aloft_terrain::Terrain>),
     options: &MissionOptions,
     (wind, wind_text, air): (&Wind, String, Air),
     outputs: &MissionOutputs,
@@ -319,6 +344,15 @@ fn plan_in(
     summary
         .warnings
         .extend(sorties.note.map(|n| format!("not split into sorties: {n}")));
+    if let Some(t) = terrain {
+        let least_m = options.min_clearance_m.unwrap_or(DEFAULT_MIN_CLEARANCE_M);
+        judge_clearances(
+            &mut summary,
+            &Ground::at_home(t, mission.spec())?,
+            &compiled,
+            least_m,
+        )?;
+    }
     let summary = finite(summary, "mission", || {
         format!("mission {} with {}", mission.origin(), vehicle.name())
     })?;
@@ -344,6 +378,43 @@ fn plan_in(
         compiled,
         plot_samples,
     })
+}
+
+/// The tiles of `dir`, opened: a directory that cannot be read or holds no tile is an error
+/// naming it (a server checks its `--terrain` once at its start).
+///
+/// # Errors
+/// The tiles' own.
+pub fn open_terrain_dir(dir: &std::path::Path) -> Result<aloft_terrain::Terrain, Error> {
+    Ok(aloft_terrain::Terrain::open(dir)?)
+}
+
+/// The mission of a request flown over the ground of its options' terrain
+/// ([`Mission::over_ground`]), with the tiles; none without terrain.
+///
+/// # Errors
+/// A directory that cannot be read or holds no tile, no ground under the route, a mission placed
+/// in metres; `min_clearance_m` not finite or negative.
+pub(in crate::engine) fn over_terrain(
+    mission: &Mission,
+    options: &MissionOptions,
+) -> Result<Option<(Mission, aloft_terrain::Terrain)>, Error> {
+    if let Some(m) = options.min_clearance_m {
+        if !(m.is_finite() && (0.0..=aloft_planner::mission::MAX_MISSION_VALUE).contains(&m)) {
+            return Err(Error::InvalidInput {
+                name: "min_clearance_m",
+                value: m,
+                unit: "m",
+                expected: "a height above the ground, 0 or more, at most 1e7",
+            });
+        }
+    }
+    let Some(dir) = &options.terrain else {
+        return Ok(None);
+    };
+    let terrain = aloft_terrain::Terrain::open(dir)?;
+    let over = mission.over_ground(&Ground::at_home(&terrain, mission.spec())?)?;
+    Ok(Some((over, terrain)))
 }
 
 /// A request's flight and the mission it flies: the spec with the options applied, a loiter

@@ -4,6 +4,8 @@
 use std::path::Path;
 
 use aloft_missions::{route_figures, ReadOptions, RouteFigures, SourceFormat};
+
+use crate::engine::missions::ground::{Frame, Ground};
 use aloft_planner::MissionSpec;
 
 use crate::engine::files::read_text_file;
@@ -216,6 +218,60 @@ impl Mission {
             what: "mission",
             message: e.to_string(),
         })
+    }
+
+    /// The mission flown over `ground`: a planner file read again knowing the terrain, the legs
+    /// of its terrain-frame items (frame 10/11) followed over the ground, its landings on the
+    /// ground where they are; the route figures counted on that (its climbs and descents over
+    /// the ground), the segment ranges of the items flown moved with the legs added.
+    ///
+    /// # Errors
+    /// The reader's, the tiles' (no tile or a void under the route).
+    pub(in crate::engine) fn over_ground(&self, ground: &Ground<'_>) -> Result<Self, Error> {
+        let mut read = self.read;
+        read.terrain = true;
+        let mut mission = self.read_with(read)?;
+        let mut frames = vec![Frame::Relative; mission.spec.segments.len()];
+        if let Some(kept) = &mission.kept {
+            for f in &kept.flown {
+                let frame = kept
+                    .items
+                    .get(f.item)
+                    .map_or(Frame::Relative, |i| Frame::of_mavlink(i.frame));
+                for slot in frames
+                    .iter_mut()
+                    .take(f.segments.end)
+                    .skip(f.segments.start)
+                {
+                    *slot = frame;
+                }
+            }
+        }
+        let (spec, made) = ground.follow(&mission.spec, &frames)?;
+        let reader_warnings = mission.kept.as_ref().map(|k| k.warnings.clone());
+        if let Some(kept) = &mut mission.kept {
+            let starts: Vec<usize> = std::iter::once(0)
+                .chain(made.iter().scan(0, |sum, n| {
+                    *sum += n;
+                    Some(*sum)
+                }))
+                .collect();
+            for f in &mut kept.flown {
+                let at = |k: usize| starts.get(k).copied().unwrap_or(spec.segments.len());
+                f.segments = at(f.segments.start)..at(f.segments.end);
+            }
+            kept.spec = spec.clone();
+        }
+        let mut route = route_figures(
+            &spec,
+            mission.route.source_format,
+            reader_warnings.unwrap_or_default(),
+        );
+        route.items = mission.route.items;
+        route.warnings.extend(ground.notes.iter().cloned());
+        mission.route = route;
+        mission.spec = spec;
+        Ok(mission)
     }
 
     /// The planner file as read, to be written again (none for aloft's own formats).

@@ -12,6 +12,11 @@ use crate::engine::conditions::air::AirInput;
 use crate::engine::step_meter::StepMeter;
 use crate::error::Error;
 
+/// The least clearance over the ground of a route flown over terrain, m (the default:
+/// a mission that passes closer than 10 m to the ground outside take-off and landing is
+/// infeasible).
+pub const DEFAULT_MIN_CLEARANCE_M: f64 = 10.0;
+
 /// Options of [`plan_mission`]: the options of `aloft mission` (JSON keys as the field names;
 /// every key optional, unknown keys rejected).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -63,6 +68,13 @@ pub struct MissionOptions {
     pub low_voltage_v: Option<f64>,
     /// The autopilot's critical-voltage failsafe, pack volts (as `low_voltage_v`).
     pub critical_voltage_v: Option<f64>,
+    /// A directory of elevation tiles (SRTM `.hgt`, `.hgt.zip`, GeoTIFF): the answer gives each
+    /// segment's least height above the ground, terrain-frame items are flown over it, and a
+    /// route closer than `min_clearance_m` is infeasible (default none: a flat Earth).
+    pub terrain: Option<PathBuf>,
+    /// The least height above the ground any segment in the air may pass, take-off and landing
+    /// excepted, m (default [`DEFAULT_MIN_CLEARANCE_M`]; with `terrain` only).
+    pub min_clearance_m: Option<f64>,
     /// The budget of planner steps of the request these options are part of, when its caller
     /// bounds its work (`aloft serve`; not in the JSON; default none: unbounded, as the planner's
     /// own limit on one flight allows).
@@ -80,6 +92,8 @@ impl Default for MissionOptions {
             gusts: None,
             low_voltage_v: None,
             critical_voltage_v: None,
+            terrain: None,
+            min_clearance_m: None,
             reserve_percent: None,
             start_percent: 100.0,
             start_voltage_v: None,

@@ -6,6 +6,7 @@
 pub(crate) mod day;
 pub(crate) mod flight;
 pub(crate) mod flown;
+pub(crate) mod ground;
 pub(crate) mod loiter;
 pub(crate) mod mission;
 pub(crate) mod mission_file;

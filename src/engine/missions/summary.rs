@@ -9,6 +9,7 @@ use aloft_planner::{Limit, MissionReport, SegmentReport, Shortfall};
 
 use crate::engine::conditions::air::Air;
 use crate::engine::missions::flown::PlanningSpeed;
+pub use crate::engine::missions::ground::GroundAt;
 use crate::engine::missions::loiter::LoiterSummary;
 use crate::engine::missions::sorties::SortieSummary;
 use crate::error::Error;
@@ -48,6 +49,12 @@ pub struct SegmentSummary {
     /// `climb` or `descent` (absent when flown as planned).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub limit: Option<Limit>,
+    /// The least height above the ground along the segment's whole path, m (with terrain only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_clearance_m: Option<f64>,
+    /// Where it occurs (with terrain only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_clearance_at: Option<GroundAt>,
 }
 
 /// Where the point of no return lies (flattened into the [`MissionSummary`]).
@@ -161,6 +168,10 @@ pub struct MissionSummary {
     /// `[failsafe]`) and when each would trigger.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failsafes: Vec<FailsafeTime>,
+    /// The least height above the ground of the segments in the air, take-off and landing
+    /// excepted, m (with terrain only; each segment's in `segments`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_clearance_m: Option<f64>,
     /// What the reader should know: speeds clamped to the vehicle's, why a route was not split.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
@@ -251,6 +262,7 @@ pub fn mission_summary(
         batteries_required: report.feasible.then_some(1),
         sorties: Vec::new(),
         failsafes: Vec::new(),
+        min_clearance_m: None,
         warnings: Vec::new(),
         route: RouteFigures::default(),
         segments: report
@@ -269,6 +281,8 @@ pub fn mission_summary(
                 time_lost_s: s.edge.map(|_| s.time_lost_s),
                 min_ground_speed_mps: s.edge.and_then(|e| e.slowest_mps),
                 limit: s.edge.map(|e| e.limit),
+                min_clearance_m: None,
+                min_clearance_at: None,
             })
             .collect(),
     }

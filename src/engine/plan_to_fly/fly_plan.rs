@@ -372,7 +372,11 @@ pub fn plan_to_fly(
     // An unlimited loiter lasts a stated time, and the items after it are flown (module step 0).
     let mission = &mission.read_with(aloft_missions::ReadOptions {
         loiter_unlimited_s: Some(request.loiter_unlimited_s),
+        ..mission.read_options()
     })?;
+    // Over terrain: the mission flown over the ground (its terrain-frame legs followed).
+    let over = crate::engine::missions::mission::over_terrain(mission, options)?;
+    let mission = over.as_ref().map_or(mission, |(m, _)| m);
     // The air once: every candidate flies the vehicle in it (and finds it so when it decides
     // the air again from its own file).
     let (vehicle, air) = crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;

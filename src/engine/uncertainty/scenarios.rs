@@ -949,6 +949,9 @@ pub(in crate::engine) fn plan_scenarios_watched(
     watch: Option<&dyn ScenarioWatch>,
 ) -> Result<(Uncertainty, Vec<Watched>), Error> {
     sc.check()?;
+    // Over terrain, the scenarios fly the mission over the ground as the plan does.
+    let over = crate::engine::missions::mission::over_terrain(mission, options)?;
+    let mission = over.as_ref().map_or(mission, |(m, _)| m);
     let (vehicle, _air) =
         crate::engine::missions::day::mission_air(vehicle, mission, &options.air)?;
     let vehicle = &vehicle;

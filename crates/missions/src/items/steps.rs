@@ -77,10 +77,12 @@ impl Flight<'_> {
                 alt - home
             }
             10 | 11 => {
-                self.notes.add(
-                    item.at,
-                    "terrain-relative altitude (frame 10/11) flown as relative to home (aloft has no terrain model)",
-                );
+                if !self.source.options.terrain {
+                    self.notes.add(
+                        item.at,
+                        "terrain-relative altitude (frame 10/11) flown as relative to home (aloft has no terrain model)",
+                    );
+                }
                 alt
             }
             // 3 and 6: relative to home; 2 carries no altitude.
@@ -232,6 +234,7 @@ impl Flight<'_> {
                 rate_mps: autopilot.landing_rate_mps(),
                 payload_after_kg: None,
                 item: Some(item.number),
+                ground_m: None,
             },
         )?;
         self.airborne = false;

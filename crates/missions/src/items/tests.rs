@@ -145,7 +145,8 @@ fn land_mid_mission_then_a_waypoint_takes_off_again_from_the_landing_point() {
         SegmentSpec::Landing {
             rate_mps: 0.5,
             payload_after_kg: None,
-            item: Some(2)
+            item: Some(2),
+            ground_m: None,
         }
     );
 }
@@ -308,6 +309,7 @@ fn loiter_unlimited_for_a_stated_time_goes_on_with_the_items_after_it() {
     let text = format!("QGC WPL 110\n{HOME}\n{}\n", rows.join("\n"));
     let options = crate::ReadOptions {
         loiter_unlimited_s: Some(90.0),
+        ..crate::ReadOptions::default()
     };
     let i = crate::read_waypoints_with(&text, options).unwrap();
     assert_eq!(items(&i), [1, 2, 2, 3, 4, 4].map(Some), "{:?}", kinds(&i));

@@ -93,6 +93,20 @@ impl Seg {
         }
     }
 
+    /// `value` itself when it is finite and within [`MAX_MISSION_VALUE`] of zero.
+    pub(super) fn finite(
+        self,
+        name: &'static str,
+        value: f64,
+        unit: &'static str,
+    ) -> Result<f64, PlannerError> {
+        if value.is_finite() && value.abs() <= MAX_MISSION_VALUE {
+            Ok(value)
+        } else {
+            Err(self.invalid(name, value, unit, "finite, within 1e7 of home's height"))
+        }
+    }
+
     /// A piece of this segment that takes `duration_s` can be flown: finite and at most
     /// [`MAX_PIECE_S`].
     pub(super) fn duration(self, duration_s: f64) -> Result<(), PlannerError> {

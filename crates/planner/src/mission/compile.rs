@@ -61,6 +61,7 @@ impl MissionSpec {
             Compiler::new(airframe, battery_mass_kg, points, home_m, start_payload_kg)?;
         compiler.rtl_altitude_m = self.rtl_altitude_m;
         compiler.allow_end_in_air = self.allow_end_in_air;
+        compiler.over_terrain = self.over_terrain;
         compiler.default_speed_mps = self.default_speed_mps;
         compiler.clamp_speeds = self.clamp_speeds;
         compiler.clamp_to_mps = clamp_to_mps;
@@ -129,6 +130,8 @@ struct Compiler<'a> {
     loiter_until_reserve: bool,
     /// A mission may end in the air.
     allow_end_in_air: bool,
+    /// Heights are judged against the terrain, not home's height.
+    over_terrain: bool,
     /// Ground speed of segments that give none, m/s.
     default_speed_mps: Option<f64>,
     /// Speeds beyond the vehicle's are flown at its maximum (with a warning).
@@ -176,6 +179,7 @@ impl<'a> Compiler<'a> {
             rtl_altitude_m: None,
             loiter_until_reserve: false,
             allow_end_in_air: false,
+            over_terrain: false,
             default_speed_mps: None,
             clamp_speeds: false,
             clamp_to_mps: None,
@@ -269,7 +273,8 @@ impl<'a> Compiler<'a> {
                 rate_mps,
                 payload_after_kg,
                 item: _,
-            } => self.landing(rate_mps, payload_after_kg),
+                ground_m,
+            } => self.landing(rate_mps, payload_after_kg, ground_m),
             SegmentSpec::LoiterUntilReserve { item: _ } => self.loiter_until_reserve(),
         }
     }
@@ -343,8 +348,7 @@ impl<'a> Compiler<'a> {
         let seg = self.seg;
         self.need_air()?;
         let [east_m, north_m] = self.points.resolve(seg, waypoint, WAYPOINT_KEYS)?;
-        let up_m = altitude_m.unwrap_or(self.pos_m[2]);
-        seg.positive("altitude_m", up_m, "m")?;
+        let up_m = self.height("altitude_m", altitude_m.unwrap_or(self.pos_m[2]))?;
         let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
         self.straight_to([east_m, north_m, up_m], ground_speed_mps)?;
         self.change_payload(payload_after_kg)
@@ -361,7 +365,7 @@ impl<'a> Compiler<'a> {
         let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
         // The height of the return: the segment's, else at least the mission's RTL altitude.
         let up_m = match (altitude_m, self.rtl_altitude_m) {
-            (Some(a), _) => seg.positive("altitude_m", a, "m")?,
+            (Some(a), _) => self.height("altitude_m", a)?,
             (None, Some(rtl)) => self.pos_m[2].max(seg.positive("rtl_altitude_m", rtl, "m")?),
             (None, None) => self.pos_m[2],
         };
@@ -406,8 +410,7 @@ impl<'a> Compiler<'a> {
         let centre_m = self.points.resolve(seg, centre, CENTRE_KEYS)?;
         seg.positive("radius_m", radius_m, "m")?;
         let ground_speed_mps = self.ground_speed(ground_speed_mps)?;
-        let up_m = altitude_m.unwrap_or(self.pos_m[2]);
-        seg.positive("altitude_m", up_m, "m")?;
+        let up_m = self.height("altitude_m", altitude_m.unwrap_or(self.pos_m[2]))?;
         // A circle too tight for the speed (v^2 / r beyond what the tilt allows with the drag) is
         // flown at the speed the vehicle can turn it at: the envelope slows it.
         let length_m = self.orbit_length_m(radius_m, ground_speed_mps, laps_or_duration_s)?;
@@ -477,17 +480,37 @@ impl<'a> Compiler<'a> {
         &mut self,
         rate_mps: f64,
         payload_after_kg: Option<f64>,
+        ground_m: Option<f64>,
     ) -> Result<(), PlannerError> {
         let seg = self.seg;
         self.need_air()?;
         // A rate beyond the vehicle's is flown at its limit (the envelope slows the descent).
         seg.positive("rate_mps", rate_mps, "m/s")?;
-        self.vertical_to(0.0, rate_mps)?;
+        let ground_m = seg.finite("ground_m", ground_m.unwrap_or(0.0), "m")?;
+        if ground_m > self.pos_m[2] {
+            return Err(seg.invalid(
+                "ground_m",
+                ground_m,
+                "m",
+                "the ground where it lands is above the vehicle",
+            ));
+        }
+        self.vertical_to(ground_m, rate_mps)?;
         self.airborne = false;
         self.change_payload(payload_after_kg)
     }
 
     // ---- Steps the kinds share ----
+
+    /// A height to fly at: above home's (positive), or over terrain any finite height (the
+    /// ground under it is judged by the caller).
+    fn height(&self, key: &'static str, up_m: f64) -> Result<f64, PlannerError> {
+        if self.over_terrain {
+            self.seg.finite(key, up_m, "m")
+        } else {
+            self.seg.positive(key, up_m, "m")
+        }
+    }
 
     /// Every kind but a take-off needs the vehicle in the air.
     fn need_air(&self) -> Result<(), PlannerError> {
@@ -624,9 +647,10 @@ impl<'a> Compiler<'a> {
             };
             (v, self.airframe.vertical_acceleration_mps2())
         };
-        // A level leg or return may be flown through a corner at either end.
+        // A leg or return with a horizontal part may be flown through a corner at either end
+        // (a turn only between level lines at one height: see `corners.rs`).
         let role = match self.seg.kind {
-            "leg" | "return" if h > 1e-9 && d[2].abs() < 1e-9 => Role::Level {
+            "leg" | "return" if h > 1e-9 => Role::Level {
                 cruise_mps: path_speed,
                 accel_mps2: path_acc,
                 acceptance_m: self

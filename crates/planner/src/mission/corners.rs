@@ -2,7 +2,9 @@
 //!
 //! With `corners = "pass"` (the default), two level straight legs that meet at a waypoint
 //! without a hold, a payload change or a change of height are joined by a circular arc tangent
-//! to both, flown at a constant corner speed; the yaw turn in place of the stop-and-turn mode
+//! to both, flown at a constant corner speed (legs that climb or descend, as a route that
+//! follows the ground, are flown through where they go straight on in plan view, at the slower
+//! leg's speed, and stop where they turn); the yaw turn in place of the stop-and-turn mode
 //! goes. PX4's multicopter trajectory generator and ArduPilot's S-curve navigation both start
 //! the turn within the waypoint's acceptance radius and slow to a speed that the turn's
 //! lateral acceleration allows; this model keeps those two limits and a circle for the turn:
@@ -114,11 +116,17 @@ fn find_corners(pieces: &[Piece], roles: &[Role], a_lat: f64) -> Vec<Corner> {
         let (Shape::Line { dir: u, .. }, Shape::Line { dir: w, .. }) = (pa.shape, pb.shape) else {
             continue;
         };
-        let same_height = (pa.end_m()[2] - pb.end_m()[2]).abs() < 1e-6;
-        if pa.segment == pb.segment || pa.mass_phase != pb.mass_phase || !same_height {
+        let level = u[2].abs() < 1e-9 && w[2].abs() < 1e-9;
+        let same_height = level && (pa.end_m()[2] - pb.end_m()[2]).abs() < 1e-6;
+        if pa.segment == pb.segment || pa.mass_phase != pb.mass_phase {
             continue;
         }
         let theta = turn_rad([u[0], u[1]], [w[0], w[1]]);
+        // Lines that climb or descend (a route over the ground) are flown through only where
+        // they go straight on in plan view: no arc, the slower line's speed at the joint.
+        if !same_height && theta >= 1e-6 {
+            continue;
+        }
         let (l_in, l_out) = (pa.profile.length_m, pb.profile.length_m);
         let cut_m = acceptance_m.min(l_in / 2.0).min(l_out / 2.0);
         let (radius_m, v_geo) = if theta < 1e-6 {

@@ -295,6 +295,7 @@ mod tests {
                     rate_mps: 1.0,
                     payload_after_kg: None,
                     item: None,
+                    ground_m: None,
                 },
             ],
             ..MissionSpec::default()

@@ -165,6 +165,10 @@ pub enum SegmentSpec {
         /// The operator's mission item number (from a planner file), named in the reports.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         item: Option<u32>,
+        /// The ground's height where it lands, above home's ground, m (default 0: level with
+        /// home; set from the terrain under a mission flown over it).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        ground_m: Option<f64>,
     },
     /// Hover here until the pack must fly home with the reserve: an open-ended loiter (an
     /// autopilot's "loiter unlimited"), which ends the route. The report says how long the
@@ -363,6 +367,11 @@ pub struct MissionSpec {
     /// reserve is judged where it ends (default false: a mission lands).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub allow_end_in_air: bool,
+    /// The heights are judged against the ground under the route (a mission flown over terrain:
+    /// the engine checks each segment's clearance), so a leg, orbit or return at or below home's
+    /// height (over a valley) is flown instead of refused. Not a key of the file.
+    #[serde(skip)]
+    pub over_terrain: bool,
     /// Segments, in order.
     #[serde(default, rename = "segment")]
     pub segments: Vec<SegmentSpec>,

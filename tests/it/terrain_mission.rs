@@ -1,0 +1,303 @@
+//! Issue 45: every answer knows the ground. Missions built here over the shared SRTM3 tile
+//! (`terrain/N44W072.hgt`, the White Mountains) and over tiles written here (a constant slope):
+//! - a leg that passes a ridge 3 m above it is infeasible (exit 1) naming the segment, the place
+//!   and the clearance; the expected ridge is found by this test's own reading of the tile's
+//!   bytes (bilinear, sampled every metre along the leg), not by aloft;
+//! - a terrain-frame (MAVLink frame 10) leg up a constant slope follows the ground: its climb is
+//!   the slope's rise, and its extra energy over the same leg on flat ground is the climb power
+//!   of the model integrated over the profile (for a constant slope, the climb rate is constant:
+//!   the power of `aloft power` at that climb rate times the leg's time);
+//! - bad input: a mission in metres from home with terrain (exit 2, one line), a mission over no
+//!   tile (exit 2 naming the place).
+
+use std::path::{Path, PathBuf};
+
+use crate::common;
+
+use common::{aloft, stderr, stdout};
+use serde_json::Value;
+
+/// The shared tile's directory.
+fn tiles() -> PathBuf {
+    common::data_dir().join("terrain")
+}
+
+/// The shared tile's height at `(lat, lon)`, bilinear between its four samples (this test's
+/// own reading: 1201 x 1201 big-endian i16, north row first, 3 arc-seconds apart).
+fn tile_height_m(bytes: &[u8], lat: f64, lon: f64) -> f64 {
+    let n = 1201usize;
+    let raw = |r: usize, c: usize| {
+        let k = 2 * (r * n + c);
+        f64::from(i16::from_be_bytes([bytes[k], bytes[k + 1]]))
+    };
+    let y = (45.0 - lat) * 1200.0;
+    let x = (lon + 72.0) * 1200.0;
+    let (r, c) = (
+        (y.floor() as usize).min(1199),
+        (x.floor() as usize).min(1199),
+    );
+    let (fy, fx) = (y - r as f64, x - c as f64);
+    raw(r, c) * (1.0 - fx) * (1.0 - fy)
+        + raw(r, c + 1) * fx * (1.0 - fy)
+        + raw(r + 1, c) * (1.0 - fx) * fy
+        + raw(r + 1, c + 1) * fx * fy
+}
+
+/// A mission file placed by latitude and longitude: take off at home to `up_m`, one leg east at
+/// `up_m` to `to_lon`, land.
+fn east_leg_toml(home: (f64, f64), to_lon: f64, up_m: f64) -> String {
+    format!(
+        "name = \"ridge\"\n\
+         [home]\nlatitude_deg = {}\nlongitude_deg = {}\n\n\
+         [[segment]]\nkind = \"take-off\"\naltitude_m = {up_m}\nclimb_rate_mps = 3.0\n\n\
+         [[segment]]\nkind = \"leg\"\nlatitude_deg = {}\nlongitude_deg = {to_lon}\n\
+         altitude_m = {up_m}\nground_speed_mps = 8.0\n\n\
+         [[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
+        home.0, home.1, home.0
+    )
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
+    let bytes = std::fs::read(tiles().join("N44W072.hgt")).unwrap();
+    // West to east along 44.25 N: a ridge about 60 m above both ends.
+    let home = (44.25, -71.93);
+    let to_lon = -71.905;
+    let home_ground = tile_height_m(&bytes, home.0, home.1);
+    let (ridge_lon, ridge_m) = (0..=2000)
+        .map(|k| home.1 + (to_lon - home.1) * f64::from(k) / 2000.0)
+        .map(|lon| (lon, tile_height_m(&bytes, home.0, lon)))
+        .fold((0.0, f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
+    assert!(ridge_m - home_ground > 40.0, "{ridge_m} over {home_ground}");
+    let up_m = ridge_m + 3.0 - home_ground;
+    let tmp = tempfile::tempdir().unwrap();
+    let mission = write(tmp.path(), "ridge.toml", &east_leg_toml(home, to_lon, up_m));
+    let terrain = tiles();
+    let out = aloft(&[
+        "mission".as_ref(),
+        mission.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+        "--format".as_ref(),
+        "json".as_ref(),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["feasible"], false);
+    let reason = v["reason"].as_str().unwrap();
+    assert!(reason.starts_with("segment 2 (leg) passes"), "{reason}");
+    let leg = &v["segments"][1];
+    let c = leg["min_clearance_m"].as_f64().unwrap();
+    // Sampled at the tile's spacing, a peak between samples can be missed by a little.
+    assert!((2.0..=4.5).contains(&c), "{c}");
+    let at_lon = leg["min_clearance_at"]["longitude_deg"].as_f64().unwrap();
+    let metres_per_deg = 111_320.0 * home.0.to_radians().cos();
+    assert!(
+        (at_lon - ridge_lon).abs() * metres_per_deg < 100.0,
+        "{at_lon} vs the ridge at {ridge_lon}"
+    );
+    assert!((v["min_clearance_m"].as_f64().unwrap() - c).abs() < 1e-9);
+    // The take-off starts on the ground: reported, not judged.
+    assert!(v["segments"][0]["min_clearance_m"].as_f64().unwrap() < 1.0);
+    // The table says it too.
+    let table = aloft(&[
+        "mission".as_ref(),
+        mission.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+    ]);
+    assert_eq!(table.status.code(), Some(1));
+    assert!(
+        stdout(&table).contains("least clearance: "),
+        "{}",
+        stdout(&table)
+    );
+
+    // 10 m higher it passes the default 10 m, and a lower limit lets the 3 m pass.
+    let higher = write(
+        tmp.path(),
+        "higher.toml",
+        &east_leg_toml(home, to_lon, up_m + 10.0),
+    );
+    let out = aloft(&[
+        "mission".as_ref(),
+        higher.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
+    let out = aloft(&[
+        "mission".as_ref(),
+        mission.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+        "--min-clearance-m".as_ref(),
+        "2".as_ref(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
+}
+
+/// A 3 arc-second tile named `name` whose ground rises northwards by `rise_m_per_row` metres a
+/// row from `base_m` at its south edge (a constant slope north-south, level east-west).
+fn sloped_tile(dir: &Path, name: &str, base_m: f64, rise_m_per_row: f64) {
+    let n = 1201usize;
+    let mut bytes = Vec::with_capacity(2 * n * n);
+    for r in 0..n {
+        let h = base_m + rise_m_per_row * (n - 1 - r) as f64;
+        let v = h.round() as i16;
+        for _ in 0..n {
+            bytes.extend_from_slice(&v.to_be_bytes());
+        }
+    }
+    std::fs::write(dir.join(name), bytes).unwrap();
+}
+
+/// A `.waypoints` mission at N10 E010 (home on the ground at `home_amsl_m`): take off to 30 m,
+/// fly north `rows` rows of the tile at 8 m/s, 30 m above `frame` (3 relative, 10 terrain), land.
+fn north_waypoints(frame: u32, rows: f64, home_amsl_m: f64) -> String {
+    let lat0 = 10.1;
+    let lat1 = lat0 + rows / 1200.0;
+    format!(
+        "QGC WPL 110\n\
+         0\t1\t0\t16\t0\t0\t0\t0\t{lat0}\t10.5\t{home_amsl_m}\t1\n\
+         1\t0\t3\t22\t0\t0\t0\t0\t0\t0\t30\t1\n\
+         2\t0\t3\t178\t1\t8\t-1\t0\t0\t0\t0\t1\n\
+         3\t0\t{frame}\t16\t0\t0\t0\t0\t{lat1}\t10.5\t30\t1\n\
+         4\t0\t3\t21\t0\t0\t0\t0\t{lat1}\t10.5\t0\t1\n"
+    )
+}
+
+/// The same flight as an aloft mission: one straight leg climbing `rise_m` on the way, at a
+/// constant climb rate (what the model's climb power is, integrated over a constant slope).
+fn north_slanted_toml(rows: f64, rise_m: f64) -> String {
+    let lat0 = 10.1;
+    let lat1 = lat0 + rows / 1200.0;
+    format!(
+        "name = \"slanted\"\n\
+         [home]\nlatitude_deg = {lat0}\nlongitude_deg = 10.5\n\n\
+         [[segment]]\nkind = \"take-off\"\naltitude_m = 30.0\nclimb_rate_mps = 2.5\n\n\
+         [[segment]]\nkind = \"leg\"\nlatitude_deg = {lat1}\nlongitude_deg = 10.5\n\
+         altitude_m = {}\nground_speed_mps = 8.0\n\n\
+         [[segment]]\nkind = \"landing\"\nrate_mps = 1.0\n",
+        30.0 + rise_m
+    )
+}
+
+#[test]
+fn a_terrain_frame_leg_up_a_slope_climbs_with_the_ground_and_pays_the_climb_power() {
+    let tmp = tempfile::tempdir().unwrap();
+    let tiles = tmp.path().join("tiles");
+    std::fs::create_dir(&tiles).unwrap();
+    // 5 m a row (92.6 m north-south): a 5.4 % slope; 60 rows north is 300 m up.
+    sloped_tile(&tiles, "N10E010.hgt", 100.0, 5.0);
+    let (rows, rise_m) = (60.0, 300.0);
+    // Home is row 1080 from the north: 100 + 5 x 120 = 700 m.
+    let terrain = write(
+        tmp.path(),
+        "terrain.waypoints",
+        &north_waypoints(10, rows, 700.0),
+    );
+    let relative = write(
+        tmp.path(),
+        "relative.waypoints",
+        &north_waypoints(3, rows, 700.0),
+    );
+    let slanted = write(
+        tmp.path(),
+        "slanted.toml",
+        &north_slanted_toml(rows, rise_m),
+    );
+    let json = |mission: &Path| -> Value {
+        let out = aloft(&[
+            "mission".as_ref(),
+            mission.as_os_str(),
+            "--terrain".as_ref(),
+            tiles.as_os_str(),
+            "--format".as_ref(),
+            "json".as_ref(),
+        ]);
+        assert!(matches!(out.status.code(), Some(0 | 1)), "{}", stderr(&out));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let over = json(&terrain);
+    let flat = json(&relative);
+    let straight = json(&slanted);
+    assert_eq!(over["feasible"], true, "{}", over["reason"]);
+    // Frame 10 keeps 30 m over the ground: the route climbs the slope's rise on the way.
+    let climb =
+        over["route"]["climb_m"].as_f64().unwrap() - flat["route"]["climb_m"].as_f64().unwrap();
+    assert!((climb - rise_m).abs() < 1.0, "{climb} vs {rise_m}");
+    // And never comes closer than 30 m, less the tile's whole-metre rounding.
+    let least = over["min_clearance_m"].as_f64().unwrap();
+    assert!((least - 30.0).abs() < 1.5, "{least}");
+    // The relative leg keeps 30 m above home: the ground rises into it (exit 1, said).
+    assert_eq!(flat["feasible"], false);
+    assert!(flat["min_clearance_m"].as_f64().unwrap() < 0.0);
+    // The leg over the ground costs what one straight leg climbing the same rise at a constant
+    // rate costs (the climb power of the model over a constant slope), within 1 %.
+    let leg_wh = |v: &Value, item: Option<u64>| -> f64 {
+        v["segments"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|s| s["kind"] == "leg" && s["item"].as_u64() == item)
+            .map(|s| s["energy_wh"].as_f64().unwrap())
+            .sum()
+    };
+    let followed_wh = leg_wh(&over, Some(3));
+    let straight_wh = leg_wh(&straight, None);
+    let flat_wh = leg_wh(&flat, Some(3));
+    assert!(
+        (followed_wh - straight_wh).abs() < 0.01 * straight_wh,
+        "followed {followed_wh} Wh vs one straight climbing leg {straight_wh} Wh"
+    );
+    // And the climb is not free: more than the same leg level.
+    assert!(
+        followed_wh > flat_wh + 1.0,
+        "{followed_wh} vs level {flat_wh}"
+    );
+    // The warning that frame 10 is flown as relative to home is gone.
+    let warnings = over["route"]["warnings"].to_string();
+    assert!(
+        !warnings.contains("aloft has no terrain model"),
+        "{warnings}"
+    );
+}
+
+#[test]
+fn terrain_for_a_mission_in_metres_is_one_line_and_a_mission_off_the_tiles_names_the_place() {
+    let terrain = tiles();
+    // The built-in demo is placed in metres from home.
+    let out = aloft(&[
+        "mission".as_ref(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("latitude and longitude"), "{err}");
+    // A mission at 10 N, 10 E over a directory holding only N44W072.
+    let tmp = tempfile::tempdir().unwrap();
+    let far = write(
+        tmp.path(),
+        "far.toml",
+        &east_leg_toml((10.0, 10.0), 10.01, 30.0),
+    );
+    let out = aloft(&[
+        "mission".as_ref(),
+        far.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stdout(&out));
+    let err = stderr(&out);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("10"), "{err}");
+}
