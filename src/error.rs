@@ -344,6 +344,9 @@ pub enum Error {
     /// error is large and this enum travels in every `Result` of the facade.
     #[error(transparent)]
     Planner(Box<aloft_planner::PlannerError>),
+    /// A terrain tile that cannot be read, or no ground (no tile, a void) under a place asked.
+    #[error(transparent)]
+    Terrain(#[from] aloft_terrain::TerrainError),
     /// A wind the planner rejects (a speed, a profile, a field, gusts).
     #[error("{origin}: {source}")]
     Wind {
