@@ -10,6 +10,7 @@
 //! - [`engine`]: the embedding facade for ground stations (vehicles, power, missions, endurance,
 //!   in-flight efficiency re-estimate); the C ABI of `aloft-ffi` wraps it.
 //! - [`identify`]: flight logs to the power model: lag alignment, fit samples, validation.
+//! - [`terrain`]: the ground under a flight from elevation tiles read offline (`aloft-terrain`).
 //!
 //! ```
 //! // The power seed's M100 at the paper's 3.29 kg hovers on 400-600 W (its Fig. 4).
@@ -34,6 +35,7 @@ pub mod vehicle;
 
 pub use aloft_power as power;
 pub use aloft_propulsion as propulsion;
+pub use engine::terrain;
 pub use engine::{
     endurance, mission_summary, plan_mission, plan_mission_in, EnduranceOptions, EnduranceSummary,
     InFlightEstimator, Mission, MissionOptions, MissionSummary, Plan, Vehicle,

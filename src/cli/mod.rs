@@ -28,6 +28,7 @@ mod rotor;
 #[cfg(feature = "serve")]
 mod serve;
 mod signals;
+mod terrain;
 mod validate;
 mod vehicles;
 
@@ -79,6 +80,9 @@ enum Command {
     /// The missions to fly: one file per battery, cut where each pack reaches the reserve, at
     /// the speeds the wind favours.
     Plan(Box<plan::PlanArgs>),
+    /// The ground's height at places (LAT,LON...), from elevation tiles read offline (SRTM .hgt,
+    /// .hgt.zip, WGS 84 GeoTIFF in --terrain DIR).
+    Terrain(terrain::TerrainArgs),
     /// A local web server whose JSON API is the command line (`/api/mission`, `/api/endurance`,
     /// `/api/vehicles`).
     #[cfg(feature = "serve")]
@@ -136,6 +140,7 @@ pub fn main() -> ExitCode {
         Command::Mission(args) => mission::run(*args),
         Command::Endurance(args) => endurance::run(args),
         Command::Plan(args) => plan::run(*args),
+        Command::Terrain(args) => terrain::run(args),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve::run(args),
     };

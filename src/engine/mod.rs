@@ -28,6 +28,7 @@
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
 //! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag; a [`StepMeter`] in [`MissionOptions`]: the steps of every flight of a mission or a plan | [`crate::Error::TooMuchWork`], [`crate::Error::RequestTooLong`], [`crate::Error::Cancelled`] | `step_meter.rs` |
 //! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `conditions/`, `logs.rs` |
+//! | the ground (`aloft terrain`) | `--terrain DIR` or `ALOFT_TERRAIN` → [`terrain::from_flag_or_env`]; a [`terrain::Terrain`] and places → [`terrain::heights`] | [`terrain::Heights`] | `terrain/` |
 //! | files written | [`write_output`], [`Output`], [`OutputSet`] (aloft's one way: exclusive temporary file, rename, nothing replaced without `force`, sets all or nothing), [`safe_stem`] (a name from an input's file name), [`abandon_outputs`] (interrupted) | the files, or [`crate::Error::Output`] | `files.rs` (`aloft_core::output`) |
 //!
 //! The folders stand in layers, each importing only those below it: `vehicles/` and
@@ -73,6 +74,7 @@ mod missions;
 mod packs;
 mod performance;
 mod plan_to_fly;
+pub mod terrain;
 mod uncertainty;
 mod vehicles;
 
@@ -115,8 +117,7 @@ pub use missions::flown::PlanningSpeed;
 pub use missions::ground::{GroundAt, HOME_DISAGREES_M};
 pub use missions::loiter::LoiterSummary;
 pub use missions::mission::{
-    open_terrain_dir, plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan,
-    PlanContext, Remaining,
+    plan_mission, plan_mission_in, plan_mission_with, PackDescription, Plan, PlanContext, Remaining,
 };
 pub use missions::mission_file::{Mission, DEMO_MISSION, DEMO_ORIGIN};
 pub use missions::mission_options::{GustSpec, MissionOptions, DEFAULT_MIN_CLEARANCE_M};
@@ -209,4 +210,5 @@ const _: () = {
     send_sync::<ScenarioOptions>();
     send_sync::<Uncertainty>();
     send_sync::<crate::Error>();
+    send_sync::<terrain::Terrain>();
 };

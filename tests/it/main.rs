@@ -66,6 +66,7 @@ mod serve_browser;
 mod serve_hold;
 mod serve_hostile;
 mod serve_plan;
+mod terrain_cli;
 mod terrain_mission;
 mod vehicle_file_doc;
 mod vehicles_cli;

@@ -9,7 +9,7 @@ use aloft_core::Num;
 #[non_exhaustive]
 pub enum TerrainError {
     /// A file or the directory cannot be read.
-    #[error("terrain file {}: {source}", .file.display())]
+    #[error("terrain tiles: {}: {source}", .file.display())]
     Io {
         /// The file or directory.
         file: PathBuf,

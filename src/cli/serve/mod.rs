@@ -173,7 +173,8 @@ pub fn run(args: ServeArgs) -> Result<Outcome> {
     let logbook = logbook_of(&args)?;
     // Tiles that cannot be read stop the server at its start, not each request.
     if let Some(dir) = &args.terrain {
-        aloft::engine::open_terrain_dir(dir).map_err(|e| anyhow::anyhow!("--terrain: {e}"))?;
+        aloft::engine::terrain::from_flag_or_env(Some(dir))
+            .map_err(|e| anyhow::anyhow!("--terrain: {e}"))?;
     }
     let uploads = uploads_folder().context("creating the uploads' folder")?;
     let runtime = tokio::runtime::Builder::new_multi_thread()

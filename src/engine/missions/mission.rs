@@ -380,15 +380,6 @@ fn plan_in(
     })
 }
 
-/// The tiles of `dir`, opened: a directory that cannot be read or holds no tile is an error
-/// naming it (a server checks its `--terrain` once at its start).
-///
-/// # Errors
-/// The tiles' own.
-pub fn open_terrain_dir(dir: &std::path::Path) -> Result<aloft_terrain::Terrain, Error> {
-    Ok(aloft_terrain::Terrain::open(dir)?)
-}
-
 /// The mission of a request flown over the ground of its options' terrain
 /// ([`Mission::over_ground`]), with the tiles; none without terrain.
 ///
