@@ -862,10 +862,29 @@ pub struct PlanFlags {
     #[arg(value_parser = finite(), long, default_value_t = DEFAULT_LOITER_UNLIMITED_S,
         value_name = "S", allow_negative_numbers = true)]
     pub loiter_unlimited_s: f64,
+    /// Write the mission to keep this height above the ground, m (with --terrain): each
+    /// waypoint and loiter relative to home, for the autopilot of --autopilot.
+    #[arg(value_parser = finite(), long, value_name = "M", allow_negative_numbers = true)]
+    pub follow_terrain: Option<f64>,
+    /// The autopilot a terrain-following plan is written for: px4 (above mean sea level, a
+    /// waypoint at every terrain sample where the height changes, as QGroundControl writes it)
+    /// or ardupilot (the terrain frame, which ArduPilot follows itself).
+    #[arg(long, value_enum, default_value_t = AutopilotFlag::Px4, requires = "follow_terrain")]
+    pub autopilot: AutopilotFlag,
     /// What the request may spend (set by a caller that serves others: its cancellation; no
     /// flag).
     #[arg(skip)]
     pub bounds: WorkBounds,
+}
+
+/// The autopilot a terrain-following plan is written for (`--autopilot`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum AutopilotFlag {
+    /// PX4: altitudes above mean sea level.
+    #[default]
+    Px4,
+    /// ArduPilot: the terrain frame.
+    Ardupilot,
 }
 
 impl PlanFlags {
@@ -923,6 +942,11 @@ impl PlanFlags {
             confidence: self.sure.confidence(),
             scenarios: None,
             keep_angle: self.keep_angle,
+            follow_terrain_m: self.follow_terrain,
+            follow_frames: match self.autopilot {
+                AutopilotFlag::Px4 => aloft_missions::follow_terrain::FollowFrames::Amsl,
+                AutopilotFlag::Ardupilot => aloft_missions::follow_terrain::FollowFrames::Terrain,
+            },
             bounds: self.bounds.clone(),
         })
     }

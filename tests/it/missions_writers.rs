@@ -52,7 +52,7 @@ const ARDUPILOT: PlanHeader = PlanHeader {
 
 /// Whether python3 can import `modules`; where it cannot, the test fails when it is required
 /// (`ALOFT_PYMAVLINK_TESTS=require` or `CI`), else it says so and is skipped.
-fn python_ready(modules: &str) -> bool {
+pub(crate) fn python_ready(modules: &str) -> bool {
     if common::python_has(modules) {
         return true;
     }
@@ -78,7 +78,7 @@ impl Drop for Killed {
 }
 
 /// `mission_readers.py args`, which must succeed within [`SCRIPT_S`]: its JSON answer.
-fn readers(args: &[String]) -> Value {
+pub(crate) fn readers(args: &[String]) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/mission_readers.py");
     let child = Command::new("python3")
         .arg(script)

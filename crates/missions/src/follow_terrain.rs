@@ -17,6 +17,8 @@
 //! climbs and one forward pass for the descents, which reach the fixed point its repeated passes
 //! converge to (each only raises points).
 
+use aloft_logs::telemetry::MissionItem;
+
 /// A point of a ground profile: where, how far along the line, and the ground's height.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroundPoint {
@@ -188,6 +190,112 @@ fn thin(path: &[FollowPoint], tolerance_m: f64) -> Vec<FollowPoint> {
     kept
 }
 
+/// How a mission that follows the ground is written for its autopilot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FollowFrames {
+    /// Altitudes above mean sea level (frame 0, or 5 for an `_INT` item), with a waypoint at every
+    /// terrain sample kept between the operator's: what QGroundControl writes for PX4, which
+    /// cannot fly the terrain frame.
+    Amsl,
+    /// The terrain frame (10, or 11 for an `_INT` item), the height above the ground: ArduPilot
+    /// keeps it between the waypoints from its own terrain data.
+    Terrain,
+}
+
+/// The commands whose altitude is a height to fly at (the take-off, the landing and the return
+/// keep theirs).
+fn flies_at_height(command: u32) -> bool {
+    use crate::commands::*;
+    matches!(
+        command,
+        NAV_WAYPOINT
+            | NAV_SPLINE_WAYPOINT
+            | NAV_LOITER_UNLIM
+            | NAV_LOITER_TURNS
+            | NAV_LOITER_TIME
+            | NAV_LOITER_TO_ALT
+    )
+}
+
+/// The items of a mission rewritten to keep `height_m` above the ground: every waypoint or
+/// loiter in a frame relative to home (3 or 6) with a position is flown `height_m` above the
+/// ground under it, in `frames`; with [`FollowFrames::Amsl`] the terrain samples kept between
+/// consecutive positions (as [`follow_ground`] keeps them, with `following`) become waypoints of
+/// their own, without a hold. Other items are kept as they are; the items are numbered again
+/// from 1 (`seq`). `ground` gives the ground profile of the straight line between two places
+/// (latitude, longitude), both ends included, and its height at a place; `home` is where the
+/// vehicle starts.
+///
+/// # Errors
+/// `ground`'s.
+pub fn follow_items<E>(
+    items: &[MissionItem],
+    home: (f64, f64),
+    height_m: f64,
+    frames: FollowFrames,
+    following: &Following,
+    mut ground: impl FnMut((f64, f64), (f64, f64)) -> Result<Vec<GroundPoint>, E>,
+) -> Result<Vec<MissionItem>, E> {
+    let mut out = Vec::with_capacity(items.len());
+    let mut here = home;
+    for item in items {
+        let [.., lat, lon, _] = item.params;
+        let placed = lat.is_finite() && lon.is_finite() && !(lat == 0.0 && lon == 0.0);
+        let relative = matches!(item.frame, 3 | 6);
+        if !(placed && relative && flies_at_height(item.command)) {
+            if placed && crate::items::has_position(item.command) {
+                here = (lat, lon);
+            }
+            out.push(*item);
+            continue;
+        }
+        let profile = ground(here, (lat, lon))?;
+        let int = item.frame == 6;
+        match frames {
+            FollowFrames::Amsl => {
+                let line = FollowLine {
+                    profile: &profile,
+                    start_above_m: height_m,
+                    end_above_m: height_m,
+                };
+                let path = follow_ground(&[line], following);
+                for p in path.iter().filter(|p| p.added) {
+                    out.push(MissionItem {
+                        seq: 0,
+                        frame: if int { 5 } else { 0 },
+                        command: crate::commands::NAV_WAYPOINT,
+                        params: [
+                            0.0,
+                            0.0,
+                            0.0,
+                            f64::NAN,
+                            p.latitude_deg,
+                            p.longitude_deg,
+                            p.altitude_amsl_m,
+                        ],
+                    });
+                }
+                let end_m = profile.last().map_or(0.0, |g| g.ground_m) + height_m;
+                let mut own = *item;
+                own.frame = if int { 5 } else { 0 };
+                own.params[6] = end_m;
+                out.push(own);
+            }
+            FollowFrames::Terrain => {
+                let mut own = *item;
+                own.frame = if int { 11 } else { 10 };
+                own.params[6] = height_m;
+                out.push(own);
+            }
+        }
+        here = (lat, lon);
+    }
+    for (k, item) in out.iter_mut().enumerate() {
+        item.seq = u32::try_from(k + 1).unwrap_or(u32::MAX);
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,5 +437,82 @@ mod tests {
             &Following::default(),
         );
         assert!(path.is_empty());
+    }
+
+    fn item(seq: u32, frame: u32, command: u32, lat: f64, lon: f64, alt: f64) -> MissionItem {
+        MissionItem {
+            seq,
+            frame,
+            command,
+            params: [0.0, 0.0, 0.0, f64::NAN, lat, lon, alt],
+        }
+    }
+
+    /// Ground rising 10 m every 100 m northwards from 500 m at 44 N.
+    fn slope(from: (f64, f64), to: (f64, f64)) -> Result<Vec<GroundPoint>, ()> {
+        let n = 11;
+        let d_m = (to.0 - from.0) * 111_000.0;
+        Ok((0..n)
+            .map(|i| {
+                let f = i as f64 / (n - 1) as f64;
+                let lat = from.0 + f * (to.0 - from.0);
+                GroundPoint {
+                    distance_m: f * d_m,
+                    latitude_deg: lat,
+                    longitude_deg: from.1 + f * (to.1 - from.1),
+                    ground_m: 500.0 + 0.1 * (lat - 44.0) * 111_000.0,
+                }
+            })
+            .collect())
+    }
+
+    #[test]
+    fn relative_waypoints_are_written_over_the_ground_for_each_autopilot() {
+        let items = [
+            item(1, 3, 22, 0.0, 0.0, 40.0),
+            item(2, 3, 16, 44.01, -71.0, 40.0),
+            item(3, 3, 178, 0.0, 0.0, 0.0),
+            item(4, 3, 20, 0.0, 0.0, 0.0),
+        ];
+        let home = (44.0, -71.0);
+        let amsl = follow_items(
+            &items,
+            home,
+            50.0,
+            FollowFrames::Amsl,
+            &Following::default(),
+            slope,
+        )
+        .unwrap();
+        // 1110 m north, 111 m up: 9 samples inside, 11.1 m apart in height; a 10 m tolerance
+        // keeps each: 9 waypoints added before the operator's.
+        let added: Vec<&MissionItem> = amsl.iter().filter(|i| i.command == 16).collect();
+        assert_eq!(added.len(), 10, "{amsl:?}");
+        assert!(amsl
+            .iter()
+            .filter(|i| i.command == 16)
+            .all(|i| i.frame == 0));
+        let last = added.last().unwrap();
+        assert!((last.params[6] - (500.0 + 0.1 * 1110.0 + 50.0)).abs() < 1e-6);
+        assert_eq!(
+            (amsl[0].command, amsl[0].frame, amsl[0].params[6]),
+            (22, 3, 40.0)
+        );
+        assert_eq!(
+            amsl.iter().map(|i| i.seq).collect::<Vec<_>>(),
+            (1..=amsl.len() as u32).collect::<Vec<_>>()
+        );
+        let terrain = follow_items(
+            &items,
+            home,
+            50.0,
+            FollowFrames::Terrain,
+            &Following::default(),
+            slope,
+        )
+        .unwrap();
+        assert_eq!(terrain.len(), 4);
+        assert_eq!((terrain[1].frame, terrain[1].params[6]), (10, 50.0));
+        assert_eq!(terrain[2].command, 178);
     }
 }

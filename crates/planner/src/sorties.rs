@@ -15,6 +15,10 @@
 use crate::mission::{Mission, MissionSpec, SegmentSpec};
 use crate::plan::MissionReport;
 
+/// The take-off height of a sortie that resumes at a point at or below home's height (a route
+/// over a valley, flown over terrain), m.
+pub const RESUME_TAKE_OFF_M: f64 = 10.0;
+
 /// A point of the route where a sortie ends: the end of segment `segment` (`fraction` 1), or a
 /// point `fraction` of the way along it (a leg).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -428,7 +432,9 @@ impl<'a> Route<'a> {
         let [east_m, north_m, up_m] = self.point_m(cut);
         [
             SegmentSpec::TakeOff {
-                altitude_m: up_m,
+                // A point below home's height (a route over a valley) is reached by a take-off to
+                // RESUME_TAKE_OFF_M and the transit down to it.
+                altitude_m: if up_m > 0.0 { up_m } else { RESUME_TAKE_OFF_M },
                 climb_rate_mps: self.climb_rate_mps,
                 item: None,
             },

@@ -127,7 +127,8 @@ impl<'a> Ground<'a> {
     /// `spec` with the legs of the segments in [`Frame::Terrain`] (`frames`, by segment number
     /// from 0) flown over the ground, the heights of those in [`Frame::Amsl`] placed from the
     /// tile's home, its landings on the ground where they are, and heights at or below home's
-    /// allowed. Also: for each segment of `spec`, how many it became.
+    /// allowed; a return flies at least at `rtl_altitude_m` (the request's, else the file's).
+    /// Also: for each segment of `spec`, how many it became.
     ///
     /// # Errors
     /// The tiles' (no tile or a void under the route).
@@ -135,6 +136,7 @@ impl<'a> Ground<'a> {
         &self,
         spec: &MissionSpec,
         frames: &[Frame],
+        rtl_altitude_m: Option<f64>,
     ) -> Result<(MissionSpec, Vec<usize>), Error> {
         let terrain_legs: Vec<bool> = frames.iter().map(|f| *f == Frame::Terrain).collect();
         let mut out = spec.clone();
@@ -145,6 +147,7 @@ impl<'a> Ground<'a> {
         // For each segment of `spec`, how many it became.
         let mut made = Vec::with_capacity(spec.segments.len());
         let mut walk = Walk::at_home(self);
+        walk.rtl_altitude_m = rtl_altitude_m.or(spec.rtl_altitude_m);
         let mut k = 0;
         while k < spec.segments.len() {
             if !terrain_legs.get(k).copied().unwrap_or(false) || !is_leg(&spec.segments[k]) {
@@ -393,6 +396,8 @@ fn leg_altitude_m(s: &SegmentSpec) -> Option<f64> {
 struct Walk {
     here: [f64; 2],
     up_m: f64,
+    /// The mission's lowest return height, m.
+    rtl_altitude_m: Option<f64>,
 }
 
 impl Walk {
@@ -400,6 +405,7 @@ impl Walk {
         Self {
             here: ground.home,
             up_m: 0.0,
+            rtl_altitude_m: None,
         }
     }
 
@@ -422,8 +428,11 @@ impl Walk {
                 self.up_m = altitude_m.unwrap_or(self.up_m);
             }
             SegmentSpec::Return { altitude_m, .. } => {
+                // As the planner flies it: the segment's height, else at least the RTL altitude.
                 self.here = ground.home;
-                self.up_m = altitude_m.unwrap_or(self.up_m);
+                self.up_m = altitude_m
+                    .or(self.rtl_altitude_m.map(|r| r.max(self.up_m)))
+                    .unwrap_or(self.up_m);
             }
             SegmentSpec::Landing { ground_m, .. } => self.up_m = ground_m.unwrap_or(0.0),
             _ => {}

@@ -404,7 +404,8 @@ pub(in crate::engine) fn over_terrain(
         return Ok(None);
     };
     let terrain = aloft_terrain::Terrain::open(dir)?;
-    let over = mission.over_ground(&Ground::at_home(&terrain, mission.spec())?)?;
+    let ground = Ground::at_home(&terrain, mission.spec())?;
+    let over = mission.over_ground(&ground, options.rtl_altitude_m)?;
     Ok(Some((over, terrain)))
 }
 

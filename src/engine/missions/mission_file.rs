@@ -227,7 +227,11 @@ impl Mission {
     ///
     /// # Errors
     /// The reader's, the tiles' (no tile or a void under the route).
-    pub(in crate::engine) fn over_ground(&self, ground: &Ground<'_>) -> Result<Self, Error> {
+    pub(in crate::engine) fn over_ground(
+        &self,
+        ground: &Ground<'_>,
+        rtl_altitude_m: Option<f64>,
+    ) -> Result<Self, Error> {
         let mut read = self.read;
         read.terrain = true;
         let mut mission = self.read_with(read)?;
@@ -247,7 +251,7 @@ impl Mission {
                 }
             }
         }
-        let (spec, made) = ground.follow(&mission.spec, &frames)?;
+        let (spec, made) = ground.follow(&mission.spec, &frames, rtl_altitude_m)?;
         let reader_warnings = mission.kept.as_ref().map(|k| k.warnings.clone());
         if let Some(kept) = &mut mission.kept {
             let starts: Vec<usize> = std::iter::once(0)

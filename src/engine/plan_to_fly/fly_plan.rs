@@ -228,6 +228,12 @@ pub struct FlyPlanRequest {
     /// wind where that saves energy and covers its polygon as before, its transects drawn again
     /// at every [`ANGLE_STEP_DEG`](crate::engine::plan_to_fly::survey_angle::ANGLE_STEP_DEG) degrees and along and across the wind).
     pub keep_angle: bool,
+    /// Write the mission to keep this height above the ground, m (with the options' terrain; a
+    /// planner file's waypoints and loiters relative to home): `--follow-terrain`.
+    pub follow_terrain_m: Option<f64>,
+    /// How a mission that follows the ground is written: above mean sea level with a waypoint at
+    /// every terrain sample kept (PX4, the default), or in the terrain frame (ArduPilot).
+    pub follow_frames: aloft_missions::follow_terrain::FollowFrames,
     /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
     /// candidate, angle or sortie once cancelled (its steps, and its flights once cancelled, are
     /// bounded by the options' [`StepMeter`](crate::engine::step_meter::StepMeter) when the caller gives one).
@@ -246,6 +252,8 @@ impl Default for FlyPlanRequest {
             confidence: PlanConfidence::default(),
             scenarios: None,
             keep_angle: false,
+            follow_terrain_m: None,
+            follow_frames: aloft_missions::follow_terrain::FollowFrames::Amsl,
             bounds: WorkBounds::default(),
         }
     }
@@ -358,6 +366,34 @@ pub struct FlyPlan {
     pub texts: Vec<String>,
 }
 
+/// [`Error::NoPlan`] when the mission as given (over the options' terrain) passes closer to the
+/// ground than the options' least clearance, naming the segment and the place.
+///
+/// # Errors
+/// As [`plan_mission`], and that.
+fn too_close_to_the_ground(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+) -> Result<(), Error> {
+    let whole = plan_mission(vehicle, mission, options)?;
+    let s = whole.summary();
+    let least_m = options
+        .min_clearance_m
+        .unwrap_or(crate::engine::missions::mission_options::DEFAULT_MIN_CLEARANCE_M);
+    match s.min_clearance_m {
+        Some(c) if c < least_m => Err(Error::NoPlan {
+            reason: s
+                .reason
+                .as_deref()
+                .and_then(|r| r.split("; and ").next())
+                .unwrap_or("the route passes too close to the ground")
+                .to_string(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// Plan the missions to fly for `mission` with `vehicle` (module steps 1-5).
 ///
 /// # Errors
@@ -374,6 +410,17 @@ pub fn plan_to_fly(
         loiter_unlimited_s: Some(request.loiter_unlimited_s),
         ..mission.read_options()
     })?;
+    // Written again to follow the ground, when asked (its files carry those frames).
+    let followed = match request.follow_terrain_m {
+        Some(h) => Some(crate::engine::plan_to_fly::follow::follow_terrain(
+            mission,
+            options,
+            h,
+            request.follow_frames,
+        )?),
+        None => None,
+    };
+    let mission = followed.as_ref().unwrap_or(mission);
     // Over terrain: the mission flown over the ground (its terrain-frame legs followed).
     let over = crate::engine::missions::mission::over_terrain(mission, options)?;
     let mission = over.as_ref().map_or(mission, |(m, _)| m);
@@ -389,6 +436,11 @@ pub fn plan_to_fly(
         ..request.clone()
     };
     let options = &request.options;
+    // Over terrain, a route that passes too close to the ground has no plan: no cut or speed
+    // changes the path (the return's height is `--rtl-altitude-m`).
+    if options.terrain.is_some() {
+        too_close_to_the_ground(vehicle, mission, options)?;
+    }
     let (wind, _) = mission_wind(options, mission, vehicle)?;
     let scenarios = plan_scenarios(mission, request)?;
     let request = &FlyPlanRequest {

@@ -3,5 +3,6 @@
 //! and the page's map of them.
 
 pub(crate) mod fly_plan;
+pub(crate) mod follow;
 pub(crate) mod plan_files;
 pub(crate) mod survey_angle;

@@ -102,6 +102,10 @@ impl SortieMaker for PlannerSorties<'_> {
         let text = self.text(start, end)?;
         let mission = Mission::from_text_with(&text, "the sortie's file", self.read)
             .map_err(|e| e.to_string())?;
+        // Over terrain, the file is flown over the ground as `aloft mission` flies it.
+        let over = crate::engine::missions::mission::over_terrain(&mission, self.options)
+            .map_err(|e| e.to_string())?;
+        let mission = over.map_or(mission, |(m, _)| m);
         let payload_kg = self.route.payload_at_kg(start);
         let flown = flown_mission(
             self.flight,

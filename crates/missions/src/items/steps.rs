@@ -68,6 +68,11 @@ impl Flight<'_> {
                     at: item.at,
                     hint: "an altitude above mean sea level (frame 0) needs the home's altitude (a home row)",
                 })?;
+                // Over terrain the ground under the route is judged by the caller: an altitude
+                // below home's (down a valley) is flown as it is.
+                if self.source.options.terrain {
+                    return Ok(Some(alt - home));
+                }
                 if alt < home {
                     self.notes.add(
                         item.at,

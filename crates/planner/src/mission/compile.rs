@@ -460,7 +460,7 @@ impl<'a> Compiler<'a> {
     fn descent(&mut self, altitude_m: f64, rate_mps: f64) -> Result<(), PlannerError> {
         let seg = self.seg;
         self.need_air()?;
-        seg.positive("altitude_m", altitude_m, "m")?;
+        self.height("altitude_m", altitude_m)?;
         // A rate beyond the vehicle's is flown at its limit (the envelope slows the descent).
         seg.positive("rate_mps", rate_mps, "m/s")?;
         if altitude_m >= self.pos_m[2] {
@@ -486,7 +486,12 @@ impl<'a> Compiler<'a> {
         self.need_air()?;
         // A rate beyond the vehicle's is flown at its limit (the envelope slows the descent).
         seg.positive("rate_mps", rate_mps, "m/s")?;
-        let ground_m = seg.finite("ground_m", ground_m.unwrap_or(0.0), "m")?;
+        let mut ground_m = seg.finite("ground_m", ground_m.unwrap_or(0.0), "m")?;
+        // Over terrain a vehicle below the ground it lands on has flown into it: the caller's
+        // clearance says so; it lands where it is.
+        if self.over_terrain {
+            ground_m = ground_m.min(self.pos_m[2]);
+        }
         if ground_m > self.pos_m[2] {
             return Err(seg.invalid(
                 "ground_m",
