@@ -112,5 +112,96 @@ fn bench_plan(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_plan);
+/// A tile under the shared survey (25-26 N, 121-122 E) with the White Mountains' shape
+/// (`terrain/N44W072.hgt`) at 2 % of their relief: the ground rises 0-33 m over the survey, so
+/// its 50 m transects stay clear and a terrain-following plan has hills to follow.
+fn gentle_tile(dir: &std::path::Path) -> bool {
+    let Ok(bytes) = std::fs::read(data_dir().join("terrain/N44W072.hgt")) else {
+        return false;
+    };
+    let heights: Vec<i16> = bytes
+        .chunks_exact(2)
+        .map(|b| i16::from_be_bytes([b[0], b[1]]))
+        .collect();
+    let low = heights
+        .iter()
+        .copied()
+        .filter(|h| *h > -1000)
+        .min()
+        .unwrap_or(0);
+    let out: Vec<u8> = heights
+        .iter()
+        .flat_map(|h| {
+            let g = 5.0 + 0.02 * f64::from(h.saturating_sub(low).max(0));
+            (g.round() as i16).to_be_bytes()
+        })
+        .collect();
+    std::fs::write(dir.join("N25E121.hgt"), out).is_ok()
+}
+
+/// Issue 45: the 38 km survey planned over the ground. `plan/terrain/mission_38km_*`: the
+/// mission answer (`plan_mission`) flat and with each segment's clearance;
+/// `plan/terrain/plan_38km_*`: `aloft plan` for the forecast alone (confidence 0.5), flat and
+/// written to follow the ground at 60 m (`--follow-terrain 60`, PX4: a waypoint at every
+/// terrain sample kept, every sortie's file flown over the ground). Target: at most 100 ms more
+/// than flat for each.
+fn bench_terrain(c: &mut Criterion) {
+    let path = data_dir().join("missions/neilvaltec_test.plan");
+    let dir = std::env::temp_dir().join(format!("aloft-bench-terrain-{}", std::process::id()));
+    if !path.is_file() || std::fs::create_dir_all(&dir).is_err() || !gentle_tile(&dir) {
+        eprintln!("terrain bench skipped: the shared survey or tile is missing");
+        return;
+    }
+    let vehicle = Vehicle::builtin("dji-m100").expect("built-in vehicle");
+    let big = Mission::from_text(&big_survey::scaled_survey(&path, 2.8), "survey-38km.plan")
+        .expect("the scaled survey reads");
+    let flat = MissionOptions::from_json(r#"{"wind": {"speed_mps": 8, "from_deg": 240}}"#)
+        .expect("options");
+    let over = MissionOptions {
+        terrain: Some(dir.clone()),
+        rtl_altitude_m: Some(120.0),
+        ..flat.clone()
+    };
+    let mut group = c.benchmark_group("plan/terrain");
+    group.sample_size(10);
+    let answer = aloft::engine::plan_mission(&vehicle, &big, &over).expect("over the ground");
+    eprintln!(
+        "38 km survey: least clearance {:?} m",
+        answer.summary().min_clearance_m
+    );
+    for (name, options) in [
+        ("mission_38km_flat", &flat),
+        ("mission_38km_clearances", &over),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| aloft::engine::plan_mission(black_box(&vehicle), black_box(&big), options))
+        });
+    }
+    let plain = FlyPlanRequest {
+        options: flat.clone(),
+        ..request("{}", 0.5)
+    };
+    let following = FlyPlanRequest {
+        options: over.clone(),
+        follow_terrain_m: Some(60.0),
+        ..request("{}", 0.5)
+    };
+    let written = plan_to_fly(&vehicle, &big, &following).expect("a terrain-following plan");
+    eprintln!(
+        "38 km survey following the ground: {} sorties",
+        written.sorties.len()
+    );
+    for (name, req) in [
+        ("plan_38km_flat", &plain),
+        ("plan_38km_follow_terrain", &following),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| plan_to_fly(black_box(&vehicle), black_box(&big), black_box(req)))
+        });
+    }
+    group.finish();
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+criterion_group!(benches, bench_plan, bench_terrain);
 criterion_main!(benches);
