@@ -240,17 +240,7 @@ impl<'a> Ground<'a> {
         let mut ends = Vec::with_capacity(legs.len());
         for leg in legs {
             let to = self.point_of(leg).unwrap_or(from);
-            let profile: Vec<GroundPoint> = self
-                .terrain
-                .profile((from[0], from[1]), (to[0], to[1]))?
-                .into_iter()
-                .map(|g| GroundPoint {
-                    distance_m: g.distance_m,
-                    latitude_deg: g.latitude_deg,
-                    longitude_deg: g.longitude_deg,
-                    ground_m: g.height_m,
-                })
-                .collect();
+            let profile = ground_points(self.terrain, (from[0], from[1]), (to[0], to[1]))?;
             let end_above_m = leg_altitude_m(leg).unwrap_or(above_m);
             ends.push((above_m, end_above_m));
             profiles.push(profile);
@@ -377,6 +367,28 @@ impl<'a> Ground<'a> {
         }
         Ok(out)
     }
+}
+
+/// The ground under the straight line from `a` to `b` (latitude, longitude), as the follower
+/// of [`aloft_missions::follow_terrain`] takes it.
+///
+/// # Errors
+/// The tiles' (no tile or a void under the line).
+pub(in crate::engine) fn ground_points(
+    terrain: &Terrain,
+    a: (f64, f64),
+    b: (f64, f64),
+) -> Result<Vec<GroundPoint>, Error> {
+    Ok(terrain
+        .profile(a, b)?
+        .into_iter()
+        .map(|g| GroundPoint {
+            distance_m: g.distance_m,
+            latitude_deg: g.latitude_deg,
+            longitude_deg: g.longitude_deg,
+            ground_m: g.height_m,
+        })
+        .collect())
 }
 
 /// A leg (not a take-off, orbit or return).

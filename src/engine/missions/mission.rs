@@ -404,9 +404,22 @@ pub(in crate::engine) fn over_terrain(
         return Ok(None);
     };
     let terrain = aloft_terrain::Terrain::open(dir)?;
-    let ground = Ground::at_home(&terrain, mission.spec())?;
-    let over = mission.over_ground(&ground, options.rtl_altitude_m)?;
+    let over = over_these_tiles(mission, options, &terrain)?;
     Ok(Some((over, terrain)))
+}
+
+/// As [`over_terrain`] with tiles already open (a caller that flies many versions of a mission,
+/// as `aloft plan` its sorties, opens them once).
+///
+/// # Errors
+/// No ground under the route, a mission placed in metres.
+pub(in crate::engine) fn over_these_tiles(
+    mission: &Mission,
+    options: &MissionOptions,
+    terrain: &aloft_terrain::Terrain,
+) -> Result<Mission, Error> {
+    let ground = Ground::at_home(terrain, mission.spec())?;
+    mission.over_ground(&ground, options.rtl_altitude_m)
 }
 
 /// A request's flight and the mission it flies: the spec with the options applied, a loiter

@@ -619,6 +619,10 @@ fn plan_for(
     }
     let check = day_scenarios((vehicle, mission), request, &prepared)?;
     let fly_out = FlyOut::of(vehicle, &prepared, request, wind)?;
+    let terrain = match &options.terrain {
+        Some(dir) => Some(aloft_terrain::Terrain::open(dir)?),
+        None => None,
+    };
     let cx = Context {
         vehicle,
         mission,
@@ -627,6 +631,7 @@ fn plan_for(
         bounds: &request.bounds,
         check: sure.map(|_| &check),
         fly_out: fly_out.as_ref(),
+        terrain: terrain.as_ref(),
     };
     best_candidate(&cx, candidates)
 }
@@ -1034,6 +1039,8 @@ struct Context<'a> {
     check: Option<&'a SortieScenarios<'a>>,
     /// The speed of a resumed sortie's fly-out.
     fly_out: Option<&'a FlyOut<'a>>,
+    /// The request's terrain tiles, open once for every sortie tried.
+    terrain: Option<&'a aloft_terrain::Terrain>,
 }
 
 /// The best candidate (module step 4), and the figures of the mission as given split at whole
@@ -1277,6 +1284,7 @@ impl<'a> Maker<'a> {
                 flight: &cx.prepared.flight,
                 read: cx.mission.read_options(),
                 fly_out: cx.fly_out.map(|f| f as &dyn FlyOutSpeed),
+                terrain: cx.terrain,
             }),
             None => Maker::Spec(SpecSorties {
                 route,

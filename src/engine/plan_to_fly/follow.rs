@@ -9,9 +9,10 @@
 //! as their stored items) and read again. The plan then flies, cuts and writes that mission: its
 //! files carry the frames written here.
 
-use aloft_missions::follow_terrain::{follow_items, FollowFrames, Following, GroundPoint};
+use aloft_missions::follow_terrain::{follow_items, FollowFrames, Following};
 use aloft_missions::{Home, MissionEntry, SourceFormat};
 
+use crate::engine::missions::ground::ground_points;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::MissionOptions;
 use crate::error::Error;
@@ -64,18 +65,7 @@ pub(in crate::engine) fn follow_terrain(
         altitude_amsl_m: Some(ground_m),
         ..home
     };
-    let profile = |a: (f64, f64), b: (f64, f64)| -> Result<Vec<GroundPoint>, Error> {
-        Ok(terrain
-            .profile(a, b)?
-            .into_iter()
-            .map(|g| GroundPoint {
-                distance_m: g.distance_m,
-                latitude_deg: g.latitude_deg,
-                longitude_deg: g.longitude_deg,
-                ground_m: g.height_m,
-            })
-            .collect())
-    };
+    let profile = |a, b| ground_points(&terrain, a, b);
     let items = follow_items(
         &kept.items,
         (home.latitude_deg, home.longitude_deg),

@@ -95,6 +95,8 @@ pub(in crate::engine) struct PlannerSorties<'a> {
     pub(in crate::engine) read: aloft_missions::ReadOptions,
     /// The speed of a resumed sortie's fly-out, when aloft chooses it.
     pub(in crate::engine) fly_out: Option<&'a dyn FlyOutSpeed>,
+    /// The request's terrain tiles, open (none: a flat Earth).
+    pub(in crate::engine) terrain: Option<&'a aloft_terrain::Terrain>,
 }
 
 impl SortieMaker for PlannerSorties<'_> {
@@ -103,9 +105,13 @@ impl SortieMaker for PlannerSorties<'_> {
         let mission = Mission::from_text_with(&text, "the sortie's file", self.read)
             .map_err(|e| e.to_string())?;
         // Over terrain, the file is flown over the ground as `aloft mission` flies it.
-        let over = crate::engine::missions::mission::over_terrain(&mission, self.options)
-            .map_err(|e| e.to_string())?;
-        let mission = over.map_or(mission, |(m, _)| m);
+        let mission = match self.terrain {
+            Some(t) => {
+                crate::engine::missions::mission::over_these_tiles(&mission, self.options, t)
+                    .map_err(|e| e.to_string())?
+            }
+            None => mission,
+        };
         let payload_kg = self.route.payload_at_kg(start);
         let flown = flown_mission(
             self.flight,
