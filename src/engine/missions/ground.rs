@@ -330,6 +330,20 @@ impl<'a> Ground<'a> {
         }
     }
 
+    /// A point of a planned path (east, north, up of `origin_m`, m, as the map draws it) on the
+    /// ground's terms: latitude, longitude and altitude above mean sea level (home's ground on
+    /// the tiles plus the height above home).
+    pub(in crate::engine) fn path_point(&self, p: &[f64; 3], origin_m: [f64; 3]) -> PathPoint {
+        let [la, lo] = self
+            .frame
+            .to_lat_lon_deg(p[0] - origin_m[0], p[1] - origin_m[1]);
+        PathPoint {
+            latitude_deg: la,
+            longitude_deg: lo,
+            altitude_amsl_m: self.home_amsl_m + p[2] - origin_m[2],
+        }
+    }
+
     /// Each segment's least height above the ground along `paths` (east, north, up of
     /// `origin_m`, segment numbers from 0, as the map draws them), and where.
     ///
@@ -343,20 +357,9 @@ impl<'a> Ground<'a> {
     ) -> Result<Vec<Option<SegmentClearance>>, Error> {
         let mut out = vec![None; segments];
         for (k, points) in paths {
-            let at = |p: &[f64; 3]| {
-                let [la, lo] = self
-                    .frame
-                    .to_lat_lon_deg(p[0] - origin_m[0], p[1] - origin_m[1]);
-                PathPoint {
-                    latitude_deg: la,
-                    longitude_deg: lo,
-                    altitude_amsl_m: self.home_amsl_m + p[2] - origin_m[2],
-                }
-            };
+            let at = |p: &[f64; 3]| self.path_point(p, origin_m);
             let mut least: Option<SegmentClearance> = None;
-            let pairs = points.windows(2).map(|w| (w[0], w[1]));
-            let single = (points.len() == 1).then(|| (points[0], points[0]));
-            for (a, b) in pairs.chain(single) {
+            for (a, b) in path_lines(points) {
                 let c = self.terrain.least_clearance(at(&a), at(&b))?;
                 if least.is_none_or(|l| c.clearance_m < l.clearance_m) {
                     least = Some(SegmentClearance {
@@ -374,6 +377,16 @@ impl<'a> Ground<'a> {
         }
         Ok(out)
     }
+}
+
+/// The straight lines of a segment's path, in order: each pair of its points, or its one point
+/// as a line of no length (a hold).
+pub(in crate::engine) fn path_lines(
+    points: &[[f64; 3]],
+) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
+    let pairs = points.windows(2).map(|w| (w[0], w[1]));
+    let single = (points.len() == 1).then(|| (points[0], points[0]));
+    pairs.chain(single)
 }
 
 /// A leg (not a take-off, orbit or return).
@@ -458,7 +471,7 @@ fn orbit_centre(s: &SegmentSpec, ground: &Ground<'_>) -> Option<[f64; 2]> {
 /// Whether a segment of `kind` (followed by one of `next`) is judged against the least
 /// clearance: every segment in the air but the take-off and the landing, which start or end on
 /// the ground, with the descent that begins a landing (to the height where it slows).
-fn judged(kind: &str, next: Option<&str>) -> bool {
+pub(in crate::engine) fn judged(kind: &str, next: Option<&str>) -> bool {
     let landing = matches!(kind, "take-off" | "landing");
     let descent_to_land = kind == "descent" && next == Some("landing");
     !(landing || descent_to_land)
