@@ -21,6 +21,7 @@ use crate::engine::flags::{
     EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags, PlanFlags,
     ValidateFlags,
 };
+use crate::engine::maps::profile::route_profile;
 use crate::error::Error;
 
 /// A value as the command line's JSON text.
@@ -83,8 +84,8 @@ pub fn mission_map_answer(
 }
 
 /// The page's map of a mission already read ([`MissionMap`](super::MissionMap)): the route
-/// per segment, the point of no return, the state of charge over time and, when the flags ask
-/// for scenarios, its band, as compact JSON. Planned with the same flags as [`mission_answer_for`], so the two
+/// per segment, the point of no return, the state of charge over time, when the flags ask
+/// for scenarios its band, and with terrain the route's profile over the ground, as compact JSON. Planned with the same flags as [`mission_answer_for`], so the two
 /// answers describe one flight.
 ///
 /// # Errors
@@ -112,8 +113,10 @@ pub fn mission_map_answer_with(
         None => None,
         Some(sc) => plan_scenarios(v, m, &opts, &sc)?.soc_fan,
     };
+    let mut map = mission_map(&plan, m, fan);
+    map.profile = route_profile(&plan, m, opts.terrain.as_deref())?;
     // Compact: the page's, not a reader's (a long route is thousands of points).
-    serde_json::to_string(&mission_map(&plan, m, fan)).map_err(|e| Error::OptionsFormat {
+    serde_json::to_string(&map).map_err(|e| Error::OptionsFormat {
         what: "answer",
         message: e.to_string(),
     })

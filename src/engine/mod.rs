@@ -22,7 +22,7 @@
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `live/` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `uncertainty/` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`LiveReplies`] to the link | `live/` |
-//! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] | [`MissionMap`] | `maps/` |
+//! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] (with terrain, the route's [`TerrainProfile`] over the ground) | [`MissionMap`] | `maps/` |
 //! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `plan_to_fly/` (sorties: `missions/sorties.rs`) |
 //! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `maps/` |
 //! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
@@ -113,6 +113,7 @@ pub use maps::mission_map::{
     mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };
 pub use maps::plan_map::{fly_plan_map, SortieMap};
+pub use maps::profile::{ProfileLeast, TerrainProfile, PROFILE_POINTS};
 pub use missions::flown::PlanningSpeed;
 pub use missions::ground::{GroundAt, HOME_DISAGREES_M};
 pub use missions::loiter::LoiterSummary;

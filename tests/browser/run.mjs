@@ -26,6 +26,8 @@ const DROP_MISSION = path.join(DATA, 'missions/kasperg3_mission.plan');
 const PLAN_MISSION = path.join(DATA, 'missions/neilvaltec_test.plan');
 const PLAN_WAYPOINTS = path.join(DATA, 'missions/brucdeng_aircart_mission.waypoints');
 const TLOG = path.join(DATA, 'telemetry/ayoub_auto_mission_sitl.tlog');
+const TERRAIN = path.join(DATA, 'terrain');
+const RIDGE = path.join(repo, 'fixtures/missions/ridge-44n.toml');
 const MISSION_EXT = /\.(plan|waypoints|toml|json|txt)$/i;
 const started = Date.now();
 
@@ -367,8 +369,8 @@ async function main() {
     executablePath: CHROMIUM,
     args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
   });
-  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup, =logbook or =fly.
-  const only = { markup: markupEverywhere, logbook: logbookPanel, fly: planToFlyPanel }[process.env.ALOFT_BROWSER_ONLY];
+  // One section alone, while working on it: ALOFT_BROWSER_ONLY=markup, =logbook, =fly or =terrain.
+  const only = { markup: markupEverywhere, logbook: logbookPanel, fly: planToFlyPanel, terrain: terrainProfile }[process.env.ALOFT_BROWSER_ONLY];
   if (only) {
     await only();
     await noProblems();
@@ -569,6 +571,9 @@ async function main() {
   }
 
   await planToFlyPanel();
+
+  // --- the route's profile over the ground (aloft serve --terrain)
+  await terrainProfile();
 
   // --- geographic map with a tile layer (tiles served by aloft itself: works offline)
   const geo = await serve([DROP_MISSION, '--tiles', '/vendor/leaflet/images/layers.png?{z}/{x}/{y}', '--attribution', 'test tiles']);
@@ -978,6 +983,106 @@ async function planToFlyPanel() {
     fly.stop();
   }
 
+}
+
+// --- 12: the route's profile over the ground (issue 45): served with --terrain, the ridge
+// mission's profile chart under the map (the route's altitude, the ground filled), its least
+// clearance labelled as `aloft mission --terrain` gives it; values with markup shown as text;
+// hidden for a mission refused over the tiles and without terrain.
+async function terrainProfile() {
+  const cli = cliMission(RIDGE, ['--terrain', TERRAIN]);
+  const server = await serve([RIDGE, '--terrain', TERRAIN]);
+  const profileOf = (page) =>
+    page.$eval('#profile', (c) => {
+      const count = (sel) => {
+        const e = c.querySelector(sel);
+        return e ? e.getAttribute('points').trim().split(/\s+/).length : 0;
+      };
+      const label = c.querySelector('text.least-label');
+      const box = c.getBoundingClientRect();
+      return {
+        hidden: document.querySelector('#profile-panel').hidden,
+        points: c.dataset.points,
+        ground: count('polygon.ground'),
+        route: count('polyline.route-altitude'),
+        label: label ? label.textContent : null,
+        dot: Boolean(c.querySelector('circle.least-dot')),
+        height: box.height,
+        mapHeight: document.querySelector('#map').getBoundingClientRect().height,
+      };
+    });
+  try {
+    const page = await openPage(server.url);
+    if ((await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent)) !== path.basename(RIDGE)) {
+      const before = await plans(page);
+      await page.selectOption('#mission-select', { label: path.basename(RIDGE) });
+      await waitReady(page, before);
+    }
+    await check(`${path.basename(RIDGE)} with --terrain: the profile under the map draws the route and the ground, its least clearance labelled as aloft mission --terrain gives it`, async () => {
+      assert(cli.status === 1 && typeof cli.json.min_clearance_m === 'number', JSON.stringify(cli).slice(0, 300));
+      const least = cli.json.min_clearance_m;
+      const segment = cli.json.segments.find((s) => s.kind === 'leg' && s.min_clearance_m === least);
+      const expected = `least clearance ${least.toFixed(1)} m, segment ${segment.index}`;
+      // docs/terrain.md's figures for this mission.
+      assert(expected === 'least clearance 2.6 m, segment 2', expected);
+      const answer = await mapAnswer(server.url, RIDGE, readFileSync(RIDGE));
+      const n = answer.profile.distance_m.length;
+      await page.waitForSelector('#profile svg polyline.route-altitude', { timeout: 10000 });
+      const drawn = await profileOf(page);
+      assert(!drawn.hidden && drawn.height > 80 && drawn.mapHeight > 200, JSON.stringify(drawn));
+      assert(drawn.label === expected && drawn.dot, JSON.stringify(drawn));
+      assert(drawn.points === String(n) && drawn.route === n && drawn.ground === n + 2, `${n} points: ${JSON.stringify(drawn)}`);
+      await page.locator('#profile').screenshot({ path: path.join(SHOTS, 'profile.png') });
+    });
+    await check("markup: a profile's values carrying markup are shown as text, nothing runs", async () => {
+      await page.route('**/api/map?**', async (route) => {
+        const response = await route.fetch();
+        const map = await response.json().catch(() => ({}));
+        if (map.profile && map.profile.least) map.profile.least.segment = evil('profile-segment');
+        await route.fulfill({ response, json: map });
+      });
+      try {
+        const before = await plans(page);
+        await setOptions(page, { payload: '0.1' });
+        await waitReady(page, before);
+        const drawn = await profileOf(page);
+        assert(drawn.label === `least clearance ${cli.json.min_clearance_m.toFixed(1)} m, segment –`, JSON.stringify(drawn));
+        assert((await page.$$('#profile img')).length === 0, 'an image element was made');
+        await assertClean(page, 'the profile');
+      } finally {
+        await page.unroute('**/api/map?**');
+        const b2 = await plans(page);
+        await setOptions(page, { payload: '' });
+        await waitReady(page, b2);
+      }
+    });
+    await check('the demo (placed in metres) is flown over a flat Earth: a plan, no profile', async () => {
+      const before = await plans(page);
+      await page.selectOption('#mission-select', 'demo');
+      await waitReady(page, before);
+      assert(await page.$eval('#error', (e) => e.hidden), 'an error shown');
+      assert((await page.$$('#segments tbody tr')).length > 0, 'no plan');
+      const drawn = await profileOf(page);
+      assert(drawn.hidden && drawn.route === 0, JSON.stringify(drawn));
+    });
+    await page.context().close();
+  } finally {
+    server.stop();
+  }
+  const flat = await serve([RIDGE]);
+  try {
+    const page = await openPage(flat.url);
+    await check(`${path.basename(RIDGE)} without --terrain: no profile`, async () => {
+      const label = await page.$eval('#mission-select', (s) => s.selectedOptions[0].textContent);
+      assert(label === path.basename(RIDGE), label);
+      assert((await page.$$('#segments tbody tr')).length > 0, 'no plan');
+      const drawn = await profileOf(page);
+      assert(drawn.hidden && drawn.route === 0, JSON.stringify(drawn));
+    });
+    await page.context().close();
+  } finally {
+    flat.stop();
+  }
 }
 
 async function noProblems() {

@@ -67,6 +67,7 @@ mod serve_hold;
 mod serve_hostile;
 mod serve_plan;
 mod terrain_cli;
+mod terrain_map;
 mod terrain_mission;
 mod vehicle_file_doc;
 mod vehicles_cli;

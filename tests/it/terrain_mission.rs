@@ -24,7 +24,7 @@ fn tiles() -> PathBuf {
 
 /// The shared tile's height at `(lat, lon)`, bilinear between its four samples (this test's
 /// own reading: 1201 x 1201 big-endian i16, north row first, 3 arc-seconds apart).
-fn tile_height_m(bytes: &[u8], lat: f64, lon: f64) -> f64 {
+pub(crate) fn tile_height_m(bytes: &[u8], lat: f64, lon: f64) -> f64 {
     let n = 1201usize;
     let raw = |r: usize, c: usize| {
         let k = 2 * (r * n + c);

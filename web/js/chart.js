@@ -14,9 +14,9 @@ function niceTicks(lo, hi, count) {
   return ticks;
 }
 
-// A frame with axes; returns {root, x(v), y(v), plot} for drawing.
+// A frame with axes (560 wide unless `opts.width`); returns {root, x(v), y(v), plot} for drawing.
 export function frame(container, opts) {
-  const W = 560;
+  const W = opts.width || 560;
   const H = opts.height || 220;
   const m = { l: 48, r: 14, t: 12, b: 38 };
   const root = svg('svg', { viewBox: `0 0 ${W} ${H}`, width: '100%', role: 'img', 'aria-label': opts.label, class: 'plot' });

@@ -7,6 +7,7 @@ import { distance, duration, fmt, pct, socColour } from './format.js';
 import { api, ApiError, busy, clearError, fetchText, settle, showError } from './api.js';
 import { highlight, renderMap } from './map.js';
 import { renderChart, updateSweep } from './mission-charts.js';
+import { clearProfile, renderProfile } from './profile.js';
 import { clearFly } from './fly.js';
 import { syncBatteries } from './vehicles.js';
 
@@ -101,6 +102,7 @@ function clearPlan() {
   delete s.dataset.energyWh;
   $('#segments tbody').replaceChildren();
   $('#chart').replaceChildren();
+  clearProfile();
   if (state.routeLayer) state.routeLayer.clearLayers();
   state.segLayers.clear();
 }
@@ -108,6 +110,8 @@ function clearPlan() {
 function render(mission, map) {
   renderSummary(mission);
   renderSegments(mission);
+  // The profile first: shown or hidden, it sets the map's height before the map fits the route.
+  renderProfile(map);
   renderMap(mission, map);
   renderChart(mission, map);
   syncBatteries(mission);

@@ -208,7 +208,14 @@ async fn planned<T: MissionRequest>(
     let work = shared.clone();
     let job = move |cancel: &_| {
         let meter = flags.bound(&work.work, cancel);
-        let answered = mission_of(&body, &origin).and_then(|m| answer(&vehicle, &m, &flags));
+        let answered = mission_of(&body, &origin).and_then(|m| {
+            // A mission placed in metres from home (the built-in demo) has no place on the
+            // tiles: it is answered over a flat Earth.
+            if m.spec().home.latitude_deg.is_none() {
+                flags.mission().terrain = None;
+            }
+            answer(&vehicle, &m, &flags)
+        });
         meter.verdict(answered).map_err(engine_message)
     };
     Ok(shared.work.run(job).await)

@@ -1,7 +1,9 @@
 //! A planned mission as a map and a chart draw it (the page of `aloft serve`): the route over the
 //! ground, segment by segment, in east-north-up metres from home and, for a mission with a
 //! geographic home (every planner file), in latitude and longitude; the point of no return; the
-//! state of charge over time; and with scenarios its 5-95 % band.
+//! state of charge over time; with scenarios its 5-95 % band; and with terrain the route's profile
+//! over the ground ([`route_profile`](crate::engine::maps::profile::route_profile), set by
+//! `answers::mission_map_answer_with`).
 //!
 //! The route is the compiled mission's pieces (the path the planner flies, corners and the way
 //! home it adds included): a line by its ends, an arc by 36 points, a hold by its
@@ -12,6 +14,7 @@ use serde::Serialize;
 
 use aloft_planner::geodesy::LocalFrame;
 
+use crate::engine::maps::profile::TerrainProfile;
 use crate::engine::missions::mission::Plan;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_outputs::segment_paths;
@@ -36,6 +39,9 @@ pub struct MissionMap {
     /// Its 5th, 50th and 95th percentiles over time, with scenarios (`samples`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub band: Option<SocFan>,
+    /// The route's altitude and the ground under it along the path, with terrain (`--terrain`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile: Option<TerrainProfile>,
 }
 
 /// A point on the ground.
@@ -129,6 +135,7 @@ pub fn mission_map(plan: &Plan, mission: &Mission, fan: Option<SocFan>) -> Missi
         point_of_no_return,
         battery: soc_line(plan),
         band: fan,
+        profile: None,
     }
 }
 

@@ -323,6 +323,20 @@ impl<'a> Ground<'a> {
         }
     }
 
+    /// A point of a planned path (east, north, up of `origin_m`, m, as the map draws it) on the
+    /// ground's terms: latitude, longitude and altitude above mean sea level (home's ground on
+    /// the tiles plus the height above home).
+    pub(in crate::engine) fn path_point(&self, p: &[f64; 3], origin_m: [f64; 3]) -> PathPoint {
+        let [la, lo] = self
+            .frame
+            .to_lat_lon_deg(p[0] - origin_m[0], p[1] - origin_m[1]);
+        PathPoint {
+            latitude_deg: la,
+            longitude_deg: lo,
+            altitude_amsl_m: self.home_amsl_m + p[2] - origin_m[2],
+        }
+    }
+
     /// Each segment's least height above the ground along `paths` (east, north, up of
     /// `origin_m`, segment numbers from 0, as the map draws them), and where.
     ///
@@ -336,20 +350,9 @@ impl<'a> Ground<'a> {
     ) -> Result<Vec<Option<SegmentClearance>>, Error> {
         let mut out = vec![None; segments];
         for (k, points) in paths {
-            let at = |p: &[f64; 3]| {
-                let [la, lo] = self
-                    .frame
-                    .to_lat_lon_deg(p[0] - origin_m[0], p[1] - origin_m[1]);
-                PathPoint {
-                    latitude_deg: la,
-                    longitude_deg: lo,
-                    altitude_amsl_m: self.home_amsl_m + p[2] - origin_m[2],
-                }
-            };
+            let at = |p: &[f64; 3]| self.path_point(p, origin_m);
             let mut least: Option<SegmentClearance> = None;
-            let pairs = points.windows(2).map(|w| (w[0], w[1]));
-            let single = (points.len() == 1).then(|| (points[0], points[0]));
-            for (a, b) in pairs.chain(single) {
+            for (a, b) in path_lines(points) {
                 let c = self.terrain.least_clearance(at(&a), at(&b))?;
                 if least.is_none_or(|l| c.clearance_m < l.clearance_m) {
                     least = Some(SegmentClearance {
@@ -389,6 +392,16 @@ pub(in crate::engine) fn ground_points(
             ground_m: g.height_m,
         })
         .collect())
+}
+
+/// The straight lines of a segment's path, in order: each pair of its points, or its one point
+/// as a line of no length (a hold).
+pub(in crate::engine) fn path_lines(
+    points: &[[f64; 3]],
+) -> impl Iterator<Item = ([f64; 3], [f64; 3])> + '_ {
+    let pairs = points.windows(2).map(|w| (w[0], w[1]));
+    let single = (points.len() == 1).then(|| (points[0], points[0]));
+    pairs.chain(single)
 }
 
 /// A leg (not a take-off, orbit or return).
@@ -479,7 +492,7 @@ fn orbit_centre(s: &SegmentSpec, ground: &Ground<'_>) -> Option<[f64; 2]> {
 /// Whether a segment of `kind` (followed by one of `next`) is judged against the least
 /// clearance: every segment in the air but the take-off and the landing, which start or end on
 /// the ground, with the descent that begins a landing (to the height where it slows).
-fn judged(kind: &str, next: Option<&str>) -> bool {
+pub(in crate::engine) fn judged(kind: &str, next: Option<&str>) -> bool {
     let landing = matches!(kind, "take-off" | "landing");
     let descent_to_land = kind == "descent" && next == Some("landing");
     !(landing || descent_to_land)
@@ -497,21 +510,28 @@ pub(in crate::engine) fn judge_clearances(
     compiled: &aloft_planner::Mission,
     min_clearance_m: f64,
 ) -> Result<(), Error> {
+    // The whole planned route is judged, also past where a pack that falls short stops (the
+    // answer's segments end there).
+    let kinds = compiled.segment_kinds();
+    let items = compiled.segment_items();
     let paths = crate::engine::missions::mission_outputs::segment_paths(compiled);
-    let clearances = ground.clearances(&paths, compiled.home_m(), summary.segments.len())?;
+    let clearances = ground.clearances(&paths, compiled.home_m(), kinds.len())?;
     let mut least: Option<f64> = None;
     let mut first_too_close = None;
-    let kinds: Vec<String> = summary.segments.iter().map(|s| s.kind.clone()).collect();
-    for (k, (s, c)) in summary.segments.iter_mut().zip(clearances).enumerate() {
+    for (k, c) in clearances.into_iter().enumerate() {
         let Some(c) = c else { continue };
-        s.min_clearance_m = Some(c.clearance_m);
-        s.min_clearance_at = Some(c.at);
-        if !judged(&s.kind, kinds.get(k + 1).map(String::as_str)) {
+        if let Some(s) = summary.segments.iter_mut().find(|s| s.index == k + 1) {
+            s.min_clearance_m = Some(c.clearance_m);
+            s.min_clearance_at = Some(c.at);
+        }
+        let kind = kinds.get(k).copied().unwrap_or("segment");
+        if !judged(kind, kinds.get(k + 1).copied()) {
             continue;
         }
         least = Some(least.map_or(c.clearance_m, |l: f64| l.min(c.clearance_m)));
         if c.clearance_m < min_clearance_m && first_too_close.is_none() {
-            first_too_close = Some((s.index, s.item, s.kind.clone(), c));
+            let item = items.get(k).copied().flatten();
+            first_too_close = Some((k + 1, item, kind.to_string(), c));
         }
     }
     summary.min_clearance_m = least;
