@@ -445,3 +445,40 @@ fn data_val_plan_follow_terrain_writes_a_mission_that_keeps_its_height_and_mavsd
         );
     }
 }
+
+#[test]
+fn data_val_a_pack_that_runs_out_before_the_ridge_still_has_the_ridge_judged() {
+    // Two legs along 44.25 N: the first ends before the ridge of `ridge-44n`, the second passes
+    // it 2.6 m up. From 3 % the pack runs out on the first leg, where the answer's segments end;
+    // the ridge on the second is still judged (it was not when only the answer's segments were).
+    let text = east_leg_toml((44.25, -71.93), -71.905, 63.6).replace(
+        "[[segment]]\nkind = \"leg\"",
+        "[[segment]]\nkind = \"leg\"\nlatitude_deg = 44.25\nlongitude_deg = -71.925\naltitude_m = 63.6\nground_speed_mps = 8.0\n\n[[segment]]\nkind = \"leg\"",
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let mission = write(tmp.path(), "two.toml", &text);
+    let terrain = tiles();
+    let out = aloft(&[
+        "mission".as_ref(),
+        mission.as_os_str(),
+        "--terrain".as_ref(),
+        terrain.as_os_str(),
+        "--start-percent".as_ref(),
+        "3".as_ref(),
+        "--format".as_ref(),
+        "json".as_ref(),
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let v: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        v["segments"].as_array().unwrap().len() <= 2,
+        "{}",
+        v["segments"]
+    );
+    let reason = v["reason"].as_str().unwrap();
+    assert!(
+        reason.starts_with("segment 3 (leg) passes 2.6 m"),
+        "{reason}"
+    );
+    assert!((v["min_clearance_m"].as_f64().unwrap() - 2.6).abs() < 0.05);
+}
