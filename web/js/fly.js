@@ -7,6 +7,7 @@ import { fmt, mmss, pct, safeFileName, sortieColour, uniqueNames } from './forma
 import { api, clearError, fetchText, settle, showError } from './api.js';
 import { zipStored } from './zip.js';
 import { replanPending } from './mission.js';
+import { clearFly } from './fly-clear.js';
 
 // The plan's options: the page's controls (not the mission's samples: a plan draws its own
 // scenarios) and the panel's own.
@@ -22,20 +23,6 @@ function flyOptions() {
   add('overlap_m', '#fly-overlap');
   add('max_speed', '#fly-max-speed');
   return q;
-}
-
-// Forget the plan shown (the mission or its conditions changed): its layers, its links.
-export function clearFly(note) {
-  state.flySeq += 1;
-  for (const url of state.flyUrls) URL.revokeObjectURL(url);
-  state.flyUrls = [];
-  if (state.flyLayer) state.flyLayer.clearLayers();
-  $('#map').classList.remove('flying');
-  $('#fly-title').textContent = '';
-  const box = $('#fly');
-  box.dataset.state = 'none';
-  delete box.dataset.batteries;
-  box.replaceChildren(el('p', { class: 'muted', text: note || 'The files to upload, one per battery, for this mission in these conditions.' }));
 }
 
 export async function planToFly() {

@@ -8,7 +8,7 @@ import { api, ApiError, busy, clearError, fetchText, settle, showError } from '.
 import { highlight, renderMap } from './map.js';
 import { renderChart, updateSweep } from './mission-charts.js';
 import { clearProfile, renderProfile } from './profile.js';
-import { clearFly } from './fly.js';
+import { clearFly } from './fly-clear.js';
 import { syncBatteries } from './vehicles.js';
 
 export function addMission(entry) {

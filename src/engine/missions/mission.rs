@@ -12,7 +12,7 @@ use crate::engine::finite::finite;
 use crate::engine::missions::day::{mission_air, mission_wind};
 use crate::engine::missions::flight::Flight;
 use crate::engine::missions::flown::flown_spec;
-use crate::engine::missions::ground::{judge_clearances, Ground};
+use crate::engine::missions::ground::Ground;
 use crate::engine::missions::loiter::resolve_loiter;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::{MissionOptions, DEFAULT_MIN_CLEARANCE_M};
@@ -678,6 +678,62 @@ pub(in crate::engine) fn start_soc(options: &MissionOptions, pack: &Pack) -> Res
     }
     // At least a tenth of a per cent: the planner starts from a charge.
     Ok(pack.soc_at_ocv_v(v).max(0.001))
+}
+
+/// The clearances of `compiled` written into `summary`: each segment's least height above the
+/// ground and where, the mission's least over the segments judged, and an infeasible answer
+/// naming the first judged segment closer to the ground than `min_clearance_m`.
+///
+/// # Errors
+/// The tiles' (no tile or a void under the route).
+fn judge_clearances(
+    summary: &mut MissionSummary,
+    ground: &Ground<'_>,
+    compiled: &aloft_planner::Mission,
+    min_clearance_m: f64,
+) -> Result<(), Error> {
+    // The whole planned route is judged, also past where a pack that falls short stops (the
+    // answer's segments end there).
+    let kinds = compiled.segment_kinds();
+    let items = compiled.segment_items();
+    let paths = crate::engine::missions::mission_outputs::segment_paths(compiled);
+    let clearances = ground.clearances(&paths, compiled.home_m(), kinds.len())?;
+    let mut least: Option<f64> = None;
+    let mut first_too_close = None;
+    for (k, c) in clearances.into_iter().enumerate() {
+        let Some(c) = c else { continue };
+        if let Some(s) = summary.segments.iter_mut().find(|s| s.index == k + 1) {
+            s.min_clearance_m = Some(c.clearance_m);
+            s.min_clearance_at = Some(c.at);
+        }
+        let kind = kinds.get(k).copied().unwrap_or("segment");
+        if !crate::engine::missions::ground::judged(kind, kinds.get(k + 1).copied()) {
+            continue;
+        }
+        least = Some(least.map_or(c.clearance_m, |l: f64| l.min(c.clearance_m)));
+        if c.clearance_m < min_clearance_m && first_too_close.is_none() {
+            let item = items.get(k).copied().flatten();
+            first_too_close = Some((k + 1, item, kind.to_string(), c));
+        }
+    }
+    summary.min_clearance_m = least;
+    if let Some((index, item, kind, c)) = first_too_close {
+        let name = match item {
+            Some(i) => format!("segment {index} (item {i}, {kind})"),
+            None => format!("segment {index} ({kind})"),
+        };
+        let why = format!(
+            "{name} passes {:.1} m above the ground at {:.5}, {:.5}: closer than the least \
+             clearance of {min_clearance_m} m",
+            c.clearance_m, c.at.latitude_deg, c.at.longitude_deg
+        );
+        summary.reason = Some(match summary.reason.take() {
+            Some(energy) => format!("{why}; and {energy}"),
+            None => why,
+        });
+        summary.feasible = false;
+    }
+    Ok(())
 }
 
 #[cfg(test)]
