@@ -14,19 +14,23 @@
 //!    and descents along the way are flown and cost their energy; a landing lands on the ground
 //!    where it is.
 //! 3. [`Ground::clearances`]: each segment's least height above the ground along its planned
-//!    path (every line of it sampled at the tile's spacing, not only its ends), and where.
+//!    path (every line of it walked cell by cell over the tile's bilinear ground, exactly, not
+//!    only at its ends), and where; the mission's steps (`mission.rs`, `judge_clearances`) judge
+//!    them against the least clearance ([`judged`]: every segment in the air but the take-off
+//!    and the landing).
 //!
 //! The tiles' heights are above the EGM96 geoid, which is what autopilots and planners call
 //! "above mean sea level" (the GPS's geoid height); the clearance is that height's difference.
 
-use aloft_missions::follow_terrain::GroundPoint;
-use aloft_missions::follow_terrain::{follow_ground, FollowLine, FollowPoint, Following};
+use aloft_missions::follow_terrain::{
+    follow_ground, FollowLine, FollowPoint, Following, GroundPoint,
+};
 use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::{MissionSpec, SegmentSpec};
+use aloft_terrain::{PathPoint, Terrain};
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
-use aloft_terrain::{PathPoint, Terrain};
 
 /// The planned home's altitude and the tile's ground under it may differ by this much before it
 /// is said, m (the issue's; SRTM's absolute accuracy is 16 m at 90 %).
