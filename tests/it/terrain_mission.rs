@@ -118,6 +118,12 @@ fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
         "{}",
         stdout(&table)
     );
+    // The verdict says why (it said FEASIBLE when only the pack was judged).
+    assert!(
+        stdout(&table).contains("NOT FEASIBLE: segment 2 (leg) passes "),
+        "{}",
+        stdout(&table)
+    );
 
     // 10 m higher it passes the default 10 m, and a lower limit lets the 3 m pass.
     let higher = write(
