@@ -7,6 +7,7 @@
 mod common;
 
 mod air_cli;
+mod build_profiles;
 mod cli_ffi;
 mod cli_power;
 mod disclosure;

@@ -502,13 +502,13 @@ fn plan_writes_its_set_all_or_nothing() {
 fn an_interrupted_plan_leaves_the_whole_set_or_nothing() {
     let d = folder("plan-interrupt");
     let mission = d.join("lines.toml");
-    std::fs::write(&mission, survey_lines("lines", 40)).unwrap();
+    std::fs::write(&mission, survey_lines("lines", 30)).unwrap();
     let start = Instant::now();
     let expected = files_of(&mission, "plan-interrupt-dry");
     let whole = start.elapsed();
     assert!(expected.len() >= 2, "{expected:?}");
     let mut interrupted = 0;
-    for k in 0..12u32 {
+    for k in 0..6u32 {
         let out = d.join(format!("out-{k}"));
         std::fs::create_dir_all(&out).unwrap();
         let mut child = Command::new(env!("CARGO_BIN_EXE_aloft"))
@@ -517,8 +517,8 @@ fn an_interrupted_plan_leaves_the_whole_set_or_nothing() {
             .stderr(Stdio::null())
             .spawn()
             .unwrap();
-        // From 10 % to 120 % of an uninterrupted run.
-        std::thread::sleep(whole.mul_f64(0.1 + 0.1 * f64::from(k)));
+        // From 10 % to 110 % of an uninterrupted run.
+        std::thread::sleep(whole.mul_f64(0.1 + 0.2 * f64::from(k)));
         let signal = if k % 2 == 0 { "-INT" } else { "-TERM" };
         let _ = Command::new("kill")
             .args([signal, &child.id().to_string()])
