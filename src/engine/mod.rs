@@ -16,25 +16,26 @@
 //! | endurance | [`EnduranceOptions`] → [`endurance`], [`power_curve`]; + [`PayloadSweep`] → [`payload_sweep`] | [`EnduranceSummary`], [`PowerCurve`], [`PayloadCurve`] | `performance/` |
 //! | power | [`PowerQuery`] → [`power_point`]; [`power_csv`] | [`PowerAnswer`] | `performance/` |
 //! | propulsion | [`hover`], [`hover_sweep`], [`RotorRequest`] → [`rotor_response`] | [`HoverResult`], [`HoverSweep`], [`RotorAnswer`] | `performance/` |
-//! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `logs.rs` |
+//! | logs | [`LogReadOptions`] → [`log_info`], [`convert_log`] | [`LogInfo`], [`ConvertSummary`] | `basics/logs.rs` |
 //! | identification | [`FitRequest`] → [`fit_logs`]; [`ValidateRequest`] → [`validate_logs`] | [`FitAnswer`], [`ValidateAnswer`] | `identification/` |
 //! | packs | [`PackFitRequest`] → [`fit_pack`] (logs → a pack file); a `--battery` value → [`fly_with_battery`] (the command line: [`load_flying`]) (a pack name, or a [`PackFile`] flown, for every command that flies) | [`PackFitAnswer`], [`FlyingPack`] | `packs/` |
 //! | in flight | [`InFlightEstimator`] | re-estimated efficiency | `live/` |
 //! | how sure | [`ScenarioOptions`] → [`plan_scenarios`], [`endurance_scenarios`] | [`Uncertainty`], [`EnduranceUncertainty`] | `uncertainty/` |
 //! | a flight followed live | [`LiveRequest`] and a [`LiveSource`] → [`follow_live`] (or event by event, [`LiveSession`]); [`LiveReplayRequest`] → [`replay_live`] | [`LiveUpdate`], [`LiveSummary`], [`LiveCheck`]; [`LiveReplies`] to the link | `live/` |
-//! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] (with terrain, the route's [`TerrainProfile`] over the ground) | [`MissionMap`] | `maps/` |
+//! | the page's map (`aloft serve`) | a [`Plan`] → [`mission_map`] (with terrain, the route's [`TerrainProfile`] over the ground) | [`MissionMap`] | `front_door/maps/` |
 //! | plans to fly (`aloft plan`) | a [`Mission`] + [`FlyPlanRequest`] → [`plan_to_fly`] (candidates, speeds for the wind, surveys turned, sorties cut inside legs, each file read back); [`FlyPlan::write`] | [`FlyPlan`] (its files' texts) | `plan_to_fly/` (sorties: `missions/sorties.rs`) |
-//! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `maps/` |
-//! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `answers.rs`, `flags.rs`, `keywords.rs` |
-//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag; a [`StepMeter`] in [`MissionOptions`]: the steps of every flight of a mission or a plan | [`crate::Error::TooMuchWork`], [`crate::Error::RequestTooLong`], [`crate::Error::Cancelled`] | `step_meter.rs` |
-//! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `files.rs`, `keywords.rs`, `conditions/`, `logs.rs` |
-//! | the ground (`aloft terrain`) | `--terrain DIR` or `ALOFT_TERRAIN` → [`terrain::from_flag_or_env`]; a [`terrain::Terrain`] and places → [`terrain::heights`] | [`terrain::Heights`] | `terrain/` |
-//! | files written | [`write_output`], [`Output`], [`OutputSet`] (aloft's one way: exclusive temporary file, rename, nothing replaced without `force`, sets all or nothing), [`safe_stem`] (a name from an input's file name), [`abandon_outputs`] (interrupted) | the files, or [`crate::Error::Output`] | `files.rs` (`aloft_core::output`) |
+//! | a plan to fly on the page's map | a [`FlyPlan`] → [`fly_plan_map`] | [`SortieMap`] per sortie | `front_door/maps/` |
+//! | answers as the command line's JSON text (Python, `aloft serve`) | the option groups of [`flags`], or keywords ([`parse_keywords`]) → [`answers`] (with a vehicle already loaded: the `*_with` functions) | JSON text | `front_door/` |
+//! | work a caller bounds (`aloft serve`) | [`WorkBounds`] in [`ScenarioOptions`] and [`FlyPlanRequest`]: the steps of a request's scenarios, a cancellation flag; a [`StepMeter`] in [`MissionOptions`]: the steps of every flight of a mission or a plan | [`crate::Error::TooMuchWork`], [`crate::Error::RequestTooLong`], [`crate::Error::Cancelled`] | `basics/step_meter.rs` |
+//! | files a request names | [`read_text_file`] (regular files, at most [`MAX_INPUT_BYTES`]), [`file_keywords`] (the options that name one), [`read_wind_field`], [`check_profile`] | their text, or errors that quote none of it | `basics/files.rs`, `front_door/keywords.rs`, `conditions/`, `basics/logs.rs` |
+//! | the ground (`aloft terrain`) | `--terrain DIR` or `ALOFT_TERRAIN` → [`terrain::from_flag_or_env`]; a [`terrain::Terrain`] and places → [`terrain::heights`] | [`terrain::Heights`] | `conditions/terrain.rs` |
+//! | files written | [`write_output`], [`Output`], [`OutputSet`] (aloft's one way: exclusive temporary file, rename, nothing replaced without `force`, sets all or nothing), [`safe_stem`] (a name from an input's file name), [`abandon_outputs`] (interrupted) | the files, or [`crate::Error::Output`] | `basics/files.rs` (`aloft_core::output`) |
 //!
-//! The folders stand in layers, each importing only those below it: `vehicles/` and
-//! `conditions/` at the ground (with `finite`, `files`, `step_meter`, `keywords`), then
-//! `missions/`, then `performance/`, `plan_to_fly/`, `packs/` and `logs.rs`, then
-//! `uncertainty/` and `identification/`, then `live/` and `maps/`; `flags` and `answers` on top.
+//! The folders stand in layers, each importing only those below it: `basics/` (files, logs,
+//! finite numbers, the step meter) at the ground, then `vehicles/` and `conditions/` (the air,
+//! the wind, the ground), then `missions/`, then `performance/` and `packs/`, then
+//! `uncertainty/` and `identification/`, then `plan_to_fly/` and `live/`; `front_door/` (the
+//! flags, the keywords, the JSON answers, the page's maps) on top. This file only re-exports.
 //! The physics and geometry live in the model crates; a folder keeps the steps of its requests.
 //!
 //! Defaults and precedences are decided here once: which wind a mission flies in (a gridded field,
@@ -58,34 +59,41 @@
 //! # Ok::<(), aloft::Error>(())
 //! ```
 
-pub mod answers;
-mod files;
-mod finite;
-pub mod flags;
-mod keywords;
-mod live;
-mod step_meter;
-
+mod basics;
 mod conditions;
+mod front_door;
 mod identification;
-mod logs;
-mod maps;
+mod live;
 mod missions;
 mod packs;
 mod performance;
 mod plan_to_fly;
-pub mod terrain;
 mod uncertainty;
 mod vehicles;
 
+// The public paths of the front door's modules and the ground, as before they had folders.
+pub use conditions::terrain;
+pub use front_door::{answers, flags};
+
 pub use aloft_missions::{ItemCounts, RouteFigures, SourceFormat};
-/// The route figures of a mission and the formats a mission file may be in (from the
-/// `aloft-missions` importers), for the CLI and embedding programs.
-pub use conditions::air::{resolve_air, Air, AirInput, AirSource};
-pub use files::{
+pub use basics::files::{
     abandon_outputs, check_output, escaped, read_text_file, safe_stem, shown_path, write_output,
     Output, OutputError, OutputSet, MAX_INPUT_BYTES,
 };
+pub use basics::logs::{
+    check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,
+    LogInfo, LogReadOptions, LogTime, LogTopic, SkippedLog, TopicCount,
+};
+pub use basics::step_meter::{StepMeter, WorkBounds};
+/// The route figures of a mission and the formats a mission file may be in (from the
+/// `aloft-missions` importers), for the CLI and embedding programs.
+pub use conditions::air::{resolve_air, Air, AirInput, AirSource};
+pub use front_door::keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
+pub use front_door::maps::mission_map::{
+    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
+};
+pub use front_door::maps::plan_map::{fly_plan_map, SortieMap};
+pub use front_door::maps::profile::{ProfileLeast, TerrainProfile, PROFILE_POINTS};
 pub use identification::fit::{
     fit_logs, fit_parameter, FitAnswer, FitProgress, FitRequest, LogFitReport,
 };
@@ -97,7 +105,6 @@ pub use identification::replay::{
 pub use identification::validate::{
     validate_logs, MeanBand, MeanRow, PowerSeries, ValidateAnswer, ValidateReport, ValidateRequest,
 };
-pub use keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use live::estimator::InFlightEstimator;
 pub use live::{
     follow_live, replay_live, FailsafeCheck, FailsafeCheckpoint, LiveCheck, LiveCheckpoint,
@@ -105,15 +112,6 @@ pub use live::{
     LiveSource, LiveSummary, LiveUpdate, Position, SocBand, TimeBand, DEFAULT_BATTERY_ID,
     DEFAULT_DISPLAY_COMPONENT_ID, LIVE_SCENARIOS,
 };
-pub use logs::{
-    check_profile, convert_log, log_info, ConvertSummary, FlightLogs, LagInfo, LogArg, LogChannel,
-    LogInfo, LogReadOptions, LogTime, LogTopic, SkippedLog, TopicCount,
-};
-pub use maps::mission_map::{
-    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
-};
-pub use maps::plan_map::{fly_plan_map, SortieMap};
-pub use maps::profile::{ProfileLeast, TerrainProfile, PROFILE_POINTS};
 pub use missions::flown::PlanningSpeed;
 pub use missions::ground::{GroundAt, HOME_DISAGREES_M};
 pub use missions::loiter::LoiterSummary;
@@ -156,7 +154,6 @@ pub use plan_to_fly::fly_plan::{
     DEFAULT_WIND_FROM_SD_DEG, MIN_WIND_SPEED_SD_MPS, WIND_SPEED_SD_SHARE,
 };
 pub use plan_to_fly::survey_angle::{AngleChange, AngleKept, ANGLE_STEP_DEG};
-pub use step_meter::{StepMeter, WorkBounds};
 pub use uncertainty::scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
 pub use uncertainty::scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,

@@ -1,7 +1,7 @@
 // The route's profile over the ground, under the map (with `aloft serve --terrain DIR`): the
 // vehicle's altitude and the ground under it (filled) along the distance flown from home, the
 // least clearance of the answer marked and labelled. Drawn from the map answer's `profile`
-// (the engine's, src/engine/maps/profile.rs); hidden when the answer has none.
+// (the engine's, src/engine/front_door/maps/profile.rs); hidden when the answer has none.
 
 import { $, state } from './state.js';
 import { svg } from './dom.js';

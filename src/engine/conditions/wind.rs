@@ -6,7 +6,7 @@ use std::path::Path;
 
 use aloft_planner::{Wind, WindGrid, WindProfileKind, WindSpec};
 
-use crate::engine::files::{check_csv_header, read_text_file};
+use crate::engine::basics::files::{check_csv_header, read_text_file};
 use crate::error::Error;
 
 /// A `[wind]` table in words: `6.0 m/s from 250 deg at 10 m, power law exponent 0.143`, with

@@ -14,11 +14,11 @@ use aloft_power::fit::{
 use aloft_power::{FitOptions, FitSample};
 use aloft_propulsion::fit::battery::{fit_pack_resistance, PackResistanceFit};
 
-use crate::engine::files::{check_output, escaped, write_output};
-use crate::engine::finite::finite;
+use crate::engine::basics::files::{check_output, escaped, write_output};
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::logs::{FlightLogs, SkippedLog};
 use crate::engine::identification::fit_quality::{judge_fit, Alignment, Envelope, FitQuality};
 use crate::engine::identification::own_vehicle::{complete_vehicle, Completed, OwnVehicle};
-use crate::engine::logs::{FlightLogs, SkippedLog};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 use crate::identify::force_samples;
@@ -110,7 +110,7 @@ pub struct LogFitReport {
 /// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitAnswer {
-    /// The verdict: `good`, `usable` or `poor` (see [`crate::engine::logs::fit_quality`]).
+    /// The verdict: `good`, `usable` or `poor` (see [`crate::engine::basics::logs::fit_quality`]).
     pub quality: FitQuality,
     /// Why, one reason a line.
     pub quality_reasons: Vec<String>,

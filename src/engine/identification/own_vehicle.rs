@@ -30,7 +30,7 @@ use std::collections::BTreeMap;
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
 use aloft_planner::{AirframeSpec, BatterySpec};
 
-use crate::engine::logs::FlightLogs;
+use crate::engine::basics::logs::FlightLogs;
 use crate::engine::packs::pack_fit::{fit_pack, PackFitRequest};
 use crate::error::Error;
 use crate::vehicle::VehicleFile;

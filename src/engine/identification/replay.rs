@@ -18,10 +18,10 @@ use aloft_logs::{GroundReport, Log};
 use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint};
 use aloft_power::{AoaModel, ModelOptions};
 
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::logs::ground_time;
 use crate::engine::conditions::air::{log_air, Air, AirInput};
 use crate::engine::conditions::wind::{describe_wind_spec, steady};
-use crate::engine::finite::finite;
-use crate::engine::logs::ground_time;
 use crate::engine::vehicles::vehicle::{MassParts, Vehicle};
 use crate::error::Error;
 use crate::identify::{align_flight, power_samples, AlignOptions};

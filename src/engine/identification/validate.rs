@@ -4,13 +4,13 @@
 
 use serde::Serialize;
 
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::logs::{FlightLogs, SkippedLog};
 use crate::engine::conditions::air::{log_air, AirInput};
-use crate::engine::finite::finite;
 use crate::engine::identification::fit_quality::{
     judge_flight, Alignment, FitQuality, FlightJudged,
 };
 use crate::engine::identification::replay::compared_airborne;
-use crate::engine::logs::{FlightLogs, SkippedLog};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 use crate::identify::{

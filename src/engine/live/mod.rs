@@ -20,8 +20,8 @@ use serde::Serialize;
 use aloft_logs::frame::enu_to_geodetic;
 use aloft_logs::telemetry::TelemetrySource;
 
+use crate::engine::basics::finite::finite;
 use crate::engine::conditions::air::AirInput;
-use crate::engine::finite::finite;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::uncertainty::scenario_stats::Percentiles;
 use crate::engine::vehicles::vehicle::Vehicle;

@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use aloft_logs::telemetry::{Paced, Reply, Telemetry, TelemetrySource};
 
-use crate::engine::logs::FlightLogs;
+use crate::engine::basics::logs::FlightLogs;
 use crate::error::Error;
 
 /// A source of `aloft live`.

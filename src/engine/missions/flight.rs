@@ -8,7 +8,7 @@ use aloft_planner::{
     PlannerError, SampleSink, SegmentSpec, Wind,
 };
 
-use crate::engine::step_meter::StepMeter;
+use crate::engine::basics::step_meter::StepMeter;
 
 /// Descent rate of the landing after a return home that aloft adds (a loiter's, a sortie's), m/s
 /// (or the airframe's limit if lower): an autopilot's gentle landing.

@@ -7,8 +7,8 @@ use serde::Serialize;
 use aloft_planner::{MissionReport, MissionSpec, Pack, PlanOptions, Sample, Shortfall, Wind};
 use aloft_power::AoaModel;
 
+use crate::engine::basics::finite::finite;
 use crate::engine::conditions::air::Air;
-use crate::engine::finite::finite;
 use crate::engine::missions::day::{mission_air, mission_wind};
 use crate::engine::missions::flight::Flight;
 use crate::engine::missions::flown::flown_spec;

@@ -8,7 +8,7 @@ use aloft_missions::{route_figures, ReadOptions, RouteFigures, SourceFormat};
 use crate::engine::missions::ground::{Frame, Ground};
 use aloft_planner::MissionSpec;
 
-use crate::engine::files::read_text_file;
+use crate::engine::basics::files::read_text_file;
 use crate::error::Error;
 
 /// The built-in demonstration mission (identical to `fixtures/missions/demo-survey.toml`): four

@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 use aloft_planner::{CornerMode, WindSpec};
 use aloft_power::AoaModel;
 
+use crate::engine::basics::step_meter::StepMeter;
 use crate::engine::conditions::air::AirInput;
-use crate::engine::step_meter::StepMeter;
 use crate::error::Error;
 
 /// The least clearance over the ground of a route flown over terrain, m (the default:

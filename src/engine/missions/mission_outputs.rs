@@ -2,7 +2,7 @@
 //! not grow with the flight: a CSV time series, MCAP (the samples and the planned path) that
 //! Foxglove displays, and a decimated copy for a chart.
 //!
-//! The files are written in aloft's one way ([`crate::engine::files`]): each to a temporary file beside
+//! The files are written in aloft's one way ([`crate::engine::basics::files`]): each to a temporary file beside
 //! it, placed together when the flight is flown (all or nothing); a run that fails, or a program
 //! interrupted, leaves none of them; an existing file is kept unless `force`.
 
@@ -13,8 +13,8 @@ use aloft_logs::{Attitude, BatteryPoint, McapFile, MissionSample, PathPoint, Pow
 use aloft_planner::trajectory::Shape;
 use aloft_planner::{PlannerError, Sample, SampleSink};
 
-use crate::engine::files::{shown_path, Output, OutputError, OutputSet};
-use crate::engine::finite::first_non_finite;
+use crate::engine::basics::files::{shown_path, Output, OutputError, OutputSet};
+use crate::engine::basics::finite::first_non_finite;
 use crate::error::Error;
 
 /// Points drawn per arc of the planned path, so the path shows the circle.

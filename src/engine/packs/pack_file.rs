@@ -25,7 +25,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::engine::files::read_text_file;
+use crate::engine::basics::files::read_text_file;
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 

@@ -38,9 +38,9 @@ use aloft_logs::BatterySample;
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
 use aloft_packs::{analyse_with, FittedOcv, PackOptions, PackReport};
 
-use crate::engine::files::{check_output, write_output};
-use crate::engine::finite::finite;
-use crate::engine::logs::SkippedLog;
+use crate::engine::basics::files::{check_output, write_output};
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::logs::SkippedLog;
 use crate::engine::packs::pack_file::{Failsafe, PackFile};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;

@@ -9,9 +9,9 @@ use aloft_planner::{
 };
 use aloft_power::AoaModel;
 
+use crate::engine::basics::finite::finite;
 use crate::engine::conditions::air::{vehicle_air, Air, AirInput};
 use crate::engine::conditions::wind::{describe_wind_spec, steady};
-use crate::engine::finite::finite;
 use crate::engine::vehicles::vehicle::{TakeoffMass, Vehicle};
 use crate::error::Error;
 

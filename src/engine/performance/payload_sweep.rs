@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use aloft_planner::EnduranceReport;
 
-use crate::engine::finite::finite;
+use crate::engine::basics::finite::finite;
 use crate::engine::performance::endurance::{endurance, EnduranceOptions, EnduranceSummary};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::{Error, SweepProblem};

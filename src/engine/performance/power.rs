@@ -11,9 +11,9 @@ use serde::Serialize;
 use aloft_power::{AoaInput, AoaModel, FlightState, ModelOptions, PowerBreakdown, PowerModel};
 use aloft_power::{Term, Terms};
 
+use crate::engine::basics::files::{open_input_file, shown_path, Output};
+use crate::engine::basics::finite::finite;
 use crate::engine::conditions::air::{vehicle_air, Air, AirInput};
-use crate::engine::files::{open_input_file, shown_path, Output};
-use crate::engine::finite::finite;
 use crate::engine::performance::power_batch::power_csv;
 use crate::engine::vehicles::vehicle::{TakeoffMass, Vehicle};
 use crate::error::Error;
@@ -230,7 +230,7 @@ fn aoa_input(aoa: Option<AoaModel>, air_direction_deg: Option<f64>) -> Result<Ao
 /// Stream the CSV of states at `input` through the model of `vehicle` at the query's take-off
 /// mass, terms and cutoff ([`power_model`]; the states come from the rows) into `output`, or
 /// standard output when `None`, one row at a time (see [`power_csv`]). Returns the number of
-/// rows. The output file is written in aloft's one way ([`crate::engine::files::write_output`]): placed when
+/// rows. The output file is written in aloft's one way ([`crate::engine::basics::files::write_output`]): placed when
 /// every row is written (an error leaves nothing), an existing file replaced only with `force`.
 ///
 /// # Errors

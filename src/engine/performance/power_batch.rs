@@ -11,8 +11,8 @@ use std::io::{Read, Write};
 
 use aloft_power::{AoaInput, FlightState, PowerBreakdown, PowerModel};
 
-use crate::engine::files::check_csv_header;
-use crate::engine::finite::first_non_finite;
+use crate::engine::basics::files::check_csv_header;
+use crate::engine::basics::finite::first_non_finite;
 use crate::error::Error;
 
 /// The result columns, in order (the same keys as `aloft power --format json`).

@@ -9,8 +9,8 @@ use aloft_propulsion::{
     mass_range_kg, rotor_step_response, EscProtocol, HoverResult, RotorSpec, RotorTransientResult,
 };
 
-use crate::engine::files::read_text_file;
-use crate::engine::finite::finite;
+use crate::engine::basics::files::read_text_file;
+use crate::engine::basics::finite::finite;
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 

@@ -40,8 +40,9 @@ use aloft_missions::SourceFormat;
 use aloft_planner::geodesy::LocalFrame;
 use aloft_planner::{best_range_within_limits, MissionSpec, SegmentSpec, Wind};
 
-use crate::engine::files::{safe_stem, shown_path, OutputSet};
-use crate::engine::finite::finite;
+use crate::engine::basics::files::{safe_stem, shown_path, OutputSet};
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::step_meter::WorkBounds;
 use crate::engine::missions::day::mission_wind;
 use crate::engine::missions::mission::{plan_mission, prepare, Prepared};
 use crate::engine::missions::mission_file::{Mission, DEMO_FILE_STEM, DEMO_ORIGIN};
@@ -55,7 +56,6 @@ use crate::engine::plan_to_fly::plan_files::PlannerSorties;
 use crate::engine::plan_to_fly::survey_angle::{
     turned_to_wind, unturnable, AngleChange, AngleKept,
 };
-use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenarios::{ScenarioOptions, Spreads};
 use crate::engine::uncertainty::sortie_bands::SortieScenarios;
 use crate::engine::vehicles::vehicle::Vehicle;
@@ -236,7 +236,7 @@ pub struct FlyPlanRequest {
     pub follow_frames: aloft_missions::follow_terrain::FollowFrames,
     /// What the request may spend: a plan stops with [`Error::Cancelled`] before its next
     /// candidate, angle or sortie once cancelled (its steps, and its flights once cancelled, are
-    /// bounded by the options' [`StepMeter`](crate::engine::step_meter::StepMeter) when the caller gives one).
+    /// bounded by the options' [`StepMeter`](crate::engine::basics::step_meter::StepMeter) when the caller gives one).
     pub bounds: WorkBounds,
 }
 

@@ -22,8 +22,8 @@ use aloft_missions::survey::candidate_angles;
 use aloft_missions::{plan_entries, write_plan, Imported};
 use aloft_planner::Wind;
 
+use crate::engine::basics::step_meter::WorkBounds;
 use crate::engine::missions::mission_file::Mission;
-use crate::engine::step_meter::WorkBounds;
 use crate::error::Error;
 
 /// The step of the candidate angles, deg (the geometry of a survey's turn, its coverage and

@@ -68,7 +68,7 @@ impl SegmentBand {
 /// Bands of the state of charge over time across the scenarios flown to the end of the route: at
 /// each time of a fixed grid, the 5th, 50th and 95th percentiles (a scenario that has landed
 /// keeps its last state; one that ended early, its pack empty or a path it could not fly, is
-/// left out). Resolution 0.1 % of state of charge. The map's `band` ([`crate::engine::maps::mission_map::MissionMap`]).
+/// left out). Resolution 0.1 % of state of charge. The map's `band` ([`crate::engine::front_door::maps::mission_map::MissionMap`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SocFan {
     /// Times of the grid, s.

@@ -72,7 +72,8 @@ use aloft_planner::{
     WindSpec,
 };
 
-use crate::engine::finite::finite;
+use crate::engine::basics::finite::finite;
+use crate::engine::basics::step_meter::WorkBounds;
 use crate::engine::missions::day::mission_wind;
 use crate::engine::missions::flight::Flight;
 use crate::engine::missions::flown::flown_spec;
@@ -83,7 +84,6 @@ use crate::engine::missions::mission_options::MissionOptions;
 use crate::engine::missions::summary::reason;
 use crate::engine::missions::summary::MissionSummary;
 use crate::engine::performance::endurance::EnduranceOptions;
-use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenario_stats::{
     nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
 };

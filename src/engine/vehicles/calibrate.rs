@@ -327,12 +327,12 @@ pub struct SpecCalibration {
 
 impl SpecCalibration {
     /// Write the vehicle file ([`Self::to_toml`]) to `path` (`aloft vehicles calibrate -o`), in
-    /// aloft's one way ([`crate::engine::files::write_output`]): an existing file is replaced only with `force`.
+    /// aloft's one way ([`crate::engine::basics::files::write_output`]): an existing file is replaced only with `force`.
     ///
     /// # Errors
     /// [`Error::Output`] naming the file when it exists (without `force`) or cannot be written.
     pub fn write_vehicle_file(&self, path: &std::path::Path, force: bool) -> Result<(), Error> {
-        crate::engine::files::write_output(path, self.to_toml()?.as_bytes(), force)
+        crate::engine::basics::files::write_output(path, self.to_toml()?.as_bytes(), force)
     }
 
     /// The vehicle file as TOML, headed by comments that say where each part came from.
@@ -411,16 +411,16 @@ pub fn calibrate_spec(spec: &SpecSheet, origin: &str) -> Result<SpecCalibration,
 /// # Errors
 /// The file's read error, and those of [`SpecSheet::from_toml`] and [`calibrate_spec`].
 pub fn calibrate_spec_file(path: &std::path::Path) -> Result<SpecCalibration, Error> {
-    let text = crate::engine::files::read_text_file(path, "spec sheet")?;
+    let text = crate::engine::basics::files::read_text_file(path, "spec sheet")?;
     let origin = path.display().to_string();
     calibrate_spec(&SpecSheet::from_toml(&text, &origin)?, &origin)
 }
 
 /// Text for a TOML comment: anything that would end the comment line or reorder it (a control
-/// character, a bidirectional override) escaped ([`crate::engine::files::escaped`]), the line separators of
+/// character, a bidirectional override) escaped ([`crate::engine::basics::files::escaped`]), the line separators of
 /// Unicode too.
 fn comment_text(text: &str) -> String {
-    crate::engine::files::escaped(text)
+    crate::engine::basics::files::escaped(text)
         .replace('\u{2028}', "\\u{2028}")
         .replace('\u{2029}', "\\u{2029}")
 }

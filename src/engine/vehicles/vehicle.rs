@@ -7,7 +7,7 @@ use serde::Serialize;
 use aloft_planner::{Aircraft, Pack};
 use aloft_power::{FlightState, ModelOptions, PowerBreakdown, PowerModel};
 
-use crate::engine::files::read_text_file;
+use crate::engine::basics::files::read_text_file;
 use crate::error::Error;
 use crate::vehicle::{builtin_names, VehicleFile, VehicleSource, BUILTIN_VEHICLES};
 

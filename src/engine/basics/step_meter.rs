@@ -34,7 +34,7 @@ pub struct WorkBounds {
 
 impl WorkBounds {
     /// Whether the caller has given up on the answer.
-    pub(super) fn cancelled(&self) -> bool {
+    pub(in crate::engine) fn cancelled(&self) -> bool {
         self.cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::Relaxed))
@@ -44,7 +44,11 @@ impl WorkBounds {
     ///
     /// # Errors
     /// [`Error::TooMuchWork`] beyond the bound.
-    pub(super) fn check(&self, samples: u32, steps_per_flight: u64) -> Result<(), Error> {
+    pub(in crate::engine) fn check(
+        &self,
+        samples: u32,
+        steps_per_flight: u64,
+    ) -> Result<(), Error> {
         let Some(max_steps) = self.max_steps else {
             return Ok(());
         };
@@ -116,7 +120,7 @@ impl StepMeter {
 
     /// `options` with the planner's limit on a flight's steps lowered to what is left (at least
     /// one step: a flight with none left stops at its first block).
-    pub(super) fn within(&self, options: &PlanOptions) -> PlanOptions {
+    pub(in crate::engine) fn within(&self, options: &PlanOptions) -> PlanOptions {
         match self.left() {
             Some(left) if left < options.max_samples => PlanOptions {
                 max_samples: left.max(1),
@@ -129,7 +133,7 @@ impl StepMeter {
     /// Count a flight flown with `options` ([`Self::within`]) of `own_max` steps of its own: its
     /// steps (its duration over the time step), or, when it stopped at the lowered limit, that
     /// limit and the budget refused.
-    pub(super) fn count(
+    pub(in crate::engine) fn count(
         &self,
         flown: &Result<MissionReport, PlannerError>,
         options: &PlanOptions,

@@ -17,7 +17,7 @@
 
 use serde::Serialize;
 
-use crate::engine::maps::mission_map::{mission_map, GeoPoint, MapPoint, SegmentPath};
+use crate::engine::front_door::maps::mission_map::{mission_map, GeoPoint, MapPoint, SegmentPath};
 use crate::engine::missions::mission::plan_mission;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::plan_to_fly::fly_plan::{FlyPlan, FlyPlanRequest};

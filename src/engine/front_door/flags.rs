@@ -5,7 +5,7 @@
 //! need or exclude each other) and the mapping from what was given to the engine's request
 //! (precedence included). The `aloft` command line flattens these groups into its subcommands;
 //! the Python package parses its keyword arguments with the very same groups
-//! ([`crate::engine::keywords`]), so an option's name, default and range are written once. Python's
+//! ([`crate::engine::front_door::keywords`]), so an option's name, default and range are written once. Python's
 //! keyword is the flag's long name in snake_case (`--payload-kg` is `payload_kg=`).
 //!
 //! What only one front end has (output formats, files to write, progress) stays with it.
@@ -18,15 +18,17 @@ use clap::Args;
 use aloft_planner::{CornerMode, WindProfileKind, WindSpec};
 use aloft_power::{AoaModel, Term};
 
-use super::EnduranceOptions;
+use crate::engine::basics::logs::{FlightLogs, LogArg, LogReadOptions};
+use crate::engine::basics::step_meter::StepMeter;
+use crate::engine::basics::step_meter::WorkBounds;
 use crate::engine::conditions::air::AirInput;
 use crate::engine::identification::fit::{fit_parameter, FitRequest};
 use crate::engine::identification::own_vehicle::OwnVehicle;
 use crate::engine::identification::validate::ValidateRequest;
 use crate::engine::live::{LiveReplayRequest, LiveRequest, LiveSource};
-use crate::engine::logs::{FlightLogs, LogArg, LogReadOptions};
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_options::{GustSpec, MissionOptions, DEFAULT_MIN_CLEARANCE_M};
+use crate::engine::performance::endurance::EnduranceOptions;
 use crate::engine::performance::payload_sweep::PayloadSweep;
 use crate::engine::performance::power::PowerModelQuery;
 use crate::engine::plan_to_fly::fly_plan::{
@@ -34,8 +36,6 @@ use crate::engine::plan_to_fly::fly_plan::{
     DEFAULT_LOITER_UNLIMITED_S, DEFAULT_OVERLAP_M, DEFAULT_PLAN_SCENARIOS,
     DEFAULT_WIND_FROM_SD_DEG,
 };
-use crate::engine::step_meter::StepMeter;
-use crate::engine::step_meter::WorkBounds;
 use crate::engine::uncertainty::scenarios::{
     ScenarioOptions, DEFAULT_POWER_SD_PERCENT, MAX_SCENARIOS,
 };
@@ -1020,7 +1020,7 @@ pub struct LiveFlags {
     #[arg(value_parser = finite(), long, value_name = "V")]
     pub start_voltage_v: Option<f64>,
     /// Monte-Carlo scenarios of the route ahead per update.
-    #[arg(long, default_value_t = super::LIVE_SCENARIOS, value_parser = clap::value_parser!(u32).range(1..=10_000), value_name = "N")]
+    #[arg(long, default_value_t = crate::engine::live::LIVE_SCENARIOS, value_parser = clap::value_parser!(u32).range(1..=10_000), value_name = "N")]
     pub scenarios: u32,
     /// aloft's MAVLink system id on the link (a ground station's).
     #[arg(long, default_value_t = 255, value_name = "ID")]
@@ -1032,11 +1032,11 @@ pub struct LiveFlags {
     /// The component of the vehicle's own system aloft's battery, texts and values are sent
     /// from, 1-255 (191: MAV_COMP_ID_ONBOARD_COMPUTER), so a ground station shows them beside
     /// the autopilot's.
-    #[arg(long, default_value_t = super::DEFAULT_DISPLAY_COMPONENT_ID, value_parser = clap::value_parser!(u8).range(1..), value_name = "ID", allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::engine::live::DEFAULT_DISPLAY_COMPONENT_ID, value_parser = clap::value_parser!(u8).range(1..), value_name = "ID", allow_negative_numbers = true)]
     pub display_component_id: u8,
     /// The BATTERY_STATUS id aloft's own estimate of the pack is sent under, 0-255 (100: above
     /// ArduPilot's 0-15 and PX4's 0-3, so no autopilot battery's).
-    #[arg(long, default_value_t = super::DEFAULT_BATTERY_ID, value_name = "ID", allow_negative_numbers = true)]
+    #[arg(long, default_value_t = crate::engine::live::DEFAULT_BATTERY_ID, value_name = "ID", allow_negative_numbers = true)]
     pub battery_id: u8,
     /// Silence of the vehicle after which the link is said lost, s (in a telemetry log: a
     /// forward step of its clock longer than this, not waited through nor counted as time).

@@ -2,7 +2,7 @@
 //! ground, segment by segment, in east-north-up metres from home and, for a mission with a
 //! geographic home (every planner file), in latitude and longitude; the point of no return; the
 //! state of charge over time; with scenarios its 5-95 % band; and with terrain the route's profile
-//! over the ground ([`route_profile`](crate::engine::maps::profile::route_profile), set by
+//! over the ground ([`route_profile`](crate::engine::front_door::maps::profile::route_profile), set by
 //! `answers::mission_map_answer_with`).
 //!
 //! The route is the compiled mission's pieces (the path the planner flies, corners and the way
@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use aloft_planner::geodesy::LocalFrame;
 
-use crate::engine::maps::profile::TerrainProfile;
+use crate::engine::front_door::maps::profile::TerrainProfile;
 use crate::engine::missions::mission::Plan;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_outputs::segment_paths;

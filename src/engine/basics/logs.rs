@@ -15,8 +15,8 @@ use aloft_logs::{
 use aloft_logs::{GroundDetector, GroundOptions, GroundPoint, GroundReport, Log};
 use aloft_power::AoaModel;
 
-use crate::engine::files::check_output;
-use crate::engine::finite::finite;
+use crate::engine::basics::files::check_output;
+use crate::engine::basics::finite::finite;
 use crate::error::Error;
 use crate::identify::{align_flight, AlignOptions, AlignedFlight};
 
@@ -831,7 +831,7 @@ pub(crate) type Loaded = (AlignedFlight, aloft_logs::Log);
 pub(crate) type LoadedLog = Result<Loaded, Error>;
 
 /// Whether a log flew, the one rule of `aloft fit` and `aloft validate` (through
-/// [`crate::engine::logs::FlightLogs::usable`]): a log whose own landed state (PX4
+/// [`crate::engine::basics::logs::FlightLogs::usable`]): a log whose own landed state (PX4
 /// `vehicle_land_detected`, ArduPilot's arming and landing) keeps it on the ground from its first
 /// record to its last never flew. A log without a landed state is not judged here (nothing in
 /// it tells a hover from the ground without a model of the vehicle).

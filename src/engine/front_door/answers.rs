@@ -10,18 +10,28 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{
-    calibrate_spec_file, endurance, endurance_scenarios, fit_logs, fly_plan_map, follow_live,
-    list_vehicles, log_info, mission_map, payload_sweep, plan_mission, plan_mission_with,
-    plan_scenarios, plan_to_fly, power_curve, replay_live, validate_logs, EnduranceWithUncertainty,
-    FlyPlan, LiveUpdate, Mission, MissionOutputs, MissionWithUncertainty, SortieMap, Vehicle,
-    VehicleEntry,
-};
-use crate::engine::flags::{
+use crate::engine::basics::logs::log_info;
+use crate::engine::front_door::flags::{
     EnduranceFlags, FitFlags, LiveFlags, LiveTask, LogInfoFlags, MissionScenarioFlags, PlanFlags,
     ValidateFlags,
 };
-use crate::engine::maps::profile::route_profile;
+use crate::engine::front_door::maps::mission_map::mission_map;
+use crate::engine::front_door::maps::plan_map::{fly_plan_map, SortieMap};
+use crate::engine::front_door::maps::profile::route_profile;
+use crate::engine::identification::fit::fit_logs;
+use crate::engine::identification::validate::validate_logs;
+use crate::engine::live::{follow_live, replay_live, LiveUpdate};
+use crate::engine::missions::mission::{plan_mission, plan_mission_with};
+use crate::engine::missions::mission_file::Mission;
+use crate::engine::missions::mission_outputs::MissionOutputs;
+use crate::engine::performance::endurance::{endurance, power_curve};
+use crate::engine::performance::payload_sweep::payload_sweep;
+use crate::engine::plan_to_fly::fly_plan::{plan_to_fly, FlyPlan};
+use crate::engine::uncertainty::scenarios::{
+    endurance_scenarios, plan_scenarios, EnduranceWithUncertainty, MissionWithUncertainty,
+};
+use crate::engine::vehicles::calibrate::calibrate_spec_file;
+use crate::engine::vehicles::vehicle::{list_vehicles, Vehicle, VehicleEntry};
 use crate::error::Error;
 
 /// A value as the command line's JSON text.
@@ -83,7 +93,7 @@ pub fn mission_map_answer(
     mission_map_answer_for(&Mission::load(path)?, flags)
 }
 
-/// The page's map of a mission already read ([`MissionMap`](super::MissionMap)): the route
+/// The page's map of a mission already read ([`MissionMap`](crate::engine::MissionMap)): the route
 /// per segment, the point of no return, the state of charge over time, when the flags ask
 /// for scenarios its band, and with terrain the route's profile over the ground, as compact JSON. Planned with the same flags as [`mission_answer_for`], so the two
 /// answers describe one flight.

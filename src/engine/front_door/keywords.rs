@@ -1,5 +1,5 @@
 //! Options by keyword (Python's `aloft.mission(payload_kg=0.5)`), parsed with the command
-//! line's own description of the options ([`crate::engine::flags`]): the same names, defaults, ranges
+//! line's own description of the options ([`crate::engine::front_door::flags`]): the same names, defaults, ranges
 //! and pairs, so the two cannot drift. Only the words of the messages differ: a keyword is named
 //! `'payload_kg' of aloft.mission`, as the caller wrote it.
 
@@ -10,7 +10,7 @@ use clap::{Arg, ArgAction, Args, Command, FromArgMatches};
 
 use crate::error::Error;
 
-/// An option group that can be parsed from keywords (every group of [`crate::engine::flags`]).
+/// An option group that can be parsed from keywords (every group of [`crate::engine::front_door::flags`]).
 pub trait FlagGroup: Args + FromArgMatches {}
 
 impl<T: Args + FromArgMatches> FlagGroup for T {}
@@ -62,7 +62,7 @@ const FILE_VALUE_WORDS: [&str; 6] = ["FILE", "CSV", "TOML", "LOG", "MCAP", "PROF
 
 /// The keywords of the options of `T` whose value may name a file to read (or write): a caller
 /// that answers others (`aloft serve`) resolves or refuses each, so that no request names a
-/// file of the server's ([`crate::engine::flags`] gives every such option a value name that says so).
+/// file of the server's ([`crate::engine::front_door::flags`] gives every such option a value name that says so).
 pub fn file_keywords<T: FlagGroup>() -> Vec<String> {
     let cmd = T::augment_args(Command::new("aloft"));
     let mut names: Vec<String> = cmd
@@ -333,7 +333,7 @@ fn needers(cmd: &Command, first: &str) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::engine::flags::{
+    use crate::engine::front_door::flags::{
         EnduranceFlags, FitFlags, LiveFlags, LogInfoFlags, MissionScenarioFlags, PowerModelFlags,
         ValidateFlags,
     };
