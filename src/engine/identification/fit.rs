@@ -110,7 +110,7 @@ pub struct LogFitReport {
 /// The answer of [`fit_logs`]: the JSON of `aloft fit --format json`, and the vehicle file.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FitAnswer {
-    /// The verdict: `good`, `usable` or `poor` (see [`crate::engine::basics::logs::fit_quality`]).
+    /// The verdict: `good`, `usable` or `poor` (see [`crate::engine::identification::fit_quality`]).
     pub quality: FitQuality,
     /// Why, one reason a line.
     pub quality_reasons: Vec<String>,
