@@ -39,6 +39,19 @@ impl Trapezoid {
         self.last = Some((time, value));
     }
 
+    /// As [`Trapezoid::push`], but a step from the previous sample that is not forward or is
+    /// longer than `max_gap` (a gap in the data) adds no panel; the sample is the last either way.
+    #[inline]
+    pub fn push_bridging(&mut self, time: f64, value: f64, max_gap: f64) {
+        if let Some((t0, v0)) = self.last {
+            let dt = time - t0;
+            if dt > 0.0 && dt <= max_gap {
+                self.integral += panel(t0, v0, time, value);
+            }
+        }
+        self.last = Some((time, value));
+    }
+
     /// The integral so far (0 before the second sample), in value units times time units.
     pub fn integral(&self) -> f64 {
         self.integral
@@ -84,6 +97,21 @@ mod tests {
         assert_eq!(trapezoid(&[], &[]).to_bits(), 0f64.to_bits());
         assert_eq!(trapezoid(&[1.0], &[5.0]).to_bits(), 0f64.to_bits());
         assert_eq!(Trapezoid::new().last(), None);
+    }
+
+    #[test]
+    fn a_gap_or_a_step_back_is_not_bridged() {
+        // Panels 0-1 s (150) and 5-7 s (400) with gaps of at most 5 s; the 4 s step from 1 to 5
+        // is bridged (800), the 6 s step from 7 to 13 and the step back to 12 are not.
+        let mut acc = Trapezoid::new();
+        for (t, v) in [(0.0, 100.0), (1.0, 200.0), (5.0, 200.0), (7.0, 200.0)] {
+            acc.push_bridging(t, v, 5.0);
+        }
+        assert_eq!(acc.integral(), 150.0 + 800.0 + 400.0);
+        acc.push_bridging(13.0, 200.0, 5.0);
+        acc.push_bridging(12.0, 200.0, 5.0);
+        assert_eq!(acc.integral(), 1350.0);
+        assert_eq!(acc.last(), Some((12.0, 200.0)));
     }
 
     proptest! {
