@@ -157,7 +157,7 @@ pub use plan_to_fly::fly_plan::{
 };
 pub use plan_to_fly::survey_angle::{AngleChange, AngleKept, ANGLE_STEP_DEG};
 pub use step_meter::{StepMeter, WorkBounds};
-pub use uncertainty::scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
+pub use uncertainty::scenario_stats::{Percentiles, SegmentBand};
 pub use uncertainty::scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,
