@@ -112,6 +112,24 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     err
 }
 
+/// Refused as the input contract says: exit 2, exactly one stderr line holding every needle, no
+/// panic, nothing on stdout.
+pub fn assert_refused(args: &[&str], needles: &[&str]) {
+    let o = aloft(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: one line expected: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: '{n}' missing in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    assert!(o.stdout.is_empty(), "{args:?}: nothing on stdout expected");
+}
+
 /// Writes a wind-field CSV to `path` (`x_m,y_m,z_m,u_mps,v_mps,w_mps`): the same `wind` (`u,v,w`
 /// in m/s) at each corner of the box `[half_width_m, top_m]`, ±`half_width_m` east and north of
 /// home from the ground to `top_m`.
