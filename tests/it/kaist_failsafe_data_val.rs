@@ -57,23 +57,11 @@ struct Judged {
 
 /// The CSV's (time s from the first row, voltage V), read here (not through aloft).
 fn csv_voltage(path: &Path) -> Vec<(f64, f64)> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (ts, vol) = (col("timestamp"), col("vol"));
-    let rows: Vec<(f64, f64)> = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (
-                f[ts].parse::<f64>().unwrap() * 1e-6,
-                f[vol].parse().unwrap(),
-            )
-        })
-        .collect();
-    let t0 = rows[0].0;
-    rows.into_iter().map(|(t, v)| (t - t0, v)).collect()
+    let rows = common::csv_columns(path, ["timestamp", "vol"]);
+    let t0 = rows[0][0] * 1e-6;
+    rows.into_iter()
+        .map(|[t_us, v]| (t_us * 1e-6 - t0, v))
+        .collect()
 }
 
 /// The voltage averaged over the 5 s before each row, time-weighted, each row's value held until

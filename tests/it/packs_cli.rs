@@ -6,7 +6,7 @@
 
 use crate::common;
 use common::kaist::pack_fit;
-use common::{aloft, assert_refused, data_dir, ok_json, ok_stdout, scratch};
+use common::{aloft, assert_refused, csv_columns, data_dir, ok_json, ok_stdout, scratch};
 
 use std::path::{Path, PathBuf};
 
@@ -27,21 +27,10 @@ fn s(p: &Path) -> &str {
 /// changed; steps are consecutive updates under 1.5 s apart whose current changed by more than
 /// max(2 A, 5 % of the largest current); the median of -dV/dI.
 fn kaist_step_r(p: &Path) -> f64 {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cv, ci) = (col("timestamp"), col("vol"), col("cur"));
     let mut u: Vec<(f64, f64, f64)> = Vec::new();
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
-        let (t, v, i): (f64, f64, f64) = (
-            f[ct].parse::<f64>().unwrap() * 1e-6,
-            f[cv].parse().unwrap(),
-            f[ci].parse().unwrap(),
-        );
+    for [t_us, v, i] in csv_columns(p, ["timestamp", "vol", "cur"]) {
         if u.last().is_none_or(|&(_, v0, i0)| v0 != v || i0 != i) {
-            u.push((t, v, i));
+            u.push((t_us * 1e-6, v, i));
         }
     }
     let i_max = u.iter().map(|x| x.2).fold(0.0, f64::max);
@@ -334,23 +323,11 @@ fn flugdrohne_fit_json(logs: &[&Path], extra: &[&str], out: &Path) -> serde_json
 /// The rows of a flugdrohne `battery_status` table: time (s from its first row), voltage (V),
 /// current (A), read here from the CSV export.
 fn battery_rows(csv: &Path) -> Vec<(f64, f64, f64)> {
-    let text = std::fs::read_to_string(csv).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cv, ci) = (col("timestamp"), col("voltage_v"), col("current_a"));
-    let rows: Vec<(f64, f64, f64)> = lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (
-                f[ct].parse::<f64>().unwrap() * 1e-6,
-                f[cv].parse().unwrap(),
-                f[ci].parse().unwrap(),
-            )
-        })
-        .collect();
-    let t0 = rows[0].0;
-    rows.into_iter().map(|(t, v, i)| (t - t0, v, i)).collect()
+    let rows = csv_columns(csv, ["timestamp", "voltage_v", "current_a"]);
+    let t0 = rows[0][0] * 1e-6;
+    rows.into_iter()
+        .map(|[t_us, v, i]| (t_us * 1e-6 - t0, v, i))
+        .collect()
 }
 
 /// The first number in `text` after `after`.
@@ -580,17 +557,9 @@ fn a_newline_in_a_log_name_stays_in_its_table_row() {
 
 /// The KAIST CSV's rows: (time s, gauge mA h, voltage V, current A), read here.
 fn kaist_rows(p: &Path) -> Vec<(f64, f64, f64, f64)> {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cq, cv, ci) = (col("timestamp"), col("capacity"), col("vol"), col("cur"));
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let x = |k: usize| f[k].parse::<f64>().unwrap();
-            (x(ct) * 1e-6, x(cq), x(cv), x(ci))
-        })
+    csv_columns(p, ["timestamp", "capacity", "vol", "cur"])
+        .into_iter()
+        .map(|[t_us, q, v, i]| (t_us * 1e-6, q, v, i))
         .collect()
 }
 
