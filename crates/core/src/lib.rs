@@ -33,7 +33,7 @@ pub mod output;
 
 pub use bisect::bisect;
 pub use input::{open_regular_file, read_regular_text};
-pub use integrate::{trapezoid, Trapezoid};
+pub use integrate::{trapezoid, trapezoid_window, Trapezoid};
 pub use line::IndexLine;
 
 /// Standard gravity `g0`, m/s^2 (CGPM 1901; ISO 80000-3). The default when a vehicle file does
