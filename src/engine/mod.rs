@@ -110,7 +110,7 @@ pub use logs::{
     LogInfo, LogReadOptions, LogTime, LogTopic, SkippedLog, TopicCount,
 };
 pub use maps::mission_map::{
-    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
+    mission_map, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };
 pub use maps::plan_map::{fly_plan_map, SortieMap};
 pub use maps::profile::{ProfileLeast, TerrainProfile, PROFILE_POINTS};
