@@ -538,17 +538,7 @@ fn held_integral(times: &[f64], values: &[f64], a: f64, b: f64) -> f64 {
             values[values.len() - 1]
         })
     };
-    let mut ts = vec![a];
-    let mut vs = vec![at(a)];
-    for (&t, &v) in times.iter().zip(values) {
-        if t > a && t < b {
-            ts.push(t);
-            vs.push(v);
-        }
-    }
-    ts.push(b);
-    vs.push(at(b));
-    aloft_core::trapezoid(&ts, &vs)
+    aloft_core::trapezoid_window(times, values, (a, b), at)
 }
 
 /// Validate `model` on `flight` over its airborne `spans` (motion time), where its samples

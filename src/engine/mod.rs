@@ -90,7 +90,7 @@ pub use basics::step_meter::{StepMeter, WorkBounds};
 pub use conditions::air::{resolve_air, Air, AirInput, AirSource};
 pub use front_door::keywords::{file_keywords, keywords, parse_keywords, FlagGroup, Keyword};
 pub use front_door::maps::mission_map::{
-    mission_map, GeoPoint, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
+    mission_map, MapPoint, MissionMap, SegmentPath, SocLine, MAP_CHART_POINTS,
 };
 pub use front_door::maps::plan_map::{fly_plan_map, SortieMap};
 pub use front_door::maps::profile::{ProfileLeast, TerrainProfile, PROFILE_POINTS};
@@ -154,7 +154,7 @@ pub use plan_to_fly::fly_plan::{
     DEFAULT_WIND_FROM_SD_DEG, MIN_WIND_SPEED_SD_MPS, WIND_SPEED_SD_SHARE,
 };
 pub use plan_to_fly::survey_angle::{AngleChange, AngleKept, ANGLE_STEP_DEG};
-pub use uncertainty::scenario_stats::{Percentiles, PointOfNoReturnPercentiles, SegmentBand};
+pub use uncertainty::scenario_stats::{Percentiles, SegmentBand};
 pub use uncertainty::scenarios::{
     endurance_scenarios, options_from_json, plan_scenarios, EnduranceUncertainty,
     EnduranceWithUncertainty, MissionWithUncertainty, ScenarioOptions, SocFan, Spreads,

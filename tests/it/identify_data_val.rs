@@ -203,12 +203,7 @@ fn data_val_px4_fit_with_defaults_gives_a_physical_vehicle_on_every_short_flight
         );
         let eta = v["power"]["vehicle"]["efficiency"].as_f64().unwrap();
         assert!(eta > 0.0 && eta <= 1.0, "{log}: efficiency {eta}");
-        let fitted: Vec<&str> = v["fitted_parameters"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_str().unwrap())
-            .collect();
+        let fitted = common::strs(&v["fitted_parameters"]);
         let kept = v["kept_parameters"].as_array().unwrap();
         for k in kept {
             assert!(!k["reason"].as_str().unwrap().is_empty(), "{k}");
@@ -472,12 +467,7 @@ fn data_val_validate_says_where_the_model_loses_to_a_constant() {
             (baseline / constant - 1.0).abs() < 0.1,
             "{baseline} vs {constant}"
         );
-        let reasons: Vec<&str> = f["quality_reasons"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|r| r.as_str().unwrap())
-            .collect();
+        let reasons = common::strs(&f["quality_reasons"]);
         let loses = reasons
             .iter()
             .any(|r| r.contains("loses to a constant at the flight's mean power"));

@@ -3,7 +3,7 @@
 //! never a signal, never NaN or inf in an output.
 
 use crate::common;
-use common::aloft;
+use common::{aloft, assert_refused};
 
 use std::io::Write as _;
 use std::process::{Command, Stdio};
@@ -53,23 +53,6 @@ fn aloft_limited(
 fn tmp(name: &str) -> String {
     let path = std::env::temp_dir().join(format!("aloft-contract-{}-{name}", std::process::id()));
     path.display().to_string()
-}
-
-/// Exit 2, exactly one stderr line, that line contains every needle, and no panic.
-fn assert_refused(args: &[&str], needles: &[&str]) {
-    let o = aloft(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: one line expected: {err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: '{n}' missing in: {err}");
-    }
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
-    assert!(o.stdout.is_empty(), "{args:?}: nothing on stdout expected");
 }
 
 const TAKE_OFF: &str =

@@ -20,7 +20,7 @@
 
 use crate::common;
 use common::kaist::{
-    fit_without_day, kaist, median, most_gauge_mah, pack_evidence, pack_fit, DAYS,
+    fit_without_day, kaist, live_check, median, most_gauge_mah, pack_evidence, pack_fit, DAYS,
 };
 
 use std::path::{Path, PathBuf};
@@ -57,23 +57,11 @@ struct Judged {
 
 /// The CSV's (time s from the first row, voltage V), read here (not through aloft).
 fn csv_voltage(path: &Path) -> Vec<(f64, f64)> {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let (ts, vol) = (col("timestamp"), col("vol"));
-    let rows: Vec<(f64, f64)> = lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (
-                f[ts].parse::<f64>().unwrap() * 1e-6,
-                f[vol].parse().unwrap(),
-            )
-        })
-        .collect();
-    let t0 = rows[0].0;
-    rows.into_iter().map(|(t, v)| (t - t0, v)).collect()
+    let rows = common::csv_columns(path, ["timestamp", "vol"]);
+    let t0 = rows[0][0] * 1e-6;
+    rows.into_iter()
+        .map(|[t_us, v]| (t_us * 1e-6 - t0, v))
+        .collect()
 }
 
 /// The voltage averaged over the 5 s before each row, time-weighted, each row's value held until
@@ -127,7 +115,7 @@ fn vehicle_without(held_out: &str) -> String {
         .fold(0.0, f64::max);
     let q_mah = (gauge_mah / 100.0).ceil() * 100.0;
     let pack_file = format!("{path}.pack.toml");
-    let fit = pack_fit(&other_days, q_mah, &pack_file);
+    let fit = pack_fit(&other_days, q_mah, 1.0, &pack_file);
     std::fs::remove_file(&pack_file).ok();
     let battery = &fit["pack"]["battery"];
     let list = |k: &str| {
@@ -166,30 +154,6 @@ fn vehicle_without(held_out: &str) -> String {
     path
 }
 
-/// `aloft live --route log` on `path` with the low-voltage failsafe at `threshold_v`: the check.
-fn live_check(path: &str, vehicle: &str, threshold_v: f64) -> serde_json::Value {
-    let threshold = format!("{threshold_v:.2}");
-    let out = common::ok_stdout(&[
-        "live",
-        "--replay",
-        path,
-        "--profile",
-        "kaist",
-        "--route",
-        "log",
-        "--vehicle",
-        vehicle,
-        "--every",
-        "10",
-        "--low-voltage-v",
-        &threshold,
-        "--format",
-        "json",
-    ]);
-    let last = out.lines().last().unwrap();
-    serde_json::from_str::<serde_json::Value>(last).unwrap()["check"].clone()
-}
-
 /// One flight judged with `vehicle`.
 fn judge_flight(path: &str, vehicle: &str) -> Judged {
     let rows = csv_voltage(Path::new(path));
@@ -198,7 +162,8 @@ fn judge_flight(path: &str, vehicle: &str) -> Judged {
     let at = rows.partition_point(|r| r.0 < THRESHOLD_AT * span_s);
     let threshold_v = (averages[at] * 100.0).round() / 100.0;
     let k = first_below(&averages, threshold_v);
-    let check = live_check(path, vehicle, threshold_v);
+    let threshold = format!("{threshold_v:.2}");
+    let check = live_check(path, vehicle, &["--low-voltage-v", &threshold]);
     let f = &check["failsafes"][0];
     let time = |c: &serde_json::Value, p: &str| c["predicted_s"][p].as_f64();
     let checkpoints = f["checkpoints"]

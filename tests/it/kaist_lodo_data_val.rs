@@ -17,7 +17,7 @@ use common::ok_json as aloft;
 
 use std::sync::OnceLock;
 
-use common::kaist::{fit_without_day, kaist, words, DAYS};
+use common::kaist::{fit_without_day, kaist, live_check, words, DAYS};
 
 /// One held-out flight.
 #[derive(Debug, Clone)]
@@ -63,29 +63,6 @@ fn sideslip_deg(path: &str) -> f64 {
     r2.sqrt().atan2(f2.sqrt()).to_degrees()
 }
 
-/// `aloft live --replay FLIGHT --route log --every 10` with `vehicle`: its last line, the check
-/// (an update every 10 s: the checkpoints at 40, 60 and 80 % fall on the first update after
-/// them).
-fn live_check(path: &str, vehicle: &str) -> serde_json::Value {
-    let out = common::ok_stdout(&words(&[
-        "live",
-        "--replay",
-        path,
-        "--profile",
-        "kaist",
-        "--route",
-        "log",
-        "--vehicle",
-        vehicle,
-        "--every",
-        "10",
-        "--format",
-        "json",
-    ]));
-    let last = out.lines().last().unwrap();
-    serde_json::from_str::<serde_json::Value>(last).unwrap()["check"].clone()
-}
-
 /// Fit on every day but `held_out`, then judge each flight of `held_out`.
 fn judge_day(held_out: &'static str) -> Vec<Judged> {
     let vehicle =
@@ -123,7 +100,7 @@ fn judge_day(held_out: &'static str) -> Vec<Judged> {
                 "--format",
                 "json",
             ]));
-            let live = live_check(path, &vehicle);
+            let live = live_check(path, &vehicle, &[]);
             Judged {
                 live: live["checkpoints"]
                     .as_array()

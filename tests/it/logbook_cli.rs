@@ -353,12 +353,7 @@ print(json.dumps(out))
     let tables = v["tables"].as_object().unwrap();
     assert_eq!(tables.len(), SCHEMA.len(), "{v}");
     for (table, columns) in SCHEMA {
-        let got: Vec<&str> = tables[table]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|c| c.as_str().unwrap())
-            .collect();
+        let got = common::strs(&tables[table]);
         assert_eq!(got, columns, "{table}");
     }
     assert_eq!(v["flights"][0], 2);

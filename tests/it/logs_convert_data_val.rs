@@ -42,16 +42,9 @@ fn trapezoid_wh(t: &[f64], p: &[f64]) -> f64 {
 
 /// Time (s) and V x I (W) of every row of a KAIST CSV, read here by column name.
 fn kaist_power(path: &Path) -> (Vec<f64>, Vec<f64>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ts, vol, cur) = (col("timestamp"), col("vol"), col("cur"));
-    lines
-        .map(|l| {
-            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (f[ts] * 1e-6, f[vol] * f[cur])
-        })
+    common::csv_columns(path, ["timestamp", "vol", "cur"])
+        .into_iter()
+        .map(|[t_us, v, i]| (t_us * 1e-6, v * i))
         .unzip()
 }
 

@@ -137,24 +137,7 @@ fn writers() -> Vec<Writer> {
         },
         Writer {
             name: "pack fit -o",
-            args: |o| {
-                let log = kaist_log();
-                strings(&[
-                    "pack",
-                    "fit",
-                    &log,
-                    "--profile",
-                    "kaist",
-                    "--cells",
-                    "12",
-                    "--capacity-mah",
-                    "12000",
-                    "--mass-kg",
-                    "4",
-                    "-o",
-                    o,
-                ])
-            },
+            args: |o| common::kaist::pack_fit_words(&[kaist_log()], 12000.0, 4.0, o),
         },
         Writer {
             name: "fit -o",

@@ -5,7 +5,8 @@
 //! copied from aloft's answers.
 
 use crate::common;
-use common::{aloft, data_dir, ok_json, scratch};
+use common::kaist::pack_fit;
+use common::{aloft, assert_refused, csv_columns, data_dir, ok_json, ok_stdout, scratch};
 
 use std::path::{Path, PathBuf};
 
@@ -26,21 +27,10 @@ fn s(p: &Path) -> &str {
 /// changed; steps are consecutive updates under 1.5 s apart whose current changed by more than
 /// max(2 A, 5 % of the largest current); the median of -dV/dI.
 fn kaist_step_r(p: &Path) -> f64 {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cv, ci) = (col("timestamp"), col("vol"), col("cur"));
     let mut u: Vec<(f64, f64, f64)> = Vec::new();
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
-        let (t, v, i): (f64, f64, f64) = (
-            f[ct].parse::<f64>().unwrap() * 1e-6,
-            f[cv].parse().unwrap(),
-            f[ci].parse().unwrap(),
-        );
+    for [t_us, v, i] in csv_columns(p, ["timestamp", "vol", "cur"]) {
         if u.last().is_none_or(|&(_, v0, i0)| v0 != v || i0 != i) {
-            u.push((t, v, i));
+            u.push((t_us * 1e-6, v, i));
         }
     }
     let i_max = u.iter().map(|x| x.2).fold(0.0, f64::max);
@@ -70,24 +60,7 @@ fn data_val_pack_fit_on_kaist_writes_the_median_step_resistance() {
     let a = kaist("2018-08-03.10_31_21random5-1.csv");
     let b = kaist("2018-08-03.10_52_43random5-2.csv");
     let out = tmp("kaist.toml");
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&a),
-        s(&b),
-        "--profile",
-        "kaist",
-        "--cells",
-        "12",
-        "--capacity-mah",
-        "12000",
-        "--mass-kg",
-        "4.0",
-        "-o",
-        s(&out),
-        "--format",
-        "json",
-    ]);
+    let j = pack_fit(&[a.clone(), b.clone()], 12000.0, 4.0, s(&out));
     let (ra, rb) = (kaist_step_r(&a), kaist_step_r(&b));
     let want = 0.5 * (ra + rb);
     let got = j["internal_resistance_ohm"].as_f64().unwrap();
@@ -218,17 +191,6 @@ fn failsafe_time_is_the_first_sample_below_the_threshold() {
     );
 }
 
-/// Exit 2 and one stderr line naming what is wrong.
-fn refused(args: &[&str], needles: &[&str]) {
-    let out = aloft(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {err} lacks {n}");
-    }
-}
-
 #[test]
 fn bad_input_is_exit_2_with_one_line() {
     // A pack file whose capacity is 0: the key and its range.
@@ -244,25 +206,25 @@ fn bad_input_is_exit_2_with_one_line() {
         vec!["endurance", "--battery", s(&zero)],
         vec!["power", "--battery", s(&zero), "--airspeed", "5"],
     ] {
-        refused(&cmd, &["capacity_mah = 0", "from 10 to 1e7 mA h", s(&zero)]);
+        assert_refused(&cmd, &["capacity_mah = 0", "from 10 to 1e7 mA h", s(&zero)]);
     }
     // A file that is not a log.
     let text = tmp("notes.txt");
     std::fs::write(&text, "not a log\n").unwrap();
     let out = tmp("x.toml");
-    refused(
+    assert_refused(
         &["pack", "fit", s(&text), "--mass-kg", "1", "-o", s(&out)],
         &[s(&text), "unsupported log format"],
     );
     // A missing file.
     let missing = tmp("missing.ulg");
-    refused(
+    assert_refused(
         &["pack", "fit", s(&missing), "--mass-kg", "1", "-o", s(&out)],
         &[s(&missing), "no such file"],
     );
     // The SITL log does not give its cells: named.
     let sitl = data_dir().join("flight_logs/sitl_ac47_00000002.BIN");
-    refused(
+    assert_refused(
         &["pack", "fit", s(&sitl), "--mass-kg", "0.3", "-o", s(&out)],
         &["cells_series", "--cells"],
     );
@@ -361,23 +323,11 @@ fn flugdrohne_fit_json(logs: &[&Path], extra: &[&str], out: &Path) -> serde_json
 /// The rows of a flugdrohne `battery_status` table: time (s from its first row), voltage (V),
 /// current (A), read here from the CSV export.
 fn battery_rows(csv: &Path) -> Vec<(f64, f64, f64)> {
-    let text = std::fs::read_to_string(csv).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cv, ci) = (col("timestamp"), col("voltage_v"), col("current_a"));
-    let rows: Vec<(f64, f64, f64)> = lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (
-                f[ct].parse::<f64>().unwrap() * 1e-6,
-                f[cv].parse().unwrap(),
-                f[ci].parse().unwrap(),
-            )
-        })
-        .collect();
-    let t0 = rows[0].0;
-    rows.into_iter().map(|(t, v, i)| (t - t0, v, i)).collect()
+    let rows = csv_columns(csv, ["timestamp", "voltage_v", "current_a"]);
+    let t0 = rows[0][0] * 1e-6;
+    rows.into_iter()
+        .map(|[t_us, v, i]| (t_us * 1e-6 - t0, v, i))
+        .collect()
 }
 
 /// The first number in `text` after `after`.
@@ -511,7 +461,7 @@ fn with_logged_capacity(stem: &str, mah: f32) -> PathBuf {
 fn data_val_a_logged_capacity_below_10_mah_is_unset_with_a_note() {
     let log = with_logged_capacity("log_66_2023-6-21-08-44-02", 1e-38);
     let out = tmp("tiny-capacity.toml");
-    refused(
+    assert_refused(
         &["pack", "fit", s(&log), "--mass-kg", "0.37", "-o", s(&out)],
         &["--capacity-mah"],
     );
@@ -544,7 +494,7 @@ fn a_given_capacity_below_10_mah_is_refused_with_its_range() {
     let log = flugdrohne("log_66_2023-6-21-08-44-02");
     let out = tmp("given-tiny.toml");
     for mah in ["5", "1e-38", "9.99"] {
-        refused(
+        assert_refused(
             &[
                 "pack",
                 "fit",
@@ -582,7 +532,7 @@ fn a_given_capacity_below_10_mah_is_refused_with_its_range() {
                 String::from_utf8_lossy(&o.stderr)
             );
         } else {
-            refused(&args, &["capacity_mah = 5", "from 10 to 1e7 mA h"]);
+            assert_refused(&args, &["capacity_mah = 5", "from 10 to 1e7 mA h"]);
         }
     }
 }
@@ -595,14 +545,7 @@ fn a_newline_in_a_log_name_stays_in_its_table_row() {
     let _ = std::fs::remove_file(&link);
     std::os::unix::fs::symlink(flugdrohne("log_66_2023-6-21-08-44-02"), &link).unwrap();
     let out = tmp("newline.toml");
-    let o = aloft(&flugdrohne_fit(&[&link], &[], &out));
-    let text = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let text = ok_stdout(&flugdrohne_fit(&[&link], &[], &out));
     assert!(
         text.lines()
             .any(|l| l.contains(r"two\nlines\u{1b}[31m.ulg")),
@@ -614,17 +557,9 @@ fn a_newline_in_a_log_name_stays_in_its_table_row() {
 
 /// The KAIST CSV's rows: (time s, gauge mA h, voltage V, current A), read here.
 fn kaist_rows(p: &Path) -> Vec<(f64, f64, f64, f64)> {
-    let text = std::fs::read_to_string(p).unwrap();
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
-    let (ct, cq, cv, ci) = (col("timestamp"), col("capacity"), col("vol"), col("cur"));
-    lines
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let x = |k: usize| f[k].parse::<f64>().unwrap();
-            (x(ct) * 1e-6, x(cq), x(cv), x(ci))
-        })
+    csv_columns(p, ["timestamp", "capacity", "vol", "cur"])
+        .into_iter()
+        .map(|[t_us, q, v, i]| (t_us * 1e-6, q, v, i))
         .collect()
 }
 
@@ -660,25 +595,7 @@ fn data_val_pack_fit_on_kaist_writes_the_packs_own_curve() {
     let a = kaist("2018-08-03.10_31_21random5-1.csv");
     let b = kaist("2018-08-03.10_52_43random5-2.csv");
     let out = tmp("kaist-ocv.toml");
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&a),
-        s(&b),
-        "--profile",
-        "kaist",
-        "--cells",
-        "12",
-        "--capacity-mah",
-        "13000",
-        "--mass-kg",
-        "4.0",
-        "-o",
-        s(&out),
-        "--force",
-        "--format",
-        "json",
-    ]);
+    let j = pack_fit(&[a, b], 13000.0, 4.0, s(&out));
     let ocv = &j["ocv"];
     let (lo, hi) = (
         ocv["measured_from_soc"].as_f64().unwrap(),
@@ -727,24 +644,7 @@ fn data_val_pack_fit_on_kaist_writes_the_packs_own_curve() {
 fn pack_fit_says_why_there_is_no_curve() {
     let b = kaist("2018-08-03.10_52_43random5-2.csv");
     let out = tmp("kaist-no-ocv.toml");
-    let j = ok_json(&[
-        "pack",
-        "fit",
-        s(&b),
-        "--profile",
-        "kaist",
-        "--cells",
-        "12",
-        "--capacity-mah",
-        "12000",
-        "--mass-kg",
-        "4.0",
-        "-o",
-        s(&out),
-        "--force",
-        "--format",
-        "json",
-    ]);
+    let j = pack_fit(&[b], 12000.0, 4.0, s(&out));
     let why = j["ocv_refused"].as_str().unwrap();
     // The gauge reads 12 596 mA h at the first record (the CSV's `capacity`).
     assert!(

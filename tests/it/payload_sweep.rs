@@ -3,7 +3,7 @@
 //! maximum take-off mass with a note, and the CLI's table, JSON, CSV, chart and refusals.
 
 use crate::common;
-use common::{aloft, ok_json, ok_stdout as stdout_of};
+use common::{assert_refused, ok_json, ok_stdout as stdout_of};
 
 use aloft::engine::{
     endurance, payload_sweep, EnduranceOptions, PayloadCurve, PayloadSweep, Vehicle,
@@ -202,19 +202,6 @@ fn every_number_of_a_sweep_is_finite_and_none_is_null() {
 }
 
 // ---- the command line ----
-
-/// Exit 2, exactly one stderr line holding every needle, nothing on stdout, no panic.
-fn assert_refused(args: &[&str], needles: &[&str]) {
-    let o = aloft(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: '{n}' missing in: {err}");
-    }
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
-    assert!(o.stdout.is_empty(), "{args:?}");
-}
 
 fn tmp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("aloft-payload-sweep-{}-{name}", std::process::id()))

@@ -136,12 +136,7 @@ fn the_sorties_resume_where_the_last_turned_home_less_the_overlap() {
     let mission = write_mission("overlap.toml", &survey_lines("lines", 24));
     for overlap in ["0", "30"] {
         let (answer, _) = plan(&mission, &["--overlap-m", overlap, "--speeds", "keep"]);
-        let files: Vec<&str> = answer["files"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_str().unwrap())
-            .collect();
+        let files = common::strs(&answer["files"]);
         let read =
             |p: &str| -> toml::Table { std::fs::read_to_string(p).unwrap().parse().unwrap() };
         for pair in files.windows(2) {

@@ -834,12 +834,7 @@ fn data_val_a_resumed_sortie_flies_out_at_its_own_speed_above_the_rtl_altitude()
         ));
         let (code, answer, err) = plan(&file, &scratch("plan-files", "fly-out"), &flags);
         assert_eq!(code, 0, "{err}");
-        let files: Vec<&str> = answer["files"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|f| f.as_str().unwrap())
-            .collect();
+        let files = common::strs(&answer["files"]);
         assert!(files.len() >= 2, "{answer}");
         for later in &files[1..] {
             let (speeds, resume) = speeds_and_resume(&std::fs::read_to_string(later).unwrap());

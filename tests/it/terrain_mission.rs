@@ -10,7 +10,9 @@
 //! - bad input: a mission in metres from home with terrain (exit 2, one line), a mission over no
 //!   tile (exit 2 naming the place).
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use crate::common;
 
@@ -63,6 +65,18 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// `aloft mission MISSION --terrain TERRAIN EXTRA...`.
+fn over_terrain(mission: &Path, terrain: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        OsStr::new("mission"),
+        mission.as_os_str(),
+        OsStr::new("--terrain"),
+        terrain.as_os_str(),
+    ];
+    args.extend(extra.iter().map(OsStr::new));
+    aloft(&args)
+}
+
 #[test]
 fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
     let bytes = std::fs::read(tiles().join("N44W072.hgt")).unwrap();
@@ -79,14 +93,7 @@ fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
     let tmp = tempfile::tempdir().unwrap();
     let mission = write(tmp.path(), "ridge.toml", &east_leg_toml(home, to_lon, up_m));
     let terrain = tiles();
-    let out = aloft(&[
-        "mission".as_ref(),
-        mission.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-        "--format".as_ref(),
-        "json".as_ref(),
-    ]);
+    let out = over_terrain(&mission, &terrain, &["--format", "json"]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["feasible"], false);
@@ -106,12 +113,7 @@ fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
     // The take-off starts on the ground: reported, not judged.
     assert!(v["segments"][0]["min_clearance_m"].as_f64().unwrap() < 1.0);
     // The table says it too.
-    let table = aloft(&[
-        "mission".as_ref(),
-        mission.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-    ]);
+    let table = over_terrain(&mission, &terrain, &[]);
     assert_eq!(table.status.code(), Some(1));
     assert!(
         stdout(&table).contains("least clearance: "),
@@ -131,21 +133,9 @@ fn data_val_a_leg_3_m_over_a_ridge_is_infeasible_naming_the_place() {
         "higher.toml",
         &east_leg_toml(home, to_lon, up_m + 10.0),
     );
-    let out = aloft(&[
-        "mission".as_ref(),
-        higher.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-    ]);
+    let out = over_terrain(&higher, &terrain, &[]);
     assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
-    let out = aloft(&[
-        "mission".as_ref(),
-        mission.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-        "--min-clearance-m".as_ref(),
-        "2".as_ref(),
-    ]);
+    let out = over_terrain(&mission, &terrain, &["--min-clearance-m", "2"]);
     assert_eq!(out.status.code(), Some(0), "{}", stdout(&out));
 }
 
@@ -220,14 +210,7 @@ fn a_terrain_frame_leg_up_a_slope_climbs_with_the_ground_and_pays_the_climb_powe
         &north_slanted_toml(rows, rise_m),
     );
     let json = |mission: &Path| -> Value {
-        let out = aloft(&[
-            "mission".as_ref(),
-            mission.as_os_str(),
-            "--terrain".as_ref(),
-            tiles.as_os_str(),
-            "--format".as_ref(),
-            "json".as_ref(),
-        ]);
+        let out = over_terrain(mission, &tiles, &["--format", "json"]);
         assert!(matches!(out.status.code(), Some(0 | 1)), "{}", stderr(&out));
         serde_json::from_slice(&out.stdout).unwrap()
     };
@@ -296,12 +279,7 @@ fn terrain_for_a_mission_in_metres_is_one_line_and_a_mission_off_the_tiles_names
         "far.toml",
         &east_leg_toml((10.0, 10.0), 10.01, 30.0),
     );
-    let out = aloft(&[
-        "mission".as_ref(),
-        far.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-    ]);
+    let out = over_terrain(&far, &terrain, &[]);
     assert_eq!(out.status.code(), Some(2), "{}", stdout(&out));
     let err = stderr(&out);
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
@@ -392,16 +370,11 @@ fn data_val_plan_follow_terrain_writes_a_mission_that_keeps_its_height_and_mavsd
     }
     // Flown as written: never closer than 50 m less the 10 m thinning tolerance (and the
     // bilinear ground's bends between two kept samples).
-    let out = aloft(&[
-        "mission".as_ref(),
-        written.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-        "--rtl-altitude-m".as_ref(),
-        "120".as_ref(),
-        "--format".as_ref(),
-        "json".as_ref(),
-    ]);
+    let out = over_terrain(
+        &written,
+        &terrain,
+        &["--rtl-altitude-m", "120", "--format", "json"],
+    );
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let m: Value = serde_json::from_slice(&out.stdout).unwrap();
     let least = m["min_clearance_m"].as_f64().unwrap();
@@ -464,16 +437,11 @@ fn data_val_a_pack_that_runs_out_before_the_ridge_still_has_the_ridge_judged() {
     let tmp = tempfile::tempdir().unwrap();
     let mission = write(tmp.path(), "two.toml", &text);
     let terrain = tiles();
-    let out = aloft(&[
-        "mission".as_ref(),
-        mission.as_os_str(),
-        "--terrain".as_ref(),
-        terrain.as_os_str(),
-        "--start-percent".as_ref(),
-        "3".as_ref(),
-        "--format".as_ref(),
-        "json".as_ref(),
-    ]);
+    let out = over_terrain(
+        &mission,
+        &terrain,
+        &["--start-percent", "3", "--format", "json"],
+    );
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(

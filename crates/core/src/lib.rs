@@ -9,6 +9,8 @@
 //!   other integral of sampled data, sample by sample or over slices;
 //! - [`atmosphere`]: the International Standard Atmosphere and the density of a day's air
 //!   (elevation, temperature, humidity, QNH);
+//! - [`IndexLine`], the least-squares line through values one step apart (a trend over flights,
+//!   a series' slow drift);
 //! - [`bisect`], the bracketing of a crossing by halving;
 //! - [`input`]: opening the files aloft reads, regular files only (a FIFO or a device is refused
 //!   before it is opened, so it cannot block), with a size limit for whole-file inputs;
@@ -26,11 +28,13 @@ pub mod atmosphere;
 pub mod bisect;
 pub mod input;
 pub mod integrate;
+pub mod line;
 pub mod output;
 
 pub use bisect::bisect;
 pub use input::{open_regular_file, read_regular_text};
-pub use integrate::{trapezoid, Trapezoid};
+pub use integrate::{trapezoid, trapezoid_window, Trapezoid};
+pub use line::IndexLine;
 
 /// Standard gravity `g0`, m/s^2 (CGPM 1901; ISO 80000-3). The default when a vehicle file does
 /// not give its own, and the unit `g` of accelerations in logs.

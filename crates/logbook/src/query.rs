@@ -2,6 +2,7 @@
 //! their flights. Flights are in flying order: by start time where the log gives one, then in
 //! the order they were added.
 
+use aloft_core::IndexLine;
 use rusqlite::Row;
 use serde::Serialize;
 
@@ -159,15 +160,8 @@ pub fn trend(values: &[f64]) -> Option<Trend> {
     let n = values.len();
     let nf = n as f64;
     let slope = (n >= 2).then(|| {
-        let mean_x = (nf - 1.0) / 2.0;
-        let mean_y = values.iter().sum::<f64>() / nf;
-        let (mut sxy, mut sxx) = (0.0, 0.0);
-        for (i, y) in values.iter().enumerate() {
-            let dx = i as f64 - mean_x;
-            sxy += dx * (y - mean_y);
-            sxx += dx * dx;
-        }
-        (sxy / sxx, mean_y - sxy / sxx * mean_x)
+        let line = IndexLine::of(values);
+        (line.slope, line.at(0.0))
     });
     let change_percent = slope
         .filter(|_| n >= 3)

@@ -10,6 +10,7 @@
 //! function only aligns two uniformly sampled series. [`resample_uniform`] brings a log's
 //! channel onto a uniform grid first.
 
+use aloft_core::IndexLine;
 use serde::Serialize;
 
 use crate::error::{LogError, Result};
@@ -30,19 +31,10 @@ pub struct LagEstimate {
 }
 
 fn detrend(y: &[f64]) -> Vec<f64> {
-    let n = y.len() as f64;
-    let xm = (n - 1.0) / 2.0;
-    let ym = y.iter().sum::<f64>() / n;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (i, v) in y.iter().enumerate() {
-        let dx = i as f64 - xm;
-        sxy += dx * (v - ym);
-        sxx += dx * dx;
-    }
-    let b = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    let line = IndexLine::of(y);
     y.iter()
         .enumerate()
-        .map(|(i, v)| v - ym - b * (i as f64 - xm))
+        .map(|(i, v)| v - line.mean_y - line.slope * (i as f64 - line.mean_x))
         .collect()
 }
 

@@ -24,6 +24,7 @@
 //! ([`PackError`]). A pack read straight after landing still recovers (surface charge, §2.4 of
 //! the research note), which is why the rest must hold.
 
+use aloft_core::Trapezoid;
 use aloft_logs::BatterySample;
 use aloft_propulsion::OcvCurve;
 use serde::Serialize;
@@ -43,21 +44,14 @@ pub const MIN_SOC_DROP: f64 = 0.1;
 
 /// Charge drawn over `samples` (trapezoid, gaps over [`MAX_GAP_S`] not bridged), mA h.
 pub fn coulomb_count_mah(samples: &[BatterySample]) -> f64 {
-    let mut q_as = 0.0;
-    let mut last: Option<(f64, f64)> = None;
+    let mut q_as = Trapezoid::new();
     for s in samples {
         let Some(i) = s.current_a.filter(|i| i.is_finite()) else {
             continue;
         };
-        if let Some((t0, i0)) = last {
-            let dt = s.time_s - t0;
-            if dt > 0.0 && dt <= MAX_GAP_S {
-                q_as += 0.5 * (i0 + i) * dt;
-            }
-        }
-        last = Some((s.time_s, i));
+        q_as.push_bridging(s.time_s, i, MAX_GAP_S);
     }
-    q_as / 3.6
+    q_as.integral() / 3.6
 }
 
 /// A capacity from two rests.

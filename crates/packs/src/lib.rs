@@ -231,20 +231,12 @@ pub fn analyse_with(log: &BatteryLog, options: &PackOptions) -> Result<PackRepor
 
 /// Energy drawn, ∫V·I dt (trapezoid; gaps over [`capacity::MAX_GAP_S`] not bridged), W h.
 pub fn energy_wh(log: &BatteryLog) -> f64 {
-    let mut e = 0.0;
-    let mut last: Option<(f64, f64)> = None;
+    let mut e = aloft_core::Trapezoid::new();
     for s in &log.samples {
         let Some(i) = s.current_a else { continue };
-        let p = s.voltage_v * i;
-        if let Some((t0, p0)) = last {
-            let dt = s.time_s - t0;
-            if dt > 0.0 && dt <= capacity::MAX_GAP_S {
-                e += 0.5 * (p0 + p) * dt;
-            }
-        }
-        last = Some((s.time_s, p));
+        e.push_bridging(s.time_s, s.voltage_v * i, capacity::MAX_GAP_S);
     }
-    e / 3600.0
+    e.integral() / 3600.0
 }
 
 #[cfg(test)]

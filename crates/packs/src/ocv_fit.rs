@@ -43,6 +43,7 @@
 //! under the flight's load less its resistive drop, not its rested voltage (a pack rested after
 //! the flight reads higher). That is the voltage the planner's model `V_oc(s) − I R` flies on.
 
+use aloft_core::Trapezoid;
 use aloft_logs::BatterySample;
 use aloft_propulsion::OcvCurve;
 use serde::Serialize;
@@ -207,7 +208,7 @@ fn check_inputs(capacity_mah: f64, resistance_ohm: f64) -> Result<(), PackError>
 /// the charge drawn up to each (trapezoid over all records, gaps over [`MAX_GAP_S`] not bridged).
 fn points(samples: &[BatterySample]) -> Vec<Point> {
     let mut out: Vec<Point> = Vec::new();
-    let (mut q_as, mut last) = (0.0, None::<(f64, f64)>);
+    let mut q_as = Trapezoid::new();
     for s in samples {
         let Some(i) = s.current_a.filter(|i| i.is_finite()) else {
             continue;
@@ -215,19 +216,13 @@ fn points(samples: &[BatterySample]) -> Vec<Point> {
         if !(s.voltage_v.is_finite() && s.time_s.is_finite()) {
             continue;
         }
-        if let Some((t0, i0)) = last {
-            let dt = s.time_s - t0;
-            if dt > 0.0 && dt <= MAX_GAP_S {
-                q_as += 0.5 * (i0 + i) * dt;
-            }
-        }
-        last = Some((s.time_s, i));
+        q_as.push_bridging(s.time_s, i, MAX_GAP_S);
         let repeat = out.last().is_some_and(|p| {
             p.voltage_v.to_bits() == s.voltage_v.to_bits() && p.current_a.to_bits() == i.to_bits()
         });
         if !repeat {
             out.push(Point {
-                drawn_mah: q_as / 3.6,
+                drawn_mah: q_as.integral() / 3.6,
                 gauge_mah: s.remaining_mah.filter(|g| g.is_finite() && *g >= 0.0),
                 voltage_v: s.voltage_v,
                 current_a: i,

@@ -517,13 +517,7 @@ impl SocFilter {
             gain = Some((k, h));
         }
         let Some((k, h)) = gain else { return };
-        let i_kh = Mat::identity() - k * h;
-        let p = i_kh * self.p * i_kh.transpose() + k * k.transpose() * r;
-        if xi.iter().chain(p.iter()).all(|v| v.is_finite()) {
-            self.x = xi;
-            self.p = 0.5 * (p + p.transpose());
-            self.keep_resistance_positive();
-        }
+        self.take(xi, k, h, r);
     }
 
     /// A state of charge `soc` (0-1) another estimator reports, believed as `kind` says; not
@@ -552,7 +546,13 @@ impl SocFilter {
             return;
         }
         let k = ph / s;
-        let x = self.x + k * y;
+        self.take(self.x + k * y, k, h, r);
+    }
+
+    /// The updated state `x` of a measurement with Jacobian `h` and variance `r` taken with
+    /// gain `k`, and its covariance in Joseph form (symmetrised), both where every value is
+    /// finite.
+    fn take(&mut self, x: Vect, k: Vect, h: Row, r: f64) {
         let i_kh = Mat::identity() - k * h;
         let p = i_kh * self.p * i_kh.transpose() + k * k.transpose() * r;
         if x.iter().chain(p.iter()).all(|v| v.is_finite()) {

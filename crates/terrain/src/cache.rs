@@ -57,21 +57,9 @@ impl Cache {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::georef::Georef;
 
     fn grid(samples: usize) -> Arc<Grid> {
-        Arc::new(Grid {
-            georef: Georef {
-                north_deg: 1.0,
-                west_deg: 0.0,
-                per_deg_lat: 1.0,
-                per_deg_lon: 1.0,
-                rows: 2,
-                cols: 2,
-                margin_px: 0.0,
-            },
-            samples: vec![0.0; samples],
-        })
+        Arc::new(Grid::one_cell(vec![0.0; samples]))
     }
 
     #[test]

@@ -104,6 +104,26 @@ pub(crate) fn bilinear(h: [f64; 4], u: f64, w: f64) -> f64 {
 }
 
 #[cfg(test)]
+impl Grid {
+    /// A test tile of one cell a degree square, its north-west corner at 1 deg N 0 deg E, with
+    /// `samples` (2 x 2: NW, NE, SW, SE; more only to weigh in memory).
+    pub(crate) fn one_cell(samples: Vec<f32>) -> Grid {
+        Grid {
+            georef: Georef {
+                north_deg: 1.0,
+                west_deg: 0.0,
+                per_deg_lat: 1.0,
+                per_deg_lon: 1.0,
+                rows: 2,
+                cols: 2,
+                margin_px: 0.0,
+            },
+            samples,
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 

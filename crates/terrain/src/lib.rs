@@ -331,11 +331,7 @@ impl Terrain {
             alt0_m: from.altitude_amsl_m,
             dalt_m: to.altitude_amsl_m - from.altitude_amsl_m,
         };
-        let mut least = Least {
-            clearance_m: f64::INFINITY,
-            t: 0.0,
-            ground_m: f64::NAN,
-        };
+        let mut least = Least::NONE;
         walk::for_each_run(&self.inner.index, &line, |run| {
             let grid = self.grid(run.tile)?;
             walk::run_least(&grid, &run, alt, &mut least)

@@ -180,6 +180,15 @@ pub(crate) struct Least {
     pub ground_m: f64,
 }
 
+impl Least {
+    /// None found yet: infinitely far, over no ground.
+    pub(crate) const NONE: Least = Least {
+        clearance_m: f64::INFINITY,
+        t: 0.0,
+        ground_m: f64::NAN,
+    };
+}
+
 /// The altitude along the path: `alt0_m + t * dalt_m`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Altitude {
@@ -380,7 +389,7 @@ mod tests {
                 sx: (lon_b - lon_a) * g.per_deg_lon,
                 sy: -(lat_b - lat_a) * g.per_deg_lat,
             };
-            let mut least = Least { clearance_m: f64::INFINITY, t: 0.0, ground_m: 0.0 };
+            let mut least = Least::NONE;
             let altitude = Altitude { alt0_m: alt.0, dalt_m: alt.1 - alt.0 };
             run_least(&grid, &run, altitude, &mut least).unwrap();
             let n = 20_000;
@@ -413,18 +422,7 @@ mod tests {
     /// would see 20 m.
     #[test]
     fn a_ridge_between_samples_is_found_inside_the_cell() {
-        let grid = Grid {
-            georef: Georef {
-                north_deg: 1.0,
-                west_deg: 0.0,
-                per_deg_lat: 1.0,
-                per_deg_lon: 1.0,
-                rows: 2,
-                cols: 2,
-                margin_px: 0.0,
-            },
-            samples: vec![0.0, 80.0, 80.0, 0.0],
-        };
+        let grid = Grid::one_cell(vec![0.0, 80.0, 80.0, 0.0]);
         // From the NW corner to the SE corner: u = w = t; ground = 160 t (1 - t), 40 m at t = 0.5.
         let run = Run {
             tile: 0,
@@ -435,11 +433,7 @@ mod tests {
             sx: 1.0,
             sy: 1.0,
         };
-        let mut least = Least {
-            clearance_m: f64::INFINITY,
-            t: 0.0,
-            ground_m: 0.0,
-        };
+        let mut least = Least::NONE;
         let alt = Altitude {
             alt0_m: 100.0,
             dalt_m: 0.0,
@@ -449,11 +443,7 @@ mod tests {
         assert!((least.t - 0.5).abs() < 1e-9 && (least.ground_m - 40.0).abs() < 1e-9);
         // Climbing 40 m along the way moves the vertex: c(t) = 100 + 40 t - 160 t + 160 t^2,
         // least at t = 120 / 320 = 0.375: 100 - 120 * 0.375 + 160 * 0.140625 = 77.5 m.
-        let mut least = Least {
-            clearance_m: f64::INFINITY,
-            t: 0.0,
-            ground_m: 0.0,
-        };
+        let mut least = Least::NONE;
         let climbing = Altitude {
             alt0_m: 100.0,
             dalt_m: 40.0,

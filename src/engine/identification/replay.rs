@@ -13,7 +13,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use aloft_core::trapezoid;
+use aloft_core::trapezoid_window;
 use aloft_logs::{GroundReport, Log};
 use aloft_planner::{differentiate_velocity, power_only_aircraft, replay, ReplayPoint};
 use aloft_power::{AoaModel, ModelOptions};
@@ -667,14 +667,5 @@ fn window_integral(times: &[f64], values: &[f64], a: f64, b: f64) -> f64 {
         let w = if t1 > t0 { (t - t0) / (t1 - t0) } else { 0.0 };
         values[i - 1] + w * (values[i] - values[i - 1])
     };
-    let (mut ts, mut vs) = (vec![a], vec![interp(a)]);
-    for (&t, &v) in times.iter().zip(values) {
-        if t > a && t < b {
-            ts.push(t);
-            vs.push(v);
-        }
-    }
-    ts.push(b);
-    vs.push(interp(b));
-    trapezoid(&ts, &vs)
+    trapezoid_window(times, values, (a, b), interp)
 }

@@ -36,7 +36,7 @@ use crate::error::Error;
 /// is said, m (the issue's; SRTM's absolute accuracy is 16 m at 90 %).
 pub const HOME_DISAGREES_M: f64 = 30.0;
 
-/// A point on the ground, degrees.
+/// A point on the ground, degrees (where a clearance is least, a map's home).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GroundAt {
     /// Latitude, deg.

@@ -1,6 +1,8 @@
 //! Missions: load one (a file, text, the built-in demo), plan it with a vehicle, and what the
 //! plan answers (summary, samples, what is left after a time, files for other tools).
 
+use std::borrow::Cow;
+
 use aloft_core::Trapezoid;
 use serde::Serialize;
 
@@ -227,22 +229,7 @@ pub fn plan_mission_with(
     options: &MissionOptions,
     outputs: &MissionOutputs,
 ) -> Result<Plan, Error> {
-    // Over terrain: the mission flown over the ground (its terrain-frame legs followed), in the
-    // air of home's ground.
-    let over = over_terrain(mission, options)?;
-    let (mission, terrain) = match &over {
-        Some((m, t)) => (m, Some(t)),
-        None => (mission, None),
-    };
-    let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
-    let (wind, wind_text) = mission_wind(options, mission, &vehicle)?;
-    plan_in(
-        &vehicle,
-        (mission, terrain),
-        options,
-        (&wind, wind_text, air),
-        outputs,
-    )
+    plan_over(vehicle, mission, options, None, outputs)
 }
 
 /// [`plan_mission`] in a wind built by the caller, which replaces the options' and the mission
@@ -256,19 +243,44 @@ pub fn plan_mission_in(
     options: &MissionOptions,
     wind: &Wind,
 ) -> Result<Plan, Error> {
+    plan_over(
+        vehicle,
+        mission,
+        options,
+        Some(wind),
+        &MissionOutputs::default(),
+    )
+}
+
+/// The day of a plan, then [`plan_in`]: over terrain, the mission flown over the ground (its
+/// terrain-frame legs followed), in the air of home's ground; in the wind `given`, else the one
+/// the options and the mission decide.
+fn plan_over(
+    vehicle: &Vehicle,
+    mission: &Mission,
+    options: &MissionOptions,
+    given: Option<&Wind>,
+    outputs: &MissionOutputs,
+) -> Result<Plan, Error> {
     let over = over_terrain(mission, options)?;
     let (mission, terrain) = match &over {
         Some((m, t)) => (m, Some(t)),
         None => (mission, None),
     };
     let (vehicle, air) = mission_air(vehicle, mission, &options.air)?;
-    let wind = (wind, "given by the caller".to_string(), air);
+    let (wind, wind_text) = match given {
+        Some(wind) => (Cow::Borrowed(wind), "given by the caller".to_string()),
+        None => {
+            let (wind, text) = mission_wind(options, mission, &vehicle)?;
+            (Cow::Owned(wind), text)
+        }
+    };
     plan_in(
         &vehicle,
         (mission, terrain),
         options,
-        wind,
-        &MissionOutputs::default(),
+        (&wind, wind_text, air),
+        outputs,
     )
 }
 

@@ -7,28 +7,6 @@ use aloft_planner::{PlannerError, Sample, SampleSink};
 
 pub use aloft_planner::percentiles::{nearest_rank, Percentiles};
 
-/// Percentiles of the time of the point of no return, s: each absent when it falls among the
-/// scenarios without a point of no return.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct PointOfNoReturnPercentiles {
-    /// 5th percentile: 95 % of the scenarios can still turn back until then.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub p5: Option<f64>,
-    /// Median.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub p50: Option<f64>,
-    /// 95th percentile.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub p95: Option<f64>,
-}
-
-impl PointOfNoReturnPercentiles {
-    /// Whether no percentile is known (the key is then left out).
-    pub fn is_empty(&self) -> bool {
-        self.p5.is_none() && self.p50.is_none() && self.p95.is_none()
-    }
-}
-
 /// The state of charge at the end of one segment over the completed scenarios.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SegmentBand {
@@ -288,12 +266,13 @@ mod tests {
     }
 }
 
-/// When something happens in a flight (a failsafe triggers), s, over scenarios: a percentile is
-/// left out where it falls on scenarios in which it does not happen before the landing (`p95`
-/// absent: in more than 5 % of them it never does).
+/// When something happens in a flight (a failsafe triggers, the point of no return), s, over
+/// scenarios: a percentile is left out where it falls on scenarios in which it does not happen
+/// (before the landing: `p95` absent where in more than 5 % of them it never does).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct TimeBand {
-    /// 5th percentile, s.
+    /// 5th percentile, s (of the point of no return: 95 % of the scenarios can still turn back
+    /// until then).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p5: Option<f64>,
     /// Median, s.
@@ -304,19 +283,23 @@ pub struct TimeBand {
     pub p95: Option<f64>,
 }
 
-/// The 5th, 50th and 95th percentiles (nearest rank) of sorted times, infinite where it does not
-/// happen, each left out where it falls on such a scenario; `None` where it happens in none.
+impl TimeBand {
+    /// Whether no percentile is known (the key is then left out).
+    pub fn is_empty(&self) -> bool {
+        self.p5.is_none() && self.p50.is_none() && self.p95.is_none()
+    }
+}
+
+/// The 5th, 50th and 95th percentiles ([`nearest_rank`]) of sorted times, infinite where it does
+/// not happen, each left out where it falls on such a scenario; `None` where it happens in none.
 pub(in crate::engine) fn time_band(sorted: &[f64]) -> Option<TimeBand> {
     if sorted.first().is_none_or(|t| !t.is_finite()) {
         return None;
     }
-    let at = |p: f64| {
-        let k = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
-        Some(sorted[k]).filter(|t| t.is_finite())
-    };
+    let at = |p: usize| Some(nearest_rank(sorted, p)).filter(|t| t.is_finite());
     Some(TimeBand {
-        p5: at(0.05),
-        p50: at(0.5),
-        p95: at(0.95),
+        p5: at(5),
+        p50: at(50),
+        p95: at(95),
     })
 }

@@ -84,10 +84,8 @@ use crate::engine::missions::mission_options::MissionOptions;
 use crate::engine::missions::summary::reason;
 use crate::engine::missions::summary::MissionSummary;
 use crate::engine::performance::endurance::EnduranceOptions;
-use crate::engine::uncertainty::scenario_stats::{
-    nearest_rank, FanHistogram, FanSink, Percentiles, PointOfNoReturnPercentiles, SegmentBand,
-};
 use crate::engine::uncertainty::scenario_stats::{time_band, TimeBand};
+use crate::engine::uncertainty::scenario_stats::{FanHistogram, FanSink, Percentiles, SegmentBand};
 use crate::engine::vehicles::vehicle::Vehicle;
 use crate::error::Error;
 
@@ -309,8 +307,8 @@ pub struct Uncertainty {
     pub p_point_of_no_return: f64,
     /// Time of the point of no return, s (see the module docs for how scenarios without one
     /// count); absent when fewer than 5 % of the scenarios have one.
-    #[serde(default, skip_serializing_if = "PointOfNoReturnPercentiles::is_empty")]
-    pub point_of_no_return_s: PointOfNoReturnPercentiles,
+    #[serde(default, skip_serializing_if = "TimeBand::is_empty")]
+    pub point_of_no_return_s: TimeBand,
     /// State of charge at the end of each segment, over the completed scenarios (absent when
     /// none completes, or when scenarios x segments exceed ten million).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -1008,7 +1006,6 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
     let mut pnr: Vec<f64> = records.iter().map(|r| r.pnr_s).collect();
     pnr.sort_by(f64::total_cmp);
     let with_pnr = pnr.iter().filter(|t| t.is_finite()).count();
-    let finite_at = |p: usize| Some(nearest_rank(&pnr, p)).filter(|t| t.is_finite());
     Uncertainty {
         samples: sc.samples,
         seed: sc.seed,
@@ -1025,11 +1022,7 @@ fn summarise(sc: &ScenarioOptions, records: &[Record], soc_fan: Option<SocFan>) 
         end_soc: of(|r| r.end_soc),
         duration_s: of(|r| r.duration_s),
         p_point_of_no_return: with_pnr as f64 / n as f64,
-        point_of_no_return_s: PointOfNoReturnPercentiles {
-            p5: finite_at(5),
-            p50: finite_at(50),
-            p95: finite_at(95),
-        },
+        point_of_no_return_s: time_band(&pnr).unwrap_or_default(),
         segments: SegmentBand::of(completed.iter().map(|r| r.segment_end_soc.as_slice())),
         soc_fan,
         failsafes: Vec::new(),

@@ -78,25 +78,23 @@ pub fn records(log: &BatteryLog) -> Vec<Record> {
 
 /// A 12S pack of `capacity_mah` and `r_ohm` on the generic LiPo open-circuit curve.
 pub fn pack(capacity_mah: f64, r_ohm: f64) -> Pack {
-    let nominal = 12.0 * 3.7;
-    Pack::new(&BatterySpec {
-        name: "kaist".into(),
-        cells_series: 12,
-        capacity_mah,
-        nominal_v: Some(nominal),
-        energy_wh: Some(capacity_mah / 1000.0 * nominal),
-        mass_kg: Some(1.0),
-        internal_resistance_ohm: Some(r_ohm),
-        cutoff_cell_v: Some(3.0),
-        ..BatterySpec::default()
-    })
-    .unwrap()
+    Pack::new(&spec(capacity_mah, r_ohm)).unwrap()
 }
 
 /// [`pack`] on the open-circuit curve `(ocv_soc, ocv_cell_v)` instead of the generic one.
 pub fn pack_on_curve(capacity_mah: f64, r_ohm: f64, ocv_soc: &[f64], ocv_cell_v: &[f64]) -> Pack {
-    let nominal = 12.0 * 3.7;
     Pack::new(&BatterySpec {
+        ocv_soc: Some(ocv_soc.to_vec()),
+        ocv_cell_v: Some(ocv_cell_v.to_vec()),
+        ..spec(capacity_mah, r_ohm)
+    })
+    .unwrap()
+}
+
+/// The spec of [`pack`]: 12S at 3.7 V a cell nominal, 1 kg, cut off at 3.0 V a cell.
+fn spec(capacity_mah: f64, r_ohm: f64) -> BatterySpec {
+    let nominal = 12.0 * 3.7;
+    BatterySpec {
         name: "kaist".into(),
         cells_series: 12,
         capacity_mah,
@@ -105,11 +103,8 @@ pub fn pack_on_curve(capacity_mah: f64, r_ohm: f64, ocv_soc: &[f64], ocv_cell_v:
         mass_kg: Some(1.0),
         internal_resistance_ohm: Some(r_ohm),
         cutoff_cell_v: Some(3.0),
-        ocv_soc: Some(ocv_soc.to_vec()),
-        ocv_cell_v: Some(ocv_cell_v.to_vec()),
         ..BatterySpec::default()
-    })
-    .unwrap()
+    }
 }
 
 /// The RMS (V) of the terminal voltage the pack predicts for the logged power, against the
@@ -158,12 +153,12 @@ pub fn most_gauge_mah(path: &std::path::Path) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// `aloft pack fit` on `logs` (12S, `capacity_mah`), written to `out`: its JSON answer, the
-/// pack's own open-circuit curve in `pack.battery.ocv_soc` / `ocv_cell_v`.
-pub fn pack_fit(logs: &[PathBuf], capacity_mah: f64, out: &str) -> serde_json::Value {
+/// `aloft pack fit LOGS --profile kaist --cells 12 --capacity-mah C --mass-kg M -o OUT` as
+/// words.
+pub fn pack_fit_words(logs: &[String], capacity_mah: f64, mass_kg: f64, out: &str) -> Vec<String> {
     let mut args = words(&["pack", "fit"]);
-    args.extend(super::strings(logs));
-    let capacity = format!("{capacity_mah}");
+    args.extend_from_slice(logs);
+    let (capacity, mass) = (format!("{capacity_mah}"), format!("{mass_kg}"));
     args.extend(words(&[
         "--profile",
         "kaist",
@@ -172,14 +167,43 @@ pub fn pack_fit(logs: &[PathBuf], capacity_mah: f64, out: &str) -> serde_json::V
         "--capacity-mah",
         &capacity,
         "--mass-kg",
-        "1.0",
+        &mass,
         "-o",
         out,
-        "--force",
-        "--format",
-        "json",
     ]));
+    args
+}
+
+/// `aloft pack fit` on `logs` (12S, `capacity_mah`, `mass_kg`), written to `out` (`--force`):
+/// its JSON answer, the pack's own open-circuit curve in `pack.battery.ocv_soc` / `ocv_cell_v`.
+pub fn pack_fit(logs: &[PathBuf], capacity_mah: f64, mass_kg: f64, out: &str) -> serde_json::Value {
+    let mut args = pack_fit_words(&super::strings(logs), capacity_mah, mass_kg, out);
+    args.extend(words(&["--force", "--format", "json"]));
     super::ok_json(&args)
+}
+
+/// `aloft live --replay FLIGHT --profile kaist --route log --vehicle VEHICLE --every 10 EXTRA
+/// --format json`: its last line's `check` (an update every 10 s: the checkpoints at 40, 60 and
+/// 80 % fall on the first update after them).
+pub fn live_check(path: &str, vehicle: &str, extra: &[&str]) -> serde_json::Value {
+    let mut args = words(&[
+        "live",
+        "--replay",
+        path,
+        "--profile",
+        "kaist",
+        "--route",
+        "log",
+        "--vehicle",
+        vehicle,
+        "--every",
+        "10",
+    ]);
+    args.extend(words(extra));
+    args.extend(words(&["--format", "json"]));
+    let out = super::ok_stdout(&args);
+    let last = out.lines().last().unwrap();
+    serde_json::from_str::<serde_json::Value>(last).unwrap()["check"].clone()
 }
 
 /// A long flight's pack evidence: its records and the resistance of its current steps (ohm,

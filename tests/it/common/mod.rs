@@ -112,6 +112,40 @@ pub fn refused<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> String {
     err
 }
 
+/// The columns `names` of every row of the CSV file at `path` (a header row, then one record
+/// a line, blank lines passed over), read as numbers here, not through aloft.
+pub fn csv_columns<const N: usize>(path: &Path, names: [&str; N]) -> Vec<[f64; N]> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = names.map(|n| head.iter().position(|h| *h == n).unwrap());
+    lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            col.map(|k| f[k].parse::<f64>().unwrap())
+        })
+        .collect()
+}
+
+/// Refused as the input contract says: exit 2, exactly one stderr line holding every needle, no
+/// panic, nothing on stdout.
+pub fn assert_refused(args: &[&str], needles: &[&str]) {
+    let o = aloft(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: one line expected: {err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: '{n}' missing in: {err}");
+    }
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    assert!(o.stdout.is_empty(), "{args:?}: nothing on stdout expected");
+}
+
 /// Writes a wind-field CSV to `path` (`x_m,y_m,z_m,u_mps,v_mps,w_mps`): the same `wind` (`u,v,w`
 /// in m/s) at each corner of the box `[half_width_m, top_m]`, ±`half_width_m` east and north of
 /// home from the ground to `top_m`.
@@ -189,6 +223,12 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
         String::from_utf8_lossy(&out.stderr)
     );
     true
+}
+
+/// The strings of the JSON array `array`.
+pub fn strs(array: &serde_json::Value) -> Vec<&str> {
+    let items = array.as_array().expect("a JSON array");
+    items.iter().map(|x| x.as_str().unwrap()).collect()
 }
 
 /// The `key` string of each element of the JSON array `array`.

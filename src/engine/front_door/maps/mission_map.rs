@@ -15,6 +15,7 @@ use serde::Serialize;
 use aloft_planner::geodesy::LocalFrame;
 
 use crate::engine::front_door::maps::profile::TerrainProfile;
+use crate::engine::missions::ground::GroundAt;
 use crate::engine::missions::mission::Plan;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::missions::mission_outputs::segment_paths;
@@ -28,7 +29,7 @@ pub const MAP_CHART_POINTS: usize = 2_000;
 pub struct MissionMap {
     /// Home, when the mission gives it as latitude and longitude.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub home: Option<GeoPoint>,
+    pub home: Option<GroundAt>,
     /// The route, one path per segment flown, in order.
     pub segments: Vec<SegmentPath>,
     /// The point of no return, when part of the mission lies past it.
@@ -42,15 +43,6 @@ pub struct MissionMap {
     /// The route's altitude and the ground under it along the path, with terrain (`--terrain`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub profile: Option<TerrainProfile>,
-}
-
-/// A point on the ground.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct GeoPoint {
-    /// Latitude, deg.
-    pub latitude_deg: f64,
-    /// Longitude, deg.
-    pub longitude_deg: f64,
 }
 
 /// The path of one segment.
@@ -98,7 +90,7 @@ pub fn mission_map(plan: &Plan, mission: &Mission, fan: Option<SocFan>) -> Missi
     let home = &mission.spec().home;
     let geo = match (home.latitude_deg, home.longitude_deg) {
         (Some(la), Some(lo)) if la.is_finite() && lo.is_finite() && la.abs() < 90.0 => Some((
-            GeoPoint {
+            GroundAt {
                 latitude_deg: la,
                 longitude_deg: lo,
             },

@@ -17,7 +17,8 @@
 
 use serde::Serialize;
 
-use crate::engine::front_door::maps::mission_map::{mission_map, GeoPoint, MapPoint, SegmentPath};
+use crate::engine::front_door::maps::mission_map::{mission_map, MapPoint, SegmentPath};
+use crate::engine::missions::ground::GroundAt;
 use crate::engine::missions::mission::plan_mission;
 use crate::engine::missions::mission_file::Mission;
 use crate::engine::plan_to_fly::fly_plan::{FlyPlan, FlyPlanRequest};
@@ -31,7 +32,7 @@ pub struct SortieMap {
     pub file: String,
     /// Home, when the file gives it as latitude and longitude.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub home: Option<GeoPoint>,
+    pub home: Option<GroundAt>,
     /// Take-off and transit to the route, one path per segment (numbered as the file's).
     pub way_out: Vec<SegmentPath>,
     /// The route it flies, one path per segment.
@@ -81,7 +82,7 @@ pub fn fly_plan_map(
 /// The segments split into way out (the first `out`, at most), route and way home.
 fn parts(
     file: &str,
-    home: Option<GeoPoint>,
+    home: Option<GroundAt>,
     mut segments: Vec<SegmentPath>,
     out: usize,
     point_of_no_return: Option<MapPoint>,
