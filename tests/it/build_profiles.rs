@@ -1,8 +1,9 @@
-//! `.ci/run` builds the Python extension's test copy into the workspace's target directory with
-//! the workspace's dev profile and features, so that cargo reuses the engine the tests built
-//! (python/Cargo.toml's `workspace-features`). It does so only while the two manifests' dev
-//! profiles and the two lock files' versions agree: drift would cost CI a second build of the
-//! engine (about two minutes on 2 cores), silently. These tests make it loud.
+//! `.ci/run` builds the Python extension's wheel in the dev profile into the workspace's target
+//! directory, so that cargo reuses the dependencies the tests built (aloft's own crates build
+//! again: a path dependency's build is keyed by its path from its workspace's root, and the
+//! extension has its own workspace). It does so only while the two manifests' dev profiles and
+//! the two lock files' versions agree: drift would cost CI a second build of every dependency,
+//! silently. These tests make it loud.
 
 use std::collections::BTreeMap;
 use std::path::Path;
