@@ -36,7 +36,10 @@ pub(crate) fn first_non_finite<T: Serialize + ?Sized>(value: &T) -> Option<(Stri
     // The walker's only error is the finding itself.
     match value.serialize(&mut walker) {
         Ok(()) => None,
-        Err(Found(value)) => Some((walker.path.join("."), value)),
+        Err(Found(value)) => {
+            walker.path.reverse();
+            Some((walker.path.join("."), value))
+        }
     }
 }
 
@@ -59,7 +62,8 @@ impl ser::Error for Found {
     }
 }
 
-/// Walks a value, keeping the path of field names and indices to where it is.
+/// Walks a value. The path to a finding is written on the way back out of it, innermost name
+/// first, so a walk that finds nothing allocates nothing (the power batch walks every row).
 #[derive(Default)]
 struct Walker {
     path: Vec<String>,
@@ -85,18 +89,24 @@ struct Part<'w> {
 
 impl Part<'_> {
     fn element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Found> {
-        self.walker.path.push(self.index.to_string());
+        let index = self.index;
         self.index += 1;
-        value.serialize(&mut *self.walker)?;
-        self.walker.path.pop();
-        Ok(())
+        self.named(value, || index.to_string())
     }
 
     fn field<T: Serialize + ?Sized>(&mut self, key: &str, value: &T) -> Result<(), Found> {
-        self.walker.path.push(key.to_string());
-        value.serialize(&mut *self.walker)?;
-        self.walker.path.pop();
-        Ok(())
+        self.named(value, || key.to_string())
+    }
+
+    /// Walks `value`; a finding in it adds `name` to the path on its way out.
+    fn named<T: Serialize + ?Sized>(
+        &mut self,
+        value: &T,
+        name: impl FnOnce() -> String,
+    ) -> Result<(), Found> {
+        value.serialize(&mut *self.walker).inspect_err(|_| {
+            self.walker.path.push(name());
+        })
     }
 }
 
@@ -227,15 +237,20 @@ elements_are_parts!(
     SerializeTupleVariant::serialize_field
 );
 
+/// A map key as the path names it (a JSON string's text, else its JSON).
+fn key_name<K: Serialize + ?Sized>(key: &K) -> Option<String> {
+    match serde_json::to_value(key) {
+        Ok(serde_json::Value::String(k)) => Some(k),
+        Ok(other) => Some(other.to_string()),
+        Err(_) => None,
+    }
+}
+
 impl ser::SerializeMap for Part<'_> {
     type Ok = ();
     type Error = Found;
     fn serialize_key<T: Serialize + ?Sized>(&mut self, key: &T) -> Result<(), Found> {
-        self.key = match serde_json::to_value(key) {
-            Ok(serde_json::Value::String(k)) => Some(k),
-            Ok(other) => Some(other.to_string()),
-            Err(_) => None,
-        };
+        self.key = key_name(key);
         Ok(())
     }
     fn serialize_value<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Found> {
@@ -243,6 +258,17 @@ impl ser::SerializeMap for Part<'_> {
             Some(k) => self.field(&k, value),
             None => self.element(value),
         }
+    }
+    /// A whole entry (maps and flattened structs): the key is named only for a finding (by its
+    /// place in the map where it does not serialise).
+    fn serialize_entry<K: Serialize + ?Sized, V: Serialize + ?Sized>(
+        &mut self,
+        key: &K,
+        value: &V,
+    ) -> Result<(), Found> {
+        let index = self.index;
+        self.index += 1;
+        self.named(value, || key_name(key).unwrap_or_else(|| index.to_string()))
     }
     fn end(self) -> Result<(), Found> {
         Ok(())
@@ -329,6 +355,26 @@ mod tests {
             e.contains("rows.1.optional_w") && e.contains("airspeed_mps 1e308"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn map_entries_are_named_by_their_keys_at_any_depth() {
+        use std::collections::BTreeMap;
+        let mut by_name = BTreeMap::new();
+        by_name.insert("a".to_string(), vec![1.0, 2.0]);
+        by_name.insert("b".to_string(), vec![3.0, f64::NAN]);
+        let nested = vec![Some(by_name)];
+        assert_eq!(first_non_finite(&nested).unwrap().0, "0.b.1");
+        let mut by_number = BTreeMap::new();
+        by_number.insert(3_u32, 1.0);
+        by_number.insert(7_u32, f64::NEG_INFINITY);
+        assert_eq!(first_non_finite(&by_number).unwrap().0, "7");
+        assert_eq!(
+            first_non_finite(&(1.0, [2.0, f64::INFINITY])).unwrap().0,
+            "1.1"
+        );
+        let finite_map: BTreeMap<String, f64> = [("x".to_string(), 1.0)].into();
+        assert!(first_non_finite(&finite_map).is_none());
     }
 
     #[test]
