@@ -20,8 +20,9 @@
 
 use crate::common;
 use common::kaist::{
-    fit_without_day, kaist, live_check, median, most_gauge_mah, pack_evidence, pack_fit, DAYS,
+    fit_without_day, kaist, live_check, most_gauge_mah, pack_evidence, pack_fit, DAYS,
 };
+use common::median;
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;

@@ -18,6 +18,7 @@ use common::ok_json as aloft;
 use std::sync::OnceLock;
 
 use common::kaist::{fit_without_day, kaist, live_check, words, DAYS};
+use common::median;
 
 /// One held-out flight.
 #[derive(Debug, Clone)]
@@ -240,13 +241,6 @@ fn data_val_kaist_lodo_live_at_120_s_is_the_calibrated_validation() {
         let (_, live, _, _) = j.live.iter().find(|c| c.0 == "120 s").unwrap();
         assert!((live - j.calibrated_percent).abs() < 0.05, "{j:?}");
     }
-}
-
-/// The median of `v` (sorted copy).
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    (v[(n - 1) / 2] + v[n / 2]) / 2.0
 }
 
 /// Issue 25 targets on the held-out days: the error of `remaining_wh.p50` at 120 s and at 40,

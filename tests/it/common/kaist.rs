@@ -134,15 +134,6 @@ pub fn best_capacity(recs: &[Record], r_ohm: f64) -> f64 {
         .unwrap()
 }
 
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n % 2 {
-        1 => v[n / 2],
-        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
-}
-
 /// The most the pack's gauge (KAIST's BMS `capacity`, mA h) reads in `path`.
 pub fn most_gauge_mah(path: &std::path::Path) -> f64 {
     let profile = aloft_logs::Profile::resolve("kaist").unwrap();

@@ -225,6 +225,16 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
     true
 }
 
+/// The median of `v`: its middle value, or the mean of the middle two (panics when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n % 2 {
+        1 => v[n / 2],
+        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
+}
+
 /// The strings of the JSON array `array`.
 pub fn strs(array: &serde_json::Value) -> Vec<&str> {
     let items = array.as_array().expect("a JSON array");
