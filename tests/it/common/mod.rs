@@ -15,7 +15,8 @@ pub use data::{data_dir, files};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, ExitStatus, Output};
+use std::time::{Duration, Instant};
 
 /// Runs the `aloft` binary built for this test with `args`.
 pub fn aloft<S: AsRef<OsStr>>(args: &[S]) -> Output {
@@ -223,6 +224,23 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
         String::from_utf8_lossy(&out.stderr)
     );
     true
+}
+
+/// Waits for `child` to end, at most `limit`: its exit status, or `None` when it ran longer (it
+/// is then killed and reaped). Its pipes are left to the caller.
+pub fn wait_within(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(status);
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
 
 /// The median of `v`: its middle value, or the mean of the middle two (panics when empty).
