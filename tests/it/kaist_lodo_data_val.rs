@@ -17,7 +17,7 @@ use common::ok_json as aloft;
 
 use std::sync::OnceLock;
 
-use common::kaist::{fit_without_day, kaist, live_check, words, DAYS};
+use common::kaist::{fit_without_day, kaist, live_check, per_day, words, DAYS};
 use common::median;
 
 /// One held-out flight.
@@ -139,16 +139,7 @@ fn judge_day(held_out: &'static str) -> Vec<Judged> {
 fn lodo() -> &'static [Judged] {
     static LODO: OnceLock<Vec<Judged>> = OnceLock::new();
     LODO.get_or_init(|| {
-        let out: Vec<Judged> = std::thread::scope(|s| {
-            let handles: Vec<_> = DAYS
-                .iter()
-                .map(|d| s.spawn(move || judge_day(d)))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap())
-                .collect()
-        });
+        let out: Vec<Judged> = per_day(&DAYS, judge_day);
         println!("| held-out day | flight | sideslip, deg | validate | after 120 s calibration | efficiency | replay |");
         for j in &out {
             println!(

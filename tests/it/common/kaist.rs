@@ -10,6 +10,21 @@ use aloft_planner::{BatterySpec, Pack};
 /// The shared KAIST days: 2018-08-03 (5 flights), 2018-08-06 (5) and 2018-08-08 (1, 300 s).
 pub const DAYS: [&str; 3] = ["2018-08-03", "2018-08-06", "2018-08-08"];
 
+/// `judge` of each of `days`, the days in parallel, the results in the days' order.
+pub fn per_day<T: Send>(
+    days: &[&'static str],
+    judge: impl Fn(&'static str) -> Vec<T> + Sync,
+) -> Vec<T> {
+    let judge = &judge;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = days.iter().map(|&d| s.spawn(move || judge(d))).collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
+    })
+}
+
 /// The flights of one day, as command-line words.
 pub fn kaist(day: &str) -> Vec<String> {
     super::strings(&super::files_like("kaist_energy_drone", day, ".csv"))
