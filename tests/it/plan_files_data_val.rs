@@ -280,17 +280,7 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
             "{path}"
         );
         // Read back by `aloft mission`: the reserve kept, the sortie's energy.
-        let mut args = vec!["mission", path, "--format", "json"];
-        args.extend(mission_flags(extra));
-        let (code, out, err) = run(&args);
-        assert_eq!(code, 0, "{tag}: {path} read back: {err}");
-        let flown: Value = serde_json::from_str(&out).unwrap();
-        assert_eq!(flown["feasible"], true, "{path}");
-        let (e, want) = (f(&flown["energy_wh"]), f(&sortie["energy_wh"]));
-        assert!(
-            (e - want).abs() <= 1e-9 * want,
-            "{path}: {e} Wh read back, {want} planned"
-        );
+        common::flies_as_planned(path, &mission_flags(extra), sortie, 1e-9);
         // The items, read independently.
         let written = import(&std::fs::read_to_string(path).unwrap()).unwrap();
         let items = &written.items;

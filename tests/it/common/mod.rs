@@ -243,6 +243,30 @@ pub fn wait_within(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
     }
 }
 
+/// A written sortie flown by `aloft mission PATH --format json FLAGS`: exit 0, feasible, and
+/// the energy the plan gave it (`sortie["energy_wh"]`) within the fraction `tolerance`; the
+/// flown answer.
+pub fn flies_as_planned(
+    path: &str,
+    flags: &[&str],
+    sortie: &serde_json::Value,
+    tolerance: f64,
+) -> serde_json::Value {
+    let mut args = vec!["mission", path, "--format", "json"];
+    args.extend_from_slice(flags);
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "{path} read back: {err}");
+    let flown: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(flown["feasible"], true, "{path}");
+    let number = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("{path}: {v}"));
+    let (got, want) = (number(&flown["energy_wh"]), number(&sortie["energy_wh"]));
+    assert!(
+        (got - want).abs() <= tolerance * want,
+        "{path}: flown {got} Wh, planned {want} Wh"
+    );
+    flown
+}
+
 /// The median of `v`: its middle value, or the mean of the middle two (panics when empty).
 pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
