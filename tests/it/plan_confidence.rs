@@ -151,7 +151,7 @@ fn grid_of_winds(file: &Path, reserve: &str) -> Vec<(f64, f64)> {
                 for from in ["195", "240", "285", "60"] {
                     let winds = ["--wind-speed", speed, "--wind-from", from];
                     let flown = mission(
-                        &file,
+                        file,
                         &[&winds[..], &["--reserve-percent", reserve]].concat(),
                     );
                     flights += 1;
