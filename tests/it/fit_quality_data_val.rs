@@ -23,13 +23,9 @@ fn flugdrohne() -> Vec<std::path::PathBuf> {
     common::files("px4_flugdrohne/ulg", |n| n.ends_with(".ulg"))
 }
 
-fn reasons(v: &Value) -> Vec<String> {
-    v["quality_reasons"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|r| r.as_str().unwrap().to_string())
-        .collect()
+/// The fit's `quality_reasons`.
+fn reasons(v: &Value) -> Vec<&str> {
+    common::strs(&v["quality_reasons"])
 }
 
 #[test]

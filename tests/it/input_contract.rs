@@ -32,21 +32,14 @@ fn aloft_limited(
         .spawn()
         .expect("spawn");
     let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            let mut err = String::new();
-            if let Some(mut e) = child.stderr.take() {
-                let _ = std::io::Read::read_to_string(&mut e, &mut err);
-            }
-            return (status.code(), err, start.elapsed());
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return (None, "killed: took too long".into(), start.elapsed());
-        }
-        std::thread::sleep(Duration::from_millis(20));
+    let Some(status) = common::wait_within(&mut child, limit) else {
+        return (None, "killed: took too long".into(), start.elapsed());
+    };
+    let mut err = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = std::io::Read::read_to_string(&mut e, &mut err);
     }
+    (status.code(), err, start.elapsed())
 }
 
 /// A scratch file `name` of this test process, as a command-line word.

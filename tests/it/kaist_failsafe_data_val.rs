@@ -20,8 +20,9 @@
 
 use crate::common;
 use common::kaist::{
-    fit_without_day, kaist, live_check, median, most_gauge_mah, pack_evidence, pack_fit, DAYS,
+    fit_without_day, kaist, live_check, most_gauge_mah, pack_evidence, pack_fit, per_day, DAYS,
 };
+use common::median;
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -203,28 +204,15 @@ fn or_dash(x: Option<f64>) -> String {
 fn judged() -> &'static [Judged] {
     static JUDGED: OnceLock<Vec<Judged>> = OnceLock::new();
     JUDGED.get_or_init(|| {
-        let days = [DAYS[0], DAYS[1]];
-        let out: Vec<Judged> = std::thread::scope(|s| {
-            let handles: Vec<_> = days
-                .iter()
-                .map(|d| {
-                    s.spawn(move || {
-                        let vehicle = vehicle_without(d);
-                        let flights: Vec<String> = kaist(d)
-                            .into_iter()
-                            .filter(|f| !f.contains("testgpsfense"))
-                            .collect();
-                        let j: Vec<Judged> =
-                            flights.iter().map(|f| judge_flight(f, &vehicle)).collect();
-                        std::fs::remove_file(&vehicle).ok();
-                        j
-                    })
-                })
-                .collect();
-            handles
+        let out: Vec<Judged> = per_day(&[DAYS[0], DAYS[1]], |d| {
+            let vehicle = vehicle_without(d);
+            let flights: Vec<String> = kaist(d)
                 .into_iter()
-                .flat_map(|h| h.join().unwrap())
-                .collect()
+                .filter(|f| !f.contains("testgpsfense"))
+                .collect();
+            let j: Vec<Judged> = flights.iter().map(|f| judge_flight(f, &vehicle)).collect();
+            std::fs::remove_file(&vehicle).ok();
+            j
         });
         println!("| flight | threshold, V | crossed, s | before | actual, s | predicted p50 (p5-p95), s | error, s | naive, s | naive error, s |");
         for j in &out {

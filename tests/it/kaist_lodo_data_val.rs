@@ -17,7 +17,8 @@ use common::ok_json as aloft;
 
 use std::sync::OnceLock;
 
-use common::kaist::{fit_without_day, kaist, live_check, words, DAYS};
+use common::kaist::{fit_without_day, kaist, live_check, per_day, words, DAYS};
+use common::median;
 
 /// One held-out flight.
 #[derive(Debug, Clone)]
@@ -138,16 +139,7 @@ fn judge_day(held_out: &'static str) -> Vec<Judged> {
 fn lodo() -> &'static [Judged] {
     static LODO: OnceLock<Vec<Judged>> = OnceLock::new();
     LODO.get_or_init(|| {
-        let out: Vec<Judged> = std::thread::scope(|s| {
-            let handles: Vec<_> = DAYS
-                .iter()
-                .map(|d| s.spawn(move || judge_day(d)))
-                .collect();
-            handles
-                .into_iter()
-                .flat_map(|h| h.join().unwrap())
-                .collect()
-        });
+        let out: Vec<Judged> = per_day(&DAYS, judge_day);
         println!("| held-out day | flight | sideslip, deg | validate | after 120 s calibration | efficiency | replay |");
         for j in &out {
             println!(
@@ -240,13 +232,6 @@ fn data_val_kaist_lodo_live_at_120_s_is_the_calibrated_validation() {
         let (_, live, _, _) = j.live.iter().find(|c| c.0 == "120 s").unwrap();
         assert!((live - j.calibrated_percent).abs() < 0.05, "{j:?}");
     }
-}
-
-/// The median of `v` (sorted copy).
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    (v[(n - 1) / 2] + v[n / 2]) / 2.0
 }
 
 /// Issue 25 targets on the held-out days: the error of `remaining_wh.p50` at 120 s and at 40,

@@ -99,14 +99,8 @@ fn stop(mut child: Child, signal: &str) -> Output {
         .status()
         .expect("kill runs");
     assert!(sent.success());
-    let start = Instant::now();
-    while child.try_wait().expect("wait").is_none() {
-        if start.elapsed() > Duration::from_secs(10) {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("aloft live still running 10 s after SIG{signal}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
+    if common::wait_within(&mut child, Duration::from_secs(10)).is_none() {
+        panic!("aloft live still running 10 s after SIG{signal}");
     }
     child.wait_with_output().expect("output")
 }

@@ -170,14 +170,8 @@ fn live(path: &Path, extra: &[&str], limit: Duration) -> (Option<i32>, Vec<Value
         .stderr(Stdio::piped())
         .spawn()
         .expect("aloft starts");
-    let start = Instant::now();
-    while child.try_wait().expect("wait").is_none() {
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("aloft live {extra:?} still running after {limit:?}");
-        }
-        std::thread::sleep(Duration::from_millis(20));
+    if common::wait_within(&mut child, limit).is_none() {
+        panic!("aloft live {extra:?} still running after {limit:?}");
     }
     let out = child.wait_with_output().expect("output");
     let text = String::from_utf8(out.stdout).expect("UTF-8");

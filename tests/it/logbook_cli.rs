@@ -442,19 +442,14 @@ fn logbook_pack_file_from_the_packs_logs() {
     assert_eq!(r.len(), 5);
     r.sort_by(f64::total_cmp);
     let pack = tmp.path().join("pack.toml");
-    let (code, out, err) = run(&[
-        "logbook",
-        "pack-file",
-        "flugdrohne-3s",
-        "--db",
-        s(&db),
-        "-o",
-        s(&pack),
-        "--capacity-mah",
-        "2200",
-        "--mass-kg",
-        "0.19",
-    ]);
+    // `logbook pack-file KEY --db DB -o pack.toml EXTRA`.
+    let pack_file = |key: &str, db: &Path, extra: &[&str]| {
+        let mut args = vec!["logbook", "pack-file", key, "--db", s(db), "-o", s(&pack)];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let rating = ["--capacity-mah", "2200", "--mass-kg", "0.19"];
+    let (code, out, err) = pack_file("flugdrohne-3s", &db, &rating);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("from 5 logs"), "{out}");
     let text = std::fs::read_to_string(&pack).unwrap();
@@ -486,40 +481,12 @@ fn logbook_pack_file_from_the_packs_logs() {
         0
     );
     std::fs::remove_file(&moved).unwrap();
-    let (code, _, err) = run(&[
-        "logbook",
-        "pack-file",
-        "p",
-        "--db",
-        s(&db2),
-        "-o",
-        s(&pack),
-        "--capacity-mah",
-        "2200",
-        "--mass-kg",
-        "0.19",
-    ]);
+    let (code, _, err) = pack_file("p", &db2, &rating);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("moved.ulg: left out"), "{err}");
-    let (code, _, err) = run(&[
-        "logbook",
-        "pack-file",
-        "unknown",
-        "--db",
-        s(&db2),
-        "-o",
-        s(&pack),
-    ]);
+    let (code, _, err) = pack_file("unknown", &db2, &[]);
     assert_eq!(code, 2, "{err}");
-    let (code, _, err) = run(&[
-        "logbook",
-        "pack-file",
-        "nope",
-        "--db",
-        s(&db2),
-        "-o",
-        s(&pack),
-    ]);
+    let (code, _, err) = pack_file("nope", &db2, &[]);
     assert_eq!(code, 2);
     assert!(err.contains("no such pack"), "{err}");
 }

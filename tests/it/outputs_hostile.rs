@@ -55,14 +55,8 @@ fn run_within(args: &[String], limit: Duration) -> (i32, String, String) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > limit {
-            child.kill().unwrap();
-            let _ = child.wait();
-            panic!("aloft {args:?} still runs after {limit:?} (blocked on a FIFO?)");
-        }
-        std::thread::sleep(Duration::from_millis(20));
+    if common::wait_within(&mut child, limit).is_none() {
+        panic!("aloft {args:?} still runs after {limit:?} (blocked on a FIFO?)");
     }
     let out = child.wait_with_output().unwrap();
     (

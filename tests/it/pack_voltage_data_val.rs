@@ -22,7 +22,8 @@ use std::path::PathBuf;
 
 use aloft_logs::{read_battery_log, OpenOptions, Profile};
 
-use common::kaist::{best_capacity, median, pack, pack_on_curve, records, rms_v, Record};
+use common::kaist::{best_capacity, pack, pack_on_curve, records, rms_v, Record};
+use common::median;
 
 /// The day of a KAIST flight (its file name's first 10 characters).
 fn day(name: &str) -> &str {

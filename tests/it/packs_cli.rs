@@ -35,18 +35,12 @@ fn kaist_step_r(p: &Path) -> f64 {
     }
     let i_max = u.iter().map(|x| x.2).fold(0.0, f64::max);
     let thr = f64::max(2.0, 0.05 * i_max);
-    let mut r: Vec<f64> = u
+    let r: Vec<f64> = u
         .windows(2)
         .filter(|w| w[1].0 - w[0].0 < 1.5 && (w[1].2 - w[0].2).abs() > thr)
         .map(|w| -(w[1].1 - w[0].1) / (w[1].2 - w[0].2))
         .collect();
-    r.sort_by(f64::total_cmp);
-    let n = r.len();
-    if n % 2 == 1 {
-        r[n / 2]
-    } else {
-        0.5 * (r[n / 2 - 1] + r[n / 2])
-    }
+    common::median(r)
 }
 
 fn toml_value(path: &Path) -> toml::Table {

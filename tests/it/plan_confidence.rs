@@ -48,13 +48,9 @@ fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or_else(|| panic!("not a number: {v}"))
 }
 
-fn files(answer: &Value) -> Vec<String> {
-    answer["files"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f.as_str().unwrap().to_string())
-        .collect()
+/// The files a plan wrote.
+fn files(answer: &Value) -> Vec<&str> {
+    common::strs(&answer["files"])
 }
 
 /// The forecast of the survey's plans: 8 m/s from 240 deg, a 70 % reserve (several packs of the
@@ -155,7 +151,7 @@ fn grid_of_winds(file: &Path, reserve: &str) -> Vec<(f64, f64)> {
                 for from in ["195", "240", "285", "60"] {
                     let winds = ["--wind-speed", speed, "--wind-from", from];
                     let flown = mission(
-                        &file,
+                        file,
                         &[&winds[..], &["--reserve-percent", reserve]].concat(),
                     );
                     flights += 1;

@@ -49,6 +49,18 @@ fn shared_mission(name: &str) -> PathBuf {
     path
 }
 
+/// The shared survey `neilvaltec_test.plan` with its polygon scaled 2 times (about 20 km of
+/// flight), written as the scratch file `name`.
+fn survey_20km(name: &str) -> PathBuf {
+    let file = scratch("plan-files", name);
+    std::fs::write(
+        &file,
+        common::big_survey::scaled_survey(&shared_mission("neilvaltec_test.plan"), 2.0),
+    )
+    .unwrap();
+    file
+}
+
 /// `aloft plan FILE -o DIR --format json EXTRA`: exit code, JSON, stderr.
 fn plan(file: &Path, dir: &Path, extra: &[String]) -> (i32, Value, String) {
     let _ = std::fs::remove_dir_all(dir);
@@ -280,17 +292,7 @@ fn check(file: &Path, extra: &[String], seen: &mut Seen) {
             "{path}"
         );
         // Read back by `aloft mission`: the reserve kept, the sortie's energy.
-        let mut args = vec!["mission", path, "--format", "json"];
-        args.extend(mission_flags(extra));
-        let (code, out, err) = run(&args);
-        assert_eq!(code, 0, "{tag}: {path} read back: {err}");
-        let flown: Value = serde_json::from_str(&out).unwrap();
-        assert_eq!(flown["feasible"], true, "{path}");
-        let (e, want) = (f(&flown["energy_wh"]), f(&sortie["energy_wh"]));
-        assert!(
-            (e - want).abs() <= 1e-9 * want,
-            "{path}: {e} Wh read back, {want} planned"
-        );
+        common::flies_as_planned(path, &mission_flags(extra), sortie, 1e-9);
         // The items, read independently.
         let written = import(&std::fs::read_to_string(path).unwrap()).unwrap();
         let items = &written.items;
@@ -692,12 +694,7 @@ fn data_val_a_survey_that_cannot_be_drawn_again_is_flown_as_stored_and_said() {
 /// the angle tried and what it costs.
 #[test]
 fn data_val_a_survey_beyond_one_pack_is_turned_to_the_wind() {
-    let file = scratch("plan-files", "survey-20km.plan");
-    std::fs::write(
-        &file,
-        common::big_survey::scaled_survey(&shared_mission("neilvaltec_test.plan"), 2.0),
-    )
-    .unwrap();
+    let file = survey_20km("survey-20km.plan");
     let wind = flags("--wind-speed 8 --wind-from 240 --confidence 0.5");
     let (code, turned, err) = plan(&file, &scratch("plan-files", "turned-20km"), &wind);
     assert_eq!(code, 0, "{err}");
@@ -822,12 +819,7 @@ fn speeds_and_resume(text: &str) -> (Vec<(usize, f64)>, Option<usize>) {
 /// (among the items that restore what was in force there).
 #[test]
 fn data_val_a_resumed_sortie_flies_out_at_its_own_speed_above_the_rtl_altitude() {
-    let file = scratch("plan-files", "survey-20km-fly-out.plan");
-    std::fs::write(
-        &file,
-        common::big_survey::scaled_survey(&shared_mission("neilvaltec_test.plan"), 2.0),
-    )
-    .unwrap();
+    let file = survey_20km("survey-20km-fly-out.plan");
     for (extra, fast) in [("", false), (" --rtl-altitude-m 40", true)] {
         let flags = flags(&format!(
             "--wind-speed 8 --wind-from 240 --confidence 0.5 --keep-angle{extra}"

@@ -84,23 +84,13 @@ fn data_val_plan_texts_fly_to_their_sorties() {
         assert!(!std::path::Path::new(name).exists(), "{name} was written");
         let file = scratch("serve-plan", name);
         std::fs::write(&file, text["text"].as_str().unwrap()).unwrap();
-        let mut args = vec!["mission", file.to_str().unwrap(), "--format", "json"];
-        args.extend_from_slice(&CONDITIONS);
-        let (code, out, err) = run(&args);
-        assert_eq!(code, 0, "{name} read back: {err}");
-        let flown: Value = serde_json::from_str(&out).unwrap();
-        assert_eq!(flown["feasible"], true, "{name}");
-        let (got, want) = (f(&flown["energy_wh"]), f(&sortie["energy_wh"]));
-        assert!(
-            (got - want).abs() <= 1e-6 * want,
-            "{name}: flown {got} Wh, plan {want} Wh"
-        );
+        let flown = common::flies_as_planned(file.to_str().unwrap(), &CONDITIONS, sortie, 1e-6);
         assert!(
             f(&flown["end_soc"]) >= 0.70 - 1e-9,
             "{name}: {}",
             flown["end_soc"]
         );
-        energy_wh += want;
+        energy_wh += f(&sortie["energy_wh"]);
         duration_s += f(&sortie["duration_s"]);
     }
     assert!((energy_wh - f(&answer["energy_wh"])).abs() <= 1e-9 * energy_wh);

@@ -10,6 +10,21 @@ use aloft_planner::{BatterySpec, Pack};
 /// The shared KAIST days: 2018-08-03 (5 flights), 2018-08-06 (5) and 2018-08-08 (1, 300 s).
 pub const DAYS: [&str; 3] = ["2018-08-03", "2018-08-06", "2018-08-08"];
 
+/// `judge` of each of `days`, the days in parallel, the results in the days' order.
+pub fn per_day<T: Send>(
+    days: &[&'static str],
+    judge: impl Fn(&'static str) -> Vec<T> + Sync,
+) -> Vec<T> {
+    let judge = &judge;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = days.iter().map(|&d| s.spawn(move || judge(d))).collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
+    })
+}
+
 /// The flights of one day, as command-line words.
 pub fn kaist(day: &str) -> Vec<String> {
     super::strings(&super::files_like("kaist_energy_drone", day, ".csv"))
@@ -132,15 +147,6 @@ pub fn best_capacity(recs: &[Record], r_ohm: f64) -> f64 {
         .map(|k| f64::from(k) * 250.0)
         .min_by(|a, b| rms_v(&pack(*a, r_ohm), recs).total_cmp(&rms_v(&pack(*b, r_ohm), recs)))
         .unwrap()
-}
-
-pub fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    match n % 2 {
-        1 => v[n / 2],
-        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
-    }
 }
 
 /// The most the pack's gauge (KAIST's BMS `capacity`, mA h) reads in `path`.

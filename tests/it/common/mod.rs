@@ -15,7 +15,8 @@ pub use data::{data_dir, files};
 
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Child, Command, ExitStatus, Output};
+use std::time::{Duration, Instant};
 
 /// Runs the `aloft` binary built for this test with `args`.
 pub fn aloft<S: AsRef<OsStr>>(args: &[S]) -> Output {
@@ -223,6 +224,57 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
         String::from_utf8_lossy(&out.stderr)
     );
     true
+}
+
+/// Waits for `child` to end, at most `limit`: its exit status, or `None` when it ran longer (it
+/// is then killed and reaped). Its pipes are left to the caller.
+pub fn wait_within(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(status);
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// A written sortie flown by `aloft mission PATH --format json FLAGS`: exit 0, feasible, and
+/// the energy the plan gave it (`sortie["energy_wh"]`) within the fraction `tolerance`; the
+/// flown answer.
+pub fn flies_as_planned(
+    path: &str,
+    flags: &[&str],
+    sortie: &serde_json::Value,
+    tolerance: f64,
+) -> serde_json::Value {
+    let mut args = vec!["mission", path, "--format", "json"];
+    args.extend_from_slice(flags);
+    let (code, out, err) = run(&args);
+    assert_eq!(code, 0, "{path} read back: {err}");
+    let flown: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(flown["feasible"], true, "{path}");
+    let number = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("{path}: {v}"));
+    let (got, want) = (number(&flown["energy_wh"]), number(&sortie["energy_wh"]));
+    assert!(
+        (got - want).abs() <= tolerance * want,
+        "{path}: flown {got} Wh, planned {want} Wh"
+    );
+    flown
+}
+
+/// The median of `v`: its middle value, or the mean of the middle two (panics when empty).
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n % 2 {
+        1 => v[n / 2],
+        _ => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+    }
 }
 
 /// The strings of the JSON array `array`.
