@@ -2,6 +2,7 @@
 //! (`aloft_logbook`). This module parses the arguments, finds the file and renders the answers;
 //! the schema, the ingest and the queries are the logbook crate's.
 
+use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -13,8 +14,10 @@ use aloft_logbook::{
     AddOutcome, Flight, KeyKind, Labels, Logbook, PackSummary, ReadOptions, Skipped, VehicleSummary,
 };
 
+use super::flights::escaped;
 use super::output::{self, fixed, fixed_or_dash, Row};
 use super::Outcome;
+use aloft::engine::shown_path;
 
 #[path = "logbook_read.rs"]
 mod read;
@@ -326,7 +329,7 @@ fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
             answer.copies,
             answer.already_present,
             answer.skipped,
-            book.path().display()
+            shown_path(book.path())
         )?,
     }
     Ok(if answer.skipped == answer.files.len() {
@@ -337,6 +340,7 @@ fn add(book: &mut Logbook, a: AddArgs) -> Result<Outcome> {
 }
 
 fn add_line(file: &str, o: &AddOutcome) -> String {
+    let file = escaped(file);
     match o {
         AddOutcome::Added {
             flight_id,
@@ -346,7 +350,7 @@ fn add_line(file: &str, o: &AddOutcome) -> String {
         AddOutcome::AlreadyPresent { flight_id } => {
             format!("already in the logbook: {file} (flight {flight_id})")
         }
-        AddOutcome::Skipped { reason } => format!("skipped: {file} ({reason})"),
+        AddOutcome::Skipped { reason } => format!("skipped: {file} ({})", escaped(reason)),
         AddOutcome::Copy {
             flight_id,
             copy_of,
@@ -370,15 +374,20 @@ fn relabel(book: &mut Logbook, a: RelabelArgs) -> Result<Outcome> {
         "{kind} {:?} is now {:?} ({n} {flights}; {})",
         a.old,
         a.new,
-        book.path().display()
+        shown_path(book.path())
     )?;
     Ok(Outcome::Ok)
 }
 
-/// Rows as aligned columns under a header (text left, numbers right).
+/// Rows as aligned columns under a header (text left, numbers right); a cell's control
+/// characters escaped, so that a row stays one line.
 fn write_columns(out: &mut impl Write, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
+    let rows: Vec<Vec<Cow<'_, str>>> = rows
+        .iter()
+        .map(|r| r.iter().map(|c| escaped(c)).collect())
+        .collect();
     let mut widths: Vec<usize> = header.iter().map(|h| h.len()).collect();
-    for r in rows {
+    for r in &rows {
         for (w, c) in widths.iter_mut().zip(r) {
             *w = (*w).max(c.chars().count());
         }
@@ -399,8 +408,8 @@ fn write_columns(out: &mut impl Write, header: &[&str], rows: &[Vec<String>]) ->
         parts.join("  ").trim_end().to_string()
     };
     writeln!(out, "{}", line(header.to_vec()))?;
-    for r in rows {
-        writeln!(out, "{}", line(r.iter().map(String::as_str).collect()))?;
+    for r in &rows {
+        writeln!(out, "{}", line(r.iter().map(|c| &**c).collect()))?;
     }
     Ok(())
 }
@@ -450,10 +459,10 @@ fn flights_table(out: &mut impl Write, flights: &[Flight]) -> Result<()> {
 /// A titled block of label and value lines, both left-aligned (the values are words and
 /// figures with their units).
 fn write_block(out: &mut impl Write, title: &str, rows: &[Row<'_>]) -> Result<()> {
-    writeln!(out, "{title}")?;
+    writeln!(out, "{}", escaped(title))?;
     let lw = rows.iter().map(|r| r.label.len()).max().unwrap_or(0);
     for r in rows {
-        let line = format!("  {:<lw$}  {} {}", r.label, r.value, r.unit);
+        let line = format!("  {:<lw$}  {} {}", r.label, escaped(&r.value), r.unit);
         writeln!(out, "{}", line.trim_end())?;
     }
     Ok(())
@@ -610,7 +619,7 @@ fn skipped_table(out: &mut impl Write, skipped: &[Skipped]) -> Result<()> {
         writeln!(out, "no skipped files")?;
     }
     for s in skipped {
-        writeln!(out, "{}: {}", s.file_name, s.reason)?;
+        writeln!(out, "{}: {}", escaped(&s.file_name), escaped(&s.reason))?;
     }
     Ok(())
 }
@@ -659,18 +668,18 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
     if flights.is_empty() {
         anyhow::bail!(
             "pack \"{}\": no such pack in {}",
-            a.pack,
-            book.path().display()
+            escaped(&a.pack),
+            shown_path(book.path())
         );
     }
     let (logs, notes) = pack_logs(&flights);
     for n in &notes {
-        eprintln!("aloft logbook pack-file: {n}");
+        eprintln!("aloft logbook pack-file: {}", escaped(n));
     }
     if logs.is_empty() {
         eprintln!(
             "aloft logbook pack-file: no log of pack \"{}\" can be read again: no pack written",
-            a.pack
+            escaped(&a.pack)
         );
         return Ok(Outcome::Failed);
     }
@@ -686,12 +695,7 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
         ..PackFitRequest::default()
     };
     let answer = fit_pack(&request)?;
-    for s in &answer.skipped {
-        eprintln!("aloft logbook pack-file: {}: skipped: {}", s.file, s.reason);
-    }
-    for n in &answer.notes {
-        eprintln!("aloft logbook pack-file: {n}");
-    }
+    super::pack::write_fit_remarks("aloft logbook pack-file", &answer);
     if answer.pack.is_none() {
         eprintln!("aloft logbook pack-file: no usable log: no pack written");
         return Ok(Outcome::Failed);
@@ -703,7 +707,7 @@ fn pack_file(book: &Logbook, a: PackFileArgs) -> Result<Outcome> {
             out,
             "wrote {}: pack {} from {} logs, resistance {} mOhm, capacity {} mAh",
             answer.output,
-            a.pack,
+            escaped(&a.pack),
             answer.logs.len(),
             fixed_or_dash(answer.internal_resistance_ohm.map(|r| r * 1000.0), 1),
             fixed_or_dash(answer.pack_capacity_mah.or(answer.capacity_mah), 0)

@@ -105,16 +105,7 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         force: a.force.force,
     };
     let answer = fit_pack(&request)?;
-    for s in &answer.skipped {
-        eprintln!(
-            "aloft pack fit: {}: skipped: {}",
-            file_name(&s.file),
-            escaped(&s.reason)
-        );
-    }
-    for n in &answer.notes {
-        eprintln!("aloft pack fit: {}", escaped(n));
-    }
+    write_fit_remarks("aloft pack fit", &answer);
     if answer.pack.is_none() {
         eprintln!("aloft pack fit: no usable log: no pack written");
         return Ok(Outcome::Failed);
@@ -125,6 +116,21 @@ fn fit(a: PackFitArgs) -> Result<Outcome> {
         Format::Table | Format::Csv => render(&mut out, &answer)?,
     }
     Ok(Outcome::Ok)
+}
+
+/// A pack fit's logs left out and its notes, a line each on standard error after `command`'s
+/// name (`aloft pack fit`, `aloft logbook pack-file`), names and reasons escaped.
+pub(super) fn write_fit_remarks(command: &str, answer: &PackFitAnswer) {
+    for s in &answer.skipped {
+        eprintln!(
+            "{command}: {}: skipped: {}",
+            file_name(&s.file),
+            escaped(&s.reason)
+        );
+    }
+    for n in &answer.notes {
+        eprintln!("{command}: {}", escaped(n));
+    }
 }
 
 fn render(out: &mut impl Write, a: &PackFitAnswer) -> Result<()> {

@@ -1018,3 +1018,73 @@ fn logbook_relabel_from_the_command_line() {
         .collect();
     assert_eq!(keys, vec!["flug-a", "spare"]);
 }
+
+/// Issue 41's rule in the logbook's text answers: a log whose name holds a newline and an
+/// escape sequence is shown escaped on one line by `logbook add`, `flights`, `skipped` and
+/// `pack-file` (its notes on a log moved or changed since it was added), never as a second line
+/// or a terminal's colour.
+#[test]
+fn logbook_text_answers_show_hostile_file_names_escaped_on_one_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let db = tmp.path().join("book.sqlite");
+    let ulgs = common::files("px4_flugdrohne/ulg", |_| true);
+    // Two flights, moved and changed before pack-file reads them again, and a damaged file.
+    let gone = tmp.path().join("gone\nFORGED: \u{1b}[31mmoved.ulg");
+    let changed = tmp.path().join("changed\nFORGED: edited.ulg");
+    let damaged = tmp.path().join("cut\nFORGED: damaged.csv");
+    std::fs::copy(&ulgs[0], &gone).unwrap();
+    std::fs::copy(&ulgs[1], &changed).unwrap();
+    std::fs::write(&damaged, "time_s,voltage_v\n0,").unwrap();
+    let clean = |what: &str, text: &str| {
+        for line in text.lines() {
+            assert!(
+                !line.starts_with("FORGED") && !line.contains('\u{1b}'),
+                "{what}: a name broke a line or coloured it: {line:?} in\n{text}"
+            );
+        }
+    };
+    let (_, out, err) = run(&[
+        "logbook",
+        "add",
+        "--db",
+        s(&db),
+        "--pack-label",
+        "p",
+        s(&gone),
+        s(&changed),
+        s(&damaged),
+    ]);
+    clean("logbook add", &out);
+    clean("logbook add", &err);
+    assert!(out.contains(r"gone\nFORGED: \u{1b}[31mmoved"), "{out}");
+    for kind in ["flights", "skipped"] {
+        let (code, out, err) = run(&["logbook", kind, "--db", s(&db)]);
+        assert_eq!(code, 0, "{err}");
+        clean(kind, &out);
+        assert!(out.contains(r"\nFORGED"), "{kind}: {out}");
+    }
+    std::fs::remove_file(&gone).unwrap();
+    std::fs::write(&changed, b"not the log it was").unwrap();
+    let pack = tmp.path().join("pack.toml");
+    let (_, out, err) = run(&[
+        "logbook",
+        "pack-file",
+        "p",
+        "--db",
+        s(&db),
+        "-o",
+        s(&pack),
+        "--capacity-mah",
+        "5000",
+    ]);
+    clean("logbook pack-file", &out);
+    clean("logbook pack-file", &err);
+    assert!(
+        err.contains(r"gone\nFORGED: \u{1b}[31mmoved.ulg: left out"),
+        "{err}"
+    );
+    assert!(
+        err.contains(r"changed\nFORGED: edited.ulg: left out"),
+        "{err}"
+    );
+}
