@@ -74,7 +74,7 @@ fn ffi_mission(vehicle: &CVehicle, mission: Option<&str>, options: &str) -> Stri
 fn mission_answers_are_the_same_bytes() {
     let m100 = CVehicle::builtin("dji-m100");
     let example = std::fs::read_to_string("fixtures/missions/example.toml").unwrap();
-    let grid = std::env::temp_dir().join("aloft-cli-ffi-grid.csv");
+    let grid = common::scratch("cli-ffi", "grid.csv");
     common::write_wind_grid(&grid, [1000.0, 200.0], "2,-1,0");
     let grid = grid.display().to_string();
     let cases: Vec<(Vec<&str>, Option<&str>, String)> = vec![

@@ -183,9 +183,7 @@ fn vehicle_files_load_and_bad_files_are_named() {
 /// nor a file lists the built-ins (issue 23, item 7).
 #[test]
 fn a_missing_vehicle_file_is_named_and_a_wrong_name_lists_the_builtins() {
-    let missing = std::env::temp_dir()
-        .join(format!("aloft-missing-{}", std::process::id()))
-        .join("my-quad.toml");
+    let missing = common::scratch("missing", "no-such-folder").join("my-quad.toml");
     let path = missing.to_str().unwrap();
     for command in ["power", "endurance", "mission"] {
         let err = refused(&[command, "--vehicle", path]);

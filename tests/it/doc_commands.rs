@@ -319,8 +319,7 @@ fn run_server(mut command: Command, shown: &[String]) -> Result<(), String> {
             }
         }
     };
-    let _ = child.kill();
-    let _ = child.wait();
+    crate::common::stop(&mut child);
     result
 }
 

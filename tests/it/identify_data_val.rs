@@ -47,7 +47,7 @@ fn kaist_validation() -> serde_json::Value {
     // One file per call: the tests run in parallel threads of one process.
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-    let tmp = std::env::temp_dir().join(format!("aloft-kaist-{}-{call}.toml", std::process::id()));
+    let tmp = common::scratch("kaist", &format!("{call}.toml"));
     let fit = fit_json(
         &["fit", "--profile", "kaist"],
         &files("kaist_energy_drone", "2018-08-03", ".csv"),
@@ -156,7 +156,7 @@ fn data_val_kaist_calibrated_energy_within_2_percent() {
 /// is recognised.
 #[test]
 fn data_val_px4_fit_and_validate_report() {
-    let tmp = std::env::temp_dir().join(format!("aloft-px4-{}.toml", std::process::id()));
+    let tmp = common::scratch("px4", "fitted.toml");
     let template = template("px4-template.toml");
     let logs = files("px4_flugdrohne/csv", "", "_vehicle_local_position_0.csv");
     assert_eq!(logs.len(), 5);
@@ -193,8 +193,7 @@ fn data_val_px4_fit_with_defaults_gives_a_physical_vehicle_on_every_short_flight
         .iter()
         .enumerate()
     {
-        let out =
-            std::env::temp_dir().join(format!("aloft-px4-one-{}-{k}.toml", std::process::id()));
+        let out = common::scratch("px4-one", &format!("{k}.toml"));
         let v = fit_json(
             &["fit", "--profile", "px4"],
             std::slice::from_ref(log),

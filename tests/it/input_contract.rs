@@ -44,7 +44,7 @@ fn aloft_limited(
 
 /// A scratch file `name` of this test process, as a command-line word.
 fn tmp(name: &str) -> String {
-    let path = std::env::temp_dir().join(format!("aloft-contract-{}-{name}", std::process::id()));
+    let path = common::scratch("contract", name);
     path.display().to_string()
 }
 

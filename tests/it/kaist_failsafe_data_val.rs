@@ -100,8 +100,7 @@ fn first_below(averages: &[f64], threshold_v: f64) -> usize {
 /// them) on a capacity their gauge holds (the most it read, rounded up to 100 mA h; no rated
 /// capacity is logged).
 fn vehicle_without(held_out: &str) -> String {
-    let path =
-        std::env::temp_dir().join(format!("aloft-fs-{}-{held_out}.toml", std::process::id()));
+    let path = common::scratch("failsafe", &format!("{held_out}.toml"));
     let path = path.display().to_string();
     fit_without_day(held_out, &path);
     let other_days: Vec<PathBuf> = common::kaist::long_flights()

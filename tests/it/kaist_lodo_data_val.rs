@@ -66,8 +66,7 @@ fn sideslip_deg(path: &str) -> f64 {
 
 /// Fit on every day but `held_out`, then judge each flight of `held_out`.
 fn judge_day(held_out: &'static str) -> Vec<Judged> {
-    let vehicle =
-        std::env::temp_dir().join(format!("aloft-lodo-{}-{held_out}.toml", std::process::id()));
+    let vehicle = common::scratch("lodo", &format!("{held_out}.toml"));
     let vehicle = vehicle.display().to_string();
     let fitted = fit_without_day(held_out, &vehicle);
     println!(

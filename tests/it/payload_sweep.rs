@@ -204,7 +204,7 @@ fn every_number_of_a_sweep_is_finite_and_none_is_null() {
 // ---- the command line ----
 
 fn tmp(name: &str) -> std::path::PathBuf {
-    std::env::temp_dir().join(format!("aloft-payload-sweep-{}-{name}", std::process::id()))
+    common::scratch("payload-sweep", name)
 }
 
 /// How many payloads of `0, step, ..., n step` fit with each pack of the M100 (from the file).

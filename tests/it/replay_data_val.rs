@@ -74,8 +74,7 @@ fn fit_on_08_03() -> String {
 #[test]
 fn data_val_kaist_replay_from_trajectory() {
     let fitted = fit_on_08_03();
-    let vehicle_path =
-        std::env::temp_dir().join(format!("aloft-replay-kaist-{}.toml", std::process::id()));
+    let vehicle_path = common::scratch("replay-kaist", "vehicle.toml");
     std::fs::write(&vehicle_path, fitted).unwrap();
     let mut worst: f64 = 0.0;
     let mut lines = Vec::new();

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use serde_json::Value;
 
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("aloft-replay-ground-{}-{name}", std::process::id()));
+    let d = common::scratch("replay-ground", name);
     std::fs::create_dir_all(&d).unwrap();
     d
 }

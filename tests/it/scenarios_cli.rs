@@ -53,7 +53,7 @@ fn mission_json_carries_the_uncertainty_keys() {
 
 #[test]
 fn the_table_says_it_in_a_line_and_the_chart_is_drawn() {
-    let svg = std::env::temp_dir().join("aloft-scenarios-fan.svg");
+    let svg = common::scratch("scenarios", "fan.svg");
     // A file of an earlier run is kept without --force: start without it.
     let _ = std::fs::remove_file(&svg);
     let (code, out, err) = aloft(&[

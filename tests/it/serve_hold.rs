@@ -458,7 +458,8 @@ fn start_outcome(args: &[&str]) -> (Option<i32>, String) {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let Some(status) = common::wait_within(&mut child, Duration::from_secs(10)) else {
+    let Some(status) = common::ended_within(&mut child, Duration::from_secs(10)) else {
+        common::stop(&mut child);
         return (None, "still serving after 10 s".to_string());
     };
     let mut err = String::new();

@@ -81,12 +81,53 @@ pub fn fixture(folder: &str, name: &str) -> PathBuf {
         .join(name)
 }
 
-/// A scratch file `name` in a folder of the system's temporary directory that is this test
-/// process's own (`aloft-<tag>-<pid>`, created if need be).
+/// A scratch file `name` in the folder `tag` of this test process's own scratch folder
+/// ([`scratch_root`]; the folders are created if need be, the file is not).
 pub fn scratch(tag: &str, name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("aloft-{tag}-{}", std::process::id()));
+    let dir = scratch_root().join(tag);
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
+}
+
+/// The start of the name of a test process's scratch folder in the system's temporary directory.
+const SCRATCH_PREFIX: &str = "aloft-test-scratch-";
+
+/// This test process's scratch folder, `<temp>/aloft-test-scratch-<pid>`. The first call removes
+/// the scratch folders of test processes that have ended (where `/proc` says which processes
+/// run), so that runs of the suite leave at most the last one's files behind, not theirs all.
+pub fn scratch_root() -> &'static Path {
+    static ROOT: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    ROOT.get_or_init(|| {
+        let temp = std::env::temp_dir();
+        remove_ended_scratch(&temp);
+        let root = temp.join(format!("{SCRATCH_PREFIX}{}", std::process::id()));
+        std::fs::create_dir_all(&root).unwrap();
+        root
+    })
+}
+
+/// Removes the folders `aloft-test-scratch-<pid>` of `temp` whose process has ended: a folder
+/// (never a link) whose name is the prefix and a number, and no `/proc/<pid>`.
+fn remove_ended_scratch(temp: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(temp) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let pid = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(SCRATCH_PREFIX))
+            .and_then(|n| n.parse::<u32>().ok());
+        let is_folder = entry.file_type().is_ok_and(|t| t.is_dir());
+        if let Some(pid) = pid {
+            if is_folder && !Path::new("/proc").join(pid.to_string()).exists() {
+                let _ = std::fs::remove_dir_all(entry.path());
+            }
+        }
+    }
 }
 
 /// The files `<prefix>*<suffix>` of the data folder `sub`, sorted; there must be some.
@@ -229,17 +270,38 @@ pub fn check_mcap_with_python(file: &Path, expect: &serde_json::Value) -> bool {
 /// Waits for `child` to end, at most `limit`: its exit status, or `None` when it ran longer (it
 /// is then killed and reaped). Its pipes are left to the caller.
 pub fn wait_within(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
+    let status = ended_within(child, limit);
+    if status.is_none() {
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    status
+}
+
+/// Waits for `child` to end, at most `limit`: its exit status, or `None` when it still runs.
+pub fn ended_within(child: &mut Child, limit: Duration) -> Option<ExitStatus> {
     let start = Instant::now();
     loop {
         if let Some(status) = child.try_wait().expect("wait") {
             return Some(status);
         }
         if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
             return None;
         }
         std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// Stops `child` as a user stops a server (SIGTERM), so that it removes what it made in the
+/// temporary directory; killed when it is not gone within 5 s.
+pub fn stop(child: &mut Child) {
+    let asked = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !asked || ended_within(child, Duration::from_secs(5)).is_none() {
+        let _ = child.kill();
+        let _ = child.wait();
     }
 }
 
@@ -443,4 +505,31 @@ pub fn survey_lines(name: &str, lines: usize) -> String {
     text.push_str(&return_home(8.0));
     text.push_str(&landing(1.0));
     text
+}
+
+/// The scratch folders of ended runs go, and nothing else: not a live process's, not a link
+/// named like one (nor what it points to), not a name with more after the number.
+#[test]
+fn scratch_folders_of_ended_runs_are_removed_and_nothing_else() {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let temp = tempfile::tempdir().unwrap();
+    let ended = temp.path().join(format!("{SCRATCH_PREFIX}4294967294"));
+    let live = temp
+        .path()
+        .join(format!("{SCRATCH_PREFIX}{}", std::process::id()));
+    let longer = temp.path().join(format!("{SCRATCH_PREFIX}4294967294-keep"));
+    let target = temp.path().join("kept");
+    let link = temp.path().join(format!("{SCRATCH_PREFIX}4294967293"));
+    for d in [&ended, &live, &longer, &target] {
+        std::fs::create_dir_all(d.join("inner")).unwrap();
+    }
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    remove_ended_scratch(temp.path());
+    assert!(!ended.exists());
+    for kept in [&live, &longer, &target.join("inner")] {
+        assert!(kept.exists(), "{}", kept.display());
+    }
+    assert!(link.symlink_metadata().is_ok());
 }

@@ -215,10 +215,11 @@ fn unchunked(mut body: &str) -> String {
     out
 }
 
+/// A server is stopped as a user stops it ([`super::stop`]), so that it removes its private
+/// folder of uploads.
 impl Drop for Server {
     fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        super::stop(&mut self.child);
     }
 }
 
